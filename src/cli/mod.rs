@@ -1,0 +1,144 @@
+//! Subcommand dispatch, help texts and the CLI's error type.
+
+pub mod args;
+mod serve;
+
+use std::fmt;
+
+/// An error of the command line: a usage mistake (exit 2) or a failure (exit 1).
+#[derive(Debug)]
+pub enum CliError {
+    /// Wrong arguments; the message says what to change.
+    Usage(String),
+    /// A file could not be read or written.
+    Io(String),
+    /// The library refused the input.
+    Robocal(robocal::Error),
+}
+
+impl CliError {
+    /// A usage error of `command`, pointing at its help.
+    pub fn usage(command: &str, message: impl Into<String>) -> Self {
+        CliError::Usage(format!(
+            "{command}: {} (see 'robocal {command} --help')",
+            message.into()
+        ))
+    }
+
+    /// The process exit code for this error.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            CliError::Usage(_) => 2,
+            CliError::Io(_) | CliError::Robocal(_) => 1,
+        }
+    }
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CliError::Usage(m) | CliError::Io(m) => write!(f, "{m}"),
+            CliError::Robocal(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl From<robocal::Error> for CliError {
+    fn from(e: robocal::Error) -> Self {
+        CliError::Robocal(e)
+    }
+}
+
+const HELP: &str = "robocal - camera and robot hand-eye calibration
+
+Usage: robocal <command> [options]
+
+Commands:
+  serve       serve the web app (a static folder) on http://127.0.0.1:8080
+  info        decode images and print their format and size
+
+Run 'robocal <command> --help' for the options of each command.
+Options common to all commands: --help, --version.";
+
+/// Run the command line `args` (without the program name).
+pub fn run(args: &[String]) -> Result<(), CliError> {
+    let Some((command, rest)) = args.split_first() else {
+        println!("{HELP}");
+        return Ok(());
+    };
+    let wants_help = rest.iter().any(|a| a == "--help" || a == "-h");
+    match command.as_str() {
+        "--help" | "-h" | "help" => {
+            println!("{HELP}");
+            Ok(())
+        }
+        "--version" | "-V" => {
+            println!("robocal {}", robocal::VERSION);
+            Ok(())
+        }
+        "serve" if wants_help => print_help(serve::HELP),
+        "serve" => serve::run(rest),
+        "info" if wants_help => print_help(INFO_HELP),
+        "info" => info(rest),
+        other => Err(CliError::Usage(format!(
+            "unknown command '{other}'; run 'robocal --help' for the list"
+        ))),
+    }
+}
+
+fn print_help(text: &str) -> Result<(), CliError> {
+    println!("{text}");
+    Ok(())
+}
+
+/// Read a whole file, with an error that names it.
+pub fn read_file(path: &str) -> Result<Vec<u8>, CliError> {
+    std::fs::read(path).map_err(|e| CliError::Io(format!("cannot read '{path}': {e}")))
+}
+
+const INFO_HELP: &str = "robocal info - decode images and print what they are
+
+Usage: robocal info IMAGES...
+
+Prints one JSON object per line: {\"file\", \"format\", \"width\", \"height\",
+\"channels\", \"bits_per_channel\"} or {\"file\", \"error\"} for files that are not
+supported images. Exits with 1 if any file failed.
+
+Example:
+  robocal info left01.jpg board.tiff";
+
+fn info(raw: &[String]) -> Result<(), CliError> {
+    let spec = args::Spec {
+        command: "info",
+        valued: &[],
+        switches: &[],
+    };
+    let parsed = args::Args::parse(raw, &spec)?;
+    if parsed.positionals.is_empty() {
+        return Err(CliError::usage("info", "give at least one image file"));
+    }
+    let mut failed = 0;
+    for file in &parsed.positionals {
+        let line = match read_file(file)
+            .and_then(|b| robocal::image::decode(&b, &Default::default()).map_err(CliError::from))
+        {
+            Ok(d) => {
+                let mut v = serde_json::to_value(&d.info).unwrap_or_default();
+                v["file"] = serde_json::Value::String(file.clone());
+                v
+            }
+            Err(e) => {
+                failed += 1;
+                serde_json::json!({ "file": file, "error": e.to_string() })
+            }
+        };
+        println!("{line}");
+    }
+    if failed > 0 {
+        return Err(CliError::Io(format!(
+            "{failed} of {} files could not be decoded",
+            parsed.positionals.len()
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,44 @@
+//! # robocal
+//!
+//! Camera and robot hand-eye calibration in pure Rust: target detection,
+//! camera intrinsics and lens distortion, hand-eye transforms, exports. The
+//! same core runs natively (the `robocal` CLI), in node (the npm package) and
+//! in a browser tab (the web app in `www/`), where images never leave the
+//! user's machine.
+//!
+//! The math core never touches files, the DOM or the clock: everything is
+//! parsed from `&str`/`&[u8]` and returned as values. Only `src/wasm.rs`
+//! (feature `wasm`) and the CLI binary talk to a host.
+//!
+//! # Conventions
+//!
+//! Fixed once here; every module, JSON key and export follows them.
+//!
+//! - **Pixels**: (0, 0) is the *centre* of the top-left pixel, x to the right,
+//!   y down. OpenCV uses the same convention. MATLAB is 1-based (its principal
+//!   point is ours + 1); Halcon's image coordinates are (row, column), i.e.
+//!   (y, x), also with the pixel centre at integer coordinates. Exports convert.
+//! - **Camera frame**: x right, y down, z forward (optical axis).
+//! - **Units inside**: metres and radians. Millimetres and degrees appear only
+//!   at the edges (file parsers and exports), and then in the field name
+//!   (`translation_mm`, `rotation_deg`, `rms_px`).
+//! - **Transforms** are named `a_from_b`: `a_from_b * p_b = p_a`. They compose
+//!   so that inner names cancel: `base_from_camera = base_from_gripper *
+//!   gripper_from_camera`. One pose type, [`nalgebra::Isometry3<f64>`].
+//! - **Quaternions** always name their component order at a boundary
+//!   (`quaternion_xyzw`, `quaternion_wxyz`).
+//! - **Matrices** in JSON and text are row-major (`matrix_row_major`).
+//! - **Board points** are numbered row by row from the board origin; the
+//!   board frame has z = 0 on the board plane.
+#![deny(missing_docs)]
+
+pub mod error;
+pub mod image;
+
+#[cfg(feature = "wasm")]
+pub mod wasm;
+
+pub use error::{Error, Result};
+
+/// The crate version, stamped into every report and export.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -1,0 +1,120 @@
+//! The WebAssembly boundary: the only file with `#[wasm_bindgen]`.
+//!
+//! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
+//! errors as `JsError` whose message is the library's error text.
+//!
+//! wasm32-unknown-unknown aborts on panic (a `RuntimeError: unreachable` in
+//! JS). The module holds no state across calls, so the instance stays usable;
+//! a panic hook records the message so the JS side can show it
+//! ([`last_panic_message`]) instead of a dead worker.
+
+use crate::image::{decode, DecodeOptions};
+use serde::Serialize;
+use wasm_bindgen::prelude::*;
+
+fn js_error(e: crate::Error) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+thread_local! {
+    static LAST_PANIC: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) };
+}
+
+/// Install the panic hook that records panic messages. Called once by the JS
+/// side after instantiating the module; calling it again is harmless.
+#[wasm_bindgen]
+pub fn init() {
+    std::panic::set_hook(Box::new(|info| {
+        let text = info.to_string();
+        LAST_PANIC.with(|p| *p.borrow_mut() = text);
+    }));
+}
+
+/// The message of the last panic, if any (empty when none). JS calls this
+/// after catching a `RuntimeError` from any other function.
+#[wasm_bindgen]
+pub fn last_panic_message() -> String {
+    LAST_PANIC.with(|p| p.borrow().clone())
+}
+
+/// The crate version.
+#[wasm_bindgen]
+pub fn version() -> String {
+    crate::VERSION.to_string()
+}
+
+/// A decoded image's description plus an RGBA preview for thumbnails.
+#[wasm_bindgen]
+pub struct ImagePreview {
+    info_json: String,
+    rgba: Vec<u8>,
+    width: u32,
+    height: u32,
+}
+
+#[wasm_bindgen]
+impl ImagePreview {
+    /// JSON: `{format, width, height, channels, bits_per_channel}`.
+    #[wasm_bindgen(getter)]
+    pub fn info_json(&self) -> String {
+        self.info_json.clone()
+    }
+    /// Preview pixels, RGBA, row-major.
+    #[wasm_bindgen(getter)]
+    pub fn rgba(&self) -> Vec<u8> {
+        self.rgba.clone()
+    }
+    /// Preview width in pixels.
+    #[wasm_bindgen(getter)]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// Preview height in pixels.
+    #[wasm_bindgen(getter)]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+}
+
+#[derive(Serialize)]
+struct InfoJson<'a> {
+    #[serde(flatten)]
+    info: &'a crate::image::ImageInfo,
+    format_name: &'static str,
+}
+
+/// Decode image bytes (PNG, JPEG, TIFF, BMP, PNM, GIF); return its
+/// description and a preview whose longer side is at most `max_side` px.
+#[wasm_bindgen]
+pub fn decode_image_preview(bytes: &[u8], max_side: u32) -> Result<ImagePreview, JsError> {
+    let options = DecodeOptions {
+        preview_max_side: Some(max_side),
+        ..Default::default()
+    };
+    let decoded = decode(bytes, &options).map_err(js_error)?;
+    let info_json = serde_json::to_string(&InfoJson {
+        info: &decoded.info,
+        format_name: decoded.info.format.name(),
+    })
+    .map_err(|e| JsError::new(&e.to_string()))?;
+    let preview = decoded
+        .preview
+        .ok_or_else(|| JsError::new("no preview was produced"))?;
+    Ok(ImagePreview {
+        info_json,
+        rgba: preview.pixels,
+        width: preview.width,
+        height: preview.height,
+    })
+}
+
+/// Decode image bytes and return only the description as JSON.
+#[wasm_bindgen]
+pub fn image_info(bytes: &[u8]) -> Result<String, JsError> {
+    let decoded = decode(bytes, &DecodeOptions::default()).map_err(js_error)?;
+    serde_json::to_string(&InfoJson {
+        info: &decoded.info,
+        format_name: decoded.info.format.name(),
+    })
+    .map_err(|e| JsError::new(&e.to_string()))
+}
