@@ -34,6 +34,7 @@
 
 pub mod error;
 pub mod image;
+pub mod synth;
 
 #[cfg(feature = "wasm")]
 pub mod wasm;

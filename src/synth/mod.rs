@@ -1,0 +1,7 @@
+//! Seeded synthetic data: the one generator shared by tests, benchmarks,
+//! examples and the web app's demo button. Deterministic for a given seed on
+//! every platform (native and wasm).
+
+pub mod rng;
+
+pub use rng::Rng;
