@@ -1,0 +1,60 @@
+# robocal's single entry point. The two commands a new machine needs:
+#   make serve   build everything and serve the web app on http://127.0.0.1:8080
+#   make test    run every test tier (native, wasm in node, npm package, browser)
+
+SHELL := /bin/bash
+export PATH := $(HOME)/.cargo/bin:$(PATH)
+
+WASM_TARGET := wasm32-unknown-unknown
+WASM_FILE := target/$(WASM_TARGET)/release/robocal.wasm
+CLI := target/release/robocal
+PORT ?= 8080
+
+.PHONY: serve test setup wasm web pkg cli test-native test-wasm test-node test-e2e check-wasm-core bench clean-web
+
+setup:
+	tools/setup.sh build
+
+# The wasm is built in its own cargo invocation so that the native CLI's
+# features never unify into it.
+wasm: setup
+	cargo build --lib --release --target $(WASM_TARGET) --features wasm
+
+web: wasm
+	wasm-bindgen --target web --out-dir www/pkg --out-name robocal --no-typescript $(WASM_FILE)
+	@tools/wasm-size.sh www/pkg/robocal_bg.wasm
+
+cli:
+	cargo build --release --bin robocal
+
+serve: web cli
+	$(CLI) serve --dir www --port $(PORT)
+
+pkg: wasm
+	rm -rf pkg
+	wasm-bindgen --target nodejs --out-dir pkg/node --out-name robocal $(WASM_FILE)
+	wasm-bindgen --target web --out-dir pkg/web --out-name robocal $(WASM_FILE)
+	node tools/make-pkg.mjs
+	@tools/wasm-size.sh pkg/node/robocal_bg.wasm
+
+check-wasm-core: setup
+	cargo check --lib --target $(WASM_TARGET)
+
+test-native:
+	cargo test
+
+test-wasm: setup
+	CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --lib --target $(WASM_TARGET)
+
+test-node: pkg
+	node tests/node/smoke.mjs
+
+test-e2e: web cli
+	tools/setup.sh e2e
+	node tests/e2e/run.mjs
+
+test: test-native check-wasm-core test-wasm test-node test-e2e
+	@echo "make test: all tiers passed"
+
+bench:
+	cargo bench

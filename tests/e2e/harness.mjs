@@ -1,0 +1,69 @@
+// A tiny harness for the browser tests: starts `robocal serve` on a free
+// port, launches Debian's Chromium headless, gives each test a fresh page and
+// saves a screenshot per step under tests/e2e/screenshots/.
+import { spawn } from 'node:child_process';
+import { mkdirSync } from 'node:fs';
+import { join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+export const root = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
+export const shotsDir = join(root, 'tests/e2e/screenshots');
+
+export async function startServer() {
+  const bin = join(root, 'target/release/robocal');
+  const child = spawn(bin, ['serve', '--dir', join(root, 'www'), '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
+  const url = await new Promise((resolve, reject) => {
+    let out = '';
+    child.stdout.on('data', (d) => {
+      out += d;
+      const m = /at (http:\/\/\S+)/.exec(out);
+      if (m) resolve(m[1]);
+    });
+    child.on('exit', (code) => reject(new Error(`robocal serve exited with ${code}`)));
+    setTimeout(() => reject(new Error('robocal serve did not print its URL within 10 s')), 10000);
+  });
+  return { url, stop: () => child.kill() };
+}
+
+export async function launch() {
+  return chromium.launch({
+    executablePath: '/usr/bin/chromium',
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
+  });
+}
+
+/** Runs `tests` ([name, fn(page, ctx)]) each in a fresh browser context. */
+export async function run(suite, tests) {
+  mkdirSync(shotsDir, { recursive: true });
+  const server = await startServer();
+  const browser = await launch();
+  let failed = 0;
+  try {
+    for (const [name, fn] of tests) {
+      const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+      const page = await context.newPage();
+      const consoleErrors = [];
+      page.on('pageerror', (e) => consoleErrors.push(e.message));
+      let step = 0;
+      const shot = (label) => page.screenshot({ path: join(shotsDir, `${suite}-${name.replace(/\W+/g, '_')}-${++step}-${label}.png`), fullPage: true });
+      const started = Date.now();
+      try {
+        await fn(page, { url: server.url, shot, consoleErrors, browser });
+        if (consoleErrors.length) throw new Error(`uncaught page errors: ${consoleErrors.join('; ')}`);
+        console.log(`ok   ${suite}: ${name} (${Date.now() - started} ms)`);
+      } catch (e) {
+        failed++;
+        await shot('failure').catch(() => {});
+        console.log(`FAIL ${suite}: ${name}\n     ${e.stack || e}`);
+      } finally {
+        await context.close();
+      }
+    }
+  } finally {
+    await browser.close();
+    server.stop();
+  }
+  return failed;
+}

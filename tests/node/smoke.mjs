@@ -1,0 +1,48 @@
+// Node tier: pack pkg/ with npm, install the tarball into a fresh folder, and
+// call the package from both ESM and CommonJS, asserting real results.
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, writeFileSync, readdirSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { makePng } from '../support/images.mjs';
+
+const root = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
+const work = mkdtempSync(join(tmpdir(), 'robocal-node-'));
+const npm = (args, cwd) => execFileSync('npm', args, { cwd, stdio: ['ignore', 'pipe', 'inherit'] }).toString();
+
+npm(['pack', join(root, 'pkg'), '--pack-destination', work, '--silent'], work);
+const tarball = readdirSync(work).find((f) => f.endsWith('.tgz'));
+if (!tarball) throw new Error('npm pack produced no tarball');
+writeFileSync(join(work, 'package.json'), '{ "name": "robocal-smoke", "private": true }\n');
+npm(['install', '--no-audit', '--no-fund', '--offline', join(work, tarball)], work);
+
+writeFileSync(join(work, 'board.png'), makePng(64, 48, (x, y) => [x * 4, y * 5, 128]));
+
+const esm = `
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import robocal, { version, image_info } from 'robocal';
+const expected = JSON.parse(readFileSync(new URL('./node_modules/robocal/package.json', import.meta.url))).version;
+assert.equal(version(), expected);
+assert.equal(typeof robocal.image_info, 'function');
+const info = JSON.parse(image_info(readFileSync(new URL('./board.png', import.meta.url))));
+assert.deepEqual([info.format, info.width, info.height, info.channels, info.bits_per_channel], ['png', 64, 48, 3, 8]);
+assert.throws(() => image_info(new Uint8Array([1, 2, 3])), { message: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF' });
+console.log('esm ok');
+`;
+const cjs = `
+const assert = require('node:assert/strict');
+const { readFileSync } = require('node:fs');
+const robocal = require('robocal');
+const info = JSON.parse(robocal.image_info(readFileSync(__dirname + '/board.png')));
+assert.equal(info.format_name, 'PNG');
+assert.equal(info.width * info.height, 64 * 48);
+console.log('cjs ok');
+`;
+writeFileSync(join(work, 'esm.mjs'), esm);
+writeFileSync(join(work, 'cjs.cjs'), cjs);
+for (const f of ['esm.mjs', 'cjs.cjs']) {
+  process.stdout.write(execFileSync('node', [f], { cwd: work }).toString());
+}
+console.log(`node smoke test passed (${tarball})`);

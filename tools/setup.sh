@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Installs what the build needs when it is missing; fast no-op when present.
+#   tools/setup.sh build   the wasm32 target and wasm-bindgen-cli (exact Cargo.lock version)
+#   tools/setup.sh e2e     Debian's chromium and playwright-core (for the browser tests)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need_build() {
+  if ! rustup target list --installed | grep -qx wasm32-unknown-unknown; then
+    echo "setup: adding the wasm32-unknown-unknown target"
+    rustup target add wasm32-unknown-unknown
+  fi
+  local want
+  want=$(awk '/^name = "wasm-bindgen"$/ {getline; gsub(/version = |"/, ""); print; exit}' Cargo.lock)
+  if [ -z "$want" ]; then
+    echo "setup: cannot read the wasm-bindgen version from Cargo.lock" >&2
+    exit 1
+  fi
+  local have=""
+  if command -v wasm-bindgen >/dev/null 2>&1; then
+    have=$(wasm-bindgen --version | awk '{print $2}')
+  fi
+  if [ "$have" != "$want" ]; then
+    echo "setup: installing wasm-bindgen-cli $want (found '${have:-none}'; takes a few minutes once)"
+    cargo install wasm-bindgen-cli --version "$want"
+  fi
+}
+
+need_e2e() {
+  if [ ! -x /usr/bin/chromium ]; then
+    echo "setup: installing Debian's chromium"
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    $sudo apt-get install -y chromium || { $sudo apt-get update && $sudo apt-get install -y chromium; }
+  fi
+  if [ ! -d tests/e2e/node_modules/playwright-core ]; then
+    echo "setup: installing playwright-core for the browser tests"
+    (cd tests/e2e && npm install --no-audit --no-fund)
+  fi
+}
+
+case "${1:-build}" in
+  build) need_build ;;
+  e2e) need_e2e ;;
+  *) echo "usage: tools/setup.sh build|e2e" >&2; exit 2 ;;
+esac

@@ -1,0 +1,43 @@
+// The calibration engine's thread: loads the wasm once and answers requests,
+// so the page never freezes. Every request gets exactly one reply, success or
+// error; a Rust panic becomes an error reply, never a dead worker.
+import init, * as robocal from './pkg/robocal.js';
+
+const ready = init().then(() => {
+  robocal.init();
+  return robocal.version();
+});
+
+function errorText(err) {
+  if (err instanceof WebAssembly.RuntimeError) {
+    const panic = robocal.last_panic_message();
+    return `internal error (${panic || err.message}); please report it with the file that caused it`;
+  }
+  return err && err.message ? err.message : String(err);
+}
+
+const handlers = {
+  async version() {
+    return { version: await ready };
+  },
+  async preview({ bytes, maxSide }) {
+    await ready;
+    const p = robocal.decode_image_preview(new Uint8Array(bytes), maxSide);
+    const reply = { info: JSON.parse(p.info_json), width: p.width, height: p.height, rgba: p.rgba.buffer };
+    p.free();
+    return { value: reply, transfer: [reply.rgba] };
+  },
+};
+
+self.onmessage = async (event) => {
+  const { id, op, args } = event.data;
+  try {
+    const handler = handlers[op];
+    if (!handler) throw new Error(`unknown request '${op}'`);
+    const out = await handler(args || {});
+    const value = out && 'value' in out ? out.value : out;
+    self.postMessage({ id, ok: true, value }, (out && out.transfer) || []);
+  } catch (err) {
+    self.postMessage({ id, ok: false, error: errorText(err) });
+  }
+};
