@@ -27,7 +27,16 @@ const handlers = {
     p.free();
     return { value: reply, transfer: [reply.rgba] };
   },
+  async detect({ bytes, spec }) {
+    await ready;
+    requireFn('detect_target');
+    return JSON.parse(robocal.detect_target(new Uint8Array(bytes), spec));
+  },
 };
+
+function requireFn(name) {
+  if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
+}
 
 self.onmessage = async (event) => {
   const { id, op, args } = event.data;

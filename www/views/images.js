@@ -1,0 +1,336 @@
+// Step 2: images. Load (files or a folder), decode and detect in the worker
+// with progress and cancel, thumbnails with the detected points, an
+// inspector with zoom and residuals, include/exclude, and a coverage map.
+import { $, h, fill } from '../lib/dom.js';
+import { targetSpec } from './target.js';
+
+const THUMB_SIDE = 320;
+const IMAGE_EXT = /\.(png|jpe?g|tiff?|bmp|pgm|ppm|pnm|gif)$/i;
+
+export class ImagesView {
+  constructor(store, engine) {
+    this.store = store;
+    this.engine = engine;
+    this.previews = new Map(); // id -> { width, height, rgba, scale }
+    this.cards = new Map(); // id -> { li, canvas, meta, toggle }
+    this.cancelled = false;
+    this.busy = false;
+    this.residuals = new Map(); // image name -> [{x, y, dx, dy}]
+    this.wire();
+  }
+
+  get images() { return this.store.session.images; }
+
+  wire() {
+    $('file-input').addEventListener('change', (e) => { this.addFiles([...e.target.files]); e.target.value = ''; });
+    $('folder-input').addEventListener('change', (e) => { this.addFiles([...e.target.files].filter((f) => IMAGE_EXT.test(f.name))); e.target.value = ''; });
+    const zone = $('dropzone');
+    zone.addEventListener('dragover', (e) => { e.preventDefault(); zone.classList.add('over'); });
+    zone.addEventListener('dragleave', () => zone.classList.remove('over'));
+    zone.addEventListener('drop', async (e) => {
+      e.preventDefault();
+      zone.classList.remove('over');
+      this.addFiles(await filesFromDrop(e.dataTransfer));
+    });
+    zone.addEventListener('keydown', (e) => {
+      if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); $('file-input').click(); }
+    });
+    $('detect-all').addEventListener('click', () => this.detectAll());
+    $('cancel-detect').addEventListener('click', () => { this.cancelled = true; $('progress-text').textContent = 'cancelling after the current image…'; });
+    $('clear-images').addEventListener('click', async () => {
+      await this.store.removeImages(this.images.map((i) => i.id));
+      this.previews.clear();
+      this.cards.clear();
+      fill($('cards'));
+      this.refresh();
+    });
+    $('inspector-close').addEventListener('click', () => $('inspector').close());
+    $('inspector-zoom').addEventListener('input', () => this.drawInspector());
+  }
+
+  /** Rebuild cards from the session (after a reload or a demo load). */
+  async restore() {
+    fill($('cards'));
+    this.cards.clear();
+    for (const img of this.images) {
+      this.makeCard(img);
+      if (this.store.bytes.has(img.id)) await this.preview(img);
+      this.renderCard(img);
+    }
+    this.refresh();
+  }
+
+  async addFiles(files) {
+    const added = [];
+    for (const file of files) {
+      const img = { id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name: file.name, size: file.size, included: true, status: 'pending', info: null, detection: null, error: null };
+      const bytes = await file.arrayBuffer();
+      await this.store.addImage(img, bytes);
+      this.makeCard(img);
+      added.push(img);
+    }
+    this.refresh();
+    // Sequential on purpose: the worker is single-threaded and memory stays bounded.
+    for (const img of added) {
+      await this.preview(img);
+      this.renderCard(img);
+      this.refresh();
+    }
+    if (added.some((i) => i.status === 'decoded')) await this.detectAll(added);
+  }
+
+  async addBytes(list) {
+    const added = [];
+    for (const { name, bytes } of list) {
+      const img = { id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name, size: bytes.byteLength, included: true, status: 'pending', info: null, detection: null, error: null };
+      await this.store.addImage(img, bytes);
+      this.makeCard(img);
+      added.push(img);
+    }
+    for (const img of added) { await this.preview(img); this.renderCard(img); }
+    this.refresh();
+    await this.detectAll(added);
+  }
+
+  async preview(img) {
+    try {
+      const bytes = this.store.bytes.get(img.id).slice(0);
+      const p = await this.engine.call('preview', { bytes, maxSide: THUMB_SIDE }, [bytes]);
+      img.info = p.info;
+      if (img.status === 'pending') img.status = 'decoded';
+      this.previews.set(img.id, { width: p.width, height: p.height, rgba: p.rgba, scale: p.width / p.info.width });
+    } catch (err) {
+      img.status = 'error';
+      img.error = err.message;
+    }
+    this.store.changed('images');
+  }
+
+  async detectAll(subset) {
+    if (this.busy) return;
+    const todo = (subset || this.images).filter((i) => i.status !== 'error' || i.detectError);
+    if (!todo.length) return;
+    let spec;
+    try { spec = targetSpec(this.store.session.target); } catch (e) { return; }
+    this.busy = true;
+    this.cancelled = false;
+    $('progress-row').hidden = false;
+    $('detect-progress').max = todo.length;
+    let done = 0;
+    for (const img of todo) {
+      if (this.cancelled) break;
+      $('detect-progress').value = done;
+      $('progress-text').textContent = `detecting ${done + 1} of ${todo.length}: ${img.name}`;
+      const card = this.cards.get(img.id);
+      if (card) card.meta.textContent = 'detecting…';
+      try {
+        const bytes = this.store.bytes.get(img.id).slice(0);
+        img.detection = await this.engine.call('detect', { bytes, spec }, [bytes]);
+        img.status = 'detected';
+        img.error = null;
+        img.detectError = false;
+      } catch (err) {
+        img.detection = null;
+        img.status = 'error';
+        img.error = err.message;
+        img.detectError = !!img.info; // decoded fine, the target was not found
+      }
+      done++;
+      this.renderCard(img);
+      this.refresh();
+    }
+    $('detect-progress').value = done;
+    $('progress-text').textContent = this.cancelled ? `cancelled after ${done} of ${todo.length}` : `detected ${done} of ${todo.length}`;
+    this.busy = false;
+    setTimeout(() => { if (!this.busy) $('progress-row').hidden = true; }, 1500);
+    this.store.changed('detections');
+  }
+
+  makeCard(img) {
+    const canvas = h('canvas', { width: 4, height: 3, role: 'img', 'aria-label': `thumbnail of ${img.name}`, tabindex: 0 });
+    const meta = h('p', { class: 'meta' }, 'decoding');
+    const toggle = h('input', { type: 'checkbox', checked: img.included, 'aria-label': `use ${img.name} in the calibration` });
+    toggle.addEventListener('change', () => { img.included = toggle.checked; this.renderCard(img); this.refresh(); this.store.changed('included'); });
+    const open = () => this.inspect(img);
+    canvas.addEventListener('click', open);
+    canvas.addEventListener('keydown', (e) => { if (e.key === 'Enter') open(); });
+    const li = h('li', { class: 'card pending', dataset: { id: img.id } }, canvas,
+      h('p', { class: 'name' }, img.name), meta, h('label', { class: 'include' }, toggle, ' use'));
+    $('cards').append(li);
+    this.cards.set(img.id, { li, canvas, meta, toggle });
+  }
+
+  renderCard(img) {
+    const card = this.cards.get(img.id);
+    if (!card) return;
+    const p = this.previews.get(img.id);
+    card.toggle.checked = img.included;
+    if (img.status === 'error' && !img.info) {
+      card.canvas.hidden = true;
+      card.li.className = 'card error';
+      card.li.setAttribute('role', 'alert');
+      card.meta.textContent = img.error;
+      return;
+    }
+    if (p) drawImage(card.canvas, p, img.detection ? img.detection.points : [], p.scale, 1);
+    card.li.className = `card ${img.status === 'error' ? 'warn' : 'ok'}${img.included ? '' : ' excluded'}`;
+    const parts = [describe(img.info)];
+    if (img.detection) parts.push(`${img.detection.points.length} points`);
+    if (img.status === 'error') parts.push(img.error);
+    card.meta.textContent = parts.join(' · ');
+  }
+
+  refresh() {
+    const imgs = this.images;
+    const count = (s) => imgs.filter((i) => i.status === s).length;
+    const decoded = imgs.filter((i) => i.info).length;
+    const failedDecode = imgs.filter((i) => i.status === 'error' && !i.info).length;
+    const parts = [`${imgs.length} file${imgs.length === 1 ? '' : 's'}`, `${decoded} decoded`];
+    if (failedDecode) parts.push(`${failedDecode} failed`);
+    if (count('detected')) parts.push(`${count('detected')} with the target`);
+    const notFound = imgs.filter((i) => i.status === 'error' && i.info).length;
+    if (notFound) parts.push(`${notFound} without the target`);
+    const excluded = imgs.filter((i) => !i.included).length;
+    if (excluded) parts.push(`${excluded} excluded`);
+    if (count('pending')) parts.push(`${count('pending')} in progress`);
+    $('image-summary').textContent = parts.join(', ');
+    drawCoverage($('coverage-canvas'), imgs.filter((i) => i.included && i.detection));
+  }
+
+  /** Per-point residuals from a camera solve, keyed by image name. */
+  setResiduals(map) {
+    this.residuals = map;
+  }
+
+  async inspect(img) {
+    if (!img.info) return;
+    this.inspected = img;
+    $('inspector-title').textContent = img.name;
+    try {
+      const bytes = this.store.bytes.get(img.id).slice(0);
+      const side = Math.max(img.info.width, img.info.height);
+      this.full = await this.engine.call('preview', { bytes, maxSide: Math.min(side, 4096) }, [bytes]);
+      this.full.scale = this.full.width / img.info.width;
+    } catch (err) {
+      $('inspector-info').textContent = err.message;
+      return;
+    }
+    this.drawInspector();
+    if (!$('inspector').open) $('inspector').showModal();
+  }
+
+  drawInspector() {
+    const img = this.inspected;
+    if (!img || !this.full) return;
+    const zoom = Number($('inspector-zoom').value);
+    const res = this.residuals.get(img.name) || [];
+    drawImage($('inspector-canvas'), this.full, img.detection ? img.detection.points : [], this.full.scale, zoom, res);
+    const rms = res.length ? Math.sqrt(res.reduce((s, r) => s + r.dx * r.dx + r.dy * r.dy, 0) / res.length) : null;
+    $('inspector-info').textContent = `${describe(img.info)} · ${img.detection ? img.detection.points.length + ' points' : img.error || 'not detected'}` +
+      (rms !== null ? ` · reprojection RMS ${rms.toFixed(3)} px (residual vectors drawn ×${RESIDUAL_GAIN})` : '');
+  }
+}
+
+const RESIDUAL_GAIN = 20;
+
+function describe(info) {
+  if (!info) return '';
+  const channels = { 1: 'grey', 2: 'grey + alpha', 3: 'RGB', 4: 'RGBA' }[info.channels] || `${info.channels} channels`;
+  return `${info.format_name} · ${info.width}×${info.height} px · ${channels}, ${info.bits_per_channel}-bit`;
+}
+
+/** Draw a preview with its points (pixel coordinates of the full image) at `zoom`. */
+function drawImage(canvas, p, points, scale, zoom, residuals = []) {
+  canvas.width = Math.round(p.width * zoom);
+  canvas.height = Math.round(p.height * zoom);
+  const ctx = canvas.getContext('2d');
+  const tmp = new OffscreenCanvas(p.width, p.height);
+  tmp.getContext('2d').putImageData(new ImageData(new Uint8ClampedArray(p.rgba), p.width, p.height), 0, 0);
+  ctx.imageSmoothingEnabled = zoom < 2;
+  ctx.drawImage(tmp, 0, 0, canvas.width, canvas.height);
+  const k = scale * zoom;
+  // Pixel centres are at integer coordinates: +0.5 maps them to canvas space.
+  const X = (x) => (x + 0.5) * k;
+  const Y = (y) => (y + 0.5) * k;
+  const r = Math.max(2, Math.min(6, 3 * zoom));
+  points.forEach((pt, i) => {
+    ctx.strokeStyle = i === 0 ? '#1f77b4' : '#ff7f0e';
+    ctx.lineWidth = i === 0 ? 2.5 : 1.5;
+    ctx.beginPath();
+    ctx.arc(X(pt.x_px), Y(pt.y_px), i === 0 ? r * 1.6 : r, 0, 2 * Math.PI);
+    ctx.stroke();
+  });
+  if (points.length > 1) {
+    ctx.strokeStyle = 'rgba(255,127,14,0.5)';
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    points.forEach((pt, i) => (i ? ctx.lineTo(X(pt.x_px), Y(pt.y_px)) : ctx.moveTo(X(pt.x_px), Y(pt.y_px))));
+    ctx.stroke();
+  }
+  ctx.strokeStyle = '#d62728';
+  ctx.lineWidth = 1.5;
+  for (const res of residuals) {
+    ctx.beginPath();
+    ctx.moveTo(X(res.x), Y(res.y));
+    ctx.lineTo(X(res.x + RESIDUAL_GAIN * res.dx), Y(res.y + RESIDUAL_GAIN * res.dy));
+    ctx.stroke();
+  }
+}
+
+/** Coverage: every detected point of every included image on one frame. */
+function drawCoverage(canvas, imgs) {
+  const ctx = canvas.getContext('2d');
+  ctx.fillStyle = '#222';
+  ctx.fillRect(0, 0, canvas.width, canvas.height);
+  if (!imgs.length) {
+    ctx.fillStyle = '#aaa';
+    ctx.font = '14px system-ui';
+    ctx.fillText('No detections yet', 16, 28);
+    return;
+  }
+  const [w, hgt] = imgs[0].detection.image_size_px;
+  const s = Math.min(canvas.width / w, canvas.height / hgt);
+  // 8x6 cells: cells without any point are marked, so missing corners stand out.
+  const cells = new Array(48).fill(0);
+  for (const img of imgs) {
+    for (const p of img.detection.points) {
+      const cx = Math.min(7, Math.max(0, Math.floor((p.x_px / w) * 8)));
+      const cy = Math.min(5, Math.max(0, Math.floor((p.y_px / hgt) * 6)));
+      cells[cy * 8 + cx]++;
+    }
+  }
+  for (let i = 0; i < 48; i++) {
+    if (cells[i] === 0) {
+      ctx.fillStyle = 'rgba(214,39,40,0.35)';
+      ctx.fillRect((i % 8) * (w / 8) * s, Math.floor(i / 8) * (hgt / 6) * s, (w / 8) * s, (hgt / 6) * s);
+    }
+  }
+  const hues = imgs.map((_, i) => `hsl(${(i * 137) % 360} 80% 60%)`);
+  imgs.forEach((img, i) => {
+    ctx.fillStyle = hues[i];
+    for (const p of img.detection.points) ctx.fillRect(p.x_px * s - 1, p.y_px * s - 1, 2.5, 2.5);
+  });
+  ctx.strokeStyle = '#888';
+  ctx.strokeRect(0, 0, w * s, hgt * s);
+}
+
+async function filesFromDrop(dt) {
+  const entries = [...dt.items].map((i) => (i.webkitGetAsEntry ? i.webkitGetAsEntry() : null)).filter(Boolean);
+  if (!entries.length) return [...dt.files];
+  const out = [];
+  const walk = async (entry) => {
+    if (entry.isFile) {
+      const file = await new Promise((res, rej) => entry.file(res, rej));
+      if (IMAGE_EXT.test(file.name) || !entry.fullPath.includes('/', 1)) out.push(file);
+    } else if (entry.isDirectory) {
+      const reader = entry.createReader();
+      let batch;
+      do {
+        batch = await new Promise((res, rej) => reader.readEntries(res, rej));
+        for (const e of batch) await walk(e);
+      } while (batch.length);
+    }
+  };
+  for (const e of entries) await walk(e);
+  return out.sort((a, b) => a.name.localeCompare(b.name, undefined, { numeric: true }));
+}
