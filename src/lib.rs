@@ -32,6 +32,7 @@
 //!   board frame has z = 0 on the board plane.
 #![deny(missing_docs)]
 
+pub mod camera;
 pub mod error;
 pub mod image;
 pub mod synth;
@@ -39,6 +40,7 @@ pub mod synth;
 #[cfg(feature = "wasm")]
 pub mod wasm;
 
+pub use camera::{Camera, Distortion};
 pub use error::{Error, Result};
 
 /// The crate version, stamped into every report and export.

@@ -1,0 +1,243 @@
+//! The camera: pinhole intrinsics plus one lens model ([`Distortion`]).
+//!
+//! A camera-frame point `p` (x right, y down, z forward) maps to a distorted
+//! normalised point `m` by the lens model, then to pixels by
+//!
+//! ```text
+//! u = fx m_x + skew m_y + cx
+//! v =          fy m_y + cy
+//! ```
+//!
+//! with pixel (0, 0) the centre of the top-left pixel (as OpenCV). The
+//! parameter vector of [`Camera::params`] is `[fx, fy, cx, cy, skew,
+//! distortion coefficients...]` in the order of [`Camera::param_names`]; the
+//! calibration solvers optimise exactly this vector.
+
+mod distortion;
+mod division;
+mod eucm;
+mod examples;
+mod kannala_brandt;
+mod polynomial;
+mod undistort;
+
+#[cfg(test)]
+mod tests;
+
+pub use distortion::Distortion;
+pub use undistort::{remap_gray, UndistortMap};
+
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, Matrix2, Matrix2x3, Matrix3, Point2, Point3, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Number of pinhole parameters before the distortion coefficients in
+/// [`Camera::params`]: fx, fy, cx, cy, skew.
+pub const N_PINHOLE_PARAMS: usize = 5;
+
+/// A calibrated (or to-be-calibrated) camera: intrinsics, image size and
+/// lens model. Serialises to JSON as these fields, the lens model as an
+/// object tagged by `model`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    /// Focal length along x, in pixels.
+    pub fx: f64,
+    /// Focal length along y, in pixels.
+    pub fy: f64,
+    /// Principal point x, in pixels (pixel-centre convention).
+    pub cx: f64,
+    /// Principal point y, in pixels.
+    pub cy: f64,
+    /// Skew, in pixels (the (0, 1) entry of the camera matrix; Zhang's
+    /// gamma). Usually 0.
+    pub skew: f64,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// The lens model.
+    pub distortion: Distortion,
+}
+
+impl Camera {
+    /// A distortion-free camera.
+    pub fn pinhole(fx: f64, fy: f64, cx: f64, cy: f64, width: u32, height: u32) -> Camera {
+        Camera {
+            fx,
+            fy,
+            cx,
+            cy,
+            skew: 0.0,
+            width,
+            height,
+            distortion: Distortion::None,
+        }
+    }
+
+    /// The same intrinsics without lens distortion (the usual target of an
+    /// undistortion map).
+    pub fn without_distortion(&self) -> Camera {
+        Camera {
+            distortion: Distortion::None,
+            ..self.clone()
+        }
+    }
+
+    /// The 3x3 camera matrix `[[fx, skew, cx], [0, fy, cy], [0, 0, 1]]`.
+    pub fn camera_matrix(&self) -> Matrix3<f64> {
+        Matrix3::new(
+            self.fx, self.skew, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0,
+        )
+    }
+
+    /// All parameters: `[fx, fy, cx, cy, skew, distortion coefficients...]`.
+    pub fn params(&self) -> Vec<f64> {
+        let mut p = vec![self.fx, self.fy, self.cx, self.cy, self.skew];
+        p.extend(self.distortion.coefficients());
+        p
+    }
+
+    /// Names of [`Camera::params`], e.g. `fx fy cx cy skew k1 k2 p1 p2 k3`.
+    pub fn param_names(&self) -> Vec<&'static str> {
+        let mut names = vec!["fx", "fy", "cx", "cy", "skew"];
+        names.extend_from_slice(self.distortion.coefficient_names());
+        names
+    }
+
+    /// The same camera model and image size with new parameters (layout of
+    /// [`Camera::params`]). Focal lengths must be positive and finite.
+    pub fn with_params(&self, params: &[f64]) -> Result<Camera> {
+        let expected = N_PINHOLE_PARAMS + self.distortion.coefficient_names().len();
+        if params.len() != expected {
+            return Err(Error::invalid(
+                "params",
+                format!(
+                    "a camera with the {} model has {expected} parameters, got {}",
+                    self.distortion.model_name(),
+                    params.len()
+                ),
+            ));
+        }
+        let (pinhole, coeffs) = params.split_at(N_PINHOLE_PARAMS);
+        if let Some(i) = pinhole.iter().position(|v| !v.is_finite()) {
+            return Err(Error::invalid(
+                self.param_names()[i],
+                format!("must be finite, got {}", pinhole[i]),
+            ));
+        }
+        for (name, value) in [("fx", pinhole[0]), ("fy", pinhole[1])] {
+            if value <= 0.0 {
+                return Err(Error::invalid(
+                    name,
+                    format!("focal length must be > 0 px, got {value}"),
+                ));
+            }
+        }
+        Ok(Camera {
+            fx: pinhole[0],
+            fy: pinhole[1],
+            cx: pinhole[2],
+            cy: pinhole[3],
+            skew: pinhole[4],
+            width: self.width,
+            height: self.height,
+            distortion: self.distortion.with_coefficients(coeffs)?,
+        })
+    }
+
+    /// Pixel of a camera-frame point. Fails for points the model cannot
+    /// project (behind the camera for the perspective models, outside the
+    /// field of view of the wide-angle ones, outside the division model's
+    /// domain).
+    pub fn project(&self, p_camera: &Point3<f64>) -> Result<Point2<f64>> {
+        let ray = self.distortion.project_ray(&p_camera.coords)?;
+        Ok(self.pixel_from_normalized(&ray.m))
+    }
+
+    /// [`Camera::project`] with the analytic Jacobians: d pixel / d point
+    /// (2x3) and d pixel / d params (2 x `params().len()`, columns in the
+    /// order of [`Camera::param_names`]).
+    pub fn project_with_jacobians(
+        &self,
+        p_camera: &Point3<f64>,
+    ) -> Result<(Point2<f64>, Matrix2x3<f64>, DMatrix<f64>)> {
+        let ray = self.distortion.project_ray(&p_camera.coords)?;
+        let k = self.linear_part();
+        let (mx, my) = (ray.m.x, ray.m.y);
+        let mut d_params = DMatrix::zeros(2, N_PINHOLE_PARAMS + ray.d_coeffs.len());
+        d_params[(0, 0)] = mx;
+        d_params[(1, 1)] = my;
+        d_params[(0, 2)] = 1.0;
+        d_params[(1, 3)] = 1.0;
+        d_params[(0, 4)] = my;
+        for (i, d) in ray.d_coeffs.iter().enumerate() {
+            let col = k * d;
+            d_params[(0, N_PINHOLE_PARAMS + i)] = col.x;
+            d_params[(1, N_PINHOLE_PARAMS + i)] = col.y;
+        }
+        Ok((
+            self.pixel_from_normalized(&ray.m),
+            k * ray.d_point,
+            d_params,
+        ))
+    }
+
+    /// The unit-norm bearing (camera frame) of a pixel. Iterative for the
+    /// polynomial models; fails with [`Error::NoConvergence`] when the
+    /// inverse does not converge or lands beyond a fold of the model.
+    pub fn unproject(&self, pixel: &Point2<f64>) -> Result<Vector3<f64>> {
+        let m = self.normalized_from_pixel(pixel)?;
+        self.distortion.unproject_ray(&m)
+    }
+
+    /// Apply the lens model to an ideal normalised point `(X/Z, Y/Z)`.
+    pub fn distort_normalized(&self, undistorted: &Point2<f64>) -> Result<Point2<f64>> {
+        let (m, _, _) = self
+            .distortion
+            .distort_with_jacobians(&undistorted.coords)?;
+        Ok(Point2::from(m))
+    }
+
+    /// Remove the lens model from a distorted normalised point: the ideal
+    /// `(X/Z, Y/Z)`. Fails for rays at or beyond 90 degrees (no pinhole image).
+    pub fn undistort_normalized(&self, distorted: &Point2<f64>) -> Result<Point2<f64>> {
+        let ray = self.distortion.unproject_ray(&distorted.coords)?;
+        if !(ray.z > 0.0) {
+            return Err(Error::invalid(
+                "point",
+                format!(
+                    "({:.6}, {:.6}) is a ray at or beyond 90 degrees: it has no undistorted pinhole position",
+                    distorted.x, distorted.y
+                ),
+            ));
+        }
+        Ok(Point2::new(ray.x / ray.z, ray.y / ray.z))
+    }
+
+    /// The 2x2 linear part of the camera matrix.
+    fn linear_part(&self) -> Matrix2<f64> {
+        Matrix2::new(self.fx, self.skew, 0.0, self.fy)
+    }
+
+    fn pixel_from_normalized(&self, m: &Vector2<f64>) -> Point2<f64> {
+        Point2::new(
+            self.fx * m.x + self.skew * m.y + self.cx,
+            self.fy * m.y + self.cy,
+        )
+    }
+
+    fn normalized_from_pixel(&self, pixel: &Point2<f64>) -> Result<Vector2<f64>> {
+        if !(self.fx > 0.0 && self.fy > 0.0) {
+            return Err(Error::invalid(
+                "camera",
+                format!(
+                    "focal lengths must be > 0 px, got fx {} fy {}",
+                    self.fx, self.fy
+                ),
+            ));
+        }
+        let my = (pixel.y - self.cy) / self.fy;
+        let mx = (pixel.x - self.cx - self.skew * my) / self.fx;
+        Ok(Vector2::new(mx, my))
+    }
+}
