@@ -34,6 +34,7 @@
 
 pub mod camera;
 pub mod error;
+pub mod geometry;
 pub mod image;
 pub mod synth;
 
