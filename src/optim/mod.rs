@@ -1,0 +1,327 @@
+//! The project's one Levenberg-Marquardt solver, for block-structured
+//! least-squares problems: a few global parameters (intrinsics, a hand-eye
+//! transform) shared by all residuals, plus per-block parameters (one pose
+//! per view) that each residual block touches at most one of. The normal
+//! equations are solved by the Schur complement over the blocks, so the
+//! cost grows linearly with the number of views.
+//!
+//! The cost is `0.5 * sum_k rho(|r_k|^2)` over residual blocks `r_k` (for
+//! calibration: one block per observed point, 2 residuals in pixels), with
+//! `rho` from [`Loss`]. Parameters can be held fixed ([`LmOptions::fixed_global`],
+//! [`LmOptions::fixed_blocks`]); manifold parameters (rotations) use
+//! [`BlockProblem::retract`].
+
+mod loss;
+mod normal;
+
+#[cfg(test)]
+mod tests;
+
+pub use loss::Loss;
+
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, DVector};
+use normal::{Mask, Normal};
+use serde::{Deserialize, Serialize};
+
+/// Parameter values (or a step): the global vector and one vector per block.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlockParams {
+    /// Parameters shared by every residual block.
+    pub global: Vec<f64>,
+    /// Per-block parameters (e.g. one 6-vector pose per view).
+    pub blocks: Vec<Vec<f64>>,
+}
+
+/// One group of residuals (e.g. the 2 pixel residuals of one point) and its
+/// Jacobians. The robust loss applies to the group's squared norm.
+#[derive(Clone, Debug)]
+pub struct ResidualBlock {
+    /// The block whose parameters these residuals depend on, if any.
+    pub block: Option<usize>,
+    /// The residuals (m values).
+    pub residuals: DVector<f64>,
+    /// d residuals / d global parameters (m x n_global); may have 0 columns
+    /// when Jacobians were not requested.
+    pub jac_global: DMatrix<f64>,
+    /// d residuals / d block parameters (m x block size); 0 columns when
+    /// `block` is `None` or Jacobians were not requested.
+    pub jac_block: DMatrix<f64>,
+}
+
+/// A least-squares problem for [`solve`].
+pub trait BlockProblem {
+    /// All residual blocks at `params`; with `jacobians == false` the
+    /// Jacobian matrices may be left empty. Errors (e.g. a point behind the
+    /// camera) make the solver reject the step that led there.
+    fn residuals_and_jacobian(
+        &self,
+        params: &BlockParams,
+        jacobians: bool,
+    ) -> Result<Vec<ResidualBlock>>;
+
+    /// Apply a step; the Jacobians are with respect to this step. Additive
+    /// by default; override for rotations (e.g. `R <- exp(delta) R`).
+    fn retract(&self, params: &BlockParams, step: &BlockParams) -> BlockParams {
+        let add = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, d)| x + d).collect::<Vec<f64>>();
+        BlockParams {
+            global: add(&params.global, &step.global),
+            blocks: params
+                .blocks
+                .iter()
+                .zip(&step.blocks)
+                .map(|(a, b)| add(a, b))
+                .collect(),
+        }
+    }
+}
+
+/// Solver settings. Defaults converge noise-free problems to ~1e-12.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LmOptions {
+    /// Most Jacobian evaluations (default 200).
+    pub max_iterations: usize,
+    /// Stop when an accepted step lowers the cost by less than this
+    /// fraction (default 1e-14).
+    pub cost_tolerance: f64,
+    /// Stop when the largest gradient component is below this (default 1e-14).
+    pub gradient_tolerance: f64,
+    /// Stop when the step is below this relative to the parameters (default 1e-12).
+    pub step_tolerance: f64,
+    /// Initial damping relative to diag(J^T J) (default 1e-4).
+    pub initial_lambda: f64,
+    /// Robust loss (default [`Loss::Squared`]).
+    pub loss: Loss,
+    /// Global parameters held at their initial value (empty: none).
+    pub fixed_global: Vec<bool>,
+    /// Blocks held at their initial value (empty: none).
+    pub fixed_blocks: Vec<bool>,
+}
+
+impl Default for LmOptions {
+    fn default() -> Self {
+        LmOptions {
+            max_iterations: 200,
+            cost_tolerance: 1e-14,
+            gradient_tolerance: 1e-14,
+            step_tolerance: 1e-12,
+            initial_lambda: 1e-4,
+            loss: Loss::Squared,
+            fixed_global: vec![],
+            fixed_blocks: vec![],
+        }
+    }
+}
+
+/// Why the solver stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// The relative cost decrease fell below the tolerance (or the cost is 0).
+    CostTolerance,
+    /// The gradient fell below the tolerance.
+    GradientTolerance,
+    /// The step fell below the tolerance.
+    StepTolerance,
+    /// No step lowered the cost even with very strong damping: a minimum
+    /// to machine precision.
+    NoDecrease,
+    /// The iteration limit was reached.
+    MaxIterations,
+}
+
+/// The outcome of [`solve`].
+#[derive(Clone, Debug)]
+pub struct LmResult {
+    /// The final parameters.
+    pub params: BlockParams,
+    /// Cost at the initial parameters.
+    pub initial_cost: f64,
+    /// Final cost `0.5 sum rho(|r|^2)`.
+    pub cost: f64,
+    /// Jacobian evaluations done.
+    pub iterations: usize,
+    /// Why it stopped.
+    pub termination: Termination,
+    /// Number of scalar residuals.
+    pub n_residuals: usize,
+    /// Number of parameters that were free to move.
+    pub n_free_params: usize,
+    /// Residual variance estimate `2 cost / (n_residuals - n_free_params)`.
+    pub residual_variance: f64,
+    /// Covariance of the global parameters, `(J^T J)^-1` marginalised over
+    /// the blocks and scaled by the residual variance; zero rows for held
+    /// parameters. `None` when J^T J is singular at the optimum.
+    pub covariance_global: Option<DMatrix<f64>>,
+    /// Marginal covariance of each block, scaled likewise.
+    pub covariance_blocks: Option<Vec<DMatrix<f64>>>,
+}
+
+impl LmResult {
+    /// Standard deviations of the global parameters (sqrt of the covariance diagonal).
+    pub fn std_global(&self) -> Option<Vec<f64>> {
+        self.covariance_global
+            .as_ref()
+            .map(|c| c.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect())
+    }
+}
+
+/// Damping beyond which the solver gives up finding a lower cost.
+const MAX_LAMBDA: f64 = 1e16;
+
+/// Minimise the problem's cost from `initial` with Levenberg-Marquardt.
+pub fn solve(
+    problem: &dyn BlockProblem,
+    initial: &BlockParams,
+    options: &LmOptions,
+) -> Result<LmResult> {
+    let mask = make_mask(initial, options)?;
+    let cost_of = |blocks: &[ResidualBlock]| -> f64 {
+        blocks
+            .iter()
+            .map(|b| 0.5 * options.loss.evaluate(b.residuals.norm_squared()).0)
+            .sum()
+    };
+    let mut params = initial.clone();
+    let mut residuals = problem.residuals_and_jacobian(&params, true)?;
+    let n_residuals: usize = residuals.iter().map(|b| b.residuals.len()).sum();
+    let initial_cost = cost_of(&residuals);
+    if !initial_cost.is_finite() {
+        return Err(Error::invalid(
+            "initial",
+            "the cost at the initial parameters is not finite",
+        ));
+    }
+    let mut cost = initial_cost;
+    let mut lambda = options.initial_lambda;
+    let mut iterations = 0;
+    let mut normal = Normal::build(&params, &residuals, &options.loss, &mask);
+    let termination = 'outer: loop {
+        if cost == 0.0 {
+            break Termination::CostTolerance;
+        }
+        if normal.gradient_max() <= options.gradient_tolerance {
+            break Termination::GradientTolerance;
+        }
+        if iterations >= options.max_iterations {
+            break Termination::MaxIterations;
+        }
+        iterations += 1;
+        // Raise the damping until a step lowers the cost.
+        loop {
+            if lambda > MAX_LAMBDA {
+                break 'outer Termination::NoDecrease;
+            }
+            let Some((step, predicted)) = normal.solve(lambda) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let candidate = problem.retract(&params, &step);
+            let new_residuals = match problem.residuals_and_jacobian(&candidate, true) {
+                Ok(r) => r,
+                Err(_) => {
+                    lambda *= 10.0;
+                    continue;
+                }
+            };
+            let new_cost = cost_of(&new_residuals);
+            if !(new_cost < cost) {
+                lambda *= 10.0;
+                continue;
+            }
+            let ratio = if predicted > 0.0 {
+                (cost - new_cost) / predicted
+            } else {
+                0.0
+            };
+            lambda *= if ratio > 0.75 {
+                1.0 / 3.0
+            } else if ratio < 0.25 {
+                2.0
+            } else {
+                1.0
+            };
+            lambda = lambda.max(1e-15);
+            let decrease = cost - new_cost;
+            let small_step = step_norm(&step)
+                <= options.step_tolerance * (step_norm(&params) + options.step_tolerance);
+            params = candidate;
+            residuals = new_residuals;
+            cost = new_cost;
+            normal = Normal::build(&params, &residuals, &options.loss, &mask);
+            if decrease <= options.cost_tolerance * (cost + decrease) {
+                break 'outer Termination::CostTolerance;
+            }
+            if small_step {
+                break 'outer Termination::StepTolerance;
+            }
+            break;
+        }
+    };
+    let n_free_params = mask.global.iter().filter(|f| **f).count()
+        + params
+            .blocks
+            .iter()
+            .zip(&mask.blocks)
+            .filter(|(_, f)| **f)
+            .map(|(b, _)| b.len())
+            .sum::<usize>();
+    let dof = n_residuals.saturating_sub(n_free_params);
+    let residual_variance = if dof > 0 {
+        2.0 * cost / dof as f64
+    } else {
+        0.0
+    };
+    let covariances = normal.covariances(&mask);
+    Ok(LmResult {
+        initial_cost,
+        cost,
+        iterations,
+        termination,
+        n_residuals,
+        n_free_params,
+        residual_variance,
+        covariance_global: covariances.as_ref().map(|(g, _)| g * residual_variance),
+        covariance_blocks: covariances
+            .map(|(_, b)| b.into_iter().map(|c| c * residual_variance).collect()),
+        params,
+    })
+}
+
+fn step_norm(p: &BlockParams) -> f64 {
+    let global: f64 = p.global.iter().map(|v| v * v).sum();
+    let blocks: f64 = p.blocks.iter().flatten().map(|v| v * v).sum();
+    (global + blocks).sqrt()
+}
+
+fn make_mask(initial: &BlockParams, options: &LmOptions) -> Result<Mask> {
+    let global = if options.fixed_global.is_empty() {
+        vec![true; initial.global.len()]
+    } else if options.fixed_global.len() == initial.global.len() {
+        options.fixed_global.iter().map(|f| !f).collect()
+    } else {
+        return Err(Error::invalid(
+            "fixed_global",
+            format!(
+                "{} flags for {} global parameters",
+                options.fixed_global.len(),
+                initial.global.len()
+            ),
+        ));
+    };
+    let blocks = if options.fixed_blocks.is_empty() {
+        vec![true; initial.blocks.len()]
+    } else if options.fixed_blocks.len() == initial.blocks.len() {
+        options.fixed_blocks.iter().map(|f| !f).collect()
+    } else {
+        return Err(Error::invalid(
+            "fixed_blocks",
+            format!(
+                "{} flags for {} blocks",
+                options.fixed_blocks.len(),
+                initial.blocks.len()
+            ),
+        ));
+    };
+    Ok(Mask { global, blocks })
+}

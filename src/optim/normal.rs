@@ -1,0 +1,196 @@
+//! The normal equations of a block-structured least-squares problem and
+//! their solution by the Schur complement over the per-block parameters.
+//!
+//! ```text
+//! [ U    W ] [dg]   [-g_g]      U: global x global, V = diag(V_i): per block,
+//! [ W^T  V ] [db] = [-g_b]      W = [W_1 .. W_n]: global x block
+//! S = U - sum W_i V_i^-1 W_i^T,  S dg = -g_g + sum W_i V_i^-1 g_i,
+//! db_i = V_i^-1 (-g_i - W_i^T dg)
+//! ```
+//! Each V_i is small (6 for a pose), so the cost is linear in the number
+//! of blocks.
+
+use super::{BlockParams, Loss, ResidualBlock};
+use nalgebra::{DMatrix, DVector};
+
+/// Floor of the Marquardt scaling `diag(H)`, so that parameters the data
+/// does not constrain still get damped.
+const MIN_DIAGONAL: f64 = 1e-9;
+
+/// J^T J and J^T r, accumulated per block, with robust weights applied.
+#[derive(Clone, Debug)]
+pub(crate) struct Normal {
+    pub u: DMatrix<f64>,
+    pub w: Vec<DMatrix<f64>>,
+    pub v: Vec<DMatrix<f64>>,
+    pub g_global: DVector<f64>,
+    pub g_blocks: Vec<DVector<f64>>,
+}
+
+/// Which parameters move (true) and which are held.
+#[derive(Clone, Debug)]
+pub(crate) struct Mask {
+    pub global: Vec<bool>,
+    pub blocks: Vec<bool>,
+}
+
+impl Normal {
+    /// Accumulate the weighted normal equations of `residuals`.
+    pub fn build(
+        layout: &BlockParams,
+        residuals: &[ResidualBlock],
+        loss: &Loss,
+        mask: &Mask,
+    ) -> Normal {
+        let ng = layout.global.len();
+        let mut n = Normal {
+            u: DMatrix::zeros(ng, ng),
+            w: layout
+                .blocks
+                .iter()
+                .map(|b| DMatrix::zeros(ng, b.len()))
+                .collect(),
+            v: layout
+                .blocks
+                .iter()
+                .map(|b| DMatrix::zeros(b.len(), b.len()))
+                .collect(),
+            g_global: DVector::zeros(ng),
+            g_blocks: layout
+                .blocks
+                .iter()
+                .map(|b| DVector::zeros(b.len()))
+                .collect(),
+        };
+        for rb in residuals {
+            let (_, d_rho) = loss.evaluate(rb.residuals.norm_squared());
+            // IRLS: scale J and r by sqrt(rho'), so J^T J gets rho' and the
+            // gradient is rho' J^T r.
+            if rb.jac_global.ncols() == ng && ng > 0 {
+                n.u.gemm_tr(d_rho, &rb.jac_global, &rb.jac_global, 1.0);
+                n.g_global
+                    .gemv_tr(d_rho, &rb.jac_global, &rb.residuals, 1.0);
+            }
+            if let Some(b) = rb.block {
+                let jb = &rb.jac_block;
+                n.v[b].gemm_tr(d_rho, jb, jb, 1.0);
+                n.g_blocks[b].gemv_tr(d_rho, jb, &rb.residuals, 1.0);
+                if rb.jac_global.ncols() == ng && ng > 0 {
+                    n.w[b].gemm_tr(d_rho, &rb.jac_global, jb, 1.0);
+                }
+            }
+        }
+        n.apply_mask(mask);
+        n
+    }
+
+    /// Held parameters get an identity row and column and zero gradient,
+    /// so their step is exactly 0.
+    fn apply_mask(&mut self, mask: &Mask) {
+        for (k, &free) in mask.global.iter().enumerate() {
+            if free {
+                continue;
+            }
+            self.u.row_mut(k).fill(0.0);
+            self.u.column_mut(k).fill(0.0);
+            self.u[(k, k)] = 1.0;
+            self.g_global[k] = 0.0;
+            for w in &mut self.w {
+                w.row_mut(k).fill(0.0);
+            }
+        }
+        for (b, &free) in mask.blocks.iter().enumerate() {
+            if !free {
+                self.v[b].fill_with_identity();
+                self.w[b].fill(0.0);
+                self.g_blocks[b].fill(0.0);
+            }
+        }
+    }
+
+    /// Largest gradient component.
+    pub fn gradient_max(&self) -> f64 {
+        let g = self.g_global.amax();
+        self.g_blocks.iter().map(|g| g.amax()).fold(g, f64::max)
+    }
+
+    /// Solve `(H + lambda D) delta = -g` with D the clamped diagonal of H.
+    /// Returns the step and the cost reduction the quadratic model predicts,
+    /// or `None` when the damped system is not positive definite.
+    pub fn solve(&self, lambda: f64) -> Option<(BlockParams, f64)> {
+        let damp = |m: &DMatrix<f64>| {
+            let mut d = m.clone();
+            for i in 0..d.nrows() {
+                d[(i, i)] += lambda * m[(i, i)].max(MIN_DIAGONAL);
+            }
+            d
+        };
+        let (s, v_inv) = self.schur(damp)?;
+        let mut rhs = -self.g_global.clone();
+        for (b, w) in self.w.iter().enumerate() {
+            rhs += w * (&v_inv[b] * &self.g_blocks[b]);
+        }
+        let dg = s.cholesky()?.solve(&rhs);
+        let mut predicted = -0.5 * self.g_global.dot(&dg);
+        for i in 0..dg.len() {
+            predicted += 0.5 * lambda * self.u[(i, i)].max(MIN_DIAGONAL) * dg[i] * dg[i];
+        }
+        let mut blocks = Vec::with_capacity(self.v.len());
+        for (b, w) in self.w.iter().enumerate() {
+            let db = &v_inv[b] * (-&self.g_blocks[b] - w.transpose() * &dg);
+            predicted -= 0.5 * self.g_blocks[b].dot(&db);
+            for i in 0..db.len() {
+                predicted += 0.5 * lambda * self.v[b][(i, i)].max(MIN_DIAGONAL) * db[i] * db[i];
+            }
+            blocks.push(db.iter().copied().collect());
+        }
+        Some((
+            BlockParams {
+                global: dg.iter().copied().collect(),
+                blocks,
+            },
+            predicted,
+        ))
+    }
+
+    /// The Schur complement of the (damped) system and the inverted blocks.
+    fn schur(
+        &self,
+        damp: impl Fn(&DMatrix<f64>) -> DMatrix<f64>,
+    ) -> Option<(DMatrix<f64>, Vec<DMatrix<f64>>)> {
+        let mut s = damp(&self.u);
+        let mut v_inv = Vec::with_capacity(self.v.len());
+        for (b, v) in self.v.iter().enumerate() {
+            let inv = damp(v).cholesky()?.inverse();
+            let y = &self.w[b] * &inv;
+            s.gemm(-1.0, &y, &self.w[b].transpose(), 1.0);
+            v_inv.push(inv);
+        }
+        Some((s, v_inv))
+    }
+
+    /// Undamped marginal covariances (unscaled: (J^T J)^-1) of the global
+    /// parameters and of each block, with zero rows and columns for held
+    /// parameters. `None` when J^T J is singular (unobservable parameters).
+    pub fn covariances(&self, mask: &Mask) -> Option<(DMatrix<f64>, Vec<DMatrix<f64>>)> {
+        let (s, v_inv) = self.schur(|m| m.clone())?;
+        let mut s_inv = s.cholesky()?.inverse();
+        for (k, &free) in mask.global.iter().enumerate() {
+            if !free {
+                s_inv.row_mut(k).fill(0.0);
+                s_inv.column_mut(k).fill(0.0);
+            }
+        }
+        let mut blocks = Vec::with_capacity(v_inv.len());
+        for (b, inv) in v_inv.into_iter().enumerate() {
+            if !mask.blocks[b] {
+                blocks.push(DMatrix::zeros(inv.nrows(), inv.ncols()));
+                continue;
+            }
+            // Sigma_bb = V^-1 + Y^T S^-1 Y with Y = W V^-1.
+            let y = &self.w[b] * &inv;
+            blocks.push(&inv + y.transpose() * &s_inv * &y);
+        }
+        Some((s_inv, blocks))
+    }
+}
