@@ -30,7 +30,9 @@ fn camera_of(case: &Value) -> Camera {
         other => panic!("unknown model {other}"),
     };
     // OpenCV's fisheye skew is alpha = skew / fx; its pinhole model ignores K[0][1].
-    let skew = case["fisheye_alpha"].as_f64().map_or(k[1], |alpha| alpha * k[0]);
+    let skew = case["fisheye_alpha"]
+        .as_f64()
+        .map_or(k[1], |alpha| alpha * k[0]);
     let mut params = vec![k[0], k[4], k[2], k[5], skew];
     params.extend(d);
     template.with_params(&params).expect("valid parameters")
