@@ -36,6 +36,7 @@ pub mod camera;
 pub mod error;
 pub mod geometry;
 pub mod image;
+pub mod io;
 pub mod optim;
 pub mod synth;
 

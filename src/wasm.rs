@@ -118,3 +118,18 @@ pub fn image_info(bytes: &[u8]) -> Result<String, JsError> {
     })
     .map_err(|e| JsError::new(&e.to_string()))
 }
+
+/// Write a report (camera or hand-eye JSON) in an export format: the same
+/// bytes as `robocal export REPORT --format FORMAT [--transform NAME]`.
+/// `transform` may be empty for the default transform.
+#[wasm_bindgen]
+pub fn export_report(report_json: &str, format: &str, transform: &str) -> Result<String, JsError> {
+    let transform = (!transform.is_empty()).then_some(transform);
+    crate::io::export::export(report_json, format, transform).map_err(js_error)
+}
+
+/// The export format names, as a JSON array of strings.
+#[wasm_bindgen]
+pub fn export_formats() -> String {
+    serde_json::to_string(&crate::io::export::format_names()).unwrap_or_else(|_| "[]".into())
+}

@@ -1,6 +1,7 @@
 //! Subcommand dispatch, help texts and the CLI's error type.
 
 pub mod args;
+mod export;
 mod serve;
 
 use std::fmt;
@@ -55,6 +56,8 @@ Usage: robocal <command> [options]
 
 Commands:
   serve       serve the web app (a static folder) on http://127.0.0.1:8080
+  export      convert a calibration report into OpenCV, ROS, Kalibr, mrcal, Halcon,
+              MATLAB, URDF, robot-controller and other formats
   info        decode images and print their format and size
 
 Run 'robocal <command> --help' for the options of each command.
@@ -78,6 +81,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
         }
         "serve" if wants_help => print_help(serve::HELP),
         "serve" => serve::run(rest),
+        "export" if wants_help => print_help(export::HELP),
+        "export" => export::run(rest),
         "info" if wants_help => print_help(INFO_HELP),
         "info" => info(rest),
         other => Err(CliError::Usage(format!(
@@ -89,6 +94,26 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
 fn print_help(text: &str) -> Result<(), CliError> {
     println!("{text}");
     Ok(())
+}
+
+/// Read a whole text file, with an error that names it.
+pub fn read_text(path: &str) -> Result<String, CliError> {
+    std::fs::read_to_string(path).map_err(|e| CliError::Io(format!("cannot read '{path}': {e}")))
+}
+
+/// Write `text` to `path`, or to stdout when `path` is `None` or `-`.
+pub fn write_output(path: Option<&str>, text: &str) -> Result<(), CliError> {
+    match path {
+        None | Some("-") => {
+            use std::io::Write;
+            let mut out = std::io::stdout().lock();
+            out.write_all(text.as_bytes())
+                .map_err(|e| CliError::Io(format!("cannot write to stdout: {e}")))
+        }
+        Some(p) => {
+            std::fs::write(p, text).map_err(|e| CliError::Io(format!("cannot write '{p}': {e}")))
+        }
+    }
 }
 
 /// Read a whole file, with an error that names it.

@@ -1,0 +1,113 @@
+//! `export(report, format)`: the one entry point the CLI, node and the web
+//! app share, so all three write byte-identical files.
+//!
+//! A report is the JSON of a camera calibration (top-level `image_size_px`,
+//! `model`, `camera_matrix`, `distortion`, `rms_px`) or of a hand-eye
+//! calibration (transforms such as `gripper_from_camera` as
+//! `{matrix_row_major, translation_m, quaternion_xyzw}`), or both.
+
+use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
+use super::export_transform::{export_transform, FrameNames, TransformFormat};
+use super::import_camera::import_camera;
+use crate::error::{Error, Result};
+use crate::geometry::{pose_from_matrix4, Pose};
+use nalgebra::Matrix4;
+
+/// Transforms looked for, in order, when the caller names none.
+pub const DEFAULT_TRANSFORMS: [&str; 4] = [
+    "gripper_from_camera",
+    "base_from_camera",
+    "right_from_left",
+    "base_from_target",
+];
+
+/// What [`export`] can write: every camera format, `report` (the report
+/// itself, pretty-printed) and every transform format.
+pub fn format_names() -> Vec<String> {
+    let mut names: Vec<String> = CameraFormat::ALL
+        .iter()
+        .map(|f| f.name().to_string())
+        .collect();
+    names.push("report".into());
+    names.extend(TransformFormat::names().iter().map(|n| n.to_string()));
+    names.push("euler-<intrinsic|extrinsic>-<order>-<deg|rad>".into());
+    names
+}
+
+/// Write `report_json` in `format`; `transform` picks which transform of a
+/// hand-eye report (default: the first of [`DEFAULT_TRANSFORMS`] present).
+pub fn export(report_json: &str, format: &str, transform: Option<&str>) -> Result<String> {
+    let report: serde_json::Value = serde_json::from_str(report_json).map_err(|e| {
+        Error::parse(
+            e.line(),
+            e.column(),
+            format!("the report is not valid JSON: {e}"),
+        )
+    })?;
+    if format == "report" {
+        return serde_json::to_string_pretty(&report)
+            .map(|s| s + "\n")
+            .map_err(|e| Error::invalid("report", e.to_string()));
+    }
+    if let Ok(camera_format) = CameraFormat::from_name(format) {
+        let (camera, _) = import_camera(report_json).map_err(|e| match e {
+            Error::Invalid { field, .. } if field == "image_size_px" => Error::invalid(
+                "report",
+                format!(
+                    "format '{format}' needs a camera, and this report has none (no image_size_px)"
+                ),
+            ),
+            other => other,
+        })?;
+        let info = CameraExportInfo {
+            name: report["name"].as_str().unwrap_or("camera").to_string(),
+            rms_px: report["rms_px"].as_f64(),
+            ..CameraExportInfo::default()
+        };
+        return export_camera(&camera, &info, camera_format);
+    }
+    let transform_format = TransformFormat::from_name(format).map_err(|_| {
+        Error::invalid(
+            "format",
+            format!(
+                "unknown export format '{format}' (known: {})",
+                format_names().join(", ")
+            ),
+        )
+    })?;
+    let name = match transform {
+        Some(n) => n.to_string(),
+        None => DEFAULT_TRANSFORMS
+            .iter()
+            .find(|n| report.get(**n).is_some())
+            .map(|n| n.to_string())
+            .ok_or_else(|| {
+                Error::invalid(
+                    "report",
+                    format!(
+                        "format '{format}' needs a transform, and this report has none of {}",
+                        DEFAULT_TRANSFORMS.join(", ")
+                    ),
+                )
+            })?,
+    };
+    let pose = pose_from_report(&report, &name)?;
+    Ok(export_transform(
+        &pose,
+        &FrameNames::from_transform_name(&name)?,
+        transform_format,
+    ))
+}
+
+/// Read the transform `name` (`{matrix_row_major: [16 numbers]}`) from a report.
+pub fn pose_from_report(report: &serde_json::Value, name: &str) -> Result<Pose> {
+    let entry = report
+        .get(name)
+        .ok_or_else(|| Error::invalid("transform", format!("the report has no '{name}'")))?;
+    let m: Vec<f64> = entry["matrix_row_major"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|v| v.as_f64()).collect())
+        .filter(|m: &Vec<f64>| m.len() == 16)
+        .ok_or_else(|| Error::invalid(name, "expected matrix_row_major with 16 numbers"))?;
+    pose_from_matrix4(&Matrix4::from_row_slice(&m))
+}

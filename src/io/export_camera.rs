@@ -1,0 +1,491 @@
+//! Camera exports: one writer per format, all from the same [`Camera`].
+//!
+//! Conventions converted here (see the crate's conventions): OpenCV, ROS,
+//! Kalibr and mrcal share ours (pixel centres at integer coordinates, so the
+//! principal point is written as is); MATLAB is 1-based (principal point
+//! + 1) and stores the transposed camera matrix; Halcon's camera parameters
+//! are metric (focal length and pixel size in metres, distortion scaled by
+//! powers of the focal length) with the principal point in pixels.
+
+use crate::camera::{Camera, Distortion};
+use crate::error::{Error, Result};
+
+/// The camera formats robocal writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CameraFormat {
+    /// robocal's own JSON (`robocal.camera.v1`), read back by [`super::import_camera`].
+    Json,
+    /// OpenCV FileStorage YAML (`cv2.FileStorage`), `camera_matrix` + `distortion_coefficients`.
+    OpencvYaml,
+    /// OpenCV FileStorage XML.
+    OpencvXml,
+    /// ROS `camera_info` YAML (camera_calibration_parsers).
+    RosYaml,
+    /// Kalibr camchain YAML (`cam0`).
+    Kalibr,
+    /// mrcal `.cameramodel`.
+    Mrcal,
+    /// Halcon camera parameter tuple (HDevelop syntax).
+    Halcon,
+    /// MATLAB script building `cameraIntrinsics` (1-based principal point).
+    Matlab,
+    /// The 3x3 camera matrix as plain text.
+    Text,
+}
+
+impl CameraFormat {
+    /// Every format, in menu order.
+    pub const ALL: [CameraFormat; 9] = [
+        CameraFormat::Json,
+        CameraFormat::OpencvYaml,
+        CameraFormat::OpencvXml,
+        CameraFormat::RosYaml,
+        CameraFormat::Kalibr,
+        CameraFormat::Mrcal,
+        CameraFormat::Halcon,
+        CameraFormat::Matlab,
+        CameraFormat::Text,
+    ];
+
+    /// The name used by the CLI and the wasm boundary.
+    pub fn name(self) -> &'static str {
+        match self {
+            CameraFormat::Json => "json",
+            CameraFormat::OpencvYaml => "opencv-yaml",
+            CameraFormat::OpencvXml => "opencv-xml",
+            CameraFormat::RosYaml => "ros-yaml",
+            CameraFormat::Kalibr => "kalibr",
+            CameraFormat::Mrcal => "mrcal",
+            CameraFormat::Halcon => "halcon",
+            CameraFormat::Matlab => "matlab",
+            CameraFormat::Text => "text",
+        }
+    }
+
+    /// The usual file name extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            CameraFormat::Json => "json",
+            CameraFormat::OpencvYaml | CameraFormat::RosYaml | CameraFormat::Kalibr => "yaml",
+            CameraFormat::OpencvXml => "xml",
+            CameraFormat::Mrcal => "cameramodel",
+            CameraFormat::Halcon => "hdev.txt",
+            CameraFormat::Matlab => "m",
+            CameraFormat::Text => "txt",
+        }
+    }
+
+    /// Parse a format name; an unknown name lists the known ones.
+    pub fn from_name(name: &str) -> Result<CameraFormat> {
+        CameraFormat::ALL
+            .into_iter()
+            .find(|f| f.name() == name)
+            .ok_or_else(|| {
+                let known: Vec<&str> = CameraFormat::ALL.iter().map(|f| f.name()).collect();
+                Error::invalid(
+                    "format",
+                    format!(
+                        "unknown camera format '{name}' (known: {})",
+                        known.join(", ")
+                    ),
+                )
+            })
+    }
+}
+
+/// What a camera export says besides the camera itself.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraExportInfo {
+    /// Camera name (ROS `camera_name`, Kalibr topic `/<name>/image_raw`).
+    pub name: String,
+    /// Reprojection RMS of the calibration, when known.
+    pub rms_px: Option<f64>,
+    /// Physical pixel size for Halcon's metric parameters, metres
+    /// (default [`DEFAULT_PIXEL_SIZE_M`]; only the ratio focal/pixel matters).
+    pub pixel_size_m: f64,
+}
+
+/// Nominal pixel size used for Halcon when none is known: 5 µm.
+pub const DEFAULT_PIXEL_SIZE_M: f64 = 5e-6;
+
+impl Default for CameraExportInfo {
+    fn default() -> Self {
+        CameraExportInfo {
+            name: "camera".into(),
+            rms_px: None,
+            pixel_size_m: DEFAULT_PIXEL_SIZE_M,
+        }
+    }
+}
+
+/// Write `camera` in `format`.
+pub fn export_camera(
+    camera: &Camera,
+    info: &CameraExportInfo,
+    format: CameraFormat,
+) -> Result<String> {
+    match format {
+        CameraFormat::Json => json(camera, info),
+        CameraFormat::OpencvYaml => opencv_yaml(camera, info),
+        CameraFormat::OpencvXml => opencv_xml(camera, info),
+        CameraFormat::RosYaml => ros_yaml(camera, info),
+        CameraFormat::Kalibr => kalibr(camera, info),
+        CameraFormat::Mrcal => mrcal(camera),
+        CameraFormat::Halcon => halcon(camera, info),
+        CameraFormat::Matlab => matlab(camera),
+        CameraFormat::Text => Ok(text3x3(camera)),
+    }
+}
+
+/// A float as the shortest text that reads back to the same value, always
+/// with a decimal point and never in exponent form (YAML 1.1 readers such
+/// as PyYAML take `1e-5` for a string).
+pub fn float(x: f64) -> String {
+    // -0.0 prints as "-0"; a sign on zero only confuses readers.
+    let x = if x == 0.0 { 0.0 } else { x };
+    let s = format!("{x}");
+    if s.contains('.') || s.contains("inf") || s.contains("NaN") {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+fn list(values: &[f64]) -> String {
+    values
+        .iter()
+        .map(|v| float(*v))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn k_row_major(c: &Camera) -> [f64; 9] {
+    [c.fx, c.skew, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0]
+}
+
+/// OpenCV's distortion vector for the models OpenCV has; which API reads it.
+fn opencv_distortion(c: &Camera) -> Result<(Vec<f64>, bool)> {
+    let d = &c.distortion;
+    Ok(match d {
+        Distortion::None => (vec![0.0; 5], false),
+        Distortion::Brown { k1, k2, k3, p1, p2 } => (vec![*k1, *k2, *p1, *p2, *k3], false),
+        Distortion::RadialK1K2K5 { k1, k2, k5 } => (vec![*k1, *k2, 0.0, 0.0, *k5], false),
+        Distortion::Rational { .. } => {
+            let v = d.coefficients();
+            let prism = v[8..].iter().any(|s| *s != 0.0);
+            (if prism { v } else { v[..8].to_vec() }, false)
+        }
+        Distortion::KannalaBrandt { k1, k2, k3, k4 } => (vec![*k1, *k2, *k3, *k4], true),
+        Distortion::Division { .. } | Distortion::Eucm { .. } => {
+            return Err(unsupported(
+                c,
+                "OpenCV (use robocal JSON, Halcon for division, Kalibr for EUCM)",
+            ))
+        }
+    })
+}
+
+fn unsupported(c: &Camera, target: &str) -> Error {
+    Error::invalid(
+        "format",
+        format!(
+            "the {} lens model cannot be written for {target}",
+            c.distortion.model_name()
+        ),
+    )
+}
+
+fn json(c: &Camera, info: &CameraExportInfo) -> Result<String> {
+    let mut distortion = serde_json::Map::new();
+    for (name, value) in c
+        .distortion
+        .coefficient_names()
+        .iter()
+        .zip(c.distortion.coefficients())
+    {
+        distortion.insert((*name).to_string(), serde_json::json!(value));
+    }
+    let value = serde_json::json!({
+        "schema": "robocal.camera.v1",
+        "robocal_version": crate::VERSION,
+        "name": info.name,
+        "image_size_px": [c.width, c.height],
+        "model": c.distortion.model_name(),
+        "camera_matrix": k_row_major(c),
+        "distortion": distortion,
+        "rms_px": info.rms_px,
+    });
+    serde_json::to_string_pretty(&value)
+        .map(|s| s + "\n")
+        .map_err(|e| Error::invalid("json", e.to_string()))
+}
+
+fn opencv_yaml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
+    let (dist, fisheye) = opencv_distortion(c)?;
+    let mut out = String::from("%YAML:1.0\n---\n");
+    out += &format!(
+        "# robocal {}: {} model{}\n",
+        crate::VERSION,
+        c.distortion.model_name(),
+        if fisheye {
+            " (read with cv2.fisheye)"
+        } else {
+            ""
+        }
+    );
+    out += &format!("image_width: {}\nimage_height: {}\n", c.width, c.height);
+    out += &yaml_matrix("camera_matrix", 3, 3, &k_row_major(c));
+    out += &yaml_matrix("distortion_coefficients", 1, dist.len(), &dist);
+    if let Some(rms) = info.rms_px {
+        out += &format!("avg_reprojection_error: {}\n", float(rms));
+    }
+    Ok(out)
+}
+
+fn yaml_matrix(name: &str, rows: usize, cols: usize, data: &[f64]) -> String {
+    format!(
+        "{name}: !!opencv-matrix\n   rows: {rows}\n   cols: {cols}\n   dt: d\n   data: [ {} ]\n",
+        list(data)
+    )
+}
+
+fn opencv_xml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
+    let (dist, fisheye) = opencv_distortion(c)?;
+    let matrix = |name: &str, rows: usize, cols: usize, data: &[f64]| {
+        let values: Vec<String> = data.iter().map(|v| float(*v)).collect();
+        format!(
+            "<{name} type_id=\"opencv-matrix\">\n  <rows>{rows}</rows>\n  <cols>{cols}</cols>\n  <dt>d</dt>\n  <data>\n    {}</data></{name}>\n",
+            values.join(" ")
+        )
+    };
+    let mut out = String::from("<?xml version=\"1.0\"?>\n<opencv_storage>\n");
+    out += &format!(
+        "<!-- robocal {}: {} model{} -->\n",
+        crate::VERSION,
+        c.distortion.model_name(),
+        if fisheye {
+            " (read with cv2.fisheye)"
+        } else {
+            ""
+        }
+    );
+    out += &format!(
+        "<image_width>{}</image_width>\n<image_height>{}</image_height>\n",
+        c.width, c.height
+    );
+    out += &matrix("camera_matrix", 3, 3, &k_row_major(c));
+    out += &matrix("distortion_coefficients", 1, dist.len(), &dist);
+    if let Some(rms) = info.rms_px {
+        out += &format!(
+            "<avg_reprojection_error>{}</avg_reprojection_error>\n",
+            float(rms)
+        );
+    }
+    out += "</opencv_storage>\n";
+    Ok(out)
+}
+
+fn ros_yaml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
+    let (dist, fisheye) = opencv_distortion(c)?;
+    let model = match (&c.distortion, fisheye) {
+        (_, true) => "equidistant",
+        (Distortion::Rational { .. }, false) => "rational_polynomial",
+        _ => "plumb_bob",
+    };
+    let k = k_row_major(c);
+    let p = [
+        k[0], k[1], k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0,
+    ];
+    let block = |name: &str, rows: usize, cols: usize, data: &[f64]| {
+        format!(
+            "{name}:\n  rows: {rows}\n  cols: {cols}\n  data: [{}]\n",
+            list(data)
+        )
+    };
+    let mut out = format!(
+        "image_width: {}\nimage_height: {}\ncamera_name: {}\n",
+        c.width, c.height, info.name
+    );
+    out += &block("camera_matrix", 3, 3, &k);
+    out += &format!("distortion_model: {model}\n");
+    out += &block("distortion_coefficients", 1, dist.len(), &dist);
+    out += &block(
+        "rectification_matrix",
+        3,
+        3,
+        &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+    );
+    out += &block("projection_matrix", 3, 4, &p);
+    Ok(out)
+}
+
+fn kalibr(c: &Camera, info: &CameraExportInfo) -> Result<String> {
+    if c.skew != 0.0 {
+        return Err(Error::invalid(
+            "format",
+            "Kalibr has no skew: calibrate with zero skew to export to Kalibr",
+        ));
+    }
+    let (camera_model, mut intrinsics, distortion_model, coeffs) = match c.distortion {
+        Distortion::None => ("pinhole", vec![], "none", vec![]),
+        Distortion::Brown { k1, k2, k3, p1, p2 } if k3 == 0.0 => {
+            ("pinhole", vec![], "radtan", vec![k1, k2, p1, p2])
+        }
+        Distortion::RadialK1K2K5 { k1, k2, k5 } if k5 == 0.0 => {
+            ("pinhole", vec![], "radtan", vec![k1, k2, 0.0, 0.0])
+        }
+        Distortion::KannalaBrandt { k1, k2, k3, k4 } => {
+            ("pinhole", vec![], "equidistant", vec![k1, k2, k3, k4])
+        }
+        Distortion::Eucm { alpha, beta } => ("eucm", vec![alpha, beta], "none", vec![]),
+        Distortion::Brown { .. } | Distortion::RadialK1K2K5 { .. } => {
+            return Err(Error::invalid(
+                "format",
+                "Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr",
+            ))
+        }
+        Distortion::Rational { .. } | Distortion::Division { .. } => {
+            return Err(unsupported(c, "Kalibr"))
+        }
+    };
+    intrinsics.extend([c.fx, c.fy, c.cx, c.cy]);
+    let mut out = String::from("cam0:\n");
+    out += &format!(
+        "  camera_model: {camera_model}\n  intrinsics: [{}]\n",
+        list(&intrinsics)
+    );
+    out += &format!(
+        "  distortion_model: {distortion_model}\n  distortion_coeffs: [{}]\n",
+        list(&coeffs)
+    );
+    out += &format!(
+        "  resolution: [{}, {}]\n  rostopic: /{}/image_raw\n",
+        c.width, c.height, info.name
+    );
+    Ok(out)
+}
+
+fn mrcal(c: &Camera) -> Result<String> {
+    if c.skew != 0.0 {
+        return Err(Error::invalid(
+            "format",
+            "mrcal has no skew: calibrate with zero skew to export to mrcal",
+        ));
+    }
+    let (lensmodel, coeffs) = match &c.distortion {
+        Distortion::None => ("LENSMODEL_PINHOLE", vec![]),
+        Distortion::Brown { k1, k2, k3, p1, p2 } => {
+            ("LENSMODEL_OPENCV5", vec![*k1, *k2, *p1, *p2, *k3])
+        }
+        Distortion::RadialK1K2K5 { k1, k2, k5 } => {
+            ("LENSMODEL_OPENCV5", vec![*k1, *k2, 0.0, 0.0, *k5])
+        }
+        Distortion::Rational { .. } => {
+            let v = c.distortion.coefficients();
+            if v[8..].iter().any(|s| *s != 0.0) {
+                ("LENSMODEL_OPENCV12", v)
+            } else {
+                ("LENSMODEL_OPENCV8", v[..8].to_vec())
+            }
+        }
+        Distortion::KannalaBrandt { .. }
+        | Distortion::Division { .. }
+        | Distortion::Eucm { .. } => {
+            return Err(unsupported(c, "mrcal (it has no equivalent model)"))
+        }
+    };
+    let mut intrinsics = vec![c.fx, c.fy, c.cx, c.cy];
+    intrinsics.extend(coeffs);
+    Ok(format!(
+        "# generated by robocal {}\n{{\n    'lensmodel':  '{lensmodel}',\n    'intrinsics': [ {} ],\n    'imagersize': [ {}, {} ],\n}}\n",
+        crate::VERSION,
+        list(&intrinsics),
+        c.width,
+        c.height
+    ))
+}
+
+fn halcon(c: &Camera, info: &CameraExportInfo) -> Result<String> {
+    if c.skew != 0.0 {
+        return Err(Error::invalid(
+            "format",
+            "Halcon area-scan cameras have no skew: calibrate with zero skew",
+        ));
+    }
+    let sx = info.pixel_size_m;
+    let focus = c.fx * sx;
+    let sy = focus / c.fy;
+    let f2 = focus * focus;
+    let (kind, distortion) = match c.distortion {
+        Distortion::None => ("area_scan_division", vec![0.0]),
+        Distortion::Division { kappa } => ("area_scan_division", vec![kappa / f2]),
+        Distortion::Brown { k1, k2, k3, p1, p2 } => (
+            "area_scan_polynomial",
+            vec![
+                k1 / f2,
+                k2 / (f2 * f2),
+                k3 / (f2 * f2 * f2),
+                p2 / focus,
+                p1 / focus,
+            ],
+        ),
+        Distortion::RadialK1K2K5 { k1, k2, k5 } => (
+            "area_scan_polynomial",
+            vec![k1 / f2, k2 / (f2 * f2), k5 / (f2 * f2 * f2), 0.0, 0.0],
+        ),
+        Distortion::Rational { .. }
+        | Distortion::KannalaBrandt { .. }
+        | Distortion::Eucm { .. } => return Err(unsupported(c, "Halcon area-scan parameters")),
+    };
+    let mut values = vec![focus];
+    values.extend(distortion);
+    values.extend([sx, sy, c.cx, c.cy]);
+    let names = if kind == "area_scan_division" {
+        "Focus [m], Kappa [1/m^2], Sx [m], Sy [m], Cx [px], Cy [px], ImageWidth, ImageHeight"
+    } else {
+        "Focus [m], K1, K2, K3, P1, P2, Sx [m], Sy [m], Cx [px], Cy [px], ImageWidth, ImageHeight"
+    };
+    Ok(format!(
+        "* robocal {}: Halcon camera parameters ({names}).\n* Sx is a nominal pixel size of {} m: only Focus/Sx is calibrated.\nCameraParam := ['{kind}', {}, {}, {}]\n",
+        crate::VERSION,
+        float(sx),
+        list(&values),
+        c.width,
+        c.height
+    ))
+}
+
+fn matlab(c: &Camera) -> Result<String> {
+    let (radial, tangential) = match c.distortion {
+        Distortion::None => (vec![0.0, 0.0], vec![0.0, 0.0]),
+        Distortion::Brown { k1, k2, k3, p1, p2 } => (vec![k1, k2, k3], vec![p1, p2]),
+        Distortion::RadialK1K2K5 { k1, k2, k5 } => (vec![k1, k2, k5], vec![0.0, 0.0]),
+        Distortion::Rational { .. }
+        | Distortion::Division { .. }
+        | Distortion::KannalaBrandt { .. }
+        | Distortion::Eucm { .. } => return Err(unsupported(c, "MATLAB cameraIntrinsics")),
+    };
+    Ok(format!(
+        "% robocal {}: MATLAB conventions (1-based pixels: principal point = robocal's + 1)\n\
+focalLength = [{}, {}];\nprincipalPoint = [{}, {}];\nimageSize = [{}, {}];\n\
+radialDistortion = [{}];\ntangentialDistortion = [{}];\nskew = {};\n\
+intrinsics = cameraIntrinsics(focalLength, principalPoint, imageSize, ...\n    'RadialDistortion', radialDistortion, 'TangentialDistortion', tangentialDistortion, 'Skew', skew);\n",
+        crate::VERSION,
+        float(c.fx),
+        float(c.fy),
+        float(c.cx + 1.0),
+        float(c.cy + 1.0),
+        c.height,
+        c.width,
+        list(&radial),
+        list(&tangential),
+        float(c.skew)
+    ))
+}
+
+fn text3x3(c: &Camera) -> String {
+    let k = k_row_major(c);
+    k.chunks(3)
+        .map(|row| row.iter().map(|v| float(*v)).collect::<Vec<_>>().join(" ") + "\n")
+        .collect()
+}

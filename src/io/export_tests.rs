@@ -1,0 +1,201 @@
+//! Round trips of the camera and transform exports (golden files live in
+//! tests/exports.rs, natively, with the UPDATE_FIXTURES switch).
+
+use super::export_camera::{export_camera, float, CameraExportInfo, CameraFormat};
+use super::export_transform::{export_transform, FrameNames, TransformFormat};
+use super::import_camera::{import_camera, CameraSource};
+use crate::camera::{Camera, Distortion};
+use crate::geometry::{rotation_from_euler, EulerKind, EulerOrder, Pose};
+use nalgebra::{Translation3, Vector3};
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn brown() -> Camera {
+    Camera {
+        fx: 812.3456789,
+        fy: 815.25,
+        cx: 319.75,
+        cy: 241.125,
+        skew: 0.0,
+        width: 640,
+        height: 480,
+        distortion: Distortion::Brown {
+            k1: -0.2286,
+            k2: 0.1904,
+            k3: -0.0123,
+            p1: 0.00123,
+            p2: -0.000456,
+        },
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn floats_read_back_exactly_and_never_use_exponents() {
+    for x in [0.1, 1.0, -2.5e-9, 123456.789, 1e-20, f64::MAX / 3.0] {
+        let s = float(x);
+        assert!(!s.contains('e'), "{s}");
+        assert_eq!(s.parse::<f64>().unwrap(), x);
+    }
+    assert_eq!(float(3.0), "3.0");
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn cameras_round_trip_through_every_readable_format() {
+    let kb = Camera {
+        distortion: Distortion::KannalaBrandt {
+            k1: 0.01,
+            k2: -0.002,
+            k3: 0.0003,
+            k4: -0.00004,
+        },
+        ..brown()
+    };
+    let rational = Camera {
+        distortion: Distortion::Rational {
+            k1: 0.1,
+            k2: 0.01,
+            k3: 0.001,
+            k4: 0.2,
+            k5: 0.02,
+            k6: 0.002,
+            p1: 0.001,
+            p2: -0.001,
+            s1: 0.0001,
+            s2: 0.0002,
+            s3: -0.0001,
+            s4: 0.00005,
+        },
+        skew: 0.25,
+        ..brown()
+    };
+    let info = CameraExportInfo::default();
+    for camera in [brown(), kb, rational] {
+        for (format, source) in [
+            (CameraFormat::Json, CameraSource::Json),
+            (CameraFormat::OpencvYaml, CameraSource::OpencvYaml),
+            (CameraFormat::OpencvXml, CameraSource::OpencvXml),
+            (CameraFormat::RosYaml, CameraSource::RosYaml),
+        ] {
+            let text = export_camera(&camera, &info, format).unwrap();
+            let (back, seen) = import_camera(&text).unwrap();
+            assert_eq!(seen, source, "{format:?}");
+            assert_eq!(
+                back,
+                camera,
+                "{format:?} of {}:\n{text}",
+                camera.distortion.model_name()
+            );
+        }
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn matlab_is_one_based_and_halcon_is_metric() {
+    let c = brown();
+    let m = export_camera(&c, &CameraExportInfo::default(), CameraFormat::Matlab).unwrap();
+    assert!(m.contains("principalPoint = [320.75, 242.125];"), "{m}");
+    assert!(m.contains("imageSize = [480, 640];"), "{m}");
+    let h = export_camera(&c, &CameraExportInfo::default(), CameraFormat::Halcon).unwrap();
+    // Focus = fx * 5 µm; K1 = k1 / Focus^2.
+    let focus = 812.3456789 * 5e-6;
+    assert!(
+        h.contains(&format!(
+            "['area_scan_polynomial', {}, {}, ",
+            float(focus),
+            float(-0.2286 / (focus * focus))
+        )),
+        "{h}"
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn formats_without_the_model_say_why() {
+    let c = Camera {
+        distortion: Distortion::Division { kappa: -0.1 },
+        ..brown()
+    };
+    let err =
+        export_camera(&c, &CameraExportInfo::default(), CameraFormat::OpencvYaml).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "format: the division lens model cannot be written for OpenCV (use robocal JSON, Halcon for division, Kalibr for EUCM)"
+    );
+    let err =
+        export_camera(&brown(), &CameraExportInfo::default(), CameraFormat::Kalibr).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "format: Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr"
+    );
+    assert_eq!(
+        CameraFormat::from_name("yml").unwrap_err().to_string(),
+        "format: unknown camera format 'yml' (known: json, opencv-yaml, opencv-xml, ros-yaml, kalibr, mrcal, halcon, matlab, text)"
+    );
+}
+
+fn pose() -> Pose {
+    let r = rotation_from_euler(EulerOrder::ZYX, EulerKind::Intrinsic, [0.3, -0.2, 1.1]);
+    Pose::from_parts(Translation3::from(Vector3::new(0.1, -0.05, 0.3)), r)
+}
+
+fn numbers(line: &str) -> Vec<f64> {
+    line.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|s| s.parse().ok())
+        .collect()
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn transforms_read_back_to_the_same_pose() {
+    let names = FrameNames::from_transform_name("gripper_from_camera").unwrap();
+    let p = pose();
+    // Every Euler order and kind, in radians: the printed angles rebuild the rotation.
+    for order in EulerOrder::ALL {
+        for kind in [EulerKind::Intrinsic, EulerKind::Extrinsic] {
+            let text = export_transform(
+                &p,
+                &names,
+                TransformFormat::Euler {
+                    order,
+                    kind,
+                    degrees: false,
+                },
+            );
+            let v = numbers(text.lines().nth(1).unwrap());
+            let r = rotation_from_euler(order, kind, [v[3], v[4], v[5]]);
+            assert!(r.angle_to(&p.rotation) < 1e-12, "{order:?} {kind:?}");
+        }
+    }
+    // KUKA ABC (intrinsic ZYX, deg) and FANUC WPR (extrinsic XYZ, deg), mm.
+    let k = export_transform(&p, &names, TransformFormat::KukaFrame);
+    let v = numbers(k.lines().nth(1).unwrap());
+    assert_eq!(&v[..3], &[100.0, -50.0, 300.0]);
+    let r = rotation_from_euler(
+        EulerOrder::ZYX,
+        EulerKind::Intrinsic,
+        [v[3], v[4], v[5]].map(f64::to_radians),
+    );
+    // Each angle is rounded to 1e-4 deg (8.7e-7 rad): three of them stay under 2.7e-6 rad.
+    assert!(
+        r.angle_to(&p.rotation) < 2.7e-6,
+        "KUKA angles rounded to 1e-4 deg"
+    );
+    let f = export_transform(&p, &names, TransformFormat::FanucFrame);
+    let v = numbers(f.lines().nth(1).unwrap());
+    let r = rotation_from_euler(
+        EulerOrder::XYZ,
+        EulerKind::Extrinsic,
+        [v[3], v[4], v[5]].map(f64::to_radians),
+    );
+    // 1e-3 deg (8.7e-6 rad) per angle: under 2.7e-5 rad.
+    assert!(
+        r.angle_to(&p.rotation) < 2.7e-5,
+        "FANUC angles rounded to 1e-3 deg"
+    );
+    let ros = export_transform(&p, &names, TransformFormat::Ros2StaticTransform);
+    assert!(
+        ros.ends_with("--frame-id gripper --child-frame-id camera\n"),
+        "{ros}"
+    );
+    assert_eq!(
+        TransformFormat::from_name("euler-sideways-xyz-deg").unwrap_err().to_string(),
+        "format: unknown transform format 'euler-sideways-xyz-deg' (known: matrix4, xyz-quat-xyzw, xyz-quat-wxyz, urdf, ros2-static-tf, ur, kuka, abb-tooldata, abb-wobjdata, fanuc, euler-<intrinsic|extrinsic>-<order>-<deg|rad>)"
+    );
+}

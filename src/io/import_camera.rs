@@ -1,0 +1,308 @@
+//! Reading cameras back: robocal JSON (a camera export or a calibration
+//! report), OpenCV FileStorage YAML and XML, and ROS `camera_info` YAML.
+//! The format is recognised from the content.
+
+use crate::camera::{Camera, Distortion};
+use crate::error::{Error, Result};
+
+/// The formats [`import_camera`] recognises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CameraSource {
+    /// robocal JSON.
+    Json,
+    /// OpenCV FileStorage YAML.
+    OpencvYaml,
+    /// OpenCV FileStorage XML.
+    OpencvXml,
+    /// ROS camera_info YAML.
+    RosYaml,
+}
+
+/// Read a camera from text in any of the [`CameraSource`] formats.
+pub fn import_camera(text: &str) -> Result<(Camera, CameraSource)> {
+    let trimmed = text.trim_start();
+    if trimmed.starts_with('{') {
+        return from_json(text).map(|c| (c, CameraSource::Json));
+    }
+    if trimmed.starts_with("<?xml") || trimmed.starts_with("<opencv_storage>") {
+        return from_xml(text).map(|c| (c, CameraSource::OpencvXml));
+    }
+    if text.contains("!!opencv-matrix") {
+        return from_yaml(text, false).map(|c| (c, CameraSource::OpencvYaml));
+    }
+    if text.contains("camera_matrix:") && text.contains("distortion_model:") {
+        return from_yaml(text, true).map(|c| (c, CameraSource::RosYaml));
+    }
+    Err(Error::parse(
+        0,
+        0,
+        "not a camera file: expected robocal JSON, OpenCV YAML/XML (camera_matrix, distortion_coefficients) or ROS camera_info YAML",
+    ))
+}
+
+fn from_json(text: &str) -> Result<Camera> {
+    let v: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| Error::parse(e.line(), e.column(), format!("invalid JSON: {e}")))?;
+    // A full calibration report nests nothing: the camera keys are top level.
+    let size = v["image_size_px"]
+        .as_array()
+        .filter(|a| a.len() == 2)
+        .ok_or_else(|| missing("image_size_px"))?;
+    let dim = |i: usize| {
+        size[i]
+            .as_u64()
+            .filter(|&d| d > 0 && d <= u32::MAX as u64)
+            .map(|d| d as u32)
+    };
+    let (width, height) = (
+        dim(0).ok_or_else(|| missing("image_size_px"))?,
+        dim(1).ok_or_else(|| missing("image_size_px"))?,
+    );
+    let k: Vec<f64> = v["camera_matrix"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
+        .filter(|k: &Vec<f64>| k.len() == 9)
+        .ok_or_else(|| missing("camera_matrix (9 numbers, row-major)"))?;
+    let model = v["model"].as_str().ok_or_else(|| missing("model"))?;
+    let template = distortion_template(model)?;
+    let coeffs = template
+        .coefficient_names()
+        .iter()
+        .map(|name| {
+            v["distortion"][*name].as_f64().ok_or_else(|| {
+                Error::invalid(
+                    "distortion",
+                    format!("the {model} model needs coefficient '{name}'"),
+                )
+            })
+        })
+        .collect::<Result<Vec<f64>>>()?;
+    let distortion = template.with_coefficients(&coeffs)?;
+    camera_from_k(&k, width, height, distortion)
+}
+
+fn missing(key: &str) -> Error {
+    Error::invalid(key, format!("the camera JSON has no valid '{key}'"))
+}
+
+/// A model with zero coefficients, from its name.
+pub fn distortion_template(model: &str) -> Result<Distortion> {
+    Ok(match model {
+        "none" => Distortion::None,
+        "brown" => Distortion::Brown { k1: 0.0, k2: 0.0, k3: 0.0, p1: 0.0, p2: 0.0 },
+        "rational" => Distortion::Rational {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            k4: 0.0,
+            k5: 0.0,
+            k6: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+            s1: 0.0,
+            s2: 0.0,
+            s3: 0.0,
+            s4: 0.0,
+        },
+        "division" => Distortion::Division { kappa: 0.0 },
+        "radial_k1_k2_k5" => Distortion::RadialK1K2K5 { k1: 0.0, k2: 0.0, k5: 0.0 },
+        "kannala_brandt" => Distortion::KannalaBrandt { k1: 0.0, k2: 0.0, k3: 0.0, k4: 0.0 },
+        "eucm" => Distortion::Eucm { alpha: 0.0, beta: 1.0 },
+        other => {
+            return Err(Error::invalid(
+                "model",
+                format!("unknown lens model '{other}' (known: none, brown, rational, division, radial_k1_k2_k5, kannala_brandt, eucm)"),
+            ))
+        }
+    })
+}
+
+fn camera_from_k(k: &[f64], width: u32, height: u32, distortion: Distortion) -> Result<Camera> {
+    if k[3] != 0.0 || k[6] != 0.0 || k[7] != 0.0 || (k[8] - 1.0).abs() > 1e-12 {
+        return Err(Error::invalid(
+            "camera_matrix",
+            "expected [fx s cx; 0 fy cy; 0 0 1]",
+        ));
+    }
+    if !(k[0] > 0.0 && k[4] > 0.0) {
+        return Err(Error::invalid(
+            "camera_matrix",
+            format!(
+                "focal lengths must be positive, got fx {} fy {}",
+                k[0], k[4]
+            ),
+        ));
+    }
+    Ok(Camera {
+        fx: k[0],
+        fy: k[4],
+        cx: k[2],
+        cy: k[5],
+        skew: k[1],
+        width,
+        height,
+        distortion,
+    })
+}
+
+/// OpenCV's distortion vector to a model (`fisheye` for cv::fisheye's 4).
+fn distortion_from_opencv(d: &[f64], fisheye: bool) -> Result<Distortion> {
+    let g = |i: usize| d.get(i).copied().unwrap_or(0.0);
+    Ok(match (d.len(), fisheye) {
+        (0, _) => Distortion::None,
+        (4, true) => Distortion::KannalaBrandt {
+            k1: g(0),
+            k2: g(1),
+            k3: g(2),
+            k4: g(3),
+        },
+        (4 | 5, false) => Distortion::Brown {
+            k1: g(0),
+            k2: g(1),
+            p1: g(2),
+            p2: g(3),
+            k3: g(4),
+        },
+        (8 | 12, false) => Distortion::Rational {
+            k1: g(0),
+            k2: g(1),
+            p1: g(2),
+            p2: g(3),
+            k3: g(4),
+            k4: g(5),
+            k5: g(6),
+            k6: g(7),
+            s1: g(8),
+            s2: g(9),
+            s3: g(10),
+            s4: g(11),
+        },
+        (n, _) => {
+            return Err(Error::invalid(
+                "distortion_coefficients",
+                format!("{n} coefficients: robocal reads 4 (fisheye or k1 k2 p1 p2), 5, 8 or 12"),
+            ))
+        }
+    })
+}
+
+/// The numbers of the `data` list that follows the line `key:` (YAML).
+fn yaml_data(text: &str, keys: &[&str]) -> Option<Vec<f64>> {
+    let start = text.lines().scan(0usize, |offset, line| {
+        let here = *offset;
+        *offset += line.len() + 1;
+        Some((here, line))
+    });
+    for (offset, line) in start {
+        let name = line.trim_start().split(':').next().unwrap_or("");
+        if line.starts_with(' ') || !keys.contains(&name) {
+            continue;
+        }
+        let rest = &text[offset..];
+        let open = rest.find("data:")? + 5;
+        let body = &rest[open..];
+        let lb = body.find('[')?;
+        let rb = body.find(']')?;
+        return body[lb + 1..rb]
+            .split(',')
+            .map(|s| s.trim().parse().ok())
+            .collect();
+    }
+    None
+}
+
+fn yaml_scalar(text: &str, key: &str) -> Option<String> {
+    text.lines().find_map(|l| {
+        let (k, v) = l.split_once(':')?;
+        (k == key).then(|| v.trim().trim_matches('"').to_string())
+    })
+}
+
+const K_NAMES: [&str; 4] = ["camera_matrix", "cameraMatrix", "K", "M1"];
+const D_NAMES: [&str; 6] = [
+    "distortion_coefficients",
+    "dist_coeffs",
+    "distCoeffs",
+    "D",
+    "D1",
+    "distortion",
+];
+
+fn size_from(w: Option<String>, h: Option<String>) -> Result<(u32, u32)> {
+    let parse = |s: Option<String>, key: &str| {
+        s.and_then(|v| v.parse::<u32>().ok())
+            .filter(|&v| v > 0)
+            .ok_or_else(|| {
+                Error::invalid(
+                    key,
+                    format!("the camera file has no valid {key}: robocal needs the image size"),
+                )
+            })
+    };
+    Ok((parse(w, "image_width")?, parse(h, "image_height")?))
+}
+
+fn from_yaml(text: &str, ros: bool) -> Result<Camera> {
+    let k = yaml_data(text, &K_NAMES)
+        .filter(|k| k.len() == 9)
+        .ok_or_else(|| {
+            Error::invalid(
+                "camera_matrix",
+                "no 3x3 camera_matrix with 9 numbers in the file",
+            )
+        })?;
+    let d = yaml_data(text, &D_NAMES).unwrap_or_default();
+    let (width, height) = size_from(
+        yaml_scalar(text, "image_width"),
+        yaml_scalar(text, "image_height"),
+    )?;
+    let fisheye = if ros {
+        matches!(
+            yaml_scalar(text, "distortion_model").as_deref(),
+            Some("equidistant" | "fisheye")
+        )
+    } else {
+        text.contains("cv2.fisheye") || text.contains("fisheye")
+    };
+    camera_from_k(&k, width, height, distortion_from_opencv(&d, fisheye)?)
+}
+
+fn xml_element<'a>(text: &'a str, name: &str) -> Option<&'a str> {
+    let open = text.find(&format!("<{name}"))?;
+    let body_start = open + text[open..].find('>')? + 1;
+    let close = text[body_start..].find(&format!("</{name}>"))?;
+    Some(&text[body_start..body_start + close])
+}
+
+fn from_xml(text: &str) -> Result<Camera> {
+    let matrix = |names: &[&str]| {
+        names
+            .iter()
+            .find_map(|n| xml_element(text, n))
+            .and_then(|m| {
+                xml_element(m, "data").map(|d| {
+                    d.split_whitespace()
+                        .map(|s| s.parse::<f64>().ok())
+                        .collect::<Option<Vec<f64>>>()
+                })
+            })
+    };
+    let k = matrix(&K_NAMES)
+        .flatten()
+        .filter(|k| k.len() == 9)
+        .ok_or_else(|| {
+            Error::invalid(
+                "camera_matrix",
+                "no 3x3 camera_matrix with 9 numbers in the file",
+            )
+        })?;
+    let d = matrix(&D_NAMES).flatten().unwrap_or_default();
+    let get = |n: &str| xml_element(text, n).map(|s| s.trim().to_string());
+    let (width, height) = size_from(get("image_width"), get("image_height"))?;
+    camera_from_k(
+        &k,
+        width,
+        height,
+        distortion_from_opencv(&d, text.contains("fisheye"))?,
+    )
+}

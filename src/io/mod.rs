@@ -1,0 +1,10 @@
+//! Text formats at the edge of the core: parsers take `&str`/`&[u8]`,
+//! writers return `String`. No filesystem here.
+
+pub mod export;
+pub mod export_camera;
+pub mod export_transform;
+pub mod import_camera;
+
+#[cfg(test)]
+mod export_tests;
