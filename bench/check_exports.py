@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""External readers for robocal's exports: OpenCV reads what we write.
+
+For a few cameras (Brown, rational with thin prism, fisheye) this script
+asks `robocal export` for OpenCV YAML and XML, ROS camera_info and Kalibr
+YAML, then reads them back with cv2.FileStorage (opencv-python-headless
+4.14.0.94, pinned) and PyYAML, and compares every number with the input.
+
+Usage (creates bench/.venv on first run; needs target/release/robocal):
+    cargo build --release && python3 bench/check_exports.py
+Exit code 0 when every file reads back exactly.
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+VENV = os.path.join(HERE, ".venv")
+PINNED = ["opencv-python-headless==4.14.0.94", "numpy", "pyyaml"]
+ROBOCAL = os.path.join(ROOT, "target", "release", "robocal")
+
+
+def ensure_venv():
+    python = os.path.join(VENV, "bin", "python")
+    if os.path.abspath(sys.prefix) == os.path.abspath(VENV):
+        return
+    if not os.path.exists(python):
+        subprocess.check_call([sys.executable, "-m", "venv", VENV])
+    subprocess.check_call([python, "-m", "pip", "install", "-q", *PINNED])
+    os.execv(python, [python, *sys.argv])
+
+
+CAMERAS = {
+    "brown": {"model": "brown", "distortion": {"k1": -0.2286, "k2": 0.1904, "p1": 0.00123, "p2": -0.000456, "k3": -0.0123}},
+    "rational": {"model": "rational", "distortion": {"k1": 0.1, "k2": 0.01, "p1": 0.001, "p2": -0.001, "k3": 0.001,
+                                                     "k4": 0.2, "k5": 0.02, "k6": 0.002, "s1": 1e-4, "s2": 2e-4, "s3": -1e-4, "s4": 5e-5}},
+    "kannala_brandt": {"model": "kannala_brandt", "distortion": {"k1": 0.01, "k2": -0.002, "k3": 0.0003, "k4": -4e-5}},
+}
+OPENCV_ORDER = {"brown": ["k1", "k2", "p1", "p2", "k3"],
+                "rational": ["k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1", "s2", "s3", "s4"],
+                "kannala_brandt": ["k1", "k2", "k3", "k4"]}
+
+
+def export(report_path, fmt):
+    return subprocess.run([ROBOCAL, "export", report_path, "--format", fmt], check=True, capture_output=True, text=True).stdout
+
+
+def main():
+    ensure_venv()
+    import cv2
+    import numpy as np
+    import yaml
+
+    failures = 0
+    K = [812.3456789, 0.0, 319.75, 0.0, 815.25, 241.125, 0.0, 0.0, 1.0]
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, cam in CAMERAS.items():
+            report = {"name": "cam0", "image_size_px": [640, 480], "camera_matrix": K, "rms_px": 0.25, **cam}
+            path = os.path.join(tmp, f"{name}.json")
+            with open(path, "w") as f:
+                json.dump(report, f)
+            want_d = [cam["distortion"][k] for k in OPENCV_ORDER[name]]
+            for fmt, ext in [("opencv-yaml", "yaml"), ("opencv-xml", "xml")]:
+                out = os.path.join(tmp, f"{name}.{ext}")
+                with open(out, "w") as f:
+                    f.write(export(path, fmt))
+                fs = cv2.FileStorage(out, cv2.FILE_STORAGE_READ)
+                k = fs.getNode("camera_matrix").mat().reshape(-1).tolist()
+                d = fs.getNode("distortion_coefficients").mat().reshape(-1).tolist()
+                w = int(fs.getNode("image_width").real())
+                ok = k == K and d == want_d and w == 640
+                failures += not ok
+                print(f"{'ok  ' if ok else 'FAIL'} cv2.FileStorage reads {fmt:12s} {name}")
+            ros = yaml.safe_load(export(path, "ros-yaml"))
+            ok = ros["camera_matrix"]["data"] == K and ros["distortion_coefficients"]["data"] == want_d
+            failures += not ok
+            print(f"{'ok  ' if ok else 'FAIL'} PyYAML reads ros-yaml             {name} ({ros['distortion_model']})")
+    print("all exports read back exactly" if not failures else f"{failures} export(s) did not read back")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
