@@ -39,6 +39,7 @@ pub mod image;
 pub mod io;
 pub mod optim;
 pub mod synth;
+pub mod workflows;
 
 #[cfg(feature = "wasm")]
 pub mod wasm;

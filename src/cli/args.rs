@@ -97,6 +97,15 @@ impl Args {
             .map(|(_, v)| v.as_str())
     }
 
+    /// Every value given for `--name`, in order (for repeatable flags).
+    pub fn values(&self, name: &str) -> Vec<&str> {
+        self.values
+            .iter()
+            .filter(|(n, _)| n == name)
+            .map(|(_, v)| v.as_str())
+            .collect()
+    }
+
     /// Whether the switch `--name` was given.
     pub fn switch(&self, name: &str) -> bool {
         self.switches.iter().any(|s| s == name)

@@ -2,6 +2,7 @@
 
 pub mod args;
 mod export;
+mod planar;
 mod serve;
 
 use std::fmt;
@@ -59,6 +60,7 @@ Commands:
   export      convert a calibration report into OpenCV, ROS, Kalibr, mrcal, Halcon,
               MATLAB, URDF, robot-controller and other formats
   info        decode images and print their format and size
+  planar      eye-to-hand calibration at any height (plate corners per height)
 
 Run 'robocal <command> --help' for the options of each command.
 Options common to all commands: --help, --version.";
@@ -85,6 +87,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
         "export" => export::run(rest),
         "info" if wants_help => print_help(INFO_HELP),
         "info" => info(rest),
+        "planar" if wants_help => print_help(planar::HELP),
+        "planar" => planar::run(rest),
         other => Err(CliError::Usage(format!(
             "unknown command '{other}'; run 'robocal --help' for the list"
         ))),
@@ -119,6 +123,24 @@ pub fn write_output(path: Option<&str>, text: &str) -> Result<(), CliError> {
 /// Read a whole file, with an error that names it.
 pub fn read_file(path: &str) -> Result<Vec<u8>, CliError> {
     std::fs::read(path).map_err(|e| CliError::Io(format!("cannot read '{path}': {e}")))
+}
+
+/// Read a whole text file, with an error that names it.
+pub fn read_text(path: &str) -> Result<String, CliError> {
+    String::from_utf8(read_file(path)?)
+        .map_err(|_| CliError::Io(format!("'{path}' is not UTF-8 text")))
+}
+
+/// Print `text` to stdout, or write it to the file given with `-o`.
+pub fn write_output(args: &args::Args, text: &str) -> Result<(), CliError> {
+    match args.value("output") {
+        Some(path) => std::fs::write(path, format!("{text}\n"))
+            .map_err(|e| CliError::Io(format!("cannot write '{path}': {e}"))),
+        None => {
+            println!("{text}");
+            Ok(())
+        }
+    }
 }
 
 const INFO_HELP: &str = "robocal info - decode images and print what they are

@@ -1,0 +1,117 @@
+//! Plain-data requests and reports of the planar workflow, shared by the CLI
+//! (`robocal planar ...`) and the wasm boundary (`planar_fit`,
+//! `planar_solve`): JSON in, JSON out.
+
+use super::linear_fit::LinearFit;
+use super::planar::PlanarMatrix;
+use super::planar_height::{ByParameter, HeightModel, MappedPoint};
+use super::planar_solve::{solve_planar, HeightPoint, PlanarSolveOptions, PlanarSolveReport};
+use crate::error::Result;
+use serde::{Deserialize, Serialize};
+
+/// One per-height matrix, as in the article's Table 4.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HeightMatrix {
+    /// Calibration height, mm.
+    pub height_mm: f64,
+    /// The matrix `robot_from_image` at that height.
+    #[serde(flatten)]
+    pub robot_from_image: PlanarMatrix,
+}
+
+/// A pixel to map at some height.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PredictRequest {
+    /// Height of the plane, mm.
+    pub height_mm: f64,
+    /// Image point, px.
+    pub image_px: [f64; 2],
+}
+
+/// Input of [`planar_fit`]: matrices per height.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanarFitRequest {
+    /// One matrix per calibration height.
+    pub matrices: Vec<HeightMatrix>,
+    /// Optional rejection threshold (standard deviations), see
+    /// [`HeightModel::fit`].
+    #[serde(default)]
+    pub reject_threshold: Option<f64>,
+    /// Pixels to map with the fitted model.
+    #[serde(default)]
+    pub predict: Vec<PredictRequest>,
+}
+
+/// Output of [`planar_fit`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanarFitReport {
+    /// Per parameter: its line against height (`intercept`, `slope`, `r2`,
+    /// `pearson_r`, `adj_r2`, `rss`, plus `n` and standard errors).
+    pub fit: ByParameter<LinearFit>,
+    /// Per parameter: heights rejected before the final fit.
+    pub rejected_heights_mm: ByParameter<Vec<f64>>,
+    /// The mapped pixels, in request order.
+    pub predictions: Vec<MappedPoint>,
+    /// The request, for re-solving.
+    pub input: PlanarFitRequest,
+}
+
+/// Fit every matrix parameter against height and map the requested pixels.
+pub fn planar_fit(request: &PlanarFitRequest) -> Result<PlanarFitReport> {
+    let h: Vec<f64> = request.matrices.iter().map(|m| m.height_mm).collect();
+    let m: Vec<PlanarMatrix> = request
+        .matrices
+        .iter()
+        .map(|m| m.robot_from_image)
+        .collect();
+    let model = HeightModel::fit(&h, &m, request.reject_threshold)?;
+    let predictions = request
+        .predict
+        .iter()
+        .map(|p| model.map(p.height_mm, p.image_px))
+        .collect();
+    Ok(PlanarFitReport {
+        fit: model.fit,
+        rejected_heights_mm: model.rejected_heights_mm,
+        predictions,
+        input: request.clone(),
+    })
+}
+
+/// Input of [`planar_solve`]: point pairs at several heights.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanarSolveRequest {
+    /// The observed points; equal `height_mm` values form one height.
+    pub points: Vec<HeightPoint>,
+    /// Options (transform model, rejection, plate size).
+    #[serde(default)]
+    pub options: PlanarSolveOptions,
+    /// Pixels to map with the fitted model.
+    #[serde(default)]
+    pub predict: Vec<PredictRequest>,
+}
+
+/// Output of [`planar_solve`]: the workflow report plus the mapped pixels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanarSolveResponse {
+    /// Per-height matrices with residuals, the fit against height, pixel density.
+    #[serde(flatten)]
+    pub report: PlanarSolveReport,
+    /// The mapped pixels, in request order.
+    pub predictions: Vec<MappedPoint>,
+}
+
+/// Solve the planar workflow from point pairs and map the requested pixels.
+pub fn planar_solve(request: &PlanarSolveRequest) -> Result<PlanarSolveResponse> {
+    let report = solve_planar(&request.points, &request.options)?;
+    let model = report.model();
+    let predictions = request
+        .predict
+        .iter()
+        .map(|p| model.map(p.height_mm, p.image_px))
+        .collect();
+    Ok(PlanarSolveResponse {
+        report,
+        predictions,
+    })
+}
