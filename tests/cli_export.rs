@@ -4,7 +4,10 @@
 use std::process::Command;
 
 fn robocal(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_robocal")).args(args).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .args(args)
+        .output()
+        .unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -20,29 +23,58 @@ fn export_writes_the_golden_bytes_to_stdout_and_files() {
     let (code, out, err) = robocal(&["export", &camera, "--format", "ros-yaml"]);
     assert_eq!((code, err.as_str()), (0, ""));
     // camera.json is itself an export (name cam0, rms 0.123): exporting it again gives the golden ROS file.
-    assert_eq!(out, std::fs::read_to_string(format!("{FIXTURES}/camera.ros.yaml")).unwrap());
+    assert_eq!(
+        out,
+        std::fs::read_to_string(format!("{FIXTURES}/camera.ros.yaml")).unwrap()
+    );
     let dir = std::env::temp_dir().join(format!("robocal-export-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let target = dir.join("k.txt");
-    let (code, out, _) = robocal(&["export", &camera, "--format=text", "-o", target.to_str().unwrap()]);
+    let (code, out, _) = robocal(&[
+        "export",
+        &camera,
+        "--format=text",
+        "-o",
+        target.to_str().unwrap(),
+    ]);
     assert_eq!((code, out.as_str()), (0, ""));
-    assert_eq!(std::fs::read_to_string(&target).unwrap(), "1000.5 0.0 640.25\n0.0 1001.75 479.5\n0.0 0.0 1.0\n");
+    assert_eq!(
+        std::fs::read_to_string(&target).unwrap(),
+        "1000.5 0.0 640.25\n0.0 1001.75 479.5\n0.0 0.0 1.0\n"
+    );
 }
 
 #[test]
 fn export_errors_say_what_to_fix() {
     let camera = format!("{FIXTURES}/camera.json");
     let (code, _, err) = robocal(&["export", &camera]);
-    assert_eq!((code, err.as_str()), (2, "robocal: export: --format is required (see 'robocal export --help')\n"));
+    assert_eq!(
+        (code, err.as_str()),
+        (
+            2,
+            "robocal: export: --format is required (see 'robocal export --help')\n"
+        )
+    );
     let (code, _, err) = robocal(&["export", "/nonexistent/r.json", "--format", "json"]);
     assert_eq!(code, 1);
-    assert!(err.starts_with("robocal: cannot read '/nonexistent/r.json': "), "{err}");
+    assert!(
+        err.starts_with("robocal: cannot read '/nonexistent/r.json': "),
+        "{err}"
+    );
     let (code, _, err) = robocal(&["export", &camera, "--format", "urdf"]);
     assert_eq!(code, 1);
     assert_eq!(err, "robocal: report: format 'urdf' needs a transform, and this report has none of gripper_from_camera, base_from_camera, right_from_left, base_from_target\n");
     let (code, out, _) = robocal(&["export", "--help"]);
     assert_eq!(code, 0);
-    assert!(out.contains("Examples:\n  robocal export camera.json --format opencv-yaml -o camera.yaml"));
+    assert!(
+        out.contains("Examples:\n  robocal export camera.json --format opencv-yaml -o camera.yaml")
+    );
     let (code, _, err) = robocal(&["frobnicate"]);
-    assert_eq!((code, err.as_str()), (2, "robocal: unknown command 'frobnicate'; run 'robocal --help' for the list\n"));
+    assert_eq!(
+        (code, err.as_str()),
+        (
+            2,
+            "robocal: unknown command 'frobnicate'; run 'robocal --help' for the list\n"
+        )
+    );
 }

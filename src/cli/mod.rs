@@ -125,24 +125,6 @@ pub fn read_file(path: &str) -> Result<Vec<u8>, CliError> {
     std::fs::read(path).map_err(|e| CliError::Io(format!("cannot read '{path}': {e}")))
 }
 
-/// Read a whole text file, with an error that names it.
-pub fn read_text(path: &str) -> Result<String, CliError> {
-    String::from_utf8(read_file(path)?)
-        .map_err(|_| CliError::Io(format!("'{path}' is not UTF-8 text")))
-}
-
-/// Print `text` to stdout, or write it to the file given with `-o`.
-pub fn write_output(args: &args::Args, text: &str) -> Result<(), CliError> {
-    match args.value("output") {
-        Some(path) => std::fs::write(path, format!("{text}\n"))
-            .map_err(|e| CliError::Io(format!("cannot write '{path}': {e}"))),
-        None => {
-            println!("{text}");
-            Ok(())
-        }
-    }
-}
-
 const INFO_HELP: &str = "robocal info - decode images and print what they are
 
 Usage: robocal info IMAGES...

@@ -122,7 +122,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         }
     }
     .map_err(|e| CliError::Io(format!("cannot encode the result as JSON: {e}")))?;
-    write_output(&args, &json)
+    write_output(args.value("output"), &format!("{json}\n"))
 }
 
 /// Prefix a parse error with the file name.
