@@ -1,12 +1,30 @@
 //! Text formats at the edge of the core: parsers take `&str`/`&[u8]`,
 //! writers return `String`. No filesystem here.
+//!
+//! Robot poses: [`parse_poses`] (format named, from a header, or unique by
+//! value count), [`parse_pose_candidates`] (every plausible reading, ranked),
+//! [`format_poses`] (the inverse). See [`PoseFormat`] for each vendor's
+//! convention and formula.
 
 pub mod csv_table;
 pub mod export;
 pub mod export_camera;
 pub mod export_transform;
 pub mod import_camera;
+mod pose_candidates;
+mod pose_formats;
+mod pose_json;
+mod pose_table;
+mod pose_writer;
+mod poses;
 pub mod workflow_csv;
 
 #[cfg(test)]
 mod export_tests;
+#[cfg(test)]
+mod pose_tests;
+
+pub use pose_candidates::{parse_pose_candidates, Candidate};
+pub use pose_formats::{AngleUnit, LengthUnit, PoseFormat, QUATERNION_NORM_TOLERANCE};
+pub use pose_writer::format_poses;
+pub use poses::{parse_poses, ParsedPoses, PoseDirection, PoseFileOptions, RobotPose};
