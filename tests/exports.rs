@@ -15,7 +15,7 @@ const CAMERA_REPORT: &str = r#"{
   "distortion": {"k1": -0.125, "k2": 0.0625, "p1": 0.001, "p2": -0.0005, "k3": 0.0},
   "rms_px": 0.123,
   "gripper_from_camera": {
-    "matrix_row_major": [0.0, -1.0, 0.0, 0.05, 1.0, 0.0, 0.0, -0.02, 0.0, 0.0, 1.0, 0.1, 0.0, 0.0, 0.0, 1.0]
+    "matrix_row_major": [[0.0, -1.0, 0.0, 0.05], [1.0, 0.0, 0.0, -0.02], [0.0, 0.0, 1.0, 0.1], [0.0, 0.0, 0.0, 1.0]]
   }
 }"#;
 
@@ -101,6 +101,23 @@ fn bad_requests_say_what_to_fix() {
         .unwrap_err()
         .to_string();
     assert_eq!(err, "report: format 'urdf' needs a transform, and this report has none of gripper_from_camera, base_from_camera, right_from_left, base_from_target");
+    // Flat 16-number matrices are read too.
+    let flat = r#"{"base_from_camera": {"matrix_row_major": [1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]}}"#;
+    assert_eq!(
+        export(flat, "xyz-quat-xyzw", None).unwrap(),
+        "# base_from_camera: x y z (m) qx qy qz qw\n0.5 0.0 0.0 0.0 0.0 0.0 1.0\n"
+    );
+    let err = export(
+        r#"{"base_from_camera": {"matrix_row_major": [1, 2]}}"#,
+        "urdf",
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert_eq!(
+        err,
+        "base_from_camera: expected matrix_row_major with 4 rows of 4 numbers"
+    );
     let err = export("{", "json", None).unwrap_err().to_string();
     assert!(
         err.starts_with("line 1, column 1: the report is not valid JSON"),

@@ -99,15 +99,24 @@ pub fn export(report_json: &str, format: &str, transform: Option<&str>) -> Resul
     ))
 }
 
-/// Read the transform `name` (`{matrix_row_major: [16 numbers]}`) from a report.
+/// Read the transform `name` (`{matrix_row_major: 4 rows of 4, or 16
+/// numbers}`) from a report.
 pub fn pose_from_report(report: &serde_json::Value, name: &str) -> Result<Pose> {
     let entry = report
         .get(name)
         .ok_or_else(|| Error::invalid("transform", format!("the report has no '{name}'")))?;
-    let m: Vec<f64> = entry["matrix_row_major"]
+    let rows = entry["matrix_row_major"]
         .as_array()
-        .map(|a| a.iter().filter_map(|v| v.as_f64()).collect())
-        .filter(|m: &Vec<f64>| m.len() == 16)
-        .ok_or_else(|| Error::invalid(name, "expected matrix_row_major with 16 numbers"))?;
+        .cloned()
+        .unwrap_or_default();
+    // Nested rows are flattened; a flat list stays as it is.
+    let values: Option<Vec<f64>> = rows
+        .iter()
+        .flat_map(|x| x.as_array().cloned().unwrap_or_else(|| vec![x.clone()]))
+        .map(|x| x.as_f64())
+        .collect();
+    let m = values.filter(|m| m.len() == 16).ok_or_else(|| {
+        Error::invalid(name, "expected matrix_row_major with 4 rows of 4 numbers")
+    })?;
     pose_from_matrix4(&Matrix4::from_row_slice(&m))
 }

@@ -283,13 +283,13 @@ pub fn export_transform(pose: &Pose, names: &FrameNames, format: TransformFormat
     }
 }
 
-/// The transform as `{matrix_row_major, translation_m, quaternion_xyzw}`,
-/// the JSON shape every report uses.
+/// The transform as `{matrix_row_major (4 rows of 4), translation_m,
+/// quaternion_xyzw}`, the JSON shape every report uses.
 pub fn transform_json(pose: &Pose) -> serde_json::Value {
     let m = matrix4_from_pose(pose);
     let t = pose.translation.vector;
     serde_json::json!({
-        "matrix_row_major": (0..16).map(|i| m[(i / 4, i % 4)]).collect::<Vec<f64>>(),
+        "matrix_row_major": (0..4).map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)], m[(r, 3)]]).collect::<Vec<[f64; 4]>>(),
         "translation_m": [t.x, t.y, t.z],
         "quaternion_xyzw": quaternion_xyzw_from_rotation(&pose.rotation),
     })
