@@ -32,6 +32,7 @@
 //!   board frame has z = 0 on the board plane.
 #![deny(missing_docs)]
 
+pub mod calib;
 pub mod camera;
 pub mod error;
 pub mod geometry;

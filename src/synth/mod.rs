@@ -3,5 +3,7 @@
 //! every platform (native and wasm).
 
 pub mod rng;
+pub mod scene;
 
 pub use rng::Rng;
+pub use scene::Scene;

@@ -1,0 +1,348 @@
+//! The calibration report: parameters, residuals per view, parameter
+//! uncertainty and correlation, a projection-uncertainty grid and warnings.
+
+use super::refine::{pose_from_block, CalibProblem};
+use super::CalibrationOptions;
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::geometry::{matrix4_from_pose, quaternion_xyzw_from_rotation, Pose};
+use crate::optim::{BlockProblem, LmResult, Termination};
+use nalgebra::{DMatrix, Point2, Point3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Fewer views than this draw a warning.
+const RECOMMENDED_VIEWS: usize = 10;
+/// A largest target tilt below this (degrees) draws a warning: the focal
+/// length is then poorly separated from the distance.
+const MIN_TILT_DEG: f64 = 15.0;
+/// Parameter correlations above this draw a warning.
+const STRONG_CORRELATION: f64 = 0.95;
+/// Grid of the projection-uncertainty map (columns, rows).
+const UNCERTAINTY_GRID: (usize, usize) = (9, 7);
+
+/// A point dropped by outlier rejection.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Outlier {
+    /// Index of the point in its view.
+    pub index: usize,
+    /// Its residual norm when it was dropped, px.
+    pub residual_px: f64,
+    /// Why it was dropped.
+    pub reason: String,
+}
+
+/// A pose in the report: 4x4 matrix, translation and quaternion.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PoseReport {
+    /// Homogeneous 4x4 matrix, rows.
+    pub matrix_row_major: [[f64; 4]; 4],
+    /// Translation, metres.
+    pub translation_m: [f64; 3],
+    /// Rotation as a unit quaternion, x y z w.
+    pub quaternion_xyzw: [f64; 4],
+}
+
+/// Per-view results.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ViewReport {
+    /// The view's name.
+    pub name: String,
+    /// RMS of the residual norms of the view's used points, px.
+    pub rms_px: f64,
+    /// Points used.
+    pub n_points: usize,
+    /// Pose of the target in the camera frame.
+    pub camera_from_target: PoseReport,
+    /// Points dropped as outliers.
+    pub outliers: Vec<Outlier>,
+}
+
+/// Correlation matrix of the camera parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Correlation {
+    /// Parameter names (rows and columns).
+    pub names: Vec<String>,
+    /// Correlation coefficients, rows; 0 for held parameters.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+/// How far a projected point may move (1 sigma, worst direction, px) from
+/// the uncertainty of the camera parameters, on a grid over the image, for
+/// points at the reference depth (mrcal's "projection uncertainty", here
+/// from the intrinsics covariance with the point fixed in the camera frame).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ProjectionUncertainty {
+    /// Distance of the points from the camera, metres (median target distance).
+    pub reference_depth_m: f64,
+    /// Grid pixel x coordinates.
+    pub x_px: Vec<f64>,
+    /// Grid pixel y coordinates.
+    pub y_px: Vec<f64>,
+    /// Per row (y), per column (x): 1-sigma px; `None` where the camera cannot unproject.
+    pub std_px: Vec<Vec<Option<f64>>>,
+    /// The largest value in the grid, px.
+    pub max_std_px: f64,
+}
+
+/// Result of [`super::calibrate`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CameraCalibration {
+    /// robocal version that produced the report.
+    pub crate_version: String,
+    /// Image width and height, px.
+    pub image_size_px: [u32; 2],
+    /// Lens model name.
+    pub model: String,
+    /// The calibrated camera.
+    pub camera: Camera,
+    /// Camera matrix, rows.
+    pub camera_matrix: [[f64; 3]; 3],
+    /// Named distortion coefficients.
+    pub distortion: BTreeMap<String, f64>,
+    /// sqrt(sum of squared residual norms / number of points), px (OpenCV's RMS).
+    pub rms_px: f64,
+    /// Standard deviation of every camera parameter (0 if held), from the
+    /// covariance scaled by the residual variance.
+    pub std: BTreeMap<String, f64>,
+    /// Per-view results.
+    pub views: Vec<ViewReport>,
+    /// Parameter correlations.
+    pub correlation: Correlation,
+    /// Projection uncertainty over the image.
+    pub projection_uncertainty: ProjectionUncertainty,
+    /// Things the user should know (coverage, tilt, correlations, ...).
+    pub warnings: Vec<String>,
+    /// Solver iterations in the last round.
+    pub iterations: usize,
+    /// Why the solver stopped.
+    pub termination: Termination,
+    /// Points used in total.
+    pub n_points: usize,
+    /// The options used.
+    pub options: CalibrationOptions,
+}
+
+pub(crate) fn build_report(
+    problem: &CalibProblem,
+    result: &LmResult,
+    outliers: Vec<Vec<Outlier>>,
+    size: (u32, u32),
+    options: &CalibrationOptions,
+) -> Result<CameraCalibration> {
+    let camera = problem.camera(&result.params.global)?;
+    let names: Vec<String> = camera.param_names().iter().map(|s| s.to_string()).collect();
+    let covariance = parameter_covariance(result, problem.aspect)?;
+    let std: BTreeMap<String, f64> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.clone(), covariance[(i, i)].max(0.0).sqrt()))
+        .collect();
+    let correlation = correlation(&names, &covariance);
+    let blocks = problem.residuals_and_jacobian(&result.params, false)?;
+    let mut squared = vec![0.0; problem.views.len()];
+    let mut counts = vec![0usize; problem.views.len()];
+    for b in &blocks {
+        if let Some(v) = b.block {
+            squared[v] += b.residuals.norm_squared();
+            counts[v] += 1;
+        }
+    }
+    let n_points: usize = counts.iter().sum();
+    let poses: Vec<Pose> = result
+        .params
+        .blocks
+        .iter()
+        .map(|b| pose_from_block(b))
+        .collect();
+    let views = problem
+        .views
+        .iter()
+        .enumerate()
+        .zip(outliers)
+        .map(|((v, view), outliers)| ViewReport {
+            name: view.name.clone(),
+            rms_px: (squared[v] / counts[v].max(1) as f64).sqrt(),
+            n_points: counts[v],
+            camera_from_target: pose_report(&poses[v]),
+            outliers,
+        })
+        .collect();
+    let mut depths: Vec<f64> = poses.iter().map(|p| p.translation.vector.norm()).collect();
+    depths.sort_by(f64::total_cmp);
+    let depth = depths.get(depths.len() / 2).copied().unwrap_or(1.0);
+    let k = camera.camera_matrix();
+    Ok(CameraCalibration {
+        crate_version: crate::VERSION.to_string(),
+        image_size_px: [size.0, size.1],
+        model: camera.distortion.model_name().to_string(),
+        camera_matrix: [0, 1, 2].map(|r| [k[(r, 0)], k[(r, 1)], k[(r, 2)]]),
+        distortion: camera
+            .distortion
+            .coefficient_names()
+            .iter()
+            .zip(camera.distortion.coefficients())
+            .map(|(n, v)| (n.to_string(), v))
+            .collect(),
+        rms_px: (squared.iter().sum::<f64>() / n_points.max(1) as f64).sqrt(),
+        std,
+        projection_uncertainty: projection_uncertainty(&camera, &covariance, depth),
+        warnings: warnings(problem, &poses, &correlation),
+        views,
+        correlation,
+        iterations: result.iterations,
+        termination: result.termination,
+        n_points,
+        options: options.clone(),
+        camera,
+    })
+}
+
+/// The covariance of the camera parameters, with fy's row and column
+/// derived from fx's when the aspect ratio is fixed (fy = a fx).
+fn parameter_covariance(result: &LmResult, aspect: Option<f64>) -> Result<DMatrix<f64>> {
+    let mut c = result.covariance_global.clone().ok_or_else(|| {
+        Error::degenerate(
+            "the camera parameters are not all determined by the views (singular normal equations)",
+        )
+    })?;
+    if let Some(a) = aspect {
+        let n = c.nrows();
+        let mut t = DMatrix::<f64>::identity(n, n);
+        t[(1, 0)] = a;
+        t[(1, 1)] = 0.0;
+        c = &t * c * t.transpose();
+    }
+    Ok(c)
+}
+
+fn correlation(names: &[String], c: &DMatrix<f64>) -> Correlation {
+    let n = names.len();
+    let matrix = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    let d = (c[(i, i)] * c[(j, j)]).sqrt();
+                    if d > 0.0 {
+                        c[(i, j)] / d
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    Correlation {
+        names: names.to_vec(),
+        matrix,
+    }
+}
+
+fn pose_report(pose: &Pose) -> PoseReport {
+    let m = matrix4_from_pose(pose);
+    let t = pose.translation.vector;
+    PoseReport {
+        matrix_row_major: [0, 1, 2, 3].map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)], m[(r, 3)]]),
+        translation_m: [t.x, t.y, t.z],
+        quaternion_xyzw: quaternion_xyzw_from_rotation(&pose.rotation),
+    }
+}
+
+fn projection_uncertainty(camera: &Camera, c: &DMatrix<f64>, depth: f64) -> ProjectionUncertainty {
+    let (cols, rows) = UNCERTAINTY_GRID;
+    let at = |i: usize, n: usize, size: u32| i as f64 * (size as f64 - 1.0) / (n - 1) as f64;
+    let x_px: Vec<f64> = (0..cols).map(|i| at(i, cols, camera.width)).collect();
+    let y_px: Vec<f64> = (0..rows).map(|i| at(i, rows, camera.height)).collect();
+    let std_at = |x: f64, y: f64| -> Option<f64> {
+        let ray = camera.unproject(&Point2::new(x, y)).ok()?;
+        let (_, _, j) = camera
+            .project_with_jacobians(&Point3::from(ray * depth))
+            .ok()?;
+        let s = &j * c * j.transpose();
+        Some(s.symmetric_eigenvalues().max().max(0.0).sqrt())
+    };
+    let std_px: Vec<Vec<Option<f64>>> = y_px
+        .iter()
+        .map(|&y| x_px.iter().map(|&x| std_at(x, y)).collect())
+        .collect();
+    let max_std_px = std_px
+        .iter()
+        .flatten()
+        .flatten()
+        .fold(0.0, |a: f64, &b| a.max(b));
+    ProjectionUncertainty {
+        reference_depth_m: depth,
+        x_px,
+        y_px,
+        std_px,
+        max_std_px,
+    }
+}
+
+fn warnings(problem: &CalibProblem, poses: &[Pose], correlation: &Correlation) -> Vec<String> {
+    let mut out = vec![];
+    let n_views = problem.views.len();
+    if n_views < RECOMMENDED_VIEWS {
+        out.push(format!(
+            "only {n_views} views: {RECOMMENDED_VIEWS} or more from varied angles are recommended"
+        ));
+    }
+    // Image corners: the outer thirds of the image in both directions.
+    let (w, h) = (
+        problem.template.width as f64,
+        problem.template.height as f64,
+    );
+    let mut corner_hits = [false; 4];
+    for (view, used) in problem.views.iter().zip(problem.used) {
+        for (p, &u) in view.image_px.iter().zip(used) {
+            let (left, right) = (p.x < w / 3.0, p.x > 2.0 * w / 3.0);
+            let (top, bottom) = (p.y < h / 3.0, p.y > 2.0 * h / 3.0);
+            for (i, hit) in [left && top, right && top, left && bottom, right && bottom]
+                .iter()
+                .enumerate()
+            {
+                corner_hits[i] |= u && *hit;
+            }
+        }
+    }
+    for (name, hit) in ["top-left", "top-right", "bottom-left", "bottom-right"]
+        .iter()
+        .zip(corner_hits)
+    {
+        if !hit {
+            out.push(format!("no target points in the {name} corner of the image: the distortion there is extrapolated"));
+        }
+    }
+    let max_tilt = poses
+        .iter()
+        .map(|p| {
+            (p.rotation * Vector3::z())
+                .z
+                .abs()
+                .clamp(0.0, 1.0)
+                .acos()
+                .to_degrees()
+        })
+        .fold(0.0, f64::max);
+    if max_tilt < MIN_TILT_DEG {
+        out.push(format!(
+            "the target is tilted at most {max_tilt:.1} deg from facing the camera: tilt it 20-45 deg in some views to pin down the focal length"
+        ));
+    }
+    // fx and fy move together by construction (square-ish pixels); their
+    // correlation says nothing about a degeneracy, so it is not reported.
+    let n = correlation.names.len();
+    for i in 0..n {
+        for j in (i + 1)..n {
+            let r = correlation.matrix[i][j];
+            let pair = (correlation.names[i].as_str(), correlation.names[j].as_str());
+            if r.abs() > STRONG_CORRELATION && pair != ("fx", "fy") {
+                out.push(format!(
+                    "{} and {} are strongly correlated ({r:.3}): the views do not separate them",
+                    pair.0, pair.1
+                ));
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,308 @@
+//! Zhang's planar calibration, end to end: validate, homographies,
+//! closed-form intrinsics, poses, bundle adjustment with optional iterative
+//! outlier rejection, report.
+
+use super::closed_form::{intrinsics_from_homographies, pose_from_homography};
+use super::homography::homography;
+use super::refine::{block_from_pose, CalibProblem};
+use super::report::{build_report, Outlier};
+use super::{CameraCalibration, View};
+use crate::camera::{Camera, Distortion, N_PINHOLE_PARAMS};
+use crate::error::{Error, Result};
+use crate::optim::{solve, BlockParams, LmOptions, Loss};
+use nalgebra::{Matrix3, Point2};
+use serde::{Deserialize, Serialize};
+
+/// Points per view below which a view cannot give a homography.
+const MIN_POINTS_PER_VIEW: usize = 4;
+/// |z| above which a target point is not on the z = 0 plane, metres.
+const PLANE_TOLERANCE_M: f64 = 1e-9;
+/// Ratio of the median residual norm to sigma for 2-D Gaussian residuals
+/// (median of a Rayleigh distribution: sqrt(2 ln 2)).
+const RAYLEIGH_MEDIAN: f64 = 1.177_410_022_515_474_6;
+
+/// What to estimate and how. Defaults: Brown model (k1 k2 p1 p2 k3 from 0),
+/// zero skew, nothing else fixed, squared loss, no outlier rejection.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CalibrationOptions {
+    /// The lens model; its coefficients are the initial values (and the
+    /// values of fixed coefficients).
+    pub model: Distortion,
+    /// Start from this camera instead of the closed-form solution (its
+    /// lens model is replaced by `model` if they differ).
+    pub initial_camera: Option<Camera>,
+    /// Hold cx, cy at the initial value (the image centre without an initial camera).
+    pub fix_principal_point: bool,
+    /// Hold fy / fx at the initial ratio.
+    pub fix_aspect_ratio: bool,
+    /// Hold the skew at 0 (default true; OpenCV has no skew).
+    pub zero_skew: bool,
+    /// Coefficient names (of `model`) held at their value in `model`.
+    pub fixed_coefficients: Vec<String>,
+    /// Robust loss on each point's residual norm, px.
+    pub loss: Loss,
+    /// With `Some(k)`, points whose residual exceeds k robust sigmas are
+    /// dropped and the problem re-solved, until none is dropped.
+    pub outlier_sigma: Option<f64>,
+    /// Most rejection rounds (default 5).
+    pub max_outlier_rounds: usize,
+    /// Most solver iterations per round (default 200).
+    pub max_iterations: usize,
+}
+
+impl Default for CalibrationOptions {
+    fn default() -> Self {
+        CalibrationOptions {
+            model: Distortion::Brown {
+                k1: 0.0,
+                k2: 0.0,
+                k3: 0.0,
+                p1: 0.0,
+                p2: 0.0,
+            },
+            initial_camera: None,
+            fix_principal_point: false,
+            fix_aspect_ratio: false,
+            zero_skew: true,
+            fixed_coefficients: vec![],
+            loss: Loss::Squared,
+            outlier_sigma: None,
+            max_outlier_rounds: 5,
+            max_iterations: 200,
+        }
+    }
+}
+
+/// Calibrate a camera from planar-target views of one image size.
+pub fn calibrate(
+    views: &[View],
+    image_size_px: (u32, u32),
+    options: &CalibrationOptions,
+) -> Result<CameraCalibration> {
+    // 1. Validate the input.
+    validate(views, image_size_px, options)?;
+    // 2. Homographies and the closed-form start (or the given guess).
+    let homographies: Vec<Matrix3<f64>> = views
+        .iter()
+        .map(|v| {
+            let plane: Vec<Point2<f64>> = v.object_m.iter().map(|p| p.xy()).collect();
+            homography(&plane, &v.image_px)
+        })
+        .collect::<Result<_>>()?;
+    let initial = initial_camera(&homographies, image_size_px, options)?;
+    // 3. Poses from the homographies.
+    let k = initial.camera_matrix();
+    let poses = homographies
+        .iter()
+        .map(|h| pose_from_homography(&k, h).map(|p| block_from_pose(&p)))
+        .collect::<Result<Vec<_>>>()?;
+    // 4. Bundle adjustment, with outlier rounds.
+    let all_used: Vec<Vec<bool>> = views.iter().map(|v| vec![true; v.object_m.len()]).collect();
+    let mut used = all_used.clone();
+    let mut params = BlockParams {
+        global: initial.params(),
+        blocks: poses,
+    };
+    let lm_options = lm_options(&initial, options)?;
+    let aspect = options.fix_aspect_ratio.then(|| initial.fy / initial.fx);
+    let mut rounds = 0;
+    loop {
+        let problem = CalibProblem {
+            template: &initial,
+            views,
+            used: &used,
+            aspect,
+        };
+        let result = solve(&problem, &params, &lm_options)?;
+        let Some(k) = options.outlier_sigma else {
+            return build_report(
+                &problem,
+                &result,
+                vec![vec![]; views.len()],
+                image_size_px,
+                options,
+            );
+        };
+        // Classify every point, dropped ones included, so that inliers
+        // pulled off by an outlier in an early round come back.
+        let every = CalibProblem {
+            used: &all_used,
+            ..problem
+        };
+        let (next_used, outliers) = classify(&every, &result.params, &used, k)?;
+        if next_used == used || rounds >= options.max_outlier_rounds {
+            // 5. The report.
+            return build_report(&problem, &result, outliers, image_size_px, options);
+        }
+        params = result.params;
+        used = next_used;
+        rounds += 1;
+    }
+}
+
+fn validate(views: &[View], image_size_px: (u32, u32), options: &CalibrationOptions) -> Result<()> {
+    if image_size_px.0 == 0 || image_size_px.1 == 0 {
+        return Err(Error::invalid(
+            "image_size_px",
+            format!(
+                "must be positive, got {}x{}",
+                image_size_px.0, image_size_px.1
+            ),
+        ));
+    }
+    let required = if options.zero_skew || options.initial_camera.is_some() {
+        2
+    } else {
+        3
+    };
+    if views.len() < required {
+        return Err(Error::too_few("views", required, views.len()));
+    }
+    for v in views {
+        if v.object_m.len() != v.image_px.len() {
+            return Err(Error::invalid(
+                format!("views[{}].image_px", v.name),
+                format!(
+                    "{} target points but {} image points",
+                    v.object_m.len(),
+                    v.image_px.len()
+                ),
+            ));
+        }
+        if v.object_m.len() < MIN_POINTS_PER_VIEW {
+            return Err(Error::too_few(
+                format!("points in view {}", v.name),
+                MIN_POINTS_PER_VIEW,
+                v.object_m.len(),
+            ));
+        }
+        if let Some(p) = v
+            .object_m
+            .iter()
+            .find(|p| p.z.abs() > PLANE_TOLERANCE_M || !p.iter().all(|x| x.is_finite()))
+        {
+            return Err(Error::invalid(
+                format!("views[{}].object_m", v.name),
+                format!(
+                    "planar calibration needs target points on z = 0, got z = {}",
+                    p.z
+                ),
+            ));
+        }
+    }
+    for name in &options.fixed_coefficients {
+        if !options.model.coefficient_names().contains(&name.as_str()) {
+            return Err(Error::invalid(
+                "fixed_coefficients",
+                format!(
+                    "the {} model has no coefficient '{name}' (it has {:?})",
+                    options.model.model_name(),
+                    options.model.coefficient_names()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn initial_camera(
+    homographies: &[Matrix3<f64>],
+    size: (u32, u32),
+    options: &CalibrationOptions,
+) -> Result<Camera> {
+    if let Some(c) = &options.initial_camera {
+        return Ok(Camera {
+            width: size.0,
+            height: size.1,
+            distortion: options.model.clone(),
+            ..c.clone()
+        });
+    }
+    let k = intrinsics_from_homographies(homographies, size, options.zero_skew)?;
+    let (mut cx, mut cy) = (k[(0, 2)], k[(1, 2)]);
+    if options.fix_principal_point {
+        cx = 0.5 * (size.0 as f64 - 1.0);
+        cy = 0.5 * (size.1 as f64 - 1.0);
+    }
+    let skew = if options.zero_skew { 0.0 } else { k[(0, 1)] };
+    Ok(Camera {
+        fx: k[(0, 0)],
+        fy: k[(1, 1)],
+        cx,
+        cy,
+        skew,
+        width: size.0,
+        height: size.1,
+        distortion: options.model.clone(),
+    })
+}
+
+fn lm_options(initial: &Camera, options: &CalibrationOptions) -> Result<LmOptions> {
+    let names = initial.param_names();
+    let mut fixed = vec![false; names.len()];
+    fixed[1] = options.fix_aspect_ratio;
+    fixed[2] = options.fix_principal_point;
+    fixed[3] = options.fix_principal_point;
+    fixed[4] = options.zero_skew;
+    for (i, name) in names.iter().enumerate().skip(N_PINHOLE_PARAMS) {
+        fixed[i] = options.fixed_coefficients.iter().any(|f| f == name);
+    }
+    Ok(LmOptions {
+        max_iterations: options.max_iterations,
+        loss: options.loss,
+        fixed_global: fixed,
+        ..LmOptions::default()
+    })
+}
+
+/// The points within k robust sigmas (sigma from the median residual of
+/// the currently used points), and an [`Outlier`] record for each point the
+/// current mask leaves out.
+fn classify(
+    every: &CalibProblem,
+    params: &BlockParams,
+    used: &[Vec<bool>],
+    k: f64,
+) -> Result<(Vec<Vec<bool>>, Vec<Vec<Outlier>>)> {
+    let blocks = crate::optim::BlockProblem::residuals_and_jacobian(every, params, false)?;
+    let norms: Vec<f64> = blocks.iter().map(|b| b.residuals.norm()).collect();
+    let mut used_norms: Vec<f64> = norms
+        .iter()
+        .zip(used.iter().flatten())
+        .filter(|(_, &u)| u)
+        .map(|(r, _)| *r)
+        .collect();
+    used_norms.sort_by(f64::total_cmp);
+    let sigma = used_norms.get(used_norms.len() / 2).copied().unwrap_or(0.0) / RAYLEIGH_MEDIAN;
+    let threshold = k * sigma;
+    let mut next = Vec::with_capacity(used.len());
+    let mut outliers = Vec::with_capacity(used.len());
+    let mut it = norms.iter().zip(used.iter().flatten());
+    for view in used {
+        let mut view_next = Vec::with_capacity(view.len());
+        let mut view_outliers = vec![];
+        for index in 0..view.len() {
+            let Some((&r, &was_used)) = it.next() else {
+                break;
+            };
+            // Noise-free data has sigma 0: keep everything then.
+            view_next.push(threshold == 0.0 || r <= threshold);
+            if !was_used {
+                let reason = if r > threshold {
+                    format!("residual {r:.3} px > {k} x robust sigma {sigma:.3} px")
+                } else {
+                    format!("dropped in an earlier round; now {r:.3} px (rejection round limit reached)")
+                };
+                view_outliers.push(Outlier {
+                    index,
+                    residual_px: r,
+                    reason,
+                });
+            }
+        }
+        next.push(view_next);
+        outliers.push(view_outliers);
+    }
+    Ok((next, outliers))
+}
