@@ -11,7 +11,7 @@ const CAMERA_REPORT: &str = r#"{
   "name": "cam0",
   "image_size_px": [1280, 960],
   "model": "brown",
-  "camera_matrix": [1000.5, 0.0, 640.25, 0.0, 1001.75, 479.5, 0.0, 0.0, 1.0],
+  "camera_matrix": [[1000.5, 0.0, 640.25], [0.0, 1001.75, 479.5], [0.0, 0.0, 1.0]],
   "distortion": {"k1": -0.125, "k2": 0.0625, "p1": 0.001, "p2": -0.0005, "k3": 0.0},
   "rms_px": 0.123,
   "gripper_from_camera": {

@@ -105,18 +105,10 @@ pub fn pose_from_report(report: &serde_json::Value, name: &str) -> Result<Pose> 
     let entry = report
         .get(name)
         .ok_or_else(|| Error::invalid("transform", format!("the report has no '{name}'")))?;
-    let rows = entry["matrix_row_major"]
-        .as_array()
-        .cloned()
-        .unwrap_or_default();
-    // Nested rows are flattened; a flat list stays as it is.
-    let values: Option<Vec<f64>> = rows
-        .iter()
-        .flat_map(|x| x.as_array().cloned().unwrap_or_else(|| vec![x.clone()]))
-        .map(|x| x.as_f64())
-        .collect();
-    let m = values.filter(|m| m.len() == 16).ok_or_else(|| {
-        Error::invalid(name, "expected matrix_row_major with 4 rows of 4 numbers")
-    })?;
+    let m = super::json_matrix_numbers(&entry["matrix_row_major"])
+        .filter(|m| m.len() == 16)
+        .ok_or_else(|| {
+            Error::invalid(name, "expected matrix_row_major with 4 rows of 4 numbers")
+        })?;
     pose_from_matrix4(&Matrix4::from_row_slice(&m))
 }

@@ -211,7 +211,7 @@ fn json(c: &Camera, info: &CameraExportInfo) -> Result<String> {
         "name": info.name,
         "image_size_px": [c.width, c.height],
         "model": c.distortion.model_name(),
-        "camera_matrix": k_row_major(c),
+        "camera_matrix": k_row_major(c).chunks(3).collect::<Vec<_>>(),
         "distortion": distortion,
         "rms_px": info.rms_px,
     });

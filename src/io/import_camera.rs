@@ -58,11 +58,9 @@ fn from_json(text: &str) -> Result<Camera> {
         dim(0).ok_or_else(|| missing("image_size_px"))?,
         dim(1).ok_or_else(|| missing("image_size_px"))?,
     );
-    let k: Vec<f64> = v["camera_matrix"]
-        .as_array()
-        .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
-        .filter(|k: &Vec<f64>| k.len() == 9)
-        .ok_or_else(|| missing("camera_matrix (9 numbers, row-major)"))?;
+    let k: Vec<f64> = super::json_matrix_numbers(&v["camera_matrix"])
+        .filter(|k| k.len() == 9)
+        .ok_or_else(|| missing("camera_matrix (3 rows of 3 numbers)"))?;
     let model = v["model"].as_str().ok_or_else(|| missing("model"))?;
     let template = distortion_template(model)?;
     let coeffs = template

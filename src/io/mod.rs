@@ -28,3 +28,14 @@ pub use pose_candidates::{parse_pose_candidates, Candidate};
 pub use pose_formats::{AngleUnit, LengthUnit, PoseFormat, QUATERNION_NORM_TOLERANCE};
 pub use pose_writer::format_poses;
 pub use poses::{parse_poses, ParsedPoses, PoseDirection, PoseFileOptions, RobotPose};
+
+/// The numbers of a JSON matrix given as rows of numbers (`[[..], [..]]`)
+/// or as one flat list, row-major; `None` if anything is not a number.
+pub(crate) fn json_matrix_numbers(value: &serde_json::Value) -> Option<Vec<f64>> {
+    let items = value.as_array()?;
+    items
+        .iter()
+        .flat_map(|x| x.as_array().cloned().unwrap_or_else(|| vec![x.clone()]))
+        .map(|x| x.as_f64())
+        .collect()
+}
