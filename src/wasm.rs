@@ -133,3 +133,11 @@ pub fn export_report(report_json: &str, format: &str, transform: &str) -> Result
 pub fn export_formats() -> String {
     serde_json::to_string(&crate::io::export::format_names()).unwrap_or_else(|_| "[]".into())
 }
+
+/// Read a robot pose file: `{"parsed": {...} | null, "ambiguity": null |
+/// "why", "candidates": [...]}` (see `robocal::io::poses_api`).
+/// `options_json` may be empty or `{"format", "length_unit", "angle_unit", "direction"}`.
+#[wasm_bindgen]
+pub fn read_robot_poses(text: &str, options_json: &str) -> Result<String, JsError> {
+    crate::io::poses_api::read_poses_json(text, options_json).map_err(js_error)
+}

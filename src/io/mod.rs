@@ -17,6 +17,7 @@ mod pose_json;
 mod pose_table;
 mod pose_writer;
 mod poses;
+pub mod poses_api;
 pub mod workflow_csv;
 
 #[cfg(test)]
