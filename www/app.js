@@ -1,18 +1,26 @@
 // The page: bootstraps the engine (a Web Worker running the Rust core), the
 // session store (IndexedDB) and the steps, and routes between steps by hash.
+// A URL whose fragment is #share=... opens a read-only results page.
 import { Engine } from './engine.js';
-import { Store } from './store.js';
+import { Store, defaultSession } from './store.js';
 import { $ } from './lib/dom.js';
 import { initTarget } from './views/target.js';
 import { ImagesView } from './views/images.js';
+import { CameraView } from './views/camera.js';
+import { RobotView } from './views/robot.js';
+import { ExportView } from './views/export.js';
+import { ShareView, sharedFragment, decodeShare } from './views/share.js';
 
 const engine = new Engine();
 const store = new Store();
+const READONLY_STEPS = ['camera', 'export', 'share'];
 
-function showStep() {
+function showStep(readonly) {
   const links = [...document.querySelectorAll('#step-list a')];
-  const wanted = (location.hash || '#images').slice(1);
-  const step = links.some((a) => a.dataset.step === wanted) ? wanted : 'images';
+  for (const a of links) a.parentElement.hidden = readonly && !READONLY_STEPS.includes(a.dataset.step);
+  const allowed = links.filter((a) => !a.parentElement.hidden).map((a) => a.dataset.step);
+  const wanted = location.hash.slice(1);
+  const step = allowed.includes(wanted) ? wanted : readonly ? 'camera' : 'images';
   for (const a of links) {
     if (a.dataset.step === step) a.setAttribute('aria-current', 'step');
     else a.removeAttribute('aria-current');
@@ -20,27 +28,66 @@ function showStep() {
   for (const s of document.querySelectorAll('section.step')) s.hidden = s.id !== `step-${step}`;
 }
 
+async function engineVersion() {
+  try {
+    const { version } = await engine.call('version');
+    $('engine-status').textContent = `Calibration engine ready (robocal ${version}).`;
+    $('engine-status').classList.add('ready');
+    $('version').textContent = `robocal ${version}`;
+    return version;
+  } catch (err) {
+    $('engine-status').textContent = `The calibration engine could not start: ${err.message}`;
+    $('engine-status').classList.add('failed');
+    return 'unknown';
+  }
+}
+
+/** A shared link: results only, in memory (never written over the user's own session). */
+async function openShared(fragment) {
+  const version = await engineVersion();
+  let payload;
+  try {
+    payload = await decodeShare(fragment);
+  } catch (err) {
+    $('readonly-banner').hidden = false;
+    $('readonly-banner').textContent = `${err.message}. Start your own session at ${location.pathname}.`;
+    return;
+  }
+  store.session = defaultSession();
+  store.session.target = payload.target || store.session.target;
+  if (payload.camera) Object.assign(store.session.camera, payload.camera);
+  if (payload.handeye) Object.assign(store.session.handeye, payload.handeye);
+  store.persistent = false;
+  document.body.classList.add('readonly');
+  $('readonly-banner').hidden = false;
+  for (const id of ['demo-button', 'new-session']) $(id).hidden = true;
+  const images = { setResiduals() {} };
+  const camera = new CameraView(store, engine, images, { readonly: true });
+  new ExportView(store, engine);
+  new ShareView(store, version, () => camera.plots || []);
+  showStep(true);
+  window.addEventListener('hashchange', () => showStep(true));
+}
+
 async function main() {
-  engine.call('version').then(
-    ({ version }) => {
-      $('engine-status').textContent = `Calibration engine ready (robocal ${version}).`;
-      $('engine-status').classList.add('ready');
-      $('version').textContent = `robocal ${version}`;
-    },
-    (err) => {
-      $('engine-status').textContent = `The calibration engine could not start: ${err.message}`;
-      $('engine-status').classList.add('failed');
-    },
-  );
+  const fragment = sharedFragment();
+  if (fragment) return openShared(fragment);
+  const versionPromise = engineVersion();
   await store.load();
   initTarget(store);
   const images = new ImagesView(store, engine);
   await images.restore();
+  const camera = new CameraView(store, engine, images);
+  new RobotView(store, engine);
+  new ExportView(store, engine);
+  new ShareView(store, await versionPromise, () => camera.plots || []);
+  store.onChange((what) => { if (/detections|included|images|all/.test(what)) camera.summarise(); });
   $('new-session').addEventListener('click', async () => {
     if (store.session.images.length && !confirm('Start a new session? Images, detections and results of this session are removed from this browser.')) return;
     await store.reset();
     await images.restore();
     store.changed('target-loaded');
+    camera.render();
   });
   $('demo-button').addEventListener('click', async () => {
     $('demo-button').disabled = true;
@@ -55,8 +102,8 @@ async function main() {
       $('demo-button').disabled = false;
     }
   });
-  window.addEventListener('hashchange', showStep);
-  showStep();
+  window.addEventListener('hashchange', () => showStep(false));
+  showStep(false);
 }
 
 main();

@@ -34,6 +34,22 @@ const handlers = {
   },
 };
 
+handlers.export = async ({ report, format, transform }) => {
+  await ready;
+  return robocal.export_report(report, format, transform || '');
+};
+
+handlers.poses = async ({ text, options }) => {
+  await ready;
+  return JSON.parse(robocal.read_robot_poses(text, options || ''));
+};
+
+handlers.calibrate = async ({ input }) => {
+  await ready;
+  requireFn('calibrate_camera');
+  return JSON.parse(robocal.calibrate_camera(input));
+};
+
 function requireFn(name) {
   if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
 }

@@ -21,8 +21,8 @@ export function targetSpec(t) {
   const mm = (x) => `${Number(x)}mm`;
   switch (t.kind) {
     case 'chessboard': return `chessboard:${t.cols}x${t.rows}:${mm(t.size_mm)}`;
-    case 'circles': return `circles:${t.cols}x${t.rows}:${mm(t.size_mm)}${t.layout === 'asymmetric' ? ':asymmetric' : ''}${t.polarity === 'light' ? ':light' : ''}`;
-    case 'dots': return `dots:${t.cols}x${t.rows}:${mm(t.size_mm)}${t.polarity === 'light' ? ':light' : ''}`;
+    case 'circles': return `circles:${t.cols}x${t.rows}:${mm(t.size_mm)}${t.layout === 'asymmetric' ? ':asymmetric' : ''}${t.polarity === 'light' ? ':light-on-dark' : ''}`;
+    case 'dots': return `dots:${t.cols}x${t.rows}:${mm(t.size_mm)}:${mm(t.diameter_mm)}`;
     case 'circle': return `circle:${mm(t.diameter_mm)}`;
     default: throw new Error(`unknown target kind ${t.kind}`);
   }
@@ -63,7 +63,7 @@ export function boardLayout(t) {
   const margin = s;
   return {
     width: maxX + 2 * margin, height: maxY + 2 * margin, origin: [margin, margin], rects: [],
-    circles: pts.map(([x, y]) => [x, y, radius]), light: t.polarity === 'light',
+    circles: pts.map(([x, y]) => [x, y, radius]), light: t.kind === 'circles' && t.polarity === 'light',
   };
 }
 

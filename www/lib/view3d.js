@@ -1,0 +1,84 @@
+// A small 3-D view of coordinate frames (robot base, gripper, camera, target)
+// on a canvas: drag to rotate, wheel to zoom. Frames are 4x4 row-major
+// matrices in one world frame (metres); each is drawn as an x/y/z triad
+// (red/green/blue) with its name, so a wrong direction is visible at once.
+
+function mat(m) { return { R: [[m[0], m[1], m[2]], [m[4], m[5], m[6]], [m[8], m[9], m[10]]], t: [m[3], m[7], m[11]] }; }
+
+export class FrameView {
+  constructor(canvas) {
+    this.canvas = canvas;
+    this.yaw = -0.7;
+    this.pitch = 0.5;
+    this.zoom = 1;
+    this.frames = [];
+    this.links = [];
+    let drag = null;
+    canvas.addEventListener('pointerdown', (e) => { drag = [e.clientX, e.clientY]; canvas.setPointerCapture(e.pointerId); });
+    canvas.addEventListener('pointerup', () => { drag = null; });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!drag) return;
+      this.yaw += (e.clientX - drag[0]) * 0.01;
+      this.pitch = Math.max(-1.5, Math.min(1.5, this.pitch + (e.clientY - drag[1]) * 0.01));
+      drag = [e.clientX, e.clientY];
+      this.draw();
+    });
+    canvas.addEventListener('wheel', (e) => { e.preventDefault(); this.zoom *= e.deltaY < 0 ? 1.1 : 1 / 1.1; this.draw(); }, { passive: false });
+    canvas.tabIndex = 0;
+    canvas.addEventListener('keydown', (e) => {
+      const k = { ArrowLeft: [-0.1, 0], ArrowRight: [0.1, 0], ArrowUp: [0, -0.1], ArrowDown: [0, 0.1] }[e.key];
+      if (!k) return;
+      e.preventDefault();
+      this.yaw += k[0]; this.pitch = Math.max(-1.5, Math.min(1.5, this.pitch + k[1]));
+      this.draw();
+    });
+  }
+
+  /** frames: [{name, matrix_row_major, size?}], links: [[nameA, nameB]] drawn as dashed lines. */
+  set(frames, links = []) {
+    this.frames = frames.map((f) => ({ name: f.name, ...mat(f.matrix_row_major), size: f.size }));
+    this.links = links;
+    const ext = Math.max(0.05, ...this.frames.flatMap((f) => f.t.map(Math.abs)));
+    this.scale = ext;
+    this.draw();
+  }
+
+  project([x, y, z]) {
+    const cy = Math.cos(this.yaw), sy = Math.sin(this.yaw), cp = Math.cos(this.pitch), sp = Math.sin(this.pitch);
+    // World z up on screen: rotate about z (yaw), then tilt about the screen x axis (pitch).
+    const x1 = cy * x - sy * y, y1 = sy * x + cy * y;
+    const depth = cp * y1 + sp * z, up = -sp * y1 + cp * z;
+    const f = (Math.min(this.canvas.width, this.canvas.height) * 0.4 * this.zoom) / this.scale;
+    const persp = 1 / (1 + depth / (6 * this.scale));
+    return [this.canvas.width / 2 + x1 * f * persp, this.canvas.height / 2 - up * f * persp, depth];
+  }
+
+  draw() {
+    const ctx = this.canvas.getContext('2d');
+    ctx.fillStyle = '#fafafa';
+    ctx.fillRect(0, 0, this.canvas.width, this.canvas.height);
+    const byName = new Map(this.frames.map((f) => [f.name, f]));
+    ctx.setLineDash([5, 4]); ctx.strokeStyle = '#999'; ctx.lineWidth = 1;
+    for (const [a, b] of this.links) {
+      const fa = byName.get(a), fb = byName.get(b);
+      if (!fa || !fb) continue;
+      const [x0, y0] = this.project(fa.t), [x1, y1] = this.project(fb.t);
+      ctx.beginPath(); ctx.moveTo(x0, y0); ctx.lineTo(x1, y1); ctx.stroke();
+    }
+    ctx.setLineDash([]);
+    const axisLen = this.scale * 0.18;
+    for (const f of this.frames) {
+      const o = this.project(f.t);
+      const L = f.size || axisLen;
+      ['#d62728', '#2ca02c', '#1f77b4'].forEach((c, k) => {
+        const tip = this.project([f.t[0] + f.R[0][k] * L, f.t[1] + f.R[1][k] * L, f.t[2] + f.R[2][k] * L]);
+        ctx.strokeStyle = c; ctx.lineWidth = 2.5;
+        ctx.beginPath(); ctx.moveTo(o[0], o[1]); ctx.lineTo(tip[0], tip[1]); ctx.stroke();
+      });
+      ctx.fillStyle = '#222'; ctx.font = '12px system-ui';
+      ctx.fillText(f.name, o[0] + 6, o[1] - 6);
+    }
+    ctx.fillStyle = '#666'; ctx.font = '11px system-ui';
+    ctx.fillText('drag or arrow keys: rotate · wheel: zoom · x red, y green, z blue', 8, this.canvas.height - 8);
+  }
+}

@@ -1,0 +1,153 @@
+// Step 3: the camera. Model, method and options; solve in the worker; every
+// parameter with its standard deviation, per-view errors, residual plots,
+// the projection-uncertainty map, the distortion field, an undistorted
+// preview and the warnings in plain words.
+import { $, h, fill, table, num, message } from '../lib/dom.js';
+import { bars, scatter, vectors, heatmap } from '../lib/plot.js';
+
+export const MODELS = [
+  ['brown', 'Brown-Conrady k1 k2 k3 p1 p2 (OpenCV 5, Halcon polynomial)'],
+  ['radial_k1_k2_k5', 'Radial k1 k2 k5 (seed 000)'],
+  ['rational', 'OpenCV rational k1..k6 p1 p2 (+ thin prism)'],
+  ['division', 'Division (Halcon, Fitzgibbon)'],
+  ['kannala_brandt', 'Kannala-Brandt fisheye (OpenCV fisheye)'],
+  ['eucm', 'Enhanced unified (wide angle)'],
+  ['none', 'Pinhole, no distortion'],
+];
+export const METHODS = [
+  ['zhang', 'Zhang + bundle adjustment'],
+  ['dlt', '12-parameter DLT'],
+  ['tsai', 'Tsai (radial alignment)'],
+  ['ekf', 'Extended Kalman filter'],
+  ['all', 'All, side by side'],
+];
+const OPTIONS = [
+  ['fix_principal_point', 'Fix the principal point at the image centre'],
+  ['fix_aspect_ratio', 'Fix the aspect ratio (fx = fy)'],
+  ['zero_skew', 'Zero skew', true],
+  ['robust', 'Robust loss with outlier rejection'],
+];
+
+export class CameraView {
+  constructor(store, engine, images, { readonly = false } = {}) {
+    this.store = store;
+    this.engine = engine;
+    this.images = images;
+    this.readonly = readonly;
+    this.render();
+  }
+
+  get state() { return this.store.session.camera; }
+
+  render() {
+    const st = this.state;
+    const select = (name, items, value) => h('select', { name, id: `camera-${name}` },
+      items.map(([v, label]) => h('option', { value: v, selected: v === value }, label)));
+    const opts = OPTIONS.map(([key, label, dflt]) => h('label', { class: 'check' },
+      h('input', { type: 'checkbox', name: key, checked: st.options[key] ?? !!dflt }), ' ', label));
+    const form = h('form', { class: 'form', id: 'camera-form' },
+      h('label', {}, 'Lens model', select('model', MODELS, st.model)),
+      h('label', {}, 'Method', select('method', METHODS, st.method)),
+      h('fieldset', {}, h('legend', {}, 'Options'), opts),
+      h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-camera' }, 'Solve camera')));
+    form.addEventListener('change', () => this.readForm(form));
+    form.addEventListener('submit', (e) => { e.preventDefault(); this.solve(); });
+    this.out = h('div', { id: 'camera-results', 'aria-live': 'polite' });
+    if (this.readonly) fill($('camera-panel'), this.out);
+    else fill($('camera-panel'), h('div', { class: 'two-col' }, form, h('div', {}, h('p', { class: 'hint', id: 'camera-input-summary' }))), this.out);
+    this.summarise();
+    if (st.result) this.show(st.result, st.comparison);
+  }
+
+  readForm(form) {
+    const st = this.state;
+    st.model = form.elements.model.value;
+    st.method = form.elements.method.value;
+    for (const [key] of OPTIONS) st.options[key] = form.elements[key].checked;
+    this.store.changed('camera-options');
+  }
+
+  usable() {
+    return this.store.session.images.filter((i) => i.included && i.detection && i.detection.points.length >= 4);
+  }
+
+  summarise() {
+    const n = this.usable().length;
+    const el = $('camera-input-summary');
+    if (el) el.textContent = `${n} view${n === 1 ? '' : 's'} with a detected target will be used (exclude views in step 2).`;
+  }
+
+  async solve() {
+    const views = this.usable();
+    const st = this.state;
+    fill(this.out, message('info', `Solving with ${views.length} views…`));
+    const input = {
+      model: st.model,
+      method: st.method,
+      options: st.options,
+      views: views.map((i) => ({ name: i.name, detection: i.detection })),
+    };
+    try {
+      const result = await this.engine.call('calibrate', { input: JSON.stringify(input) });
+      st.result = result.report || result;
+      st.comparison = result.comparison || null;
+      this.store.changed('camera-result');
+      this.show(st.result, st.comparison);
+    } catch (err) {
+      fill(this.out, message('error', err.message));
+    }
+  }
+
+  show(r, comparison) {
+    const names = ['fx', 'fy', 'cx', 'cy', 'skew', ...Object.keys(r.distortion || {})];
+    const k = r.camera_matrix;
+    const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
+    const std = r.std || {};
+    const params = table(['parameter', 'value', 'std'], names.map((n) => [n, num(value[n], 6), num(std[n], 3)]), { id: 'camera-params' });
+    const warnings = (r.warnings || []).map((w) => message('warning', typeof w === 'string' ? w : w.message));
+    const perView = (r.views || []).map((v) => ({ label: v.name, value: v.rms_px, highlight: v.rms_px > 2 * r.rms_px }));
+    const residualPoints = [];
+    const residualVectors = [];
+    const byImage = new Map();
+    (r.views || []).forEach((v, vi) => {
+      const list = [];
+      for (const p of v.residuals_px || []) {
+        residualPoints.push({ x: p.dx, y: p.dy, group: vi });
+        residualVectors.push({ x: p.x, y: p.y, dx: p.dx, dy: p.dy });
+        list.push(p);
+      }
+      byImage.set(v.name, list);
+    });
+    this.images.setResiduals(byImage);
+    const [w, hgt] = r.image_size_px;
+    const canvases = [];
+    const canvas = (id, label) => { const c = h('canvas', { id, width: 460, height: 340, role: 'img', 'aria-label': label }); canvases.push(c); return c; };
+    const viewBars = bars(canvas('plot-view-rms', 'reprojection RMS per view'), perView, { ylabel: 'RMS (px)', title: 'Reprojection error per view', threshold: r.rms_px });
+    const scat = scatter(canvas('plot-residuals', 'residual scatter'), residualPoints, { xlabel: 'du (px)', ylabel: 'dv (px)', title: 'Residuals', symmetric: true });
+    const vec = vectors(canvas('plot-vectors', 'residual vectors over the image'), residualVectors, [w, hgt], { title: 'Residual vectors', gain: 50 });
+    const unc = r.projection_uncertainty ? heatmap(canvas('plot-uncertainty', 'projection uncertainty map'), r.projection_uncertainty, { title: 'Projection uncertainty (1 sigma)' }) : null;
+    const dist = r.distortion_field ? vectors(canvas('plot-distortion', 'distortion field'), r.distortion_field.vectors, [w, hgt], { title: 'Distortion field', gain: 1 }) : null;
+    this.plots = canvases;
+    fill(this.out,
+      h('h3', {}, `Result: RMS ${num(r.rms_px, 4)} px over ${(r.views || []).length} views`),
+      warnings,
+      h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat)),
+      h('div', { class: 'plots' }, vec, unc, dist),
+      comparison ? this.comparisonTable(comparison) : null,
+      r.correlation ? this.correlationNote(r.correlation, names) : null);
+  }
+
+  comparisonTable(methods) {
+    return h('div', {}, h('h3', {}, 'Methods side by side'),
+      table(['method', 'fx', 'fy', 'cx', 'cy', 'k1', 'std u (px)', 'std v (px)', 'RMS (px)'],
+        methods.map((m) => [m.method, num(m.fx, 3), num(m.fy, 3), num(m.cx, 3), num(m.cy, 3), num(m.k1, 5),
+          num(m.std_u_px, 4), num(m.std_v_px, 4), m.error ? m.error : num(m.rms_px, 4)]), { id: 'camera-methods' }));
+  }
+
+  correlationNote(corr, names) {
+    const strong = [];
+    const n = Math.round(Math.sqrt(corr.length));
+    for (let i = 0; i < n; i++) for (let j = i + 1; j < n; j++) if (Math.abs(corr[i * n + j]) > 0.95) strong.push(`${names[i] || i}–${names[j] || j}: ${num(corr[i * n + j], 3)}`);
+    return strong.length ? message('warning', `Strongly correlated parameters (|r| > 0.95): ${strong.join(', ')}. Add views with more tilt and coverage to separate them.`) : null;
+  }
+}

@@ -1,0 +1,149 @@
+// Step 4: robot poses. Drop a pose file; see how it was read (format, units,
+// direction: editable, with vendor presets), the parsed poses, and which
+// pose goes with which image.
+import { $, h, fill, table, num, message } from '../lib/dom.js';
+
+export const PRESETS = [
+  ['auto', 'Detect from the file'],
+  ['ur', 'Universal Robots (x y z rx ry rz: m, rotation vector)'],
+  ['kuka', 'KUKA (X Y Z A B C: mm, deg)'],
+  ['abb', 'ABB (x y z q1 q2 q3 q4: mm, quaternion w first)'],
+  ['fanuc', 'FANUC (X Y Z W P R: mm, deg)'],
+  ['yaskawa', 'Yaskawa / Motoman (X Y Z Rx Ry Rz: mm, deg)'],
+  ['staubli', 'Stäubli (X Y Z Rx Ry Rz: mm, deg)'],
+  ['xyz_quat_xyzw', 'Generic x y z qx qy qz qw'],
+  ['xyz_quat_wxyz', 'Generic x y z qw qx qy qz'],
+  ['xyz_rotvec', 'Generic x y z + rotation vector'],
+  ['matrix4', '4×4 matrices (16 numbers a row)'],
+];
+
+function rotvecDeg(q) {
+  const [x, y, z, w] = q;
+  const s = Math.hypot(x, y, z);
+  const angle = 2 * Math.atan2(s, w);
+  const k = s < 1e-12 ? 2 : angle / s;
+  return [x * k, y * k, z * k].map((v) => (v * 180) / Math.PI);
+}
+
+export class RobotView {
+  constructor(store, engine) {
+    this.store = store;
+    this.engine = engine;
+    this.render();
+    store.onChange((what) => { if (/detections|included|images|all/.test(what)) this.renderPairing(); });
+  }
+
+  get state() { return this.store.session.robot; }
+
+  render() {
+    const st = this.state;
+    const sel = (id, items, value, label) => h('label', {}, label, h('select', { id }, items.map(([v, t]) => h('option', { value: v, selected: v === value }, t))));
+    const input = h('input', { type: 'file', id: 'pose-input', accept: '.csv,.tsv,.txt,.json,.dat,text/*,application/json' });
+    input.addEventListener('change', async () => {
+      const f = input.files[0];
+      if (!f) return;
+      st.fileName = f.name;
+      st.text = await f.text();
+      input.value = '';
+      await this.parse();
+    });
+    const form = h('div', { class: 'form', id: 'pose-form' },
+      h('label', {}, 'Pose file ', input),
+      sel('pose-format', PRESETS, st.format, 'Format '),
+      sel('pose-length', [['auto', 'from the file or preset'], ['mm', 'millimetres'], ['m', 'metres']], st.lengthUnit, 'Lengths '),
+      sel('pose-angle', [['auto', 'from the file or preset'], ['deg', 'degrees'], ['rad', 'radians']], st.angleUnit, 'Angles '),
+      sel('pose-direction', [['base_from_gripper', 'base_from_gripper (TCP pose in base: usual)'], ['gripper_from_base', 'gripper_from_base (inverted)']], st.direction, 'The file holds '));
+    form.addEventListener('change', (e) => {
+      if (e.target.id === 'pose-input') return;
+      st.format = $('pose-format').value;
+      st.lengthUnit = $('pose-length').value;
+      st.angleUnit = $('pose-angle').value;
+      st.direction = $('pose-direction').value;
+      this.parse();
+    });
+    this.out = h('div', { id: 'pose-results', 'aria-live': 'polite' });
+    this.pairing = h('div', { id: 'pose-pairing' });
+    fill($('robot-panel'), form, this.out, h('h3', {}, 'Pairing of poses with images'), this.pairing);
+    this.show();
+  }
+
+  options() {
+    const st = this.state;
+    const o = { direction: st.direction };
+    if (st.format !== 'auto') o.format = st.format;
+    if (st.lengthUnit !== 'auto') o.length_unit = st.lengthUnit;
+    if (st.angleUnit !== 'auto') o.angle_unit = st.angleUnit;
+    return o;
+  }
+
+  async parse() {
+    const st = this.state;
+    if (!st.text) return;
+    try {
+      st.reading = await this.engine.call('poses', { text: st.text, options: JSON.stringify(this.options()) });
+      st.error = null;
+      st.parsed = st.reading.parsed || (st.reading.candidates[0] ? { ...st.reading.candidates[0], notes: [] } : null);
+    } catch (err) {
+      st.reading = null;
+      st.parsed = null;
+      st.error = err.message;
+    }
+    this.store.changed('robot');
+    this.show();
+  }
+
+  show() {
+    const st = this.state;
+    if (st.error) { fill(this.out, message('error', `${st.fileName}: ${st.error}`)); this.renderPairing(); return; }
+    if (!st.parsed) { fill(this.out, message('info', 'Load the robot\'s poses (one per image, in image order or with a name column).')); this.renderPairing(); return; }
+    const p = st.parsed;
+    const r = st.reading;
+    const how = h('p', { id: 'pose-format-used' }, `${st.fileName}: ${p.poses.length} poses read as `, h('b', {}, p.format), `, lengths in ${p.length_unit}, angles in ${p.angle_unit}, the file holds ${st.direction}.`);
+    const notes = (p.notes || []).map((n) => message('info', n));
+    let candidates = null;
+    if (r && !r.parsed && r.candidates.length) {
+      const pick = h('select', { id: 'pose-candidate', 'aria-label': 'reading of the pose file' },
+        r.candidates.map((c, i) => h('option', { value: i }, `${c.format}, ${c.length_unit}, ${c.angle_unit}${c.reasons.length ? ' — ' + c.reasons.join('; ') : ''}`)));
+      pick.addEventListener('change', () => { st.parsed = { ...r.candidates[Number(pick.value)], notes: [] }; this.store.changed('robot'); this.show(); });
+      candidates = h('div', {}, message('warning', `The file's layout is ambiguous (${r.ambiguity}). The most plausible reading is used; choose another below, or set the format. The hand-eye step scores every reading against the camera motion.`), h('label', {}, 'Reading ', pick));
+    }
+    const rows = p.poses.map((pose, i) => {
+      const t = pose.base_from_gripper.translation_m.map((v) => num(v * 1000, 2));
+      const rv = rotvecDeg(pose.base_from_gripper.quaternion_xyzw).map((v) => num(v, 3));
+      return [String(i + 1), pose.name || '', String(pose.line), ...t, ...rv];
+    });
+    fill(this.out, how, notes, candidates,
+      table(['#', 'name', 'line', 'x (mm)', 'y (mm)', 'z (mm)', 'rx (deg)', 'ry (deg)', 'rz (deg)'], rows, { id: 'pose-table', class: 'scroll' }),
+      h('p', { class: 'hint' }, 'Rotations shown as rotation vectors in degrees (axis × angle) whatever the file\'s convention.'));
+    this.renderPairing();
+  }
+
+  /** Poses paired with images: by name when the file names images, else by order of the images with a detection. */
+  pairs() {
+    const p = this.state.parsed;
+    if (!p) return [];
+    const imgs = this.store.session.images.filter((i) => i.included);
+    const byName = p.poses.some((q) => q.name);
+    if (byName) {
+      const stem = (s) => s.replace(/\.[^.]*$/, '');
+      return p.poses.map((pose, i) => {
+        const img = imgs.find((im) => im.name === pose.name || stem(im.name) === stem(pose.name || ''));
+        return { index: i, pose, image: img || null, how: 'name' };
+      });
+    }
+    return p.poses.map((pose, i) => ({ index: i, pose, image: imgs[i] || null, how: 'order' }));
+  }
+
+  renderPairing() {
+    if (!this.pairing) return;
+    const pairs = this.pairs();
+    if (!pairs.length) { fill(this.pairing, h('p', { class: 'hint' }, 'No poses yet.')); return; }
+    const used = pairs.filter((q) => q.image && q.image.detection).length;
+    const nImages = this.store.session.images.filter((i) => i.included).length;
+    const rows = pairs.map((q) => [String(q.index + 1), q.pose.name || '', q.image ? q.image.name : '—',
+      !q.image ? 'no image' : q.image.detection ? 'used' : 'dropped: the target was not found in the image']);
+    const warn = pairs.length !== nImages ? message('warning', `${pairs.length} poses but ${nImages} images: pairing ${pairs[0].how === 'name' ? 'by name' : 'by order'} leaves some unpaired. Check that the pose file matches the images.`) : null;
+    fill(this.pairing, h('p', {}, `Paired ${pairs[0].how === 'name' ? 'by the name column' : 'by order (pose i with the i-th included image)'}: ${used} pairs usable.`), warn,
+      table(['pose', 'name', 'image', 'status'], rows, { id: 'pairing-table' }));
+  }
+}
