@@ -8,12 +8,13 @@ import { initTarget } from './views/target.js';
 import { ImagesView } from './views/images.js';
 import { CameraView } from './views/camera.js';
 import { RobotView } from './views/robot.js';
+import { HandEyeView } from './views/handeye.js';
 import { ExportView } from './views/export.js';
 import { ShareView, sharedFragment, decodeShare } from './views/share.js';
 
 const engine = new Engine();
 const store = new Store();
-const READONLY_STEPS = ['camera', 'export', 'share'];
+const READONLY_STEPS = ['camera', 'handeye', 'export', 'share'];
 
 function showStep(readonly) {
   const links = [...document.querySelectorAll('#step-list a')];
@@ -63,6 +64,7 @@ async function openShared(fragment) {
   for (const id of ['demo-button', 'new-session']) $(id).hidden = true;
   const images = { setResiduals() {} };
   const camera = new CameraView(store, engine, images, { readonly: true });
+  new HandEyeView(store, engine, { pairs: () => [] }, { readonly: true });
   new ExportView(store, engine);
   new ShareView(store, version, () => camera.plots || []);
   showStep(true);
@@ -78,7 +80,8 @@ async function main() {
   const images = new ImagesView(store, engine);
   await images.restore();
   const camera = new CameraView(store, engine, images);
-  new RobotView(store, engine);
+  const robot = new RobotView(store, engine);
+  new HandEyeView(store, engine, robot);
   new ExportView(store, engine);
   new ShareView(store, await versionPromise, () => camera.plots || []);
   store.onChange((what) => { if (/detections|included|images|all/.test(what)) camera.summarise(); });

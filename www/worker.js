@@ -50,6 +50,12 @@ handlers.calibrate = async ({ input }) => {
   return JSON.parse(robocal.calibrate_camera(input));
 };
 
+handlers.handeye = async ({ input }) => {
+  await ready;
+  requireFn('solve_handeye');
+  return JSON.parse(robocal.solve_handeye(input));
+};
+
 function requireFn(name) {
   if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
 }

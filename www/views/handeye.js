@@ -1,0 +1,146 @@
+// Step 5: hand-eye. Setup and method, solve with every method, the refined
+// result, a Halcon-style error report, the methods side by side,
+// repeatability box plots and a 3-D view of the frames.
+import { $, h, fill, table, num, message } from '../lib/dom.js';
+import { bars, boxplot } from '../lib/plot.js';
+import { FrameView } from '../lib/view3d.js';
+import { flat, mul, fromPose, IDENTITY } from '../lib/mat4.js';
+
+const METHODS = [
+  ['all', 'All methods (best one refined)'], ['tsai_lenz', 'Tsai-Lenz'], ['park_martin', 'Park-Martin'], ['horaud', 'Horaud'],
+  ['andreff', 'Andreff'], ['daniilidis', 'Daniilidis (dual quaternion)'], ['chou_kamel', 'Chou-Kamel'], ['shah', 'Shah (AX = ZB)'], ['li', 'Li (AX = ZB)'],
+];
+
+export class HandEyeView {
+  constructor(store, engine, robot, { readonly = false } = {}) {
+    this.store = store;
+    this.engine = engine;
+    this.robot = robot;
+    this.readonly = readonly;
+    this.render();
+  }
+
+  get state() { return this.store.session.handeye; }
+
+  render() {
+    const st = this.state;
+    const sel = (id, items, value, label) => h('label', {}, label, h('select', { id }, items.map(([v, t]) => h('option', { value: v, selected: v === value }, t))));
+    const form = h('form', { class: 'form', id: 'handeye-form' },
+      sel('handeye-setup', [['eye-in-hand', 'Eye-in-hand (camera on the gripper)'], ['eye-to-hand', 'Eye-to-hand (camera fixed, target on the gripper)']], st.setup, 'Setup '),
+      sel('handeye-method', METHODS, st.method, 'Method '),
+      h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-handeye' }, 'Solve hand-eye')));
+    form.addEventListener('change', () => { st.setup = $('handeye-setup').value; st.method = $('handeye-method').value; this.store.changed('handeye-options'); });
+    form.addEventListener('submit', (e) => { e.preventDefault(); this.solve(); });
+    this.out = h('div', { id: 'handeye-results', 'aria-live': 'polite' });
+    this.canvas3d = h('canvas', { width: 560, height: 420, id: 'frames-3d', role: 'img', 'aria-label': '3-D view of the robot, camera and target frames' });
+    this.view3d = new FrameView(this.canvas3d);
+    fill($('handeye-panel'), this.readonly ? null : form, this.out);
+    if (st.result) this.show(st.result);
+  }
+
+  /** Pairs of robot pose and camera_from_target from the camera solve, matched by image name. */
+  input() {
+    const cam = this.store.session.camera.result;
+    if (!cam) throw new Error('solve the camera first (step 3): hand-eye uses the target pose of every view');
+    const pairs = this.robot.pairs().filter((p) => p.image);
+    if (!pairs.length) throw new Error('load the robot poses first (step 4)');
+    const views = new Map((cam.views || []).map((v) => [v.name, v]));
+    const used = pairs.filter((p) => views.has(p.image.name));
+    return {
+      setup: this.state.setup,
+      method: this.state.method,
+      base_from_gripper: used.map((p) => ({ translation_m: p.pose.base_from_gripper.translation_m, quaternion_xyzw: p.pose.base_from_gripper.quaternion_xyzw })),
+      camera_from_target: used.map((p) => ({ matrix_row_major: views.get(p.image.name).camera_from_target.matrix_row_major })),
+      names: used.map((p) => p.image.name),
+    };
+  }
+
+  async solve() {
+    let input;
+    try { input = this.input(); } catch (err) { fill(this.out, message('error', err.message)); return; }
+    fill(this.out, message('info', `Solving from ${input.base_from_gripper.length} pose pairs…`));
+    const names = input.names;
+    delete input.names;
+    try {
+      const result = await this.engine.call('handeye', { input: JSON.stringify(input) });
+      result.pair_names = names;
+      this.state.result = result;
+      this.store.changed('handeye-result');
+      this.show(result);
+    } catch (err) {
+      fill(this.out, message('error', err.message));
+    }
+  }
+
+  show(r) {
+    const eyeInHand = r.setup === 'eye-in-hand' || r.gripper_from_camera;
+    const camKey = eyeInHand ? 'gripper_from_camera' : 'base_from_camera';
+    const tgtKey = eyeInHand ? 'base_from_target' : 'gripper_from_target';
+    const pose = (key) => {
+      const p = r[key];
+      if (!p) return null;
+      return h('p', {}, h('b', {}, key), `: translation ${p.translation_m.map((v) => num(v * 1000, 3)).join(', ')} mm · quaternion (x y z w) ${p.quaternion_xyzw.map((v) => num(v, 6)).join(', ')}`);
+    };
+    const e = r.errors || {};
+    const errors = table(['error (closure of A X = X B)', 'value'], [
+      ['translation RMS', `${num(e.translation_rms_mm, 4)} mm`], ['translation max', `${num(e.translation_max_mm, 4)} mm`],
+      ['rotation RMS', `${num(e.rotation_rms_deg, 5)} deg`], ['rotation max', `${num(e.rotation_max_deg, 5)} deg`],
+      ['reprojection RMS', e.reprojection_rms_px == null ? '—' : `${num(e.reprojection_rms_px, 4)} px`]], { id: 'handeye-errors' });
+    const methods = table(['method', 'x (mm)', 'y (mm)', 'z (mm)', 'translation RMS (mm)', 'rotation RMS (deg)', 'vs. result (mm / deg)'],
+      (r.methods || []).map((m) => {
+        const p = m[camKey];
+        if (!p) return [m.method, m.error || 'failed', '', '', '', '', ''];
+        return [m.method, ...p.translation_m.map((v) => num(v * 1000, 3)), num(m.errors && m.errors.translation_rms_mm, 4), num(m.errors && m.errors.rotation_rms_deg, 5),
+          `${num(m.disagreement_translation_mm, 3)} / ${num(m.disagreement_rotation_deg, 4)}`];
+      }), { id: 'handeye-methods' });
+    const motion = r.motion ? h('p', { class: 'hint' }, `${r.motion.motions} motions used (${r.motion.discarded_small_rotation} discarded for too little rotation); rotation angles ${num(r.motion.angle_min_deg, 1)}–${num(r.motion.angle_max_deg, 1)} deg (median ${num(r.motion.angle_median_deg, 1)}), axis spread ${num(r.motion.axis_spread_deg, 1)} deg.`) : null;
+    const perMotion = bars(h('canvas', { width: 460, height: 300, role: 'img', 'aria-label': 'closure residual per motion' }),
+      (r.per_motion || []).map((m) => ({ label: `${m.from + 1}→${m.to + 1}`, value: m.translation_mm })), { ylabel: 'translation residual (mm)', title: 'Closure residual per motion', threshold: e.translation_rms_mm });
+    const plots = [perMotion];
+    if (r.repeatability) {
+      const rep = r.repeatability;
+      const box = (stats, key) => stats[`${key}_samples`] || boxFromSpread(stats[key]);
+      plots.push(boxplot(h('canvas', { width: 460, height: 300, role: 'img', 'aria-label': 'repeatability of the translation error' }),
+        [{ label: 'leave-one-out', values: box(rep.leave_one_out, 'translation_rms_mm') }, { label: 'bootstrap', values: box(rep.bootstrap, 'translation_rms_mm') }],
+        { ylabel: 'translation RMS (mm)', title: `Repeatability (${rep.method})` }));
+      plots.push(boxplot(h('canvas', { width: 460, height: 300, role: 'img', 'aria-label': 'repeatability of the rotation error' }),
+        [{ label: 'leave-one-out', values: box(rep.leave_one_out, 'rotation_rms_deg') }, { label: 'bootstrap', values: box(rep.bootstrap, 'rotation_rms_deg') }],
+        { ylabel: 'rotation RMS (deg)', title: 'Repeatability' }));
+    }
+    this.plots = plots;
+    fill(this.out, h('h3', {}, `Result (${r.method})`), (r.warnings || []).map((w) => message('warning', w)),
+      pose(camKey), pose(tgtKey), errors, motion, h('h3', {}, 'Methods side by side'), methods,
+      h('div', { class: 'plots' }, plots), h('h3', {}, '3-D view'), this.canvas3d);
+    this.draw3d(r, camKey, tgtKey, eyeInHand);
+  }
+
+  draw3d(r, camKey, tgtKey, eyeInHand) {
+    const robot = this.robot.pairs().filter((p) => p.image).slice(0, 8).map((p) => fromPose(p.pose.base_from_gripper));
+    const frames = [{ name: 'base', matrix_row_major: IDENTITY }];
+    const links = [];
+    robot.forEach((g, i) => {
+      frames.push({ name: i === 0 ? 'gripper' : `g${i + 1}`, matrix_row_major: g });
+      links.push(['base', i === 0 ? 'gripper' : `g${i + 1}`]);
+    });
+    if (r[camKey] && r[tgtKey]) {
+      const X = flat(r[camKey]);
+      const T = flat(r[tgtKey]);
+      if (eyeInHand && robot.length) {
+        frames.push({ name: 'camera', matrix_row_major: mul(robot[0], X) });
+        frames.push({ name: 'target', matrix_row_major: T });
+        links.push(['gripper', 'camera'], ['camera', 'target']);
+      } else if (robot.length) {
+        frames.push({ name: 'camera', matrix_row_major: X });
+        frames.push({ name: 'target', matrix_row_major: mul(robot[0], T) });
+        links.push(['gripper', 'target'], ['camera', 'target']);
+      }
+    }
+    this.view3d.set(frames, links);
+  }
+}
+
+/** Without per-run samples, a box from the median and IQR (whiskers omitted). */
+function boxFromSpread(s) {
+  if (!s) return [];
+  return [s.median - s.iqr / 2, s.median, s.median + s.iqr / 2];
+}
