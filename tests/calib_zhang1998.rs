@@ -44,13 +44,12 @@ fn check(name: &str, got: f64, want: f64, std: f64) {
     );
 }
 
-#[test]
-fn reproduces_zhangs_published_calibration() {
+fn load_views() -> Option<Vec<View>> {
     let Some(dir) = dataset_dir() else {
         eprintln!(
             "skipped: zhang1998 dataset not found beside the crate or in /work/shared/datasets"
         );
-        return;
+        return None;
     };
     let read = |name: &str| std::fs::read_to_string(dir.join(name)).expect("readable file");
     let model: Vec<Point3<f64>> = points(&read("Model.txt"))
@@ -65,6 +64,12 @@ fn reproduces_zhangs_published_calibration() {
             image_px: points(&read(&format!("data{k}.txt"))),
         })
         .collect();
+    Some(views)
+}
+
+#[test]
+fn reproduces_zhangs_published_calibration() {
+    let Some(views) = load_views() else { return };
     // Zhang's model: skew estimated, radial k1 r^2 + k2 r^4 only.
     let options = CalibrationOptions {
         model: Distortion::RadialK1K2K5 {
@@ -93,4 +98,50 @@ fn reproduces_zhangs_published_calibration() {
     }
     // OpenCV 4.14 on the same points (SOURCE.md) reaches 0.337 px RMS without skew.
     assert!(report.rms_px < 0.34, "rms {} px", report.rms_px);
+}
+
+#[test]
+fn matches_opencv_calibrate_camera_on_the_same_points() {
+    let Some(views) = load_views() else { return };
+    // OpenCV 4.14 calibrateCamera (ZERO_TANGENT_DIST | FIX_K3, no skew),
+    // recorded in the dataset's SOURCE.md to the printed digits.
+    let options = CalibrationOptions {
+        model: Distortion::Brown {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+        },
+        fixed_coefficients: vec!["p1".into(), "p2".into(), "k3".into()],
+        ..CalibrationOptions::default()
+    };
+    let report = calibrate(&views, (640, 480), &options).expect("calibration");
+    let c = &report.camera;
+    let opencv = [
+        ("fx", c.fx, 832.207),
+        ("fy", c.fy, 832.243),
+        ("cx", c.cx, 304.068),
+        ("cy", c.cy, 206.372),
+        ("k1", report.distortion["k1"], -0.22853),
+        ("k2", report.distortion["k2"], 0.19101),
+    ];
+    for (name, got, want) in opencv {
+        // Same optimum: equal to OpenCV's printed digits (3 decimals for
+        // pixels, 5 for coefficients), far inside one std.
+        let digits = if name.starts_with('k') { 1e-5 } else { 1e-3 };
+        assert!(
+            (got - want).abs() <= digits,
+            "{name}: {got} vs OpenCV {want}"
+        );
+        assert!(
+            (got - want).abs() < 0.1 * report.std[name],
+            "{name}: {got} vs OpenCV {want}"
+        );
+    }
+    assert!(
+        (report.rms_px - 0.337).abs() < 5e-4,
+        "rms {} px vs OpenCV 0.337 px",
+        report.rms_px
+    );
 }
