@@ -141,3 +141,67 @@ pub fn export_formats() -> String {
 pub fn read_robot_poses(text: &str, options_json: &str) -> Result<String, JsError> {
     crate::io::poses_api::read_poses_json(text, options_json).map_err(js_error)
 }
+
+/// Parse a JSON request, run `solve`, return the JSON report.
+fn json_call<Req: serde::de::DeserializeOwned, Rep: Serialize>(
+    what: &str,
+    json: &str,
+    solve: impl Fn(&Req) -> crate::Result<Rep>,
+) -> Result<String, JsError> {
+    let request: Req =
+        serde_json::from_str(json).map_err(|e| JsError::new(&format!("{what} request: {e}")))?;
+    let report = solve(&request).map_err(js_error)?;
+    serde_json::to_string(&report).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// Planar calibration at any height from per-height matrices. JSON in:
+/// `{"matrices": [{"height_mm", "a11", "a12", "tx", "a21", "a22", "ty"}],
+/// "reject_threshold"?: number, "predict"?: [{"height_mm", "image_px": [u, v]}]}`;
+/// JSON out: `{fit: {a11..ty: {intercept, slope, r2, pearson_r, adj_r2, rss,
+/// ...}}, rejected_heights_mm, predictions, input}`.
+#[wasm_bindgen]
+pub fn planar_fit(json: &str) -> Result<String, JsError> {
+    json_call("planar_fit", json, crate::workflows::planar_api::planar_fit)
+}
+
+/// Planar calibration at any height from point pairs. JSON in:
+/// `{"points": [{"height_mm", "image_px": [u, v], "robot_mm": [x, y]}],
+/// "options"?: {"transform": "rigid"|"similarity"|"affine",
+/// "reject_threshold": number|null, "plate_size_mm": [l, w]|null},
+/// "predict"?: [...]}`; JSON out: per-height `heights`, `fit`,
+/// `pixel_density`, `density_fit`, `predictions`.
+#[wasm_bindgen]
+pub fn planar_solve(json: &str) -> Result<String, JsError> {
+    json_call(
+        "planar_solve",
+        json,
+        crate::workflows::planar_api::planar_solve,
+    )
+}
+
+/// XY-table calibration with one target. JSON in: `{"observations":
+/// [{"stage_mm": [x, y, z], "image_px": [u, v]}], "verification"?: [4 such],
+/// "still_target_px"?: [[u, v]], "measurement_noise_px2"?: [[a, b], [c, d]],
+/// "kalman_mode"?: "extended"|"linearized"}`; JSON out: `batch`, `kalman`
+/// (each with `projection_matrix` 3x4 row-major), `verification`.
+#[wasm_bindgen]
+pub fn xytable_solve(json: &str) -> Result<String, JsError> {
+    json_call(
+        "xytable_solve",
+        json,
+        crate::workflows::xytable::solve_xytable,
+    )
+}
+
+/// Camera-to-reference frame from known motions of one point (seed 000).
+/// JSON in: `{"increments_mm": [[dx, dy, dz]], "points_camera_mm": [[x, y, z]],
+/// "start_reference_mm"?: [x, y, z]}`; JSON out: `camera_from_reference`,
+/// `start_camera_mm`, `residuals_mm`, `rms_mm`.
+#[wasm_bindgen]
+pub fn known_motion_solve(json: &str) -> Result<String, JsError> {
+    json_call(
+        "known_motion_solve",
+        json,
+        crate::workflows::known_motion::solve_known_motion,
+    )
+}

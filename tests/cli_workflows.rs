@@ -143,3 +143,150 @@ fn planar_bad_input_gives_clear_errors() {
         "robocal: planar: --point needs --predict HEIGHT_MM (see 'robocal planar --help')"
     );
 }
+
+/// A synthetic XY-table scene: camera 600 mm above the stage, looking down.
+fn xytable_csv(extra: &str) -> (String, nalgebra::Matrix3x4<f64>) {
+    use nalgebra::{Matrix3, Point3, Translation3, UnitQuaternion};
+    let k = Matrix3::new(1200.0, 0.0, 640.0, 0.0, 1200.0, 480.0, 0.0, 0.0, 1.0);
+    let pose = robocal::geometry::Pose::from_parts(
+        Translation3::new(10.0, -5.0, 600.0),
+        UnitQuaternion::from_euler_angles(3.1, 0.05, 0.3),
+    );
+    let p =
+        robocal::calib::dlt::normalize_scale(&(k * pose.to_homogeneous().fixed_view::<3, 4>(0, 0)));
+    let mut csv = String::from("x_mm,y_mm,z_mm,u_px,v_px,role\n");
+    let mut row = |x: f64, y: f64, z: f64, role: &str| {
+        let q = robocal::calib::dlt::project(&p, &Point3::new(x, y, z));
+        csv.push_str(&format!("{x},{y},{z},{},{},{role}\n", q.x, q.y));
+    };
+    for z in [0.0, 40.0] {
+        for x in [-100.0, 0.0, 100.0] {
+            for y in [-80.0, 0.0, 80.0] {
+                row(x, y, z, "calibration");
+            }
+        }
+    }
+    for (x, y) in [(-60.0, -50.0), (60.0, -50.0), (60.0, 50.0), (-60.0, 50.0)] {
+        row(x, y, 20.0, "verify");
+    }
+    csv.push_str(extra);
+    (csv, p)
+}
+
+#[test]
+fn xytable_gives_both_matrices_and_the_verification_point() {
+    let (csv, truth) =
+        xytable_csv("0,0,0,640.1,480.0,still\n0,0,0,639.9,480.1,still\n0,0,0,640.0,479.9,still\n");
+    let file = scratch("xytable.csv", &csv);
+    let v = json(&robocal(&["xytable", file.to_str().unwrap()]));
+    for method in ["batch", "kalman"] {
+        let p: Vec<f64> = v[method]["projection_matrix"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert_eq!(p.len(), 12);
+        let err = (nalgebra::Matrix3x4::from_row_slice(&p) - truth).norm() / truth.norm();
+        // Noise-free centres (printed with 17 significant digits).
+        assert!(err < 1e-9, "{method}: relative error {err:e}");
+        assert!(v[method]["rms_px"].as_f64().unwrap() < 1e-6);
+    }
+    assert_eq!(v["noise_source"], "still_target");
+    assert_eq!(v["kalman"]["history"].as_array().unwrap().len(), 18);
+    let e = v["verification"]["batch_error_px"].as_f64().unwrap();
+    assert!(e < 1e-6, "verification error {e} px");
+}
+
+#[test]
+fn xytable_bad_input_gives_clear_errors() {
+    let few = scratch(
+        "few.csv",
+        "x_mm,y_mm,z_mm,u_px,v_px\n0,0,0,1,1\n1,0,0,2,1\n0,1,0,1,2\n0,0,1,1,1\n1,1,1,2,2\n",
+    );
+    let out = robocal(&["xytable", few.to_str().unwrap()]);
+    assert_eq!(
+        stderr(&out),
+        "robocal: requires at least 6 3-D/2-D point pairs, got 5"
+    );
+
+    let (csv, _) = xytable_csv("");
+    let flat: String = csv.lines().take(10).map(|l| format!("{l}\n")).collect();
+    let flat = scratch("flat.csv", &flat);
+    let out = robocal(&["xytable", flat.to_str().unwrap()]);
+    assert!(
+        stderr(&out).starts_with("robocal: the 9 3-D points are coplanar"),
+        "{}",
+        stderr(&out)
+    );
+
+    let images = scratch("images.csv", "x_mm,y_mm,z_mm,image\n0,0,0,a.png\n");
+    let out = robocal(&["xytable", images.to_str().unwrap()]);
+    assert!(
+        stderr(&out).contains("give the centres as u_px,v_px columns"),
+        "{}",
+        stderr(&out)
+    );
+
+    let out = robocal(&["xytable", few.to_str().unwrap(), "--kalman", "unscented"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        stderr(&out),
+        "robocal: xytable: --kalman: expected extended or linearized, got 'unscented' (see 'robocal xytable --help')"
+    );
+}
+
+#[test]
+fn known_motion_frame_from_the_cli() {
+    // Rotation of 90 degrees about z, start point at (100, 200, 1000) mm in
+    // the camera frame: increments d map to (-dy, dx, dz).
+    let mut csv = String::from("dx_mm,dy_mm,dz_mm,x_cam_mm,y_cam_mm,z_cam_mm\n");
+    for d in [
+        [0.0, 0.0, 0.0],
+        [50.0, 0.0, 0.0],
+        [0.0, 50.0, 0.0],
+        [0.0, 0.0, 50.0],
+        [30.0, 30.0, 30.0],
+    ] {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            d[0],
+            d[1],
+            d[2],
+            100.0 - d[1],
+            200.0 + d[0],
+            1000.0 + d[2]
+        ));
+    }
+    let file = scratch("motion.csv", &csv);
+    let v = json(&robocal(&[
+        "xytable",
+        "--known-motion",
+        file.to_str().unwrap(),
+        "--start-mm",
+        "10,0,0",
+    ]));
+    let q: Vec<f64> = v["camera_from_reference"]["quaternion_xyzw"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let h = 0.5f64.sqrt();
+    assert!(
+        (q[2].abs() - h).abs() < 1e-9 && (q[3].abs() - h).abs() < 1e-9,
+        "{q:?}"
+    );
+    // T = c - R start = (100, 200, 1000) - (0, 10, 0) mm.
+    let t: Vec<f64> = v["camera_from_reference"]["translation_m"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(
+        (t[0] - 0.1).abs() < 1e-12 && (t[1] - 0.19).abs() < 1e-12 && (t[2] - 1.0).abs() < 1e-12,
+        "{t:?}"
+    );
+    assert!(v["rms_mm"].as_f64().unwrap() < 1e-9);
+}

@@ -2,8 +2,15 @@
 //! Zhang's closed-form intrinsics and poses, then one Levenberg-Marquardt
 //! over intrinsics, distortion and every view pose ([`calibrate`]), with a
 //! report that carries residuals, uncertainties and warnings.
+//!
+//! From 3-D/2-D point pairs of a non-planar target (seed 002):
+//! - [`dlt`]: the 12-parameter projection matrix, decomposed into K, R, t;
+//! - [`dlt_kalman`]: the recursive Kalman-filter estimate of the same
+//!   12 parameters, with the measurement noise from repeated observations.
 
 mod closed_form;
+pub mod dlt;
+pub mod dlt_kalman;
 mod homography;
 mod refine;
 mod report;

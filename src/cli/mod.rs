@@ -4,6 +4,7 @@ pub mod args;
 mod export;
 mod planar;
 mod serve;
+mod xytable;
 
 use std::fmt;
 
@@ -61,6 +62,8 @@ Commands:
               MATLAB, URDF, robot-controller and other formats
   info        decode images and print their format and size
   planar      eye-to-hand calibration at any height (plate corners per height)
+  xytable     camera over an XY-table with one circular target (batch DLT and
+              Kalman filter); --known-motion: camera-to-reference frame
 
 Run 'robocal <command> --help' for the options of each command.
 Options common to all commands: --help, --version.";
@@ -89,6 +92,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
         "info" => info(rest),
         "planar" if wants_help => print_help(planar::HELP),
         "planar" => planar::run(rest),
+        "xytable" if wants_help => print_help(xytable::HELP),
+        "xytable" => xytable::run(rest),
         other => Err(CliError::Usage(format!(
             "unknown command '{other}'; run 'robocal --help' for the list"
         ))),

@@ -115,3 +115,35 @@ pub fn planar_solve(request: &PlanarSolveRequest) -> Result<PlanarSolveResponse>
         predictions,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn minimal_json_requests_work() {
+        let fit: PlanarFitRequest = serde_json::from_str(
+            r#"{"matrices": [
+                {"height_mm": 10, "a11": 0, "a12": 0.7, "tx": -1700, "a21": 0.7, "a22": 0, "ty": 700},
+                {"height_mm": 20, "a11": 0, "a12": 0.6, "tx": -1600, "a21": 0.6, "a22": 0, "ty": 710}],
+              "predict": [{"height_mm": 15, "image_px": [100, 200]}]}"#,
+        )
+        .unwrap();
+        let r = planar_fit(&fit).unwrap();
+        // Halfway: a12 = 0.65, tx = -1650: x = 0.65 * 200 - 1650.
+        assert!((r.predictions[0].robot_mm[0] - (0.65 * 200.0 - 1650.0)).abs() < 1e-9);
+        let solve: PlanarSolveRequest =
+            serde_json::from_str(r#"{"points": [], "options": {"transform": "similarity"}}"#)
+                .unwrap();
+        assert_eq!(
+            solve.options.transform,
+            super::super::planar::TransformKind::Similarity
+        );
+        assert_eq!(solve.options.reject_threshold, None);
+        assert_eq!(
+            planar_solve(&solve).unwrap_err().to_string(),
+            "requires at least 2 distinct calibration heights, got 0"
+        );
+    }
+}

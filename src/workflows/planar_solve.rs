@@ -23,8 +23,9 @@ pub struct HeightPoint {
     pub robot_mm: [f64; 2],
 }
 
-/// Options of [`solve_planar`].
+/// Options of [`solve_planar`]. Missing JSON fields take their defaults.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct PlanarSolveOptions {
     /// The per-height transform model. Default: affine (the article's).
     pub transform: TransformKind,

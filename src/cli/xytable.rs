@@ -1,0 +1,135 @@
+//! `robocal xytable`: XY-table / camera calibration with one circular target
+//! (seed 002), and `--known-motion` for the camera-to-reference frame from
+//! known motions of one point (seed 000, Eq. 27-28).
+
+use super::args::{Args, Spec};
+use super::{read_text, write_output, CliError};
+use robocal::calib::dlt_kalman::KalmanMode;
+use robocal::io::workflow_csv::{parse_known_motion, parse_xytable};
+use robocal::workflows::known_motion::solve_known_motion;
+use robocal::workflows::xytable::solve_xytable;
+
+pub const HELP: &str =
+    "robocal xytable - calibrate a camera over an XY-table with one circular target
+
+Usage: robocal xytable POSITIONS.csv [--noise-px SIGMA] [--kalman extended|linearized] [-o FILE]
+       robocal xytable --known-motion MOTIONS.csv [--start-mm X,Y,Z] [-o FILE]
+
+POSITIONS.csv: the target centre at N >= 6 non-coplanar stage positions,
+header
+  x_mm,y_mm,z_mm,u_px,v_px[,role]
+role (optional column): empty or 'calibration'; 'verify' for four extra
+positions A, B, C, D in order around a quadrilateral (the intersection of
+its diagonals AC, BD is the verification point); 'still' for repeated
+images of the target standing still (their u, v scatter is the Kalman
+filter's measurement noise R; x, y, z are ignored). Calibration rows are
+processed by the filter in file order. An 'image' column instead of u_px,
+v_px is refused in this build: the single-circle detector has not landed yet.
+
+Prints JSON: 'batch' and 'kalman', each {projection_matrix (3x4 row-major,
+for stage mm; third row = depth in mm), camera_matrix (3x3 row-major),
+camera_from_world {translation_m, quaternion_xyzw}, residuals_px, rms_px};
+'kalman.history' (per observation: projection_row_major, rms_px of all
+positions, covariance_trace); 'measurement_noise_px2', 'noise_source'
+(still_target, given or batch_residuals); 'verification' {measured_px,
+stage_mm, batch_predicted_px, batch_error_px, kalman_predicted_px,
+kalman_error_px, diagonal_gap_mm} or null.
+
+--known-motion: MOTIONS.csv holds a point moved by known increments in the
+reference frame (robot/stage) and seen by a calibrated stereo camera, header
+  dx_mm,dy_mm,dz_mm,x_cam_mm,y_cam_mm,z_cam_mm
+(first row usually 0,0,0: the start; >= 3 rows with increments in at least
+two directions). Prints camera_from_reference {translation_m,
+quaternion_xyzw}, start_camera_mm, residuals_mm, rms_mm. Only the rotation
+and the start point in the camera frame are observable; the translation
+needs the start position in the reference frame (--start-mm), otherwise the
+reference origin is placed at the start (reference_origin_given: false).
+
+Options:
+  --noise-px SIGMA      measurement noise std (px) when there are no 'still'
+                        rows (default: from the batch residuals)
+  --kalman MODE         extended (default: EKF once the state is determined)
+                        or linearized (the DLT constraint throughout)
+  --known-motion        solve the seed-000 frame from MOTIONS.csv instead
+  --start-mm X,Y,Z      known-motion: the start position in the reference frame
+  -o FILE               write the JSON to FILE instead of stdout
+
+Examples:
+  robocal xytable positions.csv --kalman extended -o xytable.json
+  robocal xytable --known-motion motions.csv --start-mm 100,-50,20";
+
+pub fn run(raw: &[String]) -> Result<(), CliError> {
+    let spec = Spec {
+        command: "xytable",
+        valued: &["noise-px", "kalman", "start-mm"],
+        switches: &["known-motion"],
+    };
+    let args = Args::parse(raw, &spec)?;
+    let file = match args.positionals.as_slice() {
+        [file] => file.as_str(),
+        [] => return Err(CliError::usage("xytable", "give the positions file")),
+        [_, extra, ..] => {
+            return Err(CliError::usage(
+                "xytable",
+                format!("unexpected argument '{extra}'"),
+            ))
+        }
+    };
+    let text = read_text(file)?;
+    let json = if args.switch("known-motion") {
+        if args.value("noise-px").is_some() || args.value("kalman").is_some() {
+            return Err(CliError::usage(
+                "xytable",
+                "--noise-px and --kalman do not apply to --known-motion",
+            ));
+        }
+        let mut request =
+            parse_known_motion(&text).map_err(|e| CliError::Io(format!("{file}: {e}")))?;
+        request.start_reference_mm = args.value("start-mm").map(triple).transpose()?;
+        serde_json::to_string_pretty(&solve_known_motion(&request)?)
+    } else {
+        if args.value("start-mm").is_some() {
+            return Err(CliError::usage(
+                "xytable",
+                "--start-mm belongs to --known-motion",
+            ));
+        }
+        let mut request = parse_xytable(&text).map_err(|e| CliError::Io(format!("{file}: {e}")))?;
+        if args.value("noise-px").is_some() {
+            let sigma: f64 = args.parsed("xytable", "noise-px", 0.0)?;
+            if !(sigma >= 0.0 && sigma.is_finite()) {
+                return Err(CliError::usage(
+                    "xytable",
+                    "--noise-px must be a non-negative number of pixels",
+                ));
+            }
+            request.measurement_noise_px2 = Some([[sigma * sigma, 0.0], [0.0, sigma * sigma]]);
+        }
+        request.kalman_mode = match args.value("kalman") {
+            None | Some("extended") => KalmanMode::Extended,
+            Some("linearized") => KalmanMode::Linearized,
+            Some(other) => {
+                return Err(CliError::usage(
+                    "xytable",
+                    format!("--kalman: expected extended or linearized, got '{other}'"),
+                ))
+            }
+        };
+        serde_json::to_string_pretty(&solve_xytable(&request)?)
+    }
+    .map_err(|e| CliError::Io(format!("cannot encode the result as JSON: {e}")))?;
+    write_output(args.value("output"), &format!("{json}\n"))
+}
+
+fn triple(text: &str) -> Result<[f64; 3], CliError> {
+    let v: Vec<Option<f64>> = text.split(',').map(|t| t.trim().parse().ok()).collect();
+    match v.as_slice() {
+        [Some(a), Some(b), Some(c)] if a.is_finite() && b.is_finite() && c.is_finite() => {
+            Ok([*a, *b, *c])
+        }
+        _ => Err(CliError::usage(
+            "xytable",
+            format!("--start-mm: expected three numbers 'X,Y,Z', got '{text}'"),
+        )),
+    }
+}
