@@ -36,6 +36,7 @@ pub mod calib;
 pub mod camera;
 pub mod error;
 pub mod geometry;
+pub mod handeye;
 pub mod image;
 pub mod io;
 pub mod optim;

@@ -1,0 +1,134 @@
+//! AX = ZB (robot-world-hand-eye): `robot[i] * X = Z * camera[i]^-1` per
+//! view, with `X = x` and `Z = y` of the [`Chain`]. Shah 2013 (Kronecker
+//! rotation, then translation) and Li-Wang-Wu 2010 (simultaneous linear).
+
+use super::axxb::kron;
+use super::math::{ascending_eigenvectors, least_squares, pose_from, project_to_so3};
+use super::{Chain, HandEyeMethod, Pose};
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
+
+/// Minimum number of views for AX = ZB.
+pub const MIN_VIEWS: usize = 3;
+
+/// Solve AX = ZB; returns `(x, y)` of the chain.
+pub fn solve(method: HandEyeMethod, chain: &Chain) -> Result<(Pose, Pose)> {
+    if chain.len() < MIN_VIEWS {
+        return Err(Error::too_few("views", MIN_VIEWS, chain.len()));
+    }
+    let (rx, rz) = match method {
+        HandEyeMethod::Shah => shah_rotations(chain)?,
+        HandEyeMethod::Li => li_rotations(chain)?,
+        other => {
+            return Err(Error::invalid(
+                "method",
+                format!("{} solves AX = XB, not AX = ZB", other.name()),
+            ))
+        }
+    };
+    let (tx, tz) = translations(chain, &rz)?;
+    Ok((pose_from(&rx, &tx), pose_from(&rz, &tz)))
+}
+
+/// `A_i = robot[i]`, `B_i = camera[i]^-1` as rotation matrices and translations.
+fn view_terms(
+    chain: &Chain,
+) -> impl Iterator<Item = (Matrix3<f64>, Vector3<f64>, Matrix3<f64>, Vector3<f64>)> + '_ {
+    chain.robot.iter().zip(&chain.camera).map(|(a, c)| {
+        let b = c.inverse();
+        (
+            a.rotation.to_rotation_matrix().into_inner(),
+            a.translation.vector,
+            b.rotation.to_rotation_matrix().into_inner(),
+            b.translation.vector,
+        )
+    })
+}
+
+/// Rotation rows `(R_A (x) I) vec(R_X) - (I (x) R_B^T) vec(R_Z) = 0`
+/// (row-major vec).
+fn rotation_block(ra: &Matrix3<f64>, rb: &Matrix3<f64>) -> DMatrix<f64> {
+    let mut k = DMatrix::zeros(9, 18);
+    k.view_mut((0, 0), (9, 9))
+        .copy_from(&kron(ra, &Matrix3::identity()));
+    k.view_mut((0, 9), (9, 9))
+        .copy_from(&(-kron(&Matrix3::identity(), &rb.transpose())));
+    k
+}
+
+/// Shah: the null vector of the stacked rotation rows holds both rotations
+/// with one common scale, fixed by `det(R_X) = 1`, then each is projected
+/// onto SO(3).
+fn shah_rotations(chain: &Chain) -> Result<(Rotation3<f64>, Rotation3<f64>)> {
+    let mut normal = DMatrix::zeros(18, 18);
+    for (ra, _, rb, _) in view_terms(chain) {
+        let k = rotation_block(&ra, &rb);
+        normal += k.transpose() * k;
+    }
+    let pairs = ascending_eigenvectors(&normal)?;
+    let v = &pairs[0].1;
+    let mx = Matrix3::from_row_slice(&v.as_slice()[0..9]);
+    let mz = Matrix3::from_row_slice(&v.as_slice()[9..18]);
+    let sign = mx.determinant().signum();
+    Ok((project_to_so3(&(mx * sign))?, project_to_so3(&(mz * sign))?))
+}
+
+/// Li-Wang-Wu: rotation and translation rows in one linear least squares over
+/// 24 unknowns `[vec(R_X), vec(R_Z), t_X, t_Z]`; the translation rows
+/// `(I (x) t_B^T) vec(R_Z) - R_A t_X + t_Z = t_A` fix the scale. The
+/// rotations are projected onto SO(3); the translations are then re-solved
+/// with the projected rotations (they depend linearly on them).
+fn li_rotations(chain: &Chain) -> Result<(Rotation3<f64>, Rotation3<f64>)> {
+    let mut normal = DMatrix::zeros(24, 24);
+    let mut rhs = DVector::zeros(24);
+    for (ra, ta, rb, tb) in view_terms(chain) {
+        let mut k = DMatrix::zeros(12, 24);
+        k.view_mut((0, 0), (9, 18))
+            .copy_from(&rotation_block(&ra, &rb));
+        for r in 0..3 {
+            for c in 0..3 {
+                k[(9 + r, 9 + 3 * r + c)] = tb[c];
+                k[(9 + r, 18 + c)] = -ra[(r, c)];
+            }
+            k[(9 + r, 21 + r)] = 1.0;
+        }
+        let mut b = DVector::zeros(12);
+        b.rows_mut(9, 3).copy_from(&ta);
+        rhs += k.transpose() * b;
+        normal += k.transpose() * k;
+    }
+    let (w, dropped) = least_squares(&normal, &rhs)?;
+    if !dropped.is_empty() {
+        return Err(Error::degenerate(
+            "Li: the linear system is rank deficient (too little motion diversity)",
+        ));
+    }
+    let mx = Matrix3::from_row_slice(&w.as_slice()[0..9]);
+    let mz = Matrix3::from_row_slice(&w.as_slice()[9..18]);
+    Ok((project_to_so3(&mx)?, project_to_so3(&mz)?))
+}
+
+/// Translations from `R_A t_X - t_Z = R_Z t_B - t_A` with fixed rotations.
+fn translations(chain: &Chain, rz: &Rotation3<f64>) -> Result<(Vector3<f64>, Vector3<f64>)> {
+    let mut normal = DMatrix::zeros(6, 6);
+    let mut rhs = DVector::zeros(6);
+    for (ra, ta, _, tb) in view_terms(chain) {
+        let mut k = DMatrix::zeros(3, 6);
+        k.view_mut((0, 0), (3, 3)).copy_from(&ra);
+        k.view_mut((0, 3), (3, 3))
+            .copy_from(&(-Matrix3::identity()));
+        let b = rz * tb - ta;
+        rhs += k.transpose() * DVector::from_column_slice(b.as_slice());
+        normal += k.transpose() * k;
+    }
+    let (t, dropped) = least_squares(&normal, &rhs)?;
+    if !dropped.is_empty() {
+        return Err(Error::degenerate(
+            "AX = ZB translation is not observable (robot rotations too similar)",
+        ));
+    }
+    Ok((
+        Vector3::new(t[0], t[1], t[2]),
+        Vector3::new(t[3], t[4], t[5]),
+    ))
+}

@@ -1,0 +1,269 @@
+//! Degeneracy and input mistakes caught before solving, each with the
+//! numbers and what to change: too few poses, too little rotation,
+//! translation-only motion, a mm/m unit mistake, inverted robot poses, a pose
+//! file shifted by one against the images, and the ranking of candidate
+//! rotation conventions from the pose parser.
+
+use super::axxb;
+use super::motion::build_motions;
+use super::report::{motion_residuals, motion_rms};
+use super::solve::{HandEyeInput, HandEyeOptions};
+use super::{Chain, HandEyeMethod, MotionPairs, Pose, Setup, MIN_MOTION_ROTATION_DEG};
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Fewest pose pairs hand-eye calibration accepts.
+pub const MIN_POSES: usize = 3;
+/// Robot motions that translate less than this (m) count as "not moving".
+const MIN_TRANSLATION_M: f64 = 1e-3;
+/// An alternative reading of the input must fit this many times better than
+/// the input as given to be reported as the likely mistake.
+const MISTAKE_RATIO: f64 = 5.0;
+/// ... and the input as given must be off by at least this much (degrees).
+const MISTAKE_MIN_ROTATION_DEG: f64 = 0.5;
+/// Fitted robot-translation scales outside [1/this, this] are a unit mistake.
+const SCALE_TOLERANCE: f64 = 1.5;
+
+/// How well robot poses fit the camera motion (Park-Martin rotation, least
+/// squares translation, residuals of `A X = X B` over all motion pairs).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Consistency {
+    /// RMS rotation residual of the motions (degrees).
+    pub rotation_rms_deg: f64,
+    /// RMS translation residual of the motions (mm).
+    pub translation_rms_mm: f64,
+    /// Scale of the robot translations that best fits the camera motion
+    /// (1 when both are in the same unit).
+    pub robot_translation_scale: f64,
+}
+
+/// Score robot poses against the camera motion.
+pub fn consistency(
+    setup: Setup,
+    base_from_gripper: &[Pose],
+    camera_from_target: &[Pose],
+) -> Result<Consistency> {
+    let chain = Chain::new(setup, base_from_gripper, camera_from_target)?;
+    let set = build_motions(&chain, MotionPairs::All);
+    let axes = super::motion::robot_axes(&set.kept);
+    let x = if super::motion::axis_spread(&axes).1 < super::scara::PARALLEL_AXES_DEG {
+        super::scara::solve(&set.kept)?.0
+    } else {
+        axxb::solve(HandEyeMethod::ParkMartin, &set.kept)?.0
+    };
+    let (t, r) = motion_rms(&motion_residuals(&set.kept, &x));
+    let r_x = x.rotation.to_rotation_matrix();
+    // (R_A - I) t - s t_A... unknowns [t, k]: (R_A - I) t + k t_A = R_X t_B.
+    let mut normal = DMatrix::zeros(4, 4);
+    let mut rhs = DVector::zeros(4);
+    for m in &set.kept {
+        let mut a = DMatrix::zeros(3, 4);
+        let c = m.robot.rotation.to_rotation_matrix().into_inner() - Matrix3::identity();
+        a.view_mut((0, 0), (3, 3)).copy_from(&c);
+        a.view_mut((0, 3), (3, 1))
+            .copy_from(&m.robot.translation.vector);
+        let b = r_x * m.camera.translation.vector;
+        rhs += a.transpose() * DVector::from_column_slice(b.as_slice());
+        normal += a.transpose() * a;
+    }
+    let scale = super::math::least_squares(&normal, &rhs)
+        .map(|(w, _)| w[3])
+        .unwrap_or(1.0);
+    Ok(Consistency {
+        rotation_rms_deg: r,
+        translation_rms_mm: t,
+        robot_translation_scale: scale,
+    })
+}
+
+/// A candidate reading of the robot pose file, scored.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct CandidateScore {
+    /// The candidate's name (e.g. a rotation convention).
+    pub name: String,
+    /// Its fit, or `None` when it could not be scored.
+    pub consistency: Option<Consistency>,
+}
+
+/// Rank candidate parses of the robot poses (e.g. the rotation conventions a
+/// pose parser could not tell apart) by how well each fits the camera
+/// motion, best first. Rotation angles of robot and camera motions must match
+/// whatever the hand-eye transform is, so a wrong convention shows up as a
+/// large rotation residual.
+pub fn rank_pose_candidates(
+    setup: Setup,
+    candidates: &[(String, Vec<Pose>)],
+    camera_from_target: &[Pose],
+) -> Vec<CandidateScore> {
+    let mut scores: Vec<CandidateScore> = candidates
+        .iter()
+        .map(|(name, poses)| CandidateScore {
+            name: name.clone(),
+            consistency: consistency(setup, poses, camera_from_target).ok(),
+        })
+        .collect();
+    let key = |c: &CandidateScore| {
+        c.consistency
+            .as_ref()
+            .map(|k| k.rotation_rms_deg)
+            .unwrap_or(f64::INFINITY)
+    };
+    scores.sort_by(|a, b| key(a).total_cmp(&key(b)));
+    scores
+}
+
+/// The recommendation message for ranked candidates.
+pub fn recommend_candidate(scores: &[CandidateScore]) -> Option<String> {
+    let best = scores.first()?;
+    let c = best.consistency.as_ref()?;
+    let runner = scores.get(1).and_then(|s| {
+        s.consistency
+            .as_ref()
+            .map(|k| (s.name.as_str(), k.rotation_rms_deg))
+    });
+    let mut msg = format!(
+        "pose format '{}' fits the camera motion best (rotation RMS {:.3} deg, translation RMS {:.2} mm)",
+        best.name, c.rotation_rms_deg, c.translation_rms_mm
+    );
+    if let Some((name, r)) = runner {
+        msg.push_str(&format!("; next best '{name}' has rotation RMS {r:.3} deg"));
+    }
+    Some(msg)
+}
+
+/// Check counts, finiteness, rotation diversity and input mistakes. Returns
+/// warnings; errors for what cannot be solved (and for mistakes when
+/// `options.strict_checks`).
+pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec<String>> {
+    let n = input
+        .base_from_gripper
+        .len()
+        .min(input.camera_from_target.len());
+    if n < MIN_POSES {
+        return Err(Error::too_few("pose pairs", MIN_POSES, n));
+    }
+    for (what, poses) in [
+        ("base_from_gripper", &input.base_from_gripper),
+        ("camera_from_target", &input.camera_from_target),
+    ] {
+        if let Some(i) = poses.iter().position(|p| {
+            !p.translation.vector.iter().all(|v| v.is_finite())
+                || !p.rotation.coords.iter().all(|v| v.is_finite())
+        }) {
+            return Err(Error::invalid(what, format!("pose {i} is not finite")));
+        }
+    }
+    let chain = Chain::new(
+        input.setup,
+        &input.base_from_gripper,
+        &input.camera_from_target,
+    )?;
+    let set = build_motions(&chain, options.motion_pairs);
+    if set.kept.len() < 2 {
+        let moved = (1..chain.len()).any(|i| {
+            (chain.robot[i].translation.vector - chain.robot[0].translation.vector).norm()
+                > MIN_TRANSLATION_M
+        });
+        let what = if moved && set.largest_rotation_deg < MIN_MOTION_ROTATION_DEG {
+            "the robot only translated"
+        } else {
+            "the robot rotations are too small"
+        };
+        return Err(Error::degenerate(format!(
+            "{what}: the largest rotation between two poses is {:.2} deg and {} motion pair(s) \
+             rotate at least {MIN_MOTION_ROTATION_DEG} deg (2 needed); the hand-eye rotation is \
+             unobservable: rotate the gripper between poses, ideally by 30 deg or more about at \
+             least two different axes",
+            set.largest_rotation_deg,
+            set.kept.len()
+        )));
+    }
+    let findings = mistakes(input)?;
+    if options.strict_checks {
+        if let Some(first) = findings.first() {
+            return Err(Error::invalid("robot poses", first.clone()));
+        }
+    }
+    Ok(findings)
+}
+
+/// Messages for likely input mistakes (empty when the input looks right).
+pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
+    let (bfg, cft) = (&input.base_from_gripper, &input.camera_from_target);
+    let given = consistency(input.setup, bfg, cft)?;
+    let mut found = Vec::new();
+    let off = given.rotation_rms_deg;
+    let better = |alt: &Consistency| {
+        off > MISTAKE_MIN_ROTATION_DEG && alt.rotation_rms_deg * MISTAKE_RATIO < off
+    };
+    let inverted: Vec<Pose> = bfg.iter().map(|p| p.inverse()).collect();
+    if let Ok(alt) = consistency(input.setup, &inverted, cft) {
+        if better(&alt) {
+            found.push(format!(
+                "the robot poses look inverted: read as gripper_from_base they fit the camera \
+                 motion with rotation RMS {:.3} deg, against {off:.3} deg as base_from_gripper: \
+                 invert them (or choose the pose format that gives base_from_gripper)",
+                alt.rotation_rms_deg
+            ));
+        }
+    }
+    let n = bfg.len();
+    for (label, robot, camera) in [
+        ("robot pose i+1 with image i", &bfg[1..], &cft[..n - 1]),
+        ("robot pose i with image i+1", &bfg[..n - 1], &cft[1..]),
+    ] {
+        if let Ok(alt) = consistency(input.setup, robot, camera) {
+            if better(&alt) && robot.len() >= MIN_POSES {
+                found.push(format!(
+                    "the pose file looks shifted by one against the images: pairing {label} fits \
+                     with rotation RMS {:.3} deg, against {off:.3} deg as given: remove the extra \
+                     first {} so that the lists pair up",
+                    alt.rotation_rms_deg,
+                    if label.starts_with("robot pose i+1") {
+                        "robot pose"
+                    } else {
+                        "image"
+                    }
+                ));
+            }
+        }
+    }
+    // The scale is only meaningful when the rotations fit as given.
+    if found.is_empty() {
+        let s = given.robot_translation_scale;
+        if s.is_finite() && s > 0.0 && (s > SCALE_TOLERANCE || s < 1.0 / SCALE_TOLERANCE) {
+            let hint = if (s.log10() + 3.0).abs() < 0.15 {
+                "the robot poses look like millimetres while the camera poses are metres: convert the \
+                 robot translations to metres (divide by 1000) or choose a pose format with mm units"
+            } else if (s.log10() - 3.0).abs() < 0.15 {
+                "the camera poses look like millimetres while the robot poses are metres: convert the \
+                 camera translations to metres (divide by 1000)"
+            } else {
+                "check the translation units of the robot and camera pose files"
+            };
+            found.push(format!(
+                "the robot translations fit the camera motion only when scaled by {s:.4}: {hint}"
+            ));
+        }
+    }
+    Ok(found)
+}
+
+/// The warning for parallel rotation axes (SCARA).
+pub fn scara_message(setup: Setup, axis: &Vector3<f64>, spread_deg: f64) -> String {
+    let frame = match setup {
+        Setup::EyeInHand => "gripper",
+        Setup::EyeToHand => "base",
+    };
+    format!(
+        "all robot rotations are about one axis (spread {spread_deg:.3} deg; a 4-axis SCARA \
+         robot or planar motion): solved the observable part only; the translation of {} along \
+         the common rotation axis [{:.4}, {:.4}, {:.4}] ({frame} frame) is unobservable and was \
+         set to 0: measure it another way (e.g. a known height) or tilt the gripper between poses",
+        setup.camera_key(),
+        axis.x,
+        axis.y,
+        axis.z
+    )
+}

@@ -1,0 +1,197 @@
+//! The JSON report (the output contract of `robocal handeye` and of the
+//! wasm `solve_handeye`): `gripper_from_camera` or `base_from_camera`, the
+//! target pose, `methods`, `errors`, `warnings`, plus per-view residuals,
+//! motion statistics and repeatability.
+
+use super::motion::MotionStats;
+use super::repeat::Repeatability;
+use super::report::{Errors, MotionResidual, ViewResidual};
+use super::solve::HandEyeResult;
+use super::{Pose, Setup};
+use serde::{Deserialize, Serialize};
+
+/// A transform as JSON: row-major 4x4, translation (m), quaternion (x, y, z, w).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct PoseJson {
+    /// The 4x4 homogeneous matrix, row by row.
+    pub matrix_row_major: [[f64; 4]; 4],
+    /// Translation (metres).
+    pub translation_m: [f64; 3],
+    /// Rotation quaternion, order x, y, z, w.
+    pub quaternion_xyzw: [f64; 4],
+}
+
+impl From<&Pose> for PoseJson {
+    fn from(p: &Pose) -> Self {
+        let m = p.to_homogeneous();
+        let mut rows = [[0.0; 4]; 4];
+        for (r, row) in rows.iter_mut().enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = m[(r, c)];
+            }
+        }
+        let t = p.translation.vector;
+        let q = p.rotation;
+        PoseJson {
+            matrix_row_major: rows,
+            translation_m: [t.x, t.y, t.z],
+            quaternion_xyzw: [q.i, q.j, q.k, q.w],
+        }
+    }
+}
+
+/// One solver in the side-by-side comparison.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct MethodJson {
+    /// Method name.
+    pub method: String,
+    /// The camera transform (key named by the setup), absent when the method failed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_camera: Option<PoseJson>,
+    /// Eye-to-hand camera transform.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_camera: Option<PoseJson>,
+    /// Eye-in-hand target transform.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_target: Option<PoseJson>,
+    /// Eye-to-hand target transform.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_target: Option<PoseJson>,
+    /// Closure errors of this method's solution.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub errors: Option<Errors>,
+    /// Translation distance of its camera transform from the primary one (mm).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub disagreement_translation_mm: Option<f64>,
+    /// Rotation distance of its camera transform from the primary one (degrees).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub disagreement_rotation_deg: Option<f64>,
+    /// Why the method failed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub error: Option<String>,
+}
+
+/// The full report.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct HandEyeReport {
+    /// `eye-in-hand` or `eye-to-hand`.
+    pub setup: Setup,
+    /// The primary solution's method.
+    pub method: String,
+    /// Eye-in-hand result.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_camera: Option<PoseJson>,
+    /// Eye-to-hand result.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_camera: Option<PoseJson>,
+    /// Eye-in-hand target pose.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_target: Option<PoseJson>,
+    /// Eye-to-hand target pose.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_target: Option<PoseJson>,
+    /// Summary errors of the primary solution.
+    pub errors: Errors,
+    /// Every solver side by side.
+    pub methods: Vec<MethodJson>,
+    /// Largest disagreement between any solver and the primary: (mm).
+    pub methods_max_disagreement_translation_mm: f64,
+    /// ... and (degrees).
+    pub methods_max_disagreement_rotation_deg: f64,
+    /// Per-view residuals.
+    pub per_view: Vec<ViewResidual>,
+    /// Per-motion residuals.
+    pub per_motion: Vec<MotionResidual>,
+    /// Motion diversity.
+    pub motion: MotionStats,
+    /// Unit directions along which the camera transform's translation is unobservable.
+    pub unobservable_translation_axes: Vec<[f64; 3]>,
+    /// Leave-one-out and bootstrap.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub repeatability: Option<Repeatability>,
+    /// Everything the user should know.
+    pub warnings: Vec<String>,
+    /// robocal version that produced the report.
+    pub robocal_version: String,
+}
+
+type PosePair = (
+    Option<PoseJson>,
+    Option<PoseJson>,
+    Option<PoseJson>,
+    Option<PoseJson>,
+);
+
+/// The four optional keys for `(x, y)` in `setup`: (gripper_from_camera,
+/// base_from_camera, base_from_target, gripper_from_target).
+fn keyed(setup: Setup, x: &Pose, y: &Pose) -> PosePair {
+    match setup {
+        Setup::EyeInHand => (Some(x.into()), None, Some(y.into()), None),
+        Setup::EyeToHand => (None, Some(x.into()), None, Some(y.into())),
+    }
+}
+
+impl HandEyeReport {
+    /// Build the serialisable report of a result.
+    pub fn new(result: &HandEyeResult) -> Self {
+        let methods: Vec<MethodJson> = result
+            .methods
+            .iter()
+            .map(|m| {
+                let mut j = MethodJson {
+                    method: m.method.name().to_string(),
+                    gripper_from_camera: None,
+                    base_from_camera: None,
+                    base_from_target: None,
+                    gripper_from_target: None,
+                    errors: None,
+                    disagreement_translation_mm: m.disagreement.map(|d| d.0),
+                    disagreement_rotation_deg: m.disagreement.map(|d| d.1),
+                    error: None,
+                };
+                match &m.outcome {
+                    Ok((x, y, e)) => {
+                        let k = keyed(result.setup, x, y);
+                        (j.gripper_from_camera, j.base_from_camera) = (k.0, k.1);
+                        (j.base_from_target, j.gripper_from_target) = (k.2, k.3);
+                        j.errors = Some(e.clone());
+                    }
+                    Err(e) => j.error = Some(e.to_string()),
+                }
+                j
+            })
+            .collect();
+        let max_t = methods
+            .iter()
+            .filter_map(|m| m.disagreement_translation_mm)
+            .fold(0.0, f64::max);
+        let max_r = methods
+            .iter()
+            .filter_map(|m| m.disagreement_rotation_deg)
+            .fold(0.0, f64::max);
+        let k = keyed(result.setup, &result.x, &result.y);
+        HandEyeReport {
+            setup: result.setup,
+            method: result.method.clone(),
+            gripper_from_camera: k.0,
+            base_from_camera: k.1,
+            base_from_target: k.2,
+            gripper_from_target: k.3,
+            errors: result.errors.clone(),
+            methods,
+            methods_max_disagreement_translation_mm: max_t,
+            methods_max_disagreement_rotation_deg: max_r,
+            per_view: result.per_view.clone(),
+            per_motion: result.per_motion.clone(),
+            motion: result.motion.clone(),
+            unobservable_translation_axes: result
+                .unobservable_translation
+                .iter()
+                .map(|v| [v.x, v.y, v.z])
+                .collect(),
+            repeatability: result.repeatability.clone(),
+            warnings: result.warnings.clone(),
+            robocal_version: crate::VERSION.to_string(),
+        }
+    }
+}
