@@ -3,6 +3,7 @@
 pub mod args;
 mod export;
 mod planar;
+mod handeye;
 mod serve;
 mod xytable;
 
@@ -60,6 +61,7 @@ Commands:
   serve       serve the web app (a static folder) on http://127.0.0.1:8080
   export      convert a calibration report into OpenCV, ROS, Kalibr, mrcal, Halcon,
               MATLAB, URDF, robot-controller and other formats
+  handeye     hand-eye calibration from robot poses and camera poses
   info        decode images and print their format and size
   planar      eye-to-hand calibration at any height (plate corners per height)
   xytable     camera over an XY-table with one circular target (batch DLT and
@@ -88,6 +90,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
         "serve" => serve::run(rest),
         "export" if wants_help => print_help(export::HELP),
         "export" => export::run(rest),
+        "handeye" if wants_help => print_help(handeye::HELP),
+        "handeye" => handeye::run(rest),
         "info" if wants_help => print_help(INFO_HELP),
         "info" => info(rest),
         "planar" if wants_help => print_help(planar::HELP),

@@ -41,6 +41,7 @@ pub mod daniilidis;
 pub mod math;
 pub mod motion;
 pub mod output;
+pub mod pose_text;
 pub mod repeat;
 pub mod report;
 pub mod scara;
