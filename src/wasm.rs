@@ -204,4 +204,12 @@ pub fn known_motion_solve(json: &str) -> Result<String, JsError> {
         json,
         crate::workflows::known_motion::solve_known_motion,
     )
+/// Hand-eye calibration: input JSON as documented in
+/// `robocal::handeye::json_api` (setup, base_from_gripper,
+/// camera_from_target, method, ...); returns the report JSON
+/// (`gripper_from_camera` or `base_from_camera`, the target pose, `methods`,
+/// `errors`, `warnings`, ...).
+#[wasm_bindgen]
+pub fn solve_handeye(input_json: &str) -> Result<String, JsError> {
+    crate::handeye::json_api::solve_handeye_json(input_json).map_err(js_error)
 }

@@ -1,22 +1,18 @@
 //! Daniilidis 1999: AX = XB with dual quaternions, rotation and translation
 //! from one SVD.
 
-use super::math::{ascending_eigenvectors, quat_from_wxyz, quat_wxyz, skew};
+use super::math::{ascending_eigenvectors, skew};
 use super::{Motion, Pose};
 use crate::error::{Error, Result};
-use nalgebra::{DMatrix, Quaternion, SMatrix, Translation3, UnitQuaternion, Vector3, Vector4};
+use crate::geometry::DualQuaternion;
+use nalgebra::{DMatrix, Quaternion, SMatrix, Vector3, Vector4};
 
-/// Unit dual quaternion `(q, q')` of a pose, `q' = 0.5 (0, t) q`, in
-/// `[w, x, y, z]` order, with the real part's scalar made non-negative.
+/// Unit dual quaternion `(q, q')` of a pose as two `[w, x, y, z]` vectors,
+/// real part with `w >= 0` ([`DualQuaternion::from_pose`]).
 fn dual_quaternion(p: &Pose) -> (Vector4<f64>, Vector4<f64>) {
-    let mut q = quat_wxyz(&p.rotation);
-    if q[0] < 0.0 {
-        q = -q;
-    }
-    let t = p.translation.vector;
-    let qq = Quaternion::new(q[0], q[1], q[2], q[3]);
-    let d = Quaternion::new(0.0, t.x, t.y, t.z) * qq * 0.5;
-    (q, Vector4::new(d.w, d.i, d.j, d.k))
+    let dq = DualQuaternion::from_pose(p);
+    let v = |q: &Quaternion<f64>| Vector4::new(q.w, q.i, q.j, q.k);
+    (v(&dq.real), v(&dq.dual))
 }
 
 /// Solve AX = XB. Per motion the 6x8 block
@@ -73,14 +69,11 @@ pub fn solve(motions: &[Motion]) -> Result<(Pose, Vec<Vector3<f64>>)> {
         .ok_or_else(|| {
             Error::degenerate("Daniilidis: no unit dual quaternion in the null space")
         })?;
-    let rotation: UnitQuaternion<f64> = quat_from_wxyz(&q)?;
-    let qq = Quaternion::new(q[0], q[1], q[2], q[3]);
-    let d = Quaternion::new(qd[0], qd[1], qd[2], qd[3]);
-    let t = (d * qq.conjugate()) * 2.0;
-    let pose = Pose::from_parts(Translation3::new(t.i, t.j, t.k), rotation);
-    if !pose.translation.vector.iter().all(|v| v.is_finite()) {
-        return Err(Error::degenerate("Daniilidis: translation is not finite"));
+    let pose = DualQuaternion {
+        real: Quaternion::new(q[0], q[1], q[2], q[3]),
+        dual: Quaternion::new(qd[0], qd[1], qd[2], qd[3]),
     }
+    .to_pose()?;
     Ok((pose, Vec::new()))
 }
 

@@ -1,5 +1,5 @@
-//! Small linear-algebra helpers shared by the hand-eye solvers: projection
-//! onto SO(3), chordal rotation means, skew matrices, the smallest
+//! Small linear-algebra helpers of the hand-eye solvers (on top of
+//! [`crate::geometry`]): projection onto SO(3), the mean pose, skew matrices, the smallest
 //! eigenvector of a symmetric matrix and a rank-aware least-squares solve.
 
 use crate::error::{Error, Result};
@@ -12,19 +12,10 @@ use nalgebra::{
 /// unobservable in [`least_squares`].
 pub const RANK_TOLERANCE: f64 = 1e-9;
 
-/// The nearest rotation (Frobenius norm) to `m`, by SVD with the determinant
-/// fixed to +1.
+/// The nearest rotation (Frobenius norm) to `m`, determinant +1 (the
+/// shared [`crate::geometry::nearest_rotation`]).
 pub fn project_to_so3(m: &Matrix3<f64>) -> Result<Rotation3<f64>> {
-    if !m.iter().all(|v| v.is_finite()) {
-        return Err(Error::degenerate("rotation estimate is not finite"));
-    }
-    let svd = m.svd(true, true);
-    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
-        return Err(Error::degenerate("SVD of the rotation estimate failed"));
-    };
-    let d = (u * v_t).determinant().signum();
-    let fix = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d));
-    Ok(Rotation3::from_matrix_unchecked(u * fix * v_t))
+    crate::geometry::nearest_rotation(m)
 }
 
 /// Skew-symmetric matrix with `skew(a) * b = a x b`.
@@ -75,29 +66,18 @@ pub fn least_squares(
     Ok((x, dropped))
 }
 
-/// Chordal L2 mean of rotations (SVD of the summed matrices).
-pub fn mean_rotation(rotations: &[Rotation3<f64>]) -> Result<Rotation3<f64>> {
-    let sum = rotations
-        .iter()
-        .fold(Matrix3::zeros(), |acc, r| acc + r.matrix());
-    project_to_so3(&sum)
-}
-
 /// Mean pose: chordal mean rotation, arithmetic mean translation.
 pub fn mean_pose(poses: &[Isometry3<f64>]) -> Result<Isometry3<f64>> {
     if poses.is_empty() {
         return Err(Error::too_few("poses to average", 1, 0));
     }
-    let rotations: Vec<Rotation3<f64>> = poses.iter().map(|p| p.rotation.into()).collect();
-    let r = mean_rotation(&rotations)?;
+    let rotations: Vec<UnitQuaternion<f64>> = poses.iter().map(|p| p.rotation).collect();
+    let r = crate::geometry::average_rotations_chordal(&rotations, None)?;
     let t = poses
         .iter()
         .fold(Vector3::zeros(), |acc, p| acc + p.translation.vector)
         / poses.len() as f64;
-    Ok(Isometry3::from_parts(
-        Translation3::from(t),
-        UnitQuaternion::from_rotation_matrix(&r),
-    ))
+    Ok(Isometry3::from_parts(Translation3::from(t), r))
 }
 
 /// Quaternion as a 4-vector `[w, x, y, z]`.
@@ -166,11 +146,9 @@ mod tests {
     }
 
     #[wasm_bindgen_test(unsupported = test)]
-    fn projection_recovers_a_scaled_rotation_and_fixes_reflections() {
+    fn projection_recovers_a_scaled_rotation() {
         let r = Rotation3::from_scaled_axis(Vector3::new(0.5, 1.0, -2.0));
         let back = project_to_so3(&(r.matrix() * 3.0)).unwrap();
         assert!((back.matrix() - r.matrix()).norm() < 1e-12);
-        let reflected = project_to_so3(&(-r.matrix())).unwrap();
-        assert!((reflected.matrix().determinant() - 1.0).abs() < 1e-12);
     }
 }

@@ -38,6 +38,7 @@ pub mod axxb;
 pub mod axzb;
 pub mod checks;
 pub mod daniilidis;
+pub mod json_api;
 pub mod math;
 pub mod motion;
 pub mod output;
@@ -51,14 +52,12 @@ pub mod solve;
 mod solver_tests;
 
 use crate::error::{Error, Result};
-use nalgebra::Isometry3;
 use serde::{Deserialize, Serialize};
 
 pub use motion::{Motion, MotionPairs};
 pub use solve::{calibrate, HandEyeInput, HandEyeOptions, HandEyeResult};
 
-/// A rigid transform `a_from_b` (metres).
-pub type Pose = Isometry3<f64>;
+pub use crate::geometry::Pose;
 
 /// Motion pairs whose robot or camera rotation is below this angle (degrees)
 /// are discarded: their rotation axis is dominated by noise.
