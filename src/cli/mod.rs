@@ -2,8 +2,8 @@
 
 pub mod args;
 mod export;
-mod planar;
 mod handeye;
+mod planar;
 mod serve;
 mod xytable;
 
