@@ -204,6 +204,8 @@ pub fn known_motion_solve(json: &str) -> Result<String, JsError> {
         json,
         crate::workflows::known_motion::solve_known_motion,
     )
+}
+
 /// Hand-eye calibration: input JSON as documented in
 /// `robocal::handeye::json_api` (setup, base_from_gripper,
 /// camera_from_target, method, ...); returns the report JSON
