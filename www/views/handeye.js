@@ -7,8 +7,8 @@ import { FrameView } from '../lib/view3d.js';
 import { flat, mul, fromPose, IDENTITY } from '../lib/mat4.js';
 
 const METHODS = [
-  ['all', 'All methods (best one refined)'], ['tsai_lenz', 'Tsai-Lenz'], ['park_martin', 'Park-Martin'], ['horaud', 'Horaud'],
-  ['andreff', 'Andreff'], ['daniilidis', 'Daniilidis (dual quaternion)'], ['chou_kamel', 'Chou-Kamel'], ['shah', 'Shah (AX = ZB)'], ['li', 'Li (AX = ZB)'],
+  ['all', 'All methods (best one refined)'], ['tsai-lenz', 'Tsai-Lenz'], ['park-martin', 'Park-Martin'], ['horaud', 'Horaud'],
+  ['andreff', 'Andreff'], ['daniilidis', 'Daniilidis (dual quaternion)'], ['chou-kamel', 'Chou-Kamel'], ['shah', 'Shah (AX = ZB)'], ['li', 'Li (AX = ZB)'],
 ];
 
 export class HandEyeView {
