@@ -258,3 +258,30 @@ fn fixed_principal_point_and_aspect_ratio_hold() {
     assert!((report.std["fy"] - ratio * report.std["fx"]).abs() < 1e-12);
     assert!((c.fx - truth.fx).abs() < 0.05 * truth.fx, "fx {}", c.fx);
 }
+
+#[test]
+fn undetermined_parameters_give_a_warning_not_a_failure() {
+    // The rational model on distortion-free data: (1 + k1 r^2) / (1 + k4 r^2)
+    // is 1 for every k1 = k4, an exact null direction of J^T J.
+    let truth = Camera::example_pinhole();
+    let scene = Scene::calibration(23, &truth, (9, 6), 0.03, 8, 0.0).expect("scene");
+    let options = options_for(&Camera::example_rational());
+    let report = calibrate(&scene.views, (1280, 960), &options).expect("calibration");
+    assert!(report.rms_px < 1e-9, "rms {} px", report.rms_px);
+    assert!((report.camera.fx - truth.fx).abs() < 1e-9 * truth.fx);
+    assert!(report.std.is_empty() && report.correlation.matrix.is_empty());
+    assert!(report
+        .projection_uncertainty
+        .std_px
+        .iter()
+        .flatten()
+        .all(Option::is_none));
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("the views do not determine every camera parameter")),
+        "{:?}",
+        report.warnings
+    );
+}

@@ -4,7 +4,7 @@
 use super::refine::{pose_from_block, CalibProblem};
 use super::CalibrationOptions;
 use crate::camera::Camera;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geometry::{matrix4_from_pose, quaternion_xyzw_from_rotation, Pose};
 use crate::optim::{BlockProblem, LmResult, Termination};
 use nalgebra::{DMatrix, Point2, Point3, Vector3};
@@ -63,7 +63,8 @@ pub struct ViewReport {
 pub struct Correlation {
     /// Parameter names (rows and columns).
     pub names: Vec<String>,
-    /// Correlation coefficients, rows; 0 for held parameters.
+    /// Correlation coefficients, rows; 0 for held parameters; empty when
+    /// the parameters are not all determined.
     pub matrix: Vec<Vec<f64>>,
 }
 
@@ -103,7 +104,8 @@ pub struct CameraCalibration {
     /// sqrt(sum of squared residual norms / number of points), px (OpenCV's RMS).
     pub rms_px: f64,
     /// Standard deviation of every camera parameter (0 if held), from the
-    /// covariance scaled by the residual variance.
+    /// covariance scaled by the residual variance; empty (with a warning)
+    /// when the parameters are not all determined.
     pub std: BTreeMap<String, f64>,
     /// Per-view results.
     pub views: Vec<ViewReport>,
@@ -132,13 +134,21 @@ pub(crate) fn build_report(
 ) -> Result<CameraCalibration> {
     let camera = problem.camera(&result.params.global)?;
     let names: Vec<String> = camera.param_names().iter().map(|s| s.to_string()).collect();
-    let covariance = parameter_covariance(result, problem.aspect)?;
-    let std: BTreeMap<String, f64> = names
-        .iter()
-        .enumerate()
-        .map(|(i, n)| (n.clone(), covariance[(i, i)].max(0.0).sqrt()))
-        .collect();
-    let correlation = correlation(&names, &covariance);
+    // A singular J^T J at the optimum: some parameter is not determined.
+    // The camera is still the least-squares solution; the uncertainty
+    // outputs stay empty and a warning says why.
+    let covariance = parameter_covariance(result, problem.aspect);
+    let zero = DMatrix::zeros(0, 0);
+    let cov = covariance.as_ref().unwrap_or(&zero);
+    let std: BTreeMap<String, f64> = match &covariance {
+        Some(c) => names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.clone(), c[(i, i)].max(0.0).sqrt()))
+            .collect(),
+        None => BTreeMap::new(),
+    };
+    let correlation = correlation(&names, cov);
     let blocks = problem.residuals_and_jacobian(&result.params, false)?;
     let mut squared = vec![0.0; problem.views.len()];
     let mut counts = vec![0usize; problem.views.len()];
@@ -186,8 +196,8 @@ pub(crate) fn build_report(
             .collect(),
         rms_px: (squared.iter().sum::<f64>() / n_points.max(1) as f64).sqrt(),
         std,
-        projection_uncertainty: projection_uncertainty(&camera, &covariance, depth),
-        warnings: warnings(problem, &poses, &correlation),
+        projection_uncertainty: projection_uncertainty(&camera, cov, depth),
+        warnings: warnings(problem, &poses, &correlation, covariance.is_none()),
         views,
         correlation,
         iterations: result.iterations,
@@ -200,12 +210,8 @@ pub(crate) fn build_report(
 
 /// The covariance of the camera parameters, with fy's row and column
 /// derived from fx's when the aspect ratio is fixed (fy = a fx).
-fn parameter_covariance(result: &LmResult, aspect: Option<f64>) -> Result<DMatrix<f64>> {
-    let mut c = result.covariance_global.clone().ok_or_else(|| {
-        Error::degenerate(
-            "the camera parameters are not all determined by the views (singular normal equations)",
-        )
-    })?;
+fn parameter_covariance(result: &LmResult, aspect: Option<f64>) -> Option<DMatrix<f64>> {
+    let mut c = result.covariance_global.clone()?;
     if let Some(a) = aspect {
         let n = c.nrows();
         let mut t = DMatrix::<f64>::identity(n, n);
@@ -213,11 +219,11 @@ fn parameter_covariance(result: &LmResult, aspect: Option<f64>) -> Result<DMatri
         t[(1, 1)] = 0.0;
         c = &t * c * t.transpose();
     }
-    Ok(c)
+    Some(c)
 }
 
 fn correlation(names: &[String], c: &DMatrix<f64>) -> Correlation {
-    let n = names.len();
+    let n = c.nrows().min(names.len());
     let matrix = (0..n)
         .map(|i| {
             (0..n)
@@ -254,6 +260,9 @@ fn projection_uncertainty(camera: &Camera, c: &DMatrix<f64>, depth: f64) -> Proj
     let x_px: Vec<f64> = (0..cols).map(|i| at(i, cols, camera.width)).collect();
     let y_px: Vec<f64> = (0..rows).map(|i| at(i, rows, camera.height)).collect();
     let std_at = |x: f64, y: f64| -> Option<f64> {
+        if c.nrows() == 0 {
+            return None;
+        }
         let ray = camera.unproject(&Point2::new(x, y)).ok()?;
         let (_, _, j) = camera
             .project_with_jacobians(&Point3::from(ray * depth))
@@ -279,8 +288,20 @@ fn projection_uncertainty(camera: &Camera, c: &DMatrix<f64>, depth: f64) -> Proj
     }
 }
 
-fn warnings(problem: &CalibProblem, poses: &[Pose], correlation: &Correlation) -> Vec<String> {
+fn warnings(
+    problem: &CalibProblem,
+    poses: &[Pose],
+    correlation: &Correlation,
+    singular: bool,
+) -> Vec<String> {
     let mut out = vec![];
+    if singular {
+        out.push(
+            "the views do not determine every camera parameter (singular normal equations): \
+             std, correlation and projection uncertainty are not available; fix parameters or add tilted views"
+                .to_string(),
+        );
+    }
     let n_views = problem.views.len();
     if n_views < RECOMMENDED_VIEWS {
         out.push(format!(
@@ -331,7 +352,7 @@ fn warnings(problem: &CalibProblem, poses: &[Pose], correlation: &Correlation) -
     }
     // fx and fy move together by construction (square-ish pixels); their
     // correlation says nothing about a degeneracy, so it is not reported.
-    let n = correlation.names.len();
+    let n = correlation.matrix.len();
     for i in 0..n {
         for j in (i + 1)..n {
             let r = correlation.matrix[i][j];

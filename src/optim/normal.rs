@@ -17,6 +17,11 @@ use nalgebra::{DMatrix, DVector};
 /// does not constrain still get damped.
 const MIN_DIAGONAL: f64 = 1e-9;
 
+/// Smallest unexplained information fraction (1 - R^2) of a parameter
+/// before J^T J counts as singular: the parameter is then a combination of
+/// the others to 12 digits.
+const RANK_TOLERANCE: f64 = 1e-12;
+
 /// J^T J and J^T r, accumulated per block, with robust weights applied.
 #[derive(Clone, Debug)]
 pub(crate) struct Normal {
@@ -174,7 +179,29 @@ impl Normal {
     /// parameters. `None` when J^T J is singular (unobservable parameters).
     pub fn covariances(&self, mask: &Mask) -> Option<(DMatrix<f64>, Vec<DMatrix<f64>>)> {
         let (s, v_inv) = self.schur(|m| m.clone())?;
-        let mut s_inv = s.cholesky()?.inverse();
+        // Rank test on the correlation form: the squared Cholesky pivot of
+        // parameter i is the fraction of its information not explained by
+        // the parameters before it (1 - R^2).
+        let d: Vec<f64> = s.diagonal().iter().map(|v| v.sqrt()).collect();
+        if d.iter().any(|v| !(*v > 0.0) || !v.is_finite()) {
+            return None;
+        }
+        let scaled = DMatrix::from_fn(s.nrows(), s.ncols(), |i, j| s[(i, j)] / (d[i] * d[j]));
+        let chol = scaled.cholesky()?;
+        if chol
+            .l_dirty()
+            .diagonal()
+            .iter()
+            .any(|p| p * p < RANK_TOLERANCE)
+        {
+            return None;
+        }
+        let mut s_inv = chol.inverse();
+        for i in 0..s_inv.nrows() {
+            for j in 0..s_inv.ncols() {
+                s_inv[(i, j)] /= d[i] * d[j];
+            }
+        }
         for (k, &free) in mask.global.iter().enumerate() {
             if !free {
                 s_inv.row_mut(k).fill(0.0);
