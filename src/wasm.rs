@@ -215,3 +215,30 @@ pub fn known_motion_solve(json: &str) -> Result<String, JsError> {
 pub fn solve_handeye(input_json: &str) -> Result<String, JsError> {
     crate::handeye::json_api::solve_handeye_json(input_json).map_err(js_error)
 }
+
+/// Read a workflow CSV (the files of `robocal planar` / `robocal xytable`)
+/// into the request JSON of the matching solver: `kind` is
+/// `planar-matrices` (-> `{"matrices"}` for `planar_fit`), `planar-points`
+/// (-> `{"points"}` for `planar_solve`), `xytable` (-> the `xytable_solve`
+/// request) or `known-motion` (-> the `known_motion_solve` request).
+#[wasm_bindgen]
+pub fn workflow_csv(kind: &str, text: &str) -> Result<String, JsError> {
+    use crate::io::workflow_csv as csv;
+    let value = match kind {
+        "planar-matrices" => csv::parse_planar_matrices(text)
+            .map(|m| serde_json::json!({ "matrices": m })),
+        "planar-points" => csv::parse_planar_points(text).map(|p| serde_json::json!({ "points": p })),
+        "xytable" => csv::parse_xytable(text).and_then(|r| {
+            serde_json::to_value(r).map_err(|e| crate::Error::invalid("xytable", e.to_string()))
+        }),
+        "known-motion" => csv::parse_known_motion(text).and_then(|r| {
+            serde_json::to_value(r).map_err(|e| crate::Error::invalid("known-motion", e.to_string()))
+        }),
+        other => Err(crate::Error::invalid(
+            "kind",
+            format!("unknown workflow file '{other}' (known: planar-matrices, planar-points, xytable, known-motion)"),
+        )),
+    }
+    .map_err(js_error)?;
+    Ok(value.to_string())
+}

@@ -9,6 +9,7 @@ import { ImagesView } from './views/images.js';
 import { CameraView } from './views/camera.js';
 import { RobotView } from './views/robot.js';
 import { HandEyeView } from './views/handeye.js';
+import { WorkflowsView } from './views/workflows.js';
 import { ExportView } from './views/export.js';
 import { ShareView, sharedFragment, decodeShare } from './views/share.js';
 
@@ -82,6 +83,7 @@ async function main() {
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);
   new HandEyeView(store, engine, robot);
+  new WorkflowsView(store, engine);
   new ExportView(store, engine);
   new ShareView(store, await versionPromise, () => camera.plots || []);
   store.onChange((what) => { if (/detections|included|images|all/.test(what)) camera.summarise(); });

@@ -56,6 +56,18 @@ handlers.handeye = async ({ input }) => {
   return JSON.parse(robocal.solve_handeye(input));
 };
 
+handlers['workflow-csv'] = async ({ kind, text }) => {
+  await ready;
+  return JSON.parse(robocal.workflow_csv(kind, text));
+};
+
+const WORKFLOW_OPS = new Set(['planar_fit', 'planar_solve', 'xytable_solve', 'known_motion_solve']);
+handlers.workflow = async ({ op, input }) => {
+  await ready;
+  if (!WORKFLOW_OPS.has(op)) throw new Error(`unknown workflow '${op}'`);
+  return JSON.parse(robocal[op](input));
+};
+
 function requireFn(name) {
   if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
 }

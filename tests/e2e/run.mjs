@@ -1,7 +1,7 @@
 // Runs every browser test suite; exits non-zero on any failure.
 import { run } from './harness.mjs';
 
-const suites = ['foundation'];
+const suites = ['foundation', 'workflows'];
 let failed = 0;
 for (const suite of suites) {
   const { tests } = await import(`./${suite}.mjs`);
