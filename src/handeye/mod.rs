@@ -43,11 +43,14 @@ pub mod math;
 pub mod motion;
 pub mod output;
 pub mod pose_text;
+pub mod refine;
 pub mod repeat;
 pub mod report;
 pub mod scara;
 pub mod solve;
 
+#[cfg(test)]
+mod refine_tests;
 #[cfg(test)]
 mod solver_tests;
 

@@ -177,3 +177,44 @@ pub fn handeye_scene(config: &HandEyeSceneConfig, seed: u64) -> HandEyeScene {
     }
     scene
 }
+
+/// Image points of a planar grid target (`cols` x `rows` points, `spacing`
+/// metres, z = 0 in the target frame) in every view of `scene`, projected
+/// with `camera` through the noise-free camera poses, plus Gaussian pixel
+/// noise `pixel_sigma` per coordinate. Points that fail to project are left out.
+pub fn project_grid(
+    scene: &HandEyeScene,
+    camera: &crate::camera::Camera,
+    grid: (usize, usize, f64),
+    pixel_sigma: f64,
+    seed: u64,
+) -> Vec<crate::handeye::refine::ViewPoints> {
+    let mut rng = Rng::new(seed);
+    let (cols, rows, spacing) = grid;
+    let object: Vec<nalgebra::Point3<f64>> = (0..rows)
+        .flat_map(|r| {
+            (0..cols)
+                .map(move |c| nalgebra::Point3::new(c as f64 * spacing, r as f64 * spacing, 0.0))
+        })
+        .collect();
+    scene
+        .camera_from_target_true
+        .iter()
+        .map(|pose| {
+            let mut view = crate::handeye::refine::ViewPoints {
+                object_points: Vec::new(),
+                image_points: Vec::new(),
+            };
+            for p in &object {
+                if let Ok(px) = camera.project(&(pose * p)) {
+                    view.object_points.push(*p);
+                    view.image_points.push(nalgebra::Point2::new(
+                        px.x + rng.gaussian(pixel_sigma),
+                        px.y + rng.gaussian(pixel_sigma),
+                    ));
+                }
+            }
+            view
+        })
+        .collect()
+}
