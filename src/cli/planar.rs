@@ -32,7 +32,11 @@ Both print JSON: 'fit' keyed a11 a12 tx a21 a22 ty, each {intercept, slope,
 r2, pearson_r, adj_r2, rss, n, intercept_std, slope_std, ...} (r2, pearson_r
 and adj_r2 are null where undefined), 'rejected_heights_mm', 'predictions';
 'solve' adds 'heights' (per height: robot_from_image, reflected,
-residuals_mm, rms_mm), 'pixel_density' and 'density_fit'.
+residuals_mm, rms_mm), 'pixel_density', 'density_fit', and 'exact_family'
+{projection_matrix, rms_px}: the physically exact alternative (the 3x4
+projection of robot (x, y, z = height) in mm fitted by the 12-parameter DLT;
+the image of each plane is a homography, linear in height; needs >= 6
+points) with 'exact_predictions_mm' for the --point pixels.
 
 Options:
   --transform KIND      solve: rigid, similarity or affine (default: affine,
@@ -40,6 +44,9 @@ Options:
   --reject SIGMA        reject heights whose residual exceeds SIGMA standard
                         deviations (externally studentized, per parameter,
                         at most a quarter of them), then refit
+  --camera FILE         solve: a calibrated camera (robocal JSON, OpenCV
+                        YAML/XML or ROS camera_info); the image points are
+                        undistorted with it first
   --plate-size-mm L,W   solve: plate length |AB| and width |BC| for the pixel
                         density (default: from the robot coordinates)
   --predict HEIGHT_MM   map pixels at this height (with --point)
@@ -54,7 +61,14 @@ Examples:
 pub fn run(raw: &[String]) -> Result<(), CliError> {
     let spec = Spec {
         command: "planar",
-        valued: &["transform", "reject", "plate-size-mm", "predict", "point"],
+        valued: &[
+            "transform",
+            "reject",
+            "plate-size-mm",
+            "camera",
+            "predict",
+            "point",
+        ],
         switches: &[],
     };
     let args = Args::parse(raw, &spec)?;
@@ -81,10 +95,13 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     let text = read_text(file)?;
     let json = match sub {
         "fit" => {
-            if args.value("transform").is_some() || args.value("plate-size-mm").is_some() {
+            if ["transform", "plate-size-mm", "camera"]
+                .iter()
+                .any(|f| args.value(f).is_some())
+            {
                 return Err(CliError::usage(
                     "planar",
-                    "--transform and --plate-size-mm belong to 'solve'",
+                    "--transform, --plate-size-mm and --camera belong to 'solve'",
                 ));
             }
             let request = PlanarFitRequest {
@@ -99,6 +116,14 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
                 Some(t) => TransformKind::parse(t)?,
                 None => TransformKind::Affine,
             };
+            let camera = match args.value("camera") {
+                None => None,
+                Some(path) => Some(
+                    robocal::io::import_camera::import_camera(&read_text(path)?)
+                        .map_err(|e| CliError::Io(format!("{path}: {e}")))?
+                        .0,
+                ),
+            };
             let plate_size_mm = args
                 .value("plate-size-mm")
                 .map(|v| pair(v, "plate-size-mm"))
@@ -109,6 +134,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
                     transform,
                     reject_threshold: reject,
                     plate_size_mm,
+                    camera,
                 },
                 predict,
             };

@@ -99,6 +99,9 @@ pub struct PlanarSolveResponse {
     pub report: PlanarSolveReport,
     /// The mapped pixels, in request order.
     pub predictions: Vec<MappedPoint>,
+    /// The same pixels mapped by the exact homography family (robot X, Y
+    /// in mm), when it was fitted.
+    pub exact_predictions_mm: Option<Vec<[f64; 2]>>,
 }
 
 /// Solve the planar workflow from point pairs and map the requested pixels.
@@ -110,9 +113,21 @@ pub fn planar_solve(request: &PlanarSolveRequest) -> Result<PlanarSolveResponse>
         .iter()
         .map(|p| model.map(p.height_mm, p.image_px))
         .collect();
+    let exact_predictions_mm = report
+        .exact_family
+        .as_ref()
+        .map(|f| {
+            request
+                .predict
+                .iter()
+                .map(|p| f.map(p.height_mm, p.image_px))
+                .collect::<Result<Vec<_>>>()
+        })
+        .transpose()?;
     Ok(PlanarSolveResponse {
         report,
         predictions,
+        exact_predictions_mm,
     })
 }
 

@@ -5,10 +5,12 @@
 
 use super::linear_fit::LinearFit;
 use super::planar::{fit_transform, PlanarFit, PointPair, TransformKind};
+use super::planar_exact::PlaneFamily;
 use super::planar_height::{
     fit_density, pixel_density, ByParameter, DensityFit, HeightModel, MappedPoint, PixelDensity,
 };
-use crate::error::Result;
+use crate::camera::Camera;
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// One observed point: the plate at `height_mm`, its image point and robot
@@ -36,6 +38,10 @@ pub struct PlanarSolveOptions {
     /// absent, the robot-measured side lengths are used. Only used when every
     /// height has exactly four points (corners A, B, C, D in order).
     pub plate_size_mm: Option<[f64; 2]>,
+    /// A calibrated camera: when given, every image point is undistorted
+    /// (mapped to the pixel the distortion-free camera would see) before
+    /// fitting. Default: none (points already undistorted).
+    pub camera: Option<Camera>,
 }
 
 impl Default for PlanarSolveOptions {
@@ -44,6 +50,7 @@ impl Default for PlanarSolveOptions {
             transform: TransformKind::Affine,
             reject_threshold: None,
             plate_size_mm: None,
+            camera: None,
         }
     }
 }
@@ -71,7 +78,11 @@ pub struct PlanarSolveReport {
     pub pixel_density: Option<Vec<PixelDensity>>,
     /// Pixel density against height (only for four-corner plates).
     pub density_fit: Option<DensityFit>,
-    /// The points that were solved.
+    /// The exact height-dependent homography family fitted to the same
+    /// points by the DLT (see [`super::planar_exact`]); `None` when the DLT
+    /// is not applicable (fewer than 6 points).
+    pub exact_family: Option<PlaneFamily>,
+    /// The points that were solved (undistorted when a camera was given).
     pub points: Vec<HeightPoint>,
     /// The options used.
     pub options: PlanarSolveOptions,
@@ -98,6 +109,17 @@ pub fn solve_planar(
     points: &[HeightPoint],
     options: &PlanarSolveOptions,
 ) -> Result<PlanarSolveReport> {
+    // 0. Undistort with the camera, if any.
+    let points: Vec<HeightPoint> = match &options.camera {
+        None => points.to_vec(),
+        Some(camera) => points
+            .iter()
+            .map(|p| {
+                undistort_pixel(camera, p.image_px).map(|image_px| HeightPoint { image_px, ..*p })
+            })
+            .collect::<Result<_>>()?,
+    };
+    let points = points.as_slice();
     // 1. Group by height, sorted.
     let groups = group_by_height(points);
     // 2. One transform per height.
@@ -131,15 +153,41 @@ pub fn solve_planar(
         None
     };
     let density_fit = pixel_density.as_deref().map(fit_density).transpose()?;
+    // 5. The exact homography family, where the DLT applies.
+    let exact_family = match PlaneFamily::fit(points) {
+        Ok(f) => Some(f),
+        Err(Error::TooFew { .. }) => None,
+        Err(e) => return Err(e),
+    };
     Ok(PlanarSolveReport {
         heights,
         fit: model.fit,
         rejected_heights_mm: model.rejected_heights_mm,
         pixel_density,
         density_fit,
+        exact_family,
         points: points.to_vec(),
         options: options.clone(),
     })
+}
+
+/// The pixel a distortion-free camera with the same intrinsics would see.
+pub fn undistort_pixel(camera: &Camera, image_px: [f64; 2]) -> Result<[f64; 2]> {
+    let ray = camera.unproject(&nalgebra::Point2::from(image_px))?;
+    if !(ray.z > 0.0) {
+        return Err(Error::invalid(
+            "image_px",
+            format!(
+                "({}, {}) looks at or beyond 90 degrees: no undistorted pixel",
+                image_px[0], image_px[1]
+            ),
+        ));
+    }
+    let (x, y) = (ray.x / ray.z, ray.y / ray.z);
+    Ok([
+        camera.fx * x + camera.skew * y + camera.cx,
+        camera.fy * y + camera.cy,
+    ])
 }
 
 fn corner_density(h: f64, p: &[HeightPoint], size: Option<[f64; 2]>) -> Result<PixelDensity> {
@@ -223,5 +271,53 @@ mod tests {
         let truth = family(80.0).apply([2000.0, 1000.0]);
         assert!((m.robot_mm[0] - truth[0]).abs() < 1e-8 && (m.robot_mm[1] - truth[1]).abs() < 1e-8);
         assert_eq!(r.pixel_density.as_ref().map(|d| d.len()), Some(3));
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn camera_undistorts_before_fitting() {
+        // Robot points seen through a Brown lens: after undistortion the
+        // per-height affine fit of a fronto-parallel similarity is exact.
+        let camera = Camera::example_brown();
+        let pinhole = camera.without_distortion();
+        let mut points = Vec::new();
+        for h in [10.0, 50.0] {
+            let depth = 1.0 - h * 1e-3;
+            for (x, y) in [
+                (-0.1, -0.05),
+                (0.1, -0.05),
+                (0.1, 0.05),
+                (-0.1, 0.05),
+                (0.0, 0.02),
+            ] {
+                let p = nalgebra::Point3::new(x, y, depth);
+                let d = camera.project(&p).unwrap();
+                let u = pinhole.project(&p).unwrap();
+                points.push(HeightPoint {
+                    height_mm: h,
+                    image_px: [d.x, d.y],
+                    robot_mm: [x * 1e3, y * 1e3],
+                });
+                let back = undistort_pixel(&camera, [d.x, d.y]).unwrap();
+                assert!((back[0] - u.x).abs() < 1e-6 && (back[1] - u.y).abs() < 1e-6);
+            }
+        }
+        let raw = solve_planar(&points, &PlanarSolveOptions::default()).unwrap();
+        let options = PlanarSolveOptions {
+            camera: Some(camera),
+            ..Default::default()
+        };
+        let fixed = solve_planar(&points, &options).unwrap();
+        for h in &fixed.heights {
+            assert!(
+                h.fit.rms_mm < 1e-6,
+                "{} mm: rms {} mm",
+                h.height_mm,
+                h.fit.rms_mm
+            );
+        }
+        assert!(
+            raw.heights[0].fit.rms_mm > 1e-3,
+            "distortion should show without the camera"
+        );
     }
 }
