@@ -21,7 +21,7 @@ wasm: setup
 	cargo build --lib --release --target $(WASM_TARGET) --features wasm
 
 web: wasm
-	wasm-bindgen --target web --out-dir www/pkg --out-name robocal --no-typescript $(WASM_FILE)
+	wasm-bindgen --target web --out-dir www/pkg --out-name robocal --no-typescript --remove-name-section --remove-producers-section $(WASM_FILE)
 	@tools/wasm-size.sh www/pkg/robocal_bg.wasm
 
 cli:
@@ -32,8 +32,8 @@ serve: web cli
 
 pkg: wasm
 	rm -rf pkg
-	wasm-bindgen --target nodejs --out-dir pkg/node --out-name robocal $(WASM_FILE)
-	wasm-bindgen --target web --out-dir pkg/web --out-name robocal $(WASM_FILE)
+	wasm-bindgen --target nodejs --out-dir pkg/node --out-name robocal --remove-name-section --remove-producers-section $(WASM_FILE)
+	wasm-bindgen --target web --out-dir pkg/web --out-name robocal --remove-name-section --remove-producers-section $(WASM_FILE)
 	node tools/make-pkg.mjs
 	@tools/wasm-size.sh pkg/node/robocal_bg.wasm
 
