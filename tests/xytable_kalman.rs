@@ -34,7 +34,7 @@ fn noise_aware_kalman_beats_batch_with_anisotropic_noise() {
     let (mut batch_sum, mut kalman_sum) = (0.0, 0.0);
     let trials = 40;
     for _ in 0..trials {
-        let mut obs = |s: [f64; 3], rng: &mut Rng| {
+        let obs = |s: [f64; 3], rng: &mut Rng| {
             let q = project(&p, &Point3::new(s[0], s[1], s[2]));
             StageObservation {
                 stage_mm: s,
