@@ -34,6 +34,7 @@
 
 pub mod calib;
 pub mod camera;
+pub mod detect;
 pub mod error;
 pub mod geometry;
 pub mod handeye;
@@ -41,6 +42,7 @@ pub mod image;
 pub mod io;
 pub mod optim;
 pub mod synth;
+pub mod target;
 pub mod workflows;
 
 #[cfg(feature = "wasm")]

@@ -3,8 +3,10 @@
 //! every platform (native and wasm).
 
 pub mod handeye;
+pub mod render;
 pub mod rng;
 pub mod scene;
 
+pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
 pub use rng::Rng;
 pub use scene::Scene;

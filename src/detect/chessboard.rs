@@ -1,0 +1,360 @@
+//! Chessboard detection: saddle candidates on a pyramid level, grid growth
+//! from seeds, the ordering rule, then saddle refinement at full resolution.
+//!
+//! # Order of the corners
+//!
+//! Corner ids run row by row (`id = i + j * cols`, `i` along the side with
+//! `cols` corners). Of the orderings that fit the board:
+//! 1. the board's x -> y turns clockwise in the image (board z points away
+//!    from the camera: a right-handed board frame seen from the front);
+//! 2. the outer square diagonally beyond corner 0 is dark (the print's
+//!    top-left square in the usual drawing). When `cols + rows` is odd this
+//!    decides the order uniquely in every view; when it is even the board is
+//!    symmetric under a 180-degree turn and both ends qualify;
+//! 3. remaining ties (symmetric boards, and square boards with `cols ==
+//!    rows`): corner 0 is the candidate nearest the image's top-left pixel.
+//!    Such orders can flip between views that turn the board by more than
+//!    90 degrees: use a board with `cols + rows` odd (e.g. 9x6) for
+//!    multi-view work.
+
+use super::filter::{to_full, Plane};
+use super::lattice::{self, Cells, PointIndex};
+use super::refine::refine_saddle;
+use super::saddle::{self, Candidate};
+use super::DetectOptions;
+use crate::error::{Error, Result};
+use crate::image::GrayImage;
+use crate::target::DetectedPoint;
+use nalgebra::{Point2, Vector2};
+
+/// Seeds tried per pyramid level.
+const MAX_SEEDS: usize = 40;
+/// Angle between a seed's edge direction and a neighbour, radians.
+const SEED_ANGLE_TOLERANCE: f64 = 0.35;
+
+/// The outcome of one level: a complete board or the best partial grid.
+enum LevelResult {
+    Complete(Vec<Point2<f64>>, f64),
+    Partial { found: usize, message: String },
+}
+
+/// Detect a `cols x rows` chessboard; corners in board order, full-resolution
+/// pixels, refined.
+pub(crate) fn detect_chessboard(
+    img: &GrayImage,
+    cols: usize,
+    rows: usize,
+    options: &DetectOptions,
+) -> Result<Vec<DetectedPoint>> {
+    let board: Vec<(i32, i32)> = (0..rows as i32)
+        .flat_map(|j| (0..cols as i32).map(move |i| (i, j)))
+        .collect();
+    let levels = super::pyramid_levels(img, options.max_working_side_px);
+    let mut best_partial: Option<(usize, String)> = None;
+    for (level, plane) in levels.iter().rev().take(2) {
+        match detect_at_level(plane, *level, cols, rows, &board)? {
+            LevelResult::Complete(coarse, step) => {
+                return refine_all(img, &coarse, *level, step, cols);
+            }
+            LevelResult::Partial { found, message } => {
+                if best_partial.as_ref().map_or(true, |b| found > b.0) {
+                    best_partial = Some((found, message));
+                }
+            }
+        }
+    }
+    let message = best_partial
+        .map(|p| p.1)
+        .unwrap_or_else(|| format!("board not found: no {cols}x{rows} chessboard corners"));
+    Err(Error::NotFound { message })
+}
+
+fn detect_at_level(
+    plane: &Plane,
+    level: u32,
+    cols: usize,
+    rows: usize,
+    board: &[(i32, i32)],
+) -> Result<LevelResult> {
+    let n = cols * rows;
+    let cands = saddle::candidates(plane, 6 * n + 300);
+    let pts: Vec<Point2<f64>> = cands.iter().map(|c| c.pos).collect();
+    let index = PointIndex::new(&pts, 16.0);
+    let mut in_board = vec![false; pts.len()];
+    let mut complete: Vec<(Vec<Point2<f64>>, f64)> = Vec::new();
+    let mut best: Option<Cells> = None;
+    for seed in 0..cands.len().min(MAX_SEEDS) {
+        if in_board[seed] {
+            continue;
+        }
+        let Some(cells) = grow_from(plane, &cands, &index, seed, 4 * n + 16) else {
+            continue;
+        };
+        let maps = lattice::complete_maps(&cells, board, false);
+        if !maps.is_empty() {
+            let prefer = |order: &[usize]| origin_is_dark(&cands, order, cols);
+            if let Some(order) = lattice::choose_order(&pts, &cells, &maps, board, cols, &prefer) {
+                cells.values().for_each(|&i| in_board[i] = true);
+                let step = mean_step(&pts, &order, cols);
+                complete.push((order.iter().map(|&i| pts[i]).collect(), step));
+                if complete.len() > 1 {
+                    return Err(Error::NotFound {
+                        message: format!(
+                            "two candidate boards: two complete {cols}x{rows} chessboards in the image"
+                        ),
+                    });
+                }
+                continue;
+            }
+        }
+        if best.as_ref().map_or(true, |b| cells.len() > b.len()) {
+            best = Some(cells);
+        }
+    }
+    if let Some((coarse, step)) = complete.pop() {
+        return Ok(LevelResult::Complete(coarse, step * (1u64 << level) as f64));
+    }
+    let Some(cells) = best else {
+        return Ok(LevelResult::Partial {
+            found: 0,
+            message: format!("board not found: no {cols}x{rows} chessboard corners"),
+        });
+    };
+    Ok(LevelResult::Partial {
+        found: cells.len(),
+        message: partial_message(plane, &pts, &cells, cols, rows),
+    })
+}
+
+/// Grow a grid from candidate `seed`; `None` when the seed has no grid
+/// neighbours along both of its edge directions.
+fn grow_from(
+    plane: &Plane,
+    cands: &[Candidate],
+    index: &PointIndex,
+    seed: usize,
+    max_cells: usize,
+) -> Option<Cells> {
+    let s = &cands[seed];
+    let dirs = saddle::edge_directions(&s.hessian)?;
+    let mut steps = [None, None];
+    for (k, d) in dirs.iter().enumerate() {
+        let mut best: Option<(f64, Vector2<f64>)> = None;
+        for sign in [1.0, -1.0] {
+            let dir = d * sign;
+            for (i, c) in cands.iter().enumerate() {
+                let v = c.pos - s.pos;
+                let dist = v.norm();
+                if i == seed || dist < 3.0 || v.dot(&dir) / dist < SEED_ANGLE_TOLERANCE.cos() {
+                    continue;
+                }
+                if best.map_or(true, |b| dist < b.0) {
+                    best = Some((dist, v * sign));
+                }
+            }
+        }
+        steps[k] = best.map(|b| b.1);
+    }
+    let (step_a, step_b) = (steps[0]?, steps[1]?);
+    let ratio = step_a.norm() / step_b.norm();
+    if !(0.25..=4.0).contains(&ratio) {
+        return None;
+    }
+    let ring = |p: Point2<f64>, a: &Vector2<f64>, b: &Vector2<f64>| {
+        is_x_junction(plane, p, RING_FRACTION * a.norm().min(b.norm()))
+    };
+    if !ring(s.pos, &step_a, &step_b) {
+        return None;
+    }
+    let seed_pol = polarity(&s.hessian, &step_a, &step_b);
+    let accept = |i: usize, cell: (i32, i32), pred: &lattice::Prediction| {
+        let expected = if (cell.0 + cell.1) % 2 == 0 {
+            seed_pol
+        } else {
+            -seed_pol
+        };
+        polarity(&cands[i].hessian, &pred.step_a, &pred.step_b) == expected
+            && ring(cands[i].pos, &pred.step_a, &pred.step_b)
+    };
+    let cells = lattice::grow(index, seed, step_a, step_b, max_cells, &accept);
+    (cells.len() >= 4).then_some(cells)
+}
+
+/// Ring radius for the X-junction test, as a fraction of the grid step.
+const RING_FRACTION: f64 = 0.35;
+/// Samples on the ring.
+const RING_SAMPLES: usize = 24;
+
+/// An inner chessboard corner shows four alternating sectors on a ring
+/// around it; the board's outer corners (L- and T-shaped, which also give a
+/// saddle response) show two. Samples within 20% of the ring's range from
+/// its mid level are ignored so that noise does not add transitions.
+fn is_x_junction(plane: &Plane, p: Point2<f64>, radius: f64) -> bool {
+    let r = radius.max(2.0);
+    let vals: Vec<f32> = (0..RING_SAMPLES)
+        .map(|k| {
+            let t = k as f64 / RING_SAMPLES as f64 * std::f64::consts::TAU;
+            plane.bilinear(p.x + r * t.cos(), p.y + r * t.sin())
+        })
+        .collect();
+    let (lo, hi) = vals
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let mid = 0.5 * (lo + hi);
+    let band = 0.2 * (hi - lo);
+    let classes: Vec<bool> = vals
+        .iter()
+        .filter(|v| (**v - mid).abs() > band)
+        .map(|v| *v > mid)
+        .collect();
+    if classes.len() < RING_SAMPLES / 2 {
+        return false;
+    }
+    let changes = (0..classes.len())
+        .filter(|&k| classes[k] != classes[(k + 1) % classes.len()])
+        .count();
+    changes == 4
+}
+
+/// Sign of the mixed second derivative along the local grid axes.
+fn polarity(h: &nalgebra::Matrix2<f64>, a: &Vector2<f64>, b: &Vector2<f64>) -> i8 {
+    if (a.transpose() * h * b)[(0, 0)] >= 0.0 {
+        1
+    } else {
+        -1
+    }
+}
+
+/// Rule 2 of the module docs: the square beyond corner 0 is dark iff the
+/// mixed derivative along the board's x and y is negative there.
+fn origin_is_dark(cands: &[Candidate], order: &[usize], cols: usize) -> bool {
+    let p0 = cands[order[0]].pos;
+    let ex = cands[order[1]].pos - p0;
+    let ey = cands[order[cols]].pos - p0;
+    polarity(&cands[order[0]].hessian, &ex, &ey) < 0
+}
+
+fn mean_step(pts: &[Point2<f64>], order: &[usize], cols: usize) -> f64 {
+    let mut sum = 0.0;
+    let mut n = 0.0;
+    for (k, &i) in order.iter().enumerate() {
+        if (k + 1) % cols != 0 {
+            sum += (pts[order[k + 1]] - pts[i]).norm();
+            n += 1.0;
+        }
+    }
+    if n > 0.0 {
+        sum / n
+    } else {
+        1.0
+    }
+}
+
+/// "found 48 of 54 corners: the board may be cut off at the right edge".
+fn partial_message(
+    plane: &Plane,
+    pts: &[Point2<f64>],
+    cells: &Cells,
+    cols: usize,
+    rows: usize,
+) -> String {
+    let n = cols * rows;
+    let found = cells.len();
+    let (amin, amax) = range(cells.keys().map(|c| c.0));
+    let (bmin, bmax) = range(cells.keys().map(|c| c.1));
+    let (span_a, span_b) = ((amax - amin + 1) as usize, (bmax - bmin + 1) as usize);
+    let fits = |x: usize, y: usize| (x <= cols && y <= rows) || (x <= rows && y <= cols);
+    if !fits(span_a, span_b) {
+        return format!(
+            "found a {span_a}x{span_b} chessboard grid, larger than the {cols}x{rows} target: check the inner-corner counts"
+        );
+    }
+    let mut sides: Vec<&str> = Vec::new();
+    let beyond = [
+        (amax + 1, true),
+        (amin - 1, true),
+        (bmax + 1, false),
+        (bmin - 1, false),
+    ];
+    for (k, along_a) in beyond {
+        let (lo, hi) = if along_a { (bmin, bmax) } else { (amin, amax) };
+        for m in lo..=hi {
+            let cell = if along_a { (k, m) } else { (m, k) };
+            let Some(p) = lattice::predict(pts, cells, cell, Vector2::zeros(), Vector2::zeros())
+            else {
+                continue;
+            };
+            let side = if p.pos.x < 0.0 {
+                "left"
+            } else if p.pos.x > plane.w as f64 - 1.0 {
+                "right"
+            } else if p.pos.y < 0.0 {
+                "top"
+            } else if p.pos.y > plane.h as f64 - 1.0 {
+                "bottom"
+            } else {
+                continue;
+            };
+            if !sides.contains(&side) {
+                sides.push(side);
+            }
+        }
+    }
+    if sides.is_empty() {
+        format!("found {found} of {n} corners: the board may be partly occluded, blurred or unevenly lit")
+    } else {
+        let edges = if sides.len() == 1 { "edge" } else { "edges" };
+        format!(
+            "found {found} of {n} corners: the board may be cut off at the {} {edges}",
+            sides.join(" and ")
+        )
+    }
+}
+
+fn range(it: impl Iterator<Item = i32>) -> (i32, i32) {
+    it.fold((i32::MAX, i32::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)))
+}
+
+/// Refine every corner at full resolution; the window is a third of the
+/// local grid step (at most 12 px, at least 2.5 px).
+fn refine_all(
+    img: &GrayImage,
+    coarse: &[Point2<f64>],
+    level: u32,
+    step_full: f64,
+    cols: usize,
+) -> Result<Vec<DetectedPoint>> {
+    let full: Vec<Point2<f64>> = coarse
+        .iter()
+        .map(|p| Point2::new(to_full(p.x, level), to_full(p.y, level)))
+        .collect();
+    let rows = full.len() / cols.max(1);
+    let mut out = Vec::with_capacity(full.len());
+    for (id, p) in full.iter().enumerate() {
+        let (i, j) = (id % cols, id / cols);
+        let mut local = step_full;
+        for (di, dj) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+            let (ni, nj) = (i as i64 + di, j as i64 + dj);
+            if ni >= 0 && nj >= 0 && (ni as usize) < cols && (nj as usize) < rows {
+                local = local.min((full[nj as usize * cols + ni as usize] - p).norm());
+            }
+        }
+        let window = (local / 3.0).clamp(2.5, 12.0);
+        let fit = refine_saddle(img, *p, window).or_else(|| refine_saddle(img, *p, window * 0.6));
+        let Some(fit) = fit else {
+            return Err(Error::NotFound {
+                message: format!(
+                    "corner {id} at ({:.1}, {:.1}) px could not be refined: blurred or occluded?",
+                    p.x, p.y
+                ),
+            });
+        };
+        out.push(DetectedPoint {
+            id,
+            x_px: fit.pos.x,
+            y_px: fit.pos.y,
+            covariance_px2: None,
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,215 @@
+//! Circle grids, dot plates and single circles: blobs grown into a lattice,
+//! ordered (right-handed, then id 0 nearest the image's top-left; asymmetric
+//! grids with an odd number of rows are unambiguous), ellipse centres
+//! refined at full resolution.
+
+use super::blobs::{find_blobs, refine_blob, Blob};
+use super::filter::to_full;
+use super::lattice::{self, PointIndex};
+use super::DetectOptions;
+use crate::error::{Error, Result};
+use crate::image::GrayImage;
+use crate::target::{DetectedPoint, Polarity, Target};
+use nalgebra::{Matrix2, Point2, Vector2};
+
+/// Seeds tried.
+const MAX_SEEDS: usize = 60;
+/// Blob working level: long side at most this many pixels.
+const BLOB_WORKING_SIDE_PX: u32 = 2048;
+/// Neighbouring grid blobs differ in area by at most this factor.
+const AREA_RATIO: f64 = 3.0;
+
+/// Working-level blobs and the level they were found at.
+fn blobs_at_level(img: &GrayImage, invert: bool, options: &DetectOptions) -> (u32, Vec<Blob>) {
+    let max_side = options.max_working_side_px.max(BLOB_WORKING_SIDE_PX);
+    let levels = super::pyramid_levels(img, max_side);
+    match levels.into_iter().next() {
+        Some((level, plane)) => (level, find_blobs(&plane, invert)),
+        None => (0, Vec::new()),
+    }
+}
+
+fn to_full_blob(b: &Blob, level: u32) -> (Point2<f64>, Matrix2<f64>) {
+    let s = (1u64 << level) as f64;
+    (
+        Point2::new(to_full(b.centre.x, level), to_full(b.centre.y, level)),
+        b.cov * (s * s),
+    )
+}
+
+/// Detect a circle grid or dot plate. `diameter_ratio` (dot plates): dot
+/// diameter over pitch, used to reject blobs of the wrong size.
+pub(crate) fn detect_grid(
+    img: &GrayImage,
+    target: &Target,
+    polarity: Polarity,
+    asymmetric: bool,
+    diameter_ratio: Option<f64>,
+    options: &DetectOptions,
+) -> Result<Vec<DetectedPoint>> {
+    let invert = polarity == Polarity::LightOnDark;
+    let (level, blobs) = blobs_at_level(img, invert, options);
+    let board = target.grid_coords();
+    let n = board.len();
+    let cols = board.iter().filter(|c| c.1 == 0).count();
+    let pts: Vec<Point2<f64>> = blobs.iter().map(|b| b.centre).collect();
+    let index = PointIndex::new(&pts, 16.0);
+    let mut in_board = vec![false; pts.len()];
+    let mut found: Vec<Vec<usize>> = Vec::new();
+    let mut best_partial = 0usize;
+    for seed in 0..pts.len().min(MAX_SEEDS) {
+        if in_board[seed] {
+            continue;
+        }
+        let Some((step_a, step_b)) = seed_steps(&blobs, seed) else {
+            continue;
+        };
+        if let Some(rho) = diameter_ratio {
+            // Equivalent diameter over the grid step within a factor 2.
+            let d = (4.0 * blobs[seed].area / std::f64::consts::PI).sqrt();
+            let q = d / step_a.norm().max(step_b.norm()) / rho;
+            if !(0.5..=2.0).contains(&q) {
+                continue;
+            }
+        }
+        let accept = |i: usize, cell: (i32, i32), pred: &lattice::Prediction| {
+            let _ = (cell, pred);
+            let r = blobs[i].area / blobs[seed].area;
+            (1.0 / AREA_RATIO..=AREA_RATIO).contains(&r)
+        };
+        let cells = lattice::grow(&index, seed, step_a, step_b, 2 * n + 8, &accept);
+        let maps = lattice::complete_maps(&cells, &board, asymmetric);
+        match lattice::choose_order(&pts, &cells, &maps, &board, cols, &|_| false) {
+            Some(order) => {
+                cells.values().for_each(|&i| in_board[i] = true);
+                found.push(order);
+                if found.len() > 1 {
+                    return Err(Error::NotFound {
+                        message: format!(
+                            "two candidate boards: two complete {} in the image",
+                            describe(target)
+                        ),
+                    });
+                }
+            }
+            None => best_partial = best_partial.max(cells.len().min(n)),
+        }
+    }
+    let Some(order) = found.pop() else {
+        let message = if best_partial > 1 {
+            format!(
+                "found {best_partial} of {n} circles of the {}: the grid may be cut off, occluded or the counts wrong",
+                describe(target)
+            )
+        } else {
+            format!("board not found: no {} in the image", describe(target))
+        };
+        return Err(Error::NotFound { message });
+    };
+    order
+        .iter()
+        .enumerate()
+        .map(|(id, &i)| {
+            let (c, cov) = to_full_blob(&blobs[i], level);
+            let fit = refine_blob(img, c, &cov, invert).ok_or_else(|| Error::NotFound {
+                message: format!(
+                    "circle {id} at ({:.1}, {:.1}) px has no clean edge",
+                    c.x, c.y
+                ),
+            })?;
+            Ok(point(id, &fit))
+        })
+        .collect()
+}
+
+fn describe(target: &Target) -> String {
+    match target {
+        Target::CircleGrid {
+            cols,
+            rows,
+            asymmetric,
+            ..
+        } => format!(
+            "{cols}x{rows} {} circle grid",
+            if *asymmetric {
+                "asymmetric"
+            } else {
+                "symmetric"
+            }
+        ),
+        Target::DotPlate { cols, rows, .. } => format!("{cols}x{rows} dot plate"),
+        Target::Chessboard { cols, rows, .. } => format!("{cols}x{rows} chessboard"),
+        Target::SingleCircle { .. } => "circle".to_string(),
+    }
+}
+
+fn point(id: usize, fit: &super::ellipse::EllipseFit) -> DetectedPoint {
+    DetectedPoint {
+        id,
+        x_px: fit.centre.x,
+        y_px: fit.centre.y,
+        covariance_px2: Some([
+            fit.covariance[(0, 0)],
+            fit.covariance[(0, 1)],
+            fit.covariance[(1, 1)],
+        ]),
+    }
+}
+
+/// The seed's two lattice steps: its nearest similar blob, and the nearest
+/// one not collinear with it.
+fn seed_steps(blobs: &[Blob], seed: usize) -> Option<(Vector2<f64>, Vector2<f64>)> {
+    let s = &blobs[seed];
+    let similar = |b: &Blob| (1.0 / AREA_RATIO..=AREA_RATIO).contains(&(b.area / s.area));
+    let mut near: Vec<(f64, Vector2<f64>)> = blobs
+        .iter()
+        .enumerate()
+        .filter(|(i, b)| *i != seed && similar(b))
+        .map(|(_, b)| {
+            let v = b.centre - s.centre;
+            (v.norm(), v)
+        })
+        .collect();
+    near.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (d1, v1) = *near.first()?;
+    let (_, v2) = *near
+        .iter()
+        .skip(1)
+        .find(|(d, v)| *d < 2.5 * d1 && (v.dot(&v1) / (d * d1)).abs() < 0.8)?;
+    Some((v1, v2))
+}
+
+/// Detect one circle: the largest elliptical dark blob, with the covariance
+/// of its fitted centre. Two blobs of similar size are reported, not guessed.
+pub(crate) fn detect_single(img: &GrayImage, options: &DetectOptions) -> Result<DetectedPoint> {
+    let (level, blobs) = blobs_at_level(img, false, options);
+    let Some(first) = blobs.first() else {
+        return Err(Error::NotFound {
+            message: "board not found: no dark circle in the image".to_string(),
+        });
+    };
+    if let Some(second) = blobs.get(1) {
+        if second.area > 0.5 * first.area {
+            let s = (1u64 << level) as f64;
+            return Err(Error::NotFound {
+                message: format!(
+                    "two candidate circles: blobs of {:.0} and {:.0} px^2 near ({:.0}, {:.0}) and ({:.0}, {:.0}) px",
+                    first.area * s * s,
+                    second.area * s * s,
+                    to_full(first.centre.x, level),
+                    to_full(first.centre.y, level),
+                    to_full(second.centre.x, level),
+                    to_full(second.centre.y, level)
+                ),
+            });
+        }
+    }
+    let (c, cov) = to_full_blob(first, level);
+    let fit = refine_blob(img, c, &cov, false).ok_or_else(|| Error::NotFound {
+        message: format!(
+            "the circle at ({:.1}, {:.1}) px has no clean edge",
+            c.x, c.y
+        ),
+    })?;
+    Ok(point(0, &fit))
+}

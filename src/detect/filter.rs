@@ -1,0 +1,152 @@
+//! Float image planes, separable Gaussian smoothing, 2x pyramid reduction and
+//! bilinear sampling: the low-level pixel work shared by the detectors.
+
+use crate::image::GrayImage;
+
+/// A single-channel f32 image, row-major.
+#[derive(Debug, Clone)]
+pub(crate) struct Plane {
+    pub w: usize,
+    pub h: usize,
+    pub data: Vec<f32>,
+}
+
+impl Plane {
+    pub fn from_gray(img: &GrayImage) -> Plane {
+        Plane {
+            w: img.width as usize,
+            h: img.height as usize,
+            data: img.pixels.iter().map(|&v| v as f32).collect(),
+        }
+    }
+
+    /// Value at integer (x, y) with coordinates clamped into the image.
+    #[inline]
+    pub fn at(&self, x: isize, y: isize) -> f32 {
+        let xc = x.clamp(0, self.w as isize - 1) as usize;
+        let yc = y.clamp(0, self.h as isize - 1) as usize;
+        self.data[yc * self.w + xc]
+    }
+
+    /// Bilinear interpolation at (x, y), clamped at the border.
+    pub fn bilinear(&self, x: f64, y: f64) -> f32 {
+        let x0 = x.floor();
+        let y0 = y.floor();
+        let fx = (x - x0) as f32;
+        let fy = (y - y0) as f32;
+        let (xi, yi) = (x0 as isize, y0 as isize);
+        let a = self.at(xi, yi);
+        let b = self.at(xi + 1, yi);
+        let c = self.at(xi, yi + 1);
+        let d = self.at(xi + 1, yi + 1);
+        (a * (1.0 - fx) + b * fx) * (1.0 - fy) + (c * (1.0 - fx) + d * fx) * fy
+    }
+
+    /// Half-size image, each pixel the mean of a 2x2 block. Pixel x of the
+    /// result covers x' = 2x + 0.5 of the input.
+    pub fn downsample2(&self) -> Plane {
+        let w = (self.w / 2).max(1);
+        let h = (self.h / 2).max(1);
+        let mut data = vec![0.0f32; w * h];
+        for y in 0..h {
+            let r0 = (2 * y).min(self.h - 1) * self.w;
+            let r1 = (2 * y + 1).min(self.h - 1) * self.w;
+            for x in 0..w {
+                let x0 = (2 * x).min(self.w - 1);
+                let x1 = (2 * x + 1).min(self.w - 1);
+                data[y * w + x] = 0.25
+                    * (self.data[r0 + x0]
+                        + self.data[r0 + x1]
+                        + self.data[r1 + x0]
+                        + self.data[r1 + x1]);
+            }
+        }
+        Plane { w, h, data }
+    }
+
+    /// Separable Gaussian smoothing with standard deviation `sigma` pixels
+    /// (kernel radius 3 sigma, borders clamped).
+    pub fn gaussian(&self, sigma: f64) -> Plane {
+        let k = gaussian_kernel(sigma);
+        let r = (k.len() / 2) as isize;
+        let (w, h) = (self.w, self.h);
+        let mut tmp = vec![0.0f32; w * h];
+        for y in 0..h {
+            let row = &self.data[y * w..(y + 1) * w];
+            let out = &mut tmp[y * w..(y + 1) * w];
+            for (x, o) in out.iter_mut().enumerate() {
+                let xi = x as isize;
+                let mut s = 0.0;
+                if xi >= r && xi + r < w as isize {
+                    let base = (xi - r) as usize;
+                    for (i, kv) in k.iter().enumerate() {
+                        s += kv * row[base + i];
+                    }
+                } else {
+                    for (i, kv) in k.iter().enumerate() {
+                        let xx = (xi + i as isize - r).clamp(0, w as isize - 1) as usize;
+                        s += kv * row[xx];
+                    }
+                }
+                *o = s;
+            }
+        }
+        let mut data = vec![0.0f32; w * h];
+        for y in 0..h {
+            let out = &mut data[y * w..(y + 1) * w];
+            for (i, kv) in k.iter().enumerate() {
+                let yy = (y as isize + i as isize - r).clamp(0, h as isize - 1) as usize;
+                let src = &tmp[yy * w..(yy + 1) * w];
+                for (o, s) in out.iter_mut().zip(src) {
+                    *o += kv * s;
+                }
+            }
+        }
+        Plane { w, h, data }
+    }
+}
+
+/// Normalised Gaussian taps, radius ceil(3 sigma) (at least 1).
+pub(crate) fn gaussian_kernel(sigma: f64) -> Vec<f32> {
+    let sigma = sigma.max(0.3);
+    let r = (3.0 * sigma).ceil().max(1.0) as isize;
+    let mut k: Vec<f32> = (-r..=r)
+        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32)
+        .collect();
+    let s: f32 = k.iter().sum();
+    k.iter_mut().for_each(|v| *v /= s);
+    k
+}
+
+/// Map a coordinate at pyramid level `level` to level 0 (full resolution).
+#[inline]
+pub(crate) fn to_full(v: f64, level: u32) -> f64 {
+    let s = (1u64 << level) as f64;
+    s * (v + 0.5) - 0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn smoothing_keeps_constants_and_pyramid_maps_centres() {
+        let p = Plane {
+            w: 7,
+            h: 5,
+            data: vec![3.0; 35],
+        };
+        let g = p.gaussian(1.5);
+        assert!(g.data.iter().all(|v| (v - 3.0).abs() < 1e-5));
+        // A ramp v = x: the 2x2 mean of columns 2 and 3 is 2.5 = to_full(1, 1).
+        let ramp = Plane {
+            w: 8,
+            h: 4,
+            data: (0..32).map(|i| (i % 8) as f32).collect(),
+        };
+        let d = ramp.downsample2();
+        assert_eq!((d.w, d.h), (4, 2));
+        assert!((d.data[1] as f64 - to_full(1.0, 1)).abs() < 1e-6);
+    }
+}

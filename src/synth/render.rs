@@ -1,0 +1,379 @@
+//! Seeded renderer of calibration targets with exact ground truth.
+//!
+//! Given a camera (anything implementing [`Projection`]: pinhole here,
+//! distorted models through the same trait), a [`Target`] and its pose
+//! `camera_from_target`, renders an 8-bit grey image: the board's albedo is
+//! integrated over each pixel (pixels whose four corners see the same colour
+//! take it directly; others are supersampled on an n x n grid whose board
+//! coordinates are interpolated between the exact ray-plane intersections
+//! at the pixel corners), then Gaussian blur, gain with vignetting and a
+//! linear illumination gradient, Gaussian noise and rounding. Ground truth
+//! is the exact projection of every board point.
+//!
+//! Board print: chessboards have a white margin one square wide; the outer
+//! square diagonally beyond corner 0 is black (the detector's ordering
+//! rule). Circle grids and dot plates have a one-unit margin. Beyond the
+//! print the scene is a uniform grey wall.
+
+use crate::error::{Error, Result};
+use crate::image::GrayImage;
+use crate::synth::Rng;
+use crate::target::{DetectedPoint, Polarity, Target};
+use nalgebra::{Isometry3, Point2, Point3, Vector3};
+
+/// A camera as the renderer needs it: pixels to rays and points to pixels.
+pub trait Projection {
+    /// Pixel of a point in the camera frame; `None` when it does not image.
+    fn project_point(&self, p: &Point3<f64>) -> Option<Point2<f64>>;
+    /// Ray direction (any length, z > 0 in front) through a pixel.
+    fn unproject_pixel(&self, px: &Point2<f64>) -> Option<Vector3<f64>>;
+    /// `(width, height)` in pixels.
+    fn image_size(&self) -> (u32, u32);
+}
+
+/// A distortion-free pinhole camera.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pinhole {
+    /// Focal lengths, pixels.
+    pub fx: f64,
+    /// Focal length along y, pixels.
+    pub fy: f64,
+    /// Principal point x, pixels.
+    pub cx: f64,
+    /// Principal point y, pixels.
+    pub cy: f64,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+}
+
+impl Projection for Pinhole {
+    fn project_point(&self, p: &Point3<f64>) -> Option<Point2<f64>> {
+        (p.z > 1e-9)
+            .then(|| Point2::new(self.fx * p.x / p.z + self.cx, self.fy * p.y / p.z + self.cy))
+    }
+    fn unproject_pixel(&self, px: &Point2<f64>) -> Option<Vector3<f64>> {
+        Some(Vector3::new(
+            (px.x - self.cx) / self.fx,
+            (px.y - self.cy) / self.fy,
+            1.0,
+        ))
+    }
+    fn image_size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+}
+
+/// Photometric settings of a render.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderOptions {
+    /// Grey level of the print's black (before gain), default 30.
+    pub black: f64,
+    /// Grey level of the print's white, default 220.
+    pub white: f64,
+    /// Grey level of the wall behind the board, default 120.
+    pub background: f64,
+    /// Global gain, default 1.
+    pub gain: f64,
+    /// Relative brightness loss at the image corners (cos^4-like, quadratic
+    /// in the radius), 0..1, default 0.
+    pub vignetting: f64,
+    /// Relative brightness change from the left to the right edge, default 0.
+    pub gradient: f64,
+    /// Gaussian blur sigma, pixels (default 0.7: a sharp lens).
+    pub blur_sigma_px: f64,
+    /// Additive Gaussian noise sigma, grey levels (default 2).
+    pub noise_sigma: f64,
+    /// Supersampling per axis for pixels on an edge (default 8).
+    pub supersample: u32,
+    /// Circle diameter over the grid unit for circle grids (default 0.5;
+    /// dot plates use their own diameter).
+    pub circle_diameter_ratio: f64,
+    /// Noise seed.
+    pub seed: u64,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            black: 30.0,
+            white: 220.0,
+            background: 120.0,
+            gain: 1.0,
+            vignetting: 0.0,
+            gradient: 0.0,
+            blur_sigma_px: 0.7,
+            noise_sigma: 2.0,
+            supersample: 8,
+            circle_diameter_ratio: 0.5,
+            seed: 1,
+        }
+    }
+}
+
+/// A rendered image and the exact pixels of the target points inside it.
+#[derive(Debug, Clone)]
+pub struct Rendered {
+    /// The image.
+    pub image: GrayImage,
+    /// Ground truth, in id order, only points inside the image.
+    pub points: Vec<DetectedPoint>,
+}
+
+/// Render `target` at `camera_from_target` through `camera`.
+pub fn render(
+    camera: &dyn Projection,
+    target: &Target,
+    camera_from_target: &Isometry3<f64>,
+    options: &RenderOptions,
+) -> Result<Rendered> {
+    let (w, h) = camera.image_size();
+    if w == 0 || h == 0 || (w as u64) * (h as u64) > 100_000_000 {
+        return Err(Error::invalid(
+            "camera",
+            format!("cannot render a {w}x{h} image"),
+        ));
+    }
+    let target = target.clone().validated()?;
+    let albedo = Albedo::new(&target, options);
+    let target_from_camera = camera_from_target.inverse();
+    let normal = camera_from_target.rotation * Vector3::z();
+    let origin = camera_from_target.translation.vector;
+    // Board coordinates at the pixel corners (x - 0.5, y - 0.5).
+    let (cw, ch) = (w as usize + 1, h as usize + 1);
+    let mut corners: Vec<Option<(f64, f64)>> = Vec::with_capacity(cw * ch);
+    for y in 0..ch {
+        for x in 0..cw {
+            let px = Point2::new(x as f64 - 0.5, y as f64 - 0.5);
+            corners.push(camera.unproject_pixel(&px).and_then(|ray| {
+                let den = normal.dot(&ray);
+                let lambda = normal.dot(&origin) / den;
+                (den.abs() > 1e-12 && lambda > 0.0).then(|| {
+                    let b = target_from_camera * Point3::from(ray * lambda);
+                    (b.x, b.y)
+                })
+            }));
+        }
+    }
+    let n = options.supersample.clamp(1, 32) as usize;
+    let mut img = vec![0.0f32; w as usize * h as usize];
+    for y in 0..h as usize {
+        for x in 0..w as usize {
+            let c = [
+                corners[y * cw + x],
+                corners[y * cw + x + 1],
+                corners[(y + 1) * cw + x],
+                corners[(y + 1) * cw + x + 1],
+            ];
+            let vals: Vec<f64> = c.iter().map(|q| albedo.at(*q)).collect();
+            let same = vals.iter().all(|v| *v == vals[0]);
+            img[y * w as usize + x] = if same && c.iter().all(|q| q.is_some()) {
+                vals[0] as f32
+            } else {
+                supersample(&albedo, &c, n) as f32
+            };
+        }
+    }
+    let blurred = if options.blur_sigma_px > 0.0 {
+        let plane = crate::detect::filter::Plane {
+            w: w as usize,
+            h: h as usize,
+            data: img,
+        };
+        plane.gaussian(options.blur_sigma_px).data
+    } else {
+        img
+    };
+    let mut rng = Rng::new(options.seed);
+    let (hw, hh) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
+    let rmax2 = hw * hw + hh * hh;
+    let mut pixels = Vec::with_capacity(blurred.len());
+    for (i, v) in blurred.iter().enumerate() {
+        let (x, y) = ((i % w as usize) as f64, (i / w as usize) as f64);
+        let r2 = ((x - hw).powi(2) + (y - hh).powi(2)) / rmax2.max(1e-9);
+        let light = options.gain
+            * (1.0 - options.vignetting * r2)
+            * (1.0 + options.gradient * (x / (w as f64).max(1.0) - 0.5));
+        let g = *v as f64 * light + rng.gaussian(options.noise_sigma);
+        pixels.push(g.round().clamp(0.0, 255.0) as u8);
+    }
+    let points = target
+        .object_points()
+        .into_iter()
+        .filter_map(|(id, p)| {
+            let q = camera.project_point(&(camera_from_target * p))?;
+            let inside = q.x >= 0.0 && q.y >= 0.0 && q.x <= w as f64 - 1.0 && q.y <= h as f64 - 1.0;
+            inside.then_some(DetectedPoint {
+                id,
+                x_px: q.x,
+                y_px: q.y,
+                covariance_px2: None,
+            })
+        })
+        .collect();
+    Ok(Rendered {
+        image: GrayImage::new(w, h, pixels)?,
+        points,
+    })
+}
+
+fn supersample(albedo: &Albedo, c: &[Option<(f64, f64)>; 4], n: usize) -> f64 {
+    let [Some(a), Some(b), Some(d), Some(e)] = *c else {
+        return albedo.background;
+    };
+    let mut sum = 0.0;
+    for sy in 0..n {
+        let v = (sy as f64 + 0.5) / n as f64;
+        for sx in 0..n {
+            let u = (sx as f64 + 0.5) / n as f64;
+            let x = (a.0 * (1.0 - u) + b.0 * u) * (1.0 - v) + (d.0 * (1.0 - u) + e.0 * u) * v;
+            let y = (a.1 * (1.0 - u) + b.1 * u) * (1.0 - v) + (d.1 * (1.0 - u) + e.1 * u) * v;
+            sum += albedo.at(Some((x, y)));
+        }
+    }
+    sum / (n * n) as f64
+}
+
+/// Grey level of the scene at board coordinates (metres).
+struct Albedo {
+    target: Target,
+    black: f64,
+    white: f64,
+    background: f64,
+    radius_m: f64,
+    extent: (f64, f64, f64, f64),
+    /// Largest integer board coordinates (x, y).
+    max_coord: (i64, i64),
+}
+
+impl Albedo {
+    fn new(target: &Target, o: &RenderOptions) -> Albedo {
+        let unit = target.unit_m();
+        let coords = target.grid_coords();
+        let maxx = coords.iter().map(|c| c.0).max().unwrap_or(0) as f64 * unit;
+        let maxy = coords.iter().map(|c| c.1).max().unwrap_or(0) as f64 * unit;
+        let (radius_m, extent) = match target {
+            Target::Chessboard { square_m, .. } => (
+                0.0,
+                (
+                    -2.0 * square_m,
+                    -2.0 * square_m,
+                    maxx + 2.0 * square_m,
+                    maxy + 2.0 * square_m,
+                ),
+            ),
+            Target::CircleGrid { spacing_m, .. } => (
+                0.5 * o.circle_diameter_ratio * spacing_m,
+                (-spacing_m, -spacing_m, maxx + spacing_m, maxy + spacing_m),
+            ),
+            Target::DotPlate {
+                pitch_m,
+                dot_diameter_m,
+                ..
+            } => (
+                0.5 * dot_diameter_m,
+                (-pitch_m, -pitch_m, maxx + pitch_m, maxy + pitch_m),
+            ),
+            Target::SingleCircle { diameter_m } => (
+                0.5 * diameter_m,
+                (
+                    -2.0 * diameter_m,
+                    -2.0 * diameter_m,
+                    2.0 * diameter_m,
+                    2.0 * diameter_m,
+                ),
+            ),
+        };
+        Albedo {
+            target: target.clone(),
+            black: o.black,
+            white: o.white,
+            background: o.background,
+            radius_m,
+            extent,
+            max_coord: (
+                coords.iter().map(|c| c.0).max().unwrap_or(0) as i64,
+                coords.iter().map(|c| c.1).max().unwrap_or(0) as i64,
+            ),
+        }
+    }
+
+    fn at(&self, q: Option<(f64, f64)>) -> f64 {
+        let Some((x, y)) = q else {
+            return self.background;
+        };
+        let (x0, y0, x1, y1) = self.extent;
+        if x < x0 || y < y0 || x > x1 || y > y1 {
+            return self.background;
+        }
+        match &self.target {
+            Target::Chessboard {
+                cols,
+                rows,
+                square_m,
+            } => {
+                let (i, j) = ((x / square_m).floor() as i64, (y / square_m).floor() as i64);
+                let on_squares =
+                    i >= -1 && j >= -1 && i <= *cols as i64 - 1 && j <= *rows as i64 - 1;
+                if on_squares && (i + j).rem_euclid(2) == 0 {
+                    self.black
+                } else {
+                    self.white
+                }
+            }
+            Target::CircleGrid { polarity, .. } => {
+                let inside = self.in_dot(x, y);
+                let dark = inside == (*polarity == Polarity::DarkOnLight);
+                if dark {
+                    self.black
+                } else {
+                    self.white
+                }
+            }
+            Target::DotPlate { .. } | Target::SingleCircle { .. } => {
+                if self.in_dot(x, y) {
+                    self.black
+                } else {
+                    self.white
+                }
+            }
+        }
+    }
+
+    fn in_dot(&self, x: f64, y: f64) -> bool {
+        let unit = self.target.unit_m();
+        let r2 = self.radius_m * self.radius_m;
+        if let Target::SingleCircle { .. } = self.target {
+            return x * x + y * y < r2;
+        }
+        // Nearest grid points: check the 3x3 integer neighbourhood.
+        let (gx, gy) = ((x / unit).round() as i64, (y / unit).round() as i64);
+        let (cols_max, rows_max) = self.max_coord;
+        let asym = matches!(
+            self.target,
+            Target::CircleGrid {
+                asymmetric: true,
+                ..
+            }
+        );
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let (cx, cy) = (gx + dx, gy + dy);
+                if cx < 0
+                    || cy < 0
+                    || cx > cols_max
+                    || cy > rows_max
+                    || (asym && (cx + cy) % 2 != 0)
+                {
+                    continue;
+                }
+                let (px, py) = (cx as f64 * unit, cy as f64 * unit);
+                if (x - px).powi(2) + (y - py).powi(2) < r2 {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}

@@ -1,0 +1,440 @@
+//! Calibration targets and detections: the plain-data seam between the
+//! detectors (pixels in) and the solvers (correspondences out).
+//!
+//! # Targets and board order
+//!
+//! Every target numbers its points row by row from the board origin; the
+//! board frame has x along a row, y from row to row and z = 0 on the board
+//! plane (z points away from the printed side, i.e. into the scene when the
+//! camera sees the board). Units are metres.
+//!
+//! | kind | points, id = `i + j * cols` | position (x, y) |
+//! |---|---|---|
+//! | `chessboard` | `cols x rows` inner corners | `(i, j) * square_m` |
+//! | `circle_grid`, symmetric | `cols x rows` circles | `(i, j) * spacing_m` |
+//! | `circle_grid`, asymmetric | `cols` circles per row, `rows` rows | `(2 i + j % 2, j) * spacing_m` (OpenCV's layout) |
+//! | `dot_plate` | `cols x rows` dots | `(i, j) * pitch_m` |
+//! | `single_circle` | one point, id 0 | `(0, 0)`, the circle centre |
+//!
+//! # Detection JSON
+//!
+//! ```json
+//! {
+//!   "image_size_px": [640, 480],
+//!   "target": {"kind": "chessboard", "cols": 9, "rows": 6, "square_m": 0.03},
+//!   "points": [
+//!     {"id": 0, "x_px": 244.21, "y_px": 94.53},
+//!     {"id": 1, "x_px": 274.57, "y_px": 92.96, "covariance_px2": [0.001, 0.0, 0.001]}
+//!   ]
+//! }
+//! ```
+//!
+//! `points` are sorted by id; ids missing from a partial detection are simply
+//! absent. `covariance_px2` (optional) is the 2x2 covariance of the point as
+//! `[xx, xy, yy]` in square pixels. Pixel coordinates follow the crate
+//! convention (0, 0 = centre of the top-left pixel). Other target kinds:
+//! `{"kind": "circle_grid", "cols": 4, "rows": 11, "spacing_m": 0.02,
+//! "asymmetric": true, "polarity": "dark_on_light"}`, `{"kind": "dot_plate",
+//! "cols": 7, "rows": 7, "pitch_m": 0.025, "dot_diameter_m": 0.0125}`,
+//! `{"kind": "single_circle", "diameter_m": 0.01}`.
+
+use crate::error::{Error, Result};
+use nalgebra::{Point2, Point3};
+use serde::{Deserialize, Serialize};
+
+/// Which way round a circle target is printed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Polarity {
+    /// Dark circles on a light background (the usual print).
+    DarkOnLight,
+    /// Light circles on a dark background.
+    LightOnDark,
+}
+
+/// A calibration target's geometry (see the module docs for the point order).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Target {
+    /// A chessboard, counted by inner corners (a 10 x 7 squares board is 9 x 6).
+    Chessboard {
+        /// Inner corners along a row.
+        cols: usize,
+        /// Inner corners along a column.
+        rows: usize,
+        /// Side of one square, metres.
+        square_m: f64,
+    },
+    /// A grid of circles, symmetric or asymmetric (OpenCV's layouts).
+    CircleGrid {
+        /// Circles per row.
+        cols: usize,
+        /// Rows of circles.
+        rows: usize,
+        /// Grid unit, metres: the centre distance in a symmetric grid; in an
+        /// asymmetric grid half the centre distance within a row (also the
+        /// row-to-row distance).
+        spacing_m: f64,
+        /// Rows shifted by half a period (OpenCV's asymmetric grid).
+        asymmetric: bool,
+        /// Dark on light or light on dark.
+        polarity: Polarity,
+    },
+    /// A plate of dark dots on a light background (seed 004: 12.5 mm dots at
+    /// 25 mm pitch).
+    DotPlate {
+        /// Dots per row.
+        cols: usize,
+        /// Rows of dots.
+        rows: usize,
+        /// Centre distance, metres.
+        pitch_m: f64,
+        /// Dot diameter, metres.
+        dot_diameter_m: f64,
+    },
+    /// One dark circle on a light background (seed 002's XY-table target).
+    SingleCircle {
+        /// Circle diameter, metres.
+        diameter_m: f64,
+    },
+}
+
+/// One detected target point in pixels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DetectedPoint {
+    /// Board id (see [`Target::object_points`]).
+    pub id: usize,
+    /// Column coordinate, pixels.
+    pub x_px: f64,
+    /// Row coordinate, pixels.
+    pub y_px: f64,
+    /// Covariance `[xx, xy, yy]`, square pixels, when the detector estimates it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub covariance_px2: Option<[f64; 3]>,
+}
+
+/// A target found in one image: what the solvers consume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Detection {
+    /// `[width, height]` of the image, pixels.
+    pub image_size_px: [u32; 2],
+    /// The target that was searched for.
+    pub target: Target,
+    /// Detected points, sorted by id.
+    pub points: Vec<DetectedPoint>,
+}
+
+impl Detection {
+    /// Board points (metres) paired with their pixels, in id order.
+    pub fn correspondences(&self) -> (Vec<Point3<f64>>, Vec<Point2<f64>>) {
+        let board = self.target.object_points();
+        let mut object = Vec::with_capacity(self.points.len());
+        let mut image = Vec::with_capacity(self.points.len());
+        for p in &self.points {
+            if let Some((_, o)) = board.get(p.id) {
+                object.push(*o);
+                image.push(Point2::new(p.x_px, p.y_px));
+            }
+        }
+        (object, image)
+    }
+}
+
+impl Target {
+    /// Parse a CLI target spec: `chessboard:9x6:30mm`,
+    /// `circles:4x11:20mm[:asymmetric][:light-on-dark]`, `dots:7x7:25mm[:12.5mm]`
+    /// (dot diameter defaults to half the pitch), `circle:10mm`. Lengths take
+    /// a unit: `mm`, `cm` or `m`.
+    pub fn parse_spec(spec: &str) -> Result<Target> {
+        let parts: Vec<&str> = spec.trim().split(':').collect();
+        let bad = |m: String| Error::invalid("target", m);
+        match parts.as_slice() {
+            ["chessboard", grid, size] => {
+                let (cols, rows) = parse_grid(grid)?;
+                Target::Chessboard {
+                    cols,
+                    rows,
+                    square_m: parse_length(size)?,
+                }
+                .validated()
+            }
+            ["circles", grid, size, flags @ ..] => {
+                let (cols, rows) = parse_grid(grid)?;
+                let mut asymmetric = false;
+                let mut polarity = Polarity::DarkOnLight;
+                for f in flags {
+                    match *f {
+                        "asymmetric" => asymmetric = true,
+                        "symmetric" => asymmetric = false,
+                        "dark-on-light" => polarity = Polarity::DarkOnLight,
+                        "light-on-dark" => polarity = Polarity::LightOnDark,
+                        other => {
+                            return Err(bad(format!(
+                                "unknown circle-grid option '{other}' (expected asymmetric, symmetric, dark-on-light or light-on-dark)"
+                            )))
+                        }
+                    }
+                }
+                Target::CircleGrid {
+                    cols,
+                    rows,
+                    spacing_m: parse_length(size)?,
+                    asymmetric,
+                    polarity,
+                }
+                .validated()
+            }
+            ["dots", grid, pitch, rest @ ..] if rest.len() <= 1 => {
+                let (cols, rows) = parse_grid(grid)?;
+                let pitch_m = parse_length(pitch)?;
+                let dot_diameter_m = match rest.first() {
+                    Some(d) => parse_length(d)?,
+                    None => pitch_m / 2.0,
+                };
+                Target::DotPlate {
+                    cols,
+                    rows,
+                    pitch_m,
+                    dot_diameter_m,
+                }
+                .validated()
+            }
+            ["circle", d] => Target::SingleCircle {
+                diameter_m: parse_length(d)?,
+            }
+            .validated(),
+            _ => Err(bad(format!(
+                "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER] or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
+            ))),
+        }
+    }
+
+    /// Check sizes and counts; returns the target unchanged when valid.
+    pub fn validated(self) -> Result<Target> {
+        let (cols, rows, min) = match &self {
+            Target::Chessboard { cols, rows, .. } => (*cols, *rows, 2),
+            Target::CircleGrid { cols, rows, .. } | Target::DotPlate { cols, rows, .. } => {
+                (*cols, *rows, 2)
+            }
+            Target::SingleCircle { .. } => (1, 1, 1),
+        };
+        if cols < min || rows < min || cols * rows > 100_000 {
+            return Err(Error::invalid(
+                "target",
+                format!(
+                    "a grid needs 2 to 100000 points with at least 2 per side, got {cols}x{rows}"
+                ),
+            ));
+        }
+        let lengths: Vec<f64> = match &self {
+            Target::Chessboard { square_m, .. } => vec![*square_m],
+            Target::CircleGrid { spacing_m, .. } => vec![*spacing_m],
+            Target::DotPlate {
+                pitch_m,
+                dot_diameter_m,
+                ..
+            } => vec![*pitch_m, *dot_diameter_m],
+            Target::SingleCircle { diameter_m } => vec![*diameter_m],
+        };
+        if lengths.iter().any(|l| !l.is_finite() || *l <= 0.0) {
+            return Err(Error::invalid("target", "sizes must be positive metres"));
+        }
+        if let Target::DotPlate {
+            pitch_m,
+            dot_diameter_m,
+            ..
+        } = &self
+        {
+            if dot_diameter_m >= pitch_m {
+                return Err(Error::invalid(
+                    "target",
+                    "the dot diameter must be smaller than the pitch",
+                ));
+            }
+        }
+        Ok(self)
+    }
+
+    /// Number of points the target has.
+    pub fn point_count(&self) -> usize {
+        match self {
+            Target::Chessboard { cols, rows, .. }
+            | Target::CircleGrid { cols, rows, .. }
+            | Target::DotPlate { cols, rows, .. } => cols * rows,
+            Target::SingleCircle { .. } => 1,
+        }
+    }
+
+    /// Integer board coordinates of every point in id order (metres are these
+    /// times [`Target::unit_m`]).
+    pub(crate) fn grid_coords(&self) -> Vec<(i32, i32)> {
+        let (cols, rows) = match self {
+            Target::Chessboard { cols, rows, .. }
+            | Target::CircleGrid { cols, rows, .. }
+            | Target::DotPlate { cols, rows, .. } => (*cols as i32, *rows as i32),
+            Target::SingleCircle { .. } => (1, 1),
+        };
+        let asymmetric = matches!(
+            self,
+            Target::CircleGrid {
+                asymmetric: true,
+                ..
+            }
+        );
+        let mut out = Vec::with_capacity((cols * rows) as usize);
+        for j in 0..rows {
+            for i in 0..cols {
+                out.push(if asymmetric {
+                    (2 * i + j % 2, j)
+                } else {
+                    (i, j)
+                });
+            }
+        }
+        out
+    }
+
+    /// Length of one grid unit, metres.
+    pub(crate) fn unit_m(&self) -> f64 {
+        match self {
+            Target::Chessboard { square_m, .. } => *square_m,
+            Target::CircleGrid { spacing_m, .. } => *spacing_m,
+            Target::DotPlate { pitch_m, .. } => *pitch_m,
+            Target::SingleCircle { .. } => 1.0,
+        }
+    }
+
+    /// Board points `(id, position in metres, z = 0)` in id order.
+    pub fn object_points(&self) -> Vec<(usize, Point3<f64>)> {
+        let unit = self.unit_m();
+        self.grid_coords()
+            .into_iter()
+            .enumerate()
+            .map(|(id, (x, y))| (id, Point3::new(x as f64 * unit, y as f64 * unit, 0.0)))
+            .collect()
+    }
+}
+
+fn parse_grid(text: &str) -> Result<(usize, usize)> {
+    let err = || {
+        Error::invalid(
+            "target",
+            format!("'{text}' is not a grid size; expected COLSxROWS such as 9x6"),
+        )
+    };
+    let (c, r) = text.split_once(['x', 'X']).ok_or_else(err)?;
+    Ok((c.parse().map_err(|_| err())?, r.parse().map_err(|_| err())?))
+}
+
+fn parse_length(text: &str) -> Result<f64> {
+    let (number, scale) = if let Some(n) = text.strip_suffix("mm") {
+        (n, 1e-3)
+    } else if let Some(n) = text.strip_suffix("cm") {
+        (n, 1e-2)
+    } else if let Some(n) = text.strip_suffix('m') {
+        (n, 1.0)
+    } else {
+        return Err(Error::invalid(
+            "target",
+            format!("length '{text}' needs a unit: mm, cm or m (e.g. 30mm)"),
+        ));
+    };
+    let v: f64 = number
+        .parse()
+        .map_err(|_| Error::invalid("target", format!("'{text}' is not a length")))?;
+    Ok(v * scale)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn specs_parse_to_targets() {
+        assert_eq!(
+            Target::parse_spec("chessboard:9x6:30mm").unwrap(),
+            Target::Chessboard {
+                cols: 9,
+                rows: 6,
+                square_m: 0.03
+            }
+        );
+        assert_eq!(
+            Target::parse_spec("circles:4x11:20mm:asymmetric").unwrap(),
+            Target::CircleGrid {
+                cols: 4,
+                rows: 11,
+                spacing_m: 0.02,
+                asymmetric: true,
+                polarity: Polarity::DarkOnLight
+            }
+        );
+        let Target::DotPlate { dot_diameter_m, .. } = Target::parse_spec("dots:7x7:25mm").unwrap()
+        else {
+            panic!("not a dot plate")
+        };
+        assert!((dot_diameter_m - 0.0125).abs() < 1e-15);
+        assert_eq!(
+            Target::parse_spec("circle:10mm").unwrap(),
+            Target::SingleCircle { diameter_m: 0.01 }
+        );
+        assert_eq!(
+            Target::parse_spec("chessboard:9x6:30")
+                .unwrap_err()
+                .to_string(),
+            "target: length '30' needs a unit: mm, cm or m (e.g. 30mm)"
+        );
+        assert_eq!(
+            Target::parse_spec("chessboard:1x6:30mm")
+                .unwrap_err()
+                .to_string(),
+            "target: a grid needs 2 to 100000 points with at least 2 per side, got 1x6"
+        );
+        assert!(Target::parse_spec("hexagons:3x3:1mm").is_err());
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn object_points_follow_the_documented_order() {
+        let t = Target::parse_spec("circles:4x11:20mm:asymmetric").unwrap();
+        let p = t.object_points();
+        assert_eq!(p.len(), 44);
+        assert!((p[1].1.x - 0.04).abs() < 1e-12 && p[1].1.y == 0.0);
+        assert!((p[4].1.x - 0.02).abs() < 1e-12 && (p[4].1.y - 0.02).abs() < 1e-12);
+        let c = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+        let q = c.object_points();
+        assert_eq!(q[10].0, 10);
+        assert!((q[10].1.x - 0.03).abs() < 1e-12 && (q[10].1.y - 0.03).abs() < 1e-12);
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn detection_round_trips_through_json() {
+        let d = Detection {
+            image_size_px: [640, 480],
+            target: Target::parse_spec("chessboard:3x2:10mm").unwrap(),
+            points: vec![
+                DetectedPoint {
+                    id: 4,
+                    x_px: 10.5,
+                    y_px: 20.25,
+                    covariance_px2: None,
+                },
+                DetectedPoint {
+                    id: 99,
+                    x_px: 1.0,
+                    y_px: 2.0,
+                    covariance_px2: Some([1.0, 0.0, 1.0]),
+                },
+            ],
+        };
+        let json = serde_json::to_string(&d).unwrap();
+        assert!(json.contains("\"kind\":\"chessboard\""), "{json}");
+        let back: Detection = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, d);
+        let (object, image) = d.correspondences();
+        // id 99 does not exist on a 3x2 board and is dropped.
+        assert_eq!(object.len(), 1);
+        assert!((object[0].x - 0.01).abs() < 1e-12 && (object[0].y - 0.01).abs() < 1e-12);
+        assert_eq!(image[0], Point2::new(10.5, 20.25));
+    }
+}

@@ -1,0 +1,162 @@
+//! Golden tests: targets rendered by the project's seeded renderer, detected,
+//! and compared with the exact projections of the board points.
+//!
+//! Tolerances: noise sigma 2 grey levels on a 190-level contrast. The
+//! corner fit averages ~150 weighted pixels, so the per-corner standard
+//! deviation is ~0.02 px; the target is a mean error <= 0.05 px on
+//! 1280x960 renders at sigma 2, which the asserts use. Harder cases (steep
+//! tilt, heavy blur) state their own bound.
+
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use robocal::detect::{detect, DetectOptions};
+use robocal::synth::{render, Pinhole, RenderOptions};
+use robocal::target::{Detection, Target};
+
+fn camera(w: u32, h: u32, f: f64) -> Pinhole {
+    Pinhole {
+        fx: f,
+        fy: f,
+        cx: (w as f64 - 1.0) / 2.0 + 3.3,
+        cy: (h as f64 - 1.0) / 2.0 - 2.1,
+        width: w,
+        height: h,
+    }
+}
+
+/// Board centre at `(ox, oy, dist)` in the camera, rotated by `rpy` (rad).
+fn pose(target: &Target, rpy: (f64, f64, f64), at: (f64, f64, f64)) -> Isometry3<f64> {
+    let pts = target.object_points();
+    let mx = pts.iter().map(|p| p.1.x).fold(0.0, f64::max) / 2.0;
+    let my = pts.iter().map(|p| p.1.y).fold(0.0, f64::max) / 2.0;
+    let r = UnitQuaternion::from_euler_angles(rpy.0, rpy.1, rpy.2);
+    let t = Vector3::new(at.0, at.1, at.2) - r * Vector3::new(mx, my, 0.0);
+    Isometry3::from_parts(Translation3::from(t), r)
+}
+
+/// Mean and max distance between detection and truth, by id.
+fn errors(det: &Detection, truth: &[robocal::target::DetectedPoint]) -> (f64, f64) {
+    assert_eq!(det.points.len(), truth.len(), "point count");
+    let mut sum = 0.0;
+    let mut max: f64 = 0.0;
+    for (d, t) in det.points.iter().zip(truth) {
+        assert_eq!(d.id, t.id);
+        let e = ((d.x_px - t.x_px).powi(2) + (d.y_px - t.y_px).powi(2)).sqrt();
+        sum += e;
+        max = max.max(e);
+    }
+    (sum / truth.len() as f64, max)
+}
+
+fn run(
+    spec: &str,
+    w: u32,
+    h: u32,
+    rpy: (f64, f64, f64),
+    dist: f64,
+    o: &RenderOptions,
+) -> (f64, f64) {
+    let target = Target::parse_spec(spec).unwrap();
+    let cam = camera(w, h, 1.1 * w as f64);
+    let r = render(&cam, &target, &pose(&target, rpy, (0.01, -0.005, dist)), o).unwrap();
+    assert_eq!(r.points.len(), target.point_count(), "whole board in view");
+    let det = detect(&r.image, &target, &DetectOptions::default())
+        .unwrap_or_else(|e| panic!("{spec} rpy {rpy:?}: {e}"));
+    errors(&det, &r.points)
+}
+
+#[test]
+fn chessboard_1280x960_noise_2_mean_error_within_005_px() {
+    let o = RenderOptions::default();
+    for (k, rpy) in [(0.1, -0.2, 0.05), (0.45, 0.3, -0.3), (-0.35, 0.5, 0.6)]
+        .into_iter()
+        .enumerate()
+    {
+        let o = RenderOptions {
+            seed: k as u64,
+            ..o.clone()
+        };
+        let (mean, max) = run("chessboard:9x6:30mm", 1280, 960, rpy, 0.55, &o);
+        assert!(mean <= 0.05, "view {k}: mean {mean} px, max {max} px");
+        assert!(max <= 0.2, "view {k}: max {max} px");
+    }
+}
+
+#[test]
+fn chessboard_blurred_vignetted_steep() {
+    // Blur 2 px, 40% vignetting, 30% left-right gradient, 60 degrees tilt.
+    let o = RenderOptions {
+        blur_sigma_px: 2.0,
+        vignetting: 0.4,
+        gradient: 0.3,
+        ..RenderOptions::default()
+    };
+    let (mean, max) = run("chessboard:9x6:30mm", 1280, 960, (1.05, 0.1, 0.2), 0.45, &o);
+    // Foreshortening to half the step and blur: allow twice the nominal bound.
+    assert!(mean <= 0.1, "mean {mean} px, max {max} px");
+}
+
+#[test]
+fn circle_grids_and_dot_plate() {
+    let o = RenderOptions::default();
+    for spec in [
+        "circles:4x11:20mm:asymmetric",
+        "circles:7x5:20mm",
+        "circles:6x4:20mm:light-on-dark",
+        "dots:7x7:25mm",
+    ] {
+        let (mean, max) = run(spec, 1280, 960, (0.25, -0.2, 0.1), 0.6, &o);
+        // Ellipse centres of 64 edge points, noise 2: sd ~0.01 px; the
+        // perspective bias of imaged circle centres (not corrected, see the
+        // module docs) is below 0.05 px at this pose.
+        assert!(mean <= 0.08, "{spec}: mean {mean} px, max {max} px");
+    }
+}
+
+#[test]
+fn single_circle_with_uncertainty() {
+    let target = Target::parse_spec("circle:10mm").unwrap();
+    let cam = camera(640, 480, 700.0);
+    let r = render(
+        &cam,
+        &target,
+        &pose(&target, (0.2, 0.1, 0.0), (0.003, 0.002, 0.2)),
+        &RenderOptions::default(),
+    )
+    .unwrap();
+    let det = detect(&r.image, &target, &DetectOptions::default()).unwrap();
+    let p = &det.points[0];
+    let truth = &r.points[0];
+    let e = ((p.x_px - truth.x_px).powi(2) + (p.y_px - truth.y_px).powi(2)).sqrt();
+    let cov = p.covariance_px2.unwrap();
+    assert!(e < 0.1, "centre error {e} px");
+    assert!(
+        cov[0] > 0.0 && cov[0].sqrt() < 0.1,
+        "sd {} px",
+        cov[0].sqrt()
+    );
+}
+
+#[test]
+fn blank_and_cut_off_boards_say_why() {
+    let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+    let cam = camera(640, 480, 700.0);
+    // Shifted right so the last columns leave the image.
+    let r = render(
+        &cam,
+        &target,
+        &pose(&target, (0.0, 0.0, 0.0), (0.07, 0.0, 0.4)),
+        &RenderOptions::default(),
+    )
+    .unwrap();
+    let e = detect(&r.image, &target, &DetectOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("found ") && e.ends_with("cut off at the right edge"),
+        "{e}"
+    );
+    let blank = robocal::image::GrayImage::new(640, 480, vec![128; 640 * 480]).unwrap();
+    let e = detect(&blank, &target, &DetectOptions::default()).unwrap_err();
+    assert_eq!(e.to_string(), "board not found: no 9x6 chessboard corners");
+    let _ = Point3::<f64>::origin();
+}
