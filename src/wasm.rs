@@ -119,6 +119,27 @@ pub fn image_info(bytes: &[u8]) -> Result<String, JsError> {
     .map_err(|e| JsError::new(&e.to_string()))
 }
 
+/// Detect a calibration target in image bytes. `target_spec_or_json` is a
+/// CLI spec (`chessboard:9x6:30mm`, `circles:4x11:20mm:asymmetric`,
+/// `dots:7x7:25mm`, `circle:10mm`) or a target JSON object. Returns the
+/// Detection JSON (see `docs/detection-json.md`).
+#[wasm_bindgen]
+pub fn detect_target(bytes: &[u8], target_spec_or_json: &str) -> Result<String, JsError> {
+    let target = if target_spec_or_json.trim_start().starts_with('{') {
+        serde_json::from_str::<crate::target::Target>(target_spec_or_json)
+            .map_err(|e| JsError::new(&format!("target JSON: {e}")))?
+            .validated()
+            .map_err(js_error)?
+    } else {
+        crate::target::Target::parse_spec(target_spec_or_json).map_err(js_error)?
+    };
+    let image = crate::image::decode_gray(bytes).map_err(js_error)?;
+    let detection =
+        crate::detect::detect(&image, &target, &crate::detect::DetectOptions::default())
+            .map_err(js_error)?;
+    serde_json::to_string(&detection).map_err(|e| JsError::new(&e.to_string()))
+}
+
 /// Write a report (camera or hand-eye JSON) in an export format: the same
 /// bytes as `robocal export REPORT --format FORMAT [--transform NAME]`.
 /// `transform` may be empty for the default transform.

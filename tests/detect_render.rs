@@ -96,6 +96,34 @@ fn chessboard_blurred_vignetted_steep() {
 }
 
 #[test]
+fn chessboard_through_strong_barrel_distortion_and_steep_tilt() {
+    // Camera::example_brown: k1 = -0.28 (about 20 px of barrel distortion at
+    // the corners of 1280x960). Ground truth is the exact distorted projection.
+    let cam = robocal::camera::Camera::example_brown();
+    let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+    for (k, (rpy, dist)) in [((0.2, 0.25, 0.1), 0.38), ((0.0, 1.0, -0.15), 0.5)]
+        .into_iter()
+        .enumerate()
+    {
+        let o = RenderOptions {
+            seed: 10 + k as u64,
+            ..RenderOptions::default()
+        };
+        let r = render(&cam, &target, &pose(&target, rpy, (0.0, 0.0, dist)), &o).unwrap();
+        assert_eq!(r.points.len(), 54);
+        let det = detect(&r.image, &target, &DetectOptions::default())
+            .unwrap_or_else(|e| panic!("view {k}: {e}"));
+        let (mean, max) = errors(&det, &r.points);
+        // Tilt of 57 degrees halves the step on one axis; same 0.05 px bound on
+        // the mean, max bounded by 4 sd of the worst corner.
+        assert!(
+            mean <= 0.05 && max <= 0.25,
+            "view {k}: mean {mean} px, max {max} px"
+        );
+    }
+}
+
+#[test]
 fn circle_grids_and_dot_plate() {
     let o = RenderOptions::default();
     for spec in [

@@ -1,6 +1,7 @@
 //! Subcommand dispatch, help texts and the CLI's error type.
 
 pub mod args;
+mod detect;
 mod export;
 mod handeye;
 mod planar;
@@ -62,6 +63,7 @@ Commands:
   export      convert a calibration report into OpenCV, ROS, Kalibr, mrcal, Halcon,
               MATLAB, URDF, robot-controller and other formats
   handeye     hand-eye calibration from robot poses and camera poses
+  detect      find a calibration target (chessboard, circles, dots) in images
   info        decode images and print their format and size
   planar      eye-to-hand calibration at any height (plate corners per height)
   xytable     camera over an XY-table with one circular target (batch DLT and
@@ -92,6 +94,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
         "export" => export::run(rest),
         "handeye" if wants_help => print_help(handeye::HELP),
         "handeye" => handeye::run(rest),
+        "detect" if wants_help => print_help(detect::HELP),
+        "detect" => detect::run(rest),
         "info" if wants_help => print_help(INFO_HELP),
         "info" => info(rest),
         "planar" if wants_help => print_help(planar::HELP),

@@ -29,6 +29,8 @@ use nalgebra::{Point2, Vector2};
 
 /// Seeds tried per pyramid level.
 const MAX_SEEDS: usize = 40;
+/// A seed's first neighbours respond at least this fraction of the seed.
+const NEIGHBOUR_RESPONSE_FRACTION: f32 = 0.15;
 /// Angle between a seed's edge direction and a neighbour, radians.
 const SEED_ANGLE_TOLERANCE: f64 = 0.35;
 
@@ -145,7 +147,13 @@ fn grow_from(
             for (i, c) in cands.iter().enumerate() {
                 let v = c.pos - s.pos;
                 let dist = v.norm();
-                if i == seed || dist < 3.0 || v.dot(&dir) / dist < SEED_ANGLE_TOLERANCE.cos() {
+                // Weak saddles along an edge (JPEG blocks, noise) are not
+                // grid neighbours: they respond far less than the seed.
+                if i == seed
+                    || dist < 4.0
+                    || c.response < NEIGHBOUR_RESPONSE_FRACTION * s.response
+                    || v.dot(&dir) / dist < SEED_ANGLE_TOLERANCE.cos()
+                {
                     continue;
                 }
                 if best.map_or(true, |b| dist < b.0) {
@@ -180,6 +188,10 @@ fn grow_from(
     (cells.len() >= 4).then_some(cells)
 }
 
+/// Largest distance between the large- and small-window saddle estimates
+/// for the large one to be trusted, pixels.
+const DISAGREEMENT_PX: f64 = 0.15;
+
 /// Ring radius for the X-junction test, as a fraction of the grid step.
 const RING_FRACTION: f64 = 0.35;
 /// Samples on the ring.
@@ -187,7 +199,7 @@ const RING_SAMPLES: usize = 24;
 
 /// An inner chessboard corner shows four alternating sectors on a ring
 /// around it; the board's outer corners (L- and T-shaped, which also give a
-/// saddle response) show two. Samples within 20% of the ring's range from
+/// saddle response) show two, or four that are not point-symmetric. Samples within 20% of the ring's range from
 /// its mid level are ignored so that noise does not add transitions.
 fn is_x_junction(plane: &Plane, p: Point2<f64>, radius: f64) -> bool {
     let r = radius.max(2.0);
@@ -213,7 +225,21 @@ fn is_x_junction(plane: &Plane, p: Point2<f64>, radius: f64) -> bool {
     let changes = (0..classes.len())
         .filter(|&k| classes[k] != classes[(k + 1) % classes.len()])
         .count();
-    changes == 4
+    if changes != 4 {
+        return false;
+    }
+    // Point symmetry: opposite samples of an X-junction agree; a T-junction
+    // next to a dark frame (four sectors, but not opposite) does not.
+    let half = RING_SAMPLES / 2;
+    let (mut pairs, mut agree) = (0, 0);
+    for k in 0..half {
+        let (a, b) = (vals[k] - mid, vals[k + half] - mid);
+        if a.abs() > band && b.abs() > band {
+            pairs += 1;
+            agree += ((a > 0.0) == (b > 0.0)) as usize;
+        }
+    }
+    pairs >= half / 2 && agree * 10 >= pairs * 9
 }
 
 /// Sign of the mixed second derivative along the local grid axes.
@@ -340,7 +366,18 @@ fn refine_all(
             }
         }
         let window = (local / 3.0).clamp(2.5, 12.0);
-        let fit = refine_saddle(img, *p, window).or_else(|| refine_saddle(img, *p, window * 0.6));
+        let small = (0.5 * window).max(2.5);
+        let fit = match (
+            refine_saddle(img, *p, window),
+            refine_saddle(img, *p, small),
+        ) {
+            // Clutter inside the large window (a thin outer square, the
+            // board's frame) pulls its estimate; the small window sees less
+            // of it. Agreement keeps the less noisy large-window estimate.
+            (Some(a), Some(b)) if (a.pos - b.pos).norm() <= DISAGREEMENT_PX => Some(a),
+            (_, Some(b)) => Some(b),
+            (a, None) => a,
+        };
         let Some(fit) = fit else {
             return Err(Error::NotFound {
                 message: format!(

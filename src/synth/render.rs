@@ -65,6 +65,18 @@ impl Projection for Pinhole {
     }
 }
 
+impl Projection for crate::camera::Camera {
+    fn project_point(&self, p: &Point3<f64>) -> Option<Point2<f64>> {
+        self.project(p).ok()
+    }
+    fn unproject_pixel(&self, px: &Point2<f64>) -> Option<Vector3<f64>> {
+        self.unproject(px).ok()
+    }
+    fn image_size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+}
+
 /// Photometric settings of a render.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
