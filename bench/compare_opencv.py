@@ -1,0 +1,146 @@
+#!/usr/bin/env python3
+"""Compare robocal's target detection with OpenCV on rendered image sets.
+
+Creates bench/.venv with the pinned reference (opencv-python-headless
+4.14.0.94), renders the sets with `cargo run --release --example
+render_set`, runs both detectors single-threaded (robocal: `robocal detect
+--threads 1`, detection time measured inside the process without decoding;
+OpenCV: cv2.setNumThreads(1), the calls timed around them, decoding
+excluded) and prints per set: boards found, mean / max point error against
+the renderer's ground truth, median times and the median of the per-image
+time ratio robocal / OpenCV.
+
+Usage (crate root):  python3 bench/compare_opencv.py [--quick] [--skip-render]
+"""
+import json
+import os
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+VENV = os.path.join(HERE, ".venv")
+PY = os.path.join(VENV, "bin", "python")
+PIN = "opencv-python-headless==4.14.0.94"
+OUT = os.path.join(HERE, "out")
+
+
+def ensure_venv():
+    if os.path.abspath(sys.executable) == os.path.abspath(PY):
+        return
+    if not os.path.exists(PY):
+        subprocess.check_call([sys.executable, "-m", "venv", VENV])
+        subprocess.check_call([PY, "-m", "pip", "install", "-q", PIN, "numpy"])
+    os.execv(PY, [PY] + sys.argv)
+
+
+def errors(found, truth):
+    """Mean and max distance; the detector's order may run from either end."""
+    import numpy as np
+
+    f = np.asarray(found, float).reshape(-1, 2)
+    t = np.asarray(truth, float).reshape(-1, 2)
+    if f.shape != t.shape:
+        return None
+    best = None
+    for cand in (f, f[::-1]):
+        d = np.sqrt(((cand - t) ** 2).sum(1))
+        if best is None or d.mean() < best[0]:
+            best = (d.mean(), d.max())
+    return best
+
+
+def opencv_methods(spec, pattern):
+    import cv2
+
+    size = tuple(pattern)
+    crit = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 30, 0.001)
+    if spec.startswith("chessboard"):
+        def classic(g):
+            ok, c = cv2.findChessboardCorners(g, size)
+            if not ok:
+                return None
+            return cv2.cornerSubPix(g, c, (11, 11), (-1, -1), crit)
+
+        def sb(g):
+            ok, c = cv2.findChessboardCornersSB(g, size)
+            return c if ok else None
+
+        return {"findChessboardCorners+cornerSubPix": classic, "findChessboardCornersSB": sb}
+    flags = cv2.CALIB_CB_ASYMMETRIC_GRID if "asymmetric" in spec else cv2.CALIB_CB_SYMMETRIC_GRID
+
+    def circles(g):
+        ok, c = cv2.findCirclesGrid(g, size, flags=flags)
+        return c if ok else None
+
+    return {"findCirclesGrid": circles}
+
+
+def summarize(name, found, errs, times):
+    import numpy as np
+
+    e = [x for x in errs if x is not None]
+    mean = np.mean([x[0] for x in e]) if e else float("nan")
+    mx = np.max([x[1] for x in e]) if e else float("nan")
+    return {"name": name, "found": found, "mean": mean, "max": mx, "median_ms": float(np.median(times)) if times else float("nan")}
+
+
+def main():
+    ensure_venv()
+    import cv2
+    import numpy as np
+
+    quick = "--quick" in sys.argv
+    if "--skip-render" not in sys.argv:
+        cmd = ["cargo", "run", "--release", "--example", "render_set", "--", OUT] + (["--quick"] if quick else [])
+        subprocess.check_call(cmd, cwd=ROOT)
+        subprocess.check_call(["cargo", "build", "--release", "--bin", "robocal"], cwd=ROOT)
+    truth = json.load(open(os.path.join(OUT, "truth.json")))
+    robocal = os.path.join(ROOT, "target", "release", "robocal")
+    cv2.setNumThreads(1)
+    print(f"OpenCV {cv2.__version__}, single-threaded; robocal {robocal} --threads 1")
+    for set_name, s in truth.items():
+        files = [im["file"] for im in s["images"]]
+        gts = [im["points"] for im in s["images"]]
+        out_json = os.path.join(OUT, set_name + ".robocal.json")
+        subprocess.run([robocal, "detect", "--threads", "1", "--target", s["target"], "-o", out_json] + files,
+                       cwd=ROOT, stderr=subprocess.DEVNULL)
+        res = json.load(open(out_json))["images"]
+        r_err, r_times, r_found = [], [], 0
+        for im, gt in zip(res, gts):
+            if "detection" in im:
+                r_found += 1
+                pts = [[p["x_px"], p["y_px"]] for p in im["detection"]["points"]]
+                r_err.append(errors(pts, gt))
+                r_times.append(im["detect_ms"])
+            else:
+                r_times.append(float("nan"))
+        rows = [summarize("robocal", r_found, r_err, [t for t in r_times if t == t])]
+        ratios = {}
+        for mname, fn in opencv_methods(s["target"], s["opencv_pattern"]).items():
+            errs, times, found = [], [], 0
+            for f, gt, rt in zip(files, gts, r_times):
+                g = cv2.imread(f, cv2.IMREAD_GRAYSCALE)
+                t0 = time.perf_counter()
+                c = fn(g)
+                ms = (time.perf_counter() - t0) * 1000.0
+                times.append(ms)
+                if c is not None:
+                    found += 1
+                    errs.append(errors(c.reshape(-1, 2), gt))
+                if rt == rt:
+                    ratios.setdefault(mname, []).append(rt / ms)
+            rows.append(summarize(mname, found, errs, times))
+        h, w = cv2.imread(files[0], cv2.IMREAD_GRAYSCALE).shape
+        print(f"\n## {set_name}: {len(files)} images {w}x{h}, target {s['target']}, noise sigma 2")
+        print(f"{'detector':38s} {'found':>7s} {'mean px':>8s} {'max px':>8s} {'median ms':>10s} {'ratio':>7s}")
+        for r in rows:
+            ratio = ratios.get(r["name"])
+            rtxt = f"{np.median(ratio):7.3f}" if ratio else "      -"
+            print(f"{r['name']:38s} {r['found']:3d}/{len(files):<3d} {r['mean']:8.4f} {r['max']:8.4f} {r['median_ms']:10.2f} {rtxt}")
+    print("\nratio = median over images of robocal time / OpenCV time (lower is faster for robocal)")
+
+
+if __name__ == "__main__":
+    main()
