@@ -37,6 +37,7 @@ Examples:
 
 /// One image's outcome.
 enum Outcome {
+    /// The detection and the detection time in seconds.
     Found(Detection, f64),
     Failed(String, String),
 }
@@ -67,9 +68,10 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     let mut found = 0;
     for (file, outcome) in files.iter().zip(outcomes) {
         images.push(match outcome {
-            Outcome::Found(d, ms) => {
+            Outcome::Found(d, seconds) => {
                 found += 1;
-                json!({"file": file, "detection": d, "detect_ms": (ms * 1000.0).round() / 1000.0})
+                let ms = (seconds * 1e6).round() / 1e3;
+                json!({"file": file, "detection": d, "detect_ms": ms})
             }
             Outcome::Failed(kind, message) => {
                 eprintln!("robocal detect: {file}: {message}");
