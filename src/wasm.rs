@@ -263,3 +263,55 @@ pub fn workflow_csv(kind: &str, text: &str) -> Result<String, JsError> {
     .map_err(js_error)?;
     Ok(value.to_string())
 }
+
+/// The demo session: rendered images (PNG, concatenated) plus a JSON index.
+#[wasm_bindgen]
+pub struct DemoData {
+    json: String,
+    bytes: Vec<u8>,
+}
+
+#[wasm_bindgen]
+impl DemoData {
+    /// `{"target", "target_spec", "images": [{"name", "offset", "length"}],
+    /// "poses_csv", "truth": {"camera", "gripper_from_camera", "base_from_target"}}`.
+    #[wasm_bindgen(getter)]
+    pub fn json(&self) -> String {
+        self.json.clone()
+    }
+    /// The PNG files one after the other (see `images` in `json`).
+    #[wasm_bindgen(getter)]
+    pub fn bytes(&self) -> Vec<u8> {
+        self.bytes.clone()
+    }
+}
+
+/// Render the demo session (seeded, deterministic): what the web app's
+/// "load demo data" button loads.
+#[wasm_bindgen]
+pub fn render_demo(seed: u32) -> Result<DemoData, JsError> {
+    let demo = crate::synth::demo::demo_session(seed as u64).map_err(js_error)?;
+    let mut bytes = Vec::new();
+    let mut index = Vec::new();
+    for (name, image) in &demo.images {
+        let png = crate::image::encode_png(image).map_err(js_error)?;
+        index.push(serde_json::json!({ "name": name, "offset": bytes.len(), "length": png.len() }));
+        bytes.extend_from_slice(&png);
+    }
+    let transform = crate::io::export_transform::transform_json;
+    let json = serde_json::json!({
+        "target": demo.target,
+        "target_spec": "chessboard:9x6:30mm",
+        "images": index,
+        "poses_csv": demo.poses_csv,
+        "truth": {
+            "camera": demo.camera,
+            "gripper_from_camera": transform(&demo.gripper_from_camera),
+            "base_from_target": transform(&demo.base_from_target),
+        },
+    });
+    Ok(DemoData {
+        json: json.to_string(),
+        bytes,
+    })
+}

@@ -14,6 +14,7 @@ import { ExportView } from './views/export.js';
 import { ShareView, sharedFragment, decodeShare } from './views/share.js';
 
 const engine = new Engine();
+let robotView = null;
 const store = new Store();
 const READONLY_STEPS = ['camera', 'handeye', 'export', 'share'];
 
@@ -82,6 +83,7 @@ async function main() {
   await images.restore();
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);
+  robotView = robot;
   new HandEyeView(store, engine, robot);
   new WorkflowsView(store, engine);
   new ExportView(store, engine);
@@ -97,10 +99,16 @@ async function main() {
   $('demo-button').addEventListener('click', async () => {
     $('demo-button').disabled = true;
     try {
-      const demo = await engine.call('demo', {});
-      store.session.target = demo.target;
+      $('engine-status').textContent = 'Rendering the demo images…';
+      const demo = await engine.call('demo', { seed: 1 });
+      const t = demo.target;
+      store.session.target = { ...store.session.target, kind: 'chessboard', cols: t.cols, rows: t.rows, size_mm: t.square_m * 1000 };
       store.changed('target-loaded');
       await images.addBytes(demo.images);
+      Object.assign(store.session.robot, { fileName: 'demo_poses.csv', text: demo.poses_csv, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper' });
+      robotView.render();
+      await robotView.parse();
+      $('engine-status').textContent = `Demo loaded: ${demo.images.length} rendered images of a ${demo.target_spec} board and the robot poses that go with them (eye-in-hand). Solve the camera in step 3, then the hand-eye in step 5.`;
     } catch (err) {
       $('engine-status').textContent = `Demo data could not be made: ${err.message}`;
     } finally {

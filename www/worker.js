@@ -68,6 +68,16 @@ handlers.workflow = async ({ op, input }) => {
   return JSON.parse(robocal[op](input));
 };
 
+handlers.demo = async ({ seed }) => {
+  await ready;
+  const demo = robocal.render_demo(seed || 1);
+  const meta = JSON.parse(demo.json);
+  const all = demo.bytes;
+  demo.free();
+  const images = meta.images.map((im) => ({ name: im.name, bytes: all.slice(im.offset, im.offset + im.length).buffer }));
+  return { value: { ...meta, images }, transfer: images.map((i) => i.bytes) };
+};
+
 function requireFn(name) {
   if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
 }

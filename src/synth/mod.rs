@@ -2,6 +2,7 @@
 //! examples and the web app's demo button. Deterministic for a given seed on
 //! every platform (native and wasm).
 
+pub mod demo;
 pub mod handeye;
 pub mod render;
 pub mod rng;
