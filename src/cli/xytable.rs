@@ -5,7 +5,7 @@
 use super::args::{Args, Spec};
 use super::{read_text, write_output, CliError};
 use robocal::calib::dlt_kalman::KalmanMode;
-use robocal::io::workflow_csv::{parse_known_motion, parse_xytable};
+use robocal::io::workflow_csv::{parse_known_motion, parse_xytable_with};
 use robocal::workflows::known_motion::solve_known_motion;
 use robocal::workflows::xytable::solve_xytable;
 
@@ -24,7 +24,8 @@ its diagonals AC, BD is the verification point); 'still' for repeated
 images of the target standing still (their u, v scatter is the Kalman
 filter's measurement noise R; x, y, z are ignored). Calibration rows are
 processed by the filter in file order. An 'image' column instead of u_px,
-v_px is refused in this build: the single-circle detector has not landed yet.
+v_px names image files (relative to the CSV's folder): the circular target's
+centre is detected in each (--target circle:DIAMETER, default circle:10mm).
 
 Prints JSON: 'batch' and 'kalman', each {projection_matrix (3x4 row-major,
 for stage mm; third row = depth in mm), camera_matrix (3x3 row-major),
@@ -52,6 +53,7 @@ Options:
                         or linearized (the DLT constraint throughout)
   --known-motion        solve the seed-000 frame from MOTIONS.csv instead
   --start-mm X,Y,Z      known-motion: the start position in the reference frame
+  --target SPEC         the target in image files (default circle:10mm)
   -o FILE               write the JSON to FILE instead of stdout
 
 Examples:
@@ -61,7 +63,7 @@ Examples:
 pub fn run(raw: &[String]) -> Result<(), CliError> {
     let spec = Spec {
         command: "xytable",
-        valued: &["noise-px", "kalman", "start-mm"],
+        valued: &["noise-px", "kalman", "start-mm", "target"],
         switches: &["known-motion"],
     };
     let args = Args::parse(raw, &spec)?;
@@ -94,7 +96,30 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
                 "--start-mm belongs to --known-motion",
             ));
         }
-        let mut request = parse_xytable(&text).map_err(|e| CliError::Io(format!("{file}: {e}")))?;
+        let target = match args.value("target") {
+            Some(spec) => robocal::target::Target::parse_spec(spec)?,
+            None => robocal::target::Target::SingleCircle { diameter_m: 0.01 },
+        };
+        let base = std::path::Path::new(file)
+            .parent()
+            .map(|p| p.to_path_buf())
+            .unwrap_or_default();
+        // Image names are relative to the CSV's folder.
+        let mut centre_of = |name: &str| -> robocal::Result<[f64; 2]> {
+            let bytes = std::fs::read(base.join(name))
+                .map_err(|e| robocal::Error::invalid("image", format!("cannot read it: {e}")))?;
+            let gray = robocal::image::decode_gray(&bytes)?;
+            let detection = robocal::detect::detect(&gray, &target, &Default::default())?;
+            let p = detection
+                .points
+                .first()
+                .ok_or_else(|| robocal::Error::NotFound {
+                    message: "no target centre in the image".into(),
+                })?;
+            Ok([p.x_px, p.y_px])
+        };
+        let mut request = parse_xytable_with(&text, &mut centre_of)
+            .map_err(|e| CliError::Io(format!("{file}: {e}")))?;
         if args.value("noise-px").is_some() {
             let sigma: f64 = args.parsed("xytable", "noise-px", 0.0)?;
             if !(sigma >= 0.0 && sigma.is_finite()) {

@@ -63,17 +63,32 @@ pub const KNOWN_MOTION_HEADER: [&str; 6] = [
 ];
 
 /// Parse an XY-table positions file into a request (extended Kalman mode,
-/// noise from the `still` rows when there are any).
+/// noise from the `still` rows when there are any). A file with an `image`
+/// column instead of `u_px,v_px` needs [`parse_xytable_with`].
 pub fn parse_xytable(text: &str) -> Result<XyTableRequest> {
-    let table = CsvTable::parse(text)?;
-    if table.column("image").is_some() && table.column("u_px").is_none() {
-        return Err(Error::invalid(
+    parse_xytable_with(text, &mut |name| {
+        Err(Error::invalid(
             "image",
-            "this build cannot detect the circle in image files yet (the single-circle \
-             detector has not landed); give the centres as u_px,v_px columns",
-        ));
-    }
-    let cols = table.require_columns(&XYTABLE_HEADER)?;
+            format!("the row names image '{name}': give the target centres as u_px,v_px columns, or run 'robocal xytable', which detects the circle in the image files"),
+        ))
+    })
+}
+
+/// [`parse_xytable`] where an `image` column (instead of `u_px,v_px`)
+/// names image files: `centre_of(name)` returns the target centre in that
+/// image, pixels (the caller reads and detects; this stays host-free).
+pub fn parse_xytable_with(
+    text: &str,
+    centre_of: &mut dyn FnMut(&str) -> Result<[f64; 2]>,
+) -> Result<XyTableRequest> {
+    let table = CsvTable::parse(text)?;
+    let image_col = table
+        .column("image")
+        .filter(|_| table.column("u_px").is_none());
+    let cols = match image_col {
+        Some(_) => table.require_columns(&XYTABLE_HEADER[..3])?,
+        None => table.require_columns(&XYTABLE_HEADER)?,
+    };
     let role = table.column("role");
     let mut request = XyTableRequest {
         observations: Vec::new(),
@@ -87,9 +102,19 @@ pub fn parse_xytable(text: &str) -> Result<XyTableRequest> {
             .iter()
             .map(|&c| table.number(row, c))
             .collect::<Result<_>>()?;
+        let image_px = match image_col {
+            Some(c) => centre_of(table.text(row, c)).map_err(|e| {
+                Error::parse(
+                    table.line_of(row),
+                    c + 1,
+                    format!("{}: {e}", table.text(row, c)),
+                )
+            })?,
+            None => [v[3], v[4]],
+        };
         let obs = StageObservation {
             stage_mm: [v[0], v[1], v[2]],
-            image_px: [v[3], v[4]],
+            image_px,
         };
         match role.map_or("", |c| table.text(row, c)) {
             "" | "calibration" => request.observations.push(obs),
@@ -159,7 +184,7 @@ mod tests {
         assert!(parse_xytable("x_mm,y_mm,z_mm,image\n1,2,3,a.png\n")
             .unwrap_err()
             .to_string()
-            .starts_with("image: this build cannot detect the circle"));
+            .starts_with("line 2, column 4: a.png: image: the row names image 'a.png'"));
         let m = parse_known_motion("dx_mm,dy_mm,dz_mm,x_cam_mm,y_cam_mm,z_cam_mm\n0,0,0,1,2,3\n")
             .unwrap();
         assert_eq!(m.points_camera_mm, vec![[1.0, 2.0, 3.0]]);
