@@ -5,6 +5,7 @@ mod detect;
 mod export;
 mod handeye;
 mod planar;
+mod render;
 mod serve;
 mod xytable;
 
@@ -65,6 +66,7 @@ Commands:
   handeye     hand-eye calibration from robot poses and camera poses
   detect      find a calibration target (chessboard, circles, dots) in images
   info        decode images and print their format and size
+  render      synthetic target images with exact ground truth (and the demo session)
   planar      eye-to-hand calibration at any height (plate corners per height)
   xytable     camera over an XY-table with one circular target (batch DLT and
               Kalman filter); --known-motion: camera-to-reference frame
@@ -88,6 +90,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
             println!("robocal {}", robocal::VERSION);
             Ok(())
         }
+        "render" if wants_help => print_help(render::HELP),
+        "render" => render::run(rest),
         "serve" if wants_help => print_help(serve::HELP),
         "serve" => serve::run(rest),
         "export" if wants_help => print_help(export::HELP),
