@@ -100,7 +100,7 @@ export class CameraView {
 
   show(r, comparison) {
     const names = ['fx', 'fy', 'cx', 'cy', 'skew', ...Object.keys(r.distortion || {})];
-    const k = r.camera_matrix;
+    const k = r.camera_matrix.flat();
     const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
     const std = r.std || {};
     const params = table(['parameter', 'value', 'std'], names.map((n) => [n, num(value[n], 6), num(std[n], 3)]), { id: 'camera-params' });
@@ -125,7 +125,11 @@ export class CameraView {
     const viewBars = bars(canvas('plot-view-rms', 'reprojection RMS per view'), perView, { ylabel: 'RMS (px)', title: 'Reprojection error per view', threshold: r.rms_px });
     const scat = scatter(canvas('plot-residuals', 'residual scatter'), residualPoints, { xlabel: 'du (px)', ylabel: 'dv (px)', title: 'Residuals', symmetric: true });
     const vec = vectors(canvas('plot-vectors', 'residual vectors over the image'), residualVectors, [w, hgt], { title: 'Residual vectors', gain: 50 });
-    const unc = r.projection_uncertainty ? heatmap(canvas('plot-uncertainty', 'projection uncertainty map'), r.projection_uncertainty, { title: 'Projection uncertainty (1 sigma)' }) : null;
+    const pu = r.projection_uncertainty;
+    const unc = pu && pu.std_px && pu.std_px.length ? heatmap(canvas('plot-uncertainty', 'projection uncertainty map'), {
+      cols: pu.x_px.length, rows: pu.y_px.length, width_px: w, height_px: hgt,
+      values: pu.std_px.flat().map((v) => (v === null ? NaN : v)),
+    }, { title: `Projection uncertainty (1 sigma, points at ${num(pu.reference_depth_m, 2)} m)` }) : null;
     const dist = r.distortion_field ? vectors(canvas('plot-distortion', 'distortion field'), r.distortion_field.vectors, [w, hgt], { title: 'Distortion field', gain: 1 }) : null;
     this.plots = canvases;
     fill(this.out,
@@ -134,7 +138,7 @@ export class CameraView {
       h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat)),
       h('div', { class: 'plots' }, vec, unc, dist),
       comparison ? this.comparisonTable(comparison) : null,
-      r.correlation ? this.correlationNote(r.correlation, names) : null);
+      r.correlation && r.correlation.matrix ? this.correlationNote(r.correlation) : null);
   }
 
   comparisonTable(methods) {
@@ -144,10 +148,9 @@ export class CameraView {
           num(m.std_u_px, 4), num(m.std_v_px, 4), m.error ? m.error : num(m.rms_px, 4)]), { id: 'camera-methods' }));
   }
 
-  correlationNote(corr, names) {
+  correlationNote({ names, matrix }) {
     const strong = [];
-    const n = Math.round(Math.sqrt(corr.length));
-    for (let i = 0; i < n; i++) for (let j = i + 1; j < n; j++) if (Math.abs(corr[i * n + j]) > 0.95) strong.push(`${names[i] || i}–${names[j] || j}: ${num(corr[i * n + j], 3)}`);
+    for (let i = 0; i < matrix.length; i++) for (let j = i + 1; j < matrix.length; j++) if (Math.abs(matrix[i][j]) > 0.95) strong.push(`${names[i]}–${names[j]}: ${num(matrix[i][j], 3)}`);
     return strong.length ? message('warning', `Strongly correlated parameters (|r| > 0.95): ${strong.join(', ')}. Add views with more tilt and coverage to separate them.`) : null;
   }
 }

@@ -112,7 +112,7 @@ export function reportHtml(session, version, canvases) {
   const tableHtml = (el) => el.outerHTML;
   const cam = session.camera.result;
   if (cam) {
-    const k = cam.camera_matrix;
+    const k = cam.camera_matrix.flat();
     const rows = [['fx', k[0]], ['fy', k[4]], ['cx', k[2]], ['cy', k[5]], ['skew', k[1]], ...Object.entries(cam.distortion || {})]
       .map(([n, v]) => [n, num(v, 6), num((cam.std || {})[n], 3)]);
     parts.push(`<h2>Camera (${esc(cam.model)})</h2><p>RMS reprojection error ${num(cam.rms_px, 4)} px over ${(cam.views || []).length} views.</p>`);
