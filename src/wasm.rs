@@ -315,3 +315,11 @@ pub fn render_demo(seed: u32) -> Result<DemoData, JsError> {
         bytes,
     })
 }
+
+/// Calibrate a camera from views (detections or point pairs) with one
+/// method or all of them: the JSON input and output of
+/// `robocal::calib::json_api::calibrate_json`.
+#[wasm_bindgen]
+pub fn calibrate_camera(input_json: &str) -> Result<String, JsError> {
+    crate::calib::json_api::calibrate_json(input_json).map_err(js_error)
+}

@@ -9,11 +9,19 @@
 //!   12 parameters, with the measurement noise from repeated observations.
 
 mod closed_form;
+pub mod compare;
 pub mod dlt;
 pub mod dlt_kalman;
+pub mod ekf;
+mod evaluate;
 mod homography;
+pub mod json_api;
+#[cfg(test)]
+mod json_api_tests;
 mod refine;
 mod report;
+mod residuals;
+mod tsai;
 mod zhang;
 
 pub use closed_form::{intrinsics_from_homographies, pose_from_homography};
@@ -21,6 +29,8 @@ pub use homography::homography;
 pub use report::{
     CameraCalibration, Correlation, Outlier, PoseReport, ProjectionUncertainty, ViewReport,
 };
+pub use residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
+pub use tsai::calibrate_tsai;
 pub use zhang::{calibrate, CalibrationOptions};
 
 use nalgebra::{Point2, Point3};

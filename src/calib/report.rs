@@ -2,6 +2,7 @@
 //! uncertainty and correlation, a projection-uncertainty grid and warnings.
 
 use super::refine::{pose_from_block, CalibProblem};
+use super::residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
 use super::CalibrationOptions;
 use crate::camera::Camera;
 use crate::error::Result;
@@ -56,6 +57,10 @@ pub struct ViewReport {
     pub camera_from_target: PoseReport,
     /// Points dropped as outliers.
     pub outliers: Vec<Outlier>,
+    /// Observed minus predicted pixel of every point (outliers included),
+    /// anchored at the observed pixel, in the view's point order.
+    #[serde(default)]
+    pub residuals_px: Vec<PixelVector>,
 }
 
 /// Correlation matrix of the camera parameters.
@@ -113,6 +118,9 @@ pub struct CameraCalibration {
     pub correlation: Correlation,
     /// Projection uncertainty over the image.
     pub projection_uncertainty: ProjectionUncertainty,
+    /// Distorted minus undistorted pixel positions on a grid over the image.
+    #[serde(default)]
+    pub distortion_field: DistortionField,
     /// Things the user should know (coverage, tilt, correlations, ...).
     pub warnings: Vec<String>,
     /// Solver iterations in the last round.
@@ -176,6 +184,7 @@ pub(crate) fn build_report(
             n_points: counts[v],
             camera_from_target: pose_report(&poses[v]),
             outliers,
+            residuals_px: view_residuals(&camera, &poses[v], view),
         })
         .collect();
     let mut depths: Vec<f64> = poses.iter().map(|p| p.translation.vector.norm()).collect();
@@ -197,6 +206,7 @@ pub(crate) fn build_report(
         rms_px: (squared.iter().sum::<f64>() / n_points.max(1) as f64).sqrt(),
         std,
         projection_uncertainty: projection_uncertainty(&camera, cov, depth),
+        distortion_field: distortion_field(&camera),
         warnings: warnings(problem, &poses, &correlation, covariance.is_none()),
         views,
         correlation,

@@ -35,8 +35,8 @@ Examples:
   robocal detect --target dots:7x7:25mm plate.tiff
   robocal detect --target circle:10mm --threads 1 table_*.png";
 
-/// One image's outcome.
-enum Outcome {
+/// One image's outcome (also used by `robocal intrinsics`).
+pub(super) enum Outcome {
     /// The detection and the detection time in seconds.
     Found(Detection, f64),
     Failed(String, String),
@@ -118,7 +118,7 @@ fn parse_target(args: &Args) -> Result<Target, CliError> {
 }
 
 /// Detect in every file with `threads` workers pulling from a shared index.
-fn run_all(
+pub(super) fn run_all(
     files: &[String],
     target: &Target,
     options: &DetectOptions,

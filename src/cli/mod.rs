@@ -4,6 +4,7 @@ pub mod args;
 mod detect;
 mod export;
 mod handeye;
+mod intrinsics;
 mod planar;
 mod render;
 mod serve;
@@ -65,6 +66,7 @@ Commands:
               MATLAB, URDF, robot-controller and other formats
   handeye     hand-eye calibration from robot poses and camera poses
   detect      find a calibration target (chessboard, circles, dots) in images
+  intrinsics  calibrate a camera (Zhang, DLT, Tsai, EKF) from images or detections
   info        decode images and print their format and size
   render      synthetic target images with exact ground truth (and the demo session)
   planar      eye-to-hand calibration at any height (plate corners per height)
@@ -94,6 +96,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
         "render" => render::run(rest),
         "serve" if wants_help => print_help(serve::HELP),
         "serve" => serve::run(rest),
+        "intrinsics" if wants_help => print_help(intrinsics::HELP),
+        "intrinsics" => intrinsics::run(rest),
         "export" if wants_help => print_help(export::HELP),
         "export" => export::run(rest),
         "handeye" if wants_help => print_help(handeye::HELP),

@@ -1,0 +1,324 @@
+//! The JSON boundary of camera calibration, shared by the wasm function
+//! `calibrate_camera` and `robocal intrinsics`.
+//!
+//! Input:
+//!
+//! ```json
+//! {"model": "brown", "method": "zhang",
+//!  "options": {"fix_principal_point": false, "fix_aspect_ratio": false,
+//!              "zero_skew": true, "robust": false, "fixed_coefficients": []},
+//!  "views": [{"name": "left01.jpg", "detection": {"image_size_px": [640, 480], "target": {...}, "points": [...]}},
+//!            {"name": "rig", "object_m": [[0, 0, 0], ...], "image_px": [[320.5, 240.1], ...]}],
+//!  "image_size_px": [640, 480]}
+//! ```
+//!
+//! `model` is one of `brown` (default), `radial_k1_k2_k5`, `rational`,
+//! `division`, `kannala_brandt`, `eucm`, `none`; `method` one of `zhang`
+//! (default), `dlt` (non-coplanar points), `tsai` (planar), `ekf` (planar)
+//! or `all`. `image_size_px` may be left out when the views carry
+//! detections (which must then agree on it). `robust` means a Huber loss
+//! (1 px) plus rejection of points beyond 3 robust sigmas, reported per view
+//! as `outliers`.
+//!
+//! Output: `{"report": <CameraCalibration>, "comparison": null | [rows]}`,
+//! the report of the chosen method (Zhang's for `all`) and, for `all`, one
+//! [`ComparisonRow`] per method.
+
+use super::compare::{calibrate_with, compare_methods, ComparisonRow, Method};
+use super::{CalibrationOptions, CameraCalibration, View};
+use crate::camera::Distortion;
+use crate::error::{Error, Result};
+use crate::optim::Loss;
+use crate::target::Detection;
+use nalgebra::{Point2, Point3};
+use serde::{Deserialize, Serialize};
+
+/// Fewest views the JSON API accepts (Zhang's closed form with free skew
+/// needs 3; fewer views leave the focal length poorly determined anyway).
+pub const MIN_VIEWS: usize = 3;
+/// Huber threshold of the robust option, px.
+pub const ROBUST_HUBER_PX: f64 = 1.0;
+/// Outlier threshold of the robust option, robust sigmas.
+pub const ROBUST_OUTLIER_SIGMA: f64 = 3.0;
+
+/// The options object of the input.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct JsonOptions {
+    /// Hold the principal point at the image centre.
+    pub fix_principal_point: bool,
+    /// Hold fy / fx at its closed-form value.
+    pub fix_aspect_ratio: bool,
+    /// Hold the skew at 0 (default true).
+    pub zero_skew: bool,
+    /// Huber loss and 3-sigma outlier rejection.
+    pub robust: bool,
+    /// Coefficient names of the model held at 0.
+    pub fixed_coefficients: Vec<String>,
+}
+
+impl Default for JsonOptions {
+    fn default() -> Self {
+        JsonOptions {
+            fix_principal_point: false,
+            fix_aspect_ratio: false,
+            zero_skew: true,
+            robust: false,
+            fixed_coefficients: vec![],
+        }
+    }
+}
+
+/// One view of the input: a detection, or explicit correspondences.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JsonView {
+    /// Image name, carried into the report.
+    pub name: String,
+    /// A target detection (`robocal detect` / `detect_target` output).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detection: Option<Detection>,
+    /// Target points, metres (with `image_px`, instead of `detection`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object_m: Option<Vec<[f64; 3]>>,
+    /// Observed pixels, same order as `object_m`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub image_px: Option<Vec<[f64; 2]>>,
+}
+
+/// The whole input of [`calibrate_json`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationInput {
+    /// Lens model name (default `brown`).
+    #[serde(default = "default_model")]
+    pub model: String,
+    /// Method name or `all` (default `zhang`).
+    #[serde(default = "default_method")]
+    pub method: String,
+    /// Options.
+    #[serde(default)]
+    pub options: JsonOptions,
+    /// The views.
+    pub views: Vec<JsonView>,
+    /// Image width and height, px; optional when every view is a detection.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub image_size_px: Option<[u32; 2]>,
+}
+
+fn default_model() -> String {
+    "brown".into()
+}
+
+fn default_method() -> String {
+    "zhang".into()
+}
+
+/// The output of [`calibrate_json`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CalibrationOutput {
+    /// The report of the chosen method (Zhang's for `all`).
+    pub report: CameraCalibration,
+    /// With method `all`: every method's row; otherwise `None` (JSON null).
+    pub comparison: Option<Vec<ComparisonRow>>,
+}
+
+/// Calibrate from the JSON input described in the module docs; returns the
+/// output JSON.
+pub fn calibrate_json(input_json: &str) -> Result<String> {
+    let input: CalibrationInput = serde_json::from_str(input_json)
+        .map_err(|e| Error::parse(e.line(), e.column(), format!("calibration input: {e}")))?;
+    let output = calibrate_input(&input)?;
+    serde_json::to_string(&output)
+        .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
+}
+
+/// [`calibrate_json`] on the parsed input.
+pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
+    // 1. The views and the image size.
+    let views = views_of(&input.views)?;
+    if views.len() < MIN_VIEWS {
+        return Err(Error::too_few("views", MIN_VIEWS, views.len()));
+    }
+    let size = image_size(input)?;
+    // 2. The options.
+    let options = calibration_options(&input.model, &input.options)?;
+    // 3. The method(s).
+    if input.method == "all" {
+        let outcomes = compare_methods(&views, size, &options);
+        let comparison = outcomes
+            .iter()
+            .map(|(m, outcome)| ComparisonRow::new(*m, outcome))
+            .collect();
+        let report = outcomes
+            .into_iter()
+            .find(|(m, _)| *m == Method::Zhang)
+            .map(|(_, outcome)| outcome)
+            .ok_or_else(|| Error::invalid("method", "the comparison has no Zhang row"))??;
+        return Ok(CalibrationOutput {
+            report,
+            comparison: Some(comparison),
+        });
+    }
+    let method = Method::from_name(&input.method)?;
+    Ok(CalibrationOutput {
+        report: calibrate_with(method, &views, size, &options)?,
+        comparison: None,
+    })
+}
+
+/// The lens model of a name, with the coefficients the solver starts from
+/// (0, except EUCM's alpha 0.5 and beta 1: at alpha = 0 beta has no effect).
+pub fn model_from_name(name: &str) -> Result<Distortion> {
+    Ok(match name {
+        "none" => Distortion::None,
+        "brown" => Distortion::Brown {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+        },
+        "radial_k1_k2_k5" => Distortion::RadialK1K2K5 {
+            k1: 0.0,
+            k2: 0.0,
+            k5: 0.0,
+        },
+        "rational" => Distortion::Rational {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            k4: 0.0,
+            k5: 0.0,
+            k6: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+            s1: 0.0,
+            s2: 0.0,
+            s3: 0.0,
+            s4: 0.0,
+        },
+        "division" => Distortion::Division { kappa: 0.0 },
+        "kannala_brandt" => Distortion::KannalaBrandt {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            k4: 0.0,
+        },
+        "eucm" => Distortion::Eucm {
+            alpha: 0.5,
+            beta: 1.0,
+        },
+        other => {
+            return Err(Error::invalid(
+                "model",
+                format!("unknown model '{other}' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none)"),
+            ))
+        }
+    })
+}
+
+/// The solver options of the JSON options.
+pub fn calibration_options(model: &str, o: &JsonOptions) -> Result<CalibrationOptions> {
+    let (loss, outlier_sigma) = if o.robust {
+        (
+            Loss::Huber {
+                scale: ROBUST_HUBER_PX,
+            },
+            Some(ROBUST_OUTLIER_SIGMA),
+        )
+    } else {
+        (Loss::Squared, None)
+    };
+    Ok(CalibrationOptions {
+        model: model_from_name(model)?,
+        fix_principal_point: o.fix_principal_point,
+        fix_aspect_ratio: o.fix_aspect_ratio,
+        zero_skew: o.zero_skew,
+        fixed_coefficients: o.fixed_coefficients.clone(),
+        loss,
+        outlier_sigma,
+        ..CalibrationOptions::default()
+    })
+}
+
+/// The correspondences of every input view.
+pub fn views_of(views: &[JsonView]) -> Result<Vec<View>> {
+    views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let field = |f: &str| format!("views[{i}].{f}");
+            match (&v.detection, &v.object_m, &v.image_px) {
+                (Some(d), None, None) => {
+                    let (object_m, image_px) = d.correspondences();
+                    Ok(View {
+                        name: v.name.clone(),
+                        object_m,
+                        image_px,
+                    })
+                }
+                (None, Some(object), Some(image)) => {
+                    if object.len() != image.len() {
+                        return Err(Error::invalid(
+                            field("image_px"),
+                            format!(
+                                "{} object points but {} image points",
+                                object.len(),
+                                image.len()
+                            ),
+                        ));
+                    }
+                    Ok(View {
+                        name: v.name.clone(),
+                        object_m: object
+                            .iter()
+                            .map(|p| Point3::new(p[0], p[1], p[2]))
+                            .collect(),
+                        image_px: image.iter().map(|p| Point2::new(p[0], p[1])).collect(),
+                    })
+                }
+                _ => Err(Error::invalid(
+                    format!("views[{i}]"),
+                    "give either \"detection\" or both \"object_m\" and \"image_px\"",
+                )),
+            }
+        })
+        .collect()
+}
+
+/// The image size: given, or the one all detections agree on.
+fn image_size(input: &CalibrationInput) -> Result<(u32, u32)> {
+    let mut from_detections = input
+        .views
+        .iter()
+        .filter_map(|v| v.detection.as_ref().map(|d| (v, d.image_size_px)));
+    if let Some([w, h]) = input.image_size_px {
+        if let Some((v, s)) = from_detections.find(|(_, s)| *s != [w, h]) {
+            return Err(Error::invalid(
+                "image_size_px",
+                format!(
+                    "{w}x{h} given but the detection of {} is {}x{}",
+                    v.name, s[0], s[1]
+                ),
+            ));
+        }
+        return Ok((w, h));
+    }
+    let Some((_, first)) = from_detections.next() else {
+        return Err(Error::invalid(
+            "image_size_px",
+            "required when the views are not detections",
+        ));
+    };
+    if let Some((v, s)) = from_detections.find(|(_, s)| *s != first) {
+        return Err(Error::invalid(
+            "image_size_px",
+            format!(
+                "the detections disagree: {}x{} and {}x{} ({})",
+                first[0], first[1], s[0], s[1], v.name
+            ),
+        ));
+    }
+    Ok((first[0], first[1]))
+}

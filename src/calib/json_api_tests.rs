@@ -1,0 +1,252 @@
+//! Tests of the calibration JSON API: the contract the web app codes
+//! against (keys, errors), on seeded synthetic scenes.
+
+use super::json_api::calibrate_json;
+use crate::camera::Camera;
+use crate::synth::Scene;
+use crate::target::{DetectedPoint, Detection, Target};
+use serde_json::{json, Value};
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn scene(noise_px: f64) -> Scene {
+    Scene::calibration(21, &Camera::example_brown(), (9, 6), 0.03, 8, noise_px).expect("scene")
+}
+
+fn point_views(scene: &Scene) -> Value {
+    scene
+        .views
+        .iter()
+        .map(|v| {
+            json!({
+                "name": v.name,
+                "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+            })
+        })
+        .collect()
+}
+
+fn run(input: Value) -> Value {
+    let out = calibrate_json(&input.to_string()).expect("calibration");
+    serde_json::from_str(&out).expect("output JSON")
+}
+
+fn error(input: Value) -> String {
+    calibrate_json(&input.to_string())
+        .expect_err("must fail")
+        .to_string()
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn noise_free_point_views_give_the_true_camera_and_the_documented_keys() {
+    let s = scene(0.0);
+    let out = run(json!({"views": point_views(&s), "image_size_px": [1280, 960]}));
+    assert!(out["comparison"].is_null());
+    let report = &out["report"];
+    let truth = Camera::example_brown();
+    let k = &report["camera_matrix"];
+    // Exact data: the optimum is the truth to ~1e-9 relative.
+    for (got, want) in [
+        (&k[0][0], truth.fx),
+        (&k[1][1], truth.fy),
+        (&k[0][2], truth.cx),
+        (&k[1][2], truth.cy),
+    ] {
+        let got = got.as_f64().expect("number");
+        assert!((got - want).abs() < 1e-9 * want, "{got} vs {want} px");
+    }
+    assert!((report["distortion"]["k1"].as_f64().expect("k1") + 0.28).abs() < 1e-9);
+    let residuals = report["views"][0]["residuals_px"]
+        .as_array()
+        .expect("array");
+    assert_eq!(residuals.len(), 54);
+    let first = &residuals[0];
+    assert_eq!(first["x"], json!(s.views[0].image_px[0].x));
+    assert!(first["dx"].as_f64().expect("dx").abs() < 1e-9, "px");
+    let field = report["distortion_field"]["vectors"]
+        .as_array()
+        .expect("array");
+    assert_eq!(field.len(), 16 * 12);
+    // Barrel distortion: the top-left corner moves towards the centre.
+    assert!(field[0]["dx"].as_f64().expect("dx") > 1.0);
+    assert!(field[0]["dy"].as_f64().expect("dy") > 1.0);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn detections_carry_the_image_size_and_method_all_adds_the_comparison() {
+    let s = scene(0.0);
+    let target = Target::Chessboard {
+        cols: 9,
+        rows: 6,
+        square_m: 0.03,
+    };
+    let views: Vec<Value> = s
+        .views
+        .iter()
+        .map(|v| {
+            let points = v
+                .image_px
+                .iter()
+                .enumerate()
+                .map(|(id, p)| DetectedPoint {
+                    id,
+                    x_px: p.x,
+                    y_px: p.y,
+                    covariance_px2: None,
+                })
+                .collect();
+            let detection = Detection {
+                image_size_px: [1280, 960],
+                target: target.clone(),
+                points,
+            };
+            json!({"name": v.name, "detection": detection})
+        })
+        .collect();
+    let out = run(json!({"views": views, "method": "all", "model": "brown"}));
+    assert_eq!(out["report"]["image_size_px"], json!([1280, 960]));
+    let rows = out["comparison"].as_array().expect("rows");
+    let zhang = &rows[0];
+    assert_eq!(zhang["method"], "zhang");
+    assert!(zhang["error"].is_null());
+    assert!(
+        (zhang["fx"].as_f64().expect("fx") - 1000.0).abs() < 1e-6,
+        "px"
+    );
+    assert!(zhang["std_u_px"].as_f64().expect("std") < 1e-9, "px");
+    for key in ["fy", "cx", "cy", "k1", "rms_px", "std_v_px"] {
+        assert!(zhang[key].is_f64(), "{key}");
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn robust_option_drops_a_gross_outlier_and_reports_it() {
+    let s = scene(0.1);
+    let mut views = point_views(&s);
+    let p = &mut views[2]["image_px"][17];
+    p[0] = json!(p[0].as_f64().expect("x") + 25.0);
+    let out = run(json!({"views": views, "image_size_px": [1280, 960],
+                         "options": {"robust": true}}));
+    let outliers = out["report"]["views"][2]["outliers"]
+        .as_array()
+        .expect("array");
+    let gross: Vec<&Value> = outliers.iter().filter(|o| o["index"] == 17).collect();
+    assert_eq!(gross.len(), 1, "{outliers:?}");
+    assert!((gross[0]["residual_px"].as_f64().expect("px") - 25.0).abs() < 1.0);
+    // A 3-sigma cut on 2-D Gaussian residual norms also drops exp(-4.5) =
+    // 1.1 % of the inliers, all of them near 3 sigma (0.3 px), none beyond
+    // 6 sigma (probability exp(-18) per point).
+    for view in out["report"]["views"].as_array().expect("views") {
+        for o in view["outliers"].as_array().expect("outliers") {
+            let r = o["residual_px"].as_f64().expect("px");
+            assert!(o["index"] == 17 || r < 0.6, "{o} px");
+        }
+    }
+    // With sigma 0.1 px the rms of the inliers is ~0.1 sqrt(2) px; 0.2 px
+    // bounds it with room (the outlier alone would add ~3.4 px rms).
+    assert!(out["report"]["rms_px"].as_f64().expect("rms") < 0.2, "px");
+    assert_eq!(out["report"]["options"]["outlier_sigma"], 3.0);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn bad_input_gives_clear_errors() {
+    let s = scene(0.0);
+    let views = point_views(&s);
+    let two = json!([views[0], views[1]]);
+    assert_eq!(
+        error(json!({"views": two, "image_size_px": [1280, 960]})),
+        "requires at least 3 views, got 2"
+    );
+    assert_eq!(
+        error(json!({"views": views, "image_size_px": [1280, 960], "model": "fisheye"})),
+        "model: unknown model 'fisheye' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none)"
+    );
+    assert_eq!(
+        error(json!({"views": views, "image_size_px": [1280, 960], "method": "magic"})),
+        "method: unknown method 'magic' (expected one of zhang, dlt, tsai, ekf, or all)"
+    );
+    assert_eq!(
+        error(json!({"views": views})),
+        "image_size_px: required when the views are not detections"
+    );
+    assert_eq!(
+        error(json!({"views": [{"name": "a"}, views[1], views[2]], "image_size_px": [1280, 960]})),
+        "views[0]: give either \"detection\" or both \"object_m\" and \"image_px\""
+    );
+    let e =
+        error(json!({"views": views, "image_size_px": [1280, 960], "options": {"robustt": true}}));
+    assert!(e.starts_with("line 1, column "), "{e}");
+    assert!(e.contains("unknown field `robustt`"), "{e}");
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn dlt_on_a_3d_rig_is_exact_and_refused_on_planar_views() {
+    use crate::geometry::{rotation_from_rotvec, Pose};
+    use nalgebra::{Point3, Translation3, Vector3};
+    let camera = Camera::pinhole(850.0, 860.0, 330.0, 250.0, 640, 480);
+    // Two faces of a calibration rig, 0.2 m apart in z.
+    let object: Vec<Point3<f64>> = (0..24)
+        .map(|i| {
+            Point3::new(
+                (i % 4) as f64 * 0.05,
+                ((i / 4) % 3) as f64 * 0.05,
+                (i / 12) as f64 * 0.2,
+            )
+        })
+        .collect();
+    let views: Vec<Value> = (0..3)
+        .map(|k| {
+            let pose = Pose::from_parts(
+                Translation3::new(-0.05 + 0.02 * k as f64, -0.05, 0.9),
+                rotation_from_rotvec(&Vector3::new(0.2, -0.1 * k as f64, 0.05)),
+            );
+            let pixels: Vec<[f64; 2]> = object
+                .iter()
+                .map(|p| {
+                    let q = camera.project(&(pose * p)).expect("in front");
+                    [q.x, q.y]
+                })
+                .collect();
+            json!({"name": format!("rig{k}"),
+                   "object_m": object.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                   "image_px": pixels})
+        })
+        .collect();
+    let out = run(json!({"views": views, "image_size_px": [640, 480], "method": "dlt"}));
+    let report = &out["report"];
+    assert_eq!(report["model"], "none");
+    // Exact data: the linear solution is exact to rounding (~1e-9 relative).
+    for (r, c, want) in [
+        (0, 0, 850.0),
+        (1, 1, 860.0),
+        (0, 2, 330.0),
+        (1, 2, 250.0),
+        (0, 1, 0.0),
+    ] {
+        let got = report["camera_matrix"][r][c].as_f64().expect("number");
+        assert!((got - want).abs() < 1e-7, "K[{r}][{c}] {got} vs {want} px");
+    }
+    assert!(report["rms_px"].as_f64().expect("rms") < 1e-9, "px");
+    // Planar views: the DLT row of the comparison says why it does not apply.
+    let s = scene(0.0);
+    let out = run(json!({"views": point_views(&s), "image_size_px": [1280, 960], "method": "all"}));
+    let rows = out["comparison"].as_array().expect("rows");
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["method"].as_str().expect("name"))
+        .collect();
+    assert_eq!(names, ["zhang", "dlt", "tsai", "ekf"]);
+    let dlt_error = rows[1]["error"].as_str().expect("message");
+    assert!(
+        dlt_error.starts_with("views[view_000]: DLT: "),
+        "{dlt_error}"
+    );
+    assert!(rows[1]["fx"].is_null());
+    // Tsai on a Brown camera with tangential terms: a model mismatch, so
+    // the fit is close but not exact (principal point forced to the centre).
+    assert!(rows[2]["error"].is_null());
+    assert!(
+        (rows[2]["fx"].as_f64().expect("fx") - 1000.0).abs() < 20.0,
+        "px"
+    );
+}

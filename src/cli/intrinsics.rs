@@ -1,0 +1,227 @@
+//! `robocal intrinsics`: calibrate a camera from images or from the
+//! detections `robocal detect` wrote.
+
+use super::args::{Args, Spec};
+use super::detect::{run_all, Outcome};
+use super::{read_text, write_output, CliError};
+use robocal::calib::compare::ComparisonRow;
+use robocal::calib::json_api::{calibrate_input, CalibrationInput, JsonOptions, JsonView};
+use robocal::detect::DetectOptions;
+use robocal::target::{Detection, Target};
+use serde::Deserialize;
+
+pub const HELP: &str = "robocal intrinsics - calibrate a camera (intrinsics and lens distortion)
+
+Usage: robocal intrinsics --target SPEC IMAGES... [options] -o camera.json
+       robocal intrinsics --detections detections.json [options] -o camera.json
+
+Options:
+  --target SPEC           the target, as for 'robocal detect' (chessboard:9x6:30mm,
+                          circles:4x11:20mm:asymmetric, dots:7x7:25mm); required
+                          with images, checked against the file with --detections
+  --detections FILE       use the JSON written by 'robocal detect' instead of images
+  --model NAME            brown (default: k1 k2 p1 p2 k3), radial_k1_k2_k5, rational,
+                          division, kannala_brandt, eucm, none
+  --method NAME           zhang (default), dlt (non-coplanar points), tsai, ekf, or
+                          all (every method side by side, as seed 000's Table II; the
+                          report is Zhang's, the comparison goes to standard error)
+  --fix-principal-point   hold the principal point at the image centre
+  --fix-aspect-ratio      hold fy/fx at its closed-form value
+  --free-skew             estimate the skew (default: held at 0, as OpenCV)
+  --fix NAME              hold a distortion coefficient at 0 (repeatable: --fix k3)
+  --robust                Huber loss and rejection of points beyond 3 robust sigmas
+  --threads N             images detected in parallel (default: all cores)
+  -o FILE                 write the report there (default: standard output)
+
+Images where the target is not found are listed on standard error and skipped.
+The report (JSON) has camera_matrix, distortion, rms_px, std, per-view residuals,
+correlations, projection uncertainty and warnings; 'robocal export' converts it.
+
+Examples:
+  robocal intrinsics --target chessboard:9x6:25mm left*.jpg -o camera.json
+  robocal intrinsics --detections detections.json --fix-aspect-ratio --fix k3 -o camera.json
+  robocal intrinsics --target chessboard:9x6:25mm --method all --robust left*.jpg
+  robocal export camera.json --format opencv-yaml -o camera.yaml";
+
+/// One entry of `robocal detect`'s output.
+#[derive(Deserialize)]
+struct DetectedImage {
+    file: String,
+    #[serde(default)]
+    detection: Option<Detection>,
+}
+
+/// `robocal detect`'s output file.
+#[derive(Deserialize)]
+struct DetectionsFile {
+    images: Vec<DetectedImage>,
+}
+
+pub fn run(raw: &[String]) -> Result<(), CliError> {
+    let spec = Spec {
+        command: "intrinsics",
+        valued: &[
+            "target",
+            "detections",
+            "model",
+            "method",
+            "fix",
+            "threads",
+            "output",
+        ],
+        switches: &[
+            "fix-principal-point",
+            "fix-aspect-ratio",
+            "free-skew",
+            "robust",
+        ],
+    };
+    let args = Args::parse(raw, &spec)?;
+    let target = match args.value("target") {
+        Some(t) => {
+            Some(Target::parse_spec(t).map_err(|e| CliError::usage("intrinsics", e.to_string()))?)
+        }
+        None => None,
+    };
+    let views = match (args.value("detections"), args.positionals.is_empty()) {
+        (Some(_), false) => {
+            return Err(CliError::usage(
+                "intrinsics",
+                "give either IMAGES or --detections, not both",
+            ))
+        }
+        (Some(file), true) => views_from_file(file, target.as_ref())?,
+        (None, false) => {
+            let target = target.ok_or_else(|| {
+                CliError::usage(
+                    "intrinsics",
+                    "--target is required with images, e.g. --target chessboard:9x6:30mm",
+                )
+            })?;
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let threads: usize = args.parsed("intrinsics", "threads", cores)?;
+            views_from_images(&args.positionals, &target, threads.max(1))
+        }
+        (None, true) => {
+            return Err(CliError::usage(
+                "intrinsics",
+                "give IMAGES or --detections FILE",
+            ))
+        }
+    };
+    let input = CalibrationInput {
+        model: args.value("model").unwrap_or("brown").to_string(),
+        method: args.value("method").unwrap_or("zhang").to_string(),
+        options: JsonOptions {
+            fix_principal_point: args.switch("fix-principal-point"),
+            fix_aspect_ratio: args.switch("fix-aspect-ratio"),
+            zero_skew: !args.switch("free-skew"),
+            robust: args.switch("robust"),
+            fixed_coefficients: args.values("fix").iter().map(|s| s.to_string()).collect(),
+        },
+        views,
+        image_size_px: None,
+    };
+    let output = calibrate_input(&input)?;
+    if let Some(rows) = &output.comparison {
+        eprint!("{}", comparison_table(rows));
+    }
+    let r = &output.report;
+    eprintln!(
+        "robocal intrinsics: {} views, {} points, rms {:.4} px, fx {:.3} fy {:.3} cx {:.3} cy {:.3}",
+        r.views.len(),
+        r.n_points,
+        r.rms_px,
+        r.camera.fx,
+        r.camera.fy,
+        r.camera.cx,
+        r.camera.cy
+    );
+    for w in &r.warnings {
+        eprintln!("robocal intrinsics: warning: {w}");
+    }
+    let text = serde_json::to_string_pretty(&output.report)
+        .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
+    write_output(args.value("output"), &(text + "\n"))
+}
+
+fn views_from_file(file: &str, target: Option<&Target>) -> Result<Vec<JsonView>, CliError> {
+    let text = read_text(file)?;
+    let parsed: DetectionsFile = serde_json::from_str(&text).map_err(|e| {
+        CliError::Io(format!(
+            "'{file}' is not a 'robocal detect' output (an object with \"images\"): {e}"
+        ))
+    })?;
+    let mut views = vec![];
+    for image in parsed.images {
+        let Some(detection) = image.detection else {
+            eprintln!("robocal intrinsics: {}: no detection, skipped", image.file);
+            continue;
+        };
+        if let Some(t) = target {
+            if *t != detection.target {
+                return Err(CliError::usage(
+                    "intrinsics",
+                    format!(
+                        "--target does not match the target of the detection of '{}'",
+                        image.file
+                    ),
+                ));
+            }
+        }
+        views.push(JsonView {
+            name: image.file,
+            detection: Some(detection),
+            object_m: None,
+            image_px: None,
+        });
+    }
+    Ok(views)
+}
+
+fn views_from_images(files: &[String], target: &Target, threads: usize) -> Vec<JsonView> {
+    let outcomes = run_all(files, target, &DetectOptions::default(), threads);
+    let mut views = vec![];
+    for (file, outcome) in files.iter().zip(outcomes) {
+        match outcome {
+            Outcome::Found(detection, _) => views.push(JsonView {
+                name: file.clone(),
+                detection: Some(detection),
+                object_m: None,
+                image_px: None,
+            }),
+            Outcome::Failed(_, message) => {
+                eprintln!("robocal intrinsics: {file}: {message}; skipped")
+            }
+        }
+    }
+    views
+}
+
+fn comparison_table(rows: &[ComparisonRow]) -> String {
+    let f = |v: Option<f64>, d: usize| v.map_or("-".to_string(), |v| format!("{v:.d$}"));
+    let mut out = format!(
+        "{:<8} {:>10} {:>10} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8}\n",
+        "method", "fx", "fy", "cx", "cy", "k1", "rms_px", "std_u", "std_v"
+    );
+    for r in rows {
+        match &r.error {
+            Some(e) => out += &format!("{:<8} not applicable: {e}\n", r.method),
+            None => {
+                out += &format!(
+                    "{:<8} {:>10} {:>10} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8}\n",
+                    r.method,
+                    f(r.fx, 3),
+                    f(r.fy, 3),
+                    f(r.cx, 3),
+                    f(r.cy, 3),
+                    f(r.k1, 5),
+                    f(r.rms_px, 4),
+                    f(r.std_u_px, 4),
+                    f(r.std_v_px, 4)
+                )
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,218 @@
+//! `robocal intrinsics` through the real binary: detections files written
+//! like `robocal detect`'s from seeded synthetic scenes (exact answers),
+//! the OpenCV sample images when present, and bad arguments.
+
+use robocal::synth::Scene;
+use robocal::Camera;
+use serde_json::{json, Value};
+use std::path::PathBuf;
+use std::process::Command;
+
+fn robocal(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .args(args)
+        .output()
+        .expect("run robocal");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("robocal-intrinsics-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// A `robocal detect` output for a noise-free scene, plus one failed image.
+fn detections_file(dir: &PathBuf) -> (PathBuf, Camera) {
+    let truth = Camera::example_brown();
+    let scene = Scene::calibration(11, &truth, (9, 6), 0.03, 6, 0.0).expect("scene");
+    let mut images: Vec<Value> = scene
+        .views
+        .iter()
+        .map(|v| {
+            let points: Vec<Value> = v
+                .image_px
+                .iter()
+                .enumerate()
+                .map(|(id, p)| json!({"id": id, "x_px": p.x, "y_px": p.y}))
+                .collect();
+            json!({"file": format!("{}.png", v.name), "detect_ms": 1.0, "detection": {
+                "image_size_px": [1280, 960],
+                "target": {"kind": "chessboard", "cols": 9, "rows": 6, "square_m": 0.03},
+                "points": points}})
+        })
+        .collect();
+    images.push(
+        json!({"file": "blurred.png", "error": {"kind": "not_found", "message": "no board"}}),
+    );
+    let doc = json!({"robocal_version": "0.1.0",
+                     "target": {"kind": "chessboard", "cols": 9, "rows": 6, "square_m": 0.03},
+                     "images": images});
+    let path = dir.join("detections.json");
+    std::fs::write(&path, doc.to_string()).expect("write");
+    (path, truth)
+}
+
+#[test]
+fn detections_file_gives_the_exact_camera_and_an_exportable_report() {
+    let dir = temp_dir("file");
+    let (detections, truth) = detections_file(&dir);
+    let out = dir.join("camera.json");
+    let (code, stdout, stderr) = robocal(&[
+        "intrinsics",
+        "--detections",
+        detections.to_str().expect("path"),
+        "--target",
+        "chessboard:9x6:30mm",
+        "-o",
+        out.to_str().expect("path"),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(stdout, "");
+    assert!(
+        stderr.contains("blurred.png: no detection, skipped"),
+        "{stderr}"
+    );
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("report JSON");
+    assert_eq!(report["views"].as_array().expect("views").len(), 6);
+    // Noise-free: the optimum is the truth to ~1e-9 relative.
+    let fx = report["camera_matrix"][0][0].as_f64().expect("fx");
+    assert!((fx - truth.fx).abs() < 1e-9 * truth.fx, "fx {fx} px");
+    assert!(report["rms_px"].as_f64().expect("rms") < 1e-9, "px");
+    assert_eq!(
+        report["views"][0]["residuals_px"]
+            .as_array()
+            .expect("r")
+            .len(),
+        54
+    );
+    let (code, yaml, stderr) = robocal(&[
+        "export",
+        out.to_str().expect("path"),
+        "--format",
+        "opencv-yaml",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(yaml.contains("camera_matrix: !!opencv-matrix"), "{yaml}");
+    assert!(
+        yaml.contains(&format!("{}", report["camera_matrix"][0][0])),
+        "{yaml}"
+    );
+}
+
+#[test]
+fn method_all_prints_the_comparison_table() {
+    let dir = temp_dir("all");
+    let (detections, _) = detections_file(&dir);
+    let (code, stdout, stderr) = robocal(&[
+        "intrinsics",
+        "--detections",
+        detections.to_str().expect("path"),
+        "--method",
+        "all",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let report: Value = serde_json::from_str(&stdout).expect("report on stdout");
+    assert_eq!(report["model"], "brown");
+    for line in [
+        "method           fx",
+        "zhang ",
+        "dlt      not applicable: ",
+        "tsai ",
+        "ekf ",
+    ] {
+        assert!(stderr.contains(line), "{line} in {stderr}");
+    }
+}
+
+#[test]
+fn bad_arguments_say_what_to_change() {
+    let dir = temp_dir("bad");
+    let (detections, _) = detections_file(&dir);
+    let d = detections.to_str().expect("path");
+    let cases: [(&[&str], i32, &str); 6] = [
+        (&["intrinsics"], 2, "robocal: intrinsics: give IMAGES or --detections FILE (see 'robocal intrinsics --help')\n"),
+        (&["intrinsics", "a.png"], 2, "robocal: intrinsics: --target is required with images, e.g. --target chessboard:9x6:30mm (see 'robocal intrinsics --help')\n"),
+        (&["intrinsics", "--detections", d, "a.png"], 2, "robocal: intrinsics: give either IMAGES or --detections, not both (see 'robocal intrinsics --help')\n"),
+        (&["intrinsics", "--detections", d, "--method", "magic"], 1, "robocal: method: unknown method 'magic' (expected one of zhang, dlt, tsai, ekf, or all)\n"),
+        (&["intrinsics", "--detections", d, "--model", "brown9"], 1, "robocal: model: unknown model 'brown9' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none)\n"),
+        (&["intrinsics", "--detections", d, "--target", "chessboard:7x5:30mm"], 2, "robocal: intrinsics: --target does not match the target of the detection of 'view_000.png' (see 'robocal intrinsics --help')\n"),
+    ];
+    for (args, want_code, want_err) in cases {
+        let (code, stdout, stderr) = robocal(args);
+        assert_eq!(
+            (code, stdout.as_str()),
+            (want_code, ""),
+            "{args:?}: {stderr}"
+        );
+        let last = stderr.lines().last().unwrap_or("").to_string() + "\n";
+        assert_eq!(last, want_err, "{args:?}");
+    }
+    let (code, _, stderr) = robocal(&["intrinsics", "--detections", "/nonexistent/d.json"]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.starts_with("robocal: cannot read '/nonexistent/d.json': "),
+        "{stderr}"
+    );
+}
+
+fn dataset() -> Option<PathBuf> {
+    [
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../shared/datasets/opencv-left-right-9x6"
+        ),
+        "/work/shared/datasets/opencv-left-right-9x6",
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|p| p.join("left01.jpg").exists())
+}
+
+#[test]
+fn opencv_left_images_calibrate_near_the_published_camera() {
+    let Some(dir) = dataset() else {
+        eprintln!("skipped: opencv-left-right-9x6 dataset not found");
+        return;
+    };
+    let mut args = vec![
+        "intrinsics".to_string(),
+        "--target".into(),
+        "chessboard:9x6:25mm".into(),
+    ];
+    let mut images: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("dir")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            name.starts_with("left") && name.ends_with(".jpg")
+        })
+        .collect();
+    images.sort();
+    args.extend(images.iter().map(|p| p.to_string_lossy().into_owned()));
+    let refs: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+    let (code, stdout, stderr) = robocal(&refs);
+    assert_eq!(code, 0, "{stderr}");
+    let report: Value = serde_json::from_str(&stdout).expect("report");
+    assert_eq!(
+        report["views"].as_array().expect("views").len(),
+        13,
+        "{stderr}"
+    );
+    // OpenCV's left_intrinsics.yml (fixed aspect ratio 1, its own corner
+    // refinement) has fx 535.9, cx 342.3, cy 235.6; Bouguet's left
+    // calibration fc 533.0, cc (341.6, 234.3). Our free-aspect result lies
+    // between them; 5 px is about 5 of our standard deviations for fx.
+    let k = &report["camera_matrix"];
+    for (got, want) in [(&k[0][0], 534.5), (&k[0][2], 342.0), (&k[1][2], 235.0)] {
+        let got = got.as_f64().expect("number");
+        assert!((got - want).abs() < 5.0, "{got} vs {want} px");
+    }
+    assert!(report["rms_px"].as_f64().expect("rms") < 0.25, "px");
+}
