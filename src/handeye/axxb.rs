@@ -195,24 +195,50 @@ fn chou_kamel(motions: &[Motion]) -> Result<Rotation3<f64>> {
     Ok(quat_from_wxyz(&Vector4::new(v[0], v[1], v[2], v[3]))?.to_rotation_matrix())
 }
 
-/// Andreff: `R_A R_X R_B^T = R_X` is linear in the row-major `vec(R_X)`:
-/// `(I9 - R_A (x) R_B) vec(R_X) = 0`. The null vector of the stacked system
-/// is a scaled rotation, projected onto SO(3) (sign fixed by the determinant).
+/// Andreff, Horaud and Espiau 2001: one linear least squares over the 12
+/// unknowns `[vec(R_X), t_X]` (row-major vec), stacking per motion the
+/// rotation rows `(I9 - R_A (x) R_B) vec(R_X) = 0` and the translation rows
+/// `(I3 (x) t_B^T) vec(R_X) + (I3 - R_A) t_X = t_A` (from `R_A t_X + t_A =
+/// R_X t_B + t_X`). The translation rows fix the scale of `vec(R_X)` and add
+/// their information to the rotation, which is what makes the method more
+/// than a null-space solve. The estimate is rescaled to unit determinant,
+/// projected onto SO(3), and `t_X` is re-solved with the projected rotation
+/// (see [`translation`]).
 fn andreff(motions: &[Motion]) -> Result<Rotation3<f64>> {
-    let mut normal = DMatrix::zeros(9, 9);
+    let mut normal = DMatrix::zeros(12, 12);
+    let mut rhs = DVector::zeros(12);
     for m in motions {
         let ra = m.robot.rotation.to_rotation_matrix().into_inner();
         let rb = m.camera.rotation.to_rotation_matrix().into_inner();
-        let k = DMatrix::identity(9, 9) - kron(&ra, &rb);
+        let tb = m.camera.translation.vector;
+        let mut k = DMatrix::zeros(12, 12);
+        k.view_mut((0, 0), (9, 9))
+            .copy_from(&(DMatrix::identity(9, 9) - kron(&ra, &rb)));
+        for r in 0..3 {
+            for c in 0..3 {
+                k[(9 + r, 3 * r + c)] = tb[c];
+                k[(9 + r, 9 + c)] = if r == c { 1.0 } else { 0.0 } - ra[(r, c)];
+            }
+        }
+        let mut b = DVector::zeros(12);
+        b.rows_mut(9, 3).copy_from(&m.robot.translation.vector);
+        rhs += k.transpose() * b;
         normal += k.transpose() * k;
     }
-    let pairs = ascending_eigenvectors(&normal)?;
-    let v = &pairs[0].1;
-    let mut m = Matrix3::from_row_slice(v.as_slice());
-    if m.determinant() < 0.0 {
-        m = -m;
+    let (w, dropped) = least_squares(&normal, &rhs)?;
+    if !dropped.is_empty() {
+        return Err(Error::degenerate(
+            "Andreff: the linear system is rank deficient (too little motion diversity)",
+        ));
     }
-    project_to_so3(&m)
+    let m = Matrix3::from_row_slice(&w.as_slice()[0..9]);
+    let det = m.determinant();
+    if !det.is_finite() || det.abs() < 1e-12 {
+        return Err(Error::degenerate(
+            "Andreff: the rotation estimate is singular",
+        ));
+    }
+    project_to_so3(&(m * (det.signum() / det.abs().cbrt())))
 }
 
 /// Kronecker product of two 3x3 matrices (9x9).
