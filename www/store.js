@@ -9,7 +9,7 @@ export function defaultSession() {
     schema: 1,
     target: { kind: 'chessboard', cols: 9, rows: 6, size_mm: 30, layout: 'symmetric', polarity: 'dark', diameter_mm: 12.5 },
     images: [], // { id, name, size, included, status, info, detection, error }
-    camera: { model: 'brown5', method: 'zhang', options: {}, result: null, comparison: null },
+    camera: { model: 'brown', method: 'zhang', options: {}, result: null, comparison: null },
     robot: { fileName: null, text: null, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper', parsed: null },
     handeye: { setup: 'eye-in-hand', method: 'all', result: null },
     workflows: { planar: null, xytable: null },

@@ -88,8 +88,9 @@ self.onmessage = async (event) => {
     const handler = handlers[op];
     if (!handler) throw new Error(`unknown request '${op}'`);
     const out = await handler(args || {});
-    const value = out && 'value' in out ? out.value : out;
-    self.postMessage({ id, ok: true, value }, (out && out.transfer) || []);
+    // Handlers that hand over buffers return { value, transfer }.
+    const moves = out !== null && typeof out === 'object' && 'transfer' in out;
+    self.postMessage({ id, ok: true, value: moves ? out.value : out }, moves ? out.transfer : []);
   } catch (err) {
     self.postMessage({ id, ok: false, error: errorText(err) });
   }

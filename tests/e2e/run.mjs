@@ -1,7 +1,7 @@
 // Runs every browser test suite; exits non-zero on any failure.
 import { run } from './harness.mjs';
 
-const suites = ['foundation', 'workflows'];
+const suites = ['foundation', 'workflows', 'flow'];
 let failed = 0;
 for (const suite of suites) {
   const { tests } = await import(`./${suite}.mjs`);
