@@ -29,7 +29,24 @@ assert.equal(typeof robocal.image_info, 'function');
 const info = JSON.parse(image_info(readFileSync(new URL('./board.png', import.meta.url))));
 assert.deepEqual([info.format, info.width, info.height, info.channels, info.bits_per_channel], ['png', 64, 48, 3, 8]);
 assert.throws(() => image_info(new Uint8Array([1, 2, 3])), { message: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF' });
-console.log('esm ok');
+// The README's example: detect, calibrate, export, on the seeded demo images.
+const demo = robocal.render_demo(1);
+const meta = JSON.parse(demo.json);
+const all = demo.bytes;
+const views = meta.images.map((im) => ({
+  name: im.name,
+  detection: JSON.parse(robocal.detect_target(all.subarray(im.offset, im.offset + im.length), meta.target_spec)),
+}));
+const { report } = JSON.parse(robocal.calibrate_camera(JSON.stringify({ model: 'brown', method: 'zhang', views })));
+// Truth of the demo camera: fx = fy = 900 px, cx 511.5, cy 383.5 (src/synth/demo.rs);
+// rendered corners are good to ~0.05 px, so the intrinsics land within 1.5 px.
+assert.ok(Math.abs(report.camera_matrix[0][0] - 900) < 1.5, 'fx ' + report.camera_matrix[0][0]);
+assert.ok(Math.abs(report.camera_matrix[0][2] - 511.5) < 1.5, 'cx ' + report.camera_matrix[0][2]);
+assert.ok(report.rms_px < 0.2, 'rms ' + report.rms_px);
+const yaml = robocal.export_report(JSON.stringify(report), 'opencv-yaml', '');
+assert.ok(yaml.startsWith('%YAML:1.0'), yaml.slice(0, 40));
+assert.match(yaml, /camera_matrix: !!opencv-matrix/);
+console.log('esm ok (demo calibrated: fx ' + report.camera_matrix[0][0].toFixed(3) + ' px, rms ' + report.rms_px.toFixed(4) + ' px)');
 `;
 const cjs = `
 const assert = require('node:assert/strict');
