@@ -7,14 +7,29 @@
 //! is `{"matrix_row_major": [[4 numbers] x 4]}` or `{"translation_m": [x, y,
 //! z], "quaternion_xyzw": [x, y, z, w]}` (metres). Output: the
 //! [`super::output::HandEyeReport`] JSON.
+//!
+//! Image points (optional): `"camera"` (a camera JSON: the robocal camera
+//! serde, a calibration report, or a string holding any format
+//! [`crate::io::import_camera::import_camera`] reads), `"views": [{"object_m":
+//! [[x, y, z]...], "image_px": [[u, v]...]}]` (one per pose, same order),
+//! `"refine": "none" | "trusted" | "stochastic" | "joint_intrinsics"`
+//! (default `trusted` when views are given, see [`RefineMode`]) and
+//! `"pixel_sigma_px"` (default 0.5). With views, `camera_from_target` may be
+//! left out: it is then computed per view by [`super::pnp`].
 
 use super::output::HandEyeReport;
+use super::refine::ViewPoints;
+use super::refined::{apply_refinement, RefineMode};
 use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
 use super::{HandEyeMethod, Pose, Setup};
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{pose_from_matrix4, rotation_from_quaternion_xyzw};
-use nalgebra::{Matrix4, Translation3, Vector3};
+use nalgebra::{Matrix4, Point2, Point3, Translation3, Vector3};
 use serde::Deserialize;
+
+/// Default expected pixel noise of the refinement (px).
+pub const DEFAULT_PIXEL_SIGMA_PX: f64 = 0.5;
 
 #[derive(Deserialize)]
 #[serde(untagged)]
@@ -30,10 +45,26 @@ enum PoseIn {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct ViewIn {
+    object_m: Vec<[f64; 3]>,
+    image_px: Vec<[f64; 2]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct InputJson {
     setup: Setup,
     base_from_gripper: Vec<PoseIn>,
-    camera_from_target: Vec<PoseIn>,
+    #[serde(default)]
+    camera_from_target: Option<Vec<PoseIn>>,
+    #[serde(default)]
+    camera: Option<serde_json::Value>,
+    #[serde(default)]
+    views: Option<Vec<ViewIn>>,
+    #[serde(default)]
+    refine: Option<String>,
+    #[serde(default)]
+    pixel_sigma_px: Option<f64>,
     #[serde(default)]
     method: Option<String>,
     #[serde(default)]
@@ -63,6 +94,50 @@ fn to_pose(p: &PoseIn, field: &str, index: usize) -> Result<Pose> {
     }
 }
 
+/// A camera from JSON: the [`Camera`] serde form, a calibration report
+/// (`{"report": {...}}` or its inner object), or a string with any text
+/// [`crate::io::import_camera::import_camera`] reads.
+pub fn camera_from_json(value: &serde_json::Value) -> Result<Camera> {
+    let located = |e: Error| Error::invalid("camera", e.to_string());
+    match value {
+        serde_json::Value::String(text) => crate::io::import_camera::import_camera(text)
+            .map(|c| c.0)
+            .map_err(located),
+        serde_json::Value::Object(map) if map.get("report").is_some_and(|r| r.is_object()) => {
+            camera_from_json(&map["report"])
+        }
+        serde_json::Value::Object(map) if map.contains_key("fx") => {
+            serde_json::from_value(value.clone())
+                .map_err(|e| Error::invalid("camera", e.to_string()))
+        }
+        other => crate::io::import_camera::import_camera(&other.to_string())
+            .map(|c| c.0)
+            .map_err(located),
+    }
+}
+
+fn to_views(list: &[ViewIn]) -> Result<Vec<ViewPoints>> {
+    list.iter()
+        .enumerate()
+        .map(|(i, v)| {
+            if v.object_m.len() != v.image_px.len() {
+                return Err(Error::invalid(
+                    format!("views[{i}]"),
+                    format!(
+                        "{} object points but {} pixels",
+                        v.object_m.len(),
+                        v.image_px.len()
+                    ),
+                ));
+            }
+            Ok(ViewPoints {
+                object_points: v.object_m.iter().map(|p| Point3::from(*p)).collect(),
+                image_points: v.image_px.iter().map(|p| Point2::from(*p)).collect(),
+            })
+        })
+        .collect()
+}
+
 /// Solve from input JSON; returns the report JSON.
 pub fn solve_handeye_json(input_json: &str) -> Result<String> {
     let input: InputJson = serde_json::from_str(input_json)
@@ -83,12 +158,60 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         None | Some("all") => {}
         Some(name) => options.methods = vec![name.parse::<HandEyeMethod>()?],
     }
+    let views = input.views.as_deref().map(to_views).transpose()?;
+    let camera = input.camera.as_ref().map(camera_from_json).transpose()?;
+    let mode = match (&input.refine, &views) {
+        (Some(name), _) => name.parse::<RefineMode>()?,
+        (None, Some(_)) => RefineMode::Trusted,
+        (None, None) => RefineMode::None,
+    };
+    let needs_images = mode != RefineMode::None || input.camera_from_target.is_none();
+    let images = match (views, camera) {
+        (Some(v), Some(c)) => Some((v, c)),
+        (v, c) if needs_images || v.is_some() || c.is_some() => {
+            let missing = if v.is_none() { "views" } else { "camera" };
+            let why = match input.camera_from_target {
+                None => "camera_from_target is absent".to_string(),
+                Some(_) if mode != RefineMode::None => format!("refine is {}", mode.name()),
+                Some(_) => "image points were given".to_string(),
+            };
+            return Err(Error::invalid(
+                missing,
+                format!("'{missing}' is required because {why}"),
+            ));
+        }
+        _ => None,
+    };
+    let camera_from_target = match (&input.camera_from_target, &images) {
+        (Some(list), _) => poses(list, "camera_from_target")?,
+        (None, Some((views, camera))) => views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                super::pnp::camera_from_target(camera, v)
+                    .map(|p| p.0)
+                    .map_err(|e| Error::invalid(format!("views[{i}]"), e.to_string()))
+            })
+            .collect::<Result<Vec<Pose>>>()?,
+        (None, None) => Vec::new(),
+    };
     let request = HandEyeInput {
         setup: input.setup,
         base_from_gripper: poses(&input.base_from_gripper, "base_from_gripper")?,
-        camera_from_target: poses(&input.camera_from_target, "camera_from_target")?,
+        camera_from_target,
     };
-    let result = calibrate(&request, &options)?;
+    let mut result = calibrate(&request, &options)?;
+    if let Some((views, camera)) = &images {
+        apply_refinement(
+            &mut result,
+            &request,
+            views,
+            camera,
+            mode,
+            options.motion_pairs,
+            input.pixel_sigma_px.unwrap_or(DEFAULT_PIXEL_SIGMA_PX),
+        )?;
+    }
     serde_json::to_string(&HandEyeReport::new(&result))
         .map_err(|e| Error::invalid("report", e.to_string()))
 }

@@ -4,6 +4,7 @@
 //! motion statistics and repeatability.
 
 use super::motion::MotionStats;
+use super::refined::RefinementSummary;
 use super::repeat::Repeatability;
 use super::report::{Errors, MotionResidual, ViewResidual};
 use super::solve::HandEyeResult;
@@ -111,6 +112,10 @@ pub struct HandEyeReport {
     pub repeatability: Option<Repeatability>,
     /// Everything the user should know.
     pub warnings: Vec<String>,
+    /// The image-based refinement, when run (the primary transforms are then
+    /// the refined ones).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub refinement: Option<RefinementSummary>,
     /// robocal version that produced the report.
     pub robocal_version: String,
 }
@@ -191,6 +196,7 @@ impl HandEyeReport {
                 .collect(),
             repeatability: result.repeatability.clone(),
             warnings: result.warnings.clone(),
+            refinement: result.refinement.clone(),
             robocal_version: crate::VERSION.to_string(),
         }
     }

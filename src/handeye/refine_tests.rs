@@ -11,7 +11,7 @@ use crate::synth::Rng;
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
 
-fn looking_scene(setup: Setup, views: usize, seed: u64) -> HandEyeScene {
+pub(super) fn looking_scene(setup: Setup, views: usize, seed: u64) -> HandEyeScene {
     let mut rng = Rng::new(seed);
     let x = Pose::from_parts(
         Translation3::new(0.03, -0.05, 0.1),
@@ -55,7 +55,7 @@ fn looking_scene(setup: Setup, views: usize, seed: u64) -> HandEyeScene {
     }
 }
 
-fn camera() -> Camera {
+pub(super) fn camera() -> Camera {
     Camera::pinhole(800.0, 800.0, 320.0, 240.0, 640, 480)
 }
 

@@ -95,6 +95,9 @@ pub struct HandEyeResult {
     pub repeatability: Option<Repeatability>,
     /// Everything the user should know.
     pub warnings: Vec<String>,
+    /// The image-based refinement, when run
+    /// ([`super::refined::apply_refinement`]).
+    pub refinement: Option<super::refined::RefinementSummary>,
 }
 
 /// Solve one method on a chain; returns `(x, y, unobservable directions)`.
@@ -157,6 +160,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             unobservable_translation: vec![axis],
             repeatability: None,
             warnings,
+            refinement: None,
         });
     }
     // 3. Every requested method; a failing one is reported, not fatal.
@@ -218,5 +222,6 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         unobservable_translation: unobservable,
         repeatability: repeat,
         warnings,
+        refinement: None,
     })
 }

@@ -1,0 +1,195 @@
+//! `camera_from_target` of one view from its target points and pixels with a
+//! known camera (perspective-n-point for planar targets): the pixels are
+//! undistorted to normalised coordinates, a homography gives the starting
+//! pose ([`crate::calib::pose_from_homography`] with K = I), and
+//! Levenberg-Marquardt ([`crate::optim`]) minimises the reprojection error
+//! over the 6 pose parameters.
+
+use super::refine::ViewPoints;
+use super::Pose;
+use crate::calib::{homography, pose_from_homography};
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::geometry::{rotation_from_rotvec, rotvec_from_rotation};
+use crate::handeye::math::skew;
+use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
+use nalgebra::{DMatrix, DVector, Matrix3, Point2, Translation3, Vector3};
+
+/// Largest |z| (relative to the target's extent) for the target to count as planar.
+const PLANAR_TOLERANCE: f64 = 1e-9;
+
+/// Pose of the target in the camera frame from one view (at least 4 points
+/// on the target plane z = 0), with the reprojection RMS (px).
+pub fn camera_from_target(camera: &Camera, view: &ViewPoints) -> Result<(Pose, f64)> {
+    let n = view.object_points.len();
+    if view.image_points.len() != n {
+        return Err(Error::invalid(
+            "image_px",
+            format!("{} object points but {} pixels", n, view.image_points.len()),
+        ));
+    }
+    if n < 4 {
+        return Err(Error::too_few("target points for a pose", 4, n));
+    }
+    let extent = view
+        .object_points
+        .iter()
+        .map(|p| p.coords.xy().norm())
+        .fold(0.0, f64::max);
+    if view
+        .object_points
+        .iter()
+        .any(|p| p.z.abs() > PLANAR_TOLERANCE * extent.max(1.0))
+    {
+        return Err(Error::invalid(
+            "object_m",
+            "the pose initialisation needs a planar target (every point at z = 0)",
+        ));
+    }
+    let plane: Vec<Point2<f64>> = view.object_points.iter().map(|p| p.xy()).collect();
+    let normalized = view
+        .image_points
+        .iter()
+        .map(|px| {
+            let ray = camera.unproject(px)?;
+            if ray.z <= 0.0 {
+                return Err(Error::degenerate(format!(
+                    "pixel ({:.1}, {:.1}) does not look forward",
+                    px.x, px.y
+                )));
+            }
+            Ok(Point2::new(ray.x / ray.z, ray.y / ray.z))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let h = homography(&plane, &normalized)?;
+    let start = pose_from_homography(&Matrix3::identity(), &h)?;
+    let problem = PoseProblem { camera, view };
+    let lm = optim::solve(
+        &problem,
+        &BlockParams {
+            global: params_of(&start),
+            blocks: Vec::new(),
+        },
+        &LmOptions::default(),
+    )?;
+    let pose = pose_of(&lm.params.global);
+    let rms = (2.0 * lm.cost / n as f64).sqrt();
+    Ok((pose, rms))
+}
+
+fn pose_of(p: &[f64]) -> Pose {
+    Pose::from_parts(
+        Translation3::new(p[3], p[4], p[5]),
+        rotation_from_rotvec(&Vector3::new(p[0], p[1], p[2])),
+    )
+}
+
+fn params_of(p: &Pose) -> Vec<f64> {
+    let r = rotvec_from_rotation(&p.rotation);
+    let t = p.translation.vector;
+    vec![r.x, r.y, r.z, t.x, t.y, t.z]
+}
+
+struct PoseProblem<'a> {
+    camera: &'a Camera,
+    view: &'a ViewPoints,
+}
+
+impl BlockProblem for PoseProblem<'_> {
+    fn residuals_and_jacobian(
+        &self,
+        params: &BlockParams,
+        jacobians: bool,
+    ) -> Result<Vec<ResidualBlock>> {
+        let pose = pose_of(&params.global);
+        let r = pose.rotation.to_rotation_matrix().into_inner();
+        let mut out = Vec::with_capacity(self.view.object_points.len());
+        for (p, obs) in self.view.object_points.iter().zip(&self.view.image_points) {
+            let w = pose * p;
+            let (pixel, d_pt, _) = self.camera.project_with_jacobians(&w)?;
+            let mut jac_global = DMatrix::zeros(2, 0);
+            if jacobians {
+                // Right perturbation pose * exp(d): dw/drot = -R [p]x, dw/dt = R.
+                jac_global = DMatrix::zeros(2, 6);
+                let d_rot = d_pt * (-r * skew(&p.coords));
+                jac_global.view_mut((0, 0), (2, 3)).copy_from(&d_rot);
+                jac_global.view_mut((0, 3), (2, 3)).copy_from(&(d_pt * r));
+            }
+            out.push(ResidualBlock {
+                block: None,
+                residuals: DVector::from_column_slice((pixel - obs).as_slice()),
+                jac_global,
+                jac_block: DMatrix::zeros(2, 0),
+            });
+        }
+        Ok(out)
+    }
+
+    fn retract(&self, params: &BlockParams, step: &BlockParams) -> BlockParams {
+        let d = &step.global;
+        let delta = Pose::from_parts(
+            Translation3::new(d[3], d[4], d[5]),
+            rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2])),
+        );
+        BlockParams {
+            global: params_of(&(pose_of(&params.global) * delta)),
+            blocks: Vec::new(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Point3, UnitQuaternion};
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    fn grid() -> Vec<Point3<f64>> {
+        (0..6)
+            .flat_map(|r| (0..9).map(move |c| Point3::new(c as f64 * 0.03, r as f64 * 0.03, 0.0)))
+            .collect()
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn recovers_the_pose_with_distortion_and_rejects_bad_input() {
+        let mut camera = Camera::pinhole(800.0, 810.0, 330.0, 235.0, 640, 480);
+        camera.distortion = crate::camera::Distortion::Brown {
+            k1: -0.2,
+            k2: 0.05,
+            k3: 0.0,
+            p1: 0.001,
+            p2: -0.0005,
+        };
+        let truth = Pose::from_parts(
+            Translation3::new(-0.1, -0.05, 0.6),
+            UnitQuaternion::from_scaled_axis(Vector3::new(0.3, -0.2, 0.1)),
+        );
+        let object = grid();
+        let image: Vec<Point2<f64>> = object
+            .iter()
+            .map(|p| camera.project(&(truth * p)).unwrap())
+            .collect();
+        let view = ViewPoints {
+            object_points: object.clone(),
+            image_points: image,
+        };
+        let (pose, rms) = camera_from_target(&camera, &view).unwrap();
+        assert!(rms < 1e-9, "rms {rms}");
+        assert!((pose.translation.vector - truth.translation.vector).norm() < 1e-9);
+        assert!(pose.rotation.angle_to(&truth.rotation) < 1e-9);
+        let few = ViewPoints {
+            object_points: object[..3].to_vec(),
+            image_points: view.image_points[..3].to_vec(),
+        };
+        assert_eq!(
+            camera_from_target(&camera, &few).unwrap_err().to_string(),
+            "requires at least 4 target points for a pose, got 3"
+        );
+        let mut bent = view.clone();
+        bent.object_points[5].z = 0.01;
+        assert_eq!(
+            camera_from_target(&camera, &bent).unwrap_err().to_string(),
+            "object_m: the pose initialisation needs a planar target (every point at z = 0)"
+        );
+    }
+}
