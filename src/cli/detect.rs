@@ -125,6 +125,9 @@ pub(super) fn run_all(
     threads: usize,
 ) -> Vec<Outcome> {
     let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    // A progress line on a terminal; nothing when stderr is piped or logged.
+    let progress = files.len() > 1 && std::io::IsTerminal::is_terminal(&std::io::stderr());
     let mut results: Vec<(usize, Outcome)> = std::thread::scope(|scope| {
         let workers: Vec<_> = (0..threads.min(files.len()))
             .map(|_| {
@@ -134,6 +137,10 @@ pub(super) fn run_all(
                         let i = next.fetch_add(1, Ordering::Relaxed);
                         let Some(file) = files.get(i) else { break };
                         mine.push((i, one(file, target, options)));
+                        let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
+                        if progress {
+                            eprint!("\rrobocal: {finished}/{} images", files.len());
+                        }
                     }
                     mine
                 })
@@ -144,6 +151,9 @@ pub(super) fn run_all(
             .flat_map(|w| w.join().unwrap_or_else(|_| vec![]))
             .collect()
     });
+    if progress {
+        eprintln!();
+    }
     results.sort_by_key(|r| r.0);
     // A worker that panicked leaves holes: report them rather than lose them.
     let mut slots: Vec<Option<Outcome>> = (0..files.len()).map(|_| None).collect();
