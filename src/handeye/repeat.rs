@@ -2,7 +2,7 @@
 //! seeded bootstrap, each giving medians and inter-quartile ranges of the
 //! summary errors and the standard deviation of every output parameter.
 
-use super::report::{errors, view_residuals, Errors};
+use super::report::{errors, pose_difference, view_residuals, Errors};
 use super::solve::{solve_method, HandEyeOptions};
 use super::{Chain, HandEyeMethod, Pose};
 use crate::synth::Rng;
@@ -46,6 +46,26 @@ pub struct RunStats {
     pub camera_std: PoseStd,
     /// Standard deviation of the target transform.
     pub target_std: PoseStd,
+    /// Per-run values of `translation_rms_mm`, in run order (for box plots).
+    #[serde(default)]
+    pub translation_rms_mm_samples: Vec<f64>,
+    /// Per-run values of `translation_max_mm`.
+    #[serde(default)]
+    pub translation_max_mm_samples: Vec<f64>,
+    /// Per-run values of `rotation_rms_deg`.
+    #[serde(default)]
+    pub rotation_rms_deg_samples: Vec<f64>,
+    /// Per-run values of `rotation_max_deg`.
+    #[serde(default)]
+    pub rotation_max_deg_samples: Vec<f64>,
+    /// Per run: translation distance of the camera transform from the
+    /// full-data solution (mm).
+    #[serde(default)]
+    pub camera_translation_deviation_mm_samples: Vec<f64>,
+    /// Per run: rotation angle between the camera transform and the
+    /// full-data solution (degrees).
+    #[serde(default)]
+    pub camera_rotation_deviation_deg_samples: Vec<f64>,
 }
 
 /// Leave-one-out and bootstrap results.
@@ -122,26 +142,39 @@ fn run_all(
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     let mut failed = 0;
+    let mut deviations = Vec::new();
     for subset in subsets {
         let sub = chain.subset(subset);
         match solve_method(method, &sub, options.motion_pairs) {
             Ok((x, y, _)) => {
                 errs.push(errors(&view_residuals(&sub, &x, &y)));
+                deviations.push(pose_difference(reference.0, &x));
                 xs.push(pose_params(reference.0, &x));
                 ys.push(pose_params(reference.1, &y));
             }
             Err(_) => failed += 1,
         }
     }
+    let samples = |f: fn(&Errors) -> f64| errs.iter().map(f).collect::<Vec<f64>>();
+    let translation_rms_mm_samples = samples(|e| e.translation_rms_mm);
+    let translation_max_mm_samples = samples(|e| e.translation_max_mm);
+    let rotation_rms_deg_samples = samples(|e| e.rotation_rms_deg);
+    let rotation_max_deg_samples = samples(|e| e.rotation_max_deg);
     RunStats {
         runs: errs.len(),
         failed,
-        translation_rms_mm: quartiles(errs.iter().map(|e| e.translation_rms_mm).collect()),
-        translation_max_mm: quartiles(errs.iter().map(|e| e.translation_max_mm).collect()),
-        rotation_rms_deg: quartiles(errs.iter().map(|e| e.rotation_rms_deg).collect()),
-        rotation_max_deg: quartiles(errs.iter().map(|e| e.rotation_max_deg).collect()),
+        translation_rms_mm: quartiles(translation_rms_mm_samples.clone()),
+        translation_max_mm: quartiles(translation_max_mm_samples.clone()),
+        rotation_rms_deg: quartiles(rotation_rms_deg_samples.clone()),
+        rotation_max_deg: quartiles(rotation_max_deg_samples.clone()),
         camera_std: std_of(&xs, jackknife),
         target_std: std_of(&ys, jackknife),
+        translation_rms_mm_samples,
+        translation_max_mm_samples,
+        rotation_rms_deg_samples,
+        rotation_max_deg_samples,
+        camera_translation_deviation_mm_samples: deviations.iter().map(|d| d.0).collect(),
+        camera_rotation_deviation_deg_samples: deviations.iter().map(|d| d.1).collect(),
     }
 }
 

@@ -123,6 +123,31 @@ fn repeatability_spread_matches_the_noise() {
     // Closure residuals come from the 5 mm camera noise: RMS between 1 and 20 mm.
     let m = rep.leave_one_out.translation_rms_mm.median;
     assert!(m > 1.0 && m < 20.0, "LOO median translation RMS {m} mm");
+    // Raw per-run samples for box plots: one per run, and their median is
+    // the reported one (12 runs: the mean of the 6th and 7th values).
+    for stats in [&rep.leave_one_out, &rep.bootstrap] {
+        for samples in [
+            &stats.translation_rms_mm_samples,
+            &stats.translation_max_mm_samples,
+            &stats.rotation_rms_deg_samples,
+            &stats.rotation_max_deg_samples,
+            &stats.camera_translation_deviation_mm_samples,
+            &stats.camera_rotation_deviation_deg_samples,
+        ] {
+            assert_eq!(samples.len(), stats.runs);
+        }
+    }
+    let mut loo = rep.leave_one_out.translation_rms_mm_samples.clone();
+    loo.sort_by(f64::total_cmp);
+    assert!(((loo[5] + loo[6]) / 2.0 - m).abs() < 1e-12);
+    // Leaving one view out of 12 moves X by about std * sqrt(1/11): far less
+    // than the 30 mm accuracy bound.
+    let worst = rep
+        .leave_one_out
+        .camera_translation_deviation_mm_samples
+        .iter()
+        .fold(0.0, |a: f64, &b| a.max(b));
+    assert!(worst > 0.0 && worst < 30.0, "LOO deviation {worst} mm");
 }
 
 fn err(input: &HandEyeInput) -> String {
