@@ -237,6 +237,17 @@ pub fn solve_handeye(input_json: &str) -> Result<String, JsError> {
     crate::handeye::json_api::solve_handeye_json(input_json).map_err(js_error)
 }
 
+/// Which reading of the robot poses fits the camera motion: input
+/// `{"setup", "candidates": [{"name", "base_from_gripper": [pose...]}],
+/// "camera_from_target": [pose...]}`; returns `{"scores": [{"name",
+/// "consistency": {"rotation_rms_deg", "translation_rms_mm",
+/// "robot_translation_scale"} | null}...] (best first), "recommendation":
+/// text | null}` (see `robocal::handeye::json_api::rank_candidates_json`).
+#[wasm_bindgen]
+pub fn rank_pose_conventions(input_json: &str) -> Result<String, JsError> {
+    crate::handeye::json_api::rank_candidates_json(input_json).map_err(js_error)
+}
+
 /// Read a workflow CSV (the files of `robocal planar` / `robocal xytable`)
 /// into the request JSON of the matching solver: `kind` is
 /// `planar-matrices` (-> `{"matrices"}` for `planar_fit`), `planar-points`

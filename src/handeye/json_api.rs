@@ -17,6 +17,7 @@
 //! `"pixel_sigma_px"` (default 0.5). With views, `camera_from_target` may be
 //! left out: it is then computed per view by [`super::pnp`].
 
+use super::checks::{rank_pose_candidates, recommend_candidate, CandidateScore};
 use super::output::HandEyeReport;
 use super::refine::ViewPoints;
 use super::refined::{apply_refinement, RefineMode};
@@ -26,7 +27,7 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{pose_from_matrix4, rotation_from_quaternion_xyzw};
 use nalgebra::{Matrix4, Point2, Point3, Translation3, Vector3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Default expected pixel noise of the refinement (px).
 pub const DEFAULT_PIXEL_SIGMA_PX: f64 = 0.5;
@@ -136,6 +137,71 @@ fn to_views(list: &[ViewIn]) -> Result<Vec<ViewPoints>> {
             })
         })
         .collect()
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CandidateIn {
+    name: String,
+    base_from_gripper: Vec<PoseIn>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RankInput {
+    setup: Setup,
+    candidates: Vec<CandidateIn>,
+    camera_from_target: Vec<PoseIn>,
+}
+
+/// The answer of [`rank_candidates_json`].
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct RankedCandidates {
+    /// Every candidate scored against the camera motion, best first.
+    pub scores: Vec<CandidateScore>,
+    /// What to use and how clear the choice is, when any candidate scored.
+    pub recommendation: Option<String>,
+}
+
+/// Rank candidate readings of the robot poses (e.g. the rotation conventions
+/// a pose file could be in) by how well each fits the camera motion
+/// ([`rank_pose_candidates`]). Input `{"setup", "candidates": [{"name",
+/// "base_from_gripper": [pose...]}], "camera_from_target": [pose...]}`;
+/// returns the [`RankedCandidates`] JSON.
+pub fn rank_candidates_json(input_json: &str) -> Result<String> {
+    let input: RankInput = serde_json::from_str(input_json)
+        .map_err(|e| Error::parse(e.line(), e.column(), e.to_string()))?;
+    if input.candidates.is_empty() {
+        return Err(Error::too_few("pose candidates", 1, 0));
+    }
+    let camera = input
+        .camera_from_target
+        .iter()
+        .enumerate()
+        .map(|(i, p)| to_pose(p, "camera_from_target", i))
+        .collect::<Result<Vec<Pose>>>()?;
+    let candidates = input
+        .candidates
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let field = format!("candidates[{k}].base_from_gripper");
+            let poses = c
+                .base_from_gripper
+                .iter()
+                .enumerate()
+                .map(|(i, p)| to_pose(p, &field, i))
+                .collect::<Result<Vec<Pose>>>()?;
+            Ok((c.name.clone(), poses))
+        })
+        .collect::<Result<Vec<(String, Vec<Pose>)>>>()?;
+    let scores = rank_pose_candidates(input.setup, &candidates, &camera);
+    let recommendation = recommend_candidate(&scores);
+    serde_json::to_string(&RankedCandidates {
+        scores,
+        recommendation,
+    })
+    .map_err(|e| Error::invalid("ranking", e.to_string()))
 }
 
 /// Solve from input JSON; returns the report JSON.
@@ -275,6 +341,61 @@ mod tests {
             bad.unwrap_err().to_string(),
             "method: unknown method 'tsai' (valid: tsai-lenz, park-martin, horaud, andreff, \
              daniilidis, chou-kamel, shah, li)"
+        );
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn candidates_are_ranked_through_json_best_first() {
+        let scene = handeye_scene(&HandEyeSceneConfig::opencv_noise(Setup::EyeInHand, 10), 8);
+        let quat = |p: &Pose| {
+            let t = p.translation.vector;
+            let q = p.rotation;
+            serde_json::json!({"translation_m": [t.x, t.y, t.z], "quaternion_xyzw": [q.i, q.j, q.k, q.w]})
+        };
+        // Wrong readings: rotation transposed, and the pose inverted.
+        let transposed: Vec<_> = scene
+            .base_from_gripper
+            .iter()
+            .map(|p| quat(&Pose::from_parts(p.translation, p.rotation.inverse())))
+            .collect();
+        let inverted: Vec<_> = scene
+            .base_from_gripper
+            .iter()
+            .map(|p| quat(&p.inverse()))
+            .collect();
+        let right: Vec<_> = scene.base_from_gripper.iter().map(quat).collect();
+        let input = serde_json::json!({
+            "setup": "eye-in-hand",
+            "candidates": [
+                {"name": "transposed", "base_from_gripper": transposed},
+                {"name": "xyz-euler", "base_from_gripper": right},
+                {"name": "inverted", "base_from_gripper": inverted},
+            ],
+            "camera_from_target": scene.camera_from_target.iter().map(quat).collect::<Vec<_>>(),
+        });
+        let out: serde_json::Value =
+            serde_json::from_str(&rank_candidates_json(&input.to_string()).unwrap()).unwrap();
+        let scores = out["scores"].as_array().unwrap();
+        assert_eq!(scores.len(), 3);
+        assert_eq!(scores[0]["name"], "xyz-euler");
+        // The right reading's residual comes from 0.002 rad camera noise.
+        let best = scores[0]["consistency"]["rotation_rms_deg"]
+            .as_f64()
+            .unwrap();
+        assert!(best < 1.0, "{best} deg");
+        for s in &scores[1..] {
+            let r = s["consistency"]["rotation_rms_deg"].as_f64().unwrap();
+            assert!(r > 5.0 * best, "{}: {r} deg", s["name"]);
+        }
+        let text = out["recommendation"].as_str().unwrap();
+        assert!(
+            text.starts_with("pose format 'xyz-euler' fits the camera motion best"),
+            "{text}"
+        );
+        let empty = r#"{"setup":"eye-in-hand","candidates":[],"camera_from_target":[]}"#;
+        assert_eq!(
+            rank_candidates_json(empty).unwrap_err().to_string(),
+            "requires at least 1 pose candidates, got 0"
         );
     }
 }
