@@ -78,6 +78,12 @@ handlers.demo = async ({ seed }) => {
   return { value: { ...meta, images }, transfer: images.map((i) => i.bytes) };
 };
 
+handlers.conventions = async ({ input }) => {
+  await ready;
+  requireFn('rank_pose_conventions');
+  return JSON.parse(robocal.rank_pose_conventions(input));
+};
+
 function requireFn(name) {
   if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
 }

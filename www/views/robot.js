@@ -105,7 +105,8 @@ export class RobotView {
       const pick = h('select', { id: 'pose-candidate', 'aria-label': 'reading of the pose file' },
         r.candidates.map((c, i) => h('option', { value: i }, `${c.format}, ${c.length_unit}, ${c.angle_unit}${c.reasons.length ? ' — ' + c.reasons.join('; ') : ''}`)));
       pick.addEventListener('change', () => { st.parsed = { ...r.candidates[Number(pick.value)], notes: [] }; this.store.changed('robot'); this.show(); });
-      candidates = h('div', {}, message('warning', `The file's layout is ambiguous (${r.ambiguity}). The most plausible reading is used; choose another below, or set the format. The hand-eye step scores every reading against the camera motion.`), h('label', {}, 'Reading ', pick));
+      const check = h('button', { type: 'button', id: 'check-conventions', onclick: () => this.checkConventions(check) }, 'Check the readings against the camera motion');
+      candidates = h('div', {}, message('warning', `The file's layout is ambiguous (${r.ambiguity}). The most plausible reading is used; choose another below, or set the format.`), h('label', {}, 'Reading ', pick), h('div', { class: 'row' }, check), h('div', { id: 'convention-result', 'aria-live': 'polite' }));
     }
     const rows = p.poses.map((pose, i) => {
       const t = pose.base_from_gripper.translation_m.map((v) => num(v * 1000, 2));
@@ -116,6 +117,36 @@ export class RobotView {
       table(['#', 'name', 'line', 'x (mm)', 'y (mm)', 'z (mm)', 'rx (deg)', 'ry (deg)', 'rz (deg)'], rows, { id: 'pose-table', class: 'scroll' }),
       h('p', { class: 'hint' }, 'Rotations shown as rotation vectors in degrees (axis × angle) whatever the file\'s convention.'));
     this.renderPairing();
+  }
+
+  /** Score every candidate reading against the camera motion (hand-eye consistency). */
+  async checkConventions(button) {
+    const out = $('convention-result');
+    const cam = this.store.session.camera.result;
+    if (!cam) { fill(out, message('info', 'Solve the camera first (step 3): the check compares robot motion with camera motion.')); return; }
+    const views = new Map((cam.views || []).map((v) => [v.name, v]));
+    const r = this.state.reading;
+    const pairs = this.pairs().filter((p) => p.image && views.has(p.image.name));
+    const idx = pairs.map((p) => p.index);
+    const input = {
+      setup: this.store.session.handeye.setup,
+      candidates: r.candidates.map((c) => ({
+        name: `${c.format}, ${c.length_unit}, ${c.angle_unit}`,
+        base_from_gripper: idx.map((i) => c.poses[i].base_from_gripper),
+      })),
+      camera_from_target: pairs.map((p) => ({ matrix_row_major: views.get(p.image.name).camera_from_target.matrix_row_major })),
+    };
+    button.disabled = true;
+    try {
+      const ranked = await this.engine.call('conventions', { input: JSON.stringify(input) });
+      fill(out, ranked.recommendation ? message('info', ranked.recommendation) : null,
+        table(['reading', 'rotation RMS (deg)', 'translation RMS (mm)'], ranked.scores.map((s) => [s.name,
+          s.consistency ? num(s.consistency.rotation_rms_deg, 4) : 'failed', s.consistency ? num(s.consistency.translation_rms_mm, 3) : ''])));
+    } catch (err) {
+      fill(out, message('error', err.message));
+    } finally {
+      button.disabled = false;
+    }
   }
 
   /** Poses paired with images: by name when the file names images, else by order of the images with a detection. */
