@@ -1,23 +1,44 @@
 //! `robocal handeye`: read the pose files, call the library, write the report.
 
 use super::args::{Args, Spec};
+use super::handeye_images::{image_pairs, read_robot_poses, RobotPoses};
 use super::{read_file, CliError};
+use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
 use robocal::handeye::pose_text::{parse_pose_text, PoseTextFormat};
+use robocal::handeye::refined::{apply_refinement, RefineMode};
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
+use robocal::target::Target;
 
 /// Help text.
 pub const HELP: &str = "robocal handeye - hand-eye calibration (camera on or beside a robot)
 
 Usage:
   robocal handeye --setup eye-in-hand|eye-to-hand --poses FILE [--pose-format NAME]
-                  --camera-poses FILE [--camera-pose-format NAME]
+                  --camera camera.json --target SPEC IMAGES... [--refine MODE] [--threads N]
                   [--method all|NAME] [--bootstrap N] [--seed N] [--lenient] -o handeye.json
+  robocal handeye --setup ... --poses FILE [--pose-format NAME]
+                  --camera-poses FILE [--camera-pose-format NAME] [...] -o handeye.json
 
-  --poses FILE          robot poses base_from_gripper, one per view (metres)
-  --pose-format NAME    matrix (16 or 12 numbers a line, row-major; default),
-                        xyz-quaternion-xyzw, xyz-quaternion-wxyz
-  --camera-poses FILE   camera_from_target per view, same line formats, paired by order
+  --poses FILE          robot poses base_from_gripper, one per view: any robot pose file
+                        (CSV/TSV/text/JSON with a header such as x,y,z,rx,ry,rz; 16 numbers
+                        a line = row-major 4x4 in metres); an 'image' column pairs poses
+                        with images by file name, otherwise poses and images pair by order
+  --pose-format NAME    a pose-file format (ur, kuka, abb, fanuc, xyz_quat_xyzw, matrix4, ...)
+                        or a line format: matrix (16 or 12 numbers), xyz-quaternion-xyzw,
+                        xyz-quaternion-wxyz. Without it an ambiguous file is read every
+                        plausible way and the reading that fits the camera motion is used
+                        (with a warning)
+  --camera FILE         the camera (robocal camera JSON or calibration report, OpenCV
+                        YAML/XML, ROS camera_info)
+  --target SPEC         the board, e.g. chessboard:9x6:30mm
+  IMAGES                one image per pose; images whose detection fails are dropped with
+                        their pose (the report's 'pairs' lists every pair and why)
+  --refine MODE         trusted (default with images), stochastic (robot pose noise
+                        estimated), joint_intrinsics (camera refined too) or none
+  --threads N           images detected in parallel (default: all cores)
+  --camera-poses FILE   camera_from_target per view instead of images (line formats of
+                        --pose-format), paired by order
   --method NAME         all (default) or one of: tsai-lenz, park-martin, horaud, andreff,
                         daniilidis, chou-kamel, shah, li
   --bootstrap N         bootstrap resamples for repeatability (default 100, 0 = off)
@@ -25,13 +46,13 @@ Usage:
                         as warnings instead of failing
   -o FILE               write the JSON report there (default: standard output)
 
-The image path (--camera camera.json IMAGES... --target SPEC) needs target detection
-and a camera model; until those are wired, give the camera poses directly.
-
 Output JSON: gripper_from_camera or base_from_camera, base_from_target or
 gripper_from_target (each {matrix_row_major, translation_m, quaternion_xyzw}),
 methods, errors {translation_rms_mm, translation_max_mm, rotation_rms_deg,
-rotation_max_deg, reprojection_rms_px}, per_view, motion, repeatability, warnings.";
+rotation_max_deg, reprojection_rms_px}, per_view, motion, repeatability, warnings,
+and with images: pairs [{pose_index, image, used, view, reason, pose_fit_rms_px}] and
+refinement. With refinement the main transform is the refined one (method
+'refined from <closed form>'); methods still lists every closed form.";
 
 fn pose_format(args: &Args, flag: &str) -> Result<Option<PoseTextFormat>, CliError> {
     args.value(flag)
@@ -59,6 +80,8 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             "seed",
             "camera",
             "target",
+            "refine",
+            "threads",
             "output",
         ],
         switches: &["lenient"],
@@ -71,18 +94,6 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     let poses_path = args
         .value("poses")
         .ok_or_else(|| CliError::usage("handeye", "--poses FILE is required"))?;
-    let Some(camera_path) = args.value("camera-poses") else {
-        return Err(CliError::usage(
-            "handeye",
-            "give --camera-poses FILE (the image path --camera/--target is not available yet)",
-        ));
-    };
-    let base_from_gripper =
-        parse_pose_text(&read_text(poses_path)?, pose_format(&args, "pose-format")?)?;
-    let camera_from_target = parse_pose_text(
-        &read_text(camera_path)?,
-        pose_format(&args, "camera-pose-format")?,
-    )?;
     let mut options = HandEyeOptions {
         strict_checks: !args.switch("lenient"),
         bootstrap_samples: args.parsed("handeye", "bootstrap", 100usize)?,
@@ -93,13 +104,104 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         None | Some("all") => {}
         Some(name) => options.methods = vec![name.parse::<HandEyeMethod>()?],
     }
-    let input = HandEyeInput {
-        setup,
-        base_from_gripper,
-        camera_from_target,
+    let poses_text = read_text(poses_path)?;
+    let mut pairs = Vec::new();
+    let mut pre_warnings = Vec::new();
+    let (input, images) = match (args.value("camera-poses"), args.value("camera")) {
+        (Some(camera_path), None) => {
+            if !args.positionals.is_empty() {
+                return Err(CliError::usage(
+                    "handeye",
+                    "images need --camera and --target, not --camera-poses",
+                ));
+            }
+            let robot = match read_robot_poses(&poses_text, args.value("pose-format"))? {
+                RobotPoses::Known(p) => p,
+                RobotPoses::Ambiguous(_) => {
+                    return Err(CliError::usage(
+                        "handeye",
+                        "the pose file's format is ambiguous: pass --pose-format NAME",
+                    ))
+                }
+            };
+            let camera_from_target = parse_pose_text(
+                &read_text(camera_path)?,
+                pose_format(&args, "camera-pose-format")?,
+            )?;
+            let input = HandEyeInput {
+                setup,
+                base_from_gripper: robot.iter().map(|p| p.base_from_gripper).collect(),
+                camera_from_target,
+            };
+            (input, None)
+        }
+        (None, Some(camera_path)) => {
+            let camera_text = read_text(camera_path)?;
+            let value = serde_json::from_str(&camera_text)
+                .unwrap_or(serde_json::Value::String(camera_text));
+            let camera = camera_from_json(&value)?;
+            let target = parse_target(&args)?;
+            if args.positionals.is_empty() {
+                return Err(CliError::usage(
+                    "handeye",
+                    "give the images after the options",
+                ));
+            }
+            let robot = read_robot_poses(&poses_text, args.value("pose-format"))?;
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let threads: usize = args.parsed("handeye", "threads", cores)?;
+            let found = image_pairs(setup, robot, &args.positionals, &camera, &target, threads)?;
+            pairs = found.pairs;
+            pre_warnings = found.warnings;
+            let input = HandEyeInput {
+                setup,
+                base_from_gripper: found.base_from_gripper,
+                camera_from_target: found.camera_from_target,
+            };
+            (input, Some((found.views, camera)))
+        }
+        (Some(_), Some(_)) => {
+            return Err(CliError::usage(
+                "handeye",
+                "give either --camera with images or --camera-poses, not both",
+            ))
+        }
+        (None, None) => {
+            return Err(CliError::usage(
+                "handeye",
+                "give --camera camera.json --target SPEC IMAGES..., or --camera-poses FILE",
+            ))
+        }
     };
-    let result = calibrate(&input, &options)?;
-    let json = serde_json::to_string_pretty(&HandEyeReport::new(&result))
+    let mode = match (args.value("refine"), &images) {
+        (Some(name), _) => name.parse::<RefineMode>()?,
+        (None, Some(_)) => RefineMode::Trusted,
+        (None, None) => RefineMode::None,
+    };
+    let mut result = calibrate(&input, &options)?;
+    match &images {
+        Some((views, camera)) => apply_refinement(
+            &mut result,
+            &input,
+            views,
+            camera,
+            mode,
+            options.motion_pairs,
+            DEFAULT_PIXEL_SIGMA_PX,
+        )?,
+        None if mode != RefineMode::None => {
+            return Err(CliError::usage(
+                "handeye",
+                "--refine needs images (--camera, --target, IMAGES)",
+            ))
+        }
+        None => {}
+    }
+    pre_warnings.append(&mut result.warnings);
+    result.warnings = pre_warnings;
+    let mut report = HandEyeReport::new(&result);
+    report.pairs = pairs;
+    let json = serde_json::to_string_pretty(&report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
     match args.value("output") {
         Some(path) => std::fs::write(path, json + "\n")
@@ -110,4 +212,19 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     Ok(())
+}
+
+fn parse_target(args: &Args) -> Result<Target, CliError> {
+    let text = args.value("target").ok_or_else(|| {
+        CliError::usage(
+            "handeye",
+            "--target SPEC is required with images, e.g. chessboard:9x6:30mm",
+        )
+    })?;
+    if text.trim_start().starts_with('{') {
+        let t: Target = serde_json::from_str(text)
+            .map_err(|e| CliError::usage("handeye", format!("--target JSON: {e}")))?;
+        return Ok(t.validated()?);
+    }
+    Target::parse_spec(text).map_err(|e| CliError::usage("handeye", e.to_string()))
 }

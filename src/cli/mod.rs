@@ -4,6 +4,7 @@ pub mod args;
 mod detect;
 mod export;
 mod handeye;
+mod handeye_images;
 mod intrinsics;
 mod planar;
 mod render;

@@ -96,7 +96,8 @@ fn to_pose(p: &PoseIn, field: &str, index: usize) -> Result<Pose> {
 }
 
 /// A camera from JSON: the [`Camera`] serde form, a calibration report
-/// (`{"report": {...}}` or its inner object), or a string with any text
+/// (`{"report": {...}}` or its inner object), an object with a `camera` key
+/// (e.g. `robocal render`'s truth.json), or a string with any text
 /// [`crate::io::import_camera::import_camera`] reads.
 pub fn camera_from_json(value: &serde_json::Value) -> Result<Camera> {
     let located = |e: Error| Error::invalid("camera", e.to_string());
@@ -106,6 +107,9 @@ pub fn camera_from_json(value: &serde_json::Value) -> Result<Camera> {
             .map_err(located),
         serde_json::Value::Object(map) if map.get("report").is_some_and(|r| r.is_object()) => {
             camera_from_json(&map["report"])
+        }
+        serde_json::Value::Object(map) if map.get("camera").is_some_and(|c| c.is_object()) => {
+            camera_from_json(&map["camera"])
         }
         serde_json::Value::Object(map) if map.contains_key("fx") => {
             serde_json::from_value(value.clone())

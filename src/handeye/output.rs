@@ -41,6 +41,26 @@ impl From<&Pose> for PoseJson {
     }
 }
 
+/// One robot pose and the image paired with it.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct PairAudit {
+    /// Index of the pose in the pose file (0-based, data rows).
+    pub pose_index: usize,
+    /// The image paired with it (`None` when no image was found for it).
+    pub image: Option<String>,
+    /// Whether the pair entered the calibration.
+    pub used: bool,
+    /// Its index among the used views (the `view` of `per_view`), when used.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub view: Option<usize>,
+    /// Why it was dropped (detection or pose failure, no image).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub reason: Option<String>,
+    /// Reprojection RMS of the target pose fitted to this image alone (px).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_fit_rms_px: Option<f64>,
+}
+
 /// One solver in the side-by-side comparison.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct MethodJson {
@@ -112,6 +132,10 @@ pub struct HandEyeReport {
     pub repeatability: Option<Repeatability>,
     /// Everything the user should know.
     pub warnings: Vec<String>,
+    /// Pairing audit of robot poses and images (image input only): every
+    /// pose with its image, whether it was used and why not.
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub pairs: Vec<PairAudit>,
     /// The image-based refinement, when run (the primary transforms are then
     /// the refined ones).
     #[serde(skip_serializing_if = "Option::is_none", default)]
@@ -196,6 +220,7 @@ impl HandEyeReport {
                 .collect(),
             repeatability: result.repeatability.clone(),
             warnings: result.warnings.clone(),
+            pairs: Vec::new(),
             refinement: result.refinement.clone(),
             robocal_version: crate::VERSION.to_string(),
         }
