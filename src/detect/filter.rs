@@ -65,33 +65,28 @@ impl Plane {
     }
 
     /// Separable Gaussian smoothing with standard deviation `sigma` pixels
-    /// (kernel radius 3 sigma, borders clamped).
+    /// (kernel radius 3 sigma, borders clamped). Both passes run tap by tap
+    /// over whole rows (vectorisable); each output sums its taps in kernel
+    /// order, as a per-pixel dot product would.
     pub fn gaussian(&self, sigma: f64) -> Plane {
         let k = gaussian_kernel(sigma);
-        let r = (k.len() / 2) as isize;
+        let r = k.len() / 2;
         let (w, h) = (self.w, self.h);
         let mut tmp = vec![0.0f32; w * h];
+        let mut padded = vec![0.0f32; w + 2 * r];
         for y in 0..h {
             let row = &self.data[y * w..(y + 1) * w];
+            pad_row(row, r, &mut padded);
             let out = &mut tmp[y * w..(y + 1) * w];
-            for (x, o) in out.iter_mut().enumerate() {
-                let xi = x as isize;
-                let mut s = 0.0;
-                if xi >= r && xi + r < w as isize {
-                    let base = (xi - r) as usize;
-                    for (i, kv) in k.iter().enumerate() {
-                        s += kv * row[base + i];
-                    }
-                } else {
-                    for (i, kv) in k.iter().enumerate() {
-                        let xx = (xi + i as isize - r).clamp(0, w as isize - 1) as usize;
-                        s += kv * row[xx];
-                    }
+            for (i, kv) in k.iter().enumerate() {
+                let src = &padded[i..i + w];
+                for (o, s) in out.iter_mut().zip(src) {
+                    *o += kv * s;
                 }
-                *o = s;
             }
         }
         let mut data = vec![0.0f32; w * h];
+        let r = r as isize;
         for y in 0..h {
             let out = &mut data[y * w..(y + 1) * w];
             for (i, kv) in k.iter().enumerate() {
@@ -104,6 +99,52 @@ impl Plane {
         }
         Plane { w, h, data }
     }
+}
+
+/// `row` with `r` clamped border copies on each side, into `out`
+/// (`row.len() + 2 r` long).
+fn pad_row(row: &[f32], r: usize, out: &mut [f32]) {
+    let w = row.len();
+    let (first, last) = (row[0], row[w - 1]);
+    out[..r].iter_mut().for_each(|v| *v = first);
+    out[r..r + w].copy_from_slice(row);
+    out[r + w..].iter_mut().for_each(|v| *v = last);
+}
+
+/// Pyramid level `level` (each pixel the mean of a `2^level` square block,
+/// borders clamped) straight from 8-bit pixels: rows are summed in integers,
+/// so the result equals repeated [`Plane::downsample2`] up to rounding.
+pub(crate) fn box_level(img: &GrayImage, level: u32) -> Plane {
+    let (iw, ih) = (img.width as usize, img.height as usize);
+    if level == 0 {
+        return Plane::from_gray(img);
+    }
+    let level = level.min(8);
+    let f = 1usize << level;
+    let w = (iw >> level).max(1);
+    let h = (ih >> level).max(1);
+    let scale = 1.0 / (f * f) as f32;
+    let mut data = vec![0.0f32; w * h];
+    // Row sums of at most 256 rows of 8-bit pixels fit in u16.
+    let mut sums = vec![0u16; iw];
+    for y in 0..h {
+        sums.iter_mut().for_each(|v| *v = 0);
+        for k in 0..f {
+            let yy = (y * f + k).min(ih - 1);
+            for (s, &p) in sums.iter_mut().zip(&img.pixels[yy * iw..(yy + 1) * iw]) {
+                *s += p as u16;
+            }
+        }
+        let out = &mut data[y * w..(y + 1) * w];
+        for (x, o) in out.iter_mut().enumerate() {
+            let mut acc = 0u32;
+            for k in 0..f {
+                acc += sums[(x * f + k).min(iw - 1)] as u32;
+            }
+            *o = acc as f32 * scale;
+        }
+    }
+    Plane { w, h, data }
 }
 
 /// Normalised Gaussian taps, radius ceil(3 sigma) (at least 1).

@@ -51,15 +51,16 @@ pub const MIN_IMAGE_SIDE_PX: u32 = 16;
 /// Tunables of [`detect`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct DetectOptions {
-    /// Long side of the pyramid level where boards are searched, pixels
-    /// (default 1024). Corners are always refined at full resolution.
+    /// Long side of the pyramid level where chessboards are first searched,
+    /// pixels (default 512; circle grids use at least 2048). Corners are
+    /// always refined at full resolution.
     pub max_working_side_px: u32,
 }
 
 impl Default for DetectOptions {
     fn default() -> Self {
         DetectOptions {
-            max_working_side_px: 1024,
+            max_working_side_px: 512,
         }
     }
 }
@@ -116,6 +117,18 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
         target,
         points,
     })
+}
+
+/// The coarsest pyramid level whose long side is at most `max_side`
+/// (at least 64 px, at most level 8).
+pub(crate) fn working_level(img: &GrayImage, max_side: u32) -> u32 {
+    let long = img.width.max(img.height).max(1);
+    let max_side = max_side.max(64);
+    let mut level = 0u32;
+    while (long >> level) > max_side && level < 8 {
+        level += 1;
+    }
+    level
 }
 
 /// Pyramid levels to search, coarsest first: the first level whose long
