@@ -3,6 +3,8 @@
 //! over intrinsics, distortion and every view pose ([`calibrate`]), with a
 //! report that carries residuals, uncertainties and warnings.
 //!
+//! Two cameras with shared views: [`stereo`] (right_from_left, seed 000).
+//!
 //! From 3-D/2-D point pairs of a non-planar target (seed 002):
 //! - [`dlt`]: the 12-parameter projection matrix, decomposed into K, R, t;
 //! - [`dlt_kalman`]: the recursive Kalman-filter estimate of the same
@@ -21,6 +23,10 @@ mod json_api_tests;
 mod refine;
 mod report;
 mod residuals;
+pub mod stereo;
+mod stereo_problem;
+#[cfg(test)]
+mod stereo_tests;
 mod tsai;
 mod zhang;
 

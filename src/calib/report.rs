@@ -254,7 +254,7 @@ fn correlation(names: &[String], c: &DMatrix<f64>) -> Correlation {
     }
 }
 
-fn pose_report(pose: &Pose) -> PoseReport {
+pub(crate) fn pose_report(pose: &Pose) -> PoseReport {
     let m = matrix4_from_pose(pose);
     let t = pose.translation.vector;
     PoseReport {

@@ -238,7 +238,7 @@ fn initial_camera(
     })
 }
 
-fn lm_options(initial: &Camera, options: &CalibrationOptions) -> Result<LmOptions> {
+pub(crate) fn lm_options(initial: &Camera, options: &CalibrationOptions) -> Result<LmOptions> {
     let names = initial.param_names();
     let mut fixed = vec![false; names.len()];
     fixed[1] = options.fix_aspect_ratio;

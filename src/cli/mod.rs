@@ -9,6 +9,7 @@ mod intrinsics;
 mod planar;
 mod render;
 mod serve;
+mod stereo;
 mod xytable;
 
 use std::fmt;
@@ -68,6 +69,7 @@ Commands:
   handeye     hand-eye calibration from robot poses and camera poses
   detect      find a calibration target (chessboard, circles, dots) in images
   intrinsics  calibrate a camera (Zhang, DLT, Tsai, EKF) from images or detections
+  stereo      calibrate a stereo pair (both cameras and right_from_left) from paired images
   info        decode images and print their format and size
   render      synthetic target images with exact ground truth (and the demo session)
   planar      eye-to-hand calibration at any height (plate corners per height)
@@ -99,6 +101,8 @@ pub fn run(args: &[String]) -> Result<(), CliError> {
         "serve" => serve::run(rest),
         "intrinsics" if wants_help => print_help(intrinsics::HELP),
         "intrinsics" => intrinsics::run(rest),
+        "stereo" if wants_help => print_help(stereo::HELP),
+        "stereo" => stereo::run(rest),
         "export" if wants_help => print_help(export::HELP),
         "export" => export::run(rest),
         "handeye" if wants_help => print_help(handeye::HELP),

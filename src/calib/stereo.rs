@@ -1,0 +1,254 @@
+//! Stereo calibration (seed 000): two cameras that saw the same board
+//! poses. Each camera is first calibrated alone ([`calibrate`]); the seed's
+//! per-view relation `R = R_R R_L^-1`, `T = T_R - R T_L` gives one
+//! right_from_left per view, averaged (rotations by the quaternion mean,
+//! translations arithmetically); then one Levenberg-Marquardt refines both
+//! cameras' intrinsics and distortion, the left camera's board poses and
+//! right_from_left jointly (the right camera sees the board at
+//! `right_from_left * left_from_target`).
+
+use super::refine::{block_from_pose, CalibProblem};
+use super::report::{build_report, pose_report};
+use super::stereo_problem::StereoProblem;
+use super::zhang::lm_options;
+use super::{calibrate, CalibrationOptions, CameraCalibration, PoseReport, View};
+use crate::error::{Error, Result};
+use crate::geometry::{average_rotations_quaternion, pose_from_matrix4, Pose};
+use crate::optim::{solve, BlockParams, BlockProblem, LmOptions, Termination};
+use nalgebra::{Matrix4, Translation3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Standard deviations of right_from_left from the joint covariance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TransformStd {
+    /// Of the rotation (small-angle vector, left perturbation), radians.
+    pub rotation_rad: [f64; 3],
+    /// Of the translation, metres.
+    pub translation_m: [f64; 3],
+}
+
+/// The result of [`calibrate_stereo`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StereoCalibration {
+    /// The left camera at the joint optimum (its `std` and correlations are
+    /// from its own observations, with the right camera held).
+    pub left: CameraCalibration,
+    /// The right camera at the joint optimum; its views' `camera_from_target`
+    /// is `right_from_left * left camera_from_target`.
+    pub right: CameraCalibration,
+    /// The refined transform: `p_right = right_from_left * p_left`.
+    pub right_from_left: PoseReport,
+    /// The averaged single-camera estimate the refinement started from.
+    pub initial_right_from_left: PoseReport,
+    /// Distance between the camera centres, metres.
+    pub baseline_m: f64,
+    /// Standard deviations of right_from_left (`None` when singular).
+    pub right_from_left_std: Option<TransformStd>,
+    /// RMS reprojection error over every point of both cameras, px.
+    pub rms_px: f64,
+    /// Joint solver iterations.
+    pub iterations: usize,
+    /// Why the joint solver stopped.
+    pub termination: Termination,
+}
+
+/// Calibrate a stereo pair from views paired by index (`left[i]` and
+/// `right[i]` saw the same board pose; their point sets may differ).
+/// `options` apply to both cameras; points a single-camera calibration
+/// rejected as outliers stay out of the joint refinement.
+pub fn calibrate_stereo(
+    left: &[View],
+    right: &[View],
+    left_size_px: (u32, u32),
+    right_size_px: (u32, u32),
+    options: &CalibrationOptions,
+) -> Result<StereoCalibration> {
+    if left.len() != right.len() {
+        return Err(Error::invalid(
+            "right",
+            format!(
+                "views are paired by order: {} left views but {} right views",
+                left.len(),
+                right.len()
+            ),
+        ));
+    }
+    let single_left = calibrate(left, left_size_px, options)?;
+    let single_right = calibrate(right, right_size_px, options)?;
+    let left_poses = report_poses(&single_left)?;
+    let right_poses = report_poses(&single_right)?;
+    let initial = initial_right_from_left(&left_poses, &right_poses)?;
+    let used_left = used_masks(left, &single_left);
+    let used_right = used_masks(right, &single_right);
+    let problem = StereoProblem {
+        left: CalibProblem {
+            template: &single_left.camera,
+            views: left,
+            used: &used_left,
+            aspect: aspect(&single_left.camera, options),
+        },
+        right: CalibProblem {
+            template: &single_right.camera,
+            views: right,
+            used: &used_right,
+            aspect: aspect(&single_right.camera, options),
+        },
+        n_left: single_left.camera.params().len(),
+        n_right: single_right.camera.params().len(),
+    };
+    let lm_left = lm_options(&single_left.camera, options)?;
+    let lm_right = lm_options(&single_right.camera, options)?;
+    let mut fixed_global = lm_left.fixed_global.clone();
+    fixed_global.extend(&lm_right.fixed_global);
+    fixed_global.extend([false; 6]);
+    let mut global = single_left.camera.params();
+    global.extend(single_right.camera.params());
+    global.extend(block_from_pose(&initial));
+    let start = BlockParams {
+        global,
+        blocks: left_poses.iter().map(block_from_pose).collect(),
+    };
+    let result = solve(
+        &problem,
+        &start,
+        &LmOptions {
+            fixed_global,
+            ..lm_left
+        },
+    )?;
+    let g = &result.params.global;
+    let (nl, nr) = (problem.n_left, problem.n_right);
+    let rfl = problem.right_from_left(g);
+    let right_blocks: Vec<Vec<f64>> = result
+        .params
+        .blocks
+        .iter()
+        .map(|b| block_from_pose(&(rfl * super::refine::pose_from_block(b))))
+        .collect();
+    let left_report = camera_report(
+        &problem.left,
+        &g[..nl],
+        &result.params.blocks,
+        &single_left,
+        left_size_px,
+        options,
+    )?;
+    let right_report = camera_report(
+        &problem.right,
+        &g[nl..nl + nr],
+        &right_blocks,
+        &single_right,
+        right_size_px,
+        options,
+    )?;
+    let blocks = problem.residuals_and_jacobian(&result.params, false)?;
+    let squared: f64 = blocks.iter().map(|b| b.residuals.norm_squared()).sum();
+    let o = problem.rfl_offset();
+    let right_from_left_std = result.std_global().map(|s| TransformStd {
+        rotation_rad: [s[o], s[o + 1], s[o + 2]],
+        translation_m: [s[o + 3], s[o + 4], s[o + 5]],
+    });
+    Ok(StereoCalibration {
+        left: left_report,
+        right: right_report,
+        right_from_left: pose_report(&rfl),
+        initial_right_from_left: pose_report(&initial),
+        baseline_m: rfl.inverse().translation.vector.norm(),
+        right_from_left_std,
+        rms_px: (squared / blocks.len().max(1) as f64).sqrt(),
+        iterations: result.iterations,
+        termination: result.termination,
+    })
+}
+
+/// The seed's closed form per view, averaged: `R_i = R_R R_L^-1`,
+/// `T_i = T_R - R_i T_L`; R = quaternion mean of the R_i, T = mean of the
+/// `T_R - R T_L` (recomputed with the averaged R so that T matches it).
+pub fn initial_right_from_left(
+    left_from_target: &[Pose],
+    right_from_target: &[Pose],
+) -> Result<Pose> {
+    let (l, r) = (left_from_target, right_from_target);
+    if l.is_empty() || l.len() != r.len() {
+        return Err(Error::invalid(
+            "views",
+            format!(
+                "need paired views, got {} left and {} right",
+                l.len(),
+                r.len()
+            ),
+        ));
+    }
+    let rotations: Vec<_> = l
+        .iter()
+        .zip(r)
+        .map(|(pl, pr)| pr.rotation * pl.rotation.inverse())
+        .collect();
+    let rotation = average_rotations_quaternion(&rotations, None)?;
+    let mut t = Vector3::zeros();
+    for (pl, pr) in l.iter().zip(r) {
+        t += pr.translation.vector - rotation * pl.translation.vector;
+    }
+    t /= l.len() as f64;
+    Ok(Pose::from_parts(Translation3::from(t), rotation))
+}
+
+fn aspect(camera: &crate::camera::Camera, options: &CalibrationOptions) -> Option<f64> {
+    options.fix_aspect_ratio.then(|| camera.fy / camera.fx)
+}
+
+/// The camera_from_target of every view of a report.
+fn report_poses(report: &CameraCalibration) -> Result<Vec<Pose>> {
+    report
+        .views
+        .iter()
+        .map(|v| {
+            let m = v.camera_from_target.matrix_row_major;
+            pose_from_matrix4(&Matrix4::from_fn(|r, c| m[r][c]))
+        })
+        .collect()
+}
+
+/// Per view, per point: not rejected by the single-camera calibration.
+fn used_masks(views: &[View], report: &CameraCalibration) -> Vec<Vec<bool>> {
+    views
+        .iter()
+        .zip(&report.views)
+        .map(|(v, r)| {
+            let mut used = vec![true; v.object_m.len()];
+            for o in &r.outliers {
+                if let Some(u) = used.get_mut(o.index) {
+                    *u = false;
+                }
+            }
+            used
+        })
+        .collect()
+}
+
+/// A camera report at the joint optimum: the solver evaluated (no
+/// iterations) at the given camera and poses, then the usual report.
+fn camera_report(
+    problem: &CalibProblem,
+    params: &[f64],
+    blocks: &[Vec<f64>],
+    single: &CameraCalibration,
+    size: (u32, u32),
+    options: &CalibrationOptions,
+) -> Result<CameraCalibration> {
+    let lm = lm_options(problem.template, options)?;
+    let start = BlockParams {
+        global: params.to_vec(),
+        blocks: blocks.to_vec(),
+    };
+    let result = solve(
+        problem,
+        &start,
+        &LmOptions {
+            max_iterations: 0,
+            ..lm
+        },
+    )?;
+    let outliers = single.views.iter().map(|v| v.outliers.clone()).collect();
+    build_report(problem, &result, outliers, size, options)
+}

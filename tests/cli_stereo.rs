@@ -1,0 +1,209 @@
+//! `robocal stereo` through the real binary on rendered image pairs (two
+//! cameras, known right_from_left), the export of its report, and bad
+//! arguments.
+
+use nalgebra::{Translation3, Vector3};
+use robocal::calib::View;
+use robocal::camera::Distortion;
+use robocal::geometry::{rotation_from_rotvec, Pose};
+use robocal::image::{encode_png, GrayImage};
+use robocal::synth::{render, RenderOptions, Scene};
+use robocal::target::Target;
+use robocal::Camera;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn robocal(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .args(args)
+        .output()
+        .expect("run robocal");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("robocal-stereo-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn camera(fx: f64, cx: f64, k1: f64) -> Camera {
+    Camera {
+        fx,
+        fy: fx,
+        cx,
+        cy: 239.5,
+        skew: 0.0,
+        width: 640,
+        height: 480,
+        distortion: Distortion::Brown {
+            k1,
+            k2: 0.0,
+            k3: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+        },
+    }
+}
+
+fn inside(c: &Camera, v: &View, pose: &Pose) -> bool {
+    v.object_m.iter().all(|p| {
+        c.project(&(pose * p)).is_ok_and(|q| {
+            q.x > 40.0 && q.y > 40.0 && q.x < c.width as f64 - 41.0 && q.y < c.height as f64 - 41.0
+        })
+    })
+}
+
+/// Writes paired images of a 9x6 board (plus one pair whose right image is
+/// blank) and returns (left files, right files, right_from_left).
+fn rendered_pairs(dir: &Path) -> (Vec<String>, Vec<String>, Pose) {
+    let left = camera(620.0, 319.5, -0.08);
+    let right = camera(640.0, 326.0, -0.05);
+    let right_from_left = Pose::from_parts(
+        Translation3::new(-0.05, 0.001, 0.002),
+        rotation_from_rotvec(&Vector3::new(0.005, -0.03, 0.01)),
+    );
+    let target = Target::parse_spec("chessboard:9x6:30mm").expect("target");
+    // The scene's points are the inner corners of the board.
+    let scene = Scene::calibration(5, &left, (9, 6), 0.03, 24, 0.0).expect("scene");
+    let options = RenderOptions {
+        supersample: 4,
+        ..RenderOptions::default()
+    };
+    let (mut lf, mut rf) = (vec![], vec![]);
+    for (i, (v, pose)) in scene
+        .views
+        .iter()
+        .zip(&scene.camera_from_target)
+        .enumerate()
+    {
+        let right_pose = right_from_left * pose;
+        if !inside(&left, v, pose) || !inside(&right, v, &right_pose) || lf.len() == 7 {
+            continue;
+        }
+        for (cam, p, list, side) in [
+            (&left, pose, &mut lf, "left"),
+            (&right, &right_pose, &mut rf, "right"),
+        ] {
+            let r = render(
+                cam,
+                &target,
+                p,
+                &RenderOptions {
+                    seed: i as u64,
+                    ..options.clone()
+                },
+            )
+            .expect("render");
+            let path = dir.join(format!("{side}{i:02}.png"));
+            std::fs::write(&path, encode_png(&r.image).expect("png")).expect("write");
+            list.push(path.to_string_lossy().into_owned());
+        }
+    }
+    assert!(lf.len() >= 6, "only {} usable pairs", lf.len());
+    let blank = GrayImage::new(640, 480, vec![120; 640 * 480]).expect("image");
+    let path = dir.join("right_blank.png");
+    std::fs::write(&path, encode_png(&blank).expect("png")).expect("write");
+    lf.push(lf[0].clone());
+    rf.push(path.to_string_lossy().into_owned());
+    (lf, rf, right_from_left)
+}
+
+#[test]
+fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
+    let dir = temp_dir("pairs");
+    let (lf, rf, truth) = rendered_pairs(&dir);
+    let out = dir.join("stereo.json");
+    let mut args = vec!["stereo", "--target", "chessboard:9x6:30mm", "--left"];
+    args.extend(lf.iter().map(String::as_str));
+    args.push("--right");
+    args.extend(rf.iter().map(String::as_str));
+    let out_s = out.to_string_lossy().into_owned();
+    args.extend(["-o", &out_s]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("pair dropped") && err.contains("right_blank.png"),
+        "{err}"
+    );
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("json");
+    for key in [
+        "left",
+        "right",
+        "right_from_left",
+        "initial_right_from_left",
+        "rms_px",
+    ] {
+        assert!(report.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(
+        report["left"]["views"].as_array().map(Vec::len),
+        Some(lf.len() - 1)
+    );
+    // Rendered corners are found to ~0.05 px (tests/detect_render.rs): the
+    // reprojection rms stays well under 0.3 px and, with ~7 pairs at
+    // 0.5-1 m, right_from_left is within 2 mm and 2 mrad.
+    let rms = report["rms_px"].as_f64().expect("rms");
+    assert!(rms < 0.3, "rms {rms}");
+    let t = &report["right_from_left"]["translation_m"];
+    let got = Vector3::new(
+        t[0].as_f64().unwrap(),
+        t[1].as_f64().unwrap(),
+        t[2].as_f64().unwrap(),
+    );
+    assert!((got - truth.translation.vector).norm() < 2e-3, "T {got}");
+    let q = &report["right_from_left"]["quaternion_xyzw"];
+    let qv: Vec<f64> = (0..4).map(|k| q[k].as_f64().unwrap()).collect();
+    let rot = robocal::geometry::rotation_from_quaternion_xyzw([qv[0], qv[1], qv[2], qv[3]])
+        .expect("quaternion");
+    assert!((rot * truth.rotation.inverse()).angle() < 2e-3);
+    // The export finds right_from_left.
+    let (code, text, err) = robocal(&["export", &out_s, "--format", "xyz-quat-xyzw"]);
+    assert_eq!(code, 0, "{err}");
+    let numbers: Vec<f64> = text
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    assert_eq!(numbers.len(), 7, "{text}");
+    assert!((numbers[0] - got.x).abs() < 1e-9, "{text}");
+}
+
+#[test]
+fn bad_arguments_say_what_to_change() {
+    let (code, _, err) = robocal(&[
+        "stereo",
+        "--target",
+        "chessboard:9x6:30mm",
+        "--left",
+        "a.png",
+        "b.png",
+        "--right",
+        "c.png",
+    ]);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim(),
+        "robocal: stereo: images are paired by order: 2 left but 1 right (see 'robocal stereo --help')"
+    );
+    let (code, _, err) = robocal(&[
+        "stereo",
+        "--target",
+        "chessboard:9x6:30mm",
+        "--left",
+        "a.png",
+    ]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("give --left IMAGES... and --right IMAGES... once each"),
+        "{err}"
+    );
+    let (code, help, _) = robocal(&["stereo", "--help"]);
+    assert_eq!(code, 0);
+    assert!(help.contains("robocal stereo --target chessboard:9x6:25mm --left left*.jpg"));
+}
