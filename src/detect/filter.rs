@@ -136,7 +136,12 @@ pub(crate) fn box_level(img: &GrayImage, level: u32) -> Plane {
             }
         }
         let out = &mut data[y * w..(y + 1) * w];
-        for (x, o) in out.iter_mut().enumerate() {
+        // Whole blocks, then a clamped last block (odd widths).
+        let whole = (iw / f).min(w);
+        for (o, block) in out.iter_mut().zip(sums.chunks_exact(f)) {
+            *o = block.iter().map(|&v| v as u32).sum::<u32>() as f32 * scale;
+        }
+        for (x, o) in out.iter_mut().enumerate().skip(whole) {
             let mut acc = 0u32;
             for k in 0..f {
                 acc += sums[(x * f + k).min(iw - 1)] as u32;

@@ -89,8 +89,19 @@ pub(crate) fn candidates(level: &Plane, max_count: usize) -> Vec<Candidate> {
             });
         }
     }
-    out.sort_by(|a, b| b.response.total_cmp(&a.response));
+    // Strongest first, ties in raster order. Noise images give tens of
+    // thousands of weak maxima: select the kept ones before sorting.
+    let order = |a: &Candidate, b: &Candidate| {
+        b.response
+            .total_cmp(&a.response)
+            .then(a.pos.y.total_cmp(&b.pos.y))
+            .then(a.pos.x.total_cmp(&b.pos.x))
+    };
+    if out.len() > max_count && max_count > 0 {
+        out.select_nth_unstable_by(max_count - 1, order);
+    }
     out.truncate(max_count);
+    out.sort_unstable_by(order);
     out
 }
 
