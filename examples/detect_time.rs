@@ -2,8 +2,9 @@
 //! also a blank and a noise image of the first file's size.
 //!
 //! Usage: cargo run --release --example detect_time -- [--target SPEC]
-//! [--repeat N] [--no-blank] [--truth bench/out/truth.json] FILES...   (default target chessboard:9x6:30mm, 11 repeats)
-//! Prints one line per file (median ms, points found) and the median over
+//! [--repeat N] [--no-blank] [--decode] [--truth bench/out/truth.json] FILES...   (default target chessboard:9x6:30mm, 11 repeats)
+//! `--decode` times decoding + detection (as the wasm `detect_target`
+//! does, for bench/wasm_detect.mjs). Prints one line per file (median ms, points found) and the median over
 //! files; used for profiling (`valgrind --tool=callgrind ... --repeat 1`).
 
 use robocal::detect::{detect, DetectOptions};
@@ -76,12 +77,14 @@ fn main() {
     let mut repeat = 11usize;
     let mut files = Vec::new();
     let mut blank_noise = true;
+    let mut with_decode = false;
     let mut truth = std::collections::HashMap::new();
     let mut errs = Vec::new();
     while let Some(a) = args.next() {
         match a.as_str() {
             "--target" => spec = args.next().expect("--target SPEC"),
             "--no-blank" => blank_noise = false,
+            "--decode" => with_decode = true,
             "--truth" => truth = load_truth(&args.next().expect("--truth FILE")),
             "--repeat" => {
                 repeat = args
@@ -99,7 +102,20 @@ fn main() {
         let bytes = std::fs::read(f).expect("read image");
         let img = decode_gray(&bytes).expect("decode image");
         size.get_or_insert((img.width, img.height));
-        let (ms, found) = median_ms(&img, &target, repeat);
+        let (ms, found) = if with_decode {
+            let mut times: Vec<f64> = (0..repeat)
+                .map(|_| {
+                    let t0 = Instant::now();
+                    let img = decode_gray(&bytes).expect("decode image");
+                    let _ = detect(&img, &target, &DetectOptions::default());
+                    t0.elapsed().as_secs_f64() * 1000.0
+                })
+                .collect();
+            times.sort_by(f64::total_cmp);
+            (times[repeat / 2], median_ms(&img, &target, 1).1)
+        } else {
+            median_ms(&img, &target, repeat)
+        };
         let abs = std::fs::canonicalize(f).map(|p| p.display().to_string());
         let err = match (&found, abs.ok().and_then(|a| truth.get(&a))) {
             (Some(pts), Some(t)) => errors(pts, t),
