@@ -170,52 +170,14 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
 /// The lens model of a name, with the coefficients the solver starts from
 /// (0, except EUCM's alpha 0.5 and beta 1: at alpha = 0 beta has no effect).
 pub fn model_from_name(name: &str) -> Result<Distortion> {
-    Ok(match name {
-        "none" => Distortion::None,
-        "brown" => Distortion::Brown {
-            k1: 0.0,
-            k2: 0.0,
-            k3: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-        },
-        "radial_k1_k2_k5" => Distortion::RadialK1K2K5 {
-            k1: 0.0,
-            k2: 0.0,
-            k5: 0.0,
-        },
-        "rational" => Distortion::Rational {
-            k1: 0.0,
-            k2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-            k5: 0.0,
-            k6: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-            s1: 0.0,
-            s2: 0.0,
-            s3: 0.0,
-            s4: 0.0,
-        },
-        "division" => Distortion::Division { kappa: 0.0 },
-        "kannala_brandt" => Distortion::KannalaBrandt {
-            k1: 0.0,
-            k2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-        },
-        "eucm" => Distortion::Eucm {
-            alpha: 0.5,
-            beta: 1.0,
-        },
-        other => {
-            return Err(Error::invalid(
-                "model",
-                format!("unknown model '{other}' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none)"),
-            ))
-        }
-    })
+    match Distortion::zeroed(name) {
+        Some(Distortion::Eucm { beta, .. }) => Ok(Distortion::Eucm { alpha: 0.5, beta }),
+        Some(model) => Ok(model),
+        None => Err(Error::invalid(
+            "model",
+            format!("unknown model '{name}' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none)"),
+        )),
+    }
 }
 
 /// The solver options of the JSON options.

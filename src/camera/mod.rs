@@ -241,3 +241,63 @@ impl Camera {
         Ok(Vector2::new(mx, my))
     }
 }
+
+/// The lens-model names of [`Distortion::model_name`], in menu order.
+pub const MODEL_NAMES: [&str; 7] = [
+    "none",
+    "brown",
+    "rational",
+    "division",
+    "radial_k1_k2_k5",
+    "kannala_brandt",
+    "eucm",
+];
+
+impl Distortion {
+    /// The model called `name` (see [`Distortion::model_name`]) with every
+    /// coefficient 0 (EUCM: alpha 0, beta 1); `None` for an unknown name.
+    pub fn zeroed(name: &str) -> Option<Distortion> {
+        let template = match name {
+            "none" => Distortion::None,
+            "brown" => Distortion::Brown {
+                k1: 0.0,
+                k2: 0.0,
+                k3: 0.0,
+                p1: 0.0,
+                p2: 0.0,
+            },
+            "rational" => Distortion::Rational {
+                k1: 0.0,
+                k2: 0.0,
+                k3: 0.0,
+                k4: 0.0,
+                k5: 0.0,
+                k6: 0.0,
+                p1: 0.0,
+                p2: 0.0,
+                s1: 0.0,
+                s2: 0.0,
+                s3: 0.0,
+                s4: 0.0,
+            },
+            "division" => Distortion::Division { kappa: 0.0 },
+            "radial_k1_k2_k5" => Distortion::RadialK1K2K5 {
+                k1: 0.0,
+                k2: 0.0,
+                k5: 0.0,
+            },
+            "kannala_brandt" => Distortion::KannalaBrandt {
+                k1: 0.0,
+                k2: 0.0,
+                k3: 0.0,
+                k4: 0.0,
+            },
+            "eucm" => Distortion::Eucm {
+                alpha: 0.0,
+                beta: 1.0,
+            },
+            _ => return None,
+        };
+        Some(template)
+    }
+}

@@ -85,33 +85,14 @@ fn missing(key: &str) -> Error {
 
 /// A model with zero coefficients, from its name.
 pub fn distortion_template(model: &str) -> Result<Distortion> {
-    Ok(match model {
-        "none" => Distortion::None,
-        "brown" => Distortion::Brown { k1: 0.0, k2: 0.0, k3: 0.0, p1: 0.0, p2: 0.0 },
-        "rational" => Distortion::Rational {
-            k1: 0.0,
-            k2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-            k5: 0.0,
-            k6: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-            s1: 0.0,
-            s2: 0.0,
-            s3: 0.0,
-            s4: 0.0,
-        },
-        "division" => Distortion::Division { kappa: 0.0 },
-        "radial_k1_k2_k5" => Distortion::RadialK1K2K5 { k1: 0.0, k2: 0.0, k5: 0.0 },
-        "kannala_brandt" => Distortion::KannalaBrandt { k1: 0.0, k2: 0.0, k3: 0.0, k4: 0.0 },
-        "eucm" => Distortion::Eucm { alpha: 0.0, beta: 1.0 },
-        other => {
-            return Err(Error::invalid(
-                "model",
-                format!("unknown lens model '{other}' (known: none, brown, rational, division, radial_k1_k2_k5, kannala_brandt, eucm)"),
-            ))
-        }
+    Distortion::zeroed(model).ok_or_else(|| {
+        Error::invalid(
+            "model",
+            format!(
+                "unknown lens model '{model}' (known: {})",
+                crate::camera::MODEL_NAMES.join(", ")
+            ),
+        )
     })
 }
 
