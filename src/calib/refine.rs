@@ -6,9 +6,9 @@
 use super::View;
 use crate::camera::Camera;
 use crate::error::Result;
-use crate::geometry::{rotation_from_rotvec, rotvec_from_rotation, Pose};
+use crate::geometry::{params_from_pose, rotation_from_rotvec, rotvec_from_rotation, Pose};
 use crate::optim::{BlockParams, BlockProblem, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix2x3, Matrix3, Point3, Translation3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix2x3, Matrix3, Point3, Vector3};
 
 /// Planar calibration as a block least-squares problem.
 pub(crate) struct CalibProblem<'a> {
@@ -21,18 +21,12 @@ pub(crate) struct CalibProblem<'a> {
     pub aspect: Option<f64>,
 }
 
-/// The 6-vector of a pose.
+/// The 6-vector of a pose (rotation vector, translation) as an LM block.
 pub(crate) fn block_from_pose(pose: &Pose) -> Vec<f64> {
-    let r = rotvec_from_rotation(&pose.rotation);
-    let t = pose.translation.vector;
-    vec![r.x, r.y, r.z, t.x, t.y, t.z]
+    params_from_pose(pose).to_vec()
 }
 
-/// The pose of a 6-vector.
-pub(crate) fn pose_from_block(b: &[f64]) -> Pose {
-    let rotation = rotation_from_rotvec(&Vector3::new(b[0], b[1], b[2]));
-    Pose::from_parts(Translation3::new(b[3], b[4], b[5]), rotation)
-}
+pub(crate) use crate::geometry::pose_from_params as pose_from_block;
 
 impl CalibProblem<'_> {
     /// The camera of a global parameter vector.

@@ -31,10 +31,10 @@ pub use average::{average_rotations_chordal, average_rotations_quaternion};
 pub use dual_quaternion::DualQuaternion;
 pub use euler::{euler_from_rotation, rotation_from_euler, EulerKind, EulerOrder};
 pub use rotation::{
-    matrix4_from_pose, nearest_rotation, pose_from_matrix4, pose_from_matrix4_with_tolerance,
-    quaternion_wxyz_from_rotation, quaternion_xyzw_from_rotation, rotation_angle_between,
-    rotation_from_quaternion_wxyz, rotation_from_quaternion_xyzw, rotation_from_rotvec,
-    rotvec_from_rotation, MATRIX4_TOLERANCE,
+    matrix4_from_pose, nearest_rotation, params_from_pose, pose_from_matrix4,
+    pose_from_matrix4_with_tolerance, pose_from_params, quaternion_wxyz_from_rotation,
+    quaternion_xyzw_from_rotation, rotation_angle_between, rotation_from_quaternion_wxyz,
+    rotation_from_quaternion_xyzw, rotation_from_rotvec, rotvec_from_rotation, MATRIX4_TOLERANCE,
 };
 
 /// A rigid transform `a_from_b` (rotation then translation, metres):

@@ -60,6 +60,24 @@ pub fn rotvec_from_rotation(rotation: &Rotation) -> Vector3<f64> {
     v * scale
 }
 
+/// A pose as the 6 parameters the solvers optimise: rotation vector
+/// (radians) then translation (metres), `[rx, ry, rz, tx, ty, tz]`.
+pub fn params_from_pose(pose: &Pose) -> [f64; 6] {
+    let r = rotvec_from_rotation(&pose.rotation);
+    let t = pose.translation.vector;
+    [r.x, r.y, r.z, t.x, t.y, t.z]
+}
+
+/// The pose of 6 solver parameters (the inverse of [`params_from_pose`]);
+/// only the first 6 values of `p` are read.
+///
+/// # Panics
+/// When `p` has fewer than 6 values (a solver bug, never input data).
+pub fn pose_from_params(p: &[f64]) -> Pose {
+    let rotation = rotation_from_rotvec(&Vector3::new(p[0], p[1], p[2]));
+    Pose::from_parts(Translation3::new(p[3], p[4], p[5]), rotation)
+}
+
 fn unit_quaternion(w: f64, x: f64, y: f64, z: f64, field: &str) -> Result<Rotation> {
     let q = Quaternion::new(w, x, y, z);
     let n = q.norm();
@@ -362,5 +380,25 @@ mod tests {
         assert!(rotation_angle_between(&p.rotation, &r) < 1e-4);
         let rm = p.rotation.to_rotation_matrix();
         assert!((rm.matrix().transpose() * rm.matrix() - Matrix3::identity()).amax() < 1e-14);
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn solver_parameters_round_trip_a_pose() {
+        let p = [0.3, -1.2, 2.9, 0.5, -0.25, 1.75];
+        let pose = pose_from_params(&p);
+        // 0.3, -1.2, 2.9 has angle 3.15 > pi: the canonical vector is the
+        // same rotation the other way round, so compare poses, then params
+        // of an angle below pi exactly.
+        let back = pose_from_params(&params_from_pose(&pose));
+        assert!(rotation_angle_between(&back.rotation, &pose.rotation) < 1e-12);
+        assert!((back.translation.vector - pose.translation.vector).norm() < 1e-15);
+        let q = [0.1, 0.2, -0.3, 1.0, 2.0, 3.0];
+        let got = params_from_pose(&pose_from_params(&q));
+        for (g, w) in got.iter().zip(q) {
+            assert!((g - w).abs() < 1e-14, "{got:?} vs {q:?}");
+        }
+        // Right-multiplying the identity step changes nothing.
+        let step = pose_from_params(&[0.0; 6]);
+        assert_eq!(pose * step, pose);
     }
 }

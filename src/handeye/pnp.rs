@@ -10,7 +10,7 @@ use super::Pose;
 use crate::calib::{homography, pose_from_homography};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::geometry::{rotation_from_rotvec, rotvec_from_rotation};
+use crate::geometry::{params_from_pose, pose_from_params, rotation_from_rotvec};
 use crate::handeye::math::skew;
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
 use nalgebra::{DMatrix, DVector, Matrix3, Point2, Translation3, Vector3};
@@ -67,27 +67,14 @@ pub fn camera_from_target(camera: &Camera, view: &ViewPoints) -> Result<(Pose, f
     let lm = optim::solve(
         &problem,
         &BlockParams {
-            global: params_of(&start),
+            global: params_from_pose(&start).to_vec(),
             blocks: Vec::new(),
         },
         &LmOptions::default(),
     )?;
-    let pose = pose_of(&lm.params.global);
+    let pose = pose_from_params(&lm.params.global);
     let rms = (2.0 * lm.cost / n as f64).sqrt();
     Ok((pose, rms))
-}
-
-fn pose_of(p: &[f64]) -> Pose {
-    Pose::from_parts(
-        Translation3::new(p[3], p[4], p[5]),
-        rotation_from_rotvec(&Vector3::new(p[0], p[1], p[2])),
-    )
-}
-
-fn params_of(p: &Pose) -> Vec<f64> {
-    let r = rotvec_from_rotation(&p.rotation);
-    let t = p.translation.vector;
-    vec![r.x, r.y, r.z, t.x, t.y, t.z]
 }
 
 struct PoseProblem<'a> {
@@ -101,7 +88,7 @@ impl BlockProblem for PoseProblem<'_> {
         params: &BlockParams,
         jacobians: bool,
     ) -> Result<Vec<ResidualBlock>> {
-        let pose = pose_of(&params.global);
+        let pose = pose_from_params(&params.global);
         let r = pose.rotation.to_rotation_matrix().into_inner();
         let mut out = Vec::with_capacity(self.view.object_points.len());
         for (p, obs) in self.view.object_points.iter().zip(&self.view.image_points) {
@@ -132,7 +119,7 @@ impl BlockProblem for PoseProblem<'_> {
             rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2])),
         );
         BlockParams {
-            global: params_of(&(pose_of(&params.global) * delta)),
+            global: params_from_pose(&(pose_from_params(&params.global) * delta)).to_vec(),
             blocks: Vec::new(),
         }
     }

@@ -19,10 +19,10 @@
 use super::{Chain, Pose, Setup};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::geometry::{rotation_from_rotvec, rotvec_from_rotation};
+use crate::geometry::{params_from_pose, pose_from_params, rotvec_from_rotation};
 use crate::handeye::math::skew;
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix3, Point2, Point3, Translation3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Point2, Point3};
 use serde::{Deserialize, Serialize};
 
 /// Target points and their detections in one view.
@@ -105,25 +105,8 @@ pub struct RefineResult {
     pub x_std: Option<[f64; 6]>,
 }
 
-fn pose_of(p: &[f64]) -> Pose {
-    Pose::from_parts(
-        Translation3::new(p[3], p[4], p[5]),
-        rotation_from_rotvec(&Vector3::new(p[0], p[1], p[2])),
-    )
-}
-
-fn params_of(p: &Pose) -> Vec<f64> {
-    let r = rotvec_from_rotation(&p.rotation);
-    let t = p.translation.vector;
-    vec![r.x, r.y, r.z, t.x, t.y, t.z]
-}
-
 fn perturb(p: &[f64], d: &[f64]) -> Vec<f64> {
-    let step = Pose::from_parts(
-        Translation3::new(d[3], d[4], d[5]),
-        rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2])),
-    );
-    params_of(&(pose_of(p) * step))
+    params_from_pose(&(pose_from_params(p) * pose_from_params(d))).to_vec()
 }
 
 struct Problem<'a> {
@@ -146,7 +129,7 @@ impl Problem<'_> {
 
     fn robot_at(&self, params: &BlockParams, i: usize) -> Pose {
         match self.prior {
-            Some(_) => pose_of(&params.blocks[i]),
+            Some(_) => pose_from_params(&params.blocks[i]),
             None => self.chain_robot[i],
         }
     }
@@ -159,7 +142,7 @@ impl BlockProblem for Problem<'_> {
         jac: bool,
     ) -> Result<Vec<ResidualBlock>> {
         let g = &params.global;
-        let (x, y) = (pose_of(&g[0..6]), pose_of(&g[6..12]));
+        let (x, y) = (pose_from_params(&g[0..6]), pose_from_params(&g[6..12]));
         let camera = self.camera_at(g)?;
         let n_global = g.len();
         let mut out = Vec::new();
@@ -277,8 +260,8 @@ pub fn refine(
     } else {
         *y0
     };
-    let mut global = params_of(x0);
-    global.extend(params_of(&y_start));
+    let mut global = params_from_pose(x0).to_vec();
+    global.extend(params_from_pose(&y_start).to_vec());
     if options.intrinsics {
         global.extend(camera.params());
     }
@@ -304,7 +287,11 @@ pub fn refine(
     let mut params = BlockParams {
         global,
         blocks: match prior {
-            Some(_) => chain.robot.iter().map(params_of).collect(),
+            Some(_) => chain
+                .robot
+                .iter()
+                .map(|p| params_from_pose(p).to_vec())
+                .collect(),
             None => Vec::new(),
         },
     };
@@ -333,10 +320,10 @@ pub fn refine(
         result = Some((lm, problem.camera_at(&params.global)?));
     }
     let (lm, camera_out) = result.ok_or_else(|| Error::invalid("refine", "no round ran"))?;
-    let x = pose_of(&params.global[0..6]);
-    let y = pose_of(&params.global[6..12]);
+    let x = pose_from_params(&params.global[0..6]);
+    let y = pose_from_params(&params.global[6..12]);
     let robots: Vec<Pose> = match prior {
-        Some(_) => params.blocks.iter().map(|b| pose_of(b)).collect(),
+        Some(_) => params.blocks.iter().map(|b| pose_from_params(b)).collect(),
         None => chain.robot.clone(),
     };
     let mut per_view = Vec::new();
@@ -379,7 +366,7 @@ pub fn refine(
 fn estimate_noise(robot0: &[Pose], blocks: &[Vec<f64>]) -> (f64, f64) {
     let (mut sr, mut st) = (0.0, 0.0);
     for (r0, b) in robot0.iter().zip(blocks) {
-        let d = r0.inverse() * pose_of(b);
+        let d = r0.inverse() * pose_from_params(b);
         sr += rotvec_from_rotation(&d.rotation).norm_squared();
         st += d.translation.vector.norm_squared();
     }

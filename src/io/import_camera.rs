@@ -221,15 +221,18 @@ fn size_from(w: Option<String>, h: Option<String>) -> Result<(u32, u32)> {
     Ok((parse(w, "image_width")?, parse(h, "image_height")?))
 }
 
+/// The camera matrix's numbers, when the file had exactly 9 of them.
+fn nine_numbers(k: Option<Vec<f64>>) -> Result<Vec<f64>> {
+    k.filter(|k| k.len() == 9).ok_or_else(|| {
+        Error::invalid(
+            "camera_matrix",
+            "no 3x3 camera_matrix with 9 numbers in the file",
+        )
+    })
+}
+
 fn from_yaml(text: &str, ros: bool) -> Result<Camera> {
-    let k = yaml_data(text, &K_NAMES)
-        .filter(|k| k.len() == 9)
-        .ok_or_else(|| {
-            Error::invalid(
-                "camera_matrix",
-                "no 3x3 camera_matrix with 9 numbers in the file",
-            )
-        })?;
+    let k = nine_numbers(yaml_data(text, &K_NAMES))?;
     let d = yaml_data(text, &D_NAMES).unwrap_or_default();
     let (width, height) = size_from(
         yaml_scalar(text, "image_width"),
@@ -266,15 +269,7 @@ fn from_xml(text: &str) -> Result<Camera> {
                 })
             })
     };
-    let k = matrix(&K_NAMES)
-        .flatten()
-        .filter(|k| k.len() == 9)
-        .ok_or_else(|| {
-            Error::invalid(
-                "camera_matrix",
-                "no 3x3 camera_matrix with 9 numbers in the file",
-            )
-        })?;
+    let k = nine_numbers(matrix(&K_NAMES).flatten())?;
     let d = matrix(&D_NAMES).flatten().unwrap_or_default();
     let get = |n: &str| xml_element(text, n).map(|s| s.trim().to_string());
     let (width, height) = size_from(get("image_width"), get("image_height"))?;
