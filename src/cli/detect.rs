@@ -117,6 +117,30 @@ fn parse_target(args: &Args) -> Result<Target, CliError> {
     Target::parse_spec(text).map_err(|e| CliError::usage("detect", e.to_string()))
 }
 
+/// Columns of the terminal progress line.
+const PROGRESS_WIDTH: usize = 79;
+
+/// `robocal [#########...........]  9/20 left09.jpg`, at most
+/// [`PROGRESS_WIDTH`] columns, the file name cut from the left when long.
+fn progress_bar(done: usize, total: usize, file: &str) -> String {
+    const BAR: usize = 24;
+    let filled = if total == 0 { BAR } else { done * BAR / total };
+    let count = format!("{done:>w$}/{total}", w = total.to_string().len());
+    let head = format!(
+        "robocal [{}{}] {count} ",
+        "#".repeat(filled),
+        ".".repeat(BAR - filled)
+    );
+    let room = PROGRESS_WIDTH.saturating_sub(head.chars().count());
+    let name: Vec<char> = file.chars().collect();
+    let shown: String = if name.len() > room {
+        name[name.len() - room..].iter().collect()
+    } else {
+        file.to_string()
+    };
+    format!("{head}{shown:<room$}")
+}
+
 /// Detect in every file with `threads` workers pulling from a shared index.
 pub(super) fn run_all(
     files: &[String],
@@ -139,7 +163,7 @@ pub(super) fn run_all(
                         mine.push((i, one(file, target, options)));
                         let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
                         if progress {
-                            eprint!("\rrobocal: {finished}/{} images", files.len());
+                            eprint!("\r{}", progress_bar(finished, files.len(), file));
                         }
                     }
                     mine
@@ -152,7 +176,8 @@ pub(super) fn run_all(
             .collect()
     });
     if progress {
-        eprintln!();
+        // Clear the bar: the summary that follows starts on a clean line.
+        eprint!("\r{:width$}\r", "", width = PROGRESS_WIDTH);
     }
     results.sort_by_key(|r| r.0);
     // A worker that panicked leaves holes: report them rather than lose them.
@@ -186,5 +211,22 @@ fn one(file: &str, target: &Target, options: &DetectOptions) -> Outcome {
     match detect(&image, target, options) {
         Ok(d) => Outcome::Found(d, start.elapsed().as_secs_f64()),
         Err(e) => Outcome::Failed(e.kind().into(), e.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn progress_bar_fills_in_proportion_and_keeps_its_width() {
+        let line = progress_bar(5, 20, "left05.jpg");
+        assert!(line.starts_with("robocal [######..................]  5/20 left05.jpg"));
+        assert_eq!(line.chars().count(), PROGRESS_WIDTH);
+        let long = format!("/data/{}/view.png", "x".repeat(100));
+        let line = progress_bar(20, 20, &long);
+        assert!(line.starts_with("robocal [########################] 20/20 "));
+        assert!(line.ends_with("xx/view.png"));
+        assert_eq!(line.chars().count(), PROGRESS_WIDTH);
     }
 }
