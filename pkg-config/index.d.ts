@@ -14,3 +14,57 @@ export interface ImageInfo {
   channels: number;
   bits_per_channel: number;
 }
+
+/** A rigid transform as the reports write it: `p_a = a_from_b * p_b`, metres. */
+export interface PoseReport {
+  matrix_row_major: number[][];
+  translation_m: [number, number, number];
+  /** Unit quaternion, component order x, y, z, w. */
+  quaternion_xyzw: [number, number, number, number];
+}
+
+/** One view of a calibration input: a `detect_target` detection, or explicit correspondences. */
+export type CalibrationView =
+  | { name: string; detection: object }
+  | { name: string; object_m: [number, number, number][]; image_px: [number, number][] };
+
+/** The options object of `calibrate_camera` and `calibrate_stereo`. */
+export interface CalibrationOptions {
+  fix_principal_point?: boolean;
+  fix_aspect_ratio?: boolean;
+  /** Default true. */
+  zero_skew?: boolean;
+  /** Huber loss (1 px) and rejection beyond 3 robust sigmas. */
+  robust?: boolean;
+  fixed_coefficients?: string[];
+}
+
+/** The input JSON of `calibrate_stereo`: `left[i]` and `right[i]` saw the same board pose. */
+export interface StereoInput {
+  /** brown (default), radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none. */
+  model?: string;
+  options?: CalibrationOptions;
+  left: CalibrationView[];
+  right: CalibrationView[];
+  /** Optional when the views are detections. */
+  left_image_size_px?: [number, number];
+  right_image_size_px?: [number, number];
+}
+
+/** The output JSON of `calibrate_stereo` (the report `robocal stereo` writes). */
+export interface StereoCalibration {
+  /** Camera calibration reports (as `calibrate_camera`'s `report`). */
+  left: object;
+  right: object;
+  /** `p_right = right_from_left * p_left`. */
+  right_from_left: PoseReport;
+  initial_right_from_left: PoseReport;
+  /** Distance between the camera centres, metres. */
+  baseline_m: number;
+  /** Standard deviations (rotation: small-angle vector); null when singular. */
+  right_from_left_std: { rotation_rad: [number, number, number]; translation_m: [number, number, number] } | null;
+  /** RMS reprojection error over every point of both cameras, px. */
+  rms_px: number;
+  iterations: number;
+  termination: string;
+}

@@ -334,3 +334,36 @@ pub fn render_demo(seed: u32) -> Result<DemoData, JsError> {
 pub fn calibrate_camera(input_json: &str) -> Result<String, JsError> {
     crate::calib::json_api::calibrate_json(input_json).map_err(js_error)
 }
+
+/// Calibrate a stereo pair: the JSON input and output of
+/// `robocal::calib::stereo_json::calibrate_stereo_json` (`left` and `right`
+/// views paired by index; returns `left`, `right`, `right_from_left`,
+/// `baseline_m`, `rms_px`, ...).
+#[wasm_bindgen]
+pub fn calibrate_stereo(input_json: &str) -> Result<String, JsError> {
+    crate::calib::stereo_json::calibrate_stereo_json(input_json).map_err(js_error)
+}
+
+/// An undistorted preview of image bytes taken by `camera_json` (the
+/// `camera` object of a calibration report): resampled through the same
+/// camera without distortion, longer side at most `max_side` px. `info_json`
+/// is `{"width", "height"}` of the preview.
+#[wasm_bindgen]
+pub fn undistort_preview(
+    bytes: &[u8],
+    camera_json: &str,
+    max_side: u32,
+) -> Result<ImagePreview, JsError> {
+    let camera: crate::camera::Camera = serde_json::from_str(camera_json)
+        .map_err(|e| JsError::new(&format!("camera JSON: {e}")))?;
+    let image = crate::image::decode_gray(bytes).map_err(js_error)?;
+    let preview = camera.pinhole_preview(max_side).map_err(js_error)?;
+    let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
+    let rgba = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();
+    Ok(ImagePreview {
+        info_json: serde_json::json!({ "width": out.width, "height": out.height }).to_string(),
+        rgba,
+        width: out.width,
+        height: out.height,
+    })
+}

@@ -10,6 +10,7 @@ import { CameraView } from './views/camera.js';
 import { RobotView } from './views/robot.js';
 import { HandEyeView } from './views/handeye.js';
 import { WorkflowsView } from './views/workflows.js';
+import { StereoView } from './views/stereo.js';
 import { ExportView } from './views/export.js';
 import { ShareView, sharedFragment, decodeShare } from './views/share.js';
 
@@ -45,9 +46,21 @@ async function engineVersion() {
   }
 }
 
+/**
+ * The service worker (sw.js) that keeps the app usable offline. Its cache is
+ * named after the engine's crate version, so a new build replaces it.
+ */
+function registerOffline(version) {
+  if (!('serviceWorker' in navigator) || version === 'unknown') return;
+  navigator.serviceWorker.register(`./sw.js?v=${encodeURIComponent(version)}`).catch((err) => {
+    $('version').textContent += ` · offline use unavailable: ${err.message}`;
+  });
+}
+
 /** A shared link: results only, in memory (never written over the user's own session). */
 async function openShared(fragment) {
   const version = await engineVersion();
+  registerOffline(version);
   let payload;
   try {
     payload = await decodeShare(fragment);
@@ -86,8 +99,11 @@ async function main() {
   robotView = robot;
   new HandEyeView(store, engine, robot);
   new WorkflowsView(store, engine);
+  const stereo = new StereoView(store, engine);
   new ExportView(store, engine);
-  new ShareView(store, await versionPromise, () => camera.plots || []);
+  const version = await versionPromise;
+  registerOffline(version);
+  new ShareView(store, version, () => camera.plots || []);
   store.onChange((what) => { if (/detections|included|images|all/.test(what)) camera.summarise(); });
   $('new-session').addEventListener('click', async () => {
     if (store.session.images.length && !confirm('Start a new session? Images, detections and results of this session are removed from this browser.')) return;
@@ -95,6 +111,9 @@ async function main() {
     await images.restore();
     store.changed('target-loaded');
     camera.render();
+    stereo.left = [];
+    stereo.right = [];
+    stereo.render();
   });
   $('demo-button').addEventListener('click', async () => {
     $('demo-button').disabled = true;

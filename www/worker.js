@@ -84,6 +84,21 @@ handlers.conventions = async ({ input }) => {
   return JSON.parse(robocal.rank_pose_conventions(input));
 };
 
+handlers.undistort = async ({ bytes, camera, maxSide }) => {
+  await ready;
+  requireFn('undistort_preview');
+  const p = robocal.undistort_preview(new Uint8Array(bytes), camera, maxSide);
+  const reply = { width: p.width, height: p.height, rgba: p.rgba.buffer };
+  p.free();
+  return { value: reply, transfer: [reply.rgba] };
+};
+
+handlers.stereo = async ({ input }) => {
+  await ready;
+  requireFn('calibrate_stereo');
+  return JSON.parse(robocal.calibrate_stereo(input));
+};
+
 function requireFn(name) {
   if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
 }

@@ -3,7 +3,8 @@
 //! over intrinsics, distortion and every view pose ([`calibrate`]), with a
 //! report that carries residuals, uncertainties and warnings.
 //!
-//! Two cameras with shared views: [`stereo`] (right_from_left, seed 000).
+//! Two cameras with shared views: [`stereo`] (right_from_left, seed 000),
+//! with its JSON boundary in [`stereo_json`].
 //!
 //! From 3-D/2-D point pairs of a non-planar target (seed 002):
 //! - [`dlt`]: the 12-parameter projection matrix, decomposed into K, R, t;
@@ -24,6 +25,7 @@ mod refine;
 mod report;
 mod residuals;
 pub mod stereo;
+pub mod stereo_json;
 mod stereo_problem;
 #[cfg(test)]
 mod stereo_tests;

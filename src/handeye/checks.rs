@@ -86,11 +86,23 @@ pub struct CandidateScore {
     pub consistency: Option<Consistency>,
 }
 
+/// Rotation fits within this factor of the best one (plus
+/// [`ROTATION_TIE_DEG`]) are ties, decided by the translation fit.
+pub const ROTATION_TIE_FACTOR: f64 = 2.0;
+/// Absolute part of the rotation tie band, degrees.
+pub const ROTATION_TIE_DEG: f64 = 0.05;
+
 /// Rank candidate parses of the robot poses (e.g. the rotation conventions a
 /// pose parser could not tell apart) by how well each fits the camera
 /// motion, best first. Rotation angles of robot and camera motions must match
 /// whatever the hand-eye transform is, so a wrong convention shows up as a
-/// large rotation residual.
+/// large rotation residual. Some wrong conventions are a fixed rotation
+/// `P` away from the right one (Euler orders that permute the axes: `R' =
+/// P R P^T`); their motions fit the rotations equally well (with `P X` as
+/// the hand-eye rotation) but not the translations, which are read the same.
+/// So candidates whose rotation RMS is within the tie band of the best
+/// ([`ROTATION_TIE_FACTOR`] times it plus [`ROTATION_TIE_DEG`]) come first,
+/// ordered by translation RMS; the others follow by rotation RMS.
 pub fn rank_pose_candidates(
     setup: Setup,
     candidates: &[(String, Vec<Pose>)],
@@ -103,13 +115,21 @@ pub fn rank_pose_candidates(
             consistency: consistency(setup, poses, camera_from_target).ok(),
         })
         .collect();
-    let key = |c: &CandidateScore| {
-        c.consistency
-            .as_ref()
-            .map(|k| k.rotation_rms_deg)
-            .unwrap_or(f64::INFINITY)
+    let best_rotation = scores
+        .iter()
+        .filter_map(|c| c.consistency.as_ref().map(|k| k.rotation_rms_deg))
+        .fold(f64::INFINITY, f64::min);
+    let band = ROTATION_TIE_FACTOR * best_rotation + ROTATION_TIE_DEG;
+    // (tier, value): 0 = rotation tie, by translation; 1 = by rotation; 2 = unscored.
+    let key = |c: &CandidateScore| match &c.consistency {
+        Some(k) if k.rotation_rms_deg <= band => (0, k.translation_rms_mm),
+        Some(k) => (1, k.rotation_rms_deg),
+        None => (2, f64::INFINITY),
     };
-    scores.sort_by(|a, b| key(a).total_cmp(&key(b)));
+    scores.sort_by(|a, b| {
+        let (ka, kb) = (key(a), key(b));
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+    });
     scores
 }
 
@@ -120,14 +140,16 @@ pub fn recommend_candidate(scores: &[CandidateScore]) -> Option<String> {
     let runner = scores.get(1).and_then(|s| {
         s.consistency
             .as_ref()
-            .map(|k| (s.name.as_str(), k.rotation_rms_deg))
+            .map(|k| (s.name.as_str(), k.rotation_rms_deg, k.translation_rms_mm))
     });
     let mut msg = format!(
         "pose format '{}' fits the camera motion best (rotation RMS {:.3} deg, translation RMS {:.2} mm)",
         best.name, c.rotation_rms_deg, c.translation_rms_mm
     );
-    if let Some((name, r)) = runner {
-        msg.push_str(&format!("; next best '{name}' has rotation RMS {r:.3} deg"));
+    if let Some((name, r, t)) = runner {
+        msg.push_str(&format!(
+            "; next best '{name}' has rotation RMS {r:.3} deg, translation RMS {t:.2} mm"
+        ));
     }
     Some(msg)
 }

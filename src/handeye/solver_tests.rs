@@ -300,6 +300,58 @@ fn candidate_conventions_are_ranked_against_the_camera_motion() {
 }
 
 #[wasm_bindgen_test(unsupported = test)]
+fn conventions_that_only_permute_axes_are_told_apart_by_the_translations() {
+    // Reading KUKA A B C as another Euler order whose axes are a cyclic
+    // permutation P of z y x gives rotations P R P^T: the rotation fit is
+    // as good as the right one's (with P X as the hand-eye rotation), only
+    // the translations (read unchanged) betray it.
+    let scene = handeye_scene(&HandEyeSceneConfig::opencv_noise(Setup::EyeInHand, 10), 9);
+    let p = nalgebra::UnitQuaternion::from_rotation_matrix(
+        &nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::new(
+            0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+        )),
+    );
+    let permuted: Vec<Pose> = scene
+        .base_from_gripper
+        .iter()
+        .map(|q| Pose::from_parts(q.translation, p * q.rotation * p.inverse()))
+        .collect();
+    let ranked = super::checks::rank_pose_candidates(
+        Setup::EyeInHand,
+        &[
+            ("permuted".to_string(), permuted),
+            ("right".to_string(), scene.base_from_gripper.clone()),
+        ],
+        &scene.camera_from_target,
+    );
+    let c: Vec<_> = ranked
+        .iter()
+        .map(|r| r.consistency.clone().unwrap())
+        .collect();
+    assert_eq!(ranked[0].name, "right");
+    // Equal rotation fits (conjugation preserves motion angles exactly)...
+    assert!(
+        (c[0].rotation_rms_deg - c[1].rotation_rms_deg).abs() < 1e-9,
+        "{c:?}"
+    );
+    // ...but the translations: OpenCV-style noise leaves the right reading a
+    // few mm, the permuted one is off by the lever arms (tens of mm).
+    assert!(
+        c[1].translation_rms_mm > 5.0 * c[0].translation_rms_mm,
+        "{c:?}"
+    );
+    let msg = super::checks::recommend_candidate(&ranked).unwrap();
+    assert!(
+        msg.starts_with("pose format 'right' fits the camera motion best"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("; next best 'permuted' has rotation RMS"),
+        "{msg}"
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
 fn joint_linear_solvers_beat_rotation_only_ones_on_noisy_data() {
     // Andreff and Li solve rotation and translation rows in one least
     // squares, so the translations add information to the rotation: over

@@ -1,7 +1,11 @@
-// Runs every browser test suite; exits non-zero on any failure.
+// Runs every browser test suite (or the ones named on the command line:
+// `node tests/e2e/run.mjs datasets offline`); exits non-zero on any failure.
 import { run } from './harness.mjs';
 
-const suites = ['foundation', 'workflows', 'flow'];
+const all = ['foundation', 'workflows', 'flow', 'pages', 'datasets', 'offline'];
+const wanted = process.argv.slice(2);
+for (const w of wanted) if (!all.includes(w)) throw new Error(`unknown suite '${w}' (known: ${all.join(', ')})`);
+const suites = wanted.length ? wanted : all;
 let failed = 0;
 for (const suite of suites) {
   const { tests } = await import(`./${suite}.mjs`);

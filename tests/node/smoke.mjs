@@ -46,7 +46,13 @@ assert.ok(report.rms_px < 0.2, 'rms ' + report.rms_px);
 const yaml = robocal.export_report(JSON.stringify(report), 'opencv-yaml', '');
 assert.ok(yaml.startsWith('%YAML:1.0'), yaml.slice(0, 40));
 assert.match(yaml, /camera_matrix: !!opencv-matrix/);
-console.log('esm ok (demo calibrated: fx ' + report.camera_matrix[0][0].toFixed(3) + ' px, rms ' + report.rms_px.toFixed(4) + ' px)');
+// Stereo through the JSON API: the same views on both sides are a pair with
+// right_from_left = identity (baseline 0 to solver precision).
+const stereo = JSON.parse(robocal.calibrate_stereo(JSON.stringify({ left: views, right: views })));
+assert.ok(stereo.baseline_m < 1e-6, 'baseline ' + stereo.baseline_m);
+assert.ok(Math.abs(stereo.right_from_left.quaternion_xyzw[3]) > 1 - 1e-9, 'rotation ' + stereo.right_from_left.quaternion_xyzw);
+assert.throws(() => robocal.calibrate_stereo(JSON.stringify({ left: views, right: views.slice(1) })), { message: 'right: views are paired by order: 12 left views but 11 right views' });
+console.log('esm ok (demo calibrated: fx calibrated: fx ' + report.camera_matrix[0][0].toFixed(3) + ' px, rms ' + report.rms_px.toFixed(4) + ' px)');
 `;
 const cjs = `
 const assert = require('node:assert/strict');

@@ -28,6 +28,14 @@ const OPTIONS = [
   ['robust', 'Robust loss with outlier rejection'],
 ];
 
+const UNDISTORT_SIDE = 480;
+
+function putPixels(canvas, p) {
+  canvas.width = p.width;
+  canvas.height = p.height;
+  canvas.getContext('2d').putImageData(new ImageData(new Uint8ClampedArray(p.rgba), p.width, p.height), 0, 0);
+}
+
 export class CameraView {
   constructor(store, engine, images, { readonly = false } = {}) {
     this.store = store;
@@ -137,8 +145,52 @@ export class CameraView {
       warnings,
       h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat)),
       h('div', { class: 'plots' }, vec, unc, dist),
+      this.undistortSection(r),
       comparison ? this.comparisonTable(comparison) : null,
       r.correlation && r.correlation.matrix ? this.correlationNote(r.correlation) : null);
+  }
+
+  /** Pick an image and see it as taken and undistorted (the core resamples it in the worker). */
+  undistortSection(r) {
+    if (this.readonly || !r.camera) return null;
+    const imgs = this.store.session.images.filter((i) => i.info && this.store.bytes.has(i.id));
+    if (!imgs.length) return null;
+    const pick = h('select', { id: 'undistort-image' }, imgs.map((i) => h('option', { value: i.id }, i.name)));
+    const status = h('p', { class: 'hint', id: 'undistort-status', 'aria-live': 'polite' });
+    const before = h('canvas', { id: 'undistort-before', width: 4, height: 3, role: 'img', 'aria-label': 'the chosen image as taken' });
+    const after = h('canvas', { id: 'undistort-after', width: 4, height: 3, role: 'img', 'aria-label': 'the chosen image undistorted' });
+    const button = h('button', { type: 'button', id: 'undistort-show' }, 'Show undistorted');
+    button.addEventListener('click', () => this.undistort(r, pick.value, { before, after, status, button }));
+    return h('section', { class: 'undistort', 'aria-labelledby': 'undistort-title' },
+      h('h3', { id: 'undistort-title' }, 'Undistorted preview'),
+      h('div', { class: 'row' }, h('label', {}, 'Image ', pick), button),
+      status,
+      h('div', { class: 'plots' },
+        h('figure', {}, before, h('figcaption', {}, 'As taken')),
+        h('figure', {}, after, h('figcaption', {}, 'Undistorted: the same camera matrix without lens distortion (straight lines look straight)'))));
+  }
+
+  async undistort(r, id, { before, after, status, button }) {
+    const img = this.store.session.images.find((i) => i.id === id);
+    const bytes = img && this.store.bytes.get(id);
+    if (!bytes) return;
+    button.disabled = true;
+    status.textContent = `Undistorting ${img.name}…`;
+    try {
+      const a = bytes.slice(0);
+      const b = bytes.slice(0);
+      const [orig, und] = await Promise.all([
+        this.engine.call('preview', { bytes: a, maxSide: UNDISTORT_SIDE }, [a]),
+        this.engine.call('undistort', { bytes: b, camera: JSON.stringify(r.camera), maxSide: UNDISTORT_SIDE }, [b]),
+      ]);
+      putPixels(before, orig);
+      putPixels(after, und);
+      status.textContent = `${img.name}: undistorted at ${und.width}×${und.height} px (preview).`;
+    } catch (err) {
+      status.textContent = `${img.name}: ${err.message}`;
+    } finally {
+      button.disabled = false;
+    }
   }
 
   comparisonTable(methods) {

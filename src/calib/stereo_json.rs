@@ -1,0 +1,241 @@
+//! The JSON boundary of stereo calibration: the wasm function
+//! `calibrate_stereo` (same solver as `robocal stereo`).
+//!
+//! Input:
+//!
+//! ```json
+//! {"model": "brown",
+//!  "options": {"fix_principal_point": false, "fix_aspect_ratio": false,
+//!              "zero_skew": true, "robust": false, "fixed_coefficients": []},
+//!  "left":  [{"name": "left01.jpg",  "detection": {...}}, ...],
+//!  "right": [{"name": "right01.jpg", "detection": {...}}, ...],
+//!  "left_image_size_px": [640, 480], "right_image_size_px": [640, 480]}
+//! ```
+//!
+//! `left[i]` and `right[i]` are one pair (the same board pose seen by both
+//! cameras): the caller pairs the images (by order or by name) and leaves out
+//! pairs where either image has no detection. Views are detections or
+//! explicit correspondences, as in [`super::json_api`]; the image sizes may
+//! be left out when the views are detections (which must then agree). The
+//! options apply to both cameras, with the meaning of [`super::json_api`]'s.
+//!
+//! Output: the [`StereoCalibration`] JSON (`left`, `right`,
+//! `right_from_left`, `initial_right_from_left`, `baseline_m`,
+//! `right_from_left_std`, `rms_px`, ...), the report `robocal stereo` writes.
+
+use super::json_api::{calibration_options, views_of, JsonOptions, JsonView, MIN_VIEWS};
+use super::stereo::{calibrate_stereo, StereoCalibration};
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// The whole input of [`calibrate_stereo_json`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StereoInput {
+    /// Lens model name of both cameras (default `brown`).
+    #[serde(default = "default_model")]
+    pub model: String,
+    /// Options of both cameras.
+    #[serde(default)]
+    pub options: JsonOptions,
+    /// The left camera's views, `left[i]` paired with `right[i]`.
+    pub left: Vec<JsonView>,
+    /// The right camera's views.
+    pub right: Vec<JsonView>,
+    /// Left image width and height, px; optional for detections.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub left_image_size_px: Option<[u32; 2]>,
+    /// Right image width and height, px; optional for detections.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub right_image_size_px: Option<[u32; 2]>,
+}
+
+fn default_model() -> String {
+    "brown".into()
+}
+
+/// Calibrate a stereo pair from the JSON input described in the module
+/// docs; returns the [`StereoCalibration`] JSON.
+pub fn calibrate_stereo_json(input_json: &str) -> Result<String> {
+    let input: StereoInput = serde_json::from_str(input_json)
+        .map_err(|e| Error::parse(e.line(), e.column(), format!("stereo input: {e}")))?;
+    let report = calibrate_stereo_input(&input)?;
+    serde_json::to_string(&report)
+        .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
+}
+
+/// [`calibrate_stereo_json`] on the parsed input.
+pub fn calibrate_stereo_input(input: &StereoInput) -> Result<StereoCalibration> {
+    if input.left.len() != input.right.len() {
+        return Err(Error::invalid(
+            "right",
+            format!(
+                "views are paired by order: {} left views but {} right views",
+                input.left.len(),
+                input.right.len()
+            ),
+        ));
+    }
+    if input.left.len() < MIN_VIEWS {
+        return Err(Error::too_few("pairs", MIN_VIEWS, input.left.len()));
+    }
+    let left_size = side_size("left", &input.left, input.left_image_size_px)?;
+    let right_size = side_size("right", &input.right, input.right_image_size_px)?;
+    let left = views_of(&input.left).map_err(|e| within("left", e))?;
+    let right = views_of(&input.right).map_err(|e| within("right", e))?;
+    let options = calibration_options(&input.model, &input.options)?;
+    calibrate_stereo(&left, &right, left_size, right_size, &options)
+}
+
+/// Field names of a view error point into the side it came from
+/// (`views[2].image_px` becomes `left[2].image_px`).
+fn within(side: &str, e: Error) -> Error {
+    match e {
+        Error::Invalid { field, message } => Error::Invalid {
+            field: field.replacen("views", side, 1),
+            message,
+        },
+        other => other,
+    }
+}
+
+/// One camera's image size: given, or the one all its detections agree on.
+fn side_size(side: &str, views: &[JsonView], given: Option<[u32; 2]>) -> Result<(u32, u32)> {
+    let field = format!("{side}_image_size_px");
+    let mut sizes = views
+        .iter()
+        .filter_map(|v| v.detection.as_ref().map(|d| (v, d.image_size_px)));
+    let first = match given {
+        Some(size) => size,
+        None => match sizes.next() {
+            Some((_, size)) => size,
+            None => {
+                return Err(Error::invalid(
+                    field,
+                    "required when the views are not detections",
+                ))
+            }
+        },
+    };
+    if let Some((v, s)) = sizes.find(|(_, s)| *s != first) {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "{}x{} and {}x{} ({}): all images of one camera must have one size",
+                first[0], first[1], s[0], s[1], v.name
+            ),
+        ));
+    }
+    Ok((first[0], first[1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::geometry::{pose_from_matrix4, rotation_from_rotvec, Pose};
+    use crate::synth::Scene;
+    use nalgebra::{Matrix4, Translation3, Vector3};
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    /// Noise-free pair: the left views of a seeded scene and the same board
+    /// poses seen by a right camera with other intrinsics, 6 cm to the left.
+    fn pair_input() -> (StereoInput, Camera, Pose) {
+        let left_camera = Camera::example_brown();
+        let scene = Scene::calibration(3, &left_camera, (9, 6), 0.03, 6, 0.0).expect("scene");
+        let right_camera = Camera {
+            fx: left_camera.fx * 1.02,
+            cx: left_camera.cx + 7.0,
+            ..left_camera.clone()
+        };
+        let right_from_left = Pose::from_parts(
+            Translation3::new(-0.06, 0.002, -0.001),
+            rotation_from_rotvec(&Vector3::new(0.01, -0.04, 0.015)),
+        );
+        let view =
+            |name: String, object: &[nalgebra::Point3<f64>], image: Vec<[f64; 2]>| JsonView {
+                name,
+                detection: None,
+                object_m: Some(object.iter().map(|p| [p.x, p.y, p.z]).collect()),
+                image_px: Some(image),
+            };
+        let mut left = vec![];
+        let mut right = vec![];
+        for (v, pose) in scene.views.iter().zip(&scene.camera_from_target) {
+            let l = v.image_px.iter().map(|p| [p.x, p.y]).collect();
+            let r = v
+                .object_m
+                .iter()
+                .map(|p| {
+                    let px = right_camera
+                        .project(&(right_from_left * pose * p))
+                        .expect("in front");
+                    [px.x, px.y]
+                })
+                .collect();
+            left.push(view(format!("l_{}", v.name), &v.object_m, l));
+            right.push(view(format!("r_{}", v.name), &v.object_m, r));
+        }
+        let size = Some([left_camera.width, left_camera.height]);
+        let input = StereoInput {
+            model: "brown".into(),
+            options: JsonOptions::default(),
+            left,
+            right,
+            left_image_size_px: size,
+            right_image_size_px: size,
+        };
+        (input, right_camera, right_from_left)
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn json_round_trip_recovers_the_true_pair() {
+        let (input, right_camera, truth) = pair_input();
+        let text = serde_json::to_string(&input).expect("serialise");
+        let out: StereoCalibration =
+            serde_json::from_str(&calibrate_stereo_json(&text).expect("solve")).expect("parse");
+        // Noise-free correspondences: the optimum is the truth to solver precision.
+        let m = out.right_from_left.matrix_row_major;
+        let got = pose_from_matrix4(&Matrix4::from_fn(|r, c| m[r][c])).expect("pose");
+        assert!((got.translation.vector - truth.translation.vector).norm() < 1e-9);
+        assert!(got.rotation.angle_to(&truth.rotation) < 1e-9);
+        assert!((out.baseline_m - truth.inverse().translation.vector.norm()).abs() < 1e-9);
+        assert!((out.right.camera.fx - right_camera.fx).abs() < 1e-6);
+        assert!((out.right.camera.cx - right_camera.cx).abs() < 1e-6);
+        assert!(out.rms_px < 1e-6, "rms {}", out.rms_px);
+        assert_eq!(out.left.views[0].name, "l_view_000");
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn bad_inputs_get_plain_messages() {
+        let (mut input, _, _) = pair_input();
+        input.right.pop();
+        assert_eq!(
+            calibrate_stereo_input(&input).unwrap_err().to_string(),
+            "right: views are paired by order: 6 left views but 5 right views"
+        );
+        let (mut input, _, _) = pair_input();
+        input.left.truncate(2);
+        input.right.truncate(2);
+        assert_eq!(
+            calibrate_stereo_input(&input).unwrap_err().to_string(),
+            "requires at least 3 pairs, got 2"
+        );
+        let (mut input, _, _) = pair_input();
+        input.right[1].image_px.as_mut().expect("points").pop();
+        assert_eq!(
+            calibrate_stereo_input(&input).unwrap_err().to_string(),
+            "right[1].image_px: 54 object points but 53 image points"
+        );
+        let (mut input, _, _) = pair_input();
+        input.left_image_size_px = None;
+        assert_eq!(
+            calibrate_stereo_input(&input).unwrap_err().to_string(),
+            "left_image_size_px: required when the views are not detections"
+        );
+        let err = calibrate_stereo_json("{\"left\": []}")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("stereo input: missing field `right`"), "{err}");
+    }
+}

@@ -1,0 +1,176 @@
+// The public data set (OpenCV's left01..left14.jpg, 9x6 chessboard, 30 mm
+// squares per its SOURCE.md) through the page: upload, detect, solve, and the
+// displayed numbers equal the CLI's for the same images (same Rust core, so
+// equal up to the page's display rounding). Plus a timing benchmark on 20
+// rendered 1280x960 images (printed, not a pass/fail timer).
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { existsSync, readdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { root } from './harness.mjs';
+
+const CLI = join(root, 'target/release/robocal');
+const SPEC = 'chessboard:9x6:30mm';
+
+/** ../shared/datasets beside the checkout (CI), else /work/shared/datasets; null when absent. */
+export function datasetDir(name) {
+  for (const base of [join(root, '..', 'shared', 'datasets'), '/work/shared/datasets']) {
+    const dir = join(base, name);
+    if (existsSync(dir)) return dir;
+  }
+  return null;
+}
+
+const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
+
+/** The value column of the row named `name` in a parameter table, as shown. */
+export const shownCell = (page, table, name) => page.$eval(`${table} tbody`, (tb, n) => {
+  const row = [...tb.rows].find((r) => r.cells[0].textContent === n);
+  return row ? row.cells[1].textContent : null;
+}, name);
+
+/**
+ * The page prints 6 decimals (num(x, 6)), or 6 significant digits in
+ * exponent form below 1e-4: the CLI's exact value must round to what is
+ * shown. 1e-9 relative on top covers wasm-vs-native libm differences in the
+ * last bits (the solver converges to the same optimum).
+ */
+export function assertShown(shown, exact, what, decimals = 6) {
+  assert.ok(shown !== null, `${what}: not shown`);
+  const x = Number(shown);
+  const rounding = /e/.test(shown) ? 0.5 * 10 ** (1 - decimals) * Math.abs(exact) : 0.5 * 10 ** -decimals;
+  const tol = rounding * 1.0001 + 1e-9 * Math.abs(exact);
+  assert.ok(Math.abs(x - exact) <= tol, `${what}: page ${shown}, CLI ${exact} (tolerance ${tol.toExponential(2)})`);
+}
+
+/** Upload files through the page's file input and wait until all are detected. */
+export async function uploadAndDetect(page, files, timeout = 300000) {
+  await page.setInputFiles('#file-input', files);
+  const n = files.length;
+  await page.waitForFunction((k) => document.getElementById('progress-text').textContent === `detected ${k} of ${k}`, n, { timeout });
+}
+
+async function setTarget(page, cols, rows, sizeMm) {
+  await page.click('a[data-step=target]');
+  await page.selectOption('#target-kind', 'chessboard');
+  await page.fill('input[name=cols]', String(cols));
+  await page.fill('input[name=rows]', String(rows));
+  await page.fill('input[name=size_mm]', String(sizeMm));
+  assert.match(await page.textContent('#target-spec'), new RegExp(`^Target spec: ${SPEC}`));
+}
+
+async function solveCamera(page) {
+  await page.click('a[data-step=camera]');
+  await page.click('#solve-camera');
+  await page.locator('#camera-params').waitFor({ timeout: 120000 });
+}
+
+const median = (xs) => [...xs].sort((a, b) => a - b)[Math.floor(xs.length / 2)];
+
+export const tests = [
+  ['OpenCV left images: page equals CLI', async (page, { url, shot }) => {
+    const dir = datasetDir('opencv-left-right-9x6');
+    if (!dir) { console.log('     skipped: opencv-left-right-9x6 not found in ../shared/datasets or /work/shared/datasets'); return; }
+    const files = readdirSync(dir).filter((f) => /^left\d+\.jpg$/.test(f)).sort().map((f) => join(dir, f));
+    assert.equal(files.length, 13);
+    const cli = JSON.parse(execFileSync(CLI, ['intrinsics', '--target', SPEC, ...files], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+    await page.goto(url);
+    await ready(page);
+    await setTarget(page, 9, 6, 30);
+    await page.click('a[data-step=images]');
+    await uploadAndDetect(page, files);
+    await shot('images');
+    assert.match(await page.textContent('#image-summary'), new RegExp(`^13 files, 13 decoded, ${cli.views.length} with the target`));
+    await solveCamera(page);
+    await shot('camera');
+    const heading = await page.textContent('#camera-results h3');
+    const m = /^Result: RMS (\S+) px over (\d+) views$/.exec(heading);
+    assert.ok(m, heading);
+    assert.equal(Number(m[2]), cli.views.length);
+    assertShown(m[1], cli.rms_px, 'RMS', 4);
+    const K = cli.camera_matrix;
+    const exact = { fx: K[0][0], fy: K[1][1], cx: K[0][2], cy: K[1][2], skew: K[0][1], ...cli.distortion };
+    assert.deepEqual(Object.keys(cli.distortion).sort(), ['k1', 'k2', 'k3', 'p1', 'p2']);
+    for (const [name, value] of Object.entries(exact)) assertShown(await shownCell(page, '#camera-params', name), value, name);
+    for (const name of ['fx', 'fy', 'cx', 'cy', 'k1']) assertShown(await page.$eval('#camera-params tbody', (tb, n) => [...tb.rows].find((r) => r.cells[0].textContent === n).cells[2].textContent, name), cli.std[name], `std ${name}`, 3);
+    // Sanity against OpenCV's published left_intrinsics.yml (fx = fy = 535.9,
+    // cx 342.3, cy 235.6, rms 0.39 with fx = fy held): within a few pixels.
+    const fx = Number(await shownCell(page, '#camera-params', 'fx'));
+    assert.ok(Math.abs(fx - 535.9) < 5, `fx ${fx}`);
+    console.log(`     left set: ${cli.views.length} views, page = CLI: fx ${K[0][0].toFixed(4)} fy ${K[1][1].toFixed(4)} cx ${K[0][2].toFixed(4)} cy ${K[1][2].toFixed(4)} k1 ${cli.distortion.k1.toFixed(6)} rms ${cli.rms_px.toFixed(5)} px`);
+  }],
+  ['OpenCV left/right pairs: stereo page equals CLI', async (page, { url, shot }) => {
+    const dir = datasetDir('opencv-left-right-9x6');
+    if (!dir) { console.log('     skipped: opencv-left-right-9x6 not found in ../shared/datasets or /work/shared/datasets'); return; }
+    const side = (s) => readdirSync(dir).filter((f) => new RegExp(`^${s}\\d+\\.jpg$`).test(f)).sort().map((f) => join(dir, f));
+    const [left, right] = [side('left'), side('right')];
+    assert.equal(left.length, 13);
+    assert.equal(right.length, 13);
+    const cli = JSON.parse(execFileSync(CLI, ['stereo', '--target', SPEC, '--left', ...left, '--right', ...right], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+    await page.goto(`${url}#stereo`);
+    await ready(page);
+    // Right before left: the page pairs by the number in the names, not by upload order.
+    await page.setInputFiles('#stereo-right-input', right);
+    await page.setInputFiles('#stereo-left-input', left);
+    await page.waitForFunction(() => /^13 pairs, paired by the number in the file names/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 30000 });
+    await page.click('#stereo-solve');
+    await page.locator('#stereo-summary').waitFor({ timeout: 300000 });
+    await shot('stereo');
+    const summary = await page.textContent('#stereo-summary');
+    const m = /^right_from_left: baseline (\S+) mm, RMS (\S+) px over (\d+) pairs$/.exec(summary);
+    assert.ok(m, summary);
+    assert.equal(Number(m[3]), cli.left.views.length);
+    assertShown(m[1], cli.baseline_m * 1000, 'baseline (mm)', 4);
+    assertShown(m[2], cli.rms_px, 'stereo RMS', 4);
+    const cells = (sel) => page.$$eval(`${sel} tbody tr`, (trs) => trs.map((tr) => [...tr.cells].slice(1).map((c) => c.textContent)));
+    const [T] = await cells('#stereo-translation');
+    cli.right_from_left.translation_m.forEach((t, i) => assertShown(T[i], t * 1000, `T[${i}] (mm)`, 4));
+    const R = await cells('#stereo-rotation');
+    for (let r = 0; r < 3; r++) for (let c = 0; c < 3; c++) assertShown(R[r][c], cli.right_from_left.matrix_row_major[r][c], `R[${r}][${c}]`);
+    const cams = await cells('#stereo-cameras');
+    [cli.left, cli.right].forEach((cam, i) => {
+      const K = cam.camera_matrix;
+      [K[0][0], K[1][1], K[0][2], K[1][2]].forEach((v, j) => assertShown(cams[i][j], v, `${i ? 'right' : 'left'} ${['fx', 'fy', 'cx', 'cy'][j]}`, 4));
+    });
+    // Bouguet's example 5 (SOURCE.md): T = [-99.80, 1.12, 0.05] mm +- [0.14, 0.11, 0.50].
+    const t = cli.right_from_left.translation_m.map((v) => v * 1000);
+    assert.ok(Math.abs(t[0] + 99.8) < 1.5 && Math.abs(t[1] - 1.12) < 1.5 && Math.abs(t[2]) < 3, `T ${t}`);
+    console.log(`     stereo: ${cli.left.views.length} pairs, page = CLI: T [${t.map((v) => v.toFixed(3)).join(', ')}] mm, baseline ${(cli.baseline_m * 1000).toFixed(3)} mm, rms ${cli.rms_px.toFixed(4)} px`);
+  }],
+  ['benchmark: 20 rendered 1280x960 images detected and solved', async (page, { url, shot }) => {
+    const dir = mkdtempSync(join(tmpdir(), 'robocal-bench-'));
+    try {
+      execFileSync(CLI, ['render', '--out', dir, '--camera', join(root, 'fixtures/exports/camera.ros.yaml'), '--views', '20', '--seed', '7'], { stdio: 'ignore' });
+      const files = readdirSync(dir).filter((f) => f.endsWith('.png')).sort().map((f) => join(dir, f));
+      assert.equal(files.length, 20);
+      await page.goto(url);
+      await ready(page);
+      const runs = Number(process.env.ROBOCAL_BENCH_RUNS || 3);
+      const detect = [];
+      const solve = [];
+      let fx = null;
+      for (let run = 0; run < runs; run++) {
+        await page.click('a[data-step=images]');
+        await page.click('#clear-images');
+        await page.waitForFunction(() => document.querySelectorAll('.card').length === 0 && document.getElementById('progress-row').hidden, null, { timeout: 10000 });
+        await page.$eval('#progress-text', (el) => { el.textContent = ''; });
+        const t0 = Date.now();
+        await uploadAndDetect(page, files);
+        detect.push(Date.now() - t0);
+        assert.match(await page.textContent('#image-summary'), /^20 files, 20 decoded, 20 with the target/);
+        const t1 = Date.now();
+        await solveCamera(page);
+        solve.push(Date.now() - t1);
+        fx = Number(await shownCell(page, '#camera-params', 'fx'));
+      }
+      await shot('solved');
+      // The fixture camera has fx = 1000.5: the renders' noise (2 grey levels)
+      // keeps the estimate within a pixel.
+      assert.ok(Math.abs(fx - 1000.5) < 2, `fx ${fx}`);
+      console.log(`     benchmark (Chromium, ${runs} runs): upload + decode + detect 20 x 1280x960 PNG: median ${median(detect)} ms [${detect.join(', ')}]; camera solve (Zhang, brown): median ${median(solve)} ms [${solve.join(', ')}]; total median ${median(detect.map((d, i) => d + solve[i]))} ms`);
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+];

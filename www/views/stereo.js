@@ -1,0 +1,149 @@
+// Stereo: two image sets (left and right camera) of the target from step 1,
+// paired by the number in the file names (left01 with right01) or else by
+// order; detection in the worker, then one joint calibration of both cameras
+// and right_from_left (the same core as `robocal stereo`). Images stay in
+// memory for this page; the result is kept in the session.
+import { $, h, fill, table, num, message } from '../lib/dom.js';
+import { targetSpec } from './target.js';
+import { MODELS } from './camera.js';
+
+const byName = (a, b) => a.name.localeCompare(b.name, undefined, { numeric: true });
+const numberIn = (name) => { const m = /(\d+)(?!.*\d)/.exec(name.replace(/\.[^.]*$/, '')); return m ? Number(m[1]) : null; };
+
+/** Pairs of left/right files: by the last number in the names when both sides have unique ones, else by order. */
+export function pairFiles(left, right) {
+  const L = [...left].sort(byName);
+  const R = [...right].sort(byName);
+  const keys = (list) => list.map((f) => numberIn(f.name));
+  const [kl, kr] = [keys(L), keys(R)];
+  const unique = (k) => k.every((x) => x !== null) && new Set(k).size === k.length;
+  if (unique(kl) && unique(kr)) {
+    const rightOf = new Map(R.map((f, i) => [kr[i], f]));
+    const leftKeys = new Set(kl);
+    const pairs = L.map((f, i) => ({ left: f, right: rightOf.get(kl[i]) || null }));
+    for (const [k, f] of rightOf) if (!leftKeys.has(k)) pairs.push({ left: null, right: f });
+    return { how: 'number', pairs };
+  }
+  const n = Math.max(L.length, R.length);
+  return { how: 'order', pairs: Array.from({ length: n }, (_, i) => ({ left: L[i] || null, right: R[i] || null })) };
+}
+
+export class StereoView {
+  constructor(store, engine) {
+    this.store = store;
+    this.engine = engine;
+    this.left = [];
+    this.right = [];
+    this.pairing = { how: 'order', pairs: [] };
+    this.render();
+  }
+
+  get state() {
+    if (!this.store.session.stereo) this.store.session.stereo = { model: 'brown', result: null };
+    return this.store.session.stereo;
+  }
+
+  render() {
+    const input = (side) => {
+      const el = h('input', { type: 'file', id: `stereo-${side}-input`, multiple: true, accept: 'image/*,.pgm,.ppm,.pnm,.tif,.tiff,.bmp' });
+      el.addEventListener('change', () => { this.add(side, [...el.files]); el.value = ''; });
+      return h('label', {}, `${side === 'left' ? 'Left' : 'Right'} camera images `, el);
+    };
+    const model = h('select', { id: 'stereo-model' }, MODELS.map(([v, t]) => h('option', { value: v, selected: v === this.state.model }, t)));
+    model.addEventListener('change', () => { this.state.model = model.value; this.store.changed('stereo'); });
+    this.solveButton = h('button', { type: 'button', class: 'primary', id: 'stereo-solve', disabled: true }, 'Detect and solve the stereo pair');
+    this.solveButton.addEventListener('click', () => this.solve());
+    this.pairsOut = h('div', { id: 'stereo-pairs' });
+    this.progress = h('p', { id: 'stereo-progress', class: 'hint', 'aria-live': 'polite' });
+    this.out = h('div', { id: 'stereo-results', 'aria-live': 'polite' });
+    fill($('stereo-panel'),
+      h('p', { class: 'hint' }, 'Two cameras that saw the same target poses at the same moments. The target is the one of step 1. Images are paired by the number in their names (left01 with right01), or else by order.'),
+      h('div', { class: 'form', id: 'stereo-form' }, input('left'), input('right'), h('label', {}, 'Lens model (both cameras) ', model)),
+      h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'stereo-clear', onclick: () => { this.left = []; this.right = []; this.showPairs(); } }, 'Remove the images')),
+      this.progress, this.pairsOut, this.out);
+    this.showPairs();
+    if (this.state.result) this.show(this.state.result);
+  }
+
+  async add(side, files) {
+    const list = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer(), detection: null, error: null })));
+    this[side] = [...this[side], ...list];
+    this.showPairs();
+  }
+
+  showPairs() {
+    this.pairing = pairFiles(this.left, this.right);
+    const { how, pairs } = this.pairing;
+    const complete = pairs.filter((p) => p.left && p.right).length;
+    this.solveButton.disabled = complete < 3;
+    if (!pairs.length) { fill(this.pairsOut, message('info', 'Load the left and the right camera\'s images (at least 3 pairs).')); return; }
+    const status = (f) => (!f ? '—' : f.error ? f.error : f.detection ? `${f.detection.points.length} points` : 'not detected yet');
+    const rows = pairs.map((p, i) => [String(i + 1), p.left ? p.left.name : '— (missing)', status(p.left), p.right ? p.right.name : '— (missing)', status(p.right)]);
+    fill(this.pairsOut,
+      h('p', { id: 'stereo-pairing' }, `${complete} pair${complete === 1 ? '' : 's'}, paired ${how === 'number' ? 'by the number in the file names' : 'by order (sorted names)'}.`),
+      pairs.length > complete ? message('warning', `${pairs.length - complete} image${pairs.length - complete === 1 ? ' has' : 's have'} no partner and will not be used.`) : null,
+      table(['pair', 'left', 'left detection', 'right', 'right detection'], rows, { id: 'stereo-pair-table', class: 'scroll' }));
+  }
+
+  async detect(file, spec) {
+    if (file.detection || file.spec === spec) return;
+    file.spec = spec;
+    try {
+      file.detection = await this.engine.call('detect', { bytes: file.bytes.slice(0), spec });
+      file.error = null;
+    } catch (err) {
+      file.detection = null;
+      file.error = err.message;
+    }
+  }
+
+  async solve() {
+    let spec;
+    try { spec = targetSpec(this.store.session.target); } catch (err) { fill(this.out, message('error', err.message)); return; }
+    const pairs = this.pairing.pairs.filter((p) => p.left && p.right);
+    this.solveButton.disabled = true;
+    try {
+      let done = 0;
+      for (const p of pairs) {
+        for (const f of [p.left, p.right]) {
+          if (f.spec !== spec) { f.detection = null; f.spec = null; }
+          this.progress.textContent = `detecting ${++done} of ${2 * pairs.length}: ${f.name}`;
+          await this.detect(f, spec);
+        }
+      }
+      this.showPairs();
+      const used = pairs.filter((p) => p.left.detection && p.right.detection);
+      this.progress.textContent = `detected ${2 * pairs.length} images: ${used.length} pairs with the target in both images; solving…`;
+      const view = (f) => ({ name: f.name, detection: f.detection });
+      const input = { model: this.state.model, left: used.map((p) => view(p.left)), right: used.map((p) => view(p.right)) };
+      const result = await this.engine.call('stereo', { input: JSON.stringify(input) });
+      this.state.result = result;
+      this.store.changed('stereo');
+      this.progress.textContent = `solved with ${used.length} pairs.`;
+      this.show(result);
+    } catch (err) {
+      this.progress.textContent = '';
+      fill(this.out, message('error', err.message));
+    } finally {
+      this.solveButton.disabled = false;
+    }
+  }
+
+  show(r) {
+    const m = r.right_from_left.matrix_row_major;
+    const t = r.right_from_left.translation_m.map((v) => v * 1000);
+    const std = r.right_from_left_std;
+    const cam = (c) => { const k = c.camera_matrix; return [num(k[0][0], 4), num(k[1][1], 4), num(k[0][2], 4), num(k[1][2], 4), num((c.distortion || {}).k1, 6), num(c.rms_px, 4)]; };
+    fill(this.out,
+      h('h3', { id: 'stereo-summary' }, `right_from_left: baseline ${num(r.baseline_m * 1000, 4)} mm, RMS ${num(r.rms_px, 4)} px over ${r.left.views.length} pairs`),
+      table(['', 'x', 'y', 'z'], [
+        ['T (mm)', ...t.map((v) => num(v, 4))],
+        ['std T (mm)', ...(std ? std.translation_m.map((v) => num(v * 1000, 3)) : ['—', '—', '—'])],
+        ['std rotation (deg)', ...(std ? std.rotation_rad.map((v) => num((v * 180) / Math.PI, 4)) : ['—', '—', '—'])],
+      ], { id: 'stereo-translation' }),
+      h('p', { class: 'hint' }, 'p_right = R p_left + T (the OpenCV stereoCalibrate R, T convention); R below, row by row.'),
+      table(['R', 'col 1', 'col 2', 'col 3'], m.slice(0, 3).map((row, i) => [`row ${i + 1}`, ...row.slice(0, 3).map((v) => num(v, 6))]), { id: 'stereo-rotation' }),
+      table(['camera', 'fx', 'fy', 'cx', 'cy', 'k1', 'RMS (px)'], [['left', ...cam(r.left)], ['right', ...cam(r.right)]], { id: 'stereo-cameras' }),
+      [...(r.left.warnings || []).map((w) => message('warning', `left: ${w}`)), ...(r.right.warnings || []).map((w) => message('warning', `right: ${w}`))]);
+  }
+}
