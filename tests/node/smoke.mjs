@@ -52,7 +52,7 @@ const stereo = JSON.parse(robocal.calibrate_stereo(JSON.stringify({ left: views,
 assert.ok(stereo.baseline_m < 1e-6, 'baseline ' + stereo.baseline_m);
 assert.ok(Math.abs(stereo.right_from_left.quaternion_xyzw[3]) > 1 - 1e-9, 'rotation ' + stereo.right_from_left.quaternion_xyzw);
 assert.throws(() => robocal.calibrate_stereo(JSON.stringify({ left: views, right: views.slice(1) })), { message: 'right: views are paired by order: 12 left views but 11 right views' });
-console.log('esm ok (demo calibrated: fx calibrated: fx ' + report.camera_matrix[0][0].toFixed(3) + ' px, rms ' + report.rms_px.toFixed(4) + ' px)');
+console.log('esm ok (demo calibrated: fx ' + report.camera_matrix[0][0].toFixed(3) + ' px, rms ' + report.rms_px.toFixed(4) + ' px)');
 `;
 const cjs = `
 const assert = require('node:assert/strict');
