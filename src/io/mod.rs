@@ -9,6 +9,7 @@
 pub mod csv_table;
 pub mod export;
 pub mod export_camera;
+mod export_camera_tools;
 pub mod export_transform;
 pub mod import_camera;
 mod pose_candidates;
