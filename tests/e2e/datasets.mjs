@@ -5,7 +5,7 @@
 // rendered 1280x960 images (printed, not a pass/fail timer).
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, readdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { existsSync, readdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { root } from './harness.mjs';
@@ -133,6 +133,26 @@ export const tests = [
       const K = cam.camera_matrix;
       [K[0][0], K[1][1], K[0][2], K[1][2]].forEach((v, j) => assertShown(cams[i][j], v, `${i ? 'right' : 'left'} ${['fx', 'fy', 'cx', 'cy'][j]}`, 4));
     });
+    // The export page writes right_from_left like `robocal export stereo.json`.
+    const tmp = mkdtempSync(join(tmpdir(), 'robocal-stereo-'));
+    let cliMatrix;
+    try {
+      writeFileSync(join(tmp, 'stereo.json'), JSON.stringify(cli));
+      cliMatrix = execFileSync(CLI, ['export', join(tmp, 'stereo.json'), '--format', 'matrix4', '--transform', 'right_from_left']).toString();
+    } finally {
+      rmSync(tmp, { recursive: true, force: true });
+    }
+    await page.click('a[data-step=export]');
+    await page.selectOption('#export-transform', 'right_from_left');
+    await page.$eval('#export-status', (el) => { el.textContent = ''; });
+    await page.click('#transform-formats button[data-format=matrix4]');
+    await page.waitForFunction(() => /^matrix4: /.test(document.getElementById('export-status').textContent), null, { timeout: 10000 });
+    const numbers = (t) => (t.match(/-?\d+(\.\d+)?(e[-+]?\d+)?/gi) || []).map(Number);
+    const [a, b] = [numbers(await page.textContent('#export-preview')), numbers(cliMatrix)];
+    assert.equal(a.length, b.length, `${a.length} vs ${b.length} numbers`);
+    // Same core, wasm vs native: equal to the last bits of libm (1e-9).
+    a.forEach((x, i) => assert.ok(Math.abs(x - b[i]) <= 1e-9 * Math.max(1, Math.abs(b[i])), `matrix4 entry ${i}: page ${x}, CLI ${b[i]}`));
+    await shot('stereo-export');
     // Bouguet's example 5 (SOURCE.md): T = [-99.80, 1.12, 0.05] mm +- [0.14, 0.11, 0.50].
     const t = cli.right_from_left.translation_m.map((v) => v * 1000);
     assert.ok(Math.abs(t[0] + 99.8) < 1.5 && Math.abs(t[1] - 1.12) < 1.5 && Math.abs(t[2]) < 3, `T ${t}`);

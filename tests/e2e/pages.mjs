@@ -8,6 +8,7 @@ import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { root } from './harness.mjs';
+import { makePng, checker } from '../support/images.mjs';
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 
@@ -66,6 +67,27 @@ function zyxAngles(R) {
 }
 
 export const tests = [
+  ['stereo page: pairs by the number in the names, refuses fewer than 3 pairs', async (page, { url, shot }) => {
+    await page.goto(`${url}#stereo`);
+    await ready(page);
+    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    const png = (name) => ({ name, mimeType: 'image/png', buffer: makePng(40, 30, checker(5)) });
+    await page.setInputFiles('#stereo-left-input', [png('cam_L_2.png'), png('cam_L_10.png')]);
+    await page.setInputFiles('#stereo-right-input', [png('cam_R_10.png'), png('cam_R_2.png'), png('cam_R_7.png')]);
+    await page.waitForFunction(() => /^2 pairs, paired by the number in the file names\.$/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
+    const rows = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [tr.cells[1].textContent, tr.cells[3].textContent]));
+    assert.deepEqual(rows, [['cam_L_2.png', 'cam_R_2.png'], ['cam_L_10.png', 'cam_R_10.png'], ['— (missing)', 'cam_R_7.png']]);
+    assert.equal(await page.textContent('#stereo-pairs .msg-warning'), '1 image has no partner and will not be used.');
+    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    await page.setInputFiles('#stereo-left-input', [png('cam_L_7.png')]);
+    await page.waitForFunction(() => /^3 pairs/.test(document.getElementById('stereo-pairing').textContent), null, { timeout: 10000 });
+    assert.equal(await page.isDisabled('#stereo-solve'), false);
+    // Without a chessboard in the images, the solve says why instead of hanging.
+    await page.click('#stereo-solve');
+    await page.locator('#stereo-results .msg-error').waitFor({ timeout: 30000 });
+    assert.match(await page.textContent('#stereo-results .msg-error'), /^requires at least 3 pairs, got 0$/);
+    await shot('pairs');
+  }],
   ['camera page: distortion field drawn, undistorted preview', async (page, { url, shot }) => {
     await demoSolved(page, url);
     // The demo lens has barrel distortion: the field's red vectors cover pixels.

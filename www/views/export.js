@@ -27,9 +27,10 @@ const TRANSFORM_FORMATS = [
 ];
 const EULER_ORDERS = ['xyz', 'xzy', 'yxz', 'yzx', 'zxy', 'zyx', 'xyx', 'xzx', 'yxy', 'yzy', 'zxz', 'zyz'];
 
-/** The report the exports read: camera keys and hand-eye transforms at the top level. */
+/** The report the exports read: camera keys, hand-eye transforms and the stereo right_from_left at the top level. */
 export function combinedReport(session) {
-  return { ...(session.camera.result || {}), ...(session.handeye.result || {}) };
+  const stereo = session.stereo && session.stereo.result ? { right_from_left: session.stereo.result.right_from_left } : {};
+  return { ...(session.camera.result || {}), ...(session.handeye.result || {}), ...stereo };
 }
 
 export class ExportView {

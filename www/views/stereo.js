@@ -118,7 +118,7 @@ export class StereoView {
       const input = { model: this.state.model, left: used.map((p) => view(p.left)), right: used.map((p) => view(p.right)) };
       const result = await this.engine.call('stereo', { input: JSON.stringify(input) });
       this.state.result = result;
-      this.store.changed('stereo');
+      this.store.changed('stereo-result');
       this.progress.textContent = `solved with ${used.length} pairs.`;
       this.show(result);
     } catch (err) {
@@ -135,6 +135,7 @@ export class StereoView {
     const std = r.right_from_left_std;
     const cam = (c) => { const k = c.camera_matrix; return [num(k[0][0], 4), num(k[1][1], 4), num(k[0][2], 4), num(k[1][2], 4), num((c.distortion || {}).k1, 6), num(c.rms_px, 4)]; };
     fill(this.out,
+      h('p', { class: 'hint' }, 'right_from_left can be exported in every transform format in step 8.'),
       h('h3', { id: 'stereo-summary' }, `right_from_left: baseline ${num(r.baseline_m * 1000, 4)} mm, RMS ${num(r.rms_px, 4)} px over ${r.left.views.length} pairs`),
       table(['', 'x', 'y', 'z'], [
         ['T (mm)', ...t.map((v) => num(v, 4))],
