@@ -46,6 +46,12 @@ assert.ok(report.rms_px < 0.2, 'rms ' + report.rms_px);
 const yaml = robocal.export_report(JSON.stringify(report), 'opencv-yaml', '');
 assert.ok(yaml.startsWith('%YAML:1.0'), yaml.slice(0, 40));
 assert.match(yaml, /camera_matrix: !!opencv-matrix/);
+// The undistorted preview of a demo image through the calibrated camera (1024x768 -> 256x192).
+const first = meta.images[0];
+const preview = robocal.undistort_preview(all.subarray(first.offset, first.offset + first.length), JSON.stringify(report.camera), 256);
+assert.deepEqual([preview.width, preview.height, preview.rgba.length], [256, 192, 256 * 192 * 4]);
+assert.deepEqual(JSON.parse(preview.info_json), { width: 256, height: 192 });
+assert.throws(() => robocal.undistort_preview(readFileSync(new URL('./board.png', import.meta.url)), JSON.stringify(report.camera), 256), { message: 'image: the image is 64x48 px but the camera was calibrated on 1024x768 px images' });
 // Stereo through the JSON API: the same views on both sides are a pair with
 // right_from_left = identity (baseline 0 to solver precision).
 const stereo = JSON.parse(robocal.calibrate_stereo(JSON.stringify({ left: views, right: views })));
