@@ -4,7 +4,7 @@
 For a few cameras (Brown, rational with thin prism, fisheye) this script
 asks `robocal export` for OpenCV YAML and XML, ROS camera_info and Kalibr
 YAML, then reads them back with cv2.FileStorage (opencv-python-headless
-4.14.0.94, pinned) and PyYAML, and compares every number with the input.
+4.14.0.94, pinned in bench/opencv_venv.py) and PyYAML, and compares every number with the input.
 
 Usage (creates bench/.venv on first run; needs target/release/robocal):
     cargo build --release && python3 bench/check_exports.py
@@ -16,21 +16,11 @@ import subprocess
 import sys
 import tempfile
 
+from opencv_venv import ensure_venv
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-VENV = os.path.join(HERE, ".venv")
-PINNED = ["opencv-python-headless==4.14.0.94", "numpy", "pyyaml"]
 ROBOCAL = os.path.join(ROOT, "target", "release", "robocal")
-
-
-def ensure_venv():
-    python = os.path.join(VENV, "bin", "python")
-    if os.path.abspath(sys.prefix) == os.path.abspath(VENV):
-        return
-    if not os.path.exists(python):
-        subprocess.check_call([sys.executable, "-m", "venv", VENV])
-    subprocess.check_call([python, "-m", "pip", "install", "-q", *PINNED])
-    os.execv(python, [python, *sys.argv])
 
 
 CAMERAS = {

@@ -11,8 +11,9 @@ Printed: per method, the median and 90th percentile of the rotation error
 (deg) and translation error (mm) of the camera transform against the truth.
 
 Usage (from the crate root, after `cargo build`):
-  bench/.venv/bin/python bench/compare_handeye.py [--trials 100] [--seed 7] [--robocal target/debug/robocal]
-The venv holds opencv-python-headless==4.14.0.94 (pinned: see issue 6).
+  python3 bench/compare_handeye.py [--trials 100] [--seed 7] [--robocal target/debug/robocal]
+It runs in bench/.venv (opencv-python-headless==4.14.0.94, pinned in
+bench/opencv_venv.py; created on first run).
 """
 import argparse
 import json
@@ -21,8 +22,11 @@ import platform
 import subprocess
 import tempfile
 
-import cv2
-import numpy as np
+from opencv_venv import ensure_venv
+
+ensure_venv()
+import cv2  # noqa: E402  (after the venv switch)
+import numpy as np  # noqa: E402
 
 cv2.setNumThreads(1)
 

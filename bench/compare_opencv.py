@@ -18,21 +18,11 @@ import subprocess
 import sys
 import time
 
+from opencv_venv import ensure_venv
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-VENV = os.path.join(HERE, ".venv")
-PY = os.path.join(VENV, "bin", "python")
-PIN = "opencv-python-headless==4.14.0.94"
 OUT = os.path.join(HERE, "out")
-
-
-def ensure_venv():
-    if os.path.abspath(sys.executable) == os.path.abspath(PY):
-        return
-    if not os.path.exists(PY):
-        subprocess.check_call([sys.executable, "-m", "venv", VENV])
-        subprocess.check_call([PY, "-m", "pip", "install", "-q", PIN, "numpy"])
-    os.execv(PY, [PY] + sys.argv)
 
 
 def errors(found, truth):

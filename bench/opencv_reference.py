@@ -3,14 +3,17 @@
 corners for the public OpenCV left/right 9x6 images, the reference that
 tests/detect_datasets.rs compares robocal's detector with.
 
-Usage (from the crate root; bench/compare_opencv.py creates bench/.venv):
-  bench/.venv/bin/python bench/opencv_reference.py [DATASET_DIR]
+Usage (from the crate root; runs in bench/.venv, see bench/opencv_venv.py):
+  python3 bench/opencv_reference.py [DATASET_DIR]
 """
 import json
 import os
 import sys
 
-import cv2
+from opencv_venv import ensure_venv
+
+ensure_venv()
+import cv2  # noqa: E402  (after the venv switch)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)

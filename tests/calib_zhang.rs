@@ -260,6 +260,46 @@ fn fixed_principal_point_and_aspect_ratio_hold() {
 }
 
 #[test]
+fn an_explicit_aspect_ratio_is_held_exactly_and_recovers_the_truth() {
+    // The truth has fx / fy = r exactly; held at r, the noise-free optimum
+    // is the truth (~1e-9 relative), unlike the closed-form ratio above.
+    let truth = Camera::example_brown();
+    let r = truth.fx / truth.fy;
+    let scene = Scene::calibration(23, &truth, (9, 6), 0.03, 10, 0.0).expect("scene");
+    let options = CalibrationOptions {
+        fix_aspect_ratio: true,
+        aspect_ratio: Some(r),
+        ..options_for(&truth)
+    };
+    let report = calibrate(&scene.views, (1280, 960), &options).expect("calibration");
+    let c = &report.camera;
+    assert!((c.fx / c.fy - r).abs() < 1e-15, "fx/fy {}", c.fx / c.fy);
+    assert!((c.fx - truth.fx).abs() < 1e-9 * truth.fx, "fx {} px", c.fx);
+    assert!((c.cy - truth.cy).abs() < 1e-7, "cy {} px", c.cy);
+    // Without fix_aspect_ratio the value is refused; so is a ratio <= 0.
+    for (fix, ratio, message) in [
+        (
+            false,
+            1.0,
+            "aspect_ratio: is the held fx / fy: set fix_aspect_ratio too",
+        ),
+        (
+            true,
+            -1.0,
+            "aspect_ratio: fx / fy must be finite and > 0, got -1",
+        ),
+    ] {
+        let bad = CalibrationOptions {
+            fix_aspect_ratio: fix,
+            aspect_ratio: Some(ratio),
+            ..options_for(&truth)
+        };
+        let err = calibrate(&scene.views, (1280, 960), &bad).expect_err("refused");
+        assert_eq!(err.to_string(), message);
+    }
+}
+
+#[test]
 fn undetermined_parameters_give_a_warning_not_a_failure() {
     // The rational model on distortion-free data: (1 + k1 r^2) / (1 + k4 r^2)
     // is 1 for every k1 = k4, an exact null direction of J^T J.

@@ -7,7 +7,8 @@ camera-frame points and the pixels cv2.projectPoints /
 cv2.fisheye.projectPoints give for them (identity pose, so the inputs are
 camera-frame points as robocal's Camera::project takes them).
 
-Usage (creates tools/.venv with the pinned OpenCV on first run):
+Usage (creates bench/.venv with the pinned OpenCV on first run, see
+bench/opencv_venv.py):
     python3 tools/opencv_reference.py
 The reference is opencv-python-headless==4.14.0.94 (see issue 5).
 """
@@ -18,20 +19,10 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-VENV = os.path.join(HERE, ".venv")
-PINNED = ["opencv-python-headless==4.14.0.94", "numpy"]
 OUT = os.path.join(ROOT, "fixtures", "opencv_project_points.json")
 
-
-def ensure_venv():
-    """Re-run this script inside tools/.venv, creating it if needed."""
-    python = os.path.join(VENV, "bin", "python")
-    if os.path.abspath(sys.prefix) == os.path.abspath(VENV):
-        return
-    if not os.path.exists(python):
-        subprocess.check_call([sys.executable, "-m", "venv", VENV])
-        subprocess.check_call([python, "-m", "pip", "install", "-q", *PINNED])
-    os.execv(python, [python, *sys.argv])
+sys.path.insert(0, os.path.join(ROOT, "bench"))
+from opencv_venv import ensure_venv  # noqa: E402  (the shared bench/.venv)
 
 
 def random_points(rng, n, max_angle_deg):

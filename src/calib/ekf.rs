@@ -216,6 +216,12 @@ impl EkfCalibrator {
         if let Some(c) = &self.calibration.initial_camera {
             (fu, fv, u0, v0) = (c.fx, c.fy, c.cx, c.cy);
         }
+        if let (true, Some(r)) = (
+            self.calibration.fix_aspect_ratio,
+            self.calibration.aspect_ratio,
+        ) {
+            fv = fu / r;
+        }
         let coeffs = self.calibration.model.coefficients();
         let k5_free = matches!(self.calibration.model, Distortion::RadialK1K2K5 { .. });
         let start = |i: usize| if k5_free { coeffs[i] } else { 0.0 };

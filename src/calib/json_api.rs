@@ -5,7 +5,7 @@
 //!
 //! ```json
 //! {"model": "brown", "method": "zhang",
-//!  "options": {"fix_principal_point": false, "fix_aspect_ratio": false,
+//!  "options": {"fix_principal_point": false, "fix_aspect_ratio": false, "aspect_ratio": null,
 //!              "zero_skew": true, "robust": false, "fixed_coefficients": []},
 //!  "views": [{"name": "left01.jpg", "detection": {"image_size_px": [640, 480], "target": {...}, "points": [...]}},
 //!            {"name": "rig", "object_m": [[0, 0, 0], ...], "image_px": [[320.5, 240.1], ...]}],
@@ -47,8 +47,12 @@ pub const ROBUST_OUTLIER_SIGMA: f64 = 3.0;
 pub struct JsonOptions {
     /// Hold the principal point at the image centre.
     pub fix_principal_point: bool,
-    /// Hold fy / fx at its closed-form value.
+    /// Hold fy / fx at its closed-form value (or at `aspect_ratio`).
     pub fix_aspect_ratio: bool,
+    /// Hold fx / fy at this value (OpenCV's aspectRatio; 1 = fx = fy);
+    /// implies `fix_aspect_ratio`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub aspect_ratio: Option<f64>,
     /// Hold the skew at 0 (default true).
     pub zero_skew: bool,
     /// Huber loss and 3-sigma outlier rejection.
@@ -62,6 +66,7 @@ impl Default for JsonOptions {
         JsonOptions {
             fix_principal_point: false,
             fix_aspect_ratio: false,
+            aspect_ratio: None,
             zero_skew: true,
             robust: false,
             fixed_coefficients: vec![],
@@ -195,7 +200,8 @@ pub fn calibration_options(model: &str, o: &JsonOptions) -> Result<CalibrationOp
     Ok(CalibrationOptions {
         model: model_from_name(model)?,
         fix_principal_point: o.fix_principal_point,
-        fix_aspect_ratio: o.fix_aspect_ratio,
+        fix_aspect_ratio: o.fix_aspect_ratio || o.aspect_ratio.is_some(),
+        aspect_ratio: o.aspect_ratio,
         zero_skew: o.zero_skew,
         fixed_coefficients: o.fixed_coefficients.clone(),
         loss,

@@ -50,7 +50,8 @@ impl BlockProblem for CalibProblem<'_> {
         jacobians: bool,
     ) -> Result<Vec<ResidualBlock>> {
         let camera = self.camera(&params.global)?;
-        let mut out = Vec::new();
+        let n_used = self.used.iter().flatten().filter(|u| **u).count();
+        let mut out = Vec::with_capacity(n_used);
         for (b, view) in self.views.iter().enumerate() {
             let pose = pose_from_block(&params.blocks[b]);
             for (i, (object, observed)) in view.object_m.iter().zip(&view.image_px).enumerate() {
@@ -68,7 +69,8 @@ impl BlockProblem for CalibProblem<'_> {
                         DMatrix::zeros(2, 0),
                     )
                 };
-                let residuals = DVector::from_vec(vec![pixel.x - observed.x, pixel.y - observed.y]);
+                let residuals =
+                    DVector::from_column_slice(&[pixel.x - observed.x, pixel.y - observed.y]);
                 let jac_block = if jacobians {
                     // Left perturbation R <- exp(d) R: d(R x)/dd = -[R x]_x.
                     let d_rot = d_point * (-skew(&rotated));

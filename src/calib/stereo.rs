@@ -194,7 +194,7 @@ pub fn initial_right_from_left(
 }
 
 fn aspect(camera: &crate::camera::Camera, options: &CalibrationOptions) -> Option<f64> {
-    options.fix_aspect_ratio.then(|| camera.fy / camera.fx)
+    super::zhang::held_aspect(camera, options)
 }
 
 /// The camera_from_target of every view of a report.

@@ -34,8 +34,14 @@ pub struct CalibrationOptions {
     pub initial_camera: Option<Camera>,
     /// Hold cx, cy at the initial value (the image centre without an initial camera).
     pub fix_principal_point: bool,
-    /// Hold fy / fx at the initial ratio.
+    /// Hold the aspect ratio: fy / fx stays at the ratio of the start
+    /// (the closed-form solution or `initial_camera`), or at `aspect_ratio`
+    /// when that is given.
     pub fix_aspect_ratio: bool,
+    /// With `fix_aspect_ratio`: the held fx / fy (OpenCV's `aspectRatio`
+    /// with `CALIB_FIX_ASPECT_RATIO`; 1 = square pixels, fx = fy exactly).
+    /// `None` holds the start's ratio instead. Must be finite and > 0.
+    pub aspect_ratio: Option<f64>,
     /// Hold the skew at 0 (default true; OpenCV has no skew).
     pub zero_skew: bool,
     /// Coefficient names (of `model`) held at their value in `model`.
@@ -64,6 +70,7 @@ impl Default for CalibrationOptions {
             initial_camera: None,
             fix_principal_point: false,
             fix_aspect_ratio: false,
+            aspect_ratio: None,
             zero_skew: true,
             fixed_coefficients: vec![],
             loss: Loss::Squared,
@@ -105,7 +112,7 @@ pub fn calibrate(
         blocks: poses,
     };
     let lm_options = lm_options(&initial, options)?;
-    let aspect = options.fix_aspect_ratio.then(|| initial.fy / initial.fx);
+    let aspect = held_aspect(&initial, options);
     let mut rounds = 0;
     loop {
         let problem = CalibProblem {
@@ -191,6 +198,20 @@ fn validate(views: &[View], image_size_px: (u32, u32), options: &CalibrationOpti
             ));
         }
     }
+    if let Some(r) = options.aspect_ratio {
+        if !options.fix_aspect_ratio {
+            return Err(Error::invalid(
+                "aspect_ratio",
+                "is the held fx / fy: set fix_aspect_ratio too",
+            ));
+        }
+        if !(r.is_finite() && r > 0.0) {
+            return Err(Error::invalid(
+                "aspect_ratio",
+                format!("fx / fy must be finite and > 0, got {r}"),
+            ));
+        }
+    }
     for name in &options.fixed_coefficients {
         if !options.model.coefficient_names().contains(&name.as_str()) {
             return Err(Error::invalid(
@@ -212,12 +233,15 @@ fn initial_camera(
     options: &CalibrationOptions,
 ) -> Result<Camera> {
     if let Some(c) = &options.initial_camera {
-        return Ok(Camera {
-            width: size.0,
-            height: size.1,
-            distortion: options.model.clone(),
-            ..c.clone()
-        });
+        return Ok(with_aspect_ratio(
+            Camera {
+                width: size.0,
+                height: size.1,
+                distortion: options.model.clone(),
+                ..c.clone()
+            },
+            options,
+        ));
     }
     let k = intrinsics_from_homographies(homographies, size, options.zero_skew)?;
     let (mut cx, mut cy) = (k[(0, 2)], k[(1, 2)]);
@@ -226,16 +250,44 @@ fn initial_camera(
         cy = 0.5 * (size.1 as f64 - 1.0);
     }
     let skew = if options.zero_skew { 0.0 } else { k[(0, 1)] };
-    Ok(Camera {
-        fx: k[(0, 0)],
-        fy: k[(1, 1)],
-        cx,
-        cy,
-        skew,
-        width: size.0,
-        height: size.1,
-        distortion: options.model.clone(),
-    })
+    Ok(with_aspect_ratio(
+        Camera {
+            fx: k[(0, 0)],
+            fy: k[(1, 1)],
+            cx,
+            cy,
+            skew,
+            width: size.0,
+            height: size.1,
+            distortion: options.model.clone(),
+        },
+        options,
+    ))
+}
+
+/// The start with the requested fx / fy, keeping the geometric mean of the
+/// focal lengths.
+fn with_aspect_ratio(camera: Camera, options: &CalibrationOptions) -> Camera {
+    match (options.fix_aspect_ratio, options.aspect_ratio) {
+        (true, Some(r)) => {
+            let f = (camera.fx * camera.fy).abs().sqrt();
+            Camera {
+                fx: f * r.sqrt(),
+                fy: f / r.sqrt(),
+                ..camera
+            }
+        }
+        _ => camera,
+    }
+}
+
+/// The held fy / fx of the problem (fy = aspect * fx), if any.
+pub(crate) fn held_aspect(start: &Camera, options: &CalibrationOptions) -> Option<f64> {
+    match (options.fix_aspect_ratio, options.aspect_ratio) {
+        (false, _) => None,
+        (true, Some(r)) => Some(1.0 / r),
+        (true, None) => Some(start.fy / start.fx),
+    }
 }
 
 pub(crate) fn lm_options(initial: &Camera, options: &CalibrationOptions) -> Result<LmOptions> {

@@ -61,6 +61,16 @@ impl Poly {
     /// The tangential and thin-prism terms are assumed small here.
     pub fn in_domain(&self, r2: f64) -> bool {
         let [k1, k2, k3, k4, k5, k6] = self.k;
+        // Fast exact path without a denominator (b = 1): the derivative
+        // condition is g(t) = 1 + 3 k1 t + 5 k2 t^2 + 7 k3 t^3 > 0, and this
+        // lower bound of g on [0, r2] being positive means every sample
+        // passes; otherwise the samples decide.
+        if k4 == 0.0 && k5 == 0.0 && k6 == 0.0 && r2 >= 0.0 {
+            let bound = 1.0 - r2 * (3.0 * k1.abs() + r2 * (5.0 * k2.abs() + r2 * 7.0 * k3.abs()));
+            if bound > 0.0 {
+                return true;
+            }
+        }
         (1..=DOMAIN_SAMPLES).all(|i| {
             let f = i as f64 / DOMAIN_SAMPLES as f64;
             let t = r2 * f * f;

@@ -82,7 +82,10 @@ pub struct LmOptions {
     /// Most Jacobian evaluations (default 200).
     pub max_iterations: usize,
     /// Stop when an accepted step lowers the cost by less than this
-    /// fraction (default 1e-14).
+    /// fraction, or when a rejected step's quadratic model predicted less
+    /// (default 1e-12: summing ~1e3 squared residuals leaves the cost
+    /// uncertain to ~1e-13 relative, so smaller changes are round-off and
+    /// further steps only fight it).
     pub cost_tolerance: f64,
     /// Stop when the largest gradient component is below this (default 1e-14).
     pub gradient_tolerance: f64,
@@ -102,7 +105,7 @@ impl Default for LmOptions {
     fn default() -> Self {
         LmOptions {
             max_iterations: 200,
-            cost_tolerance: 1e-14,
+            cost_tolerance: 1e-12,
             gradient_tolerance: 1e-14,
             step_tolerance: 1e-12,
             initial_lambda: 1e-4,
@@ -117,7 +120,8 @@ impl Default for LmOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Termination {
-    /// The relative cost decrease fell below the tolerance (or the cost is 0).
+    /// The relative cost decrease (achieved, or predicted for a rejected
+    /// step) fell below the tolerance, or the cost is 0.
     CostTolerance,
     /// The gradient fell below the tolerance.
     GradientTolerance,
@@ -226,6 +230,10 @@ pub fn solve(
             };
             let new_cost = cost_of(&new_residuals);
             if !(new_cost < cost) {
+                if predicted <= options.cost_tolerance * cost {
+                    // The model promised only round-off: at the minimum.
+                    break 'outer Termination::CostTolerance;
+                }
                 lambda *= 10.0;
                 continue;
             }
