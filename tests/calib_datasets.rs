@@ -108,6 +108,10 @@ fn opencv_left_intrinsics_yml_is_reproduced_with_fx_equal_fy() {
     let report = calibrate(&views, (640, 480), &options).expect("calibration");
     let c = &report.camera;
     assert_eq!(c.fx, c.fy, "fx = fy exactly");
+    eprintln!(
+        "left_intrinsics: {c:?} rms {} px, std {:?}",
+        report.rms_px, report.std
+    );
     assert_eq!(report.std["fx"], report.std["fy"]);
     // The published file came from an older OpenCV's corners; OpenCV 4.14
     // finds slightly different ones (the fixture; any findChessboardCorners
@@ -262,6 +266,7 @@ fn bouguet_calib1_result_is_reproduced_within_its_uncertainty() {
         data.kc[3],
     ];
     let names = ["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2"];
+    eprintln!("calib1: {got:?}, rms {} px", report.rms_px);
     for (i, name) in names.iter().enumerate() {
         // The published uncertainty (Bouguet: about 3 standard deviations)
         // bounds the difference; the same data and model make it far smaller.
@@ -345,6 +350,7 @@ fn stereo_9x6_matches_bouguets_published_right_from_left() {
     let t_ref: Vector3<f64> = Vector3::new(-99.80198, 1.12443, 0.05041);
     let t_unc: Vector3<f64> = Vector3::new(0.142, 0.11352, 0.49773);
     let std = stereo.right_from_left_std.clone().expect("std");
+    eprintln!("stereo: om {om:?} rad, T {t_mm:?} mm, std {std:?}");
     for k in 0..3 {
         let om_tol = om_unc[k].hypot(3.0 * std.rotation_rad[k]);
         assert!(

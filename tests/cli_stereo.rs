@@ -1,6 +1,7 @@
 //! `robocal stereo` through the real binary on rendered image pairs (two
-//! cameras, known right_from_left), the export of its report, and bad
-//! arguments.
+//! cameras, known right_from_left), the export of its report, bad
+//! arguments, and the public OpenCV/Bouguet 9x6 pairs against Bouguet's
+//! published stereo result.
 
 use nalgebra::{Translation3, Vector3};
 use robocal::calib::View;
@@ -206,4 +207,72 @@ fn bad_arguments_say_what_to_change() {
     let (code, help, _) = robocal(&["stereo", "--help"]);
     assert_eq!(code, 0);
     assert!(help.contains("robocal stereo --target chessboard:9x6:25mm --left left*.jpg"));
+}
+
+#[test]
+fn opencv_9x6_pairs_give_bouguets_right_from_left() {
+    let Some(dir) = [
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../shared/datasets/opencv-left-right-9x6"
+        ),
+        "/work/shared/datasets/opencv-left-right-9x6",
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|p| p.join("left01.jpg").exists()) else {
+        eprintln!("skipped: opencv-left-right-9x6 dataset not found");
+        return;
+    };
+    let pairs = [1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 13, 14];
+    let side = |s: &str| -> Vec<String> {
+        pairs
+            .iter()
+            .map(|i| {
+                dir.join(format!("{s}{i:02}.jpg"))
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect()
+    };
+    let mut args = vec!["stereo", "--target", "chessboard:9x6:30mm", "--left"];
+    let (left, right) = (side("left"), side("right"));
+    args.extend(left.iter().map(|s| s.as_str()));
+    args.push("--right");
+    args.extend(right.iter().map(|s| s.as_str()));
+    let (code, stdout, stderr) = robocal(&args);
+    assert_eq!(code, 0, "{stderr}");
+    let report: Value = serde_json::from_str(&stdout).expect("report");
+    let f = |v: &Value| v.as_f64().expect("number");
+    let q = &report["right_from_left"]["quaternion_xyzw"];
+    let t = &report["right_from_left"]["translation_m"];
+    // Small rotation: the rotation vector is 2 q_xyz (to ~1e-9 rad here).
+    let om = Vector3::new(2.0 * f(&q[0]), 2.0 * f(&q[1]), 2.0 * f(&q[2])) * f(&q[3]).signum();
+    let t_mm = Vector3::new(f(&t[0]), f(&t[1]), f(&t[2])) * 1e3;
+    // Bouguet's example 5 after his stereo optimisation, with his
+    // uncertainties (about 3 standard deviations; SOURCE.md (3)). Our
+    // corners (robocal's detector, 13 pairs, rms ~0.18 px) land within them.
+    let om_ref = [0.00669, 0.00452, -0.00350];
+    let om_unc = [0.0027, 0.00308, 0.00029];
+    let t_ref = [-99.80198, 1.12443, 0.05041];
+    let t_unc = [0.142, 0.11352, 0.49773];
+    for k in 0..3 {
+        assert!(
+            (om[k] - om_ref[k]).abs() < om_unc[k],
+            "om[{k}] {} vs {} rad",
+            om[k],
+            om_ref[k]
+        );
+        assert!(
+            (t_mm[k] - t_ref[k]).abs() < t_unc[k],
+            "T[{k}] {} vs {} mm",
+            t_mm[k],
+            t_ref[k]
+        );
+    }
+    let baseline_mm = f(&report["baseline_m"]) * 1e3;
+    assert!(
+        (baseline_mm - 99.81).abs() < 0.142,
+        "baseline {baseline_mm} mm"
+    );
 }
