@@ -99,7 +99,22 @@ export const tests = [
     // cx 342.3, cy 235.6, rms 0.39 with fx = fy held): within a few pixels.
     const fx = Number(await shownCell(page, '#camera-params', 'fx'));
     assert.ok(Math.abs(fx - 535.9) < 5, `fx ${fx}`);
-    console.log(`     left set: ${cli.views.length} views, page = CLI: fx ${K[0][0].toFixed(4)} fy ${K[1][1].toFixed(4)} cx ${K[0][2].toFixed(4)} cy ${K[1][2].toFixed(4)} k1 ${cli.distortion.k1.toFixed(6)} rms ${cli.rms_px.toFixed(5)} px`);
+    // Square pixels, as OpenCV's left_intrinsics.yml was made (flags
+    // CALIB_FIX_ASPECT_RATIO, aspect ratio 1): page = `--aspect-ratio 1`.
+    const square = JSON.parse(execFileSync(CLI, ['intrinsics', '--target', SPEC, '--aspect-ratio', '1', ...files], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+    await page.check('#camera-form input[name=square_pixels]');
+    await solveCamera(page);
+    const Ks = square.camera_matrix;
+    assert.equal(Ks[0][0], Ks[1][1]);
+    for (const [name, value] of Object.entries({ fx: Ks[0][0], fy: Ks[1][1], cx: Ks[0][2], cy: Ks[1][2], ...square.distortion })) assertShown(await shownCell(page, '#camera-params', name), value, `square pixels: ${name}`);
+    assert.equal(await shownCell(page, '#camera-params', 'fx'), await shownCell(page, '#camera-params', 'fy'));
+    // Published: OpenCV's fx = fy = 535.916 (its corners, RMS 0.39 px; std of
+    // fx ~0.9 px) and Bouguet's fc = (533.00, 533.15) (14 views, his
+    // corners). With robocal's corners (RMS ~0.16 px) fx = fy lands between
+    // them: within 3 px of both.
+    assert.ok(Math.abs(Ks[0][0] - 535.916) < 3 && Math.abs(Ks[0][0] - 533.08) < 3, `fx = fy ${Ks[0][0]}`);
+    await shot('square-pixels');
+    console.log(`     left set: ${cli.views.length} views, page = CLI: fx ${K[0][0].toFixed(4)} fy ${K[1][1].toFixed(4)} cx ${K[0][2].toFixed(4)} cy ${K[1][2].toFixed(4)} k1 ${cli.distortion.k1.toFixed(6)} rms ${cli.rms_px.toFixed(5)} px; square pixels: fx = fy ${Ks[0][0].toFixed(4)} (OpenCV 535.916, Bouguet 533.0/533.2), cx ${Ks[0][2].toFixed(4)} cy ${Ks[1][2].toFixed(4)}, rms ${square.rms_px.toFixed(5)} px`);
   }],
   ['OpenCV left/right pairs: stereo page equals CLI', async (page, { url, shot }) => {
     const dir = datasetDir('opencv-left-right-9x6');

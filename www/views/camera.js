@@ -23,7 +23,8 @@ export const METHODS = [
 ];
 const OPTIONS = [
   ['fix_principal_point', 'Fix the principal point at the image centre'],
-  ['fix_aspect_ratio', 'Fix the aspect ratio (fx = fy)'],
+  ['fix_aspect_ratio', 'Fix the aspect ratio (fy / fx) at its closed-form value'],
+  ['square_pixels', 'Square pixels: fx = fy (OpenCV CALIB_FIX_ASPECT_RATIO with aspect ratio 1)'],
   ['zero_skew', 'Zero skew', true],
   ['robust', 'Robust loss with outlier rejection'],
 ];
@@ -34,6 +35,12 @@ function putPixels(canvas, p) {
   canvas.width = p.width;
   canvas.height = p.height;
   canvas.getContext('2d').putImageData(new ImageData(new Uint8ClampedArray(p.rgba), p.width, p.height), 0, 0);
+}
+
+/** The form's options as the core's JSON options (square pixels = aspect_ratio 1). */
+function jsonOptions(options) {
+  const { square_pixels: square, ...rest } = options;
+  return square ? { ...rest, aspect_ratio: 1 } : rest;
 }
 
 export class CameraView {
@@ -92,7 +99,7 @@ export class CameraView {
     const input = {
       model: st.model,
       method: st.method,
-      options: st.options,
+      options: jsonOptions(st.options),
       views: views.map((i) => ({ name: i.name, detection: i.detection })),
     };
     try {
