@@ -171,8 +171,9 @@ fn grow_from(
     if !(0.25..=4.0).contains(&ratio) {
         return None;
     }
+    let unit = ring_unit();
     let ring = |p: Point2<f64>, a: &Vector2<f64>, b: &Vector2<f64>| {
-        is_x_junction(plane, p, RING_FRACTION * a.norm().min(b.norm()))
+        is_x_junction(plane, p, RING_FRACTION * a.norm().min(b.norm()), &unit)
     };
     if !ring(s.pos, &step_a, &step_b) {
         return None;
@@ -210,24 +211,27 @@ const RING_SAMPLES: usize = 24;
 /// around it; the board's outer corners (L- and T-shaped, which also give a
 /// saddle response) show two, or four that are not point-symmetric. Samples within 20% of the ring's range from
 /// its mid level are ignored so that noise does not add transitions.
-fn is_x_junction(plane: &Plane, p: Point2<f64>, radius: f64) -> bool {
+fn is_x_junction(
+    plane: &Plane,
+    p: Point2<f64>,
+    radius: f64,
+    unit: &[(f64, f64); RING_SAMPLES],
+) -> bool {
     let r = radius.max(2.0);
-    let vals: Vec<f32> = (0..RING_SAMPLES)
-        .map(|k| {
-            let t = k as f64 / RING_SAMPLES as f64 * std::f64::consts::TAU;
-            plane.bilinear(p.x + r * t.cos(), p.y + r * t.sin())
-        })
-        .collect();
+    let vals: [f32; RING_SAMPLES] =
+        std::array::from_fn(|k| plane.bilinear(p.x + r * unit[k].0, p.y + r * unit[k].1));
     let (lo, hi) = vals
         .iter()
         .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
     let mid = 0.5 * (lo + hi);
     let band = 0.2 * (hi - lo);
-    let classes: Vec<bool> = vals
-        .iter()
-        .filter(|v| (**v - mid).abs() > band)
-        .map(|v| *v > mid)
-        .collect();
+    let mut classes = [false; RING_SAMPLES];
+    let mut count = 0;
+    for v in vals.iter().filter(|v| (**v - mid).abs() > band) {
+        classes[count] = *v > mid;
+        count += 1;
+    }
+    let classes = &classes[..count];
     if classes.len() < RING_SAMPLES / 2 {
         return false;
     }
@@ -249,6 +253,14 @@ fn is_x_junction(plane: &Plane, p: Point2<f64>, radius: f64) -> bool {
         }
     }
     pairs >= half / 2 && agree * 10 >= pairs * 9
+}
+
+/// Unit vectors at the ring's sample angles.
+fn ring_unit() -> [(f64, f64); RING_SAMPLES] {
+    std::array::from_fn(|k| {
+        let t = k as f64 / RING_SAMPLES as f64 * std::f64::consts::TAU;
+        (t.cos(), t.sin())
+    })
 }
 
 /// Sign of the mixed second derivative along the local grid axes.

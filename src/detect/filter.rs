@@ -65,50 +65,49 @@ impl Plane {
     }
 
     /// Separable Gaussian smoothing with standard deviation `sigma` pixels
-    /// (kernel radius 3 sigma, borders clamped). Both passes run tap by tap
-    /// over whole rows (vectorisable); each output sums its taps in kernel
-    /// order, as a per-pixel dot product would.
+    /// (kernel radius 3 sigma, borders clamped). Row by row: the vertical
+    /// pass fills one padded row buffer, the horizontal pass reads it, so
+    /// no full-size intermediate is allocated. Both passes run tap by tap
+    /// over whole rows (vectorisable), pairing the symmetric taps.
     pub fn gaussian(&self, sigma: f64) -> Plane {
         let k = gaussian_kernel(sigma);
         let r = k.len() / 2;
         let (w, h) = (self.w, self.h);
-        let mut tmp = vec![0.0f32; w * h];
+        let mut data = vec![0.0f32; w * h];
         let mut padded = vec![0.0f32; w + 2 * r];
+        let row = |yy: isize| {
+            let yy = yy.clamp(0, h as isize - 1) as usize;
+            &self.data[yy * w..(yy + 1) * w]
+        };
         for y in 0..h {
-            let row = &self.data[y * w..(y + 1) * w];
-            pad_row(row, r, &mut padded);
-            let out = &mut tmp[y * w..(y + 1) * w];
-            for (i, kv) in k.iter().enumerate() {
-                let src = &padded[i..i + w];
-                for (o, s) in out.iter_mut().zip(src) {
-                    *o += kv * s;
+            let mid = &mut padded[r..r + w];
+            for (o, s) in mid.iter_mut().zip(row(y as isize)) {
+                *o = k[r] * s;
+            }
+            for d in 1..=r {
+                let (up, down) = (row(y as isize - d as isize), row((y + d) as isize));
+                let kv = k[r + d];
+                for ((o, a), b) in mid.iter_mut().zip(up).zip(down) {
+                    *o += kv * (a + b);
                 }
             }
-        }
-        let mut data = vec![0.0f32; w * h];
-        let r = r as isize;
-        for y in 0..h {
+            let (first, last) = (padded[r], padded[r + w - 1]);
+            padded[..r].iter_mut().for_each(|v| *v = first);
+            padded[r + w..].iter_mut().for_each(|v| *v = last);
             let out = &mut data[y * w..(y + 1) * w];
-            for (i, kv) in k.iter().enumerate() {
-                let yy = (y as isize + i as isize - r).clamp(0, h as isize - 1) as usize;
-                let src = &tmp[yy * w..(yy + 1) * w];
-                for (o, s) in out.iter_mut().zip(src) {
-                    *o += kv * s;
+            for (o, s) in out.iter_mut().zip(&padded[r..r + w]) {
+                *o = k[r] * s;
+            }
+            for d in 1..=r {
+                let kv = k[r + d];
+                let (left, right) = (&padded[r - d..r - d + w], &padded[r + d..r + d + w]);
+                for ((o, a), b) in out.iter_mut().zip(left).zip(right) {
+                    *o += kv * (a + b);
                 }
             }
         }
         Plane { w, h, data }
     }
-}
-
-/// `row` with `r` clamped border copies on each side, into `out`
-/// (`row.len() + 2 r` long).
-fn pad_row(row: &[f32], r: usize, out: &mut [f32]) {
-    let w = row.len();
-    let (first, last) = (row[0], row[w - 1]);
-    out[..r].iter_mut().for_each(|v| *v = first);
-    out[r..r + w].copy_from_slice(row);
-    out[r + w..].iter_mut().for_each(|v| *v = last);
 }
 
 /// Pyramid level `level` (each pixel the mean of a `2^level` square block,
@@ -125,8 +124,11 @@ pub(crate) fn box_level(img: &GrayImage, level: u32) -> Plane {
     let h = (ih >> level).max(1);
     let scale = 1.0 / (f * f) as f32;
     let mut data = vec![0.0f32; w * h];
-    // Row sums of at most 256 rows of 8-bit pixels fit in u16.
+    // Row sums of at most 256 rows of 8-bit pixels fit in u16; block sums
+    // (up to 256 x 256 pixels) need u32.
     let mut sums = vec![0u16; iw];
+    let whole = (iw / f).min(w);
+    let (mut a, mut b) = (vec![0u32; whole * f], vec![0u32; whole * f]);
     for y in 0..h {
         sums.iter_mut().for_each(|v| *v = 0);
         for k in 0..f {
@@ -136,10 +138,21 @@ pub(crate) fn box_level(img: &GrayImage, level: u32) -> Plane {
             }
         }
         let out = &mut data[y * w..(y + 1) * w];
-        // Whole blocks, then a clamped last block (odd widths).
-        let whole = (iw / f).min(w);
-        for (o, block) in out.iter_mut().zip(sums.chunks_exact(f)) {
-            *o = block.iter().map(|&v| v as u32).sum::<u32>() as f32 * scale;
+        // Whole blocks by pairwise halving (vectorisable), then a clamped
+        // last block (odd widths).
+        for (d, &s) in a.iter_mut().zip(&sums) {
+            *d = s as u32;
+        }
+        let mut n = whole * f;
+        for _ in 0..level {
+            n /= 2;
+            for (d, pair) in b[..n].iter_mut().zip(a.chunks_exact(2)) {
+                *d = pair[0] + pair[1];
+            }
+            std::mem::swap(&mut a, &mut b);
+        }
+        for (o, &v) in out.iter_mut().zip(&a[..whole]) {
+            *o = v as f32 * scale;
         }
         for (x, o) in out.iter_mut().enumerate().skip(whole) {
             let mut acc = 0u32;

@@ -9,7 +9,8 @@
 //! (composed with a 45-degree change of basis for asymmetric grids).
 
 use nalgebra::{Point2, Vector2};
-use std::collections::{HashMap, VecDeque};
+use std::collections::{HashMap, HashSet, VecDeque};
+use std::hash::{BuildHasherDefault, Hasher};
 
 /// Fraction of the local grid step within which a point may be taken.
 const SEARCH_FRACTION: f64 = 0.3;
@@ -81,7 +82,38 @@ impl<'a> PointIndex<'a> {
 }
 
 /// A grown lattice: cell (a, b) -> point index.
-pub(crate) type Cells = HashMap<(i32, i32), usize>;
+pub(crate) type Cells = CellMap<usize>;
+
+/// A map keyed by lattice cells, with [`CellHasher`].
+pub(crate) type CellMap<V> = HashMap<(i32, i32), V, BuildHasherDefault<CellHasher>>;
+
+/// A multiply-rotate hasher for small integer keys: several times cheaper
+/// than the default SipHash (no untrusted keys here), and deterministic,
+/// so iteration order does not change between runs.
+#[derive(Default, Clone, Copy)]
+pub(crate) struct CellHasher(u64);
+
+impl CellHasher {
+    const K: u64 = 0x517c_c1b7_2722_0a95;
+    #[inline]
+    fn add(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(Self::K);
+    }
+}
+
+impl Hasher for CellHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        bytes.iter().for_each(|&b| self.add(b as u64));
+    }
+    #[inline]
+    fn write_i32(&mut self, v: i32) {
+        self.add(v as u32 as u64);
+    }
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
 
 /// Local axes at a cell being added: steps along a and b, image pixels.
 pub(crate) struct Prediction {
@@ -101,12 +133,12 @@ pub(crate) fn grow(
     accept: &dyn Fn(usize, (i32, i32), &Prediction) -> bool,
 ) -> Cells {
     let pts = index.points;
-    let mut cells: Cells = HashMap::new();
+    let mut cells = Cells::default();
     let mut used = vec![false; pts.len()];
     cells.insert((0, 0), seed);
     used[seed] = true;
     let mut queue: VecDeque<(i32, i32)> = VecDeque::new();
-    let mut tried: HashMap<(i32, i32), u8> = HashMap::new();
+    let mut tried: CellMap<u8> = CellMap::default();
     push_neighbours(&mut queue, (0, 0));
     while let Some(cell) = queue.pop_front() {
         if cells.contains_key(&cell) || cells.len() >= max_cells {
@@ -241,7 +273,7 @@ pub(crate) fn complete_maps(cells: &Cells, board: &[(i32, i32)], diagonal: bool)
     if cells.len() != board.len() || board.is_empty() {
         return Vec::new();
     }
-    let set: std::collections::HashSet<(i32, i32)> = board.iter().copied().collect();
+    let set: HashSet<(i32, i32), BuildHasherDefault<CellHasher>> = board.iter().copied().collect();
     let bmin = (
         board.iter().map(|c| c.0).min().unwrap_or(0),
         board.iter().map(|c| c.1).min().unwrap_or(0),
@@ -296,8 +328,7 @@ fn candidate_matrices(diagonal: bool) -> Vec<[[i32; 2]; 2]> {
 
 /// Board-ordered image points for `map` (index = id), from `cells`.
 pub(crate) fn ordered(cells: &Cells, map: &BoardMap, board: &[(i32, i32)]) -> Option<Vec<usize>> {
-    let by_board: HashMap<(i32, i32), usize> =
-        cells.iter().map(|(&c, &i)| (map.apply(c), i)).collect();
+    let by_board: CellMap<usize> = cells.iter().map(|(&c, &i)| (map.apply(c), i)).collect();
     board.iter().map(|c| by_board.get(c).copied()).collect()
 }
 

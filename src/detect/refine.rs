@@ -123,9 +123,14 @@ fn axis(c: f64, w: f64, sigma_w2: f64, taps: &[f32]) -> Axis {
     let mut moments = [0.0f64; 5];
     let len = count + 2 * rs;
     let mut kernels = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
+    // g(t) = exp(-t^2 / s) by recurrence over unit steps of t: the ratio
+    // g(t + 1) / g(t) = exp(-(2 t + 1) / s) itself shrinks by exp(-2 / s).
+    let t0 = first as f64 - c;
+    let mut g = (-t0 * t0 / sigma_w2).exp();
+    let mut ratio = (-(2.0 * t0 + 1.0) / sigma_w2).exp();
+    let shrink = (-2.0 / sigma_w2).exp();
     for k in 0..count {
-        let t = (first + k as isize) as f64 - c;
-        let g = (-t * t / sigma_w2).exp();
+        let t = t0 + k as f64;
         let mut p = g;
         for m in moments.iter_mut() {
             *m += p;
@@ -138,6 +143,8 @@ fn axis(c: f64, w: f64, sigma_w2: f64, taps: &[f32]) -> Axis {
                 *dst += f * tap;
             }
         }
+        g *= ratio;
+        ratio *= shrink;
     }
     Axis {
         first,
