@@ -20,7 +20,7 @@ Options:
   -o FILE         write the JSON result to FILE (default: standard output)
   --threads N     images processed in parallel (default: all cores)
   --max-side N    long side of the pyramid level searched, pixels
-                  (default 512; corners are always refined at full size)
+                  (default 256; corners are always refined at full size)
 
 Output: {\"robocal_version\", \"target\", \"images\": [{\"file\",
 \"detection\": {image_size_px, target, points: [{id, x_px, y_px}]},

@@ -27,6 +27,8 @@ use crate::image::GrayImage;
 use crate::target::DetectedPoint;
 use nalgebra::{Point2, Vector2};
 
+/// Pyramid levels searched after the coarsest one, each twice as fine.
+const FINER_LEVELS: u32 = 2;
 /// Seeds tried per pyramid level.
 const MAX_SEEDS: usize = 40;
 /// A seed's first neighbours respond at least this fraction of the seed.
@@ -53,13 +55,19 @@ pub(crate) fn detect_chessboard(
         .collect();
     let mut best_partial: Option<(usize, String)> = None;
     // Coarsest level first: most boards are found there at a quarter of
-    // the next level's cost; the finer level catches small boards.
+    // the next level's cost; the finer levels catch small boards and give
+    // closer starts when a coarse level's corners cannot be refined.
     let coarse = super::working_level(img, options.max_working_side_px);
-    for level in (coarse.saturating_sub(1)..=coarse).rev() {
+    for level in (coarse.saturating_sub(FINER_LEVELS)..=coarse).rev() {
         let plane = box_level(img, level);
         match detect_at_level(&plane, level, cols, rows, &board)? {
             LevelResult::Complete(coarse, step) => {
-                return refine_all(img, &coarse, level, step, cols);
+                match refine_all(img, &coarse, level, step, cols) {
+                    Ok(points) => return Ok(points),
+                    // A finer level starts the refinement closer to the corners.
+                    Err(Error::NotFound { message }) => best_partial = Some((cols * rows, message)),
+                    Err(e) => return Err(e),
+                }
             }
             LevelResult::Partial { found, message } => {
                 if best_partial.as_ref().map_or(true, |b| found > b.0) {
@@ -387,7 +395,13 @@ fn refine_all(
             }
         }
         let window = (local / WINDOW_FRACTION_INV).clamp(2.5, MAX_WINDOW_PX);
-        let fit = refine_saddle(img, *p, window);
+        // A start from a coarse level can be a few pixels off, beyond the
+        // small window's reach: pull it in with a window twice as wide
+        // first (rarely needed; the final fit is the small window's).
+        let fit = refine_saddle(img, *p, window).or_else(|| {
+            let wide = (local / (0.5 * WINDOW_FRACTION_INV)).clamp(2.5, 2.0 * MAX_WINDOW_PX);
+            refine_saddle(img, *p, wide).and_then(|f| refine_saddle(img, f.pos, window))
+        });
         let Some(fit) = fit else {
             return Err(Error::NotFound {
                 message: format!(

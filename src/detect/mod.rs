@@ -3,7 +3,7 @@
 //!
 //! - **Chessboards** ([`chessboard`] docs state the corner order): Hessian
 //!   saddle candidates on a pyramid level whose long side is at most
-//!   [`DetectOptions::max_working_side_px`] (then one level finer if that
+//!   [`DetectOptions::max_working_side_px`] (then up to two finer levels if that
 //!   fails), grid growth from seeds with local perspective prediction and
 //!   alternating corner polarity, and a saddle-point surface fit at full
 //!   resolution for every corner.
@@ -52,7 +52,8 @@ pub const MIN_IMAGE_SIDE_PX: u32 = 16;
 #[derive(Debug, Clone, PartialEq)]
 pub struct DetectOptions {
     /// Long side of the pyramid level where chessboards are first searched,
-    /// pixels (default 512; circle grids use at least 2048). Corners are
+    /// pixels (default 256, then up to two finer levels; circle grids use
+    /// at least 2048). Corners are
     /// always refined at full resolution.
     pub max_working_side_px: u32,
 }
@@ -60,7 +61,7 @@ pub struct DetectOptions {
 impl Default for DetectOptions {
     fn default() -> Self {
         DetectOptions {
-            max_working_side_px: 512,
+            max_working_side_px: 256,
         }
     }
 }
