@@ -154,4 +154,44 @@ export const tests = [
     assert.ok(best.slice(1).every((r) => Number(r[1]) > 5 * rot || Number(r[2]) > 50 * trans), JSON.stringify(best.slice(0, 3)));
     console.log(`     convention check: the file's default reading was '${picked}'; the check names '${best[0][0]}' (rotation RMS ${best[0][1]} deg, next '${best[1][0]}' ${best[1][1]} deg)`);
   }],
+  ['every control has an accessible name, every canvas a text alternative', async (page, { url, shot }) => {
+    await demoSolved(page, url);
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-errors').waitFor({ timeout: 60000 });
+    await page.click('a[data-step=export]');
+    // Every step's DOM is built (hidden steps too): check them all at once.
+    const problems = await page.evaluate(() => {
+      const name = (el) => {
+        if (el.getAttribute('aria-label')) return el.getAttribute('aria-label');
+        const by = el.getAttribute('aria-labelledby');
+        if (by) return by.split(/\s+/).map((id) => document.getElementById(id)?.textContent || '').join(' ').trim();
+        if (el.labels && el.labels.length) return [...el.labels].map((l) => l.textContent).join(' ').trim();
+        if (el.tagName === 'BUTTON' || el.tagName === 'A') return el.textContent.trim();
+        return '';
+      };
+      const out = [];
+      for (const el of document.querySelectorAll('input, select, textarea, button, a[href]')) {
+        if (el.type === 'hidden') continue;
+        if (!name(el)) out.push(`${el.tagName.toLowerCase()}#${el.id || '?'}.${el.className || ''} has no accessible name`);
+      }
+      for (const c of document.querySelectorAll('canvas')) {
+        if (c.getAttribute('role') !== 'img' || !c.getAttribute('aria-label')) out.push(`canvas#${c.id || '?'} lacks role=img with an aria-label`);
+      }
+      return out;
+    });
+    assert.deepEqual(problems, []);
+    // Keyboard: the step links are reachable with Tab from the top of the page.
+    await page.goto(`${url}#camera`);
+    await ready(page);
+    const reached = new Set();
+    for (let i = 0; i < 30; i++) {
+      await page.keyboard.press('Tab');
+      const step = await page.evaluate(() => document.activeElement?.dataset?.step || null);
+      if (step) reached.add(step);
+    }
+    assert.deepEqual([...reached].sort(), ['camera', 'export', 'handeye', 'images', 'robot', 'share', 'stereo', 'target', 'workflows']);
+    await page.keyboard.press('Shift+Tab');
+    await shot('keyboard');
+  }],
 ];
