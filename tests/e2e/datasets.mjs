@@ -67,6 +67,29 @@ async function solveCamera(page) {
   await page.locator('#camera-params').waitFor({ timeout: 120000 });
 }
 
+/** Largest RMS distance of the board's rows and columns of corners from their fitted straight lines, px. */
+export function worstLineRms(points, cols, rows) {
+  const byId = new Map(points.map((p) => [p.id, p]));
+  const lines = [];
+  for (let r = 0; r < rows; r++) lines.push([...Array(cols).keys()].map((c) => byId.get(r * cols + c)));
+  for (let c = 0; c < cols; c++) lines.push([...Array(rows).keys()].map((r) => byId.get(r * cols + c)));
+  let worst = 0;
+  for (const line of lines) {
+    const pts = line.filter(Boolean);
+    if (pts.length < 3) continue;
+    const mx = pts.reduce((s, p) => s + p.x_px, 0) / pts.length;
+    const my = pts.reduce((s, p) => s + p.y_px, 0) / pts.length;
+    let a = 0, b = 0, c = 0;
+    for (const p of pts) { a += (p.x_px - mx) ** 2; b += (p.x_px - mx) * (p.y_px - my); c += (p.y_px - my) ** 2; }
+    [a, b, c] = [a / pts.length, b / pts.length, c / pts.length];
+    const smallest = (a + c) / 2 - Math.sqrt(((a - c) / 2) ** 2 + b * b);
+    worst = Math.max(worst, Math.sqrt(Math.max(0, smallest)));
+  }
+  return worst;
+}
+
+const detectFile = (file, spec) => JSON.parse(execFileSync(CLI, ['detect', '--target', spec, file], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString()).images[0].detection;
+
 const median = (xs) => [...xs].sort((a, b) => a - b)[Math.floor(xs.length / 2)];
 
 export const tests = [
@@ -99,6 +122,30 @@ export const tests = [
     // cx 342.3, cy 235.6, rms 0.39 with fx = fy held): within a few pixels.
     const fx = Number(await shownCell(page, '#camera-params', 'fx'));
     assert.ok(Math.abs(fx - 535.9) < 5, `fx ${fx}`);
+    // The undistorted preview straightens the board: take the image whose
+    // rows and columns of corners bend most, undistort it on the page, and
+    // detect the board in the result (the CLI, on the canvas's PNG).
+    const bent = files.map((f) => ({ f, rms: worstLineRms(detectFile(f, SPEC).points, 9, 6) })).sort((x, y) => y.rms - x.rms)[0];
+    const name = bent.f.split('/').pop();
+    await page.selectOption('#undistort-image', { label: name });
+    await page.click('#undistort-show');
+    await page.waitForFunction((n) => document.getElementById('undistort-status').textContent === `${n}: undistorted at 480×360 px (preview).`, name, { timeout: 30000 });
+    await page.locator('#undistort-after').scrollIntoViewIfNeeded();
+    await shot('undistorted');
+    const png = Buffer.from((await page.$eval('#undistort-after', (c) => c.toDataURL('image/png'))).split(',')[1], 'base64');
+    const tmpDir = mkdtempSync(join(tmpdir(), 'robocal-undistort-'));
+    let straight;
+    try {
+      writeFileSync(join(tmpDir, 'undistorted.png'), png);
+      straight = worstLineRms(detectFile(join(tmpDir, 'undistorted.png'), SPEC).points, 9, 6);
+    } finally {
+      rmSync(tmpDir, { recursive: true, force: true });
+    }
+    // Barrel distortion (k1 -0.28) bends the board's edge rows by pixels;
+    // undistorted, the lines are straight to the corner noise (~0.1 px at
+    // 640 px, scaled by 0.75 in the preview, plus resampling).
+    assert.ok(bent.rms > 1 && straight < 0.2, `worst line RMS ${bent.rms.toFixed(3)} px as taken, ${straight.toFixed(3)} px undistorted`);
+    console.log(`     undistorted preview of ${name}: worst row/column line RMS ${bent.rms.toFixed(3)} px as taken -> ${straight.toFixed(3)} px undistorted`);
     // Square pixels, as OpenCV's left_intrinsics.yml was made (flags
     // CALIB_FIX_ASPECT_RATIO, aspect ratio 1): page = `--aspect-ratio 1`.
     const square = JSON.parse(execFileSync(CLI, ['intrinsics', '--target', SPEC, '--aspect-ratio', '1', ...files], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
