@@ -111,8 +111,6 @@ async function main() {
     await images.restore();
     store.changed('target-loaded');
     camera.render();
-    stereo.left = [];
-    stereo.right = [];
     stereo.render();
   });
   $('demo-button').addEventListener('click', async () => {

@@ -13,6 +13,7 @@ export function defaultSession() {
     robot: { fileName: null, text: null, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper', parsed: null },
     handeye: { setup: 'eye-in-hand', method: 'all', result: null },
     workflows: { planar: null, xytable: null },
+    stereo: { model: 'brown', result: null, left: [], right: [] }, // left/right: { id, name, detection, error, spec }
   };
 }
 
@@ -60,6 +61,15 @@ export class Store {
         if (buf) this.bytes.set(img.id, buf);
         else { img.status = 'error'; img.error = 'the image bytes were not found in this browser\'s storage; add the file again'; }
       }
+      const stereo = this.session.stereo;
+      for (const side of ['left', 'right']) {
+        const kept = [];
+        for (const f of stereo[side] || []) {
+          const buf = await tx(this.db, 'blobs', 'readonly', (s) => s.get(f.id));
+          if (buf) { this.bytes.set(f.id, buf); kept.push(f); }
+        }
+        stereo[side] = kept;
+      }
     } catch (e) {
       this.persistent = false;
       console.warn('session storage unavailable:', e);
@@ -91,6 +101,21 @@ export class Store {
       try { await tx(this.db, 'blobs', 'readwrite', (s) => s.put(bytes, img.id)); } catch (e) { console.warn(e); }
     }
     this.changed('images');
+  }
+
+  /** Keep bytes that are not a step-2 image (the stereo page's). */
+  async putBytes(id, bytes) {
+    this.bytes.set(id, bytes);
+    if (this.db && this.persistent) {
+      try { await tx(this.db, 'blobs', 'readwrite', (s) => s.put(bytes, id)); } catch (e) { console.warn(e); }
+    }
+  }
+
+  async deleteBytes(ids) {
+    for (const id of ids) this.bytes.delete(id);
+    if (this.db && this.persistent) {
+      try { await tx(this.db, 'blobs', 'readwrite', (s) => { for (const id of ids) s.delete(id); }); } catch (e) { console.warn(e); }
+    }
   }
 
   async removeImages(ids) {

@@ -87,6 +87,17 @@ export const tests = [
     await page.locator('#stereo-results .msg-error').waitFor({ timeout: 30000 });
     assert.match(await page.textContent('#stereo-results .msg-error'), /^requires at least 3 pairs, got 0$/);
     await shot('pairs');
+    // The stereo images and their detection results survive a reload.
+    const before = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+    assert.match(before[0][2], /chessboard|target|found/i);
+    await page.waitForTimeout(500); // the store saves 300 ms after the last change
+    await page.reload();
+    await ready(page);
+    await page.waitForFunction(() => /^3 pairs/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
+    assert.deepEqual(await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent))), before);
+    await page.click('#stereo-clear');
+    await page.waitForFunction(() => !document.getElementById('stereo-pair-table'), null, { timeout: 10000 });
+    assert.equal(await page.isDisabled('#stereo-solve'), true);
   }],
   ['camera page: distortion field drawn, undistorted preview', async (page, { url, shot }) => {
     await demoSolved(page, url);

@@ -1,8 +1,8 @@
 // Stereo: two image sets (left and right camera) of the target from step 1,
 // paired by the number in the file names (left01 with right01) or else by
 // order; detection in the worker, then one joint calibration of both cameras
-// and right_from_left (the same core as `robocal stereo`). Images stay in
-// memory for this page; the result is kept in the session.
+// and right_from_left (the same core as `robocal stereo`). The images, their
+// detections and the result are kept in the session (IndexedDB).
 import { $, h, fill, table, num, message } from '../lib/dom.js';
 import { targetSpec } from './target.js';
 import { MODELS } from './camera.js';
@@ -32,16 +32,20 @@ export class StereoView {
   constructor(store, engine) {
     this.store = store;
     this.engine = engine;
-    this.left = [];
-    this.right = [];
     this.pairing = { how: 'order', pairs: [] };
     this.render();
   }
 
   get state() {
-    if (!this.store.session.stereo) this.store.session.stereo = { model: 'brown', result: null };
-    return this.store.session.stereo;
+    const st = this.store.session.stereo || (this.store.session.stereo = { model: 'brown', result: null });
+    if (!st.left) st.left = [];
+    if (!st.right) st.right = [];
+    return st;
   }
+
+  get left() { return this.state.left; }
+
+  get right() { return this.state.right; }
 
   render() {
     const input = (side) => {
@@ -59,15 +63,27 @@ export class StereoView {
     fill($('stereo-panel'),
       h('p', { class: 'hint' }, 'Two cameras that saw the same target poses at the same moments. The target is the one of step 1. Images are paired by the number in their names (left01 with right01), or else by order.'),
       h('div', { class: 'form', id: 'stereo-form' }, input('left'), input('right'), h('label', {}, 'Lens model (both cameras) ', model)),
-      h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'stereo-clear', onclick: () => { this.left = []; this.right = []; this.showPairs(); } }, 'Remove the images')),
+      h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'stereo-clear', onclick: () => this.clear() }, 'Remove the images')),
       this.progress, this.pairsOut, this.out);
     this.showPairs();
     if (this.state.result) this.show(this.state.result);
   }
 
   async add(side, files) {
-    const list = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer(), detection: null, error: null })));
-    this[side] = [...this[side], ...list];
+    for (const f of files) {
+      const id = `stereo-${side}-${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`;
+      await this.store.putBytes(id, await f.arrayBuffer());
+      this.state[side].push({ id, name: f.name, detection: null, error: null, spec: null });
+    }
+    this.store.changed('stereo');
+    this.showPairs();
+  }
+
+  async clear() {
+    await this.store.deleteBytes([...this.left, ...this.right].map((f) => f.id));
+    this.state.left = [];
+    this.state.right = [];
+    this.store.changed('stereo');
     this.showPairs();
   }
 
@@ -89,7 +105,10 @@ export class StereoView {
     if (file.detection || file.spec === spec) return;
     file.spec = spec;
     try {
-      file.detection = await this.engine.call('detect', { bytes: file.bytes.slice(0), spec });
+      const bytes = this.store.bytes.get(file.id);
+      if (!bytes) throw new Error('the image bytes were not found in this browser\'s storage; add the file again');
+      const copy = bytes.slice(0);
+      file.detection = await this.engine.call('detect', { bytes: copy, spec }, [copy]);
       file.error = null;
     } catch (err) {
       file.detection = null;
@@ -112,6 +131,7 @@ export class StereoView {
         }
       }
       this.showPairs();
+      this.store.changed('stereo');
       const used = pairs.filter((p) => p.left.detection && p.right.detection);
       this.progress.textContent = `detected ${2 * pairs.length} images: ${used.length} pairs with the target in both images; solving…`;
       const view = (f) => ({ name: f.name, detection: f.detection });
