@@ -2,8 +2,24 @@
 //!
 //! No filesystem here: callers pass bytes (from a file, an upload, a fetch).
 //! Supported: PNG, JPEG, TIFF, BMP, PGM/PPM (PNM) and GIF, 8 or 16 bits,
-//! grey or colour. Colour is converted to luma (Rec. 601 weights, as the
-//! `image` crate does); 16-bit data is scaled to 8 bits.
+//! grey or colour. Colour is converted to luma with the sRGB / Rec. 709
+//! weights 0.2126 R + 0.7152 G + 0.0722 B in f32, computed exactly as the
+//! `image` crate did before (so pixels match its output); 16-bit data is
+//! scaled to 8 bits with rounding.
+//!
+//! PNG, JPEG, GIF and TIFF use the small single-format crates (`png`,
+//! `zune-jpeg`, `gif`, `tiff` without its JPEG-in-TIFF support); BMP and PNM
+//! are read here ([`bmp`], [`pnm`]). Each codec returns a [`raster::Raster`]
+//! in its file's own channels and depth; the conversions to grey and to the
+//! RGBA preview happen once, in [`raster`].
+
+mod bmp;
+#[cfg(test)]
+mod bmp_tests;
+mod codecs;
+mod png_encode;
+mod pnm;
+mod raster;
 
 use crate::error::{Error, Result};
 use serde::Serialize;
@@ -162,30 +178,43 @@ pub fn decode_gray(bytes: &[u8]) -> Result<GrayImage> {
 /// check the size limits before allocating, convert to grey.
 pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     let format = sniff_format(bytes)?;
-    let dynamic = decode_dynamic(bytes, format, options)?;
+    let raster = match format {
+        ImageFormat::Png => codecs::decode_png(bytes, options)?,
+        ImageFormat::Jpeg => codecs::decode_jpeg(bytes, options)?,
+        ImageFormat::Tiff => codecs::decode_tiff(bytes, options)?,
+        ImageFormat::Gif => codecs::decode_gif(bytes, options)?,
+        ImageFormat::Bmp => bmp::decode(bytes, options)?,
+        ImageFormat::Pnm => pnm::decode(bytes, options)?,
+    };
     let info = ImageInfo {
         format,
-        width: dynamic.width(),
-        height: dynamic.height(),
-        channels: dynamic.color().channel_count(),
-        bits_per_channel: bits_per_channel(&dynamic),
+        width: raster.width,
+        height: raster.height,
+        channels: raster.channels,
+        bits_per_channel: raster.bits_per_channel(),
     };
-    let preview = options
-        .preview_max_side
-        .map(|side| make_preview(&dynamic, side));
-    let luma = dynamic.into_luma8();
-    let (width, height) = luma.dimensions();
-    let gray = GrayImage {
-        width,
-        height,
-        pixels: luma.into_raw(),
-    };
+    let preview = options.preview_max_side.map(|side| raster.preview(side));
+    let gray = raster.into_gray();
     Ok(Decoded {
         info,
         gray,
         preview,
     })
 }
+
+/// Formats recognised by their magic bytes but not decoded, with the name the
+/// error message gives them.
+const UNSUPPORTED_MAGIC: [(&[u8], &str); 9] = [
+    (b"DDS ", "Dds"),
+    (&[0, 0, 1, 0], "Ico"),
+    (b"#?RADIANCE", "Hdr"),
+    (&[0x76, 0x2f, 0x31, 0x01], "OpenExr"),
+    (b"qoif", "Qoi"),
+    (b"farbfeld", "Farbfeld"),
+    (b"II+\x00", "BigTiff"),
+    (b"MM\x00+", "BigTiff"),
+    (b"\x00\x00\x00\x0cjP  ", "Jpeg2000"),
+];
 
 /// Identify the container from its magic bytes.
 pub fn sniff_format(bytes: &[u8]) -> Result<ImageFormat> {
@@ -194,58 +223,49 @@ pub fn sniff_format(bytes: &[u8]) -> Result<ImageFormat> {
             message: "not an image: the file is empty".into(),
         });
     }
-    let format = match image::guess_format(bytes) {
-        Ok(image::ImageFormat::Png) => ImageFormat::Png,
-        Ok(image::ImageFormat::Jpeg) => ImageFormat::Jpeg,
-        Ok(image::ImageFormat::Tiff) => ImageFormat::Tiff,
-        Ok(image::ImageFormat::Bmp) => ImageFormat::Bmp,
-        Ok(image::ImageFormat::Pnm) => ImageFormat::Pnm,
-        Ok(image::ImageFormat::Gif) => ImageFormat::Gif,
-        Ok(other) => {
-            return Err(Error::Image {
-                message: format!(
-                    "unsupported image format {other:?}: use PNG, JPEG, TIFF, BMP, PGM/PPM or GIF"
-                ),
-            })
-        }
-        Err(_) => {
-            return Err(Error::Image {
-                message: "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF"
-                    .into(),
-            })
-        }
-    };
-    Ok(format)
-}
-
-fn to_image_format(format: ImageFormat) -> image::ImageFormat {
-    match format {
-        ImageFormat::Png => image::ImageFormat::Png,
-        ImageFormat::Jpeg => image::ImageFormat::Jpeg,
-        ImageFormat::Tiff => image::ImageFormat::Tiff,
-        ImageFormat::Bmp => image::ImageFormat::Bmp,
-        ImageFormat::Pnm => image::ImageFormat::Pnm,
-        ImageFormat::Gif => image::ImageFormat::Gif,
+    let starts = |magic: &[u8]| bytes.starts_with(magic);
+    if starts(b"\x89PNG\r\n\x1a\n") {
+        return Ok(ImageFormat::Png);
     }
+    if starts(&[0xff, 0xd8, 0xff]) {
+        return Ok(ImageFormat::Jpeg);
+    }
+    if starts(b"GIF89a") || starts(b"GIF87a") {
+        return Ok(ImageFormat::Gif);
+    }
+    if starts(b"MM\x00*") || starts(b"II*\x00") {
+        return Ok(ImageFormat::Tiff);
+    }
+    if starts(b"BM") {
+        return Ok(ImageFormat::Bmp);
+    }
+    if bytes.len() >= 2 && bytes[0] == b'P' && (b'1'..=b'7').contains(&bytes[1]) {
+        return Ok(ImageFormat::Pnm);
+    }
+    let other = if bytes.len() >= 12 && starts(b"RIFF") && &bytes[8..12] == b"WEBP" {
+        Some("WebP")
+    } else if bytes.len() >= 12 && &bytes[4..12] == b"ftypavif" {
+        Some("Avif")
+    } else {
+        UNSUPPORTED_MAGIC
+            .iter()
+            .find(|(magic, _)| starts(magic))
+            .map(|(_, name)| *name)
+    };
+    Err(Error::Image {
+        message: match other {
+            Some(name) => {
+                format!("unsupported image format {name}: use PNG, JPEG, TIFF, BMP, PGM/PPM or GIF")
+            }
+            None => {
+                "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF".into()
+            }
+        },
+    })
 }
 
-fn decode_dynamic(
-    bytes: &[u8],
-    format: ImageFormat,
-    options: &DecodeOptions,
-) -> Result<image::DynamicImage> {
-    let mut reader =
-        image::ImageReader::with_format(std::io::Cursor::new(bytes), to_image_format(format));
-    // Check the header's dimensions before the decoder allocates anything.
-    let (width, height) = reader.into_dimensions().map_err(|e| corrupt(format, e))?;
-    check_size(width, height, options)?;
-    reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), to_image_format(format));
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(options.max_alloc_bytes);
-    reader.limits(limits);
-    reader.decode().map_err(|e| corrupt(format, e))
-}
-
+/// Refuse empty images and images over [`DecodeOptions::max_pixels`]; called
+/// by every codec with the header's dimensions, before any pixel buffer.
 fn check_size(width: u32, height: u32, options: &DecodeOptions) -> Result<()> {
     if width == 0 || height == 0 {
         return Err(Error::Image {
@@ -265,39 +285,42 @@ fn check_size(width: u32, height: u32, options: &DecodeOptions) -> Result<()> {
     Ok(())
 }
 
-fn corrupt(format: ImageFormat, e: image::ImageError) -> Error {
-    let message = match e {
-        image::ImageError::Limits(l) => {
-            format!(
-                "{} image too large to decode within the memory limit ({l})",
-                format.name()
-            )
-        }
-        image::ImageError::Unsupported(u) => {
-            format!("{} variant not supported: {u}", format.name())
-        }
-        other => format!("corrupt or truncated {} file: {other}", format.name()),
-    };
-    Error::Image { message }
+/// Refuse a decoded buffer of `width * height * channels * bytes_per_sample`
+/// bytes over [`DecodeOptions::max_alloc_bytes`]; returns the byte count.
+fn check_alloc(
+    format: ImageFormat,
+    width: u32,
+    height: u32,
+    channels: u8,
+    bytes_per_sample: u8,
+    options: &DecodeOptions,
+) -> Result<usize> {
+    let bytes = width as u64 * height as u64 * channels as u64 * bytes_per_sample as u64;
+    if bytes > options.max_alloc_bytes || usize::try_from(bytes).is_err() {
+        return Err(too_large(format, options));
+    }
+    Ok(bytes as usize)
 }
 
-fn bits_per_channel(img: &image::DynamicImage) -> u8 {
-    let color = img.color();
-    let channels = color.channel_count().max(1);
-    (color.bits_per_pixel() / channels as u16) as u8
+fn too_large(format: ImageFormat, options: &DecodeOptions) -> Error {
+    Error::Image {
+        message: format!(
+            "{} image too large to decode within the memory limit ({} bytes)",
+            format.name(),
+            options.max_alloc_bytes
+        ),
+    }
 }
 
-fn make_preview(img: &image::DynamicImage, max_side: u32) -> RgbaImage {
-    let max_side = max_side.max(1);
-    let (w, h) = (img.width(), img.height());
-    let scale = (max_side as f64 / w.max(h) as f64).min(1.0);
-    let tw = ((w as f64 * scale).round() as u32).max(1);
-    let th = ((h as f64 * scale).round() as u32).max(1);
-    let small = img.thumbnail_exact(tw, th).into_rgba8();
-    RgbaImage {
-        width: tw,
-        height: th,
-        pixels: small.into_raw(),
+fn corrupt(format: ImageFormat, detail: impl std::fmt::Display) -> Error {
+    Error::Image {
+        message: format!("corrupt or truncated {} file: {detail}", format.name()),
+    }
+}
+
+fn unsupported(format: ImageFormat, detail: impl std::fmt::Display) -> Error {
+    Error::Image {
+        message: format!("{} variant not supported: {detail}", format.name()),
     }
 }
 
@@ -310,19 +333,7 @@ pub fn encode_pgm(img: &GrayImage) -> Vec<u8> {
 
 /// Encode a grey image as PNG (8-bit grey).
 pub fn encode_png(img: &GrayImage) -> Result<Vec<u8>> {
-    use image::ImageEncoder;
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(
-            &img.pixels,
-            img.width,
-            img.height,
-            image::ExtendedColorType::L8,
-        )
-        .map_err(|e| Error::Image {
-            message: format!("PNG encoding failed: {e}"),
-        })?;
-    Ok(out)
+    png_encode::encode_gray(img)
 }
 
 #[cfg(test)]
@@ -414,12 +425,25 @@ mod tests {
             state
         };
         let png = encode_png(&gradient(16, 16)).unwrap();
-        for i in 0..300 {
+        let bmp = crate::image::bmp_tests::palette_bmp();
+        // Real headers of every format, cut anywhere and followed by noise.
+        let headers: [&[u8]; 8] = [
+            &png,
+            &bmp,
+            b"P6 4 4 255\n",
+            b"P1 4 4\n",
+            b"P7\nWIDTH 2\nHEIGHT 2\nDEPTH 4\nMAXVAL 65535\nENDHDR\n",
+            b"GIF89a\x04\x00\x04\x00\xf0\x00\x00",
+            b"II*\x00\x08\x00\x00\x00",
+            b"\xff\xd8\xff\xe0\x00\x10JFIF\x00",
+        ];
+        for i in 0..800 {
             let len = (next() % 200) as usize;
             let mut bytes: Vec<u8> = (0..len).map(|_| next() as u8).collect();
-            if i % 2 == 0 {
-                let keep = (next() as usize) % png.len();
-                bytes = [&png[..keep], &bytes[..]].concat();
+            if i % 4 != 3 {
+                let header = headers[(next() % headers.len() as u64) as usize];
+                let keep = (next() as usize) % (header.len() + 1);
+                bytes = [&header[..keep], &bytes[..]].concat();
             }
             let _ = decode(
                 &bytes,

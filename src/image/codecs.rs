@@ -1,0 +1,208 @@
+//! PNG, JPEG, GIF and TIFF through their single-format crates: read the
+//! header, check the limits, decode into a [`Raster`].
+
+use super::raster::{Raster, Samples};
+use super::{check_alloc, check_size, corrupt, too_large, unsupported, DecodeOptions, ImageFormat};
+use crate::error::Result;
+use std::io::Cursor;
+
+fn alloc_limit(options: &DecodeOptions) -> usize {
+    usize::try_from(options.max_alloc_bytes).unwrap_or(usize::MAX)
+}
+
+/// PNG: palettes and sub-byte grey expanded to 8 bits, tRNS to alpha; 16-bit
+/// kept.
+pub(super) fn decode_png(bytes: &[u8], options: &DecodeOptions) -> Result<Raster> {
+    const F: ImageFormat = ImageFormat::Png;
+    let png_error = |e: png::DecodingError| match e {
+        png::DecodingError::LimitsExceeded => too_large(F, options),
+        other => corrupt(F, other),
+    };
+    let limits = png::Limits {
+        bytes: alloc_limit(options),
+    };
+    let mut decoder = png::Decoder::new_with_limits(Cursor::new(bytes), limits);
+    decoder.set_transformations(png::Transformations::EXPAND);
+    let mut reader = decoder.read_info().map_err(png_error)?;
+    let (width, height) = (reader.info().width, reader.info().height);
+    check_size(width, height, options)?;
+    let (color, depth) = reader.output_color_type();
+    let channels = color.samples() as u8;
+    let sixteen = depth == png::BitDepth::Sixteen;
+    let size = check_alloc(F, width, height, channels, 1 + sixteen as u8, options)?;
+    if reader.output_buffer_size() != Some(size) {
+        return Err(unsupported(F, format!("{color:?} at {depth:?} bits")));
+    }
+    let mut buf = vec![0u8; size];
+    reader.next_frame(&mut buf).map_err(png_error)?;
+    let samples = if sixteen {
+        Samples::U16(
+            buf.chunks_exact(2)
+                .map(|b| u16::from_be_bytes([b[0], b[1]]))
+                .collect(),
+        )
+    } else {
+        Samples::U8(buf)
+    };
+    Ok(Raster {
+        width,
+        height,
+        channels,
+        samples,
+    })
+}
+
+/// JPEG: grey stays grey, everything else (YCbCr, CMYK, ...) becomes RGB,
+/// like the `image` crate asks of zune-jpeg.
+pub(super) fn decode_jpeg(bytes: &[u8], options: &DecodeOptions) -> Result<Raster> {
+    use zune_core::colorspace::ColorSpace;
+    const F: ImageFormat = ImageFormat::Jpeg;
+    let jpeg_error = |e: zune_jpeg::errors::DecodeErrors| match e {
+        zune_jpeg::errors::DecodeErrors::Unsupported(what) => unsupported(F, format!("{what:?}")),
+        other => corrupt(F, other),
+    };
+    let zune_options = zune_core::options::DecoderOptions::default()
+        .set_strict_mode(false)
+        .set_max_width(usize::MAX)
+        .set_max_height(usize::MAX);
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(
+        zune_core::bytestream::ZCursor::new(bytes),
+        zune_options,
+    );
+    decoder.decode_headers().map_err(jpeg_error)?;
+    let (width, height) = decoder
+        .dimensions()
+        .ok_or_else(|| corrupt(F, "no frame header"))?;
+    let (width, height) = (width as u32, height as u32);
+    check_size(width, height, options)?;
+    let input = decoder
+        .input_colorspace()
+        .ok_or_else(|| corrupt(F, "no frame header"))?;
+    let output = match input {
+        ColorSpace::RGB | ColorSpace::RGBA | ColorSpace::Luma | ColorSpace::LumaA => input,
+        _ => ColorSpace::RGB,
+    };
+    decoder.set_options(decoder.options().jpeg_set_out_colorspace(output));
+    let channels = output.num_components() as u8;
+    check_alloc(F, width, height, channels, 1, options)?;
+    let pixels = decoder.decode().map_err(jpeg_error)?;
+    Ok(Raster {
+        width,
+        height,
+        channels,
+        samples: Samples::U8(pixels),
+    })
+}
+
+/// GIF: the first frame, RGBA, placed on the logical screen at its offset
+/// (outside the frame: transparent black, as the `image` crate does).
+pub(super) fn decode_gif(bytes: &[u8], options: &DecodeOptions) -> Result<Raster> {
+    const F: ImageFormat = ImageFormat::Gif;
+    let gif_error = |e: gif::DecodingError| corrupt(F, e);
+    let mut gif_options = gif::DecodeOptions::new();
+    gif_options.set_color_output(gif::ColorOutput::RGBA);
+    if let Some(limit) = std::num::NonZeroU64::new(options.max_alloc_bytes) {
+        gif_options.set_memory_limit(gif::MemoryLimit::Bytes(limit));
+    }
+    let mut decoder = gif_options
+        .read_info(Cursor::new(bytes))
+        .map_err(gif_error)?;
+    let (width, height) = (decoder.width() as u32, decoder.height() as u32);
+    check_size(width, height, options)?;
+    let size = check_alloc(F, width, height, 4, 1, options)?;
+    let frame = decoder
+        .read_next_frame()
+        .map_err(gif_error)?
+        .ok_or_else(|| corrupt(F, "no image frame"))?;
+    let mut canvas = vec![0u8; size];
+    let (fw, fh) = (frame.width as usize, frame.height as usize);
+    let (left, top) = (frame.left as usize, frame.top as usize);
+    let (w, h) = (width as usize, height as usize);
+    if fw > 0 && left < w {
+        let copy = fw.min(w - left) * 4;
+        for (fy, src) in frame.buffer.chunks_exact(fw * 4).take(fh).enumerate() {
+            let y = top + fy;
+            if y >= h {
+                break;
+            }
+            let at = (y * w + left) * 4;
+            canvas[at..at + copy].copy_from_slice(&src[..copy]);
+        }
+    }
+    Ok(Raster {
+        width,
+        height,
+        channels: 4,
+        samples: Samples::U8(canvas),
+    })
+}
+
+/// TIFF: grey, grey+alpha, RGB, RGBA at 1 (grey only), 8, 16 bits or 32-bit
+/// float; uncompressed, LZW, deflate, PackBits. No JPEG-in-TIFF.
+pub(super) fn decode_tiff(bytes: &[u8], options: &DecodeOptions) -> Result<Raster> {
+    use tiff::decoder::DecodingResult;
+    use tiff::ColorType;
+    const F: ImageFormat = ImageFormat::Tiff;
+    let tiff_error = |e: tiff::TiffError| match e {
+        tiff::TiffError::UnsupportedError(what) => unsupported(F, what),
+        tiff::TiffError::LimitsExceeded => too_large(F, options),
+        other => corrupt(F, other),
+    };
+    let mut decoder = tiff::decoder::Decoder::new(Cursor::new(bytes)).map_err(tiff_error)?;
+    let (width, height) = decoder.dimensions().map_err(tiff_error)?;
+    check_size(width, height, options)?;
+    let color = decoder.colortype().map_err(tiff_error)?;
+    let (channels, bits) = match color {
+        ColorType::Gray(b) => (1u8, b),
+        ColorType::GrayA(b) => (2, b),
+        ColorType::RGB(b) => (3, b),
+        ColorType::RGBA(b) => (4, b),
+        other => return Err(unsupported(F, format!("colour type {other:?}"))),
+    };
+    let bytes_per_sample = match (channels, bits) {
+        (1, 1) | (_, 8) => 1,
+        (_, 16) => 2,
+        (_, 32) => 4,
+        _ => return Err(unsupported(F, format!("colour type {color:?}"))),
+    };
+    check_alloc(F, width, height, channels, bytes_per_sample, options)?;
+    let mut limits = tiff::decoder::Limits::default();
+    limits.decoding_buffer_size = alloc_limit(options);
+    let mut decoder = decoder.with_limits(limits);
+    let samples = match (decoder.read_image().map_err(tiff_error)?, bits) {
+        (DecodingResult::U8(v), 1) => Samples::U8(unpack_bits(&v, width, height)),
+        (DecodingResult::U8(v), 8) => Samples::U8(v),
+        (DecodingResult::U16(v), 16) => Samples::U16(v),
+        (DecodingResult::F32(v), 32) => Samples::F32(v),
+        _ => return Err(unsupported(F, format!("sample format of {color:?}"))),
+    };
+    let expected = width as usize * height as usize * channels as usize;
+    let len = match &samples {
+        Samples::U8(v) => v.len(),
+        Samples::U16(v) => v.len(),
+        Samples::F32(v) => v.len(),
+    };
+    if len < expected {
+        return Err(corrupt(F, format!("{len} samples for {expected}")));
+    }
+    Ok(Raster {
+        width,
+        height,
+        channels,
+        samples,
+    })
+}
+
+/// 1-bit rows (MSB first, each row padded to a byte) to 0 / 255.
+fn unpack_bits(packed: &[u8], width: u32, height: u32) -> Vec<u8> {
+    let w = width as usize;
+    let stride = w.div_ceil(8);
+    let mut out = Vec::with_capacity(w * height as usize);
+    for row in packed.chunks(stride.max(1)).take(height as usize) {
+        out.extend((0..w).map(|x| {
+            let bit = row.get(x / 8).map_or(0, |b| (b >> (7 - x % 8)) & 1);
+            bit * 255
+        }));
+    }
+    out
+}
