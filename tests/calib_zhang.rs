@@ -120,7 +120,7 @@ fn noisy_scene_is_within_bounds_from_sigma() {
 fn reported_std_matches_the_scatter_over_repetitions() {
     let truth = Camera::example_brown();
     let sigma = 0.5;
-    let trials = 40;
+    let trials = 100;
     let mut inside = 0;
     let mut total = 0;
     let (mut sum_sq, mut sum_std) = (0.0, 0.0);
@@ -146,13 +146,14 @@ fn reported_std_matches_the_scatter_over_repetitions() {
         sum_sq += (report.camera.fx - truth.fx).powi(2);
         sum_std += report.std["fx"];
     }
-    // Gaussian: 99.73 % within 3 sigma; allow 2 % outside over 360 checks.
+    eprintln!("Zhang: {inside} of {total} within 3 std");
+    // Gaussian: 99.73 % within 3 sigma; issue 5 asks >= 99 %.
     assert!(
-        inside as f64 >= 0.98 * total as f64,
+        inside as f64 >= 0.99 * total as f64,
         "{inside} of {total} within 3 std"
     );
-    // The observed scatter of fx and the mean reported std agree to ~11 %
-    // (std of a 40-sample std); allow 35 % (3 of those).
+    // The observed scatter of fx and the mean reported std agree to ~7 %
+    // (std of a 100-sample std); allow 35 % (5 of those).
     let observed = (sum_sq / trials as f64).sqrt();
     let reported = sum_std / trials as f64;
     assert!(

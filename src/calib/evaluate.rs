@@ -10,6 +10,7 @@ use crate::camera::Camera;
 use crate::error::Result;
 use crate::geometry::Pose;
 use crate::optim::{solve, BlockParams, LmOptions};
+use nalgebra::DMatrix;
 
 /// The report of `camera` and one pose per view, as they are. `fixed`
 /// flags the camera parameters (layout of [`Camera::params`]) the method
@@ -36,6 +37,46 @@ pub(crate) fn refine_from(
     iterations: usize,
     options: &CalibrationOptions,
 ) -> Result<CameraCalibration> {
+    refine_with(
+        views, camera, poses, fixed, aspect, iterations, None, options,
+    )
+}
+
+/// The report of `camera` and the poses as they are, with the camera
+/// parameters' covariance given (layout of [`Camera::params`]) instead of
+/// the one of the Jacobian: for the filter, whose own covariance is its
+/// uncertainty.
+pub(crate) fn report_with_covariance(
+    views: &[View],
+    camera: &Camera,
+    poses: &[Pose],
+    covariance: DMatrix<f64>,
+    options: &CalibrationOptions,
+) -> Result<CameraCalibration> {
+    let fixed = vec![true; camera.params().len()];
+    refine_with(
+        views,
+        camera,
+        poses,
+        fixed,
+        None,
+        0,
+        Some(covariance),
+        options,
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn refine_with(
+    views: &[View],
+    camera: &Camera,
+    poses: &[Pose],
+    fixed: Vec<bool>,
+    aspect: Option<f64>,
+    iterations: usize,
+    covariance: Option<DMatrix<f64>>,
+    options: &CalibrationOptions,
+) -> Result<CameraCalibration> {
     let used: Vec<Vec<bool>> = views.iter().map(|v| vec![true; v.object_m.len()]).collect();
     let problem = CalibProblem {
         template: camera,
@@ -53,7 +94,10 @@ pub(crate) fn refine_from(
         fixed_global: fixed,
         ..LmOptions::default()
     };
-    let result = solve(&problem, &params, &lm)?;
+    let mut result = solve(&problem, &params, &lm)?;
+    if covariance.is_some() {
+        result.covariance_global = covariance;
+    }
     let options = CalibrationOptions {
         model: camera.distortion.clone(),
         ..options.clone()
