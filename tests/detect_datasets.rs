@@ -7,16 +7,22 @@
 //! tests/fixtures/opencv-left-right-9x6.json, written by
 //! bench/opencv_reference.py; OpenCV 4.14, cornerSubPix 11x11).
 //!
-//! Tolerance: median distance per image <= 0.2 px. The issue asked for
-//! 0.1 px; measured medians are 0.07-0.17 px, and the disagreement is not
-//! ours to remove: after undistorting with OpenCV's own calibration
-//! (left_intrinsics.yml) a homography fits robocal's corners better than
-//! OpenCV's (median RMS 0.166 vs 0.186 px over the 13 left images, see
-//! BENCHMARKS.md). Single corners differ by up to 6 px where the board's
-//! thin outer row meets its frame: OpenCV's 23x23 window is pulled by the
-//! frame edge, while the saddle of the image stays put for windows of
-//! 2.5 to 8 px. OpenCV's order may run from the other end of the board:
-//! the comparison keeps the direction that fits.
+//! Tolerances (measured 2026-11-22): over all 1404 corners the median
+//! distance to OpenCV is 0.092 px, asserted <= 0.1 px (the issue's bound,
+//! met in the median); per image the median is 0.06-0.131 px, asserted
+//! <= 0.14 px. The disagreement is per-corner scatter (std 0.08-0.09 px
+//! per axis, per-image mean offsets below 0.1 px), and the evidence says
+//! it is not a bias of ours: (1) after undistorting both corner sets with
+//! OpenCV's own calibration (left_intrinsics.yml) a homography fits
+//! robocal's corners better than OpenCV's (median RMS 0.166 vs 0.186 px
+//! over the 13 left images, BENCHMARKS.md); (2) on renders degraded like
+//! these photos (blur, noise, JPEG; bench/detect_jpeg_truth.py) robocal is
+//! closer to the truth than OpenCV in every case. Single corners differ
+//! by up to 6 px where the board's thin outer row meets its frame:
+//! OpenCV's 23x23 window is pulled by the frame edge, while the saddle of
+//! the image stays put for windows of 2.5 to 8 px. OpenCV's order may run
+//! from the other end of the board: the comparison keeps the direction
+//! that fits.
 //!
 //! Zhang 1998: the target is a grid of separate black squares, not a
 //! chessboard (no X-junctions); the chessboard detector must refuse it
@@ -55,6 +61,7 @@ fn opencv_left_right_9x6_agrees_with_opencv() {
     let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
     let mut checked = 0;
     let mut worst_median: f64 = 0.0;
+    let mut all: Vec<f64> = Vec::new();
     for (name, reference) in fixture["images"].as_object().unwrap() {
         let Some(reference) = reference.as_array() else {
             continue;
@@ -89,12 +96,19 @@ fn opencv_left_right_9x6_agrees_with_opencv() {
         let mean = d.iter().sum::<f64>() / d.len() as f64;
         let max = d.iter().cloned().fold(0.0, f64::max);
         eprintln!("{name}: median {median:.4} px, mean {mean:.4} px, max {max:.4} px from OpenCV");
-        assert!(median <= 0.2, "{name}: median {median} px from OpenCV");
+        assert!(median <= 0.14, "{name}: median {median} px from OpenCV");
+        all.extend(d.iter().copied());
         worst_median = worst_median.max(median);
         checked += 1;
     }
     assert_eq!(checked, 26);
-    eprintln!("worst per-image median distance to OpenCV: {worst_median:.4} px");
+    all.sort_by(f64::total_cmp);
+    let overall = all[all.len() / 2];
+    eprintln!(
+        "worst per-image median distance to OpenCV: {worst_median:.4} px; median over all {} corners {overall:.4} px",
+        all.len()
+    );
+    assert!(overall <= 0.1, "median over all corners {overall} px");
 }
 
 #[test]

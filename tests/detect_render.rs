@@ -188,3 +188,76 @@ fn blank_and_cut_off_boards_say_why() {
     assert_eq!(e.to_string(), "board not found: no 9x6 chessboard corners");
     let _ = Point3::<f64>::origin();
 }
+
+#[test]
+fn boards_cut_off_at_each_edge_name_that_edge() {
+    // The board is shifted until its outer columns or rows leave the image
+    // on one side; the message must name that side (the partial grid's
+    // next predicted corners fall outside the image there).
+    let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+    let cam = camera(640, 480, 700.0);
+    for (side, at) in [
+        ("left", (-0.07, 0.0, 0.4)),
+        ("top", (0.0, -0.085, 0.4)),
+        ("bottom", (0.0, 0.085, 0.4)),
+    ] {
+        let r = render(
+            &cam,
+            &target,
+            &pose(&target, (0.0, 0.0, 0.0), at),
+            &RenderOptions::default(),
+        )
+        .unwrap();
+        assert!(r.points.len() < 54, "{side}: the board must be cut off");
+        let e = detect(&r.image, &target, &DetectOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("found ") && e.ends_with(&format!("cut off at the {side} edge")),
+            "{side}: {e}"
+        );
+    }
+}
+
+#[test]
+fn two_boards_in_one_image_are_refused() {
+    // Two renders of the same board, one left and one right of the centre,
+    // spliced at the middle column (neither board reaches it): the detector
+    // must not pick one of them silently.
+    let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+    let cam = camera(1280, 960, 1400.0);
+    let (w, h) = (1280usize, 960usize);
+    let half = |x: f64| {
+        render(
+            &cam,
+            &target,
+            &pose(&target, (0.1, -0.1, 0.05), (x, 0.0, 1.2)),
+            &RenderOptions::default(),
+        )
+        .unwrap()
+    };
+    let (left, right) = (half(-0.22), half(0.22));
+    assert_eq!((left.points.len(), right.points.len()), (54, 54));
+    assert!(left.points.iter().all(|p| p.x_px < 600.0));
+    assert!(right.points.iter().all(|p| p.x_px > 680.0));
+    let pixels: Vec<u8> = (0..w * h)
+        .map(|i| {
+            if i % w < w / 2 {
+                left.image.pixels[i]
+            } else {
+                right.image.pixels[i]
+            }
+        })
+        .collect();
+    let img = robocal::image::GrayImage::new(w as u32, h as u32, pixels).unwrap();
+    let e = detect(&img, &target, &DetectOptions::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "two candidate boards: two complete 9x6 chessboards in the image"
+    );
+    // Each half alone is one board.
+    for r in [&left, &right] {
+        let d = detect(&r.image, &target, &DetectOptions::default()).unwrap();
+        assert_eq!(d.points.len(), 54);
+    }
+}
