@@ -1,7 +1,7 @@
 // The page: bootstraps the engine (a Web Worker running the Rust core), the
 // session store (IndexedDB) and the steps, and routes between steps by hash.
 // A URL whose fragment is #share=... opens a read-only results page.
-import { Engine } from './engine.js';
+import { Engine, EnginePool } from './engine.js';
 import { Store, defaultSession } from './store.js';
 import { $ } from './lib/dom.js';
 import { initTarget } from './views/target.js';
@@ -92,7 +92,9 @@ async function main() {
   const versionPromise = engineVersion();
   await store.load();
   initTarget(store);
-  const images = new ImagesView(store, engine);
+  // Decoding and detection use up to 4 workers (one per core).
+  const pool = new EnginePool(engine, Math.min(4, navigator.hardwareConcurrency || 1));
+  const images = new ImagesView(store, engine, pool);
   await images.restore();
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);

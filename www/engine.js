@@ -26,3 +26,32 @@ export class Engine {
     });
   }
 }
+
+/**
+ * Several engines for independent requests (image decoding and detection):
+ * `call` goes to an idle engine, starting another worker (up to `size`) when
+ * all are busy. The first engine is the page's main one.
+ */
+export class EnginePool {
+  constructor(first, size) {
+    this.engines = [first];
+    this.busy = [0];
+    this.size = Math.max(1, size);
+  }
+
+  async call(op, args = {}, transfer = []) {
+    let i = this.busy.indexOf(0);
+    if (i < 0 && this.engines.length < this.size) {
+      this.engines.push(new Engine());
+      this.busy.push(0);
+      i = this.engines.length - 1;
+    }
+    if (i < 0) i = this.busy.indexOf(Math.min(...this.busy));
+    this.busy[i]++;
+    try {
+      return await this.engines[i].call(op, args, transfer);
+    } finally {
+      this.busy[i]--;
+    }
+  }
+}

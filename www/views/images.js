@@ -7,10 +7,22 @@ import { targetSpec } from './target.js';
 const THUMB_SIDE = 320;
 const IMAGE_EXT = /\.(png|jpe?g|tiff?|bmp|pgm|ppm|pnm|gif)$/i;
 
+/** Run `fn` over `items` with at most `k` calls at a time (stops early when `stop()`). */
+async function eachConcurrent(items, k, fn, stop = () => false) {
+  let next = 0;
+  const lane = async () => {
+    while (!stop() && next < items.length) await fn(items[next++]);
+  };
+  await Promise.all(Array.from({ length: Math.max(1, Math.min(k, items.length)) }, lane));
+}
+
 export class ImagesView {
-  constructor(store, engine) {
+  /** `engine` answers single requests; `pool` (an EnginePool) decodes and detects several images at once. */
+  constructor(store, engine, pool = engine) {
     this.store = store;
     this.engine = engine;
+    this.pool = pool;
+    this.lanes = pool.size || 1;
     this.previews = new Map(); // id -> { width, height, rgba, scale }
     this.cards = new Map(); // id -> { li, canvas, meta, toggle }
     this.cancelled = false;
@@ -70,12 +82,12 @@ export class ImagesView {
       added.push(img);
     }
     this.refresh();
-    // Sequential on purpose: the worker is single-threaded and memory stays bounded.
-    for (const img of added) {
+    // One image per worker at a time: memory stays bounded.
+    await eachConcurrent(added, this.lanes, async (img) => {
       await this.preview(img);
       this.renderCard(img);
       this.refresh();
-    }
+    });
     if (added.some((i) => i.status === 'decoded')) await this.detectAll(added);
   }
 
@@ -87,7 +99,7 @@ export class ImagesView {
       this.makeCard(img);
       added.push(img);
     }
-    for (const img of added) { await this.preview(img); this.renderCard(img); }
+    await eachConcurrent(added, this.lanes, async (img) => { await this.preview(img); this.renderCard(img); });
     this.refresh();
     await this.detectAll(added);
   }
@@ -95,7 +107,7 @@ export class ImagesView {
   async preview(img) {
     try {
       const bytes = this.store.bytes.get(img.id).slice(0);
-      const p = await this.engine.call('preview', { bytes, maxSide: THUMB_SIDE }, [bytes]);
+      const p = await this.pool.call('preview', { bytes, maxSide: THUMB_SIDE }, [bytes]);
       img.info = p.info;
       if (img.status === 'pending') img.status = 'decoded';
       this.previews.set(img.id, { width: p.width, height: p.height, rgba: p.rgba, scale: p.width / p.info.width });
@@ -117,15 +129,19 @@ export class ImagesView {
     $('progress-row').hidden = false;
     $('detect-progress').max = todo.length;
     let done = 0;
-    for (const img of todo) {
-      if (this.cancelled) break;
+    const running = new Set();
+    const progress = () => {
       $('detect-progress').value = done;
-      $('progress-text').textContent = `detecting ${done + 1} of ${todo.length}: ${img.name}`;
+      $('progress-text').textContent = `detecting ${Math.min(done + 1, todo.length)} of ${todo.length}: ${[...running].join(', ')}`;
+    };
+    await eachConcurrent(todo, this.lanes, async (img) => {
+      running.add(img.name);
+      progress();
       const card = this.cards.get(img.id);
       if (card) card.meta.textContent = 'detecting…';
       try {
         const bytes = this.store.bytes.get(img.id).slice(0);
-        img.detection = await this.engine.call('detect', { bytes, spec }, [bytes]);
+        img.detection = await this.pool.call('detect', { bytes, spec }, [bytes]);
         img.status = 'detected';
         img.error = null;
         img.detectError = false;
@@ -136,9 +152,11 @@ export class ImagesView {
         img.detectError = !!img.info; // decoded fine, the target was not found
       }
       done++;
+      running.delete(img.name);
+      if (running.size) progress();
       this.renderCard(img);
       this.refresh();
-    }
+    }, () => this.cancelled);
     $('detect-progress').value = done;
     $('progress-text').textContent = this.cancelled ? `cancelled after ${done} of ${todo.length}` : `detected ${done} of ${todo.length}`;
     this.busy = false;
