@@ -1,4 +1,4 @@
-//! PNG, JPEG, GIF and TIFF through their single-format crates: read the
+//! PNG, JPEG and GIF through their single-format crates: read the
 //! header, check the limits, decode into a [`Raster`].
 
 use super::raster::{Raster, Samples};
@@ -135,74 +135,4 @@ pub(super) fn decode_gif(bytes: &[u8], options: &DecodeOptions) -> Result<Raster
         channels: 4,
         samples: Samples::U8(canvas),
     })
-}
-
-/// TIFF: grey, grey+alpha, RGB, RGBA at 1 (grey only), 8, 16 bits or 32-bit
-/// float; uncompressed, LZW, deflate, PackBits. No JPEG-in-TIFF.
-pub(super) fn decode_tiff(bytes: &[u8], options: &DecodeOptions) -> Result<Raster> {
-    use tiff::decoder::DecodingResult;
-    use tiff::ColorType;
-    const F: ImageFormat = ImageFormat::Tiff;
-    let tiff_error = |e: tiff::TiffError| match e {
-        tiff::TiffError::UnsupportedError(what) => unsupported(F, what),
-        tiff::TiffError::LimitsExceeded => too_large(F, options),
-        other => corrupt(F, other),
-    };
-    let mut decoder = tiff::decoder::Decoder::new(Cursor::new(bytes)).map_err(tiff_error)?;
-    let (width, height) = decoder.dimensions().map_err(tiff_error)?;
-    check_size(width, height, options)?;
-    let color = decoder.colortype().map_err(tiff_error)?;
-    let (channels, bits) = match color {
-        ColorType::Gray(b) => (1u8, b),
-        ColorType::GrayA(b) => (2, b),
-        ColorType::RGB(b) => (3, b),
-        ColorType::RGBA(b) => (4, b),
-        other => return Err(unsupported(F, format!("colour type {other:?}"))),
-    };
-    let bytes_per_sample = match (channels, bits) {
-        (1, 1) | (_, 8) => 1,
-        (_, 16) => 2,
-        (_, 32) => 4,
-        _ => return Err(unsupported(F, format!("colour type {color:?}"))),
-    };
-    check_alloc(F, width, height, channels, bytes_per_sample, options)?;
-    let mut limits = tiff::decoder::Limits::default();
-    limits.decoding_buffer_size = alloc_limit(options);
-    let mut decoder = decoder.with_limits(limits);
-    let samples = match (decoder.read_image().map_err(tiff_error)?, bits) {
-        (DecodingResult::U8(v), 1) => Samples::U8(unpack_bits(&v, width, height)),
-        (DecodingResult::U8(v), 8) => Samples::U8(v),
-        (DecodingResult::U16(v), 16) => Samples::U16(v),
-        (DecodingResult::F32(v), 32) => Samples::F32(v),
-        _ => return Err(unsupported(F, format!("sample format of {color:?}"))),
-    };
-    let expected = width as usize * height as usize * channels as usize;
-    let len = match &samples {
-        Samples::U8(v) => v.len(),
-        Samples::U16(v) => v.len(),
-        Samples::F32(v) => v.len(),
-    };
-    if len < expected {
-        return Err(corrupt(F, format!("{len} samples for {expected}")));
-    }
-    Ok(Raster {
-        width,
-        height,
-        channels,
-        samples,
-    })
-}
-
-/// 1-bit rows (MSB first, each row padded to a byte) to 0 / 255.
-fn unpack_bits(packed: &[u8], width: u32, height: u32) -> Vec<u8> {
-    let w = width as usize;
-    let stride = w.div_ceil(8);
-    let mut out = Vec::with_capacity(w * height as usize);
-    for row in packed.chunks(stride.max(1)).take(height as usize) {
-        out.extend((0..w).map(|x| {
-            let bit = row.get(x / 8).map_or(0, |b| (b >> (7 - x % 8)) & 1);
-            bit * 255
-        }));
-    }
-    out
 }

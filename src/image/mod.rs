@@ -7,9 +7,9 @@
 //! `image` crate did before (so pixels match its output); 16-bit data is
 //! scaled to 8 bits with rounding.
 //!
-//! PNG, JPEG, GIF and TIFF use the small single-format crates (`png`,
-//! `zune-jpeg`, `gif`, `tiff` without its JPEG-in-TIFF support); BMP and PNM
-//! are read here ([`bmp`], [`pnm`]). Each codec returns a [`raster::Raster`]
+//! PNG, JPEG and GIF use the small single-format crates (`png`, `zune-jpeg`,
+//! `gif`); TIFF, BMP and PNM are read here ([`tiff`], [`bmp`], [`pnm`], with
+//! `weezl` and `fdeflate` for TIFF's LZW and deflate). Each codec returns a [`raster::Raster`]
 //! in its file's own channels and depth; the conversions to grey and to the
 //! RGBA preview happen once, in [`raster`].
 
@@ -20,6 +20,9 @@ mod codecs;
 mod png_encode;
 mod pnm;
 mod raster;
+mod tiff;
+#[cfg(test)]
+mod tiff_tests;
 
 use crate::error::{Error, Result};
 use serde::Serialize;
@@ -181,7 +184,7 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     let raster = match format {
         ImageFormat::Png => codecs::decode_png(bytes, options)?,
         ImageFormat::Jpeg => codecs::decode_jpeg(bytes, options)?,
-        ImageFormat::Tiff => codecs::decode_tiff(bytes, options)?,
+        ImageFormat::Tiff => tiff::decode(bytes, options)?,
         ImageFormat::Gif => codecs::decode_gif(bytes, options)?,
         ImageFormat::Bmp => bmp::decode(bytes, options)?,
         ImageFormat::Pnm => pnm::decode(bytes, options)?,

@@ -114,33 +114,36 @@ impl Raster {
         }
     }
 
-    /// One row as RGBA8 into `out` (length `4 * width`).
-    fn row_rgba(&self, y: usize, out: &mut [u8]) {
-        let ch = self.channels.max(1) as usize;
-        let w = self.width as usize;
-        let start = y * w * ch;
-        let end = start + w * ch;
-        let to_rgba = |p: [u8; 4], px: &mut [u8]| px.copy_from_slice(&p);
-        macro_rules! convert {
-            ($row:expr, $cvt:expr) => {
-                if let Some(row) = $row.get(start..end) {
-                    for (p, px) in row.chunks_exact(ch).zip(out.chunks_exact_mut(4)) {
-                        let c = |i: usize| $cvt(p[i]);
-                        let rgba = match ch {
-                            1 => [c(0), c(0), c(0), 255],
-                            2 => [c(0), c(0), c(0), c(1)],
-                            3 => [c(0), c(1), c(2), 255],
-                            _ => [c(0), c(1), c(2), c(3)],
-                        };
-                        to_rgba(rgba, px);
-                    }
-                }
-            };
-        }
+    /// One row as RGBA8 into `out` (length `4 * width`); `scratch` holds the
+    /// row's samples at 8 bits. Loops are per channel layout, not per pixel,
+    /// so they stay fast at opt-level "s".
+    fn row_rgba(&self, y: usize, scratch: &mut Vec<u8>, out: &mut [u8]) {
+        let ch = self.channels.clamp(1, 4) as usize;
+        let n = self.width as usize * ch;
+        let range = y * n..(y + 1) * n;
+        scratch.clear();
         match &self.samples {
-            Samples::U8(v) => convert!(v, |s: u8| s),
-            Samples::U16(v) => convert!(v, u16_to_u8),
-            Samples::F32(v) => convert!(v, f32_to_u8),
+            Samples::U8(v) => scratch.extend_from_slice(v.get(range).unwrap_or(&[])),
+            Samples::U16(v) => {
+                scratch.extend(v.get(range).unwrap_or(&[]).iter().map(|&s| u16_to_u8(s)))
+            }
+            Samples::F32(v) => {
+                scratch.extend(v.get(range).unwrap_or(&[]).iter().map(|&s| f32_to_u8(s)))
+            }
+        }
+        scratch.resize(n, 0);
+        let px = out.chunks_exact_mut(4);
+        match ch {
+            1 => px
+                .zip(scratch.iter())
+                .for_each(|(d, &g)| d.copy_from_slice(&[g, g, g, 255])),
+            2 => px
+                .zip(scratch.chunks_exact(2))
+                .for_each(|(d, s)| d.copy_from_slice(&[s[0], s[0], s[0], s[1]])),
+            3 => px
+                .zip(scratch.chunks_exact(3))
+                .for_each(|(d, s)| d.copy_from_slice(&[s[0], s[1], s[2], 255])),
+            _ => out.copy_from_slice(&scratch[..out.len()]),
         }
     }
 
@@ -162,13 +165,14 @@ impl Raster {
         }
         let mut out = vec![0u8; tw_u * th_u * 4];
         let mut row = vec![0u8; w * 4];
+        let mut scratch = Vec::with_capacity(w * self.channels as usize);
         let mut sums = vec![0u32; tw_u * 4];
         let mut y = 0;
         for ty in 0..th_u {
             sums.iter_mut().for_each(|s| *s = 0);
             let mut rows = 0u32;
             while y < h && y * th_u / h == ty {
-                self.row_rgba(y, &mut row);
+                self.row_rgba(y, &mut scratch, &mut row);
                 for (px, &c) in row.chunks_exact(4).zip(&column) {
                     for k in 0..4 {
                         sums[c * 4 + k] += px[k] as u32;
