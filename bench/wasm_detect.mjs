@@ -2,7 +2,7 @@
 // on rendered images; compare with the native
 // `cargo run --release --example detect_time -- --decode FILES`.
 // Usage (crate root, after `make pkg` and bench/compare_opencv.py):
-//   node bench/wasm_detect.mjs [--repeat N] FILES...
+//   node bench/wasm_detect.mjs [--repeat N] [--decode-only] FILES...
 import { createRequire } from "node:module";
 import { readFileSync } from "node:fs";
 import { performance } from "node:perf_hooks";
@@ -12,9 +12,13 @@ const robocal = require("../pkg/node/robocal.js");
 
 const args = process.argv.slice(2);
 let repeat = 11;
+// --decode-only: time image_info (the same full decode, no detection), so
+// that detection alone ~ detect_target median - this median.
+let decodeOnly = false;
 const files = [];
 for (let i = 0; i < args.length; i++) {
   if (args[i] === "--repeat") repeat = Number(args[++i]);
+  else if (args[i] === "--decode-only") decodeOnly = true;
   else files.push(args[i]);
 }
 const medians = [];
@@ -25,7 +29,9 @@ for (const f of files) {
   for (let k = 0; k < repeat; k++) {
     const t0 = performance.now();
     try {
-      points = JSON.parse(robocal.detect_target(bytes, "chessboard:9x6:30mm")).points.length;
+      points = decodeOnly
+        ? JSON.parse(robocal.image_info(bytes)).width
+        : JSON.parse(robocal.detect_target(bytes, "chessboard:9x6:30mm")).points.length;
     } catch (e) {
       points = null;
     }
@@ -37,4 +43,4 @@ for (const f of files) {
   console.log(`${f}: ${ms.toFixed(3)} ms, ${points} points`);
 }
 medians.sort((a, b) => a - b);
-console.log(`median over ${medians.length} files: ${medians[Math.floor(medians.length / 2)].toFixed(3)} ms (wasm, node ${process.version})`);
+console.log(`median over ${medians.length} files: ${medians[Math.floor(medians.length / 2)].toFixed(3)} ms (wasm, node ${process.version}${decodeOnly ? ", decode only" : ""})`);
