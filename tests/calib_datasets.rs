@@ -7,25 +7,17 @@
 //! - Bouguet's stereo result of his 5th example (right_from_left) from the
 //!   same OpenCV corners.
 //!
-//! The data sit in ../shared/datasets (beside the crate root) or
-//! /work/shared/datasets; each test is skipped with a message when absent.
+//! The data sit in ../shared/datasets (beside the crate root; see
+//! tests/support); each test is skipped with a message when absent.
+
+mod support;
+use support::dataset;
 
 use nalgebra::{Point2, Point3, Vector3};
 use robocal::calib::stereo::calibrate_stereo;
 use robocal::calib::{calibrate, CalibrationOptions, View};
 use robocal::camera::Distortion;
 use serde_json::Value;
-use std::path::PathBuf;
-
-fn dataset(name: &str) -> Option<PathBuf> {
-    [
-        PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/datasets")),
-        PathBuf::from("/work/shared/datasets"),
-    ]
-    .into_iter()
-    .map(|d| d.join(name))
-    .find(|p| p.is_dir())
-}
 
 fn brown() -> Distortion {
     Distortion::Brown {

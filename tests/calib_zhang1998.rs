@@ -3,23 +3,15 @@
 //! The data lives outside the crate (../shared/datasets/zhang1998); the test
 //! is skipped with a message when it is absent.
 
+mod support;
+use support::dataset;
+
 use nalgebra::{Point2, Point3};
 use robocal::calib::{calibrate, CalibrationOptions, View};
 use robocal::Distortion;
-use std::path::PathBuf;
 
 /// Model.txt is in inches (README: 17 cm pattern, coordinates to ~6.7).
 const INCH_M: f64 = 0.0254;
-
-fn dataset_dir() -> Option<PathBuf> {
-    [
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/datasets/zhang1998"),
-        "/work/shared/datasets/zhang1998",
-    ]
-    .iter()
-    .map(PathBuf::from)
-    .find(|p| p.join("Model.txt").exists())
-}
 
 /// Whitespace-separated numbers, 8 per line = 4 (x, y) points.
 fn points(text: &str) -> Vec<Point2<f64>> {
@@ -45,7 +37,7 @@ fn check(name: &str, got: f64, want: f64, std: f64) {
 }
 
 fn load_views() -> Option<Vec<View>> {
-    let Some(dir) = dataset_dir() else {
+    let Some(dir) = dataset("zhang1998") else {
         eprintln!(
             "skipped: zhang1998 dataset not found beside the crate or in /work/shared/datasets"
         );

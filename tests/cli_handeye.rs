@@ -2,6 +2,9 @@
 //! render --demo` (exact truth, grey noise sigma 2: corners within ~0.05 px)
 //! and RWHE-Calib's CS_synthetic_1 (ground truth X = diag(1, -1, -1), t = 0).
 
+mod support;
+use support::dataset;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -143,19 +146,9 @@ fn demo_images_recover_the_truth_and_failed_images_are_dropped_with_their_pose()
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-fn dataset_dir() -> Option<PathBuf> {
-    let name = "rwhe-calib-cs-synthetic-1";
-    [
-        PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/datasets")).join(name),
-        PathBuf::from("/work/shared/datasets").join(name),
-    ]
-    .into_iter()
-    .find(|p| p.join("RobotPosesVec.txt").exists())
-}
-
 #[test]
 fn rwhe_cs_synthetic_1_recovers_its_ground_truth_from_the_images() {
-    let Some(dir) = dataset_dir() else {
+    let Some(dir) = dataset("rwhe-calib-cs-synthetic-1") else {
         eprintln!("skipped: ../shared/datasets/rwhe-calib-cs-synthetic-1 is absent");
         return;
     };

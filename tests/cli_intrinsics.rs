@@ -2,30 +2,13 @@
 //! like `robocal detect`'s from seeded synthetic scenes (exact answers),
 //! the OpenCV sample images when present, and bad arguments.
 
+mod support;
+use support::{dataset, robocal, temp_dir};
+
 use robocal::synth::Scene;
 use robocal::Camera;
 use serde_json::{json, Value};
 use std::path::PathBuf;
-use std::process::Command;
-
-fn robocal(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .output()
-        .expect("run robocal");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("robocal-intrinsics-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
 
 /// A `robocal detect` output for a noise-free scene, plus one failed image.
 fn detections_file(dir: &PathBuf) -> (PathBuf, Camera) {
@@ -60,7 +43,7 @@ fn detections_file(dir: &PathBuf) -> (PathBuf, Camera) {
 
 #[test]
 fn detections_file_gives_the_exact_camera_and_an_exportable_report() {
-    let dir = temp_dir("file");
+    let dir = temp_dir("intrinsics", "file");
     let (detections, truth) = detections_file(&dir);
     let out = dir.join("camera.json");
     let (code, stdout, stderr) = robocal(&[
@@ -108,7 +91,7 @@ fn detections_file_gives_the_exact_camera_and_an_exportable_report() {
 
 #[test]
 fn method_all_prints_the_comparison_table() {
-    let dir = temp_dir("all");
+    let dir = temp_dir("intrinsics", "all");
     let (detections, _) = detections_file(&dir);
     let (code, stdout, stderr) = robocal(&[
         "intrinsics",
@@ -133,7 +116,7 @@ fn method_all_prints_the_comparison_table() {
 
 #[test]
 fn bad_arguments_say_what_to_change() {
-    let dir = temp_dir("bad");
+    let dir = temp_dir("intrinsics", "bad");
     let (detections, _) = detections_file(&dir);
     let d = detections.to_str().expect("path");
     let cases: [(&[&str], i32, &str); 6] = [
@@ -162,22 +145,9 @@ fn bad_arguments_say_what_to_change() {
     );
 }
 
-fn dataset() -> Option<PathBuf> {
-    [
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../shared/datasets/opencv-left-right-9x6"
-        ),
-        "/work/shared/datasets/opencv-left-right-9x6",
-    ]
-    .iter()
-    .map(PathBuf::from)
-    .find(|p| p.join("left01.jpg").exists())
-}
-
 #[test]
 fn opencv_left_images_calibrate_near_the_published_camera() {
-    let Some(dir) = dataset() else {
+    let Some(dir) = dataset("opencv-left-right-9x6") else {
         eprintln!("skipped: opencv-left-right-9x6 dataset not found");
         return;
     };
@@ -219,7 +189,7 @@ fn opencv_left_images_calibrate_near_the_published_camera() {
 
 #[test]
 fn aspect_ratio_holds_fx_equal_fy_and_repeat_times_the_solve() {
-    let dir = temp_dir("aspect");
+    let dir = temp_dir("intrinsics", "aspect");
     let (detections, truth) = detections_file(&dir);
     let d = detections.to_str().expect("path");
     let (code, stdout, stderr) = robocal(&[

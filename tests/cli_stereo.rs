@@ -3,6 +3,9 @@
 //! arguments, and the public OpenCV/Bouguet 9x6 pairs against Bouguet's
 //! published stereo result.
 
+mod support;
+use support::{dataset, robocal, temp_dir};
+
 use nalgebra::{Translation3, Vector3};
 use robocal::calib::View;
 use robocal::camera::Distortion;
@@ -12,26 +15,7 @@ use robocal::synth::{render, RenderOptions, Scene};
 use robocal::target::Target;
 use robocal::Camera;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn robocal(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .output()
-        .expect("run robocal");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("robocal-stereo-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
+use std::path::Path;
 
 fn camera(fx: f64, cx: f64, k1: f64) -> Camera {
     Camera {
@@ -117,7 +101,7 @@ fn rendered_pairs(dir: &Path) -> (Vec<String>, Vec<String>, Pose) {
 
 #[test]
 fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
-    let dir = temp_dir("pairs");
+    let dir = temp_dir("stereo", "pairs");
     let (lf, rf, truth) = rendered_pairs(&dir);
     let out = dir.join("stereo.json");
     let mut args = vec!["stereo", "--target", "chessboard:9x6:30mm", "--left"];
@@ -211,16 +195,7 @@ fn bad_arguments_say_what_to_change() {
 
 #[test]
 fn opencv_9x6_pairs_give_bouguets_right_from_left() {
-    let Some(dir) = [
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../shared/datasets/opencv-left-right-9x6"
-        ),
-        "/work/shared/datasets/opencv-left-right-9x6",
-    ]
-    .iter()
-    .map(PathBuf::from)
-    .find(|p| p.join("left01.jpg").exists()) else {
+    let Some(dir) = dataset("opencv-left-right-9x6") else {
         eprintln!("skipped: opencv-left-right-9x6 dataset not found");
         return;
     };

@@ -28,20 +28,15 @@
 //! chessboard (no X-junctions); the chessboard detector must refuse it
 //! cleanly instead of inventing a board.
 
+mod support;
+use support::dataset;
+
 use robocal::detect::{detect, DetectOptions};
 use robocal::target::Target;
-use std::path::PathBuf;
-
-fn datasets() -> Option<PathBuf> {
-    let local = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/datasets"));
-    [local, PathBuf::from("/work/shared/datasets")]
-        .into_iter()
-        .find(|p| p.is_dir())
-}
 
 #[test]
 fn opencv_left_right_9x6_agrees_with_opencv() {
-    let Some(root) = datasets() else {
+    let Some(root) = dataset("") else {
         eprintln!("skipped: ../shared/datasets not found");
         return;
     };
@@ -113,7 +108,7 @@ fn opencv_left_right_9x6_agrees_with_opencv() {
 
 #[test]
 fn zhang1998_square_grid_is_not_mistaken_for_a_chessboard() {
-    let Some(root) = datasets() else {
+    let Some(root) = dataset("") else {
         eprintln!("skipped: ../shared/datasets not found");
         return;
     };

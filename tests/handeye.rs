@@ -6,6 +6,8 @@
 //! - RWHE-Calib CS_synthetic_1: its robot pose file parses into 15 rigid
 //!   base_from_gripper poses (solving needs the board detections).
 
+mod support;
+
 use nalgebra::Matrix4;
 use robocal::geometry::pose_from_matrix4;
 use robocal::handeye::pose_text::parse_pose_text;
@@ -13,15 +15,9 @@ use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, Pose, Setup};
 use std::path::PathBuf;
 
 fn dataset(name: &str) -> Option<PathBuf> {
-    let candidates = [
-        PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/datasets")),
-        PathBuf::from("/work/shared/datasets"),
-    ];
-    let found = candidates.iter().map(|c| c.join(name)).find(|p| p.exists());
+    let found = support::dataset(name);
     if found.is_none() {
-        eprintln!(
-            "skipping: dataset {name} not found in ../shared/datasets or /work/shared/datasets"
-        );
+        eprintln!("skipping: dataset {name} not found in ../shared/datasets");
     }
     found
 }

@@ -1,17 +1,14 @@
 //! Robot pose files from public datasets, parsed with the `io` presets.
-//! Skipped (with a message) when /work/shared/datasets is not present.
+//! Skipped (with a message) when ../shared/datasets is not present.
 
+mod support;
 use std::path::PathBuf;
 
 use robocal::geometry::{pose_from_matrix4, rotation_angle_between};
 use robocal::io::{parse_pose_candidates, parse_poses, PoseFileOptions, PoseFormat};
 
 fn dataset(rel: &str) -> Option<PathBuf> {
-    let candidates = [
-        PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/datasets")).join(rel),
-        PathBuf::from("/work/shared/datasets").join(rel),
-    ];
-    let found = candidates.into_iter().find(|p| p.exists());
+    let found = support::dataset(rel);
     if found.is_none() {
         eprintln!("skipping: dataset file {rel} not found");
     }

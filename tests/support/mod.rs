@@ -1,0 +1,46 @@
+//! Helpers shared by the integration tests (`mod support;` in each file
+//! that needs them): running the real `robocal` binary, scratch folders,
+//! and locating the public datasets.
+
+#![allow(dead_code)] // each test crate uses a different subset
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// Run the `robocal` binary built for this test run: (exit code, stdout, stderr).
+pub fn robocal(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .args(args)
+        .output()
+        .expect("run robocal");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fresh scratch folder `robocal-<suite>-<name>-<pid>` in the temp dir.
+pub fn temp_dir(suite: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("robocal-{suite}-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// `<datasets>/<rel>` when it exists, where `<datasets>` is, in turn,
+/// `$ROBOCAL_DATASETS`, `../shared/datasets` beside the crate root (the
+/// CI layout) or `/work/shared/datasets` (the build machine, for git
+/// worktrees elsewhere). `None` (the caller skips with a message) when
+/// absent, as in a user's clone.
+pub fn dataset(rel: &str) -> Option<PathBuf> {
+    let mut roots: Vec<PathBuf> = std::env::var_os("ROBOCAL_DATASETS")
+        .map(PathBuf::from)
+        .into_iter()
+        .collect();
+    roots.push(PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/datasets"
+    )));
+    roots.push(PathBuf::from("/work/shared/datasets"));
+    roots.into_iter().map(|r| r.join(rel)).find(|p| p.exists())
+}
