@@ -15,7 +15,10 @@
 //! `"refine": "none" | "trusted" | "stochastic" | "joint_intrinsics"`
 //! (default `trusted` when views are given, see [`RefineMode`]) and
 //! `"pixel_sigma_px"` (default 0.5). With views, `camera_from_target` may be
-//! left out: it is then computed per view by [`super::pnp`].
+//! left out: it is then computed per view by [`super::pnp`]. Instead of
+//! `"views"`, `"detections"` may give one detection JSON per pose (the
+//! [`crate::target::Detection`] format, as `detect_target` returns it): the
+//! board points then come from each detection's own target.
 
 use super::checks::{rank_pose_candidates, recommend_candidate, CandidateScore};
 use super::output::HandEyeReport;
@@ -26,6 +29,7 @@ use super::{HandEyeMethod, Pose, Setup};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{pose_from_matrix4, rotation_from_quaternion_xyzw};
+use crate::target::Detection;
 use nalgebra::{Matrix4, Point2, Point3, Translation3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -62,6 +66,8 @@ struct InputJson {
     camera: Option<serde_json::Value>,
     #[serde(default)]
     views: Option<Vec<ViewIn>>,
+    #[serde(default)]
+    detections: Option<Vec<Detection>>,
     #[serde(default)]
     refine: Option<String>,
     #[serde(default)]
@@ -139,6 +145,19 @@ fn to_views(list: &[ViewIn]) -> Result<Vec<ViewPoints>> {
                 object_points: v.object_m.iter().map(|p| Point3::from(*p)).collect(),
                 image_points: v.image_px.iter().map(|p| Point2::from(*p)).collect(),
             })
+        })
+        .collect()
+}
+
+/// The board points and pixels of each detection, in id order.
+fn views_from_detections(list: &[Detection]) -> Vec<ViewPoints> {
+    list.iter()
+        .map(|d| {
+            let (object_points, image_points) = d.correspondences();
+            ViewPoints {
+                object_points,
+                image_points,
+            }
         })
         .collect()
 }
@@ -228,7 +247,17 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         None | Some("all") => {}
         Some(name) => options.methods = vec![name.parse::<HandEyeMethod>()?],
     }
-    let views = input.views.as_deref().map(to_views).transpose()?;
+    let views = match (&input.views, &input.detections) {
+        (Some(_), Some(_)) => {
+            return Err(Error::invalid(
+                "detections",
+                "give either 'views' or 'detections', not both",
+            ))
+        }
+        (Some(list), None) => Some(to_views(list)?),
+        (None, Some(list)) => Some(views_from_detections(list)),
+        (None, None) => None,
+    };
     let camera = input.camera.as_ref().map(camera_from_json).transpose()?;
     let mode = match (&input.refine, &views) {
         (Some(name), _) => name.parse::<RefineMode>()?,

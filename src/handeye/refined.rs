@@ -290,6 +290,71 @@ mod tests {
     }
 
     #[wasm_bindgen_test(unsupported = test)]
+    fn detections_give_the_same_refinement_as_views() {
+        // The web app sends its detections as they are; the board points come
+        // from each detection's target. Same points, so the same report to
+        // the last bit; both inputs at once are refused.
+        let scene = looking_scene(Setup::EyeInHand, 8, 3);
+        let (cols, square) = (9, 0.03);
+        let views = project_grid(&scene, &camera(), (cols, 6, square), 0.3, 2);
+        let view_json: Vec<serde_json::Value> = views
+            .iter()
+            .map(|v| {
+                serde_json::json!({
+                    "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        let detection_json: Vec<serde_json::Value> = views
+            .iter()
+            .map(|v| {
+                let points: Vec<serde_json::Value> = v
+                    .object_points
+                    .iter()
+                    .zip(&v.image_points)
+                    .map(|(o, px)| {
+                        let id = (o.x / square).round() as usize
+                            + (o.y / square).round() as usize * cols;
+                        serde_json::json!({"id": id, "x_px": px.x, "y_px": px.y})
+                    })
+                    .collect();
+                serde_json::json!({
+                    "image_size_px": [1280, 960],
+                    "target": {"kind": "chessboard", "cols": cols, "rows": 6, "square_m": square},
+                    "points": points,
+                })
+            })
+            .collect();
+        let base = serde_json::json!({
+            "setup": "eye-in-hand",
+            "base_from_gripper": scene.base_from_gripper.iter().map(pose_json).collect::<Vec<_>>(),
+            "camera": camera(),
+            "refine": "trusted",
+            "bootstrap_samples": 0,
+        });
+        let with = |key: &str, value: &[serde_json::Value]| {
+            let mut input = base.clone();
+            input[key] = serde_json::Value::Array(value.to_vec());
+            input
+        };
+        let from_views = solve_handeye_json(&with("views", &view_json).to_string()).unwrap();
+        let from_detections =
+            solve_handeye_json(&with("detections", &detection_json).to_string()).unwrap();
+        assert_eq!(from_views, from_detections);
+        let out: serde_json::Value = serde_json::from_str(&from_detections).unwrap();
+        assert!(out["method"].as_str().unwrap().starts_with("refined from "));
+        let mut both = with("views", &view_json);
+        both["detections"] = serde_json::Value::Array(detection_json);
+        assert_eq!(
+            solve_handeye_json(&both.to_string())
+                .unwrap_err()
+                .to_string(),
+            "detections: give either 'views' or 'detections', not both"
+        );
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
     fn joint_intrinsics_reports_the_camera_and_missing_inputs_are_named() {
         let scene = looking_scene(Setup::EyeInHand, 8, 4);
         let views = project_grid(&scene, &camera(), (9, 6, 0.03), 0.0, 1);

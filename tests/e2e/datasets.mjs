@@ -234,12 +234,18 @@ export const tests = [
     const camera = run(['intrinsics', '--target', spec, ...images]);
     assert.equal(camera.views.length, 15);
     const tmp = mkdtempSync(join(tmpdir(), 'robocal-rwhe-'));
-    let cli;
+    let cli, cliRefined;
     try {
       // The hand-eye from the same camera poses the page uses (its camera solve = the CLI's).
       const camPoses = join(tmp, 'camera_poses.txt');
       writeFileSync(camPoses, camera.views.map((v) => v.camera_from_target.matrix_row_major.flat().join(' ')).join('\n') + '\n');
       cli = run(['handeye', '--setup', 'eye-in-hand', '--poses', poses, '--camera-poses', camPoses, '--camera-pose-format', 'matrix']);
+      // The refinement over the image points with that camera: its optimum
+      // does not depend on where it starts (the CLI starts from PnP poses,
+      // the page from the camera solve's), so page and CLI must agree.
+      const camFile = join(tmp, 'camera.json');
+      writeFileSync(camFile, JSON.stringify(camera));
+      cliRefined = run(['handeye', '--setup', 'eye-in-hand', '--poses', poses, '--camera', camFile, '--target', spec, '--refine', 'trusted', ...images]);
     } finally {
       rmSync(tmp, { recursive: true, force: true });
     }
@@ -258,16 +264,29 @@ export const tests = [
     assert.match(await page.textContent('#pose-format-used'), /^RobotPosesVec\.txt: 15 poses read as matrix4, lengths in m/);
     assert.match(await page.textContent('#pose-pairing'), /by order \(pose i with the i-th included image\): 15 pairs usable/);
     await page.click('a[data-step=handeye]');
-    await page.click('#solve-handeye');
-    await page.locator('#handeye-errors').waitFor({ timeout: 120000 });
-    await shot('handeye');
-    const text = (await page.$$eval('#handeye-results p', (ps) => ps.map((p) => p.textContent))).find((t) => t.startsWith('gripper_from_camera:')) || '';
-    const m = /gripper_from_camera: translation (\S+), (\S+), (\S+) mm · quaternion \(x y z w\) (\S+), (\S+), (\S+), (\S+)/.exec(text);
-    assert.ok(m, text.slice(0, 300));
-    const X = cli.gripper_from_camera;
-    X.translation_m.forEach((t, i) => assertShown(m[1 + i], t * 1000, `gripper_from_camera t[${i}] (mm)`, 3));
-    X.quaternion_xyzw.forEach((q, i) => assertShown(m[4 + i], q, `gripper_from_camera q[${i}]`));
+    const solveShown = async (refine) => {
+      await page.selectOption('#handeye-refine', refine);
+      await page.$eval('#handeye-results', (el) => el.replaceChildren());
+      await page.click('#solve-handeye');
+      await page.locator('#handeye-errors').waitFor({ timeout: 120000 });
+      const text = (await page.$$eval('#handeye-results p', (ps) => ps.map((p) => p.textContent))).find((t) => t.startsWith('gripper_from_camera:')) || '';
+      const m = /gripper_from_camera: translation (\S+), (\S+), (\S+) mm · quaternion \(x y z w\) (\S+), (\S+), (\S+), (\S+)/.exec(text);
+      assert.ok(m, text.slice(0, 300));
+      return m;
+    };
+    const assertX = (m, X, what) => {
+      X.translation_m.forEach((t, i) => assertShown(m[1 + i], t * 1000, `${what} gripper_from_camera t[${i}] (mm)`, 3));
+      X.quaternion_xyzw.forEach((q, i) => assertShown(m[4 + i], q, `${what} gripper_from_camera q[${i}]`));
+    };
+    // Closed forms only: the page equals the CLI on the same camera poses.
+    assertX(await solveShown('none'), cli.gripper_from_camera, 'closed form');
     assert.equal((/^Result \((.*)\)$/.exec(await page.textContent('#handeye-results h3')) || [])[1], cli.method);
+    // Refined over the image points (the page's default).
+    const mRefined = await solveShown('trusted');
+    await shot('handeye');
+    assertX(mRefined, cliRefined.gripper_from_camera, 'refined');
+    assert.match(await page.textContent('#handeye-refinement'), /^Refined \(trusted\) from \S+: reprojection RMS /);
+    const X = cli.gripper_from_camera;
     // Ground truth (GroundTruth.txt): hand2eye = diag(1, -1, -1), zero
     // translation: quaternion (±1, 0, 0, 0). Rendered corners carry ~0.02 px
     // of error over a 2-6 m range: OpenCV's closed forms land within ~11 mm.
@@ -276,6 +295,10 @@ export const tests = [
     const tMm = Math.hypot(...X.translation_m) * 1000;
     assert.ok(angleDeg < 0.05 && tMm < 15, `rotation off ${angleDeg} deg, translation ${tMm} mm`);
     console.log(`     RWHE: page = CLI (${cli.method}): gripper_from_camera off the truth by ${angleDeg.toFixed(4)} deg and ${tMm.toFixed(2)} mm`);
+    const qr = cliRefined.gripper_from_camera.quaternion_xyzw;
+    const refinedDeg = 2 * Math.acos(Math.min(1, Math.abs(qr[0]))) * 180 / Math.PI;
+    const refinedMm = Math.hypot(...cliRefined.gripper_from_camera.translation_m) * 1000;
+    console.log(`     RWHE refined (trusted, page = CLI): off the truth by ${refinedDeg.toFixed(4)} deg and ${refinedMm.toFixed(2)} mm`);
   }],
   ['benchmark: 20 rendered 1280x960 images detected and solved', async (page, { url, shot }) => {
     const dir = mkdtempSync(join(tmpdir(), 'robocal-bench-'));

@@ -17,13 +17,15 @@ function niceTicks(lo, hi, n = 5) {
   return ticks;
 }
 
-function frame(canvas, { xmin, xmax, ymin, ymax, xlabel = '', ylabel = '', title = '', equal = false, yDown = false }) {
+// categorical: the x axis holds labelled items (bars, boxes), so it gets no
+// numeric ticks; padRight: room on the right (a colour bar).
+function frame(canvas, { xmin, xmax, ymin, ymax, xlabel = '', ylabel = '', title = '', equal = false, yDown = false, categorical = false, padRight = PAD.right }) {
   const ctx = canvas.getContext('2d');
   const W = canvas.width, H = canvas.height;
   ctx.clearRect(0, 0, W, H);
   ctx.fillStyle = '#fff';
   ctx.fillRect(0, 0, W, H);
-  let pw = W - PAD.left - PAD.right, ph = H - PAD.top - PAD.bottom;
+  let pw = W - PAD.left - padRight, ph = H - PAD.top - PAD.bottom;
   if (equal) {
     const s = Math.min(pw / (xmax - xmin || 1), ph / (ymax - ymin || 1));
     pw = s * (xmax - xmin || 1); ph = s * (ymax - ymin || 1);
@@ -33,7 +35,7 @@ function frame(canvas, { xmin, xmax, ymin, ymax, xlabel = '', ylabel = '', title
   ctx.strokeStyle = '#999'; ctx.lineWidth = 1;
   ctx.strokeRect(PAD.left, PAD.top, pw, ph);
   ctx.fillStyle = '#333'; ctx.font = '11px system-ui'; ctx.textAlign = 'center';
-  for (const t of niceTicks(xmin, xmax)) {
+  for (const t of categorical ? [] : niceTicks(xmin, xmax)) {
     if (t < xmin || t > xmax) continue;
     ctx.fillText(String(t), X(t), PAD.top + ph + 14);
     ctx.strokeStyle = '#eee'; ctx.beginPath(); ctx.moveTo(X(t), PAD.top); ctx.lineTo(X(t), PAD.top + ph); ctx.stroke();
@@ -81,11 +83,15 @@ export function scatter(canvas, points, { xlabel, ylabel, title, symmetric = fal
 /** bars: [{label, value, highlight}] */
 export function bars(canvas, items, { ylabel, title, threshold } = {}) {
   const ymax = Math.max(1e-9, ...items.map((b) => b.value), threshold || 0) * 1.1;
-  const { ctx, X, Y, pw } = frame(canvas, { xmin: 0, xmax: items.length, ymin: 0, ymax, xlabel: '', ylabel, title });
+  const { ctx, X, Y, pw } = frame(canvas, { xmin: 0, xmax: items.length, ymin: 0, ymax, xlabel: '', ylabel, title, categorical: true });
   const bw = (pw / Math.max(items.length, 1)) * 0.7;
+  // Every k-th label when there are more bars than rotated labels fit
+  // (a slanted 10 px label needs about 11 px of axis).
+  const every = Math.max(1, Math.ceil((11 * items.length) / pw));
   items.forEach((b, i) => {
     ctx.fillStyle = b.highlight ? '#d62728' : '#1f77b4';
     ctx.fillRect(X(i + 0.5) - bw / 2, Y(b.value), bw, Y(0) - Y(b.value));
+    if (i % every !== 0) return;
     ctx.save(); ctx.translate(X(i + 0.5), Y(0) + 6); ctx.rotate(Math.PI / 4);
     ctx.fillStyle = '#333'; ctx.font = '10px system-ui'; ctx.textAlign = 'left';
     ctx.fillText(String(b.label).slice(0, 14), 0, 0); ctx.restore();
@@ -109,7 +115,7 @@ export function quantile(sorted, q) {
 export function boxplot(canvas, groups, { ylabel, title } = {}) {
   const all = groups.flatMap((g) => g.values);
   const [ymin, ymax] = extent(all, 0.1);
-  const { ctx, X, Y, pw } = frame(canvas, { xmin: 0, xmax: groups.length, ymin, ymax, ylabel, title });
+  const { ctx, X, Y, pw } = frame(canvas, { xmin: 0, xmax: groups.length, ymin, ymax, ylabel, title, categorical: true });
   const bw = (pw / Math.max(groups.length, 1)) * 0.4;
   groups.forEach((g, i) => {
     const s = [...g.values].sort((a, b) => a - b);
@@ -158,27 +164,45 @@ export function vectors(canvas, items, [w, h], { gain = 20, title } = {}) {
   return canvas;
 }
 
-/** A colour map from blue (low) to red (high). */
+// A perceptually ordered colour map (dark blue -> teal -> green -> yellow,
+// sampled from the viridis curve), readable in grey and by most colour-blind
+// viewers, unlike a blue-red ramp.
+const VIRIDIS = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
 function heat(t) {
-  const c = Math.max(0, Math.min(1, t));
-  const r = Math.round(255 * Math.min(1, 2 * c)), b = Math.round(255 * Math.min(1, 2 * (1 - c)));
-  const g = Math.round(255 * (1 - Math.abs(2 * c - 1)) * 0.8);
+  const c = Math.max(0, Math.min(1, t)) * (VIRIDIS.length - 1);
+  const i = Math.min(VIRIDIS.length - 2, Math.floor(c)), f = c - i;
+  const [r, g, b] = VIRIDIS[i].map((v, k) => Math.round(v + f * (VIRIDIS[i + 1][k] - v)));
   return `rgb(${r},${g},${b})`;
 }
 
+const BAR_W = 12;
+
 /** grid: {cols, rows, values (row-major), width_px, height_px}; unit label. */
 export function heatmap(canvas, grid, { title, unit = 'px' } = {}) {
-  const { ctx, X, Y } = frame(canvas, { xmin: 0, xmax: grid.width_px, ymin: 0, ymax: grid.height_px, xlabel: 'x (px)', ylabel: 'y (px)', title, equal: true, yDown: true });
-  const vmax = Math.max(1e-12, ...grid.values.filter(Number.isFinite));
+  const padRight = 64;
+  const { ctx, X, Y, ph } = frame(canvas, { xmin: 0, xmax: grid.width_px, ymin: 0, ymax: grid.height_px, xlabel: 'x (px)', ylabel: 'y (px)', title, equal: true, yDown: true, padRight });
+  const finite = grid.values.filter(Number.isFinite);
+  const vmax = Math.max(1e-12, ...finite);
+  const vmin = finite.length ? Math.min(...finite) : 0;
+  const span = vmax - vmin || vmax;
   const cw = grid.width_px / grid.cols, ch = grid.height_px / grid.rows;
   for (let r = 0; r < grid.rows; r++) {
     for (let c = 0; c < grid.cols; c++) {
       const v = grid.values[r * grid.cols + c];
-      ctx.fillStyle = Number.isFinite(v) ? heat(v / vmax) : '#ccc';
+      ctx.fillStyle = Number.isFinite(v) ? heat((v - vmin) / span) : '#ccc';
       ctx.fillRect(X(c * cw), Y(r * ch), X((c + 1) * cw) - X(c * cw) + 0.5, Y((r + 1) * ch) - Y(r * ch) + 0.5);
     }
   }
-  ctx.fillStyle = '#333'; ctx.font = '11px system-ui'; ctx.textAlign = 'right';
-  ctx.fillText(`max ${vmax.toPrecision(3)} ${unit}`, canvas.width - PAD.right, 14);
+  // Colour bar beside the map: vmax at the top, vmin at the bottom.
+  const bx = X(grid.width_px) + 10, top = Y(0), h = Math.min(ph, Y(grid.height_px) - top);
+  for (let k = 0; k < h; k++) {
+    ctx.fillStyle = heat(1 - k / Math.max(1, h - 1));
+    ctx.fillRect(bx, top + k, BAR_W, 1.5);
+  }
+  ctx.strokeStyle = '#999'; ctx.strokeRect(bx, top, BAR_W, h);
+  ctx.fillStyle = '#333'; ctx.font = '11px system-ui'; ctx.textAlign = 'left';
+  ctx.fillText(vmax.toPrecision(3), bx + BAR_W + 3, top + 9);
+  ctx.fillText(vmin.toPrecision(3), bx + BAR_W + 3, top + h);
+  ctx.fillText(unit, bx + BAR_W + 3, top + h / 2 + 4);
   return canvas;
 }

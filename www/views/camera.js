@@ -64,12 +64,13 @@ export class CameraView {
       h('label', {}, 'Lens model', select('model', MODELS, st.model)),
       h('label', {}, 'Method', select('method', METHODS, st.method)),
       h('fieldset', {}, h('legend', {}, 'Options'), opts),
+      h('p', { class: 'hint', id: 'camera-input-summary' }),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-camera' }, 'Solve camera')));
     form.addEventListener('change', () => this.readForm(form));
     form.addEventListener('submit', (e) => { e.preventDefault(); this.solve(); });
     this.out = h('div', { id: 'camera-results', 'aria-live': 'polite' });
     if (this.readonly) fill($('camera-panel'), this.out);
-    else fill($('camera-panel'), h('div', { class: 'two-col' }, form, h('div', {}, h('p', { class: 'hint', id: 'camera-input-summary' }))), this.out);
+    else fill($('camera-panel'), form, this.out);
     this.summarise();
     if (st.result) this.show(st.result, st.comparison);
   }
@@ -118,7 +119,7 @@ export class CameraView {
     const k = r.camera_matrix.flat();
     const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
     const std = r.std || {};
-    const params = table(['parameter', 'value', 'std'], names.map((n) => [n, num(value[n], 6), num(std[n], 3)]), { id: 'camera-params' });
+    const params = table(['parameter', 'value', 'std'], names.map((n) => [n, num(value[n], 6), stdText(std[n])]), { id: 'camera-params' });
     const warnings = (r.warnings || []).map((w) => message('warning', typeof w === 'string' ? w : w.message));
     const perView = (r.views || []).map((v) => ({ label: v.name, value: v.rms_px, highlight: v.rms_px > 2 * r.rms_px }));
     const residualPoints = [];
@@ -213,3 +214,15 @@ export class CameraView {
     return strong.length ? message('warning', `Strongly correlated parameters (|r| > 0.95): ${strong.join(', ')}. Add views with more tilt and coverage to separate them.`) : null;
   }
 }
+
+/**
+ * A standard deviation as shown: 3 decimals from 0.01 up, 3 significant
+ * digits in exponent form below (so a small std does not read "0.000"),
+ * "held" for a parameter the solve did not move (std exactly 0).
+ */
+function stdText(x) {
+  if (x === 0) return 'held';
+  if (typeof x === 'number' && Number.isFinite(x) && Math.abs(x) < 0.01) return x.toExponential(2);
+  return num(x, 3);
+}
+

@@ -6,6 +6,14 @@ import { bars, boxplot } from '../lib/plot.js';
 import { FrameView } from '../lib/view3d.js';
 import { flat, mul, fromPose, IDENTITY } from '../lib/mat4.js';
 
+// Refinement over the image points (the core's RefineMode names).
+const REFINE = [
+  ['trusted', 'Over the image points, robot poses exact'],
+  ['stochastic', 'Over the image points, robot pose noise estimated'],
+  ['joint_intrinsics', 'Over the image points, camera intrinsics refined too'],
+  ['none', 'None (closed forms on the camera poses only)'],
+];
+
 const METHODS = [
   ['all', 'All methods (best one refined)'], ['tsai-lenz', 'Tsai-Lenz'], ['park-martin', 'Park-Martin'], ['horaud', 'Horaud'],
   ['andreff', 'Andreff'], ['daniilidis', 'Daniilidis (dual quaternion)'], ['chou-kamel', 'Chou-Kamel'], ['shah', 'Shah (AX = ZB)'], ['li', 'Li (AX = ZB)'],
@@ -28,8 +36,14 @@ export class HandEyeView {
     const form = h('form', { class: 'form', id: 'handeye-form' },
       sel('handeye-setup', [['eye-in-hand', 'Eye-in-hand (camera on the gripper)'], ['eye-to-hand', 'Eye-to-hand (camera fixed, target on the gripper)']], st.setup, 'Setup '),
       sel('handeye-method', METHODS, st.method, 'Method '),
+      sel('handeye-refine', REFINE, st.refine || 'trusted', 'Refinement '),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-handeye' }, 'Solve hand-eye')));
-    form.addEventListener('change', () => { st.setup = $('handeye-setup').value; st.method = $('handeye-method').value; this.store.changed('handeye-options'); });
+    form.addEventListener('change', () => {
+      st.setup = $('handeye-setup').value;
+      st.method = $('handeye-method').value;
+      st.refine = $('handeye-refine').value;
+      this.store.changed('handeye-options');
+    });
     form.addEventListener('submit', (e) => { e.preventDefault(); this.solve(); });
     this.out = h('div', { id: 'handeye-results', 'aria-live': 'polite' });
     this.canvas3d = h('canvas', { width: 560, height: 420, id: 'frames-3d', role: 'img', 'aria-label': '3-D view of the robot, camera and target frames' });
@@ -46,11 +60,14 @@ export class HandEyeView {
     if (!pairs.length) throw new Error('load the robot poses first (step 4)');
     const views = new Map((cam.views || []).map((v) => [v.name, v]));
     const used = pairs.filter((p) => views.has(p.image.name));
+    const refine = this.state.refine || 'trusted';
     return {
       setup: this.state.setup,
       method: this.state.method,
       base_from_gripper: used.map((p) => ({ translation_m: p.pose.base_from_gripper.translation_m, quaternion_xyzw: p.pose.base_from_gripper.quaternion_xyzw })),
       camera_from_target: used.map((p) => ({ matrix_row_major: views.get(p.image.name).camera_from_target.matrix_row_major })),
+      // The refinement reads the detected points through the solved camera.
+      ...(refine === 'none' ? {} : { refine, camera: cam.camera, detections: used.map((p) => p.image.detection) }),
       names: used.map((p) => p.image.name),
     };
   }
@@ -93,6 +110,10 @@ export class HandEyeView {
         return [m.method, ...p.translation_m.map((v) => num(v * 1000, 3)), num(m.errors && m.errors.translation_rms_mm, 4), num(m.errors && m.errors.rotation_rms_deg, 5),
           `${num(m.disagreement_translation_mm, 3)} / ${num(m.disagreement_rotation_deg, 4)}`];
       }), { id: 'handeye-methods' });
+    const ref = r.refinement;
+    const refinement = ref ? h('p', { class: 'hint', id: 'handeye-refinement' },
+      `Refined (${ref.mode}) from ${ref.started_from}: reprojection RMS ${num(ref.reprojection_rms_px, 4)} px (closed form ${num(ref.closed_form_reprojection_rms_px, 4)} px) over ${(ref.per_view_reprojection_rms_px || []).length} views` +
+      (ref.camera ? `; camera refined too: fx ${num(ref.camera.fx, 3)}, fy ${num(ref.camera.fy, 3)} px.` : '.')) : null;
     const motion = r.motion ? h('p', { class: 'hint' }, `${r.motion.motions} motions used (${r.motion.discarded_small_rotation} discarded for too little rotation); rotation angles ${num(r.motion.angle_min_deg, 1)}–${num(r.motion.angle_max_deg, 1)} deg (median ${num(r.motion.angle_median_deg, 1)}), axis spread ${num(r.motion.axis_spread_deg, 1)} deg.`) : null;
     const perMotion = bars(h('canvas', { width: 460, height: 300, role: 'img', 'aria-label': 'closure residual per motion' }),
       (r.per_motion || []).map((m) => ({ label: `${m.from + 1}→${m.to + 1}`, value: m.translation_mm })), { ylabel: 'translation residual (mm)', title: 'Closure residual per motion', threshold: e.translation_rms_mm });
@@ -109,7 +130,7 @@ export class HandEyeView {
     }
     this.plots = plots;
     fill(this.out, h('h3', {}, `Result (${r.method})`), (r.warnings || []).map((w) => message('warning', w)),
-      pose(camKey), pose(tgtKey), errors, motion, h('h3', {}, 'Methods side by side'), methods,
+      pose(camKey), pose(tgtKey), refinement, errors, motion, h('h3', {}, 'Methods side by side'), methods,
       h('div', { class: 'plots' }, plots), h('h3', {}, '3-D view'), this.canvas3d);
     this.draw3d(r, camKey, tgtKey, eyeInHand);
   }
