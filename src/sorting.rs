@@ -67,8 +67,21 @@ fn permute<T>(v: &mut [T], order: &[usize]) {
     }
 }
 
-/// Stable sort of `v` by `cmp`, like `slice::sort_by`.
+/// Stable sort of `v` by `cmp`, like `slice::sort_by`. Short lists (the
+/// detector's neighbour queries sort a few items per call) are sorted in
+/// place by insertion, without allocating.
 pub(crate) fn sort_by<T>(v: &mut [T], cmp: impl Fn(&T, &T) -> Ordering) {
+    const SHORT: usize = 16;
+    if v.len() <= SHORT {
+        for i in 1..v.len() {
+            let mut j = i;
+            while j > 0 && cmp(&v[j - 1], &v[j]) == Ordering::Greater {
+                v.swap(j - 1, j);
+                j -= 1;
+            }
+        }
+        return;
+    }
     let order = stable_order(v.len(), &|i, j| cmp(&v[i], &v[j]));
     permute(v, &order);
 }
