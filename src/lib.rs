@@ -41,6 +41,7 @@ pub mod handeye;
 pub mod image;
 pub mod io;
 pub mod optim;
+mod sorting;
 pub mod synth;
 pub mod target;
 pub mod workflows;

@@ -53,7 +53,12 @@ pub enum Polarity {
 }
 
 /// A calibration target's geometry (see the module docs for the point order).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+///
+/// In JSON an object tagged by `kind` (`{"kind": "chessboard", "cols": 9,
+/// ...}`). Deserialized through [`TargetFields`] rather than serde's
+/// internally tagged form, which buffers every object (a large part of the
+/// wasm module); the accepted JSON and the error texts are the same.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Target {
     /// A chessboard, counted by inner corners (a 10 x 7 squares board is 9 x 6).
@@ -97,6 +102,60 @@ pub enum Target {
         /// Circle diameter, metres.
         diameter_m: f64,
     },
+}
+
+#[derive(Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum TargetKind {
+    Chessboard,
+    CircleGrid,
+    DotPlate,
+    SingleCircle,
+}
+
+/// Every field of every [`Target`] variant; the tag picks which are needed.
+#[derive(Deserialize)]
+struct TargetFields {
+    kind: Option<TargetKind>,
+    cols: Option<usize>,
+    rows: Option<usize>,
+    square_m: Option<f64>,
+    spacing_m: Option<f64>,
+    asymmetric: Option<bool>,
+    polarity: Option<Polarity>,
+    pitch_m: Option<f64>,
+    dot_diameter_m: Option<f64>,
+    diameter_m: Option<f64>,
+}
+
+impl<'de> Deserialize<'de> for Target {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use crate::error::serde_field as f;
+        let t = TargetFields::deserialize(d)?;
+        Ok(match f(t.kind, "kind")? {
+            TargetKind::Chessboard => Target::Chessboard {
+                cols: f(t.cols, "cols")?,
+                rows: f(t.rows, "rows")?,
+                square_m: f(t.square_m, "square_m")?,
+            },
+            TargetKind::CircleGrid => Target::CircleGrid {
+                cols: f(t.cols, "cols")?,
+                rows: f(t.rows, "rows")?,
+                spacing_m: f(t.spacing_m, "spacing_m")?,
+                asymmetric: f(t.asymmetric, "asymmetric")?,
+                polarity: f(t.polarity, "polarity")?,
+            },
+            TargetKind::DotPlate => Target::DotPlate {
+                cols: f(t.cols, "cols")?,
+                rows: f(t.rows, "rows")?,
+                pitch_m: f(t.pitch_m, "pitch_m")?,
+                dot_diameter_m: f(t.dot_diameter_m, "dot_diameter_m")?,
+            },
+            TargetKind::SingleCircle => Target::SingleCircle {
+                diameter_m: f(t.diameter_m, "diameter_m")?,
+            },
+        })
+    }
 }
 
 /// One detected target point in pixels.

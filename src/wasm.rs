@@ -76,11 +76,29 @@ impl ImagePreview {
     }
 }
 
+/// `ImageInfo`'s fields plus `format_name`, written as one plain struct
+/// (serde's `flatten` goes through a map serializer: more wasm).
 #[derive(Serialize)]
-struct InfoJson<'a> {
-    #[serde(flatten)]
-    info: &'a crate::image::ImageInfo,
+struct InfoJson {
+    format: crate::image::ImageFormat,
+    width: u32,
+    height: u32,
+    channels: u8,
+    bits_per_channel: u8,
     format_name: &'static str,
+}
+
+impl InfoJson {
+    fn of(info: &crate::image::ImageInfo) -> InfoJson {
+        InfoJson {
+            format: info.format,
+            width: info.width,
+            height: info.height,
+            channels: info.channels,
+            bits_per_channel: info.bits_per_channel,
+            format_name: info.format.name(),
+        }
+    }
 }
 
 /// Decode image bytes (PNG, JPEG, TIFF, BMP, PNM, GIF); return its
@@ -92,11 +110,8 @@ pub fn decode_image_preview(bytes: &[u8], max_side: u32) -> Result<ImagePreview,
         ..Default::default()
     };
     let decoded = decode(bytes, &options).map_err(js_error)?;
-    let info_json = serde_json::to_string(&InfoJson {
-        info: &decoded.info,
-        format_name: decoded.info.format.name(),
-    })
-    .map_err(|e| JsError::new(&e.to_string()))?;
+    let info_json = serde_json::to_string(&InfoJson::of(&decoded.info))
+        .map_err(|e| JsError::new(&e.to_string()))?;
     let preview = decoded
         .preview
         .ok_or_else(|| JsError::new("no preview was produced"))?;
@@ -112,11 +127,7 @@ pub fn decode_image_preview(bytes: &[u8], max_side: u32) -> Result<ImagePreview,
 #[wasm_bindgen]
 pub fn image_info(bytes: &[u8]) -> Result<String, JsError> {
     let decoded = decode(bytes, &DecodeOptions::default()).map_err(js_error)?;
-    serde_json::to_string(&InfoJson {
-        info: &decoded.info,
-        format_name: decoded.info.format.name(),
-    })
-    .map_err(|e| JsError::new(&e.to_string()))
+    serde_json::to_string(&InfoJson::of(&decoded.info)).map_err(|e| JsError::new(&e.to_string()))
 }
 
 /// Detect a calibration target in image bytes. `target_spec_or_json` is a
@@ -256,23 +267,32 @@ pub fn rank_pose_conventions(input_json: &str) -> Result<String, JsError> {
 #[wasm_bindgen]
 pub fn workflow_csv(kind: &str, text: &str) -> Result<String, JsError> {
     use crate::io::workflow_csv as csv;
-    let value = match kind {
+    // Each request serialised straight to text (no `serde_json::Value` in
+    // between: one serializer instantiation per type in the wasm).
+    #[derive(Serialize)]
+    struct Matrices {
+        matrices: Vec<crate::workflows::planar_api::HeightMatrix>,
+    }
+    #[derive(Serialize)]
+    struct Points {
+        points: Vec<crate::workflows::planar_solve::HeightPoint>,
+    }
+    fn to_text<T: Serialize>(what: &str, value: &T) -> crate::Result<String> {
+        serde_json::to_string(value).map_err(|e| crate::Error::invalid(what, e.to_string()))
+    }
+    match kind {
         "planar-matrices" => csv::parse_planar_matrices(text)
-            .map(|m| serde_json::json!({ "matrices": m })),
-        "planar-points" => csv::parse_planar_points(text).map(|p| serde_json::json!({ "points": p })),
-        "xytable" => csv::parse_xytable(text).and_then(|r| {
-            serde_json::to_value(r).map_err(|e| crate::Error::invalid("xytable", e.to_string()))
-        }),
-        "known-motion" => csv::parse_known_motion(text).and_then(|r| {
-            serde_json::to_value(r).map_err(|e| crate::Error::invalid("known-motion", e.to_string()))
-        }),
+            .and_then(|matrices| to_text("matrices", &Matrices { matrices })),
+        "planar-points" => csv::parse_planar_points(text)
+            .and_then(|points| to_text("points", &Points { points })),
+        "xytable" => csv::parse_xytable(text).and_then(|r| to_text("xytable", &r)),
+        "known-motion" => csv::parse_known_motion(text).and_then(|r| to_text("known-motion", &r)),
         other => Err(crate::Error::invalid(
             "kind",
             format!("unknown workflow file '{other}' (known: planar-matrices, planar-points, xytable, known-motion)"),
         )),
     }
-    .map_err(js_error)?;
-    Ok(value.to_string())
+    .map_err(js_error)
 }
 
 /// The demo session: rendered images (PNG, concatenated) plus a JSON index.
@@ -302,29 +322,51 @@ impl DemoData {
 #[wasm_bindgen]
 pub fn render_demo(seed: u32) -> Result<DemoData, JsError> {
     let demo = crate::synth::demo::demo_session(seed as u64).map_err(js_error)?;
+    #[derive(Serialize)]
+    struct Entry<'a> {
+        name: &'a str,
+        offset: usize,
+        length: usize,
+    }
+    #[derive(Serialize)]
+    struct Truth<'a> {
+        camera: &'a crate::camera::Camera,
+        gripper_from_camera: serde_json::Value,
+        base_from_target: serde_json::Value,
+    }
+    #[derive(Serialize)]
+    struct Index<'a> {
+        target: &'a crate::target::Target,
+        target_spec: &'static str,
+        images: Vec<Entry<'a>>,
+        poses_csv: &'a str,
+        truth: Truth<'a>,
+    }
     let mut bytes = Vec::new();
-    let mut index = Vec::new();
+    let mut images = Vec::new();
     for (name, image) in &demo.images {
         let png = crate::image::encode_png(image).map_err(js_error)?;
-        index.push(serde_json::json!({ "name": name, "offset": bytes.len(), "length": png.len() }));
+        images.push(Entry {
+            name,
+            offset: bytes.len(),
+            length: png.len(),
+        });
         bytes.extend_from_slice(&png);
     }
     let transform = crate::io::export_transform::transform_json;
-    let json = serde_json::json!({
-        "target": demo.target,
-        "target_spec": "chessboard:9x6:30mm",
-        "images": index,
-        "poses_csv": demo.poses_csv,
-        "truth": {
-            "camera": demo.camera,
-            "gripper_from_camera": transform(&demo.gripper_from_camera),
-            "base_from_target": transform(&demo.base_from_target),
+    let json = serde_json::to_string(&Index {
+        target: &demo.target,
+        target_spec: "chessboard:9x6:30mm",
+        images,
+        poses_csv: &demo.poses_csv,
+        truth: Truth {
+            camera: &demo.camera,
+            gripper_from_camera: transform(&demo.gripper_from_camera),
+            base_from_target: transform(&demo.base_from_target),
         },
-    });
-    Ok(DemoData {
-        json: json.to_string(),
-        bytes,
     })
+    .map_err(|e| JsError::new(&e.to_string()))?;
+    Ok(DemoData { json, bytes })
 }
 
 /// Calibrate a camera from views (detections or point pairs) with one
@@ -361,7 +403,7 @@ pub fn undistort_preview(
     let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
     let rgba = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();
     Ok(ImagePreview {
-        info_json: serde_json::json!({ "width": out.width, "height": out.height }).to_string(),
+        info_json: format!(r#"{{"width":{},"height":{}}}"#, out.width, out.height),
         rgba,
         width: out.width,
         height: out.height,

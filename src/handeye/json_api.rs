@@ -36,8 +36,9 @@ use serde::{Deserialize, Serialize};
 /// Default expected pixel noise of the refinement (px).
 pub const DEFAULT_PIXEL_SIGMA_PX: f64 = 0.5;
 
-#[derive(Deserialize)]
-#[serde(untagged)]
+/// A pose in JSON: `{"matrix_row_major": [[..4]; 4]}` or `{"translation_m",
+/// "quaternion_xyzw"}`. Read through [`PoseFields`] (serde's untagged form
+/// buffers every object and is a large part of the wasm module).
 enum PoseIn {
     Matrix {
         matrix_row_major: [[f64; 4]; 4],
@@ -46,6 +47,29 @@ enum PoseIn {
         translation_m: [f64; 3],
         quaternion_xyzw: [f64; 4],
     },
+}
+
+#[derive(Deserialize)]
+struct PoseFields {
+    matrix_row_major: Option<[[f64; 4]; 4]>,
+    translation_m: Option<[f64; 3]>,
+    quaternion_xyzw: Option<[f64; 4]>,
+}
+
+impl<'de> Deserialize<'de> for PoseIn {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let p = PoseFields::deserialize(d)?;
+        match (p.matrix_row_major, p.translation_m, p.quaternion_xyzw) {
+            (Some(matrix_row_major), _, _) => Ok(PoseIn::Matrix { matrix_row_major }),
+            (None, Some(translation_m), Some(quaternion_xyzw)) => Ok(PoseIn::Quaternion {
+                translation_m,
+                quaternion_xyzw,
+            }),
+            _ => Err(serde::de::Error::custom(
+                "data did not match any variant of untagged enum PoseIn",
+            )),
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -117,8 +141,10 @@ pub fn camera_from_json(value: &serde_json::Value) -> Result<Camera> {
         serde_json::Value::Object(map) if map.get("camera").is_some_and(|c| c.is_object()) => {
             camera_from_json(&map["camera"])
         }
+        // Through the text (as every JSON input is read) rather than
+        // `from_value`: one deserializer instantiation per type in the wasm.
         serde_json::Value::Object(map) if map.contains_key("fx") => {
-            serde_json::from_value(value.clone())
+            serde_json::from_str(&value.to_string())
                 .map_err(|e| Error::invalid("camera", e.to_string()))
         }
         other => crate::io::import_camera::import_camera(&other.to_string())

@@ -45,9 +45,7 @@ pub fn export(report_json: &str, format: &str, transform: Option<&str>) -> Resul
         )
     })?;
     if format == "report" {
-        return serde_json::to_string_pretty(&report)
-            .map(|s| s + "\n")
-            .map_err(|e| Error::invalid("report", e.to_string()));
+        return Ok(super::to_string_pretty(&report) + "\n");
     }
     if let Ok(camera_format) = CameraFormat::from_name(format) {
         let (camera, _) = import_camera(report_json).map_err(|e| match e {

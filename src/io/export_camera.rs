@@ -216,9 +216,7 @@ fn json(c: &Camera, info: &CameraExportInfo) -> Result<String> {
         "distortion": distortion,
         "rms_px": info.rms_px,
     });
-    serde_json::to_string_pretty(&value)
-        .map(|s| s + "\n")
-        .map_err(|e| Error::invalid("json", e.to_string()))
+    Ok(super::to_string_pretty(&value) + "\n")
 }
 
 fn opencv_yaml(c: &Camera, info: &CameraExportInfo) -> Result<String> {

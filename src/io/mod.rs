@@ -12,6 +12,7 @@ pub mod export_camera;
 mod export_camera_tools;
 pub mod export_transform;
 pub mod import_camera;
+mod json_pretty;
 mod pose_candidates;
 mod pose_formats;
 mod pose_json;
@@ -26,6 +27,7 @@ mod export_tests;
 #[cfg(test)]
 mod pose_tests;
 
+pub(crate) use json_pretty::to_string_pretty;
 pub use pose_candidates::{parse_pose_candidates, Candidate};
 pub use pose_formats::{AngleUnit, LengthUnit, PoseFormat, QUATERNION_NORM_TOLERANCE};
 pub use pose_writer::format_poses;
