@@ -23,9 +23,29 @@ export interface PoseReport {
   quaternion_xyzw: [number, number, number, number];
 }
 
+/** A calibration target as JSON (`Detection.target`; `detect_target` also
+ * takes a CLI spec such as `chessboard:9x6:30mm` or
+ * `squares:8x8:12.7mm:22.5778mm`). Lengths in metres; docs/detection-json.md
+ * gives each kind's point order. */
+export type Target =
+  | { kind: 'chessboard'; cols: number; rows: number; square_m: number }
+  | { kind: 'circle_grid'; cols: number; rows: number; spacing_m: number; asymmetric: boolean; polarity: 'dark_on_light' | 'light_on_dark' }
+  | { kind: 'dot_plate'; cols: number; rows: number; pitch_m: number; dot_diameter_m: number }
+  | { kind: 'single_circle'; diameter_m: number }
+  /** `cols x rows` separate dark squares, 4 corners each: id = 4 (i + j cols) + k. */
+  | { kind: 'square_grid'; cols: number; rows: number; side_m: number; pitch_m: number };
+
+/** What `detect_target` returns, as JSON. Pixels: (0, 0) is the centre of the top-left pixel. */
+export interface Detection {
+  image_size_px: [number, number];
+  target: Target;
+  /** Sorted by id; `covariance_px2` is `[xx, xy, yy]` when estimated. */
+  points: { id: number; x_px: number; y_px: number; covariance_px2?: [number, number, number] }[];
+}
+
 /** One view of a calibration input: a `detect_target` detection, or explicit correspondences. */
 export type CalibrationView =
-  | { name: string; detection: object }
+  | { name: string; detection: Detection | object }
   | { name: string; object_m: [number, number, number][]; image_px: [number, number][] };
 
 /** The options object of `calibrate_camera` and `calibrate_stereo`. */

@@ -15,6 +15,16 @@
 //! | `circle_grid`, asymmetric | `cols` circles per row, `rows` rows | `(2 i + j % 2, j) * spacing_m` (OpenCV's layout) |
 //! | `dot_plate` | `cols x rows` dots | `(i, j) * pitch_m` |
 //! | `single_circle` | one point, id 0 | `(0, 0)`, the circle centre |
+//! | `square_grid` | `cols x rows` separate squares, 4 corners each: id = `4 (i + j * cols) + k` | square `(i, j)` spans `(i, j) * pitch_m` to that `+ side_m`; corner `k` = 0 `(x0, y0)`, 1 `(x0 + side, y0)`, 2 `(x0 + side, y0 + side)`, 3 `(x0, y0 + side)` |
+//!
+//! A square grid's corners run square by square (row by row of squares) and,
+//! within a square, clockwise on screen from the corner nearest the board
+//! origin. Zhang's 1998 target (`Model.txt`, `squares:8x8:12.7mm:22.5778mm`,
+//! side 0.5 inch, pitch 8/9 inch) lists its squares in the same order
+//! within a row and a square, but its rows run the other way (its y axis is
+//! ours minus `7 pitch + side`): Zhang's line `n` (0-based, corners `k` =
+//! 0..3) is our square `n % 8 + 8 (7 - n / 8)`, i.e. id
+//! `4 (n % 8 + 8 (7 - n / 8)) + k`.
 //!
 //! # Detection JSON
 //!
@@ -36,7 +46,8 @@
 //! `{"kind": "circle_grid", "cols": 4, "rows": 11, "spacing_m": 0.02,
 //! "asymmetric": true, "polarity": "dark_on_light"}`, `{"kind": "dot_plate",
 //! "cols": 7, "rows": 7, "pitch_m": 0.025, "dot_diameter_m": 0.0125}`,
-//! `{"kind": "single_circle", "diameter_m": 0.01}`.
+//! `{"kind": "single_circle", "diameter_m": 0.01}`, `{"kind": "square_grid",
+//! "cols": 8, "rows": 8, "side_m": 0.0127, "pitch_m": 0.0225778}`.
 
 use crate::error::{Error, Result};
 use nalgebra::{Point2, Point3};
@@ -101,6 +112,19 @@ pub enum Target {
     SingleCircle {
         /// Circle diameter, metres.
         diameter_m: f64,
+    },
+    /// A grid of separate dark squares on a light background, four corners
+    /// per square (Zhang's 1998 target: 8 x 8 squares).
+    SquareGrid {
+        /// Squares per row.
+        cols: usize,
+        /// Rows of squares.
+        rows: usize,
+        /// Side of one square, metres.
+        side_m: f64,
+        /// Distance between neighbouring squares' origins, metres (larger
+        /// than the side: the squares do not touch).
+        pitch_m: f64,
     },
 }
 
@@ -202,8 +226,9 @@ impl Detection {
 impl Target {
     /// Parse a CLI target spec: `chessboard:9x6:30mm`,
     /// `circles:4x11:20mm[:asymmetric][:light-on-dark]`, `dots:7x7:25mm[:12.5mm]`
-    /// (dot diameter defaults to half the pitch), `circle:10mm`. Lengths take
-    /// a unit: `mm`, `cm` or `m`.
+    /// (dot diameter defaults to half the pitch), `circle:10mm`,
+    /// `squares:8x8:12.7mm:22.5778mm` (squares per row x rows, side, pitch).
+    /// Lengths take a unit: `mm`, `cm` or `m`.
     pub fn parse_spec(spec: &str) -> Result<Target> {
         let parts: Vec<&str> = spec.trim().split(':').collect();
         let bad = |m: String| Error::invalid("target", m);
@@ -262,8 +287,21 @@ impl Target {
                 diameter_m: parse_length(d)?,
             }
             .validated(),
+            ["squares", grid, side, pitch] => {
+                let (cols, rows) = parse_grid(grid)?;
+                Target::SquareGrid {
+                    cols,
+                    rows,
+                    side_m: parse_length(side)?,
+                    pitch_m: parse_length(pitch)?,
+                }
+                .validated()
+            }
+            ["squares", ..] => Err(bad(format!(
+                "'{spec}' is not a square-grid spec; expected squares:COLSxROWS:SIDE:PITCH (e.g. squares:8x8:12.7mm:22.5778mm)"
+            ))),
             _ => Err(bad(format!(
-                "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER] or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
+                "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
             ))),
         }
     }
@@ -276,8 +314,18 @@ impl Target {
                 (*cols, *rows, 2)
             }
             Target::SingleCircle { .. } => (1, 1, 1),
+            Target::SquareGrid { cols, rows, .. } => (*cols, *rows, 2),
         };
-        if cols < min || rows < min || cols * rows > 100_000 {
+        // Square grids have four points per square.
+        let per_cell = match &self {
+            Target::SquareGrid { .. } => 4,
+            Target::Chessboard { .. }
+            | Target::CircleGrid { .. }
+            | Target::DotPlate { .. }
+            | Target::SingleCircle { .. } => 1,
+        };
+        if cols < min || rows < min || cols.saturating_mul(rows).saturating_mul(per_cell) > 100_000
+        {
             return Err(Error::invalid(
                 "target",
                 format!(
@@ -294,6 +342,9 @@ impl Target {
                 ..
             } => vec![*pitch_m, *dot_diameter_m],
             Target::SingleCircle { diameter_m } => vec![*diameter_m],
+            Target::SquareGrid {
+                side_m, pitch_m, ..
+            } => vec![*side_m, *pitch_m],
         };
         if lengths.iter().any(|l| !l.is_finite() || *l <= 0.0) {
             return Err(Error::invalid("target", "sizes must be positive metres"));
@@ -311,6 +362,17 @@ impl Target {
                 ));
             }
         }
+        if let Target::SquareGrid {
+            side_m, pitch_m, ..
+        } = &self
+        {
+            if side_m >= pitch_m {
+                return Err(Error::invalid(
+                    "target",
+                    "the square side must be smaller than the pitch (the squares must not touch)",
+                ));
+            }
+        }
         Ok(self)
     }
 
@@ -321,16 +383,19 @@ impl Target {
             | Target::CircleGrid { cols, rows, .. }
             | Target::DotPlate { cols, rows, .. } => cols * rows,
             Target::SingleCircle { .. } => 1,
+            Target::SquareGrid { cols, rows, .. } => 4 * cols * rows,
         }
     }
 
     /// Integer board coordinates of every point in id order (metres are these
-    /// times [`Target::unit_m`]).
+    /// times [`Target::unit_m`]); for square grids, of every square's origin
+    /// in square order (the corners are in [`Target::object_points`]).
     pub(crate) fn grid_coords(&self) -> Vec<(i32, i32)> {
         let (cols, rows) = match self {
             Target::Chessboard { cols, rows, .. }
             | Target::CircleGrid { cols, rows, .. }
-            | Target::DotPlate { cols, rows, .. } => (*cols as i32, *rows as i32),
+            | Target::DotPlate { cols, rows, .. }
+            | Target::SquareGrid { cols, rows, .. } => (*cols as i32, *rows as i32),
             Target::SingleCircle { .. } => (1, 1),
         };
         let asymmetric = matches!(
@@ -358,7 +423,7 @@ impl Target {
         match self {
             Target::Chessboard { square_m, .. } => *square_m,
             Target::CircleGrid { spacing_m, .. } => *spacing_m,
-            Target::DotPlate { pitch_m, .. } => *pitch_m,
+            Target::DotPlate { pitch_m, .. } | Target::SquareGrid { pitch_m, .. } => *pitch_m,
             Target::SingleCircle { .. } => 1.0,
         }
     }
@@ -366,13 +431,29 @@ impl Target {
     /// Board points `(id, position in metres, z = 0)` in id order.
     pub fn object_points(&self) -> Vec<(usize, Point3<f64>)> {
         let unit = self.unit_m();
-        self.grid_coords()
-            .into_iter()
-            .enumerate()
-            .map(|(id, (x, y))| (id, Point3::new(x as f64 * unit, y as f64 * unit, 0.0)))
-            .collect()
+        let cells = self.grid_coords().into_iter();
+        match self {
+            Target::SquareGrid { side_m, .. } => cells
+                .flat_map(|(i, j)| {
+                    let (x0, y0) = (i as f64 * unit, j as f64 * unit);
+                    SQUARE_CORNERS.map(|(u, v)| Point3::new(x0 + u * side_m, y0 + v * side_m, 0.0))
+                })
+                .enumerate()
+                .collect(),
+            Target::Chessboard { .. }
+            | Target::CircleGrid { .. }
+            | Target::DotPlate { .. }
+            | Target::SingleCircle { .. } => cells
+                .enumerate()
+                .map(|(id, (x, y))| (id, Point3::new(x as f64 * unit, y as f64 * unit, 0.0)))
+                .collect(),
+        }
     }
 }
+
+/// A square's corners `k = 0..3` in units of its side, from its origin:
+/// clockwise on screen when the board is seen from the front.
+pub(crate) const SQUARE_CORNERS: [(f64, f64); 4] = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
 
 fn parse_grid(text: &str) -> Result<(usize, usize)> {
     let err = || {
@@ -451,6 +532,73 @@ mod tests {
             "target: a grid needs 2 to 100000 points with at least 2 per side, got 1x6"
         );
         assert!(Target::parse_spec("hexagons:3x3:1mm").is_err());
+        let Target::SquareGrid {
+            cols: 8,
+            rows: 8,
+            side_m,
+            pitch_m,
+        } = Target::parse_spec("squares:8x8:12.7mm:22.5778mm").unwrap()
+        else {
+            panic!("not an 8x8 square grid")
+        };
+        assert!((side_m - 0.0127).abs() < 1e-15 && (pitch_m - 0.0225778).abs() < 1e-15);
+        assert_eq!(
+            Target::parse_spec("squares:8x8:25mm:20mm")
+                .unwrap_err()
+                .to_string(),
+            "target: the square side must be smaller than the pitch (the squares must not touch)"
+        );
+        assert_eq!(
+            Target::parse_spec("squares:8x8:10mm")
+                .unwrap_err()
+                .to_string(),
+            "target: 'squares:8x8:10mm' is not a square-grid spec; expected squares:COLSxROWS:SIDE:PITCH (e.g. squares:8x8:12.7mm:22.5778mm)"
+        );
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn square_grid_corners_follow_the_documented_order_and_zhangs_mapping() {
+        let t = Target::parse_spec("squares:8x8:12.7mm:22.5778mm").unwrap();
+        assert_eq!(t.point_count(), 256);
+        let p = t.object_points();
+        assert_eq!(p.len(), 256);
+        // Square 1 (i = 1, j = 0), corner 2: (pitch + side, side).
+        assert_eq!(p[6].0, 6);
+        assert!((p[6].1.x - 0.0352778).abs() < 1e-12 && (p[6].1.y - 0.0127).abs() < 1e-12);
+        // Square 8 (i = 0, j = 1), corner 3: (0, pitch + side).
+        assert!(p[35].1.x.abs() < 1e-12 && (p[35].1.y - 0.0352778).abs() < 1e-12);
+        // Zhang's Model.txt line n, corner k (inches, y = -j pitch - side
+        // ... -j pitch) is our id 4 (n % 8 + 8 (7 - n / 8)) + k shifted by
+        // 7 pitch + side along y (module docs).
+        let (inch, pitch_in, side_in) = (0.0254, 8.0 / 9.0, 0.5);
+        for n in [0usize, 9, 63] {
+            let (i, jz) = ((n % 8) as f64, (n / 8) as f64);
+            let zhang = [
+                (i * pitch_in, -0.5 - jz * pitch_in),
+                (i * pitch_in + side_in, -0.5 - jz * pitch_in),
+                (i * pitch_in + side_in, -jz * pitch_in),
+                (i * pitch_in, -jz * pitch_in),
+            ];
+            for (k, (x, y)) in zhang.iter().enumerate() {
+                let id = 4 * (n % 8 + 8 * (7 - n / 8)) + k;
+                let ours = p[id].1;
+                let shift = 7.0 * pitch_in + side_in;
+                assert!((ours.x - x * inch).abs() < 1e-6, "n {n} k {k}");
+                assert!((ours.y - (y + shift) * inch).abs() < 1e-6, "n {n} k {k}");
+            }
+        }
+        let t = Target::SquareGrid {
+            cols: 8,
+            rows: 8,
+            side_m: 0.0127,
+            pitch_m: 0.0225778,
+        };
+        let json = serde_json::to_string(&t).unwrap();
+        assert_eq!(
+            json,
+            r#"{"kind":"square_grid","cols":8,"rows":8,"side_m":0.0127,"pitch_m":0.0225778}"#
+        );
+        assert_eq!(serde_json::from_str::<Target>(&json).unwrap(), t);
     }
 
     #[wasm_bindgen_test(unsupported = test)]

@@ -26,7 +26,8 @@
 //!
 //! Zhang 1998: the target is a grid of separate black squares, not a
 //! chessboard (no X-junctions); the chessboard detector must refuse it
-//! cleanly instead of inventing a board.
+//! cleanly instead of inventing a board, and the square-grid detector
+//! (`squares:8x8:12.7mm:22.5778mm`) must find all five boards.
 
 mod support;
 use support::dataset;
@@ -128,4 +129,128 @@ fn zhang1998_square_grid_is_not_mistaken_for_a_chessboard() {
             "image{k}: {e}"
         );
     }
+}
+
+/// Zhang's `dataK.txt` as 256 points, rows of 8 numbers (4 corners).
+fn zhang_points(text: &str) -> Vec<(f64, f64)> {
+    let v: Vec<f64> = text
+        .split_whitespace()
+        .map(|t| t.parse().expect("number"))
+        .collect();
+    v.chunks(2).map(|c| (c[0], c[1])).collect()
+}
+
+/// Our id of Zhang's point `p` (line `p / 4`, corner `p % 4`): his rows of
+/// squares run from the bottom of the image (src/target.rs).
+fn zhang_to_robocal_id(p: usize) -> usize {
+    let (n, k) = (p / 4, p % 4);
+    4 * (n % 8 + 8 * (7 - n / 8)) + k
+}
+
+#[test]
+fn zhang1998_square_grid_found_and_calibrated() {
+    // Zhang 1998: all 5 boards found as 8x8 grids of separate squares. The
+    // corners are compared with Zhang's own (data1..5.txt, lines fitted to
+    // the square edges and intersected) and the camera calibrated from
+    // robocal's detections is compared with his published result
+    // (completecalibration.txt).
+    //
+    // Measured: per image the median distance to Zhang's corners is 0.057,
+    // 0.119, 0.073, 0.114, 0.123 px (images 1-5), the max 0.19-0.77 px.
+    // Bounds: median <= 0.15 px, max <= 0.85 px. Zhang's corners are
+    // estimates too (lines fitted to whole sides and intersected, a
+    // different edge operator), so this is agreement, not error; the
+    // largest difference (0.77 px, image2 at (390, 110)) lies in the
+    // reflection that crosses that photo. The calibration from robocal's
+    // corners lands within 0.7 of its std of every published value (bound:
+    // 1 std) with RMS 0.364 px (Zhang's corners: 0.337 px). The side
+    // model is also best here: parabolas per side give RMS 0.407 px,
+    // half-side segments 0.385 px (src/detect/squares.rs).
+    use robocal::calib::{calibrate, CalibrationOptions, View};
+    let Some(dir) = dataset("zhang1998") else {
+        eprintln!(
+            "skipped: zhang1998 dataset not found beside the crate or in /work/shared/datasets"
+        );
+        return;
+    };
+    let target = Target::parse_spec("squares:8x8:12.7mm:22.5778mm").unwrap();
+    let mut views = Vec::new();
+    for k in 1..=5 {
+        let bytes = std::fs::read(dir.join(format!("image{k}.gif"))).unwrap();
+        let img = robocal::image::decode_gray(&bytes).unwrap();
+        let det = detect(&img, &target, &DetectOptions::default())
+            .unwrap_or_else(|e| panic!("image{k}: {e}"));
+        assert_eq!(det.points.len(), 256, "image{k}");
+        let zhang =
+            zhang_points(&std::fs::read_to_string(dir.join(format!("data{k}.txt"))).unwrap());
+        assert_eq!(zhang.len(), 256);
+        let dist: Vec<(f64, (f64, f64))> = zhang
+            .iter()
+            .enumerate()
+            .map(|(p, z)| {
+                let q = &det.points[zhang_to_robocal_id(p)];
+                (((q.x_px - z.0).powi(2) + (q.y_px - z.1).powi(2)).sqrt(), *z)
+            })
+            .collect();
+        let mut d: Vec<f64> = dist.iter().map(|e| e.0).collect();
+        d.sort_by(f64::total_cmp);
+        let (median, max) = (d[128], d[255]);
+        let mean = d.iter().sum::<f64>() / 256.0;
+        let worst = dist
+            .iter()
+            .fold(dist[0], |a, b| if b.0 > a.0 { *b } else { a });
+        eprintln!(
+            "image{k}: distance to Zhang's corners median {median:.4} px, mean {mean:.4} px, max {max:.4} px (at {:.0}, {:.0})",
+            worst.1 .0, worst.1 .1
+        );
+        assert!(
+            median <= 0.15,
+            "image{k}: median {median} px from Zhang's corners"
+        );
+        assert!(max <= 0.85, "image{k}: max {max} px from Zhang's corners");
+        let (object_m, image_px) = det.correspondences();
+        views.push(View {
+            name: format!("image{k}"),
+            object_m,
+            image_px,
+        });
+    }
+    // Zhang's model: radial k1 k2, no tangential terms, skew estimated.
+    let options = CalibrationOptions {
+        model: robocal::Distortion::Brown {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+        },
+        fixed_coefficients: vec!["p1".into(), "p2".into(), "k3".into()],
+        zero_skew: false,
+        ..CalibrationOptions::default()
+    };
+    let report = calibrate(&views, (640, 480), &options).expect("calibration");
+    let c = &report.camera;
+    let rows = [
+        ("fx", c.fx, 832.5),
+        ("fy", c.fy, 832.53),
+        ("cx", c.cx, 303.959),
+        ("cy", c.cy, 206.585),
+        ("skew", c.skew, 0.204494),
+        ("k1", report.distortion["k1"], -0.228601),
+        ("k2", report.distortion["k2"], 0.190353),
+    ];
+    for (name, got, want) in rows {
+        let z = (got - want) / report.std[name];
+        eprintln!(
+            "{name}: {got:.5} from robocal's detections vs published {want} (std {:.5}, {z:.2} std)",
+            report.std[name]
+        );
+        assert!(
+            z.abs() <= 1.0,
+            "{name}: {got} vs published {want} ({z:.2} std)"
+        );
+    }
+    eprintln!("rms {:.4} px", report.rms_px);
+    // Zhang's own corners give 0.337 px (OpenCV, SOURCE.md).
+    assert!(report.rms_px < 0.4, "rms {} px", report.rms_px);
 }

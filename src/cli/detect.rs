@@ -15,7 +15,9 @@ Usage: robocal detect --target SPEC [-o FILE] [--threads N] IMAGES...
 Options:
   --target SPEC   the target: chessboard:COLSxROWS:SQUARE (inner corners),
                   circles:COLSxROWS:SPACING[:asymmetric][:light-on-dark],
-                  dots:COLSxROWS:PITCH[:DIAMETER], circle:DIAMETER
+                  dots:COLSxROWS:PITCH[:DIAMETER], circle:DIAMETER,
+                  squares:COLSxROWS:SIDE:PITCH (separate dark squares, 4
+                  corners each, e.g. Zhang's squares:8x8:12.7mm:22.5778mm)
                   (lengths with mm, cm or m), or a target JSON object
   -o FILE         write the JSON result to FILE (default: standard output)
   --threads N     images processed in parallel (default: all cores)
@@ -33,6 +35,7 @@ Examples:
   robocal detect --target chessboard:9x6:30mm left*.jpg -o detections.json
   robocal detect --target circles:4x11:20mm:asymmetric acircles*.png
   robocal detect --target dots:7x7:25mm plate.tiff
+  robocal detect --target squares:8x8:12.7mm:22.5778mm image*.gif
   robocal detect --target circle:10mm --threads 1 table_*.png";
 
 /// One image's outcome (also used by `robocal intrinsics`).

@@ -19,7 +19,8 @@ Usage: robocal intrinsics --target SPEC IMAGES... [options] -o camera.json
 
 Options:
   --target SPEC           the target, as for 'robocal detect' (chessboard:9x6:30mm,
-                          circles:4x11:20mm:asymmetric, dots:7x7:25mm); required
+                          circles:4x11:20mm:asymmetric, dots:7x7:25mm,
+                          squares:8x8:12.7mm:22.5778mm); required
                           with images, checked against the file with --detections
   --detections FILE       use the JSON written by 'robocal detect' instead of images
   --model NAME            brown (default: k1 k2 p1 p2 k3), radial_k1_k2_k5, rational,

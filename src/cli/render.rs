@@ -29,7 +29,8 @@ robot poses that go with them (DIR/poses.csv, Universal Robots format with an
 image column) and truth.json with gripper_from_camera and base_from_target.
 
 Options:
-  --target SPEC     chessboard:9x6:30mm (default), circles:..., dots:...
+  --target SPEC     chessboard:9x6:30mm (default), circles:..., dots:...,
+                    squares:...
   --views N         number of images (default 12)
   --seed N          random seed (default 1); equal seeds give equal files
   --camera FILE     the camera (robocal/OpenCV/ROS camera file; default: a
@@ -110,6 +111,13 @@ fn grid_of(target: &Target) -> ((usize, usize), f64) {
             ..
         } => ((*cols, *rows), *pitch_m),
         Target::SingleCircle { diameter_m } => ((2, 2), *diameter_m),
+        // The squares' origins (the grid is half a side off centre).
+        Target::SquareGrid {
+            cols,
+            rows,
+            pitch_m,
+            ..
+        } => ((*cols, *rows), *pitch_m),
     }
 }
 

@@ -259,7 +259,7 @@ fn edge_on_ray(
     None
 }
 
-fn bilinear_u8(img: &GrayImage, x: f64, y: f64) -> f64 {
+pub(crate) fn bilinear_u8(img: &GrayImage, x: f64, y: f64) -> f64 {
     let (w, h) = (img.width as isize, img.height as isize);
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);

@@ -20,7 +20,11 @@ const BLOB_WORKING_SIDE_PX: u32 = 2048;
 const AREA_RATIO: f64 = 3.0;
 
 /// Working-level blobs and the level they were found at.
-fn blobs_at_level(img: &GrayImage, invert: bool, options: &DetectOptions) -> (u32, Vec<Blob>) {
+pub(crate) fn blobs_at_level(
+    img: &GrayImage,
+    invert: bool,
+    options: &DetectOptions,
+) -> (u32, Vec<Blob>) {
     let max_side = options.max_working_side_px.max(BLOB_WORKING_SIDE_PX);
     let levels = super::pyramid_levels(img, max_side);
     match levels.into_iter().next() {
@@ -140,6 +144,7 @@ fn describe(target: &Target) -> String {
         Target::DotPlate { cols, rows, .. } => format!("{cols}x{rows} dot plate"),
         Target::Chessboard { cols, rows, .. } => format!("{cols}x{rows} chessboard"),
         Target::SingleCircle { .. } => "circle".to_string(),
+        Target::SquareGrid { cols, rows, .. } => format!("{cols}x{rows} square grid"),
     }
 }
 
@@ -158,7 +163,7 @@ fn point(id: usize, fit: &super::ellipse::EllipseFit) -> DetectedPoint {
 
 /// The seed's two lattice steps: its nearest similar blob, and the nearest
 /// one not collinear with it.
-fn seed_steps(blobs: &[Blob], seed: usize) -> Option<(Vector2<f64>, Vector2<f64>)> {
+pub(crate) fn seed_steps(blobs: &[Blob], seed: usize) -> Option<(Vector2<f64>, Vector2<f64>)> {
     let s = &blobs[seed];
     let similar = |b: &Blob| (1.0 / AREA_RATIO..=AREA_RATIO).contains(&(b.area / s.area));
     let mut near: Vec<(f64, Vector2<f64>)> = blobs

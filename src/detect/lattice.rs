@@ -250,6 +250,45 @@ pub(crate) fn predict(
     })
 }
 
+/// When growth took in more cells than a `cols x rows` board has (clutter
+/// next to the board that happens to sit on the lattice), the cells of the
+/// one completely filled `cols x rows` (or `rows x cols`) window of the
+/// lattice. `None` when no window or more than one is full.
+pub(crate) fn trim_to_window(cells: &Cells, cols: usize, rows: usize) -> Option<Cells> {
+    let n = cols * rows;
+    if cells.len() <= n {
+        return None;
+    }
+    let (mut lo, mut hi) = ((i32::MAX, i32::MAX), (i32::MIN, i32::MIN));
+    for &(a, b) in cells.keys() {
+        lo = (lo.0.min(a), lo.1.min(b));
+        hi = (hi.0.max(a), hi.1.max(b));
+    }
+    let mut found: Option<Cells> = None;
+    let shapes = if cols == rows {
+        vec![(cols as i32, rows as i32)]
+    } else {
+        vec![(cols as i32, rows as i32), (rows as i32, cols as i32)]
+    };
+    for (wa, wb) in shapes {
+        for a0 in lo.0..=hi.0 - wa + 1 {
+            for b0 in lo.1..=hi.1 - wb + 1 {
+                let window: Option<Cells> = (a0..a0 + wa)
+                    .flat_map(|a| (b0..b0 + wb).map(move |b| (a, b)))
+                    .map(|c| cells.get(&c).map(|&i| (c, i)))
+                    .collect();
+                if let Some(w) = window {
+                    if found.is_some() {
+                        return None;
+                    }
+                    found = Some(w);
+                }
+            }
+        }
+    }
+    found
+}
+
 /// A lattice-to-board map `board = m * (a, b) + t`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct BoardMap {

@@ -14,6 +14,10 @@
 //!   Centres are those of ellipses fitted to sub-pixel edge points.
 //! - **A single circle**: the largest elliptical blob; its centre comes with
 //!   the covariance of the ellipse-fit centre.
+//! - **Square grids** ([`squares`] docs): dark blobs as for dot plates,
+//!   grown into the lattice of squares and ordered by the same rules; each
+//!   square's four corners are where parabolas fitted to its sides'
+//!   sub-pixel edge points (gradient centroids across each side) meet.
 //!
 //! # Perspective bias of circle centres
 //!
@@ -39,6 +43,7 @@ pub(crate) mod filter;
 mod lattice;
 mod refine;
 mod saddle;
+mod squares;
 
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
@@ -112,6 +117,12 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
             options,
         )?,
         Target::SingleCircle { .. } => vec![circles::detect_single(image, options)?],
+        Target::SquareGrid {
+            cols,
+            rows,
+            side_m,
+            pitch_m,
+        } => squares::detect_square_grid(image, *cols, *rows, side_m / pitch_m, options)?,
     };
     Ok(Detection {
         image_size_px: [w, h],
@@ -211,6 +222,7 @@ mod tests {
             "circles:4x4:20mm:light-on-dark",
             "dots:7x7:25mm",
             "circle:10mm",
+            "squares:8x8:12.7mm:22.5778mm",
         ];
         for case in 0..24 {
             let w = 16 + rng.below(120) as u32;

@@ -12,7 +12,8 @@
 //!
 //! Board print: chessboards have a white margin one square wide; the outer
 //! square diagonally beyond corner 0 is black (the detector's ordering
-//! rule). Circle grids and dot plates have a one-unit margin. Beyond the
+//! rule). Circle grids and dot plates have a one-unit margin, square grids
+//! a one-pitch margin beyond the outer squares. Beyond the
 //! print the scene is a uniform grey wall.
 
 use crate::error::{Error, Result};
@@ -296,6 +297,17 @@ impl Albedo {
                     2.0 * diameter_m,
                 ),
             ),
+            Target::SquareGrid {
+                side_m, pitch_m, ..
+            } => (
+                0.0,
+                (
+                    -pitch_m,
+                    -pitch_m,
+                    maxx + side_m + pitch_m,
+                    maxy + side_m + pitch_m,
+                ),
+            ),
         };
         Albedo {
             target: target.clone(),
@@ -345,6 +357,21 @@ impl Albedo {
             }
             Target::DotPlate { .. } | Target::SingleCircle { .. } => {
                 if self.in_dot(x, y) {
+                    self.black
+                } else {
+                    self.white
+                }
+            }
+            Target::SquareGrid {
+                cols,
+                rows,
+                side_m,
+                pitch_m,
+            } => {
+                let (i, j) = ((x / pitch_m).floor(), (y / pitch_m).floor());
+                let (u, v) = (x - i * pitch_m, y - j * pitch_m);
+                let on_grid = i >= 0.0 && j >= 0.0 && i < *cols as f64 && j < *rows as f64;
+                if on_grid && u < *side_m && v < *side_m {
                     self.black
                 } else {
                     self.white

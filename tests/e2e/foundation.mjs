@@ -80,5 +80,20 @@ tests.push(
     await page.fill('input[name=cols]', '1');
     assert.equal(await page.textContent('#target-error'), 'Columns must be a whole number from 2 to 100.');
     assert.equal(await page.isDisabled('#print-target'), true);
+    // Zhang's grid of separate squares: the spec the CLI takes, 64 squares
+    // at true scale (7 pitches + side + two pitches of margin).
+    await page.selectOption('#target-kind', 'squares');
+    await page.fill('input[name=cols]', '8');
+    await page.fill('input[name=rows]', '8');
+    await page.fill('input[name=size_mm]', '22.5');
+    await page.fill('input[name=side_mm]', '12.5');
+    assert.match(await page.textContent('#target-spec'), /^Target spec: squares:8x8:12.5mm:22.5mm /);
+    await shot('squares');
+    const [dl2] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
+    const svg2 = (await (await dl2.createReadStream()).toArray()).join('');
+    assert.match(svg2, /width="215mm" height="215mm" viewBox="0 0 215 215">/);
+    assert.equal((svg2.match(/<rect /g) || []).length, 65);
+    await page.fill('input[name=side_mm]', '30');
+    assert.equal(await page.textContent('#target-error'), 'The square side must be smaller than the pitch (the squares must not touch).');
   }],
 );

@@ -2,27 +2,32 @@
 // printable SVG at true scale.
 import { $, download } from '../lib/dom.js';
 
-/** Board points in millimetres, in the detector's order (row by row from the origin). */
+/** Board points in millimetres, in the detector's order (row by row from
+ * the origin; square grids: square by square, each square's four corners
+ * clockwise from the one nearest the origin). */
 export function targetPoints(t) {
   const pts = [];
   const s = Number(t.size_mm);
   if (t.kind === 'circle') return [[0, 0]];
+  const side = Number(t.side_mm);
   for (let r = 0; r < t.rows; r++) {
     for (let c = 0; c < t.cols; c++) {
       if (t.kind === 'circles' && t.layout === 'asymmetric') pts.push([(2 * c + (r % 2)) * s, r * s]);
+      else if (t.kind === 'squares') for (const [u, v] of [[0, 0], [1, 0], [1, 1], [0, 1]]) pts.push([c * s + u * side, r * s + v * side]);
       else pts.push([c * s, r * s]);
     }
   }
   return pts;
 }
 
-/** The CLI/engine spec string: chessboard:9x6:30mm, circles:4x11:20mm:asymmetric, dots:7x7:25mm, circle:10mm. */
+/** The CLI/engine spec string: chessboard:9x6:30mm, circles:4x11:20mm:asymmetric, dots:7x7:25mm, squares:8x8:12.7mm:22.5778mm (side, pitch), circle:10mm. */
 export function targetSpec(t) {
   const mm = (x) => `${Number(x)}mm`;
   switch (t.kind) {
     case 'chessboard': return `chessboard:${t.cols}x${t.rows}:${mm(t.size_mm)}`;
     case 'circles': return `circles:${t.cols}x${t.rows}:${mm(t.size_mm)}${t.layout === 'asymmetric' ? ':asymmetric' : ''}${t.polarity === 'light' ? ':light-on-dark' : ''}`;
     case 'dots': return `dots:${t.cols}x${t.rows}:${mm(t.size_mm)}:${mm(t.diameter_mm)}`;
+    case 'squares': return `squares:${t.cols}x${t.rows}:${mm(t.side_mm)}:${mm(t.size_mm)}`;
     case 'circle': return `circle:${mm(t.diameter_mm)}`;
     default: throw new Error(`unknown target kind ${t.kind}`);
   }
@@ -37,6 +42,8 @@ export function validateTarget(t) {
   }
   if ((t.kind === 'dots' || t.kind === 'circle') && !(t.diameter_mm > 0)) return 'The diameter must be a positive number of millimetres.';
   if (t.kind === 'dots' && t.diameter_mm >= t.size_mm) return 'The dot diameter must be smaller than the pitch.';
+  if (t.kind === 'squares' && !(t.side_mm > 0)) return 'The square side must be a positive number of millimetres.';
+  if (t.kind === 'squares' && t.side_mm >= t.size_mm) return 'The square side must be smaller than the pitch (the squares must not touch).';
   if (t.kind === 'chessboard' && t.cols === t.rows) return '';
   return '';
 }
@@ -51,6 +58,13 @@ export function boardLayout(t) {
       for (let c = 0; c < t.cols + 1; c++) if ((r + c) % 2 === 0) rects.push([margin + c * s, margin + r * s, s, s]);
     }
     return { width: (t.cols + 3) * s, height: (t.rows + 3) * s, origin: [margin + s, margin + s], rects, circles: [], light: false };
+  }
+  if (t.kind === 'squares') {
+    // One pitch of margin; origin at square 0's first corner.
+    const side = Number(t.side_mm);
+    const rects = [];
+    for (let r = 0; r < t.rows; r++) for (let c = 0; c < t.cols; c++) rects.push([s + c * s, s + r * s, side, side]);
+    return { width: (t.cols + 1) * s + side, height: (t.rows + 1) * s + side, origin: [s, s], rects, circles: [], light: false };
   }
   if (t.kind === 'circle') {
     const d = Number(t.diameter_mm);
@@ -119,7 +133,7 @@ function readForm(form) {
   const v = (n) => form.elements[n].value;
   return {
     kind: v('kind'), cols: Number(v('cols')), rows: Number(v('rows')), size_mm: Number(v('size_mm')),
-    layout: v('layout'), polarity: v('polarity'), diameter_mm: Number(v('diameter_mm')),
+    layout: v('layout'), polarity: v('polarity'), diameter_mm: Number(v('diameter_mm')), side_mm: Number(v('side_mm')),
   };
 }
 
@@ -136,7 +150,7 @@ export function initTarget(store) {
       const kinds = el.dataset.for.split(' ');
       el.hidden = !kinds.includes(t.kind) && !(kinds.includes('grid') && t.kind !== 'circle');
     }
-    $('size-label').textContent = { chessboard: 'Square size', circles: 'Circle spacing', dots: 'Dot pitch', circle: 'Size' }[t.kind];
+    $('size-label').textContent = { chessboard: 'Square size', circles: 'Circle spacing', dots: 'Dot pitch', squares: 'Square pitch', circle: 'Size' }[t.kind];
     form.elements.size_mm.closest('label').hidden = t.kind === 'circle';
     const err = validateTarget(t);
     $('target-error').textContent = err;
