@@ -135,6 +135,7 @@ enum TargetKind {
     CircleGrid,
     DotPlate,
     SingleCircle,
+    SquareGrid,
 }
 
 /// Every field of every [`Target`] variant; the tag picks which are needed.
@@ -150,6 +151,7 @@ struct TargetFields {
     pitch_m: Option<f64>,
     dot_diameter_m: Option<f64>,
     diameter_m: Option<f64>,
+    side_m: Option<f64>,
 }
 
 impl<'de> Deserialize<'de> for Target {
@@ -177,6 +179,12 @@ impl<'de> Deserialize<'de> for Target {
             },
             TargetKind::SingleCircle => Target::SingleCircle {
                 diameter_m: f(t.diameter_m, "diameter_m")?,
+            },
+            TargetKind::SquareGrid => Target::SquareGrid {
+                cols: f(t.cols, "cols")?,
+                rows: f(t.rows, "rows")?,
+                side_m: f(t.side_m, "side_m")?,
+                pitch_m: f(t.pitch_m, "pitch_m")?,
             },
         })
     }
