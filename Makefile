@@ -47,6 +47,7 @@ test-wasm: setup
 	CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --lib --target $(WASM_TARGET)
 
 test-node: pkg
+	tools/setup.sh node
 	node tests/node/smoke.mjs
 
 test-e2e: web cli

@@ -1,90 +1,1126 @@
 // Types of the robocal npm package (node entry). Functions come from the
-// wasm-bindgen declarations; the JSON shapes they exchange are below.
+// wasm-bindgen declarations; the JSON shapes they exchange are below, one
+// per serde type of the Rust core (the doc comments say where each comes
+// from). `RobocalJson` maps every function to its [input, output] JSON.
+//
+// Conventions (src/lib.rs): `a_from_b` maps b-frame coordinates to a:
+// `p_a = a_from_b * p_b`; lengths in metres unless the key says `_mm`;
+// pixels with (0, 0) at the centre of the top-left pixel; quaternions
+// x, y, z, w; angles in radians unless the key says `_deg`.
+//
+// Optional keys: `k?: T` is a key the Rust side leaves out (or, on input,
+// one with a default); `k: T | null` is a key always written, null when
+// there is no value.
 export * from './node/robocal.js';
 
-/** What `image_info` returns (and `ImagePreview.info_json` holds), as JSON. */
+// ---------------------------------------------------------------------------
+// Small building blocks
+
+/** `[x, y]` or `[u, v]`. */
+export type Vec2 = [number, number];
+/** `[x, y, z]`. */
+export type Vec3 = [number, number, number];
+/** `[x, y, z, w]` (quaternions: unit, scalar last). */
+export type Vec4 = [number, number, number, number];
+/** A 3x3 matrix as 3 rows. */
+export type Matrix3Rows = [Vec3, Vec3, Vec3];
+/** A 4x4 homogeneous matrix as 4 rows. */
+export type Matrix4Rows = [Vec4, Vec4, Vec4, Vec4];
+/** A 2x2 matrix as 2 rows. */
+export type Matrix2Rows = [Vec2, Vec2];
+/** A 3x3 matrix flattened row by row (9 numbers). */
+export type Matrix3Flat = [number, number, number, number, number, number, number, number, number];
+/** A 3x4 matrix flattened row by row (12 numbers). */
+export type Matrix3x4Flat = [
+  number, number, number, number,
+  number, number, number, number,
+  number, number, number, number,
+];
+/** `[width, height]` of an image, px. */
+export type ImageSize = [number, number];
+
+/**
+ * A rigid transform as every report writes it (calib `PoseReport`, hand-eye
+ * `PoseJson`, `transform_json`): `p_a = a_from_b * p_b`.
+ */
+export interface PoseReport {
+  /** The 4x4 homogeneous matrix, row by row; translation in metres. */
+  matrix_row_major: Matrix4Rows;
+  /** Translation, metres. */
+  translation_m: Vec3;
+  /** Unit quaternion, component order x, y, z, w. */
+  quaternion_xyzw: Vec4;
+}
+
+/** A rigid transform without the matrix (`geometry::pose_serde`): metres, quaternion x y z w. */
+export interface PoseQuaternion {
+  /** Translation, metres. */
+  translation_m: Vec3;
+  /** Unit quaternion, component order x, y, z, w (normalised when read). */
+  quaternion_xyzw: Vec4;
+}
+
+/**
+ * A pose as the hand-eye inputs read it: the matrix (translation in metres;
+ * the other two keys are then ignored, so a `PoseReport` works as is), or
+ * translation plus quaternion.
+ */
+export type PoseInput =
+  | { matrix_row_major: Matrix4Rows; translation_m?: Vec3; quaternion_xyzw?: Vec4 }
+  | PoseQuaternion;
+
+/** Why the Levenberg-Marquardt solver stopped (`optim::Termination`). */
+export type Termination =
+  | 'cost_tolerance'
+  | 'gradient_tolerance'
+  | 'step_tolerance'
+  | 'no_decrease'
+  | 'max_iterations';
+
+/** Euler axis sequences: 6 Tait-Bryan, then 6 proper Euler. */
+export type EulerOrder =
+  | 'xyz' | 'xzy' | 'yxz' | 'yzx' | 'zxy' | 'zyx'
+  | 'xyx' | 'xzx' | 'yxy' | 'yzy' | 'zxz' | 'zyz';
+/** Rotating (intrinsic) or fixed (extrinsic) axes. */
+export type EulerKind = 'intrinsic' | 'extrinsic';
+
+// ---------------------------------------------------------------------------
+// Images (src/image)
+
+/** What `image_info` returns (and `decode_image_preview(...).info_json` holds). */
 export interface ImageInfo {
   /** Container format, lower case. */
   format: 'png' | 'jpeg' | 'tiff' | 'bmp' | 'pnm' | 'gif';
   /** Upper-case display name, e.g. "PNG". */
-  format_name: string;
+  format_name: 'PNG' | 'JPEG' | 'TIFF' | 'BMP' | 'PNM' | 'GIF';
+  /** Width, px. */
   width: number;
+  /** Height, px. */
   height: number;
-  /** 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA. */
+  /** Channels in the file: 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA. */
   channels: number;
+  /** Bits per channel in the file: 8 or 16, 32 for float TIFF. */
   bits_per_channel: number;
 }
 
-/** A rigid transform as the reports write it: `p_a = a_from_b * p_b`, metres. */
-export interface PoseReport {
-  matrix_row_major: number[][];
-  translation_m: [number, number, number];
-  /** Unit quaternion, component order x, y, z, w. */
-  quaternion_xyzw: [number, number, number, number];
+/** `undistort_preview(...).info_json`: the preview's size, px. */
+export interface UndistortPreviewInfo {
+  width: number;
+  height: number;
 }
 
-/** A calibration target as JSON (`Detection.target`; `detect_target` also
- * takes a CLI spec such as `chessboard:9x6:30mm` or
- * `squares:8x8:12.7mm:22.5778mm`). Lengths in metres; docs/detection-json.md
- * gives each kind's point order. */
-export type Target =
-  | { kind: 'chessboard'; cols: number; rows: number; square_m: number }
-  | { kind: 'circle_grid'; cols: number; rows: number; spacing_m: number; asymmetric: boolean; polarity: 'dark_on_light' | 'light_on_dark' }
-  | { kind: 'dot_plate'; cols: number; rows: number; pitch_m: number; dot_diameter_m: number }
-  | { kind: 'single_circle'; diameter_m: number }
-  /** `cols x rows` separate dark squares, 4 corners each: id = 4 (i + j cols) + k. */
-  | { kind: 'square_grid'; cols: number; rows: number; side_m: number; pitch_m: number };
+// ---------------------------------------------------------------------------
+// Targets and detections (src/target.rs, docs/detection-json.md)
 
-/** What `detect_target` returns, as JSON. Pixels: (0, 0) is the centre of the top-left pixel. */
+/** Which way round a circle target is printed. */
+export type Polarity = 'dark_on_light' | 'light_on_dark';
+
+/**
+ * The fields of each target kind, keyed by `kind` (the serde tag). Board
+ * frame: x along a row, y from row to row, z = 0 on the board, metres;
+ * point ids `i + j * cols`, row by row. A new kind is one more entry here.
+ */
+export interface TargetKinds {
+  /** A chessboard counted by inner corners (a 10 x 7 squares board is 9 x 6); points at `(i, j) * square_m`. */
+  chessboard: { cols: number; rows: number; /** Side of one square, metres. */ square_m: number };
+  /** A grid of circles (OpenCV's layouts): symmetric `(i, j) * spacing_m`, asymmetric `(2 i + j % 2, j) * spacing_m`. */
+  circle_grid: { cols: number; rows: number; /** Grid unit, metres (asymmetric: half the centre distance within a row). */ spacing_m: number; asymmetric: boolean; polarity: Polarity };
+  /** Dark dots on a light plate, at `(i, j) * pitch_m`. */
+  dot_plate: { cols: number; rows: number; /** Centre distance, metres. */ pitch_m: number; /** Dot diameter, metres (< pitch). */ dot_diameter_m: number };
+  /** One dark circle on a light background; one point, id 0, its centre. */
+  single_circle: { /** Circle diameter, metres. */ diameter_m: number };
+  /** `cols x rows` separate dark squares (Zhang's 1998 target), 4 corners each: id = `4 (i + j * cols) + k`; square `(i, j)` spans `(i, j) * pitch_m` to that `+ side_m`, corner k = 0 (x0, y0), 1 (x0 + side, y0), 2 (x0 + side, y0 + side), 3 (x0, y0 + side). */
+  square_grid: { cols: number; rows: number; /** Side of one square, metres (< pitch). */ side_m: number; /** Distance between the origins of neighbouring squares, metres. */ pitch_m: number };
+}
+
+/** A target kind name. */
+export type TargetKind = keyof TargetKinds;
+/** The target of one kind, e.g. `TargetOf<'chessboard'>`. */
+export type TargetOf<K extends TargetKind> = { kind: K } & TargetKinds[K];
+/** A calibration target's geometry: a union discriminated by `kind`. */
+export type Target = { [K in TargetKind]: TargetOf<K> }[TargetKind];
+
+/**
+ * A CLI target spec, the other form `detect_target` takes: `chessboard:9x6:30mm`,
+ * `circles:4x11:20mm[:asymmetric|symmetric][:dark-on-light|light-on-dark]`,
+ * `dots:7x7:25mm[:12.5mm]` (dot diameter defaults to half the pitch),
+ * `circle:10mm`, `squares:8x8:12.7mm:22.5778mm` (side, then pitch); lengths in mm, cm or m.
+ */
+export type TargetSpec =
+  | `chessboard:${number}x${number}:${string}`
+  | `circles:${number}x${number}:${string}`
+  | `dots:${number}x${number}:${string}`
+  | `circle:${string}`
+  | `squares:${number}x${number}:${string}:${string}`;
+
+/** One detected target point. */
+export interface DetectedPoint {
+  /** Board id (`i + j * cols`; square grids: `4 (i + j * cols) + k`). */
+  id: number;
+  /** Column coordinate, px. */
+  x_px: number;
+  /** Row coordinate, px. */
+  y_px: number;
+  /** Covariance `[xx, xy, yy]`, px^2, when the detector estimates it (circle centres). */
+  covariance_px2?: Vec3;
+}
+
+/** What `detect_target` returns: a target found in one image. */
 export interface Detection {
-  image_size_px: [number, number];
+  /** `[width, height]` of the image, px. */
+  image_size_px: ImageSize;
+  /** The target that was searched for. */
   target: Target;
-  /** Sorted by id; `covariance_px2` is `[xx, xy, yy]` when estimated. */
-  points: { id: number; x_px: number; y_px: number; covariance_px2?: [number, number, number] }[];
+  /** Detected points, sorted by id; ids missing from a partial detection are absent. */
+  points: DetectedPoint[];
 }
 
-/** One view of a calibration input: a `detect_target` detection, or explicit correspondences. */
-export type CalibrationView =
-  | { name: string; detection: Detection | object }
-  | { name: string; object_m: [number, number, number][]; image_px: [number, number][] };
+// ---------------------------------------------------------------------------
+// Camera and lens models (src/camera)
 
-/** The options object of `calibrate_camera` and `calibrate_stereo`. */
+/**
+ * The coefficients of each lens model, keyed by `model` (the serde tag).
+ * All act on normalised coordinates (X/Z, Y/Z) or, for the wide-angle
+ * models, on the ray.
+ */
+export interface DistortionModels {
+  /** The ideal pinhole camera. */
+  none: Record<never, never>;
+  /** Brown-Conrady, OpenCV's 5 coefficients (OpenCV order k1 k2 p1 p2 k3). */
+  brown: { k1: number; k2: number; k3: number; p1: number; p2: number };
+  /** OpenCV's rational model with thin-prism terms (k4..k6 denominator, s1..s4 prism). */
+  rational: {
+    k1: number; k2: number; k3: number; k4: number; k5: number; k6: number;
+    p1: number; p2: number; s1: number; s2: number; s3: number; s4: number;
+  };
+  /** Division model: `undistorted = distorted / (1 + kappa r_d^2)`, normalised units. */
+  division: { kappa: number };
+  /** Radial-only Brown (Bouguet's kc naming): `x_d = x (1 + k1 r^2 + k2 r^4 + k5 r^6)`. */
+  radial_k1_k2_k5: { k1: number; k2: number; k5: number };
+  /** Kannala-Brandt equidistant fisheye: `theta_d = theta (1 + k1 theta^2 + ... + k4 theta^8)`. */
+  kannala_brandt: { k1: number; k2: number; k3: number; k4: number };
+  /** Enhanced unified camera model: alpha in [0, 1), beta > 0. */
+  eucm: { alpha: number; beta: number };
+}
+
+/** A lens model name (`model` of the calibration inputs and reports). */
+export type LensModel = keyof DistortionModels;
+/** A lens model with its coefficients: `{"model": "brown", "k1": -0.2, ...}`. */
+export type Distortion = { [M in LensModel]: { model: M } & DistortionModels[M] }[LensModel];
+
+/**
+ * A camera (`camera::Camera`): `u = fx m_x + skew m_y + cx`, `v = fy m_y + cy`
+ * for the distorted normalised point m; camera frame x right, y down, z forward.
+ * The `camera` of a calibration report; what `undistort_preview` takes.
+ */
+export interface Camera {
+  /** Focal length along x, px. */
+  fx: number;
+  /** Focal length along y, px. */
+  fy: number;
+  /** Principal point x, px. */
+  cx: number;
+  /** Principal point y, px. */
+  cy: number;
+  /** Skew, px (the (0, 1) entry of the camera matrix); usually 0. */
+  skew: number;
+  /** Image width, px. */
+  width: number;
+  /** Image height, px. */
+  height: number;
+  /** The lens model. */
+  distortion: Distortion;
+}
+
+// ---------------------------------------------------------------------------
+// Camera calibration (src/calib/json_api.rs, report.rs, compare.rs)
+
+/** A calibration method; `all` (input only) runs every one and compares. */
+export type CalibrationMethod = 'zhang' | 'dlt' | 'tsai' | 'ekf';
+
+/** The `options` object of `calibrate_camera` and `calibrate_stereo` (every key optional). */
 export interface CalibrationOptions {
+  /** Hold the principal point at the image centre (default false). */
   fix_principal_point?: boolean;
+  /** Hold fy / fx at its closed-form value, or at `aspect_ratio` (default false). */
   fix_aspect_ratio?: boolean;
-  /** Default true. */
+  /** Hold fx / fy at this value (OpenCV's aspectRatio; 1 = square pixels); implies `fix_aspect_ratio`. */
+  aspect_ratio?: number | null;
+  /** Hold the skew at 0 (default true). */
   zero_skew?: boolean;
-  /** Huber loss (1 px) and rejection beyond 3 robust sigmas. */
+  /** Huber loss (1 px) and rejection beyond 3 robust sigmas, reported per view as `outliers` (default false). */
   robust?: boolean;
+  /** Coefficient names of the model held at 0, e.g. `["k3"]`. */
   fixed_coefficients?: string[];
+}
+
+/**
+ * One view of a calibration input: a `detect_target` detection, or explicit
+ * correspondences (board points in metres, pixels in the same order).
+ */
+export type CalibrationView =
+  | { name: string; detection: Detection; object_m?: never; image_px?: never }
+  | { name: string; object_m: Vec3[]; image_px: Vec2[]; detection?: never };
+
+/** The input JSON of `calibrate_camera`. Unknown keys are rejected. */
+export interface CalibrationInput {
+  /** Lens model (default `brown`). */
+  model?: LensModel;
+  /** Method (default `zhang`); `all` runs every method and fills `comparison`. */
+  method?: CalibrationMethod | 'all';
+  options?: CalibrationOptions;
+  /** At least 3 views. */
+  views: CalibrationView[];
+  /** `[width, height]`, px; optional when the views are detections (which must agree). */
+  image_size_px?: ImageSize;
+}
+
+/** A robust loss on a residual block's norm (`optim::Loss`), tagged by `kind`; scale in px. */
+export type Loss =
+  | { kind: 'squared' }
+  | { kind: 'huber'; scale: number }
+  | { kind: 'cauchy'; scale: number };
+
+/** The solver options a report records (`calib::CalibrationOptions`, all keys written). */
+export interface CalibrationSolverOptions {
+  /** The lens model and its initial (and held) coefficients. */
+  model: Distortion;
+  /** The camera the solver started from instead of the closed form. */
+  initial_camera: Camera | null;
+  fix_principal_point: boolean;
+  fix_aspect_ratio: boolean;
+  /** The held fx / fy, when given. */
+  aspect_ratio: number | null;
+  zero_skew: boolean;
+  fixed_coefficients: string[];
+  loss: Loss;
+  /** Outlier rejection threshold, robust sigmas; null without rejection. */
+  outlier_sigma: number | null;
+  max_outlier_rounds: number;
+  max_iterations: number;
+}
+
+/** A point dropped by outlier rejection. */
+export interface Outlier {
+  /** Index of the point in its view. */
+  index: number;
+  /** Its residual norm when dropped, px. */
+  residual_px: number;
+  reason: string;
+}
+
+/** A vector anchored at a pixel, px. */
+export interface PixelVector {
+  x: number;
+  y: number;
+  dx: number;
+  dy: number;
+}
+
+/** Per-view results of a calibration. */
+export interface ViewReport {
+  name: string;
+  /** RMS of the residual norms of the used points, px. */
+  rms_px: number;
+  /** Points used. */
+  n_points: number;
+  /** Pose of the target in the camera frame: `p_camera = camera_from_target * p_target`. */
+  camera_from_target: PoseReport;
+  outliers: Outlier[];
+  /** Observed minus predicted pixel of every point (outliers included), anchored at the observed pixel. */
+  residuals_px: PixelVector[];
+}
+
+/** The calibration report (`calib::CameraCalibration`): the `report` of `calibrate_camera`. */
+export interface CameraCalibration {
+  /** robocal version that produced the report. */
+  crate_version: string;
+  /** `[width, height]`, px. */
+  image_size_px: ImageSize;
+  model: LensModel;
+  /** The calibrated camera. */
+  camera: Camera;
+  /** `[[fx, skew, cx], [0, fy, cy], [0, 0, 1]]`, px. */
+  camera_matrix: Matrix3Rows;
+  /** Distortion coefficients by name (the keys of the model in `camera.distortion`). */
+  distortion: Record<string, number>;
+  /** sqrt(sum of squared residual norms / number of points), px (OpenCV's RMS). */
+  rms_px: number;
+  /** Standard deviation of every camera parameter by name (fx, fy, cx, cy, skew, coefficients; 0 if held); empty when not all are determined. */
+  std: Record<string, number>;
+  views: ViewReport[];
+  /** Parameter correlations: `matrix` rows follow `names`; empty matrix when not all are determined. */
+  correlation: { names: string[]; matrix: number[][] };
+  /** 1-sigma projection uncertainty (px, worst direction) on a grid over the image, for points at the median target distance. */
+  projection_uncertainty: {
+    /** Distance of the points from the camera, metres. */
+    reference_depth_m: number;
+    /** Grid x coordinates, px. */
+    x_px: number[];
+    /** Grid y coordinates, px. */
+    y_px: number[];
+    /** Per row (y), per column (x), px; null where the camera cannot unproject. */
+    std_px: (number | null)[][];
+    max_std_px: number;
+  };
+  /** Distorted minus undistorted pixel positions on a 16 x 12 grid, px. */
+  distortion_field: { vectors: PixelVector[] };
+  /** Coverage, tilt and correlation warnings. */
+  warnings: string[];
+  /** Solver iterations in the last round. */
+  iterations: number;
+  termination: Termination;
+  /** Points used in total. */
+  n_points: number;
+  /** The options used. */
+  options: CalibrationSolverOptions;
+}
+
+/** One method's row of the `method: "all"` comparison (values null when it failed). */
+export interface ComparisonRow {
+  method: CalibrationMethod;
+  fx: number | null;
+  fy: number | null;
+  cx: number | null;
+  cy: number | null;
+  /** First radial coefficient, when the model has one. */
+  k1: number | null;
+  rms_px: number | null;
+  /** Standard deviation of the u residuals of the used points, px. */
+  std_u_px: number | null;
+  std_v_px: number | null;
+  /** Why the method failed or does not apply; null on success. */
+  error: string | null;
+}
+
+/** The output JSON of `calibrate_camera`. */
+export interface CalibrationOutput {
+  /** The report of the chosen method (Zhang's for `all`). */
+  report: CameraCalibration;
+  /** With method `all`: one row per method; otherwise null. */
+  comparison: ComparisonRow[] | null;
 }
 
 /** The input JSON of `calibrate_stereo`: `left[i]` and `right[i]` saw the same board pose. */
 export interface StereoInput {
-  /** brown (default), radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none. */
-  model?: string;
+  /** Lens model of both cameras (default `brown`). */
+  model?: LensModel;
+  /** Options of both cameras. */
   options?: CalibrationOptions;
+  /** At least 3 pairs. */
   left: CalibrationView[];
   right: CalibrationView[];
   /** Optional when the views are detections. */
-  left_image_size_px?: [number, number];
-  right_image_size_px?: [number, number];
+  left_image_size_px?: ImageSize;
+  right_image_size_px?: ImageSize;
 }
 
 /** The output JSON of `calibrate_stereo` (the report `robocal stereo` writes). */
 export interface StereoCalibration {
-  /** Camera calibration reports (as `calibrate_camera`'s `report`). */
-  left: object;
-  right: object;
+  /** The left camera at the joint optimum. */
+  left: CameraCalibration;
+  /** The right camera; its views' `camera_from_target` is `right_from_left * left camera_from_target`. */
+  right: CameraCalibration;
   /** `p_right = right_from_left * p_left`. */
   right_from_left: PoseReport;
+  /** The averaged single-camera estimate the refinement started from. */
   initial_right_from_left: PoseReport;
   /** Distance between the camera centres, metres. */
   baseline_m: number;
-  /** Standard deviations (rotation: small-angle vector); null when singular. */
-  right_from_left_std: { rotation_rad: [number, number, number]; translation_m: [number, number, number] } | null;
+  /** Standard deviations (rotation: small-angle vector, radians; translation, metres); null when singular. */
+  right_from_left_std: { rotation_rad: Vec3; translation_m: Vec3 } | null;
   /** RMS reprojection error over every point of both cameras, px. */
   rms_px: number;
   iterations: number;
-  termination: string;
+  termination: Termination;
 }
+
+// ---------------------------------------------------------------------------
+// Hand-eye (src/handeye/json_api.rs, output.rs)
+
+/** Camera on the gripper (`eye-in-hand`) or fixed in the robot's world (`eye-to-hand`). */
+export type Setup = 'eye-in-hand' | 'eye-to-hand';
+/** The closed-form solvers, in report order (input also accepts `_` or spaces and any case). */
+export type HandEyeMethod =
+  | 'tsai-lenz' | 'park-martin' | 'horaud' | 'andreff'
+  | 'daniilidis' | 'chou-kamel' | 'shah' | 'li';
+/** The refinement over the image points (input also accepts `-` for `_`). */
+export type RefineMode = 'none' | 'trusted' | 'stochastic' | 'joint_intrinsics';
+
+/** Explicit image points of one pose: board points (target frame, metres) and their pixels. */
+export interface HandEyeView {
+  object_m: Vec3[];
+  image_px: Vec2[];
+}
+
+/**
+ * A camera as `solve_handeye` reads it: the Camera JSON, a calibration
+ * report or `calibrate_camera` output, any object with a `camera` key
+ * (e.g. the demo truth), or a string in a format the camera import reads
+ * (robocal JSON, OpenCV YAML/XML, ROS camera_info YAML).
+ */
+export type HandEyeCamera = Camera | CameraCalibration | CalibrationOutput | { camera: Camera } | string;
+
+export interface HandEyeInputBase {
+  setup: Setup;
+  /** Robot poses, one per view: `p_base = base_from_gripper * p_gripper`. */
+  base_from_gripper: PoseInput[];
+  /** Target poses seen by the camera, same order; optional with image points (then solved per view by PnP). */
+  camera_from_target?: PoseInput[];
+  /** The camera of the image points (required with `views` or `detections`). */
+  camera?: HandEyeCamera;
+  /** Default `trusted` with image points, else `none`. */
+  refine?: RefineMode;
+  /** Expected pixel noise of the refinement, px (default 0.5). */
+  pixel_sigma_px?: number;
+  /** One method or `all` (default `all`: every solver side by side). */
+  method?: HandEyeMethod | 'all';
+  /** Bootstrap resamples for the repeatability (default 100; 0 = none). */
+  bootstrap_samples?: number;
+  /** Seed of the bootstrap (default 1). */
+  seed?: number;
+  /** Stop on failed consistency checks (default true). */
+  strict_checks?: boolean;
+}
+
+/**
+ * The input JSON of `solve_handeye` (unknown keys are rejected). Image points
+ * are given either as `views` or as `detections` (one `detect_target`
+ * Detection per pose, board points from each detection's target), not both.
+ */
+export type HandEyeInput =
+  | (HandEyeInputBase & { views?: HandEyeView[]; detections?: never })
+  | (HandEyeInputBase & { detections?: Detection[]; views?: never });
+
+/** Closure errors of a solution (the report's `errors`). */
+export interface HandEyeErrors {
+  /** RMS of the per-view translation residuals, mm. */
+  translation_rms_mm: number;
+  translation_max_mm: number;
+  /** RMS of the per-view rotation residuals, degrees. */
+  rotation_rms_deg: number;
+  rotation_max_deg: number;
+  /** Reprojection RMS, px, when image points were given. */
+  reprojection_rms_px: number | null;
+}
+
+/** One solver of the side-by-side comparison: its transforms (keys of the setup) and errors, or `error`. */
+export interface HandEyeMethodResult {
+  method: HandEyeMethod;
+  gripper_from_camera?: PoseReport;
+  base_from_camera?: PoseReport;
+  base_from_target?: PoseReport;
+  gripper_from_target?: PoseReport;
+  errors?: HandEyeErrors;
+  /** Translation distance of its camera transform from the primary one, mm. */
+  disagreement_translation_mm?: number;
+  /** Rotation distance from the primary one, degrees. */
+  disagreement_rotation_deg?: number;
+  /** Why the method failed. */
+  error?: string;
+}
+
+/** How far `robot[i] * x * camera[i]` lands from the solved target pose. */
+export interface HandEyeViewResidual {
+  view: number;
+  translation_mm: number;
+  rotation_deg: number;
+}
+
+/** Residual of one motion pair, and |robot angle - camera angle|. */
+export interface HandEyeMotionResidual {
+  from: number;
+  to: number;
+  translation_mm: number;
+  rotation_deg: number;
+  angle_mismatch_deg: number;
+}
+
+/** How diverse the robot motions are. */
+export interface MotionStats {
+  motions: number;
+  /** Motion pairs discarded for too little rotation. */
+  discarded_small_rotation: number;
+  angle_min_deg: number;
+  angle_median_deg: number;
+  angle_max_deg: number;
+  /** Largest angle between a motion axis and the dominant one (0..90 degrees; near 0: all parallel). */
+  axis_spread_deg: number;
+  /** Unit dominant rotation axis of the robot motions. */
+  dominant_axis: Vec3;
+}
+
+/** Median and inter-quartile range. */
+export interface Spread {
+  median: number;
+  iqr: number;
+}
+
+/** Standard deviations of a pose: translation (mm) and rotation vector (degrees) per axis. */
+export interface PoseStd {
+  translation_mm: Vec3;
+  rotation_deg: Vec3;
+}
+
+/** Statistics over the runs of one resampling scheme. */
+export interface RunStats {
+  runs: number;
+  failed: number;
+  translation_rms_mm: Spread;
+  translation_max_mm: Spread;
+  rotation_rms_deg: Spread;
+  rotation_max_deg: Spread;
+  /** Of the camera transform (`gripper_from_camera` or `base_from_camera`). */
+  camera_std: PoseStd;
+  target_std: PoseStd;
+  translation_rms_mm_samples: number[];
+  translation_max_mm_samples: number[];
+  rotation_rms_deg_samples: number[];
+  rotation_max_deg_samples: number[];
+  camera_translation_deviation_mm_samples: number[];
+  camera_rotation_deviation_deg_samples: number[];
+}
+
+/** Leave-one-out (jackknife-scaled) and bootstrap. */
+export interface Repeatability {
+  method: string;
+  leave_one_out: RunStats;
+  bootstrap: RunStats;
+}
+
+/** What the image-based refinement did. */
+export interface RefinementSummary {
+  mode: RefineMode;
+  /** The closed form it started from. */
+  started_from: string;
+  closed_form_reprojection_rms_px: number;
+  reprojection_rms_px: number;
+  per_view_reprojection_rms_px: number[];
+  /** Estimated robot rotation noise per component, degrees (stochastic mode). */
+  robot_rotation_noise_deg?: number;
+  /** Estimated robot translation noise per component, mm (stochastic mode). */
+  robot_translation_noise_mm?: number;
+  /** The refined camera (joint_intrinsics mode). */
+  camera?: Camera;
+}
+
+/** One robot pose and the image paired with it (`robocal handeye` with images only). */
+export interface PairAudit {
+  pose_index: number;
+  image: string | null;
+  used: boolean;
+  view?: number;
+  reason?: string;
+  pose_fit_rms_px?: number;
+}
+
+export interface HandEyeReportBase {
+  /** The primary solution's method: a solver name, `scara`, or `refined from <name>`. */
+  method: string;
+  errors: HandEyeErrors;
+  methods: HandEyeMethodResult[];
+  /** Largest disagreement of any solver from the primary, mm. */
+  methods_max_disagreement_translation_mm: number;
+  /** ... and degrees. */
+  methods_max_disagreement_rotation_deg: number;
+  per_view: HandEyeViewResidual[];
+  per_motion: HandEyeMotionResidual[];
+  motion: MotionStats;
+  /** Unit directions along which the camera transform's translation is unobservable. */
+  unobservable_translation_axes: Vec3[];
+  /** Absent when no resampling ran. */
+  repeatability?: Repeatability;
+  warnings: string[];
+  /** Pairing audit (image input of the CLI only). */
+  pairs?: PairAudit[];
+  /** Present when a refinement ran (the primary transforms are then the refined ones). */
+  refinement?: RefinementSummary;
+  robocal_version: string;
+}
+
+/** Eye-in-hand report: the camera on the gripper, the target fixed in the base. */
+export interface EyeInHandReport extends HandEyeReportBase {
+  setup: 'eye-in-hand';
+  /** `p_gripper = gripper_from_camera * p_camera`. */
+  gripper_from_camera: PoseReport;
+  /** `p_base = base_from_target * p_target`. */
+  base_from_target: PoseReport;
+  base_from_camera?: never;
+  gripper_from_target?: never;
+}
+
+/** Eye-to-hand report: the camera fixed in the base, the target on the gripper. */
+export interface EyeToHandReport extends HandEyeReportBase {
+  setup: 'eye-to-hand';
+  /** `p_base = base_from_camera * p_camera`. */
+  base_from_camera: PoseReport;
+  /** `p_gripper = gripper_from_target * p_target`. */
+  gripper_from_target: PoseReport;
+  gripper_from_camera?: never;
+  base_from_target?: never;
+}
+
+/** The output JSON of `solve_handeye`, discriminated by `setup`. */
+export type HandEyeReport = EyeInHandReport | EyeToHandReport;
+
+/** The input JSON of `rank_pose_conventions`: candidate readings of the robot poses. */
+export interface RankPoseInput {
+  setup: Setup;
+  /** At least one candidate, e.g. the `candidates` of `read_robot_poses`. */
+  candidates: { name: string; base_from_gripper: PoseInput[] }[];
+  camera_from_target: PoseInput[];
+}
+
+/** How well robot poses fit the camera motion. */
+export interface Consistency {
+  /** RMS rotation residual of the motions, degrees. */
+  rotation_rms_deg: number;
+  /** RMS translation residual of the motions, mm. */
+  translation_rms_mm: number;
+  /** Scale of the robot translations that best fits the camera motion (1: same unit). */
+  robot_translation_scale: number;
+}
+
+/** The output JSON of `rank_pose_conventions`. */
+export interface RankedCandidates {
+  /** Every candidate, best first; `consistency` null when it could not be scored. */
+  scores: { name: string; consistency: Consistency | null }[];
+  /** What to use and how clear the choice is, when any candidate scored. */
+  recommendation: string | null;
+}
+
+// ---------------------------------------------------------------------------
+// Robot pose files (src/io/poses.rs, pose_formats.rs, pose_candidates.rs, poses_api.rs)
+
+/**
+ * A pose file layout: vendor formats (`kuka` mm/deg A B C intrinsic ZYX,
+ * `ur` m/rotation vector, `abb` mm/quaternion w first, `fanuc` and
+ * `yaskawa` mm/deg extrinsic XYZ, `staubli` mm/deg intrinsic XYZ) and
+ * generic ones (default metres and radians).
+ */
+export type PoseFormat =
+  | 'ur' | 'kuka' | 'abb' | 'fanuc' | 'yaskawa' | 'staubli'
+  | 'xyz_quat_xyzw' | 'xyz_quat_wxyz' | 'xyz_rotvec'
+  | `xyz_euler_${EulerKind}_${EulerOrder}`
+  | 'matrix4';
+export type LengthUnit = 'mm' | 'm';
+export type AngleUnit = 'deg' | 'rad';
+/** Which transform a file holds (poses are always returned as `base_from_gripper`). */
+export type PoseDirection = 'base_from_gripper' | 'gripper_from_base';
+
+/** The options JSON of `read_robot_poses` (or `""`): what the caller knows; the rest comes from the header or the format. */
+export interface PoseFileOptions {
+  /** Case-insensitive; `motoman` = `yaskawa`. */
+  format?: PoseFormat | 'motoman' | null;
+  length_unit?: LengthUnit | null;
+  angle_unit?: AngleUnit | null;
+  /** Default `base_from_gripper`. */
+  direction?: PoseDirection;
+}
+
+/** One robot pose from a file. */
+export interface RobotPose {
+  /** The `name`/`image` column, to pair the pose with an image. */
+  name: string | null;
+  /** 1-based line of a text file, or 1-based element of a JSON array. */
+  line: number;
+  /** The gripper (TCP) pose in the robot base frame, metres. */
+  base_from_gripper: PoseQuaternion;
+}
+
+/** Poses and everything assumed to read them. */
+export interface ParsedPoses {
+  poses: RobotPose[];
+  format: PoseFormat;
+  length_unit: LengthUnit;
+  /** Meaningless for quaternion and matrix formats. */
+  angle_unit: AngleUnit;
+  direction: PoseDirection;
+  /** How format and units were chosen and what was ignored. */
+  notes: string[];
+}
+
+/** One plausible reading of an ambiguous pose file. */
+export interface PoseCandidate {
+  format: PoseFormat;
+  length_unit: LengthUnit;
+  angle_unit: AngleUnit;
+  /** The poses under this reading, as `base_from_gripper`. */
+  poses: RobotPose[];
+  /** Other format names giving exactly the same poses. */
+  same_as: string[];
+  /** Implausibility, 0 = nothing suspicious; candidates are sorted by it. */
+  penalty: number;
+  reasons: string[];
+}
+
+/** The output JSON of `read_robot_poses`: the poses, or ranked readings when the layout is ambiguous. */
+export type PoseReading =
+  | { parsed: ParsedPoses; ambiguity: null; candidates: [] }
+  | { parsed: null; ambiguity: string; candidates: PoseCandidate[] };
+
+// ---------------------------------------------------------------------------
+// Exports (src/io/export.rs, export_camera.rs, export_transform.rs)
+
+/** Camera formats (need a camera calibration report). */
+export type CameraExportFormat =
+  | 'json' | 'opencv-yaml' | 'opencv-xml' | 'ros-yaml' | 'kalibr'
+  | 'mrcal' | 'halcon' | 'matlab' | 'text';
+/** Transform formats with a fixed name. */
+export type SimpleTransformFormat =
+  | 'matrix4' | 'xyz-quat-xyzw' | 'xyz-quat-wxyz' | 'urdf' | 'ros2-static-tf'
+  | 'ur' | 'kuka' | 'abb-tooldata' | 'abb-wobjdata' | 'fanuc';
+/** Transform formats (need a transform such as `gripper_from_camera`). */
+export type TransformExportFormat =
+  | SimpleTransformFormat
+  | `euler-${EulerKind}-${EulerOrder}-${AngleUnit}`;
+/** The `format` of `export_report`; `report` writes the report itself, pretty-printed. */
+export type ExportFormat = CameraExportFormat | 'report' | TransformExportFormat;
+/** What `export_formats` lists: every name, the euler family as one pattern. */
+export type ExportFormatListEntry =
+  | CameraExportFormat
+  | 'report'
+  | SimpleTransformFormat
+  | 'euler-<intrinsic|extrinsic>-<order>-<deg|rad>';
+/** A transform key of a report, `parent_from_child` (the `transform` of `export_report`; `""` = the first present of gripper_from_camera, base_from_camera, right_from_left, base_from_target). */
+export type TransformName = `${string}_from_${string}`;
+/** What `export_report` reads: camera formats need a camera report; transform formats a report with the transform. */
+export type ExportableReport = CameraCalibration | HandEyeReport | StereoCalibration;
+
+// ---------------------------------------------------------------------------
+// Planar workflow (src/workflows/planar*.rs)
+
+/** The matrix parameter names (the article's Table 4). */
+export type PlanarParameter = 'a11' | 'a12' | 'tx' | 'a21' | 'a22' | 'ty';
+/** One value per matrix parameter. */
+export type ByParameter<T> = { [P in PlanarParameter]: T };
+
+/** `robot_from_image`: `x_mm = a11 u + a12 v + tx`, `y_mm = a21 u + a22 v + ty`, (u, v) in px. */
+export interface PlanarMatrix {
+  /** mm of robot x per px of u. */
+  a11: number;
+  /** mm of robot x per px of v. */
+  a12: number;
+  /** Robot x of the image origin, mm. */
+  tx: number;
+  a21: number;
+  a22: number;
+  /** Robot y of the image origin, mm. */
+  ty: number;
+}
+
+/** One per-height matrix (the matrix keys flattened in). */
+export interface HeightMatrix extends PlanarMatrix {
+  /** Calibration height, mm. */
+  height_mm: number;
+}
+
+/** A pixel to map at some height. */
+export interface PredictRequest {
+  /** Height of the plane, mm. */
+  height_mm: number;
+  /** Image point, px. */
+  image_px: Vec2;
+}
+
+/** The input JSON of `planar_fit`. */
+export interface PlanarFitRequest {
+  matrices: HeightMatrix[];
+  /** Rejection threshold, standard deviations (externally studentized); default none. */
+  reject_threshold?: number | null;
+  predict?: PredictRequest[];
+}
+
+/** A fitted line `value = intercept + slope * height_mm` and its statistics. */
+export interface LinearFit {
+  intercept: number;
+  slope: number;
+  /** 1 - RSS/TSS; null when y is constant. */
+  r2: number | null;
+  pearson_r: number | null;
+  /** null for n < 3 or constant y. */
+  adj_r2: number | null;
+  /** Residual sum of squares. */
+  rss: number;
+  /** Points used. */
+  n: number;
+  intercept_std: number;
+  slope_std: number;
+  intercept_slope_cov: number;
+}
+
+/** An image point mapped to the robot plane at some height. */
+export interface MappedPoint {
+  height_mm: number;
+  image_px: Vec2;
+  /** Robot X, Y, mm. */
+  robot_mm: Vec2;
+  /** One-sigma error of robot X, Y from the fitted lines, mm. */
+  std_mm: Vec2;
+  /** The interpolated matrix at this height. */
+  robot_from_image: PlanarMatrix;
+}
+
+/** The output JSON of `planar_fit`. */
+export interface PlanarFitReport {
+  fit: ByParameter<LinearFit>;
+  /** Heights rejected before the final fit, mm. */
+  rejected_heights_mm: ByParameter<number[]>;
+  /** In request order. */
+  predictions: MappedPoint[];
+  /** The request with its defaults, for re-solving. */
+  input: Required<PlanarFitRequest>;
+}
+
+/** One observed point of the planar workflow. */
+export interface HeightPoint {
+  /** Calibration height, mm. */
+  height_mm: number;
+  /** Undistorted image point, px. */
+  image_px: Vec2;
+  /** Robot X, Y, mm. */
+  robot_mm: Vec2;
+}
+
+/** The options of `planar_solve` (missing keys take their defaults). */
+export interface PlanarSolveOptions {
+  /** The per-height transform model (default `affine`). */
+  transform?: 'rigid' | 'similarity' | 'affine';
+  /** Rejection threshold, standard deviations; default none. */
+  reject_threshold?: number | null;
+  /** Plate length |AB| and width |BC|, mm (four-corner plates; default the robot-measured sides). */
+  plate_size_mm?: Vec2 | null;
+  /** A calibrated camera: image points are undistorted first. */
+  camera?: Camera | null;
+}
+
+/** The input JSON of `planar_solve`; equal `height_mm` values form one height. */
+export interface PlanarSolveRequest {
+  points: HeightPoint[];
+  options?: PlanarSolveOptions;
+  predict?: PredictRequest[];
+}
+
+/** The transform fitted at one height. */
+export interface PlanarHeightResult {
+  height_mm: number;
+  kind: 'rigid' | 'similarity' | 'affine';
+  robot_from_image: PlanarMatrix;
+  /** The linear part has a negative determinant. */
+  reflected: boolean;
+  /** Per point: fitted minus given robot X, Y, mm. */
+  residuals_mm: Vec2[];
+  rms_mm: number;
+}
+
+/** Pixel density of a four-corner plate at one height (Eq. 15). */
+export interface PixelDensity {
+  height_mm: number;
+  length_px_per_mm: number;
+  width_px_per_mm: number;
+}
+
+/** The exact height-dependent homography family (DLT). */
+export interface PlaneFamily {
+  /** Projects `[x_mm, y_mm, z_mm, 1]` to homogeneous pixels, row-major; third row = depth, mm. */
+  projection_matrix: Matrix3x4Flat;
+  rms_px: number;
+}
+
+/** The output JSON of `planar_solve`. */
+export interface PlanarSolveResponse {
+  /** Per height, sorted by height. */
+  heights: PlanarHeightResult[];
+  fit: ByParameter<LinearFit>;
+  rejected_heights_mm: ByParameter<number[]>;
+  /** Four-corner plates only. */
+  pixel_density: PixelDensity[] | null;
+  density_fit: { length: LinearFit; width: LinearFit } | null;
+  /** null with fewer than 6 points. */
+  exact_family: PlaneFamily | null;
+  /** The points solved (undistorted when a camera was given). */
+  points: HeightPoint[];
+  options: Required<PlanarSolveOptions>;
+  predictions: MappedPoint[];
+  /** The pixels mapped by the exact family (robot X, Y, mm), when it was fitted. */
+  exact_predictions_mm: Vec2[] | null;
+}
+
+// ---------------------------------------------------------------------------
+// XY-table and known-motion workflows (src/workflows/xytable.rs, known_motion.rs)
+
+/** One stage position and the target's image centre there. */
+export interface StageObservation {
+  /** Stage (world) position of the target centre, mm. */
+  stage_mm: Vec3;
+  /** Image centre of the target, px. */
+  image_px: Vec2;
+}
+
+/** The input JSON of `xytable_solve`. */
+export interface XyTableRequest {
+  /** At least 6 non-coplanar positions, in filter order. */
+  observations: StageObservation[];
+  /** Exactly four extra positions A, B, C, D around a quadrilateral, or none. */
+  verification?: StageObservation[];
+  /** Repeated image centres of the still target, px (the filter's noise). */
+  still_target_px?: Vec2[];
+  /** Noise covariance R, px^2, rows (when there is no still target). */
+  measurement_noise_px2?: Matrix2Rows | null;
+  /** Default `extended`. */
+  kalman_mode?: 'extended' | 'linearized';
+}
+
+/** One Kalman filter step. */
+export interface KalmanStep {
+  /** 0-based observation just processed. */
+  observation: number;
+  projection_row_major: Matrix3x4Flat;
+  /** Reprojection RMS of all observations with this estimate, px. */
+  rms_px: number;
+  /** Trace of the state covariance (normalised units). */
+  covariance_trace: number;
+}
+
+/** One method's projection matrix, decomposition and residuals. */
+export interface XyTableMethodResult {
+  /** Maps `[x_mm, y_mm, z_mm, 1]` to homogeneous px; third row = depth, mm. */
+  projection_matrix: Matrix3x4Flat;
+  /** K, px. */
+  camera_matrix: Matrix3Flat;
+  /** The stage frame in the camera frame, metres. */
+  camera_from_world: PoseQuaternion;
+  /** Per calibration position: projected minus measured, px. */
+  residuals_px: Vec2[];
+  rms_px: number;
+  /** Kalman only: the estimate after each observation. */
+  history?: KalmanStep[];
+}
+
+/** The verification point from the four extra positions. */
+export interface XyTableVerification {
+  /** Intersection of the image diagonals, px. */
+  measured_px: Vec2;
+  /** Intersection of the stage diagonals, mm. */
+  stage_mm: Vec3;
+  /** Distance between the two stage diagonals, mm. */
+  diagonal_gap_mm: number;
+  batch_predicted_px: Vec2;
+  batch_error_px: number;
+  kalman_predicted_px: Vec2;
+  kalman_error_px: number;
+}
+
+/** The output JSON of `xytable_solve`. */
+export interface XyTableReport {
+  batch: XyTableMethodResult;
+  kalman: XyTableMethodResult & { history: KalmanStep[] };
+  /** R used by the filter, px^2, rows. */
+  measurement_noise_px2: Matrix2Rows;
+  noise_source: 'still_target' | 'given' | 'batch_residuals';
+  verification: XyTableVerification | null;
+  input: Required<XyTableRequest>;
+}
+
+/** The input JSON of `known_motion_solve`: `P_i = R (P_ref + d_i) + T`. */
+export interface KnownMotionRequest {
+  /** Increment of every position from the start, reference frame, mm (first usually 0). */
+  increments_mm: Vec3[];
+  /** The point seen by the camera at each position, camera frame, mm. */
+  points_camera_mm: Vec3[];
+  /** The start position in the reference frame, mm; default: the origin is the start. */
+  start_reference_mm?: Vec3 | null;
+}
+
+/** The output JSON of `known_motion_solve`. */
+export interface KnownMotionReport {
+  /** The reference frame in the camera frame: translation in metres. */
+  camera_from_reference: PoseQuaternion;
+  /** The start point in the camera frame, mm. */
+  start_camera_mm: Vec3;
+  /** The start point in the reference frame, mm (zero when not given). */
+  start_reference_mm: Vec3;
+  reference_origin_given: boolean;
+  /** Per position: predicted minus observed camera point, mm. */
+  residuals_mm: Vec3[];
+  rms_mm: number;
+  input: Required<KnownMotionRequest>;
+}
+
+/** What `workflow_csv(kind, text)` returns, per `kind`. */
+export interface WorkflowCsvKinds {
+  /** Header `height_mm,a11,a12,tx,a21,a22,ty`; the `planar_fit` request. */
+  'planar-matrices': { matrices: HeightMatrix[] };
+  /** Header `height_mm,u_px,v_px,x_mm,y_mm`; the `planar_solve` request. */
+  'planar-points': { points: HeightPoint[] };
+  /** Header `x_mm,y_mm,z_mm,u_px,v_px[,role]`; the `xytable_solve` request. */
+  xytable: Required<XyTableRequest>;
+  /** Header `dx_mm,dy_mm,dz_mm,x_cam_mm,y_cam_mm,z_cam_mm`; the `known_motion_solve` request. */
+  'known-motion': Required<KnownMotionRequest>;
+}
+export type WorkflowCsvKind = keyof WorkflowCsvKinds;
+
+// ---------------------------------------------------------------------------
+// The demo session (src/synth/demo.rs)
+
+/** `render_demo(seed).json`; the PNGs are `bytes.subarray(offset, offset + length)`. */
+export interface DemoIndex {
+  target: Target;
+  target_spec: TargetSpec;
+  images: { name: string; offset: number; length: number }[];
+  /** The robot's `base_from_gripper` poses: UR-style CSV (metres, rotation vectors) with an `image` column. */
+  poses_csv: string;
+  truth: { camera: Camera; gripper_from_camera: PoseReport; base_from_target: PoseReport };
+}
+
+// ---------------------------------------------------------------------------
+// Function -> JSON map
+
+/**
+ * Every function's JSON: `[input, output]`, `never` where the function takes
+ * or returns no JSON. With it, `JSON.parse(robocal.detect_target(png, spec))
+ * as JsonOutput<'detect_target'>` is a `Detection`.
+ */
+export interface RobocalJson {
+  /** `image_info(bytes)` -> ImageInfo. */
+  image_info: [never, ImageInfo];
+  /** `decode_image_preview(bytes, max_side).info_json` -> ImageInfo. */
+  decode_image_preview: [never, ImageInfo];
+  /** `detect_target(bytes, JSON.stringify(target) or a TargetSpec)` -> Detection. */
+  detect_target: [Target, Detection];
+  /** `calibrate_camera(input)` -> `{report, comparison}`. */
+  calibrate_camera: [CalibrationInput, CalibrationOutput];
+  /** `calibrate_stereo(input)` -> the stereo report. */
+  calibrate_stereo: [StereoInput, StereoCalibration];
+  /** `undistort_preview(bytes, JSON.stringify(camera), max_side).info_json` -> `{width, height}`. */
+  undistort_preview: [Camera, UndistortPreviewInfo];
+  /** `solve_handeye(input)` -> the hand-eye report. */
+  solve_handeye: [HandEyeInput, HandEyeReport];
+  /** `rank_pose_conventions(input)` -> scores, best first. */
+  rank_pose_conventions: [RankPoseInput, RankedCandidates];
+  /** `read_robot_poses(text, JSON.stringify(options) or "")` -> the poses or candidates. */
+  read_robot_poses: [PoseFileOptions, PoseReading];
+  /** `export_report(JSON.stringify(report), format, transform or "")` returns the file's text, not JSON. */
+  export_report: [ExportableReport, never];
+  /** `export_formats()` -> the format names. */
+  export_formats: [never, ExportFormatListEntry[]];
+  /** `planar_fit(request)` -> the height model and predictions. */
+  planar_fit: [PlanarFitRequest, PlanarFitReport];
+  /** `planar_solve(request)` -> the planar workflow report. */
+  planar_solve: [PlanarSolveRequest, PlanarSolveResponse];
+  /** `xytable_solve(request)` -> batch and Kalman projection matrices. */
+  xytable_solve: [XyTableRequest, XyTableReport];
+  /** `known_motion_solve(request)` -> camera_from_reference. */
+  known_motion_solve: [KnownMotionRequest, KnownMotionReport];
+  /** `workflow_csv(kind, text)` -> the request of the matching solver (see WorkflowCsvKinds). */
+  workflow_csv: [never, WorkflowCsvKinds[WorkflowCsvKind]];
+  /** `render_demo(seed).json` -> the demo index. */
+  render_demo: [never, DemoIndex];
+}
+
+/** A function that exchanges JSON. */
+export type JsonFunction = keyof RobocalJson;
+/** The JSON a function reads (serialise it with JSON.stringify). */
+export type JsonInput<F extends JsonFunction> = RobocalJson[F][0];
+/** The JSON a function returns (the type of JSON.parse of its result). */
+export type JsonOutput<F extends JsonFunction> = RobocalJson[F][1];

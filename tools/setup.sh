@@ -2,6 +2,7 @@
 # Installs what the build needs when it is missing; fast no-op when present.
 #   tools/setup.sh build   the wasm32 target and wasm-bindgen-cli (exact Cargo.lock version)
 #   tools/setup.sh e2e     Debian's chromium and playwright-core (for the browser tests)
+#   tools/setup.sh node    the TypeScript compiler of the node tier (tests/node, pinned)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -39,8 +40,16 @@ need_e2e() {
   fi
 }
 
+need_node() {
+  if [ ! -f tests/node/node_modules/typescript/package.json ]; then
+    echo "setup: installing typescript for the node tier's type checks"
+    (cd tests/node && npm install --no-audit --no-fund)
+  fi
+}
+
 case "${1:-build}" in
   build) need_build ;;
   e2e) need_e2e ;;
-  *) echo "usage: tools/setup.sh build|e2e" >&2; exit 2 ;;
+  node) need_node ;;
+  *) echo "usage: tools/setup.sh build|e2e|node" >&2; exit 2 ;;
 esac

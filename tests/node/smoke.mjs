@@ -1,7 +1,8 @@
 // Node tier: pack pkg/ with npm, install the tarball into a fresh folder, and
 // call the package from both ESM and CommonJS, asserting real results.
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, readdirSync } from 'node:fs';
+import { mkdtempSync, writeFileSync, readdirSync, readFileSync, copyFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -74,4 +75,34 @@ writeFileSync(join(work, 'cjs.cjs'), cjs);
 for (const f of ['esm.mjs', 'cjs.cjs']) {
   process.stdout.write(execFileSync('node', [f], { cwd: work }).toString());
 }
+
+// Types: tsc --strict on tests/node/types-check.ts and on the README's
+// TypeScript example, against the installed package's index.d.ts; then the
+// README example transpiled and run, and the real JSON outputs walked
+// against the declarations (shapes.mjs).
+const here = dirname(fileURLToPath(import.meta.url));
+const ts = createRequire(join(here, 'package.json'))('typescript');
+const readme = readFileSync(join(root, 'pkg-config', 'README.md'), 'utf8');
+const example = /```ts\n([\s\S]*?)```/.exec(readme)?.[1];
+if (!example) throw new Error('pkg-config/README.md has no ```ts example');
+writeFileSync(join(work, 'readme-example.ts'), example);
+copyFileSync(join(here, 'types-check.ts'), join(work, 'types-check.ts'));
+const tsc = ['--noEmit', '--strict', '--target', 'es2022', '--lib', 'es2022,esnext.disposable,dom', '--module', 'nodenext', '--moduleResolution', 'nodenext'];
+for (const f of ['types-check.ts', 'readme-example.ts']) {
+  try {
+    execFileSync('node', [join(here, 'node_modules', 'typescript', 'bin', 'tsc'), ...tsc, f], { cwd: work, stdio: ['ignore', 'pipe', 'pipe'] });
+  } catch (e) {
+    throw new Error(`tsc ${f}:\n${e.stdout}${e.stderr}`);
+  }
+  console.log(`tsc --strict ok: ${f} (typescript ${ts.version})`);
+}
+const js = ts.transpileModule(example, { compilerOptions: { module: ts.ModuleKind.ESNext, target: ts.ScriptTarget.ES2022 } }).outputText;
+writeFileSync(join(work, 'readme-example.mjs'), js);
+const printed = execFileSync('node', ['readme-example.mjs'], { cwd: work }).toString();
+const [fxPrinted, cxPrinted, rmsPrinted, model] = printed.split('\n')[0].split(' ');
+if (!(Math.abs(fxPrinted - 900) < 1.5 && Math.abs(cxPrinted - 511.5) < 1.5 && rmsPrinted < 0.2 && model === 'brown' && printed.includes('\n[ 0.0'))) {
+  throw new Error(`README TypeScript example printed:\n${printed}`);
+}
+console.log('README TypeScript example ran: ' + printed.split('\n')[0]);
+process.stdout.write(execFileSync('node', [join(here, 'shapes.mjs'), work]).toString());
 console.log(`node smoke test passed (${tarball})`);

@@ -1,0 +1,257 @@
+// Node tier: the JSON the package really returns must match the types its
+// index.d.ts declares. Run by smoke.mjs as `node shapes.mjs WORK_DIR`, where
+// WORK_DIR has the packed package installed. The declarations are read with
+// the TypeScript compiler (tests/node/node_modules/typescript) and every
+// value below is walked against its declared type: required keys present,
+// JS types right, no undeclared key at any depth, literals and unions
+// honoured. So the .d.ts cannot drift from the Rust serde output unnoticed.
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const root = join(here, '..', '..');
+const work = process.argv[2];
+if (!work) throw new Error('usage: node shapes.mjs WORK_DIR (with robocal installed)');
+const ts = createRequire(join(here, 'package.json'))('typescript');
+const robocal = createRequire(join(work, 'package.json'))('robocal');
+const dts = join(work, 'node_modules', 'robocal', 'index.d.ts');
+
+// 1. The declarations.
+const program = ts.createProgram([dts], {
+  strict: true,
+  noEmit: true,
+  target: ts.ScriptTarget.ES2022,
+  lib: ['lib.es2022.d.ts', 'lib.esnext.disposable.d.ts'],
+});
+const diagnostics = ts.getPreEmitDiagnostics(program);
+assert.equal(diagnostics.length, 0, ts.formatDiagnostics(diagnostics, ts.createCompilerHost({})));
+const checker = program.getTypeChecker();
+const moduleSymbol = checker.getSymbolAtLocation(program.getSourceFile(dts));
+const exported = new Map(checker.getExportsOfModule(moduleSymbol).map((s) => [s.name, s]));
+const declared = (name) => {
+  const symbol = exported.get(name);
+  assert.ok(symbol, `index.d.ts exports no ${name}`);
+  return checker.getDeclaredTypeOfSymbol(symbol);
+};
+const propertyType = (type, name) => {
+  const p = checker.getPropertyOfType(type, name);
+  assert.ok(p, `no property ${name}`);
+  return checker.getTypeOfSymbol(p);
+};
+const map = declared('RobocalJson');
+const mapped = (fn, i) => checker.getTypeArguments(propertyType(map, fn))[i];
+
+// 2. A small structural checker: value against a ts.Type.
+const F = ts.TypeFlags;
+function validate(value, type, path, errors) {
+  const f = type.flags;
+  const fail = (what) => errors.push(`${path}: ${what} (declared ${checker.typeToString(type)})`);
+  if (f & (F.Any | F.Unknown)) return;
+  if (type.isUnion()) {
+    // Passes if one member does; otherwise report the member that got
+    // deepest (a discriminated union's right member), or the value itself.
+    let best = null;
+    for (const member of type.types) {
+      const e = [];
+      validate(value, member, path, e);
+      if (e.length === 0) return;
+      const deep = e.every((m) => !m.startsWith(`${path}: `));
+      if (deep && (!best || e.length < best.length)) best = e;
+    }
+    if (best) errors.push(...best);
+    else fail(`got ${JSON.stringify(value)?.slice(0, 80)}`);
+    return;
+  }
+  if (f & F.Never) return fail('a value where none is declared');
+  if (f & F.Null) return value === null || fail(`got ${JSON.stringify(value)}`);
+  if (f & (F.Undefined | F.Void)) return value === undefined || fail('an undeclared key');
+  if (f & F.StringLiteral) return value === type.value || fail(`got ${JSON.stringify(value)}`);
+  if (f & F.NumberLiteral) return value === type.value || fail(`got ${JSON.stringify(value)}`);
+  if (f & F.BooleanLiteral) return value === (type.intrinsicName === 'true') || fail(`got ${value}`);
+  if (f & F.String) return typeof value === 'string' || fail(`got ${typeof value}`);
+  if (f & F.Number) return (typeof value === 'number' && Number.isFinite(value)) || fail(`got ${JSON.stringify(value)}`);
+  if (f & F.Boolean) return typeof value === 'boolean' || fail(`got ${typeof value}`);
+  if (f & F.TemplateLiteral) {
+    if (typeof value !== 'string') return fail(`got ${typeof value}`);
+    return checker.isTypeAssignableTo(checker.getStringLiteralType(value), type) || fail(`got ${JSON.stringify(value)}`);
+  }
+  if (!(f & (F.Object | F.Intersection))) return fail('a type this checker does not know');
+  if (checker.isTupleType(type)) {
+    const elements = checker.getTypeArguments(type);
+    if (!Array.isArray(value) || value.length !== elements.length) {
+      return fail(`expected ${elements.length} elements, got ${Array.isArray(value) ? value.length : typeof value}`);
+    }
+    value.forEach((v, i) => validate(v, elements[i], `${path}[${i}]`, errors));
+    return;
+  }
+  if (checker.isArrayType(type)) {
+    if (!Array.isArray(value)) return fail(`got ${value === null ? 'null' : typeof value}`);
+    const element = checker.getTypeArguments(type)[0];
+    value.forEach((v, i) => validate(v, element, `${path}[${i}]`, errors));
+    return;
+  }
+  if (value === null || typeof value !== 'object' || Array.isArray(value)) {
+    return fail(`got ${Array.isArray(value) ? 'an array' : value === null ? 'null' : typeof value}`);
+  }
+  const properties = checker.getPropertiesOfType(type);
+  const names = new Set(properties.map((p) => p.name));
+  for (const p of properties) {
+    const optional = (p.flags & ts.SymbolFlags.Optional) !== 0;
+    if (!(p.name in value)) {
+      if (!optional) errors.push(`${path}.${p.name}: missing (declared required)`);
+      continue;
+    }
+    validate(value[p.name], checker.getTypeOfSymbol(p), `${path}.${p.name}`, errors);
+  }
+  const index = checker.getIndexInfosOfType(type).find((i) => i.keyType.flags & F.String);
+  for (const key of Object.keys(value)) {
+    if (names.has(key)) continue;
+    if (index) validate(value[key], index.type, `${path}.${key}`, errors);
+    else errors.push(`${path}.${key}: not declared`);
+  }
+}
+
+const checked = { input: new Set(), output: new Set() };
+function check(label, value, type) {
+  const errors = [];
+  validate(value, type, label, errors);
+  assert.deepEqual(errors, [], `${label} does not match index.d.ts:\n  ${errors.join('\n  ')}`);
+}
+/** The JSON `fn` returned must be its declared output. */
+const output = (fn, value, label = fn) => (check(`${label} output`, value, mapped(fn, 1)), checked.output.add(fn), value);
+/** The JSON sent to `fn` must be its declared input (the typed literals of types-check.ts stay honest). */
+const input = (fn, value, label = fn) => (check(`${label} input`, value, mapped(fn, 0)), checked.input.add(fn), value);
+const call = (fn, request, ...rest) => output(fn, JSON.parse(robocal[fn](JSON.stringify(input(fn, request)), ...rest)));
+
+// 3. Real inputs and outputs.
+const demo = robocal.render_demo(1);
+const meta = output('render_demo', JSON.parse(demo.json));
+const png = (im) => demo.bytes.subarray(im.offset, im.offset + im.length);
+output('image_info', JSON.parse(robocal.image_info(png(meta.images[0]))));
+output('decode_image_preview', JSON.parse(robocal.decode_image_preview(png(meta.images[0]), 128).info_json));
+input('detect_target', meta.target);
+const detections = meta.images.map((im) => output('detect_target', JSON.parse(robocal.detect_target(png(im), JSON.stringify(meta.target)))));
+const views = meta.images.map((im, i) => ({ name: im.name, detection: detections[i] }));
+
+const all = call('calibrate_camera', { model: 'brown', method: 'all', views }, 'calibrate_camera all');
+assert.equal(all.comparison.length, 4);
+const robust = call('calibrate_camera', { model: 'rational', options: { robust: true, aspect_ratio: 1, fixed_coefficients: ['s1', 's2', 's3', 's4'] }, views });
+assert.equal(robust.comparison, null);
+// Explicit correspondences: the board points of a 9x6 board of 30 mm squares.
+const board = (d) => d.points.map((p) => [(p.id % 9) * 0.03, Math.floor(p.id / 9) * 0.03, 0]);
+const pixels = (d) => d.points.map((p) => [p.x_px, p.y_px]);
+const pairs = views.slice(0, 4).map((v) => ({ name: v.name, object_m: board(v.detection), image_px: pixels(v.detection) }));
+call('calibrate_camera', { model: 'kannala_brandt', method: 'zhang', views: pairs, image_size_px: [1024, 768] }, 'calibrate_camera points');
+call('calibrate_stereo', { model: 'division', left: views, right: views });
+const report = all.report;
+output('undistort_preview', JSON.parse(robocal.undistort_preview(png(meta.images[0]), JSON.stringify(input('undistort_preview', report.camera)), 200).info_json));
+
+const poses = JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', {}))));
+output('read_robot_poses', poses);
+assert.ok(poses.parsed, 'the demo CSV has a header');
+output('read_robot_poses', JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', { format: 'ur', length_unit: 'm', angle_unit: null, direction: 'base_from_gripper' })))), 'read_robot_poses ur');
+const bare = meta.poses_csv.trim().split('\n').slice(1).map((l) => l.split(',').slice(1).join(' ')).join('\n');
+const ambiguous = output('read_robot_poses', JSON.parse(robocal.read_robot_poses(bare, '')), 'read_robot_poses bare');
+assert.ok(ambiguous.parsed === null && ambiguous.candidates.length > 1, 'a bare 6-column file is ambiguous');
+
+const base_from_gripper = poses.parsed.poses.map((p) => p.base_from_gripper);
+const eyeInHand = call('solve_handeye', { setup: 'eye-in-hand', base_from_gripper, detections, camera: all, bootstrap_samples: 5 }, 'solve_handeye detections');
+assert.equal(eyeInHand.setup, 'eye-in-hand');
+assert.ok(eyeInHand.refinement && eyeInHand.repeatability, 'refined, with repeatability');
+const camera_from_target = report.views.map((v) => v.camera_from_target);
+const viewsIn = detections.map((d) => ({ object_m: board(d), image_px: pixels(d) }));
+const joint = call('solve_handeye', { setup: 'eye-in-hand', base_from_gripper, camera_from_target, views: viewsIn, camera: report.camera, refine: 'joint_intrinsics', method: 'park-martin', bootstrap_samples: 0 }, 'solve_handeye joint');
+assert.ok(joint.refinement?.camera, 'joint_intrinsics reports its camera');
+// Eye-to-hand from the same data: the inverted robot poses.
+const inverse = ({ translation_m: t, quaternion_xyzw: [x, y, z, w] }) => {
+  const q = [-x, -y, -z, w];
+  const r = rotate(q, t);
+  return { translation_m: [-r[0], -r[1], -r[2]], quaternion_xyzw: q };
+};
+const eyeToHand = call('solve_handeye', { setup: 'eye-to-hand', base_from_gripper: base_from_gripper.map(inverse), camera_from_target, strict_checks: false, seed: 3, bootstrap_samples: 4 }, 'solve_handeye eye-to-hand');
+assert.equal(eyeToHand.setup, 'eye-to-hand');
+const ranked = call('rank_pose_conventions', {
+  setup: 'eye-in-hand',
+  candidates: ambiguous.candidates.map((c) => ({ name: c.format, base_from_gripper: c.poses.map((p) => p.base_from_gripper) })),
+  camera_from_target,
+});
+assert.equal(ranked.scores[0].name, 'ur');
+
+const formats = output('export_formats', JSON.parse(robocal.export_formats()));
+assert.ok(formats.includes('urdf') && formats.includes('opencv-yaml'));
+for (const r of [report, eyeInHand, eyeToHand]) input('export_report', r);
+assert.match(robocal.export_report(JSON.stringify(eyeInHand), 'euler-intrinsic-zyx-deg', 'gripper_from_camera'), /gripper/);
+
+const fixture = (name) => readFileSync(join(root, 'fixtures', 'seed001', name), 'utf8');
+const matrices = output('workflow_csv', JSON.parse(robocal.workflow_csv('planar-matrices', fixture('table4_matrices.csv'))), 'workflow_csv planar-matrices');
+check('workflow_csv planar-matrices', matrices, propertyType(declared('WorkflowCsvKinds'), 'planar-matrices'));
+call('planar_fit', { ...matrices, reject_threshold: 3, predict: [{ height_mm: 60, image_px: [1000, 1000] }] });
+const points = output('workflow_csv', JSON.parse(robocal.workflow_csv('planar-points', fixture('table3_four_points.csv'))), 'workflow_csv planar-points');
+check('workflow_csv planar-points', points, propertyType(declared('WorkflowCsvKinds'), 'planar-points'));
+const planar = call('planar_solve', { ...points, options: { transform: 'affine', plate_size_mm: [2000, 1200] }, predict: [{ height_mm: 60, image_px: [1000, 1000] }] });
+assert.ok(planar.pixel_density && planar.exact_family, 'four-corner plates give the pixel density');
+call('planar_solve', { ...points, options: { transform: 'rigid', reject_threshold: null, camera: report.camera } }, 'planar_solve rigid');
+
+// XY-table: a camera 600 mm above the stage, f = 1200 px, rotated 0.3 rad about its axis.
+const project = ([x, y, z]) => {
+  const [c, s] = [Math.cos(0.3), Math.sin(0.3)];
+  const p = [c * x - s * y + 10, s * x + c * y - 5, z + 600];
+  return [1200 * p[0] / p[2] + 640, 1200 * p[1] / p[2] + 480];
+};
+let xy = 'x_mm,y_mm,z_mm,u_px,v_px,role\n';
+for (const z of [0, 40]) for (const x of [-100, 0, 100]) for (const y of [-80, 0, 80]) xy += `${x},${y},${z},${project([x, y, z]).join(',')},calibration\n`;
+for (const [x, y] of [[-60, -50], [60, -50], [60, 50], [-60, 50]]) xy += `${x},${y},20,${project([x, y, 20]).join(',')},verify\n`;
+xy += '0,0,0,640.1,480.0,still\n0,0,0,639.9,480.1,still\n0,0,0,640.0,479.9,still\n';
+const xyRequest = output('workflow_csv', JSON.parse(robocal.workflow_csv('xytable', xy)), 'workflow_csv xytable');
+check('workflow_csv xytable', xyRequest, propertyType(declared('WorkflowCsvKinds'), 'xytable'));
+const xyReport = call('xytable_solve', xyRequest);
+assert.ok(xyReport.verification && xyReport.batch.rms_px < 1e-6, 'exact projections fit exactly');
+call('xytable_solve', { observations: xyRequest.observations, measurement_noise_px2: [[0.01, 0], [0, 0.01]], kalman_mode: 'linearized' }, 'xytable_solve given noise');
+
+let motion = 'dx_mm,dy_mm,dz_mm,x_cam_mm,y_cam_mm,z_cam_mm\n';
+for (const d of [[0, 0, 0], [50, 0, 0], [0, 50, 0], [0, 0, 50], [30, 30, 30]]) motion += `${d.join(',')},${100 - d[1]},${200 + d[0]},${1000 + d[2]}\n`;
+const motionRequest = output('workflow_csv', JSON.parse(robocal.workflow_csv('known-motion', motion)), 'workflow_csv known-motion');
+check('workflow_csv known-motion', motionRequest, propertyType(declared('WorkflowCsvKinds'), 'known-motion'));
+call('known_motion_solve', motionRequest);
+call('known_motion_solve', { ...motionRequest, start_reference_mm: [1, 2, 3] }, 'known_motion_solve start');
+
+// The checker itself: it must reject what the declarations do not allow.
+const rejects = (what, value, type) => {
+  const e = [];
+  validate(value, type, what, e);
+  assert.ok(e.length > 0, `the checker accepted ${what}`);
+};
+const detectionType = mapped('detect_target', 1);
+const { points: _points, ...noPoints } = detections[0];
+rejects('a missing key', noPoints, detectionType);
+rejects('an extra key', { ...detections[0], score: 1 }, detectionType);
+rejects('an extra nested key', { ...detections[0], target: { ...meta.target, spacing_m: 0.03 } }, detectionType);
+rejects('a wrong kind', { ...detections[0], target: { ...meta.target, kind: 'square_grid' } }, detectionType);
+rejects('a short tuple', { ...detections[0], image_size_px: [1024] }, detectionType);
+rejects('null for a number', { ...report, rms_px: null }, declared('CameraCalibration'));
+rejects('a string for a number', { ...meta.images[0], offset: '0' }, propertyType(mapped('render_demo', 1), 'images'));
+rejects('keys of the other setup', { ...eyeInHand, base_from_camera: eyeInHand.gripper_from_camera }, mapped('solve_handeye', 1));
+rejects('views and detections', { setup: 'eye-in-hand', base_from_gripper, views: viewsIn, detections }, mapped('solve_handeye', 0));
+
+// 4. Coverage: every function in the map is exercised both ways (where it
+// has JSON), and every function of the package is in the map.
+const never = (t) => (t.flags & F.Never) !== 0;
+const fns = checker.getPropertiesOfType(map).map((p) => p.name);
+for (const fn of fns) {
+  if (!never(mapped(fn, 0))) assert.ok(checked.input.has(fn), `no input of ${fn} was checked`);
+  if (!never(mapped(fn, 1))) assert.ok(checked.output.has(fn), `no output of ${fn} was checked`);
+}
+const plain = new Set(['init', 'last_panic_message', 'version', 'ImagePreview', 'DemoData']);
+const missing = Object.keys(robocal).filter((n) => !plain.has(n) && !fns.includes(n));
+assert.deepEqual(missing, [], 'package functions without a RobocalJson entry');
+console.log(`shapes ok: ${fns.length} functions, ${checked.input.size} inputs and ${checked.output.size} outputs match index.d.ts`);
+
+function rotate([x, y, z, w], v) {
+  // v + 2 w (q x v) + 2 q x (q x v), q = (x, y, z).
+  const c = [y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]];
+  const cc = [y * c[2] - z * c[1], z * c[0] - x * c[2], x * c[1] - y * c[0]];
+  return [0, 1, 2].map((i) => v[i] + 2 * w * c[i] + 2 * cc[i]);
+}
