@@ -289,6 +289,19 @@ mod tests {
         }
     }
 
+    /// The `views` input of the JSON API.
+    fn views_json(views: &[ViewPoints]) -> Vec<serde_json::Value> {
+        views
+            .iter()
+            .map(|v| {
+                serde_json::json!({
+                    "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                })
+            })
+            .collect()
+    }
+
     #[wasm_bindgen_test(unsupported = test)]
     fn detections_give_the_same_refinement_as_views() {
         // The web app sends its detections as they are; the board points come
@@ -297,15 +310,7 @@ mod tests {
         let scene = looking_scene(Setup::EyeInHand, 8, 3);
         let (cols, square) = (9, 0.03);
         let views = project_grid(&scene, &camera(), (cols, 6, square), 0.3, 2);
-        let view_json: Vec<serde_json::Value> = views
-            .iter()
-            .map(|v| {
-                serde_json::json!({
-                    "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
-                })
-            })
-            .collect();
+        let view_json = views_json(&views);
         let detection_json: Vec<serde_json::Value> = views
             .iter()
             .map(|v| {
@@ -358,15 +363,7 @@ mod tests {
     fn joint_intrinsics_reports_the_camera_and_missing_inputs_are_named() {
         let scene = looking_scene(Setup::EyeInHand, 8, 4);
         let views = project_grid(&scene, &camera(), (9, 6, 0.03), 0.0, 1);
-        let view_json: Vec<serde_json::Value> = views
-            .iter()
-            .map(|v| {
-                serde_json::json!({
-                    "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
-                })
-            })
-            .collect();
+        let view_json = views_json(&views);
         let robots: Vec<_> = scene.base_from_gripper.iter().map(pose_json).collect();
         // The camera given as a calibration-report-like JSON string (the
         // format robocal exports), 2 % off in focal length.

@@ -1,0 +1,344 @@
+//! Sub-pixel corners of one square: edge points from profiles across each
+//! side, a curve per side, corners where the curves meet (see the parent
+//! module's "Corners" section).
+
+use super::*;
+
+/// A side's curve `v = c0 + c1 u + c2 u^2` in its frame (origin `m`, `t`
+/// along the side from its first corner to its second, `n` outward), with
+/// the parameters' covariance.
+#[derive(Debug, Clone)]
+struct Curve {
+    m: Point2<f64>,
+    t: Vector2<f64>,
+    n: Vector2<f64>,
+    c: Vector3<f64>,
+    cov: Matrix3<f64>,
+}
+
+impl Curve {
+    fn local(&self, p: &Point2<f64>) -> (f64, f64) {
+        let d = p - self.m;
+        (d.dot(&self.t), d.dot(&self.n))
+    }
+    fn basis(u: f64) -> Vector3<f64> {
+        Vector3::new(1.0, u, u * u)
+    }
+    /// Signed distance-like residual `v - poly(u)` and its gradient.
+    fn eval(&self, p: &Point2<f64>) -> (f64, Vector2<f64>) {
+        let (u, v) = self.local(p);
+        let g = v - self.c.dot(&Self::basis(u));
+        let slope = self.c[1] + 2.0 * self.c[2] * u;
+        (g, self.n - self.t * slope)
+    }
+    fn point(&self, u: f64) -> Point2<f64> {
+        self.m + self.t * u + self.n * self.c.dot(&Self::basis(u))
+    }
+}
+
+/// Where curves `a` and `b` meet, near `start`, with its covariance.
+fn meet(a: &Curve, b: &Curve, start: Point2<f64>) -> Option<(Point2<f64>, Matrix2<f64>)> {
+    let mut p = start;
+    for _ in 0..8 {
+        let (ga, da) = a.eval(&p);
+        let (gb, db) = b.eval(&p);
+        let j = Matrix2::new(da.x, da.y, db.x, db.y);
+        let step = j.try_inverse()? * Vector2::new(ga, gb);
+        p -= step;
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            return None;
+        }
+        if step.norm() < 1e-9 {
+            break;
+        }
+    }
+    let (_, da) = a.eval(&p);
+    let (_, db) = b.eval(&p);
+    let jinv = Matrix2::new(da.x, da.y, db.x, db.y).try_inverse()?;
+    let var = |c: &Curve| {
+        let phi = Curve::basis(c.local(&p).0);
+        (phi.transpose() * c.cov * phi)[(0, 0)]
+    };
+    let cov = jinv * Matrix2::new(var(a), 0.0, 0.0, var(b)) * jinv.transpose();
+    Some((p, cov))
+}
+
+/// Sub-pixel corners of one dark square from its coarse corners (clockwise
+/// on screen). `gap_px`: roughly the light gap to the next square.
+pub(super) fn refine_square(
+    img: &GrayImage,
+    coarse: &[Point2<f64>; 4],
+    gap_px: f64,
+    model: SideModel,
+) -> Option<[(Point2<f64>, Matrix2<f64>); 4]> {
+    let centre = Point2::from(coarse.iter().fold(Vector2::zeros(), |s, p| s + p.coords) / 4.0);
+    let side_px = (0..4)
+        .map(|k| (coarse[(k + 1) % 4] - coarse[k]).norm())
+        .fold(f64::MAX, f64::min);
+    if !(side_px >= 4.0) || !gap_px.is_finite() {
+        return None;
+    }
+    let inside = bilinear_u8(img, centre.x, centre.y);
+    let mut corners: Vec<(Point2<f64>, Matrix2<f64>)> =
+        coarse.iter().map(|p| (*p, Matrix2::zeros())).collect();
+    // Curves from the previous pass (sides k = corner k -> k + 1).
+    let mut curves: Option<Vec<Curve>> = None;
+    let mut half_window = 3.0f64;
+    for pass in 0..PASSES {
+        let search = if pass == 0 {
+            (0.2 * side_px).min(0.35 * gap_px - half_window).max(1.0)
+        } else {
+            1.0
+        };
+        let mut fitted: Vec<[Curve; 2]> = Vec::with_capacity(4);
+        let mut widths = Vec::new();
+        for k in 0..4 {
+            let (p, q) = (corners[k].0, corners[(k + 1) % 4].0);
+            let chord = q - p;
+            let len = chord.norm();
+            if !(len >= 4.0) {
+                return None;
+            }
+            let t = chord / len;
+            let mut nrm = Vector2::new(t.y, -t.x);
+            let m = Point2::from((p.coords + q.coords) * 0.5);
+            if nrm.dot(&(m - centre)) < 0.0 {
+                nrm = -nrm;
+            }
+            // Angles at both ends set how far from each corner profiles are
+            // clear of the other side.
+            let excl = |corner: usize, other: Point2<f64>| {
+                let d = (other - corners[corner].0).normalize();
+                let along = if corner == k { t } else { -t };
+                let cos = d.dot(&along).clamp(-0.99, 0.99);
+                let sin = (1.0 - cos * cos).sqrt();
+                let reach = search + half_window + 1.0;
+                ((half_window + reach * cos.max(0.0)) / sin + 1.0).clamp(2.0, 0.3 * len)
+            };
+            let e0 = excl(k, corners[(k + 3) % 4].0);
+            let e1 = excl((k + 1) % 4, corners[(k + 2) % 4].0);
+            let prev = curves.as_ref().map(|c| &c[k]);
+            let mut edge_pts: Vec<(f64, f64)> = Vec::new();
+            let mut u = -0.5 * len + e0;
+            while u <= 0.5 * len - e1 {
+                // Base point on the previous curve (or the chord).
+                let base = match prev {
+                    Some(c) => {
+                        let (uc, _) = c.local(&(m + t * u));
+                        c.point(uc)
+                    }
+                    None => m + t * u,
+                };
+                if let Some((s, width)) =
+                    edge_on_profile(img, base, nrm, search, half_window, inside)
+                {
+                    let e = base + nrm * s;
+                    let d = e - m;
+                    edge_pts.push((d.dot(&t), d.dot(&nrm)));
+                    widths.push(width);
+                }
+                u += PROFILE_SPACING_PX;
+            }
+            let span = (-0.5 * len + e0, 0.5 * len - e1);
+            let f = fit_side(m, t, nrm, &edge_pts, span, model)?;
+            fitted.push(f);
+        }
+        // The blur seen on the edges sets the next pass's window.
+        if !widths.is_empty() {
+            widths.sort_by(f64::total_cmp);
+            let sd = widths[widths.len() / 2];
+            half_window = (WINDOW_SDS * sd + 0.5).clamp(1.5, (0.3 * gap_px).max(1.5));
+        }
+        let mut next = Vec::with_capacity(4);
+        for k in 0..4 {
+            // Corner k joins side k - 1 (its end) and side k (its start).
+            let a = &fitted[(k + 3) % 4][1];
+            let b = &fitted[k][0];
+            let (c, cov) = meet(a, b, corners[k].0)?;
+            if (c - coarse[k]).norm() > 0.35 * side_px {
+                return None;
+            }
+            next.push((c, cov));
+        }
+        corners = next;
+        // The next pass's profiles follow each side's first curve (the two
+        // half-side segments of a side nearly coincide).
+        curves = Some(fitted.iter().map(|f| f[0].clone()).collect());
+    }
+    convex(&corners.iter().map(|c| c.0).collect::<Vec<_>>())
+        .then(|| [corners[0], corners[1], corners[2], corners[3]])
+}
+
+/// Curves for a side's two ends (the same curve unless the model fits a
+/// segment per corner). `span`: the range of `u` that was measured.
+fn fit_side(
+    m: Point2<f64>,
+    t: Vector2<f64>,
+    n: Vector2<f64>,
+    pts: &[(f64, f64)],
+    span: (f64, f64),
+    model: SideModel,
+) -> Option<[Curve; 2]> {
+    match model {
+        SideModel::Line | SideModel::Parabola => {
+            let degree = if model == SideModel::Line { 1 } else { 2 };
+            let c = fit_poly(m, t, n, pts, degree)?;
+            Some([c.clone(), c])
+        }
+        SideModel::CornerSegments => {
+            let mid = 0.5 * (span.0 + span.1);
+            let first: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 <= mid).collect();
+            let second: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 >= mid).collect();
+            Some([
+                fit_poly(m, t, n, &first, 1)?,
+                fit_poly(m, t, n, &second, 1)?,
+            ])
+        }
+    }
+}
+
+/// Least-squares polynomial `v(u)` of degree 1 or 2, with one pass of
+/// outlier rejection (residuals beyond 3 robust sigmas, at least 0.15 px).
+fn fit_poly(
+    m: Point2<f64>,
+    t: Vector2<f64>,
+    n: Vector2<f64>,
+    pts: &[(f64, f64)],
+    degree: usize,
+) -> Option<Curve> {
+    let solve =
+        |use_pt: &dyn Fn(usize) -> bool| -> Option<(Vector3<f64>, Matrix3<f64>, f64, usize)> {
+            let mut ata = Matrix3::zeros();
+            let mut atb = Vector3::zeros();
+            let mut count = 0;
+            for (i, &(u, v)) in pts.iter().enumerate() {
+                if !use_pt(i) {
+                    continue;
+                }
+                let phi = Curve::basis(u);
+                ata += phi * phi.transpose();
+                atb += phi * v;
+                count += 1;
+            }
+            if count < MIN_EDGE_POINTS {
+                return None;
+            }
+            if degree < 2 {
+                // Pin c2 = 0 with a unit row that does not touch the others.
+                for k in 0..3 {
+                    ata[(2, k)] = 0.0;
+                    ata[(k, 2)] = 0.0;
+                }
+                ata[(2, 2)] = 1.0;
+                atb[2] = 0.0;
+            }
+            let inv = ata.try_inverse()?;
+            let c = inv * atb;
+            let sse: f64 = pts
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| use_pt(*i))
+                .map(|(_, &(u, v))| (v - c.dot(&Curve::basis(u))).powi(2))
+                .sum();
+            let dof = (count as f64 - (degree + 1) as f64).max(1.0);
+            let mut cov = inv * (sse / dof);
+            if degree < 2 {
+                cov[(2, 2)] = 0.0;
+            }
+            Some((c, cov, (sse / dof).sqrt(), count))
+        };
+    let (c, _, _, _) = solve(&|_| true)?;
+    let mut res: Vec<f64> = pts
+        .iter()
+        .map(|&(u, v)| (v - c.dot(&Curve::basis(u))).abs())
+        .collect();
+    let resid = res.clone();
+    res.sort_by(f64::total_cmp);
+    let robust = (1.4826 * res[res.len() / 2]).max(0.05);
+    let limit = (3.0 * robust).max(0.15);
+    let (c, cov, _, _) = solve(&|i| resid[i] <= limit)?;
+    Some(Curve { m, t, n, c, cov })
+}
+
+/// Edge on the profile `base + s n`, `|s| <= search`: the strongest rise of
+/// the grey level (dark inside to light outside), then the centroid of the
+/// derivative in a window of half-width `half_window` moved onto it.
+/// Returns the offset `s` and the edge's blur (the derivative's sd).
+fn edge_on_profile(
+    img: &GrayImage,
+    base: Point2<f64>,
+    n: Vector2<f64>,
+    search: f64,
+    half_window: f64,
+    inside: f64,
+) -> Option<(f64, f64)> {
+    let reach = search + half_window + 0.5;
+    let count = (2.0 * reach / PROFILE_STEP_PX).ceil() as usize + 1;
+    let s0 = -reach;
+    let at = |k: usize| s0 + k as f64 * PROFILE_STEP_PX;
+    let vals: Vec<f64> = (0..count)
+        .map(|k| {
+            let p = base + n * at(k);
+            bilinear_u8(img, p.x, p.y)
+        })
+        .collect();
+    // Derivative over one pixel (two samples either side), at sample k.
+    let half = (0.5 / PROFILE_STEP_PX).round() as usize;
+    let deriv: Vec<f64> = (0..count)
+        .map(|k| {
+            if k < half || k + half >= count {
+                0.0
+            } else {
+                vals[k + half] - vals[k - half]
+            }
+        })
+        .collect();
+    let mut best: Option<(usize, f64)> = None;
+    for (k, d) in deriv.iter().enumerate() {
+        if at(k).abs() <= search && best.map_or(true, |b| *d > b.1) {
+            best = Some((k, *d));
+        }
+    }
+    let (kb, peak) = best?;
+    // The rise must be a real edge: at least a fifth of the contrast
+    // between the square's inside and the light just outside this edge.
+    let outside =
+        vals[count - 1].max(vals[(kb + (1.0 / PROFILE_STEP_PX) as usize * 2).min(count - 1)]);
+    let contrast = outside - inside;
+    if !(contrast > 10.0) || peak < 0.2 * contrast {
+        return None;
+    }
+    let mut centre = at(kb);
+    let mut width = 0.0;
+    for _ in 0..4 {
+        let (mut sw, mut sws, mut swss) = (0.0, 0.0, 0.0);
+        for (k, d) in deriv.iter().enumerate() {
+            let s = at(k);
+            if (s - centre).abs() <= half_window {
+                sw += d;
+                sws += d * s;
+                swss += d * s * s;
+            }
+        }
+        if !(sw > 0.0) {
+            return None;
+        }
+        let c = sws / sw;
+        width = (swss / sw - c * c).max(0.0).sqrt();
+        let moved = (c - centre).abs();
+        centre = c;
+        if moved < 1e-3 {
+            break;
+        }
+    }
+    (centre.abs() <= search + 0.5).then_some((centre, width))
+}
+
+/// The four corners form a convex quadrilateral, clockwise on screen.
+fn convex(p: &[Point2<f64>]) -> bool {
+    (0..4).all(|k| {
+        let a = p[(k + 1) % 4] - p[k];
+        let b = p[(k + 2) % 4] - p[(k + 1) % 4];
+        a.x * b.y - a.y * b.x > 0.0
+    })
+}
