@@ -13,6 +13,8 @@ export class FrameView {
     this.zoom = 1;
     this.frames = [];
     this.links = [];
+    this.centre = [0, 0, 0];
+    this.scale = 1;
     let drag = null;
     canvas.addEventListener('pointerdown', (e) => { drag = [e.clientX, e.clientY]; canvas.setPointerCapture(e.pointerId); });
     canvas.addEventListener('pointerup', () => { drag = null; });
@@ -38,12 +40,17 @@ export class FrameView {
   set(frames, links = []) {
     this.frames = frames.map((f) => ({ name: f.name, ...mat(f.matrix_row_major), size: f.size }));
     this.links = links;
-    const ext = Math.max(0.05, ...this.frames.flatMap((f) => f.t.map(Math.abs)));
-    this.scale = ext;
+    // Look at the middle of the frames' bounding box, scaled to its size,
+    // so the scene fills the canvas wherever the frames are in the world.
+    const lo = [0, 1, 2].map((k) => Math.min(...this.frames.map((f) => f.t[k])));
+    const hi = [0, 1, 2].map((k) => Math.max(...this.frames.map((f) => f.t[k])));
+    this.centre = this.frames.length ? lo.map((v, k) => (v + hi[k]) / 2) : [0, 0, 0];
+    this.scale = Math.max(0.05, 0.5 * Math.hypot(...hi.map((v, k) => v - lo[k])));
     this.draw();
   }
 
-  project([x, y, z]) {
+  project([px, py, pz]) {
+    const [x, y, z] = [px - this.centre[0], py - this.centre[1], pz - this.centre[2]];
     const cy = Math.cos(this.yaw), sy = Math.sin(this.yaw), cp = Math.cos(this.pitch), sp = Math.sin(this.pitch);
     // World z up on screen: rotate about z (yaw), then tilt about the screen x axis (pitch).
     const x1 = cy * x - sy * y, y1 = sy * x + cy * y;
