@@ -77,7 +77,7 @@ const MIN_EDGE_POINTS: usize = 6;
 /// What is fitted to a side's edge points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 // The alternatives are measured against the default in the tests.
-#[cfg_attr(not(test), allow(dead_code))]
+#[cfg_attr(any(not(test), target_arch = "wasm32"), allow(dead_code))]
 pub(crate) enum SideModel {
     /// A straight line over the whole side: the default.
     Line,
