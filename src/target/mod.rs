@@ -475,12 +475,12 @@ fn parse_grid(text: &str) -> Result<(usize, usize)> {
 }
 
 fn parse_length(text: &str) -> Result<f64> {
-    let (number, scale) = if let Some(n) = text.strip_suffix("mm") {
-        (n, 1e-3)
+    let (number, exponent) = if let Some(n) = text.strip_suffix("mm") {
+        (n, -3)
     } else if let Some(n) = text.strip_suffix("cm") {
-        (n, 1e-2)
+        (n, -2)
     } else if let Some(n) = text.strip_suffix('m') {
-        (n, 1.0)
+        (n, 0)
     } else {
         return Err(Error::invalid(
             "target",
@@ -490,7 +490,15 @@ fn parse_length(text: &str) -> Result<f64> {
     let v: f64 = number
         .parse()
         .map_err(|_| Error::invalid("target", format!("'{text}' is not a length")))?;
-    Ok(v * scale)
+    // The decimal shifted to metres and rounded once (22.5778mm -> the
+    // double nearest 0.0225778, not 22.5778 * 0.001 = 0.022577800000000002),
+    // so that a spec and the JSON it is written to compare equal.
+    if exponent == 0 || number.contains(['e', 'E']) {
+        return Ok(v * 10f64.powi(exponent));
+    }
+    Ok(format!("{number}e{exponent}")
+        .parse()
+        .unwrap_or(v * 10f64.powi(exponent)))
 }
 
 #[cfg(test)]

@@ -54,7 +54,8 @@ fn specs_parse_to_targets() {
     else {
         panic!("not an 8x8 square grid")
     };
-    assert!((side_m - 0.0127).abs() < 1e-15 && (pitch_m - 0.0225778).abs() < 1e-15);
+    // Rounded once from the decimal: equal to the literal, not 1 ulp off.
+    assert_eq!((side_m, pitch_m), (0.0127, 0.0225778));
     assert_eq!(
         Target::parse_spec("squares:8x8:25mm:20mm")
             .unwrap_err()
@@ -156,4 +157,36 @@ fn detection_round_trips_through_json() {
     assert_eq!(object.len(), 1);
     assert!((object[0].x - 0.01).abs() < 1e-12 && (object[0].y - 0.01).abs() < 1e-12);
     assert_eq!(image[0], Point2::new(10.5, 20.25));
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn specs_and_detections_survive_json_bit_exactly() {
+    // `robocal detect` writes the target and pixels as JSON and
+    // `robocal intrinsics --target SPEC --detections FILE` compares the
+    // target read back with the spec: both must be exact, for lengths
+    // like 22.5778mm and for pixels with 17 significant digits.
+    for spec in [
+        "chessboard:9x6:30mm",
+        "squares:8x8:12.7mm:22.5778mm",
+        "dots:7x7:25mm:12.5mm",
+        "circle:0.7cm",
+    ] {
+        let t = Target::parse_spec(spec).unwrap();
+        let back: Target = serde_json::from_str(&serde_json::to_string(&t).unwrap()).unwrap();
+        assert_eq!(back, t, "{spec}");
+    }
+    let mut x = 0.1f64;
+    for k in 0..2000 {
+        // Awkward doubles: many need 17 digits to round-trip.
+        x = (x * 7.77 + 0.123_456_789_012_345_6 * k as f64) % 1280.0;
+        let p = DetectedPoint {
+            id: k,
+            x_px: x,
+            y_px: 960.0 - x / 3.0,
+            covariance_px2: None,
+        };
+        let back: DetectedPoint =
+            serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap();
+        assert_eq!(back, p);
+    }
 }
