@@ -224,3 +224,60 @@ fn aspect_ratio_holds_fx_equal_fy_and_repeat_times_the_solve() {
         assert_eq!(stderr.lines().last().unwrap_or("").to_string() + "\n", message);
     }
 }
+
+#[test]
+fn detect_output_is_accepted_with_the_same_target_spec() {
+    // `robocal detect` writes the target as JSON; `robocal intrinsics
+    // --target SPEC` must find it equal to SPEC read again, also for lengths
+    // that are not exact in binary (22.5778 mm was refused: 1 ulp apart).
+    let dir = temp_dir("intrinsics", "roundtrip");
+    let spec = "squares:8x8:12.7mm:22.5778mm";
+    let renders = dir.join("renders");
+    let (code, _, stderr) = robocal(&[
+        "render",
+        "--out",
+        renders.to_str().expect("path"),
+        "--target",
+        spec,
+        "--views",
+        "6",
+        "--seed",
+        "3",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let mut images: Vec<String> = std::fs::read_dir(&renders)
+        .expect("renders")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "png"))
+        .map(|p| p.to_string_lossy().into_owned())
+        .collect();
+    images.sort();
+    assert_eq!(images.len(), 6);
+    let detections = dir.join("detections.json");
+    let mut args = vec![
+        "detect",
+        "--target",
+        spec,
+        "-o",
+        detections.to_str().expect("path"),
+    ];
+    args.extend(images.iter().map(String::as_str));
+    let (code, _, stderr) = robocal(&args);
+    assert_eq!(code, 0, "{stderr}");
+    let out = dir.join("camera.json");
+    let (code, _, stderr) = robocal(&[
+        "intrinsics",
+        "--target",
+        spec,
+        "--detections",
+        detections.to_str().expect("path"),
+        "-o",
+        out.to_str().expect("path"),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("report")).expect("json");
+    // The renderer's default camera: fx 900 px; noise sigma 2 on 6 views.
+    let fx = report["camera_matrix"][0][0].as_f64().expect("fx");
+    assert!((fx - 900.0).abs() < 5.0, "fx {fx} px");
+}
