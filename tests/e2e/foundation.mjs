@@ -88,6 +88,10 @@ tests.push(
     await page.fill('input[name=size_mm]', '22.5');
     await page.fill('input[name=side_mm]', '12.5');
     assert.match(await page.textContent('#target-spec'), /^Target spec: squares:8x8:12.5mm:22.5mm /);
+    // Only the fields of this kind are shown (the circle-grid and dot fields were visible before).
+    for (const name of ['layout', 'polarity', 'diameter_mm']) assert.equal(await page.isVisible(`#target-form [name=${name}]`), false, `${name} shown for squares`);
+    assert.equal(await page.isVisible('#target-form [name=side_mm]'), true);
+    assert.equal(await page.textContent('#size-label'), 'Square pitch (mm)');
     await shot('squares');
     const [dl2] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
     const svg2 = (await (await dl2.createReadStream()).toArray()).join('');

@@ -150,7 +150,7 @@ export function initTarget(store) {
       const kinds = el.dataset.for.split(' ');
       el.hidden = !kinds.includes(t.kind) && !(kinds.includes('grid') && t.kind !== 'circle');
     }
-    $('size-label').textContent = { chessboard: 'Square size', circles: 'Circle spacing', dots: 'Dot pitch', squares: 'Square pitch', circle: 'Size' }[t.kind];
+    $('size-label').textContent = `${{ chessboard: 'Square size', circles: 'Circle spacing', dots: 'Dot pitch', squares: 'Square pitch', circle: 'Size' }[t.kind]} (mm)`;
     form.elements.size_mm.closest('label').hidden = t.kind === 'circle';
     const err = validateTarget(t);
     $('target-error').textContent = err;
