@@ -281,3 +281,34 @@ fn detect_output_is_accepted_with_the_same_target_spec() {
     let fx = report["camera_matrix"][0][0].as_f64().expect("fx");
     assert!((fx - 900.0).abs() < 5.0, "fx {fx} px");
 }
+
+#[test]
+fn brown5_is_the_issue_spelling_of_brown() {
+    // `robocal intrinsics --model brown5` (OpenCV's five coefficients, the
+    // spelling of the CLI contract) solves the same model as `brown`.
+    let dir = temp_dir("intrinsics", "brown5");
+    let (detections, _) = detections_file(&dir);
+    let solve = |model: &str| {
+        let out = dir.join(format!("{model}.json"));
+        let (code, _, stderr) = robocal(&[
+            "intrinsics",
+            "--detections",
+            detections.to_str().expect("path"),
+            "--model",
+            model,
+            "-o",
+            out.to_str().expect("path"),
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        let report: Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).expect("report")).expect("json");
+        (
+            report["model"].clone(),
+            report["camera_matrix"].clone(),
+            report["distortion"].clone(),
+        )
+    };
+    let brown = solve("brown");
+    assert_eq!(brown.0, "brown");
+    assert_eq!(solve("brown5"), brown);
+}

@@ -254,12 +254,13 @@ pub const MODEL_NAMES: [&str; 7] = [
 ];
 
 impl Distortion {
-    /// The model called `name` (see [`Distortion::model_name`]) with every
+    /// The model called `name` (see [`Distortion::model_name`]; `brown5`,
+    /// OpenCV's five coefficients, is another name for `brown`) with every
     /// coefficient 0 (EUCM: alpha 0, beta 1); `None` for an unknown name.
     pub fn zeroed(name: &str) -> Option<Distortion> {
         let template = match name {
             "none" => Distortion::None,
-            "brown" => Distortion::Brown {
+            "brown" | "brown5" => Distortion::Brown {
                 k1: 0.0,
                 k2: 0.0,
                 k3: 0.0,

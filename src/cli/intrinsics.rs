@@ -23,8 +23,9 @@ Options:
                           squares:8x8:12.7mm:22.5778mm); required
                           with images, checked against the file with --detections
   --detections FILE       use the JSON written by 'robocal detect' instead of images
-  --model NAME            brown (default: k1 k2 p1 p2 k3), radial_k1_k2_k5, rational,
-                          division, kannala_brandt, eucm, none
+  --model NAME            brown (default: k1 k2 p1 p2 k3; also called brown5, OpenCV's
+                          5 coefficients), radial_k1_k2_k5, rational, division,
+                          kannala_brandt, eucm, none
   --method NAME           zhang (default), dlt (non-coplanar points), tsai, ekf, or
                           all (every method side by side, as seed 000's Table II; the
                           report is Zhang's, the comparison goes to standard error)
