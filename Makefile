@@ -6,7 +6,7 @@ SHELL := /bin/bash
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 
 WASM_TARGET := wasm32-unknown-unknown
-WASM_FILE := target/$(WASM_TARGET)/release/robocal.wasm
+WASM_FILE := target/$(WASM_TARGET)/wasm/robocal.wasm
 CLI := target/release/robocal
 PORT ?= 8080
 
@@ -18,7 +18,7 @@ setup:
 # The wasm is built in its own cargo invocation so that the native CLI's
 # features never unify into it.
 wasm: setup
-	cargo build --lib --release --target $(WASM_TARGET) --features wasm
+	cargo build --lib --profile wasm --target $(WASM_TARGET) --features wasm
 
 web: wasm
 	wasm-bindgen --target web --out-dir www/pkg --out-name robocal --no-typescript --remove-name-section --remove-producers-section $(WASM_FILE)
@@ -38,13 +38,13 @@ pkg: wasm
 	@tools/wasm-size.sh pkg/node/robocal_bg.wasm
 
 check-wasm-core: setup
-	cargo check --lib --target $(WASM_TARGET)
+	cargo check --workspace --lib --target $(WASM_TARGET)
 
 test-native:
-	cargo test
+	cargo test --workspace
 
 test-wasm: setup
-	CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --lib --target $(WASM_TARGET)
+	CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --workspace --lib --target $(WASM_TARGET)
 
 test-node: pkg
 	tools/setup.sh node

@@ -33,18 +33,16 @@
 #![deny(missing_docs)]
 
 pub mod calib;
-pub mod camera;
-pub mod detect;
-pub mod error;
-pub mod geometry;
 pub mod handeye;
-pub mod image;
 pub mod io;
 pub mod optim;
-mod sorting;
 pub mod synth;
-pub mod target;
 pub mod workflows;
+
+// The pixel-level modules live in the robocal-vision crate (built for speed
+// in the wasm build, see its crate docs) and keep their paths here.
+pub use robocal_vision::{camera, detect, error, geometry, image, target};
+use robocal_vision::sorting;
 
 #[cfg(feature = "wasm")]
 pub mod wasm;

@@ -4,10 +4,9 @@
 
 pub mod demo;
 pub mod handeye;
-pub mod render;
-pub mod rng;
 pub mod scene;
 
-pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
-pub use rng::Rng;
+// The renderer and the random numbers live in robocal-vision (fast in wasm).
+pub use robocal_vision::synth::{render, rng, Pinhole, Projection, RenderOptions, Rendered, Rng};
+
 pub use scene::Scene;

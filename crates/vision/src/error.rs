@@ -162,7 +162,8 @@ mod tests {
 /// A required field of a hand-written `Deserialize` impl (an internally
 /// tagged or untagged form read through a plain struct of optional fields):
 /// serde's own "missing field `name`" error when absent.
-pub(crate) fn serde_field<T, E: serde::de::Error>(
+#[doc(hidden)]
+pub fn serde_field<T, E: serde::de::Error>(
     value: Option<T>,
     name: &'static str,
 ) -> std::result::Result<T, E> {

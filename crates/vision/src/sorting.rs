@@ -70,7 +70,7 @@ fn permute<T>(v: &mut [T], order: &[usize]) {
 /// Stable sort of `v` by `cmp`, like `slice::sort_by`. Short lists (the
 /// detector's neighbour queries sort a few items per call) are sorted in
 /// place by insertion, without allocating.
-pub(crate) fn sort_by<T>(v: &mut [T], cmp: impl Fn(&T, &T) -> Ordering) {
+pub fn sort_by<T>(v: &mut [T], cmp: impl Fn(&T, &T) -> Ordering) {
     const SHORT: usize = 16;
     if v.len() <= SHORT {
         for i in 1..v.len() {
@@ -88,7 +88,7 @@ pub(crate) fn sort_by<T>(v: &mut [T], cmp: impl Fn(&T, &T) -> Ordering) {
 
 /// Ascending `f64::total_cmp` order (NaN last), like
 /// `crate::sorting::sort_f64(&mut v)`.
-pub(crate) fn sort_f64(v: &mut [f64]) {
+pub fn sort_f64(v: &mut [f64]) {
     sort_by(v, f64::total_cmp);
 }
 
