@@ -33,6 +33,7 @@
 #![deny(missing_docs)]
 
 pub mod calib;
+pub mod geometry;
 pub mod handeye;
 pub mod io;
 pub mod optim;
@@ -41,7 +42,7 @@ pub mod workflows;
 
 // The pixel-level modules live in the robocal-vision crate (built for speed
 // in the wasm build, see its crate docs) and keep their paths here.
-pub use robocal_vision::{camera, detect, error, geometry, image, target};
+pub use robocal_vision::{camera, detect, error, image, target};
 use robocal_vision::sorting;
 
 #[cfg(feature = "wasm")]

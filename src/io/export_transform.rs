@@ -208,7 +208,7 @@ pub fn export_transform(pose: &Pose, names: &FrameNames, format: TransformFormat
             };
             format!(
                 "# {label}: x y z (m), Euler {kind_name} {} angles ({unit})\n{} {}\n",
-                order.name().to_uppercase(),
+                order.name().to_ascii_uppercase(),
                 list(&xyz),
                 list(&angles)
             )

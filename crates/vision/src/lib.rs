@@ -1,7 +1,7 @@
 //! # robocal-vision
 //!
-//! The pixel-level half of robocal's core: the error type, rotations and
-//! poses, camera models, calibration targets, image decoding, target
+//! The pixel-level half of robocal's core: the error type,
+//! camera models, calibration targets, image decoding, target
 //! detection and the synthetic renderer. Everything here is re-exported by
 //! the `robocal` crate under the same module paths (`robocal::image`,
 //! `robocal::detect`, ...); use it through `robocal`.
@@ -16,7 +16,6 @@
 pub mod camera;
 pub mod detect;
 pub mod error;
-pub mod geometry;
 pub mod image;
 #[doc(hidden)]
 pub mod sorting;

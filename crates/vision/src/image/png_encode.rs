@@ -5,35 +5,13 @@
 use super::GrayImage;
 use crate::error::{Error, Result};
 
-/// CRC-32 (ISO 3309, polynomial 0xEDB88320) table, built at compile time.
-const CRC_TABLE: [u32; 256] = {
-    let mut table = [0u32; 256];
-    let mut n = 0;
-    while n < 256 {
-        let mut c = n as u32;
-        let mut k = 0;
-        while k < 8 {
-            c = if c & 1 != 0 {
-                0xEDB8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
-            k += 1;
-        }
-        table[n] = c;
-        n += 1;
-    }
-    table
-};
-
+/// The chunk CRC (over type and data), by the workspace's crc32fast.
 fn crc32(parts: &[&[u8]]) -> u32 {
-    let mut c = 0xFFFF_FFFFu32;
+    let mut h = crc32fast::Hasher::new();
     for part in parts {
-        for &b in *part {
-            c = CRC_TABLE[((c ^ b as u32) & 0xFF) as usize] ^ (c >> 8);
-        }
+        h.update(part);
     }
-    c ^ 0xFFFF_FFFF
+    h.finalize()
 }
 
 fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
