@@ -36,13 +36,12 @@ pub mod calib;
 pub mod geometry;
 pub mod handeye;
 pub mod io;
-pub mod optim;
 pub mod synth;
 pub mod workflows;
 
 // The pixel-level modules live in the robocal-vision crate (built for speed
 // in the wasm build, see its crate docs) and keep their paths here.
-pub use robocal_vision::{camera, detect, error, image, target};
+pub use robocal_vision::{camera, detect, error, image, optim, target};
 use robocal_vision::sorting;
 
 #[cfg(feature = "wasm")]

@@ -15,9 +15,7 @@ pub(super) fn select(h: &DMatrix<f64>, pht: &DMatrix<f64>, cols: &[usize]) -> Ma
 }
 
 pub(super) fn symmetrize(p: &mut DMatrix<f64>) {
-    let t = p.transpose();
-    *p += t;
-    *p *= 0.5;
+    crate::optim::dense::symmetrize(p);
 }
 
 pub(super) fn camera_of(state: &DVector<f64>, size: (u32, u32)) -> Result<Camera> {

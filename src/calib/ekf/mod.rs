@@ -57,6 +57,7 @@ use super::{CalibrationOptions, CameraCalibration, View};
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
 use crate::geometry::Pose;
+use crate::optim::dense;
 use measure::{camera_of, measure, select, symmetrize};
 use nalgebra::{
     DMatrix, DVector, Matrix2, Matrix3, Point2, Quaternion, Translation3, UnitQuaternion, Vector2,
@@ -353,7 +354,7 @@ impl EkfCalibrator {
         for _ in 0..self.options.iterations.max(1) {
             let (predicted, h) = measure(&x, v, object, self.size)?;
             // P H^T through the 14 non-zero columns of H.
-            let pht = self.covariance.select_columns(&cols) * h.transpose();
+            let pht = dense::columns_times_transpose(&self.covariance, &cols, &h);
             let s = select(&h, &pht, &cols) + r;
             let s_inv = s
                 .try_inverse()
@@ -372,8 +373,7 @@ impl EkfCalibrator {
             }
         }
         // P <- P - K H P, with H P = (P H^T)^T.
-        self.covariance -= &gain * pht_last.transpose();
-        symmetrize(&mut self.covariance);
+        dense::subtract_product_symmetric(&mut self.covariance, &gain, &pht_last);
         self.state = x;
         Ok(())
     }

@@ -5,6 +5,7 @@
 use super::measure::{measure, select, symmetrize};
 use super::{EkfCalibrator, N_INTRINSICS, N_POSE};
 use crate::error::{Error, Result};
+use crate::optim::dense;
 use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
 /// Re-linearisation stop: relative change of the residual pixel sigma.
@@ -64,15 +65,14 @@ impl EkfCalibrator {
                 let dx =
                     DVector::from_iterator(cols.len(), cols.iter().map(|&c| self.state[c] - at[c]));
                 let innovation = residual - Vector2::from_iterator((h * dx).iter().copied());
-                let pht = self.covariance.select_columns(&cols) * h.transpose();
+                let pht = dense::columns_times_transpose(&self.covariance, &cols, h);
                 let s = select(h, &pht, &cols) + r;
                 let s_inv = s
                     .try_inverse()
                     .ok_or_else(|| Error::degenerate("EKF innovation covariance is singular"))?;
                 let gain = &pht * DMatrix::from_iterator(2, 2, s_inv.iter().copied());
                 self.state += &gain * DVector::from_column_slice(innovation.as_slice());
-                self.covariance -= &gain * pht.transpose();
-                symmetrize(&mut self.covariance);
+                dense::subtract_product_symmetric(&mut self.covariance, &gain, &pht);
             }
             self.update_quaternion_norm_at(v, &at);
         }

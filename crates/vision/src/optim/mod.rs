@@ -11,6 +11,7 @@
 //! [`LmOptions::fixed_blocks`]); manifold parameters (rotations) use
 //! [`BlockProblem::retract`].
 
+pub mod dense;
 mod loss;
 mod normal;
 
