@@ -41,8 +41,8 @@ pub mod workflows;
 
 // The pixel-level modules live in the robocal-vision crate (built for speed
 // in the wasm build, see its crate docs) and keep their paths here.
-pub use robocal_vision::{camera, detect, error, image, optim, target};
 use robocal_vision::sorting;
+pub use robocal_vision::{camera, detect, error, image, optim, target};
 
 #[cfg(feature = "wasm")]
 pub mod wasm;

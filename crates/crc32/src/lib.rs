@@ -193,7 +193,9 @@ mod tests {
 
     #[test]
     fn any_split_and_length_matches_the_bitwise_definition() {
-        let data: Vec<u8> = (0..1000u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8).collect();
+        let data: Vec<u8> = (0..1000u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+            .collect();
         for len in [0, 1, 7, 8, 9, 15, 16, 17, 100, 1000] {
             let want = reference(&data[..len]);
             assert_eq!(hash(&data[..len]), want, "length {len}");
@@ -215,7 +217,11 @@ mod tests {
             right.update(&data[a..a + b]);
             left.combine(&right);
             assert_eq!(left.amount(), (a + b) as u64);
-            assert_eq!(left.finalize(), reference(&data[..a + b]), "combine {a} + {b}");
+            assert_eq!(
+                left.finalize(),
+                reference(&data[..a + b]),
+                "combine {a} + {b}"
+            );
         }
         let mut h = Hasher::new();
         h.update(b"junk");

@@ -56,59 +56,41 @@ pub(crate) fn detect_grid(
     let board = target.grid_coords();
     let n = board.len();
     let cols = board.iter().filter(|c| c.1 == 0).count();
-    let pts: Vec<Point2<f64>> = blobs.iter().map(|b| b.centre).collect();
-    let index = PointIndex::new(&pts, 16.0);
-    let mut in_board = vec![false; pts.len()];
-    let mut found: Vec<Vec<usize>> = Vec::new();
-    let mut best_partial = 0usize;
-    for seed in 0..pts.len().min(MAX_SEEDS) {
-        if in_board[seed] {
-            continue;
+    let seed_fits = |seed: &Blob, step_a: Vector2<f64>, step_b: Vector2<f64>| match diameter_ratio {
+        // Equivalent diameter over the grid step within a factor 2.
+        Some(rho) => {
+            let d = (4.0 * seed.area / std::f64::consts::PI).sqrt();
+            (0.5..=2.0).contains(&(d / step_a.norm().max(step_b.norm()) / rho))
         }
-        let Some((step_a, step_b)) = seed_steps(&blobs, seed) else {
-            continue;
-        };
-        if let Some(rho) = diameter_ratio {
-            // Equivalent diameter over the grid step within a factor 2.
-            let d = (4.0 * blobs[seed].area / std::f64::consts::PI).sqrt();
-            let q = d / step_a.norm().max(step_b.norm()) / rho;
-            if !(0.5..=2.0).contains(&q) {
-                continue;
-            }
+        None => true,
+    };
+    let search = GridSearch {
+        board: &board,
+        cols,
+        rows: n / cols.max(1),
+        diagonal: asymmetric,
+        trim: false,
+        seed_fits: &seed_fits,
+    };
+    let two_boards = || {
+        format!(
+            "two candidate boards: two complete {} in the image",
+            describe(target)
+        )
+    };
+    let order = match search_grid(&blobs, &search, &two_boards)? {
+        Ok(order) => order,
+        Err(best_partial) => {
+            let message = if best_partial > 1 {
+                format!(
+                    "found {best_partial} of {n} circles of the {}: the grid may be cut off, occluded or the counts wrong",
+                    describe(target)
+                )
+            } else {
+                format!("board not found: no {} in the image", describe(target))
+            };
+            return Err(Error::NotFound { message });
         }
-        let accept = |i: usize, cell: (i32, i32), pred: &lattice::Prediction| {
-            let _ = (cell, pred);
-            let r = blobs[i].area / blobs[seed].area;
-            (1.0 / AREA_RATIO..=AREA_RATIO).contains(&r)
-        };
-        let cells = lattice::grow(&index, seed, step_a, step_b, 2 * n + 8, &accept);
-        let maps = lattice::complete_maps(&cells, &board, asymmetric);
-        match lattice::choose_order(&pts, &cells, &maps, &board, cols, &|_| false) {
-            Some(order) => {
-                cells.values().for_each(|&i| in_board[i] = true);
-                found.push(order);
-                if found.len() > 1 {
-                    return Err(Error::NotFound {
-                        message: format!(
-                            "two candidate boards: two complete {} in the image",
-                            describe(target)
-                        ),
-                    });
-                }
-            }
-            None => best_partial = best_partial.max(cells.len().min(n)),
-        }
-    }
-    let Some(order) = found.pop() else {
-        let message = if best_partial > 1 {
-            format!(
-                "found {best_partial} of {n} circles of the {}: the grid may be cut off, occluded or the counts wrong",
-                describe(target)
-            )
-        } else {
-            format!("board not found: no {} in the image", describe(target))
-        };
-        return Err(Error::NotFound { message });
     };
     order
         .iter()
@@ -161,9 +143,80 @@ fn point(id: usize, fit: &super::ellipse::EllipseFit) -> DetectedPoint {
     }
 }
 
+/// What the blob-lattice search of [`search_grid`] needs to know of a grid
+/// kind (circle grids and dot plates, square grids).
+pub(crate) struct GridSearch<'a> {
+    /// Board cells `(i, j)` in board order.
+    pub board: &'a [(i32, i32)],
+    /// Board width in cells (the row length of `board`).
+    pub cols: usize,
+    /// Board height in cells.
+    pub rows: usize,
+    /// Cells also meet diagonally (asymmetric circle grids).
+    pub diagonal: bool,
+    /// Keep only the one full board-sized window of a grown lattice
+    /// (clutter of the same kind beside the board may join it).
+    pub trim: bool,
+    /// Whether a seed blob's size fits the grid steps found around it.
+    pub seed_fits: &'a dyn Fn(&Blob, Vector2<f64>, Vector2<f64>) -> bool,
+}
+
+/// Grows a lattice from each of the first seeds among `blobs` (neighbours
+/// of similar area) and returns the blob indices of the one complete board
+/// in board order, or `Err(n)` with the largest partial lattice (`n` board
+/// cells) when none is complete. Two complete boards are an error with the
+/// message of `two_boards`.
+pub(crate) fn search_grid(
+    blobs: &[Blob],
+    search: &GridSearch,
+    two_boards: &dyn Fn() -> String,
+) -> Result<std::result::Result<Vec<usize>, usize>> {
+    let n = search.board.len();
+    let pts: Vec<Point2<f64>> = blobs.iter().map(|b| b.centre).collect();
+    let index = PointIndex::new(&pts, 16.0);
+    let mut in_board = vec![false; pts.len()];
+    let mut found: Vec<Vec<usize>> = Vec::new();
+    let mut best_partial = 0usize;
+    for seed in 0..pts.len().min(MAX_SEEDS) {
+        if in_board[seed] {
+            continue;
+        }
+        let Some((step_a, step_b)) = seed_steps(blobs, seed) else {
+            continue;
+        };
+        if !(search.seed_fits)(&blobs[seed], step_a, step_b) {
+            continue;
+        }
+        let accept = |i: usize, _: (i32, i32), _: &lattice::Prediction| {
+            let r = blobs[i].area / blobs[seed].area;
+            (1.0 / AREA_RATIO..=AREA_RATIO).contains(&r)
+        };
+        let mut cells = lattice::grow(&index, seed, step_a, step_b, 2 * n + 8, &accept);
+        if search.trim {
+            if let Some(window) = lattice::trim_to_window(&cells, search.cols, search.rows) {
+                cells = window;
+            }
+        }
+        let maps = lattice::complete_maps(&cells, search.board, search.diagonal);
+        match lattice::choose_order(&pts, &cells, &maps, search.board, search.cols, &|_| false) {
+            Some(order) => {
+                cells.values().for_each(|&i| in_board[i] = true);
+                found.push(order);
+                if found.len() > 1 {
+                    return Err(Error::NotFound {
+                        message: two_boards(),
+                    });
+                }
+            }
+            None => best_partial = best_partial.max(cells.len().min(n)),
+        }
+    }
+    Ok(found.pop().ok_or(best_partial))
+}
+
 /// The seed's two lattice steps: its nearest similar blob, and the nearest
 /// one not collinear with it.
-pub(crate) fn seed_steps(blobs: &[Blob], seed: usize) -> Option<(Vector2<f64>, Vector2<f64>)> {
+fn seed_steps(blobs: &[Blob], seed: usize) -> Option<(Vector2<f64>, Vector2<f64>)> {
     let s = &blobs[seed];
     let similar = |b: &Blob| (1.0 / AREA_RATIO..=AREA_RATIO).contains(&(b.area / s.area));
     let mut near: Vec<(f64, Vector2<f64>)> = blobs

@@ -9,7 +9,11 @@ use nalgebra::DMatrix;
 /// `p[:, cols] * h^T` for an `m x cols.len()` matrix `h`: the gain
 /// numerator `P H^T` when `H` is zero outside the columns `cols`.
 pub fn columns_times_transpose(p: &DMatrix<f64>, cols: &[usize], h: &DMatrix<f64>) -> DMatrix<f64> {
-    assert_eq!(h.ncols(), cols.len(), "h has one column per selected column of p");
+    assert_eq!(
+        h.ncols(),
+        cols.len(),
+        "h has one column per selected column of p"
+    );
     let (n, m) = (p.nrows(), h.nrows());
     // Column-major storage: column c of p is p[c * n..(c + 1) * n].
     let ps = p.as_slice();

@@ -46,19 +46,14 @@
 //! covariance propagated from the residuals of their two line fits.
 
 use super::blobs::{bilinear_u8, Blob};
-use super::circles::{blobs_at_level, seed_steps};
+use super::circles::{blobs_at_level, search_grid, GridSearch};
 use super::filter::to_full;
-use super::lattice::{self, PointIndex};
 use super::DetectOptions;
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
 use crate::target::DetectedPoint;
 use nalgebra::{Matrix2, Matrix3, Point2, Vector2, Vector3};
 
-/// Seeds tried.
-const MAX_SEEDS: usize = 60;
-/// Neighbouring squares differ in area by at most this factor.
-const AREA_RATIO: f64 = 3.0;
 /// Sample spacing along a profile, pixels.
 const PROFILE_STEP_PX: f64 = 0.25;
 /// Profile spacing along a side, pixels.
@@ -112,57 +107,34 @@ pub(crate) fn detect_with_model(
         .collect();
     let n = board.len();
     let name = format!("{cols}x{rows} square grid");
-    let pts: Vec<Point2<f64>> = blobs.iter().map(|b| b.centre).collect();
-    let index = PointIndex::new(&pts, 16.0);
-    let mut in_board = vec![false; pts.len()];
-    let mut found: Vec<Vec<usize>> = Vec::new();
-    let mut best_partial = 0usize;
-    for seed in 0..pts.len().min(MAX_SEEDS) {
-        if in_board[seed] {
-            continue;
-        }
-        let Some((step_a, step_b)) = seed_steps(&blobs, seed) else {
-            continue;
-        };
-        // A square's side over the grid step, within a factor 2.
-        let q = blobs[seed].area.sqrt() / step_a.norm().max(step_b.norm()) / side_over_pitch;
-        if !(0.5..=2.0).contains(&q) {
-            continue;
-        }
-        let accept = |i: usize, _: (i32, i32), _: &lattice::Prediction| {
-            let r = blobs[i].area / blobs[seed].area;
-            (1.0 / AREA_RATIO..=AREA_RATIO).contains(&r)
-        };
-        let mut cells = lattice::grow(&index, seed, step_a, step_b, 2 * n + 8, &accept);
+    // A square's side over the grid step, within a factor 2.
+    let seed_fits = |seed: &Blob, step_a: Vector2<f64>, step_b: Vector2<f64>| {
+        (0.5..=2.0)
+            .contains(&(seed.area.sqrt() / step_a.norm().max(step_b.norm()) / side_over_pitch))
+    };
+    let search = GridSearch {
+        board: &board,
+        cols,
+        rows,
+        diagonal: false,
         // Dark clutter beside the board (Zhang's image2: the backdrop next
-        // to the corner square) may join the lattice: keep the one full
-        // board-sized window.
-        if let Some(window) = lattice::trim_to_window(&cells, cols, rows) {
-            cells = window;
+        // to the corner square) may join the lattice.
+        trim: true,
+        seed_fits: &seed_fits,
+    };
+    let two_boards = || format!("two candidate boards: two complete {name}s in the image");
+    let order = match search_grid(&blobs, &search, &two_boards)? {
+        Ok(order) => order,
+        Err(best_partial) => {
+            let message = if best_partial > 1 {
+                format!(
+                    "found {best_partial} of {n} squares of the {name}: the grid may be cut off, occluded or the counts wrong"
+                )
+            } else {
+                format!("board not found: no {name} in the image")
+            };
+            return Err(Error::NotFound { message });
         }
-        let maps = lattice::complete_maps(&cells, &board, false);
-        match lattice::choose_order(&pts, &cells, &maps, &board, cols, &|_| false) {
-            Some(order) => {
-                cells.values().for_each(|&i| in_board[i] = true);
-                found.push(order);
-                if found.len() > 1 {
-                    return Err(Error::NotFound {
-                        message: format!("two candidate boards: two complete {name}s in the image"),
-                    });
-                }
-            }
-            None => best_partial = best_partial.max(cells.len().min(n)),
-        }
-    }
-    let Some(order) = found.pop() else {
-        let message = if best_partial > 1 {
-            format!(
-                "found {best_partial} of {n} squares of the {name}: the grid may be cut off, occluded or the counts wrong"
-            )
-        } else {
-            format!("board not found: no {name} in the image")
-        };
-        return Err(Error::NotFound { message });
     };
     let centres: Vec<Point2<f64>> = order.iter().map(|&i| full(&blobs[i], level)).collect();
     let mut out = Vec::with_capacity(4 * n);
