@@ -39,8 +39,8 @@ pub mod io;
 pub mod synth;
 pub mod workflows;
 
-// The pixel-level modules live in the robocal-vision crate (built for speed
-// in the wasm build, see its crate docs) and keep their paths here.
+// The number-crunching modules live in the robocal-vision crate (built for
+// speed in the wasm build, see its crate docs) and keep their paths here.
 use robocal_vision::sorting;
 pub use robocal_vision::{camera, detect, error, image, optim, target};
 
