@@ -7,7 +7,7 @@
 //! 1280x960 renders at sigma 2, which the asserts use. Harder cases (steep
 //! tilt, heavy blur) state their own bound.
 
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::Point3;
 use robocal::detect::{detect, DetectOptions};
 use robocal::synth::{render, Pinhole, RenderOptions};
 use robocal::target::{Detection, Target};
@@ -23,15 +23,7 @@ fn camera(w: u32, h: u32, f: f64) -> Pinhole {
     }
 }
 
-/// Board centre at `(ox, oy, dist)` in the camera, rotated by `rpy` (rad).
-fn pose(target: &Target, rpy: (f64, f64, f64), at: (f64, f64, f64)) -> Isometry3<f64> {
-    let pts = target.object_points();
-    let mx = pts.iter().map(|p| p.1.x).fold(0.0, f64::max) / 2.0;
-    let my = pts.iter().map(|p| p.1.y).fold(0.0, f64::max) / 2.0;
-    let r = UnitQuaternion::from_euler_angles(rpy.0, rpy.1, rpy.2);
-    let t = Vector3::new(at.0, at.1, at.2) - r * Vector3::new(mx, my, 0.0);
-    Isometry3::from_parts(Translation3::from(t), r)
-}
+use robocal::synth::board_pose as pose;
 
 /// Mean and max distance between detection and truth, by id.
 fn errors(det: &Detection, truth: &[robocal::target::DetectedPoint]) -> (f64, f64) {

@@ -7,6 +7,8 @@ pub mod handeye;
 pub mod scene;
 
 // The renderer and the random numbers live in robocal-vision (fast in wasm).
-pub use robocal_vision::synth::{render, rng, Pinhole, Projection, RenderOptions, Rendered, Rng};
+pub use robocal_vision::synth::{
+    board_pose, render, rng, Pinhole, Projection, RenderOptions, Rendered, Rng,
+};
 
 pub use scene::Scene;

@@ -4,7 +4,6 @@ use super::*;
 use crate::camera::Camera;
 use crate::synth::{render, RenderOptions};
 use crate::target::Target;
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 /// Zhang's lens scaled to 1280x960: f 1665 px, k1 -0.2286, k2 0.1904.
 #[cfg(not(target_arch = "wasm32"))]
@@ -21,14 +20,7 @@ fn zhang_camera() -> Camera {
     }
 }
 
-fn pose(target: &Target, rpy: (f64, f64, f64), at: (f64, f64, f64)) -> Isometry3<f64> {
-    let pts = target.object_points();
-    let mx = pts.iter().map(|p| p.1.x).fold(0.0, f64::max) / 2.0;
-    let my = pts.iter().map(|p| p.1.y).fold(0.0, f64::max) / 2.0;
-    let r = UnitQuaternion::from_euler_angles(rpy.0, rpy.1, rpy.2);
-    let t = Vector3::new(at.0, at.1, at.2) - r * Vector3::new(mx, my, 0.0);
-    Isometry3::from_parts(Translation3::from(t), r)
-}
+use crate::synth::board_pose as pose;
 
 /// Mean and max corner error of `model` over `views` (rpy, distance).
 #[cfg(not(target_arch = "wasm32"))]
