@@ -42,7 +42,7 @@ pub mod workflows;
 // The number-crunching modules live in the robocal-vision crate (built for
 // speed in the wasm build, see its crate docs) and keep their paths here.
 use robocal_vision::sorting;
-pub use robocal_vision::{camera, detect, error, image, optim, target};
+pub use robocal_vision::{camera, detect, error, image, number, optim, target};
 
 #[cfg(feature = "wasm")]
 pub mod wasm;

@@ -148,14 +148,23 @@ pub(crate) fn build_report(
     let covariance = parameter_covariance(result, problem.aspect);
     let zero = DMatrix::zeros(0, 0);
     let cov = covariance.as_ref().unwrap_or(&zero);
-    let std: BTreeMap<String, f64> = match &covariance {
-        Some(c) => names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| (n.clone(), c[(i, i)].max(0.0).sqrt()))
-            .collect(),
-        None => BTreeMap::new(),
-    };
+    // Maps filled by insertion: `collect` into a BTreeMap sorts first and
+    // instantiates a stable sort per key type (8 KB of wasm).
+    let mut std = BTreeMap::new();
+    if let Some(c) = &covariance {
+        for (i, n) in names.iter().enumerate() {
+            std.insert(n.clone(), c[(i, i)].max(0.0).sqrt());
+        }
+    }
+    let mut distortion = BTreeMap::new();
+    for (n, v) in camera
+        .distortion
+        .coefficient_names()
+        .iter()
+        .zip(camera.distortion.coefficients())
+    {
+        distortion.insert(n.to_string(), v);
+    }
     let correlation = correlation(&names, cov);
     let blocks = problem.residuals_and_jacobian(&result.params, false)?;
     let mut squared = vec![0.0; problem.views.len()];
@@ -196,13 +205,7 @@ pub(crate) fn build_report(
         image_size_px: [size.0, size.1],
         model: camera.distortion.model_name().to_string(),
         camera_matrix: [0, 1, 2].map(|r| [k[(r, 0)], k[(r, 1)], k[(r, 2)]]),
-        distortion: camera
-            .distortion
-            .coefficient_names()
-            .iter()
-            .zip(camera.distortion.coefficients())
-            .map(|(n, v)| (n.to_string(), v))
-            .collect(),
+        distortion,
         rms_px: (squared.iter().sum::<f64>() / n_points.max(1) as f64).sqrt(),
         std,
         projection_uncertainty: projection_uncertainty(&camera, cov, depth),

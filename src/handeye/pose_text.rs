@@ -8,6 +8,7 @@
 
 use super::Pose;
 use crate::error::{Error, Result};
+use crate::number::parse_f64;
 use nalgebra::{Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion};
 
 /// How to read a line.
@@ -58,7 +59,7 @@ pub fn parse_pose_text(text: &str, format: Option<PoseTextFormat>) -> Result<Vec
             .filter(|f| !f.is_empty())
             .enumerate()
         {
-            let v: f64 = field.parse().map_err(|_| {
+            let v = parse_f64(field).ok_or_else(|| {
                 Error::parse(line_no, col + 1, format!("'{field}' is not a number"))
             })?;
             values.push(v);

@@ -4,6 +4,7 @@
 
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
+use crate::number::parse_f64;
 
 /// The formats [`import_camera`] recognises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -184,7 +185,7 @@ fn yaml_data(text: &str, keys: &[&str]) -> Option<Vec<f64>> {
         let rb = body.find(']')?;
         return body[lb + 1..rb]
             .split(',')
-            .map(|s| s.trim().parse().ok())
+            .map(|s| parse_f64(s.trim()))
             .collect();
     }
     None
@@ -264,7 +265,7 @@ fn from_xml(text: &str) -> Result<Camera> {
             .and_then(|m| {
                 xml_element(m, "data").map(|d| {
                     d.split_whitespace()
-                        .map(|s| s.parse::<f64>().ok())
+                        .map(parse_f64)
                         .collect::<Option<Vec<f64>>>()
                 })
             })

@@ -18,6 +18,7 @@ pub mod camera;
 pub mod detect;
 pub mod error;
 pub mod image;
+pub mod number;
 pub mod optim;
 #[doc(hidden)]
 pub mod sorting;

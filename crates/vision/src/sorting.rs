@@ -87,9 +87,44 @@ pub fn sort_by<T>(v: &mut [T], cmp: impl Fn(&T, &T) -> Ordering) {
 }
 
 /// Ascending `f64::total_cmp` order (NaN last), like
-/// `crate::sorting::sort_f64(&mut v)`.
+/// `v.sort_by(f64::total_cmp)`.
 pub fn sort_f64(v: &mut [f64]) {
     sort_by(v, f64::total_cmp);
+}
+
+/// The `k`-th largest value of `v` (0-based; `k < v.len()`, no NaN), by
+/// quickselect with a three-way partition; `v` is reordered. One
+/// non-generic function instead of `select_nth_unstable_by`'s instantiation.
+pub fn kth_largest_f32(v: &mut [f32], k: usize) -> f32 {
+    let (mut lo, mut hi) = (0, v.len() - 1);
+    loop {
+        if lo == hi {
+            return v[lo];
+        }
+        let (a, b, c) = (v[lo], v[lo + (hi - lo) / 2], v[hi]);
+        let pivot = a.max(b).min(a.min(b).max(c)); // median of three
+                                                   // [lo, gt_end) > pivot, [gt_end, i) == pivot, [lt_start, hi] < pivot.
+        let (mut gt_end, mut i, mut lt_start) = (lo, lo, hi + 1);
+        while i < lt_start {
+            if v[i] > pivot {
+                v.swap(gt_end, i);
+                gt_end += 1;
+                i += 1;
+            } else if v[i] < pivot {
+                lt_start -= 1;
+                v.swap(i, lt_start);
+            } else {
+                i += 1;
+            }
+        }
+        if k < gt_end {
+            hi = gt_end - 1;
+        } else if k < lt_start {
+            return pivot;
+        } else {
+            lo = lt_start;
+        }
+    }
 }
 
 #[cfg(test)]
@@ -112,8 +147,27 @@ mod tests {
             let mut ours = items.clone();
             sort_by(&mut ours, |a, b| a.0.cmp(&b.0));
             let mut std_sorted = items.clone();
-            crate::sorting::sort_by(&mut std_sorted, |a, b| a.0.cmp(&b.0));
+            std_sorted.sort_by(|a, b| a.0.cmp(&b.0));
             assert_eq!(ours, std_sorted, "n = {n}");
+        }
+        for n in [1usize, 2, 3, 10, 101, 1000] {
+            // Repeated values and sorted runs, the quickselect's hard cases.
+            let values: Vec<f32> = (0..n)
+                .map(|i| (next() % 13) as f32 + if i % 3 == 0 { 0.5 } else { 0.0 })
+                .collect();
+            let mut sorted = values.clone();
+            sorted.sort_by(|a, b| b.total_cmp(a));
+            for k in [0, n / 3, n / 2, n - 1] {
+                let mut v = values.clone();
+                assert_eq!(kth_largest_f32(&mut v, k), sorted[k], "n = {n}, k = {k}");
+                let mut ascending = sorted.clone();
+                ascending.reverse();
+                assert_eq!(
+                    kth_largest_f32(&mut ascending, k),
+                    sorted[k],
+                    "sorted input, n = {n}, k = {k}"
+                );
+            }
         }
         let mut v = vec![3.0, f64::NAN, -1.0, 2.5, -0.0, 0.0];
         sort_f64(&mut v);

@@ -118,10 +118,19 @@ pub(crate) fn candidates(level: &Plane, max_count: usize) -> Vec<Candidate> {
             .then(a.pos.x.total_cmp(&b.pos.x))
     };
     if out.len() > max_count && max_count > 0 {
-        out.select_nth_unstable_by(max_count - 1, order);
+        let mut responses: Vec<f32> = out.iter().map(|c| c.response).collect();
+        let threshold = crate::sorting::kth_largest_f32(&mut responses, max_count - 1);
+        let mut room = max_count - out.iter().filter(|c| c.response > threshold).count();
+        out.retain(|c| {
+            let keep = c.response > threshold || (c.response == threshold && room > 0);
+            if keep && c.response == threshold {
+                room -= 1;
+            }
+            keep
+        });
     }
     out.truncate(max_count);
-    out.sort_unstable_by(order);
+    crate::sorting::sort_by(&mut out, order);
     out
 }
 

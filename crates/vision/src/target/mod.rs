@@ -487,17 +487,15 @@ fn parse_length(text: &str) -> Result<f64> {
             format!("length '{text}' needs a unit: mm, cm or m (e.g. 30mm)"),
         ));
     };
-    let v: f64 = number
-        .parse()
-        .map_err(|_| Error::invalid("target", format!("'{text}' is not a length")))?;
+    let v = crate::number::parse_f64(number)
+        .ok_or_else(|| Error::invalid("target", format!("'{text}' is not a length")))?;
     // The decimal shifted to metres and rounded once (22.5778mm -> the
     // double nearest 0.0225778, not 22.5778 * 0.001 = 0.022577800000000002),
     // so that a spec and the JSON it is written to compare equal.
     if exponent == 0 || number.contains(['e', 'E']) {
         return Ok(v * 10f64.powi(exponent));
     }
-    Ok(format!("{number}e{exponent}")
-        .parse()
+    Ok(crate::number::parse_f64(&format!("{number}e{exponent}"))
         .unwrap_or(v * 10f64.powi(exponent)))
 }
 
