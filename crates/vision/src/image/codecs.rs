@@ -1,5 +1,5 @@
-//! PNG, JPEG and GIF through their single-format crates: read the
-//! header, check the limits, decode into a [`Raster`].
+//! PNG and GIF through their single-format crates, JPEG through our own
+//! decoder: read the header, check the limits, decode into a [`Raster`].
 
 use super::raster::{Raster, Samples};
 use super::{check_alloc, check_size, corrupt, too_large, unsupported, DecodeOptions, ImageFormat};
@@ -52,45 +52,26 @@ pub(super) fn decode_png(bytes: &[u8], options: &DecodeOptions) -> Result<Raster
     })
 }
 
-/// JPEG: grey stays grey, everything else (YCbCr, CMYK, ...) becomes RGB,
-/// like the `image` crate asks of zune-jpeg.
+/// JPEG (our decoder, [`super::jpeg`]): grey stays grey, everything else
+/// (YCbCr, RGB, CMYK, YCCK) becomes RGB.
 pub(super) fn decode_jpeg(bytes: &[u8], options: &DecodeOptions) -> Result<Raster> {
-    use zune_core::colorspace::ColorSpace;
+    use super::jpeg::JpegError;
     const F: ImageFormat = ImageFormat::Jpeg;
-    let jpeg_error = |e: zune_jpeg::errors::DecodeErrors| match e {
-        zune_jpeg::errors::DecodeErrors::Unsupported(what) => unsupported(F, format!("{what:?}")),
-        other => corrupt(F, other),
+    let jpeg_error = |e: JpegError| match e {
+        JpegError::Corrupt(detail) => corrupt(F, detail),
+        JpegError::Unsupported(detail) => unsupported(F, detail),
+        JpegError::TooLarge => too_large(F, options),
     };
-    let zune_options = zune_core::options::DecoderOptions::default()
-        .set_strict_mode(false)
-        .set_max_width(usize::MAX)
-        .set_max_height(usize::MAX);
-    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(
-        zune_core::bytestream::ZCursor::new(bytes),
-        zune_options,
-    );
-    decoder.decode_headers().map_err(jpeg_error)?;
-    let (width, height) = decoder
-        .dimensions()
-        .ok_or_else(|| corrupt(F, "no frame header"))?;
-    let (width, height) = (width as u32, height as u32);
-    check_size(width, height, options)?;
-    let input = decoder
-        .input_colorspace()
-        .ok_or_else(|| corrupt(F, "no frame header"))?;
-    let output = match input {
-        ColorSpace::RGB | ColorSpace::RGBA | ColorSpace::Luma | ColorSpace::LumaA => input,
-        _ => ColorSpace::RGB,
-    };
-    decoder.set_options(decoder.options().jpeg_set_out_colorspace(output));
-    let channels = output.num_components() as u8;
-    check_alloc(F, width, height, channels, 1, options)?;
-    let pixels = decoder.decode().map_err(jpeg_error)?;
+    let header = super::jpeg::read_header(bytes).map_err(jpeg_error)?;
+    check_size(header.width, header.height, options)?;
+    let out = check_alloc(F, header.width, header.height, header.channels, 1, options)?;
+    let working = options.max_alloc_bytes.saturating_sub(out as u64);
+    let image = super::jpeg::decode(bytes, working).map_err(jpeg_error)?;
     Ok(Raster {
-        width,
-        height,
-        channels,
-        samples: Samples::U8(pixels),
+        width: image.width,
+        height: image.height,
+        channels: image.channels,
+        samples: Samples::U8(image.pixels),
     })
 }
 

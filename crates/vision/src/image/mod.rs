@@ -7,8 +7,8 @@
 //! `image` crate did before (so pixels match its output); 16-bit data is
 //! scaled to 8 bits with rounding.
 //!
-//! PNG, JPEG and GIF use the small single-format crates (`png`, `zune-jpeg`,
-//! `gif`); TIFF, BMP and PNM are read here ([`tiff`], [`bmp`], [`pnm`], with
+//! PNG and GIF use the small single-format crates (`png`, `gif`); JPEG, TIFF,
+//! BMP and PNM are read here ([`jpeg`], [`tiff`], [`bmp`], [`pnm`], with
 //! `weezl` and `fdeflate` for TIFF's LZW and deflate). Each codec returns a [`raster::Raster`]
 //! in its file's own channels and depth; the conversions to grey and to the
 //! RGBA preview happen once, in [`raster`].
@@ -17,6 +17,9 @@ mod bmp;
 #[cfg(test)]
 mod bmp_tests;
 mod codecs;
+/// The JPEG decoder itself (public for its benchmark; use [`decode`]).
+#[doc(hidden)]
+pub mod jpeg;
 mod png_encode;
 mod pnm;
 mod raster;

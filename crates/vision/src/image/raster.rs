@@ -35,7 +35,19 @@ const KB: f32 = f32::from_bits(0x3d93_cf75);
 /// Luma of RGB in 0..=1, to 8 bits: (KR r + KG g + KB b) * 255 rounded, the
 /// sum in this order, without fused multiply-add (saturating cast).
 fn luma(r: f32, g: f32, b: f32) -> u8 {
-    ((r * KR + g * KG + b * KB) * 255.0).round() as u8
+    round_non_negative((r * KR + g * KG + b * KB) * 255.0) as u8
+}
+
+/// `x.round()` for `x >= 0` (and NaN) without the libm call that wasm makes
+/// for `f32::round` (its native rounding is to even): `x - trunc(x)` is exact.
+#[inline(always)]
+fn round_non_negative(x: f32) -> f32 {
+    let t = x.trunc();
+    if x - t >= 0.5 {
+        t + 1.0
+    } else {
+        t
+    }
 }
 
 /// 16 -> 8 bits with rounding: round(v * 255 / 65535).
@@ -45,7 +57,7 @@ fn u16_to_u8(v: u16) -> u8 {
 
 /// Float in 0..=1 -> 0..=255, clamped, rounded; NaN becomes 0.
 fn f32_to_u8(v: f32) -> u8 {
-    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+    round_non_negative(v.clamp(0.0, 1.0) * 255.0) as u8
 }
 
 impl Raster {
@@ -201,6 +213,35 @@ impl Raster {
 mod tests {
     use super::*;
     use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn rounding_without_libm_is_f32_round() {
+        for x in [
+            0.0f32,
+            0.5,
+            1.5,
+            2.5,
+            0.49999997,
+            254.5,
+            254.49998,
+            8388607.5,
+            1e9,
+            f32::MIN_POSITIVE,
+        ] {
+            assert_eq!(round_non_negative(x), x.round(), "{x}");
+        }
+        assert!(round_non_negative(f32::NAN).is_nan());
+        // Every 8-bit colour's luma before rounding (every blue step of 5).
+        const S: f32 = 1.0 / 255.0;
+        for r in 0..=255u8 {
+            for g in 0..=255u8 {
+                for b in (0..=255u8).step_by(5) {
+                    let x = (r as f32 * S * KR + g as f32 * S * KG + b as f32 * S * KB) * 255.0;
+                    assert_eq!(round_non_negative(x), x.round(), "{r} {g} {b}");
+                }
+            }
+        }
+    }
 
     #[wasm_bindgen_test(unsupported = test)]
     fn luma_uses_the_srgb_weights_on_unit_samples() {
