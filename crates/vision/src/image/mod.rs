@@ -7,9 +7,9 @@
 //! `image` crate did before (so pixels match its output); 16-bit data is
 //! scaled to 8 bits with rounding.
 //!
-//! PNG and GIF use the small single-format crates (`png`, `gif`); JPEG, TIFF,
-//! BMP and PNM are read here ([`jpeg`], [`tiff`], [`bmp`], [`pnm`], with
-//! `weezl` and `fdeflate` for TIFF's LZW and deflate). Each codec returns a [`raster::Raster`]
+//! Every format is read here ([`png_decode`], [`jpeg`], [`gif`], [`tiff`],
+//! [`bmp`], [`pnm`]), with our [`lzw`] for GIF and TIFF and `fdeflate` for
+//! the deflate of PNG and TIFF: no codec crates (they were most of the wasm). Each codec returns a [`raster::Raster`]
 //! in its file's own channels and depth; the conversions to grey and to the
 //! RGBA preview happen once, in [`raster`].
 
@@ -17,9 +17,12 @@ mod bmp;
 #[cfg(test)]
 mod bmp_tests;
 mod codecs;
+mod gif;
 /// The JPEG decoder itself (public for its benchmark; use [`decode`]).
 #[doc(hidden)]
 pub mod jpeg;
+mod lzw;
+mod png_decode;
 mod png_encode;
 mod pnm;
 mod raster;
@@ -185,10 +188,10 @@ pub fn decode_gray(bytes: &[u8]) -> Result<GrayImage> {
 pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     let format = sniff_format(bytes)?;
     let raster = match format {
-        ImageFormat::Png => codecs::decode_png(bytes, options)?,
+        ImageFormat::Png => png_decode::decode(bytes, options)?,
         ImageFormat::Jpeg => codecs::decode_jpeg(bytes, options)?,
         ImageFormat::Tiff => tiff::decode(bytes, options)?,
-        ImageFormat::Gif => codecs::decode_gif(bytes, options)?,
+        ImageFormat::Gif => gif::decode(bytes, options)?,
         ImageFormat::Bmp => bmp::decode(bytes, options)?,
         ImageFormat::Pnm => pnm::decode(bytes, options)?,
     };

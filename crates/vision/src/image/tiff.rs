@@ -1,6 +1,6 @@
 //! Baseline TIFF reader (the first image of the file): grey (BlackIsZero or
 //! WhiteIsZero), grey+alpha, RGB, RGBA; 1 bit (grey), 8 or 16 bits, 32-bit
-//! float; strips or tiles, chunky samples; uncompressed, LZW (`weezl`),
+//! float; strips or tiles, chunky samples; uncompressed, LZW ([`super::lzw`]),
 //! deflate (`fdeflate`), PackBits; horizontal predictor. No JPEG-in-TIFF,
 //! palette, CMYK, YCbCr, planar layout or BigTIFF: those are reported as
 //! unsupported.
@@ -278,21 +278,9 @@ fn decompress(compression: u32, raw: &[u8], expected: usize, segment: usize) -> 
             .ok_or_else(|| short(raw.len()))?
             .to_vec(),
         5 => {
-            let mut out = vec![0u8; expected];
-            let mut decoder =
-                weezl::decode::Decoder::with_tiff_size_switch(weezl::BitOrder::Msb, 8);
-            let (mut i, mut o) = (0, 0);
-            while o < expected {
-                let r = decoder.decode_bytes(raw.get(i..).unwrap_or(&[]), &mut out[o..]);
-                i += r.consumed_in;
-                o += r.consumed_out;
-                match r.status {
-                    Ok(weezl::LzwStatus::Ok) => {}
-                    Ok(_) => break,
-                    Err(e) => return Err(corrupt(F, format!("segment {segment}: LZW: {e}"))),
-                }
-            }
-            out.truncate(o);
+            let mut out = Vec::with_capacity(expected);
+            super::lzw::decompress(raw, 8, super::lzw::Flavour::Tiff, &mut out, expected)
+                .map_err(|e| corrupt(F, format!("segment {segment}: LZW: {e}")))?;
             out
         }
         8 | 32946 => match fdeflate::decompress_to_vec_bounded(raw, expected) {
