@@ -28,7 +28,7 @@ pub const MIN_POINTS: usize = 3;
 const COLLINEAR_RATIO: f64 = 1e-6;
 
 /// The 2-D transform model fitted at each height.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TransformKind {
     /// Rotation and translation (and a reflection when the data demands it).
@@ -38,6 +38,8 @@ pub enum TransformKind {
     /// General 2x3 affine matrix.
     Affine,
 }
+// Read by name through one visitor for all such enums (wasm size).
+robocal_vision::deserialize_by_name!(TransformKind { Rigid => "rigid", Similarity => "similarity", Affine => "affine" });
 
 impl TransformKind {
     /// Parse `rigid`, `similarity` or `affine`.

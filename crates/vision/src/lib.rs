@@ -24,6 +24,8 @@ pub mod optim;
 pub mod sorting;
 pub mod synth;
 pub mod target;
+#[doc(hidden)]
+pub mod unit_enum;
 
 pub use camera::{Camera, Distortion};
 pub use error::{Error, Result};

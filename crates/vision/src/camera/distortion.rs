@@ -107,8 +107,7 @@ pub enum Distortion {
     },
 }
 
-#[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy)]
 enum Model {
     None,
     Brown,
@@ -118,6 +117,8 @@ enum Model {
     KannalaBrandt,
     Eucm,
 }
+// Read by name through one visitor for all such enums (wasm size).
+crate::deserialize_by_name!(Model { None => "none", Brown => "brown", Rational => "rational", Division => "division", RadialK1K2K5 => "radial_k1_k2_k5", KannalaBrandt => "kannala_brandt", Eucm => "eucm" });
 
 /// Every coefficient of every model; `model` picks which are needed.
 #[derive(Deserialize)]

@@ -54,7 +54,7 @@ use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 
 /// Which way round a circle target is printed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Polarity {
     /// Dark circles on a light background (the usual print).
@@ -62,6 +62,8 @@ pub enum Polarity {
     /// Light circles on a dark background.
     LightOnDark,
 }
+// Read by name through one visitor for all such enums (wasm size).
+crate::deserialize_by_name!(Polarity { DarkOnLight => "dark_on_light", LightOnDark => "light_on_dark" });
 
 /// A calibration target's geometry (see the module docs for the point order).
 ///
@@ -128,8 +130,7 @@ pub enum Target {
     },
 }
 
-#[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy)]
 enum TargetKind {
     Chessboard,
     CircleGrid,
@@ -137,6 +138,8 @@ enum TargetKind {
     SingleCircle,
     SquareGrid,
 }
+// Read by name through one visitor for all such enums (wasm size).
+crate::deserialize_by_name!(TargetKind { Chessboard => "chessboard", CircleGrid => "circle_grid", DotPlate => "dot_plate", SingleCircle => "single_circle", SquareGrid => "square_grid" });
 
 /// Every field of every [`Target`] variant; the tag picks which are needed.
 #[derive(Deserialize)]
