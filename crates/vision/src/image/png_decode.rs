@@ -67,10 +67,7 @@ pub(super) fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Raster> {
             .ok_or_else(|| corrupt(F, format!("the file ends inside chunk {name}")))?;
         let critical = kind[0].is_ascii_uppercase();
         if critical || kind == b"tRNS" {
-            let mut h = crc32fast::Hasher::new();
-            h.update(kind);
-            h.update(data);
-            if h.finalize() != crc {
+            if super::png_encode::crc32(&[kind, data]) != crc {
                 return Err(corrupt(F, format!("chunk {name} fails its CRC check")));
             }
         }

@@ -3,19 +3,10 @@
 //! interlacing, built from random rows.
 
 use super::{decode, passes, Header};
+use crate::image::png_encode::{chunk, crc32};
 use crate::image::raster::Samples;
 use crate::image::DecodeOptions;
 use wasm_bindgen_test::wasm_bindgen_test;
-
-fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
-    out.extend_from_slice(&(data.len() as u32).to_be_bytes());
-    out.extend_from_slice(kind);
-    out.extend_from_slice(data);
-    let mut h = crc32fast::Hasher::new();
-    h.update(kind);
-    h.update(data);
-    out.extend_from_slice(&h.finalize().to_be_bytes());
-}
 
 struct Rng(u64);
 impl Rng {
@@ -165,11 +156,7 @@ fn damaged_files_say_what_is_wrong() {
     );
     let mut depth = good.clone();
     depth[24] = 3;
-    let crc_ok = {
-        let mut h = crc32fast::Hasher::new();
-        h.update(&depth[12..29]);
-        h.finalize().to_be_bytes()
-    };
+    let crc_ok = crc32(&[&depth[12..29]]).to_be_bytes();
     depth[29..33].copy_from_slice(&crc_ok);
     assert_eq!(
         err(&depth),

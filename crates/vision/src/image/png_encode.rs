@@ -5,8 +5,9 @@
 use super::GrayImage;
 use crate::error::{Error, Result};
 
-/// The chunk CRC (over type and data), by the workspace's crc32fast.
-fn crc32(parts: &[&[u8]]) -> u32 {
+/// The chunk CRC (over type and data), by the workspace's crc32fast; the
+/// reader checks chunks with it too.
+pub(super) fn crc32(parts: &[&[u8]]) -> u32 {
     let mut h = crc32fast::Hasher::new();
     for part in parts {
         h.update(part);
@@ -14,7 +15,8 @@ fn crc32(parts: &[&[u8]]) -> u32 {
     h.finalize()
 }
 
-fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
+/// Append one chunk: length, type, data, CRC.
+pub(super) fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
     out.extend_from_slice(&(data.len() as u32).to_be_bytes());
     out.extend_from_slice(kind);
     out.extend_from_slice(data);
