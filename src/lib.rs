@@ -33,16 +33,17 @@
 #![deny(missing_docs)]
 
 pub mod calib;
+pub mod camera;
+pub mod detect;
+pub mod error;
 pub mod geometry;
 pub mod handeye;
+pub mod image;
 pub mod io;
+pub mod optim;
 pub mod synth;
+pub mod target;
 pub mod workflows;
-
-// The number-crunching modules live in the robocal-vision crate (built for
-// speed in the wasm build, see its crate docs) and keep their paths here.
-use robocal_vision::sorting;
-pub use robocal_vision::{camera, detect, error, image, number, optim, target};
 
 #[cfg(feature = "wasm")]
 pub mod wasm;

@@ -160,6 +160,6 @@ fn info_reports_each_file() {
     );
     assert_eq!(
         lines[1]["error"],
-        "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF"
+        "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP"
     );
 }

@@ -46,16 +46,16 @@ pub const MIN_NOISE_PX: f64 = 1e-3;
 pub const OBSERVABLE_STD: f64 = 0.1;
 
 /// Which measurement model the filter uses (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum KalmanMode {
     /// The DLT constraint, linear in the state.
+    #[serde(rename = "linearized")]
     Linearized,
     /// The EKF on the perspective division, after a linearized start.
+    #[serde(rename = "extended")]
     Extended,
 }
-// Read by name through one visitor for all such enums (wasm size).
-robocal_vision::deserialize_by_name!(KalmanMode { Linearized => "linearized", Extended => "extended" });
 
 /// Options of [`kalman_dlt`].
 #[derive(Debug, Clone, PartialEq)]

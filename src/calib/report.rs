@@ -197,7 +197,7 @@ pub(crate) fn build_report(
         })
         .collect();
     let mut depths: Vec<f64> = poses.iter().map(|p| p.translation.vector.norm()).collect();
-    crate::sorting::sort_f64(&mut depths);
+    depths.sort_by(f64::total_cmp);
     let depth = depths.get(depths.len() / 2).copied().unwrap_or(1.0);
     let k = camera.camera_matrix();
     Ok(CameraCalibration {

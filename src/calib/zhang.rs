@@ -325,7 +325,7 @@ fn classify(
         .filter(|(_, &u)| u)
         .map(|(r, _)| *r)
         .collect();
-    crate::sorting::sort_f64(&mut used_norms);
+    used_norms.sort_by(f64::total_cmp);
     let sigma = used_norms.get(used_norms.len() / 2).copied().unwrap_or(0.0) / RAYLEIGH_MEDIAN;
     let threshold = k * sigma;
     let mut next = Vec::with_capacity(used.len());

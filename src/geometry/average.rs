@@ -50,7 +50,7 @@ pub fn average_rotations_quaternion(
     }
     let eig = m.symmetric_eigen();
     let mut order: Vec<usize> = (0..4).collect();
-    crate::sorting::sort_by(&mut order, |&a, &b| {
+    order.sort_by(|&a, &b| {
         eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a])
     });
     let (l1, l2) = (eig.eigenvalues[order[0]], eig.eigenvalues[order[1]]);

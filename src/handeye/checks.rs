@@ -126,7 +126,7 @@ pub fn rank_pose_candidates(
         Some(k) => (1, k.rotation_rms_deg),
         None => (2, f64::INFINITY),
     };
-    crate::sorting::sort_by(&mut scores, |a, b| {
+    scores.sort_by(|a, b| {
         let (ka, kb) = (key(a), key(b));
         ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
     });

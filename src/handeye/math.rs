@@ -35,7 +35,7 @@ pub fn ascending_eigenvectors(m: &DMatrix<f64>) -> Result<Vec<(f64, DVector<f64>
         .enumerate()
         .map(|(i, &l)| (l, eig.eigenvectors.column(i).into_owned()))
         .collect();
-    crate::sorting::sort_by(&mut pairs, |a, b| a.0.total_cmp(&b.0));
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(pairs)
 }
 

@@ -69,17 +69,17 @@ pub use crate::geometry::Pose;
 pub const MIN_MOTION_ROTATION_DEG: f64 = 2.0;
 
 /// Where the camera is mounted.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Setup {
     /// Camera on the gripper: solves `gripper_from_camera` and `base_from_target`.
+    #[serde(rename = "eye-in-hand")]
     EyeInHand,
     /// Camera fixed in the robot's world: solves `base_from_camera` and
     /// `gripper_from_target`.
+    #[serde(rename = "eye-to-hand")]
     EyeToHand,
 }
-// Read by name through one visitor for all such enums (wasm size).
-robocal_vision::deserialize_by_name!(Setup { EyeInHand => "eye-in-hand", EyeToHand => "eye-to-hand" });
 
 impl Setup {
     /// `eye-in-hand` or `eye-to-hand`.

@@ -145,7 +145,7 @@ pub fn motion_stats(set: &MotionSet) -> MotionStats {
         .iter()
         .map(|m| m.robot_angle().to_degrees())
         .collect();
-    crate::sorting::sort_f64(&mut angles);
+    angles.sort_by(f64::total_cmp);
     let (dominant, spread) = axis_spread(&robot_axes(&set.kept));
     MotionStats {
         motions: set.kept.len(),

@@ -8,7 +8,6 @@
 
 use super::Pose;
 use crate::error::{Error, Result};
-use crate::number::parse_f64;
 use nalgebra::{Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion};
 
 /// How to read a line.
@@ -59,7 +58,7 @@ pub fn parse_pose_text(text: &str, format: Option<PoseTextFormat>) -> Result<Vec
             .filter(|f| !f.is_empty())
             .enumerate()
         {
-            let v = parse_f64(field).ok_or_else(|| {
+            let v = field.parse::<f64>().ok().ok_or_else(|| {
                 Error::parse(line_no, col + 1, format!("'{field}' is not a number"))
             })?;
             values.push(v);

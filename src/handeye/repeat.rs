@@ -84,7 +84,7 @@ fn quartiles(mut v: Vec<f64>) -> Spread {
     if v.is_empty() {
         return Spread::default();
     }
-    crate::sorting::sort_f64(&mut v);
+    v.sort_by(f64::total_cmp);
     let q = |p: f64| {
         let pos = p * (v.len() - 1) as f64;
         let lo = pos.floor() as usize;
@@ -196,7 +196,7 @@ pub fn repeatability(
     let boot: Vec<Vec<usize>> = (0..options.bootstrap_samples)
         .map(|_| {
             let mut s: Vec<usize> = (0..n).map(|_| rng.below(n)).collect();
-            crate::sorting::sort_by(&mut s, usize::cmp);
+            s.sort_by(usize::cmp);
             s
         })
         .collect();

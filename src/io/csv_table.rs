@@ -7,7 +7,6 @@
 //! 1-based line and column.
 
 use crate::error::{Error, Result};
-use crate::number::parse_f64;
 
 /// One data row with the line it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -131,7 +130,7 @@ impl CsvTable {
     pub fn number(&self, row: usize, col: usize) -> Result<f64> {
         let text = self.text(row, col);
         let name = self.header.get(col).map_or("?", |s| s.as_str());
-        match parse_f64(text) {
+        match text.parse::<f64>().ok() {
             Some(v) if v.is_finite() => Ok(v),
             _ => Err(Error::parse(
                 self.line_of(row),

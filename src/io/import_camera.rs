@@ -4,7 +4,6 @@
 
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
-use crate::number::parse_f64;
 
 /// The formats [`import_camera`] recognises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -185,7 +184,7 @@ fn yaml_data(text: &str, keys: &[&str]) -> Option<Vec<f64>> {
         let rb = body.find(']')?;
         return body[lb + 1..rb]
             .split(',')
-            .map(|s| parse_f64(s.trim()))
+            .map(|s| s.trim().parse::<f64>().ok())
             .collect();
     }
     None
@@ -265,7 +264,7 @@ fn from_xml(text: &str) -> Result<Camera> {
             .and_then(|m| {
                 xml_element(m, "data").map(|d| {
                     d.split_whitespace()
-                        .map(parse_f64)
+                        .map(|t| t.parse::<f64>().ok())
                         .collect::<Option<Vec<f64>>>()
                 })
             })

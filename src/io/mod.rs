@@ -12,7 +12,6 @@ pub mod export_camera;
 mod export_camera_tools;
 pub mod export_transform;
 pub mod import_camera;
-mod json_pretty;
 mod pose_candidates;
 mod pose_formats;
 mod pose_json;
@@ -27,7 +26,12 @@ mod export_tests;
 #[cfg(test)]
 mod pose_tests;
 
-pub(crate) use json_pretty::to_string_pretty;
+/// The pretty-printed JSON text of `value` (two-space indent). Printing a
+/// `Value` to a `String` cannot fail (its keys are strings, its numbers
+/// finite), so the text of the error-free path is all there is.
+pub(crate) fn to_string_pretty(value: &serde_json::Value) -> String {
+    serde_json::to_string_pretty(value).unwrap_or_else(|_| value.to_string())
+}
 pub use pose_candidates::{parse_pose_candidates, Candidate};
 pub use pose_formats::{AngleUnit, LengthUnit, PoseFormat, QUATERNION_NORM_TOLERANCE};
 pub use pose_writer::format_poses;

@@ -172,7 +172,7 @@ fn rank(table: &Table, readings: &[Reading], options: &PoseFileOptions) -> Resul
     // Equal penalties: the order of PoseFormat::all() (vendor presets first).
     let all = PoseFormat::all();
     let order = |f: PoseFormat| all.iter().position(|g| *g == f).unwrap_or(all.len());
-    crate::sorting::sort_by(&mut out, |a, b| {
+    out.sort_by(|a, b| {
         a.penalty
             .total_cmp(&b.penalty)
             .then(order(a.format).cmp(&order(b.format)))
@@ -203,7 +203,7 @@ fn same_poses(a: &[RobotPose], b: &[RobotPose]) -> bool {
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
-    crate::sorting::sort_f64(&mut v);
+    v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 

@@ -76,7 +76,7 @@ pub enum PoseFormat {
 }
 
 /// The unit of lengths in a file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum LengthUnit {
     /// Millimetres.
     #[serde(rename = "mm")]
@@ -85,11 +85,9 @@ pub enum LengthUnit {
     #[serde(rename = "m")]
     Metre,
 }
-// Read by name through one visitor for all such enums (wasm size).
-robocal_vision::deserialize_by_name!(LengthUnit { Millimetre => "mm", Metre => "m" });
 
 /// The unit of angles in a file (not used by quaternion and matrix formats).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum AngleUnit {
     /// Degrees.
     #[serde(rename = "deg")]
@@ -98,8 +96,6 @@ pub enum AngleUnit {
     #[serde(rename = "rad")]
     Radian,
 }
-// Read by name through one visitor for all such enums (wasm size).
-robocal_vision::deserialize_by_name!(AngleUnit { Degree => "deg", Radian => "rad" });
 
 impl LengthUnit {
     /// Metres per unit.

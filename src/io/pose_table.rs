@@ -5,7 +5,6 @@
 use super::pose_formats::{AngleUnit, LengthUnit, PoseFormat};
 use crate::error::{Error, Result};
 use crate::geometry::{EulerKind, EulerOrder};
-use crate::number::parse_f64;
 
 /// Where a row came from, for error messages.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,7 +93,7 @@ pub(crate) fn split_fields(line: &str) -> Vec<String> {
 
 /// A finite number, or None.
 pub(crate) fn number(text: &str) -> Option<f64> {
-    parse_f64(text.trim()).filter(|v| v.is_finite())
+    text.trim().parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 /// Text (CSV, TSV, whitespace) to a table; `#` comments and blank lines are

@@ -14,17 +14,17 @@ use crate::geometry::Pose;
 
 /// Which transform the file holds. Robot controllers report the TCP pose in
 /// the base frame, `base_from_gripper`; some tools store the inverse.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PoseDirection {
     /// The file holds `base_from_gripper` (the default).
     #[default]
+    #[serde(rename = "base_from_gripper")]
     BaseFromGripper,
     /// The file holds `gripper_from_base`; the parser inverts each pose.
+    #[serde(rename = "gripper_from_base")]
     GripperFromBase,
 }
-// Read by name through one visitor for all such enums (wasm size).
-robocal_vision::deserialize_by_name!(PoseDirection { BaseFromGripper => "base_from_gripper", GripperFromBase => "gripper_from_base" });
 
 /// What the caller knows about a pose file; `None` fields are read from the
 /// header or taken from the format's defaults.

@@ -99,7 +99,7 @@ pub fn solve_known_motion(request: &KnownMotionRequest) -> Result<KnownMotionRep
         spd += (b - mp) * (a - md).transpose();
     }
     let mut eig: Vec<f64> = sdd.symmetric_eigenvalues().iter().copied().collect();
-    crate::sorting::sort_f64(&mut eig);
+    eig.sort_by(f64::total_cmp);
     let ratio = if eig[2] > 0.0 {
         (eig[1].max(0.0) / eig[2]).sqrt()
     } else {

@@ -28,18 +28,19 @@ pub const MIN_POINTS: usize = 3;
 const COLLINEAR_RATIO: f64 = 1e-6;
 
 /// The 2-D transform model fitted at each height.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TransformKind {
     /// Rotation and translation (and a reflection when the data demands it).
+    #[serde(rename = "rigid")]
     Rigid,
     /// Rotation, uniform scale and translation (and reflection).
+    #[serde(rename = "similarity")]
     Similarity,
     /// General 2x3 affine matrix.
+    #[serde(rename = "affine")]
     Affine,
 }
-// Read by name through one visitor for all such enums (wasm size).
-robocal_vision::deserialize_by_name!(TransformKind { Rigid => "rigid", Similarity => "similarity", Affine => "affine" });
 
 impl TransformKind {
     /// Parse `rigid`, `similarity` or `affine`.

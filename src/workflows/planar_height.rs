@@ -161,7 +161,7 @@ impl HeightModel {
 /// Number of distinct values (exact comparison: heights come from one file).
 pub fn count_distinct(values: &[f64]) -> usize {
     let mut v: Vec<f64> = values.to_vec();
-    crate::sorting::sort_f64(&mut v);
+    v.sort_by(f64::total_cmp);
     v.dedup();
     v.len()
 }

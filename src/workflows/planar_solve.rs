@@ -214,7 +214,7 @@ fn group_by_height(points: &[HeightPoint]) -> Vec<(f64, Vec<HeightPoint>)> {
             None => groups.push((p.height_mm, vec![*p])),
         }
     }
-    crate::sorting::sort_by(&mut groups, |a, b| a.0.total_cmp(&b.0));
+    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
     groups
 }
 

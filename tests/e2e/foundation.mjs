@@ -34,7 +34,7 @@ export const tests = [
     assert.deepEqual(cards, [
       { name: 'board.png', error: false, meta: 'PNG · 160×120 px · RGB, 8-bit', thumb: [160, 120] },
       { name: 'plate.bmp', error: false, meta: 'BMP · 90×70 px · RGB, 8-bit', thumb: [90, 70] },
-      { name: 'broken.jpg', error: true, meta: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF', thumb: null },
+      { name: 'broken.jpg', error: true, meta: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP', thumb: null },
     ]);
     // The thumbnail holds the decoded pixels: a white square at (30, 10), black at (10, 10).
     const px = await page.$eval('.card canvas', (c) => {

@@ -29,7 +29,7 @@ assert.equal(version(), expected);
 assert.equal(typeof robocal.image_info, 'function');
 const info = JSON.parse(image_info(readFileSync(new URL('./board.png', import.meta.url))));
 assert.deepEqual([info.format, info.width, info.height, info.channels, info.bits_per_channel], ['png', 64, 48, 3, 8]);
-assert.throws(() => image_info(new Uint8Array([1, 2, 3])), { message: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF' });
+assert.throws(() => image_info(new Uint8Array([1, 2, 3])), { message: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP' });
 // The README's example: detect, calibrate, export, on the seeded demo images.
 const demo = robocal.render_demo(1);
 const meta = JSON.parse(demo.json);

@@ -76,7 +76,7 @@ impl<'a> PointIndex<'a> {
                 }
             }
         }
-        crate::sorting::sort_by(&mut found, |a, b| a.0.total_cmp(&b.0));
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
         found.into_iter().map(|(_, i)| i).collect()
     }
 }

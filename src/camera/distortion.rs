@@ -107,18 +107,23 @@ pub enum Distortion {
     },
 }
 
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Deserialize)]
 enum Model {
+    #[serde(rename = "none")]
     None,
+    #[serde(rename = "brown")]
     Brown,
+    #[serde(rename = "rational")]
     Rational,
+    #[serde(rename = "division")]
     Division,
+    #[serde(rename = "radial_k1_k2_k5")]
     RadialK1K2K5,
+    #[serde(rename = "kannala_brandt")]
     KannalaBrandt,
+    #[serde(rename = "eucm")]
     Eucm,
 }
-// Read by name through one visitor for all such enums (wasm size).
-crate::deserialize_by_name!(Model { None => "none", Brown => "brown", Rational => "rational", Division => "division", RadialK1K2K5 => "radial_k1_k2_k5", KannalaBrandt => "kannala_brandt", Eucm => "eucm" });
 
 /// Every coefficient of every model; `model` picks which are needed.
 #[derive(Deserialize)]

@@ -145,7 +145,7 @@ pub(super) fn refine_square(
         }
         // The blur seen on the edges sets the next pass's window.
         if !widths.is_empty() {
-            crate::sorting::sort_f64(&mut widths);
+            widths.sort_by(f64::total_cmp);
             let sd = widths[widths.len() / 2];
             half_window = (WINDOW_SDS * sd + 0.5).clamp(1.5, (0.3 * gap_px).max(1.5));
         }
@@ -253,7 +253,7 @@ fn fit_poly(
         .map(|&(u, v)| (v - c.dot(&Curve::basis(u))).abs())
         .collect();
     let resid = res.clone();
-    crate::sorting::sort_f64(&mut res);
+    res.sort_by(f64::total_cmp);
     let robust = (1.4826 * res[res.len() / 2]).max(0.05);
     let limit = (3.0 * robust).max(0.15);
     let (c, cov, _, _) = solve(&|i| resid[i] <= limit)?;

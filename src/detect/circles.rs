@@ -228,7 +228,7 @@ fn seed_steps(blobs: &[Blob], seed: usize) -> Option<(Vector2<f64>, Vector2<f64>
             (v.norm(), v)
         })
         .collect();
-    crate::sorting::sort_by(&mut near, |a, b| a.0.total_cmp(&b.0));
+    near.sort_by(|a, b| a.0.total_cmp(&b.0));
     let (d1, v1) = *near.first()?;
     let (_, v2) = *near
         .iter()

@@ -1,44 +1,45 @@
 //! Decoding image bytes into the grey image the detectors work on.
 //!
 //! No filesystem here: callers pass bytes (from a file, an upload, a fetch).
-//! Supported: PNG, JPEG, TIFF, BMP, PGM/PPM (PNM) and GIF, 8 or 16 bits,
-//! grey or colour. Colour is converted to luma with the sRGB / Rec. 709
-//! weights 0.2126 R + 0.7152 G + 0.0722 B in f32, computed exactly as the
-//! `image` crate did before (so pixels match its output); 16-bit data is
-//! scaled to 8 bits with rounding.
+//! Every format is decoded by the `image` crate: PNG (1-16 bit, palette,
+//! interlaced), JPEG (baseline, progressive, CMYK), GIF (first frame), TIFF
+//! (8/16/32-bit, uncompressed, LZW, deflate, PackBits, tiled), BMP, PNM and
+//! WebP. The format is recognised from the content, not a file name.
 //!
-//! Every format is read here ([`png_decode`], [`jpeg`], [`gif`], [`tiff`],
-//! [`bmp`], [`pnm`]), with our [`lzw`] for GIF and TIFF and `fdeflate` for
-//! the deflate of PNG and TIFF: no codec crates (they were most of the wasm). Each codec returns a [`raster::Raster`]
-//! in its file's own channels and depth; the conversions to grey and to the
-//! RGBA preview happen once, in [`raster`].
-
-mod bmp;
-#[cfg(test)]
-mod bmp_tests;
-mod codecs;
-mod gif;
-/// The JPEG decoder itself (public for its benchmark; use [`decode`]).
-#[doc(hidden)]
-pub mod jpeg;
-mod lzw;
-mod png_decode;
-mod png_encode;
-mod pnm;
-mod raster;
-mod tiff;
-#[cfg(test)]
-mod tiff_tests;
+//! Every decode runs under `image`'s [`Limits`](::image::Limits): at most
+//! [`DecodeOptions::max_pixels`] pixels (checked against the header before
+//! any pixel buffer exists) and [`DecodeOptions::max_alloc_bytes`] bytes of
+//! decoder memory. The defaults are [`DEFAULT_MAX_PIXELS`] and
+//! [`DEFAULT_MAX_ALLOC_BYTES`]: 100 MP and 1 GiB natively; 64 MP and 512 MiB
+//! in wasm, where one worker's memory is at most 4 GiB and a tab runs
+//! several. Over a limit the error names the image size and the limit.
+//!
+//! Grey is `image`'s luma conversion: 0.2126 R + 0.7152 G + 0.0722 B
+//! (sRGB / Rec. 709 weights), 16-bit and float samples scaled to 8 bits
+//! with rounding; alpha is ignored.
 
 use crate::error::{Error, Result};
+use ::image::{DynamicImage, ImageDecoder, ImageError, ImageReader, Limits};
 use serde::Serialize;
+use std::io::Cursor;
 
-/// Largest image accepted by default, in pixels (a 100 MP sensor, twice the
-/// 50 MP the detectors are specified for).
+/// Largest image accepted by default, in pixels: a 100 MP sensor natively
+/// (twice the 50 MP the detectors are specified for), 64 MP in wasm.
+#[cfg(not(target_arch = "wasm32"))]
 pub const DEFAULT_MAX_PIXELS: u64 = 100_000_000;
+/// Largest image accepted by default, in pixels: a 100 MP sensor natively
+/// (twice the 50 MP the detectors are specified for), 64 MP in wasm.
+#[cfg(target_arch = "wasm32")]
+pub const DEFAULT_MAX_PIXELS: u64 = 64_000_000;
 
-/// Largest decoder allocation accepted by default, in bytes.
+/// Largest decoder allocation accepted by default, in bytes: 1 GiB natively,
+/// 512 MiB in wasm.
+#[cfg(not(target_arch = "wasm32"))]
 pub const DEFAULT_MAX_ALLOC_BYTES: u64 = 1 << 30;
+/// Largest decoder allocation accepted by default, in bytes: 1 GiB natively,
+/// 512 MiB in wasm.
+#[cfg(target_arch = "wasm32")]
+pub const DEFAULT_MAX_ALLOC_BYTES: u64 = 512 << 20;
 
 /// An 8-bit single-channel image, row-major, no padding.
 ///
@@ -113,6 +114,9 @@ pub enum ImageFormat {
     Pnm,
     /// GIF (first frame).
     Gif,
+    /// WebP (lossy or lossless; the first frame of an animation).
+    #[serde(rename = "webp")]
+    WebP,
 }
 
 impl ImageFormat {
@@ -125,6 +129,7 @@ impl ImageFormat {
             ImageFormat::Bmp => "BMP",
             ImageFormat::Pnm => "PNM",
             ImageFormat::Gif => "GIF",
+            ImageFormat::WebP => "WebP",
         }
     }
 }
@@ -183,27 +188,36 @@ pub fn decode_gray(bytes: &[u8]) -> Result<GrayImage> {
     decode(bytes, &DecodeOptions::default()).map(|d| d.gray)
 }
 
-/// Decode image bytes: detect the format from the content (not a file name),
-/// check the size limits before allocating, convert to grey.
+/// Decode image bytes: recognise the format from the content, check the
+/// size against the limits from the header, decode under `image`'s limits,
+/// convert to grey (and a preview when asked).
 pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     let format = sniff_format(bytes)?;
-    let raster = match format {
-        ImageFormat::Png => png_decode::decode(bytes, options)?,
-        ImageFormat::Jpeg => codecs::decode_jpeg(bytes, options)?,
-        ImageFormat::Tiff => tiff::decode(bytes, options)?,
-        ImageFormat::Gif => gif::decode(bytes, options)?,
-        ImageFormat::Bmp => bmp::decode(bytes, options)?,
-        ImageFormat::Pnm => pnm::decode(bytes, options)?,
-    };
+    let mut reader = ImageReader::new(Cursor::new(bytes));
+    reader.set_format(format.to_image_crate());
+    // The header is read without limits (nothing it allocates scales with
+    // the claimed size); the pixel limit is checked next, by `check_size`,
+    // so that the message can name the size; the decode runs under `limits`.
+    reader.no_limits();
+    let mut decoder = reader.into_decoder().map_err(|e| image_error(format, e, options))?;
+    let (width, height) = decoder.dimensions();
+    check_size(width, height, options)?;
+    decoder
+        .set_limits(limits(options))
+        .map_err(|e| image_error(format, e, options))?;
+    let color = decoder.original_color_type();
+    let channels = color.channel_count();
     let info = ImageInfo {
         format,
-        width: raster.width,
-        height: raster.height,
-        channels: raster.channels,
-        bits_per_channel: raster.bits_per_channel(),
+        width,
+        height,
+        channels,
+        bits_per_channel: (color.bits_per_pixel() / channels.max(1) as u16) as u8,
     };
-    let preview = options.preview_max_side.map(|side| raster.preview(side));
-    let gray = raster.into_gray();
+    let image = DynamicImage::from_decoder(decoder).map_err(|e| image_error(format, e, options))?;
+    let preview = options.preview_max_side.map(|side| preview(&image, side));
+    let luma = image.into_luma8();
+    let gray = GrayImage::new(luma.width(), luma.height(), luma.into_raw())?;
     Ok(Decoded {
         info,
         gray,
@@ -211,70 +225,79 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     })
 }
 
-/// Formats recognised by their magic bytes but not decoded, with the name the
-/// error message gives them.
-const UNSUPPORTED_MAGIC: [(&[u8], &str); 9] = [
-    (b"DDS ", "Dds"),
-    (&[0, 0, 1, 0], "Ico"),
-    (b"#?RADIANCE", "Hdr"),
-    (&[0x76, 0x2f, 0x31, 0x01], "OpenExr"),
-    (b"qoif", "Qoi"),
-    (b"farbfeld", "Farbfeld"),
-    (b"II+\x00", "BigTiff"),
-    (b"MM\x00+", "BigTiff"),
-    (b"\x00\x00\x00\x0cjP  ", "Jpeg2000"),
-];
+fn limits(options: &DecodeOptions) -> Limits {
+    let mut limits = Limits::default();
+    let side = u32::try_from(options.max_pixels).unwrap_or(u32::MAX);
+    limits.max_image_width = Some(side);
+    limits.max_image_height = Some(side);
+    limits.max_alloc = Some(options.max_alloc_bytes);
+    limits
+}
 
-/// Identify the container from its magic bytes.
+/// RGBA preview whose longer side is at most `max_side` (never upscaled):
+/// `image`'s thumbnail, an area average over the source pixels.
+fn preview(image: &DynamicImage, max_side: u32) -> RgbaImage {
+    let max_side = max_side.max(1);
+    let (w, h) = (image.width(), image.height());
+    let scale = (max_side as f64 / w.max(h) as f64).min(1.0);
+    let tw = ((w as f64 * scale).round() as u32).clamp(1, w.max(1));
+    let th = ((h as f64 * scale).round() as u32).clamp(1, h.max(1));
+    let small = if (tw, th) == (w, h) {
+        image.to_rgba8()
+    } else {
+        image.thumbnail_exact(tw, th).into_rgba8()
+    };
+    RgbaImage {
+        width: small.width(),
+        height: small.height(),
+        pixels: small.into_raw(),
+    }
+}
+
+impl ImageFormat {
+    fn to_image_crate(self) -> ::image::ImageFormat {
+        match self {
+            ImageFormat::Png => ::image::ImageFormat::Png,
+            ImageFormat::Jpeg => ::image::ImageFormat::Jpeg,
+            ImageFormat::Tiff => ::image::ImageFormat::Tiff,
+            ImageFormat::Bmp => ::image::ImageFormat::Bmp,
+            ImageFormat::Pnm => ::image::ImageFormat::Pnm,
+            ImageFormat::Gif => ::image::ImageFormat::Gif,
+            ImageFormat::WebP => ::image::ImageFormat::WebP,
+        }
+    }
+}
+
+/// The formats we decode, in the order error messages list them.
+const SUPPORTED: &str = "PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP";
+
+/// Identify the container from its magic bytes (`image`'s table).
 pub fn sniff_format(bytes: &[u8]) -> Result<ImageFormat> {
     if bytes.is_empty() {
         return Err(Error::Image {
             message: "not an image: the file is empty".into(),
         });
     }
-    let starts = |magic: &[u8]| bytes.starts_with(magic);
-    if starts(b"\x89PNG\r\n\x1a\n") {
-        return Ok(ImageFormat::Png);
+    use ::image::ImageFormat as F;
+    match ::image::guess_format(bytes) {
+        Ok(F::Png) => Ok(ImageFormat::Png),
+        Ok(F::Jpeg) => Ok(ImageFormat::Jpeg),
+        Ok(F::Tiff) => Ok(ImageFormat::Tiff),
+        Ok(F::Bmp) => Ok(ImageFormat::Bmp),
+        Ok(F::Pnm) => Ok(ImageFormat::Pnm),
+        Ok(F::Gif) => Ok(ImageFormat::Gif),
+        Ok(F::WebP) => Ok(ImageFormat::WebP),
+        Ok(other) => Err(Error::Image {
+            message: format!("unsupported image format {other:?}: use {SUPPORTED}"),
+        }),
+        Err(_) => Err(Error::Image {
+            message: format!("not an image: the bytes match none of {SUPPORTED}"),
+        }),
     }
-    if starts(&[0xff, 0xd8, 0xff]) {
-        return Ok(ImageFormat::Jpeg);
-    }
-    if starts(b"GIF89a") || starts(b"GIF87a") {
-        return Ok(ImageFormat::Gif);
-    }
-    if starts(b"MM\x00*") || starts(b"II*\x00") {
-        return Ok(ImageFormat::Tiff);
-    }
-    if starts(b"BM") {
-        return Ok(ImageFormat::Bmp);
-    }
-    if bytes.len() >= 2 && bytes[0] == b'P' && (b'1'..=b'7').contains(&bytes[1]) {
-        return Ok(ImageFormat::Pnm);
-    }
-    let other = if bytes.len() >= 12 && starts(b"RIFF") && &bytes[8..12] == b"WEBP" {
-        Some("WebP")
-    } else if bytes.len() >= 12 && &bytes[4..12] == b"ftypavif" {
-        Some("Avif")
-    } else {
-        UNSUPPORTED_MAGIC
-            .iter()
-            .find(|(magic, _)| starts(magic))
-            .map(|(_, name)| *name)
-    };
-    Err(Error::Image {
-        message: match other {
-            Some(name) => {
-                format!("unsupported image format {name}: use PNG, JPEG, TIFF, BMP, PGM/PPM or GIF")
-            }
-            None => {
-                "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF".into()
-            }
-        },
-    })
 }
 
-/// Refuse empty images and images over [`DecodeOptions::max_pixels`]; called
-/// by every codec with the header's dimensions, before any pixel buffer.
+/// Refuse empty images and images over [`DecodeOptions::max_pixels`], from
+/// the header's dimensions, before any pixel buffer.
 fn check_size(width: u32, height: u32, options: &DecodeOptions) -> Result<()> {
     if width == 0 || height == 0 {
         return Err(Error::Image {
@@ -294,43 +317,21 @@ fn check_size(width: u32, height: u32, options: &DecodeOptions) -> Result<()> {
     Ok(())
 }
 
-/// Refuse a decoded buffer of `width * height * channels * bytes_per_sample`
-/// bytes over [`DecodeOptions::max_alloc_bytes`]; returns the byte count.
-fn check_alloc(
-    format: ImageFormat,
-    width: u32,
-    height: u32,
-    channels: u8,
-    bytes_per_sample: u8,
-    options: &DecodeOptions,
-) -> Result<usize> {
-    let bytes = width as u64 * height as u64 * channels as u64 * bytes_per_sample as u64;
-    if bytes > options.max_alloc_bytes || usize::try_from(bytes).is_err() {
-        return Err(too_large(format, options));
-    }
-    Ok(bytes as usize)
-}
-
-fn too_large(format: ImageFormat, options: &DecodeOptions) -> Error {
-    Error::Image {
-        message: format!(
-            "{} image too large to decode within the memory limit ({} bytes)",
-            format.name(),
+/// `image`'s error as ours, naming the format and what to do.
+fn image_error(format: ImageFormat, e: ImageError, options: &DecodeOptions) -> Error {
+    let name = format.name();
+    let message = match e {
+        ImageError::Limits(_) => format!(
+            "{name} image too large to decode within the memory limit ({} bytes)",
             options.max_alloc_bytes
         ),
-    }
-}
-
-fn corrupt(format: ImageFormat, detail: impl std::fmt::Display) -> Error {
-    Error::Image {
-        message: format!("corrupt or truncated {} file: {detail}", format.name()),
-    }
-}
-
-fn unsupported(format: ImageFormat, detail: impl std::fmt::Display) -> Error {
-    Error::Image {
-        message: format!("{} variant not supported: {detail}", format.name()),
-    }
+        ImageError::Unsupported(e) => format!("{name} variant not supported: {e}"),
+        ImageError::Decoding(e) => format!("corrupt or truncated {name} file: {e}"),
+        ImageError::IoError(e) => format!("corrupt or truncated {name} file: {e}"),
+        ImageError::Parameter(e) => format!("corrupt or truncated {name} file: {e}"),
+        ImageError::Encoding(e) => format!("corrupt {name} file: {e}"),
+    };
+    Error::Image { message }
 }
 
 /// Encode a grey image as a binary PGM (P5); used by the renderer and tests.
@@ -340,9 +341,16 @@ pub fn encode_pgm(img: &GrayImage) -> Vec<u8> {
     out
 }
 
-/// Encode a grey image as PNG (8-bit grey).
+/// Encode a grey image as PNG (8-bit grey) through `image`.
 pub fn encode_png(img: &GrayImage) -> Result<Vec<u8>> {
-    png_encode::encode_gray(img)
+    use ::image::ImageEncoder;
+    let mut out = Vec::new();
+    ::image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(&img.pixels, img.width, img.height, ::image::ExtendedColorType::L8)
+        .map_err(|e| Error::Image {
+            message: format!("could not encode PNG: {e}"),
+        })?;
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -395,7 +403,7 @@ mod tests {
         let err = decode_gray(b"hello, this is text").unwrap_err();
         assert_eq!(
             err.to_string(),
-            "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF"
+            "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP"
         );
         assert_eq!(
             decode_gray(&[]).unwrap_err().to_string(),
@@ -434,11 +442,10 @@ mod tests {
             state
         };
         let png = encode_png(&gradient(16, 16)).unwrap();
-        let bmp = crate::image::bmp_tests::palette_bmp();
         // Real headers of every format, cut anywhere and followed by noise.
         let headers: [&[u8]; 8] = [
             &png,
-            &bmp,
+            b"BM\x46\x00\x00\x00\x00\x00\x00\x00\x36\x00\x00\x00\x28\x00\x00\x00",
             b"P6 4 4 255\n",
             b"P1 4 4\n",
             b"P7\nWIDTH 2\nHEIGHT 2\nDEPTH 4\nMAXVAL 65535\nENDHDR\n",

@@ -119,7 +119,8 @@ pub(crate) fn candidates(level: &Plane, max_count: usize) -> Vec<Candidate> {
     };
     if out.len() > max_count && max_count > 0 {
         let mut responses: Vec<f32> = out.iter().map(|c| c.response).collect();
-        let threshold = crate::sorting::kth_largest_f32(&mut responses, max_count - 1);
+        let (_, &mut threshold, _) =
+            responses.select_nth_unstable_by(max_count - 1, |a, b| b.total_cmp(a));
         let mut room = max_count - out.iter().filter(|c| c.response > threshold).count();
         out.retain(|c| {
             let keep = c.response > threshold || (c.response == threshold && room > 0);
@@ -130,7 +131,7 @@ pub(crate) fn candidates(level: &Plane, max_count: usize) -> Vec<Candidate> {
         });
     }
     out.truncate(max_count);
-    crate::sorting::sort_by(&mut out, order);
+    out.sort_by(order);
     out
 }
 

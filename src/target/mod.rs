@@ -54,16 +54,16 @@ use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 
 /// Which way round a circle target is printed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Polarity {
     /// Dark circles on a light background (the usual print).
+    #[serde(rename = "dark_on_light")]
     DarkOnLight,
     /// Light circles on a dark background.
+    #[serde(rename = "light_on_dark")]
     LightOnDark,
 }
-// Read by name through one visitor for all such enums (wasm size).
-crate::deserialize_by_name!(Polarity { DarkOnLight => "dark_on_light", LightOnDark => "light_on_dark" });
 
 /// A calibration target's geometry (see the module docs for the point order).
 ///
@@ -130,16 +130,19 @@ pub enum Target {
     },
 }
 
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Deserialize)]
 enum TargetKind {
+    #[serde(rename = "chessboard")]
     Chessboard,
+    #[serde(rename = "circle_grid")]
     CircleGrid,
+    #[serde(rename = "dot_plate")]
     DotPlate,
+    #[serde(rename = "single_circle")]
     SingleCircle,
+    #[serde(rename = "square_grid")]
     SquareGrid,
 }
-// Read by name through one visitor for all such enums (wasm size).
-crate::deserialize_by_name!(TargetKind { Chessboard => "chessboard", CircleGrid => "circle_grid", DotPlate => "dot_plate", SingleCircle => "single_circle", SquareGrid => "square_grid" });
 
 /// Every field of every [`Target`] variant; the tag picks which are needed.
 #[derive(Deserialize)]
@@ -490,7 +493,7 @@ fn parse_length(text: &str) -> Result<f64> {
             format!("length '{text}' needs a unit: mm, cm or m (e.g. 30mm)"),
         ));
     };
-    let v = crate::number::parse_f64(number)
+    let v = number.parse::<f64>().ok()
         .ok_or_else(|| Error::invalid("target", format!("'{text}' is not a length")))?;
     // The decimal shifted to metres and rounded once (22.5778mm -> the
     // double nearest 0.0225778, not 22.5778 * 0.001 = 0.022577800000000002),
@@ -498,7 +501,7 @@ fn parse_length(text: &str) -> Result<f64> {
     if exponent == 0 || number.contains(['e', 'E']) {
         return Ok(v * 10f64.powi(exponent));
     }
-    Ok(crate::number::parse_f64(&format!("{number}e{exponent}"))
+    Ok(format!("{number}e{exponent}").parse::<f64>().ok()
         .unwrap_or(v * 10f64.powi(exponent)))
 }
 

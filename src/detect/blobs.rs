@@ -176,7 +176,7 @@ fn components(mask: &[bool], w: usize, h: usize) -> Vec<Blob> {
             })
         })
         .collect();
-    crate::sorting::sort_by(&mut blobs, |a, b| b.area.total_cmp(&a.area));
+    blobs.sort_by(|a, b| b.area.total_cmp(&a.area));
     blobs
 }
 
