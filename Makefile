@@ -38,13 +38,13 @@ pkg: wasm
 	@tools/wasm-size.sh pkg/node/robocal_bg.wasm
 
 check-wasm-core: setup
-	cargo check --workspace --lib --target $(WASM_TARGET)
+	cargo check --lib --target $(WASM_TARGET)
 
 test-native:
-	cargo test --workspace
+	cargo test
 
 test-wasm: setup
-	CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --workspace --lib --target $(WASM_TARGET)
+	CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --lib --target $(WASM_TARGET)
 
 test-node: pkg
 	tools/setup.sh node
