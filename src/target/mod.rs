@@ -320,6 +320,65 @@ impl Target {
         }
     }
 
+    /// The CLI spec of this target, the inverse of [`Target::parse_spec`]:
+    /// `parse_spec(&t.to_spec())` gives `t` back bit for bit. Lengths are
+    /// written in millimetres with the fewest decimals that read back to
+    /// the same metres (metres when no such decimal exists); a dot plate's
+    /// diameter is left out when it is the default (half the pitch).
+    pub fn to_spec(&self) -> String {
+        match self {
+            Target::Chessboard {
+                cols,
+                rows,
+                square_m,
+            } => format!("chessboard:{cols}x{rows}:{}", spec_length(*square_m)),
+            Target::CircleGrid {
+                cols,
+                rows,
+                spacing_m,
+                asymmetric,
+                polarity,
+            } => {
+                let layout = if *asymmetric { ":asymmetric" } else { "" };
+                let print = match polarity {
+                    Polarity::DarkOnLight => "",
+                    Polarity::LightOnDark => ":light-on-dark",
+                };
+                format!(
+                    "circles:{cols}x{rows}:{}{layout}{print}",
+                    spec_length(*spacing_m)
+                )
+            }
+            Target::DotPlate {
+                cols,
+                rows,
+                pitch_m,
+                dot_diameter_m,
+            } => {
+                let pitch = spec_length(*pitch_m);
+                if *dot_diameter_m == pitch_m / 2.0 {
+                    format!("dots:{cols}x{rows}:{pitch}")
+                } else {
+                    format!(
+                        "dots:{cols}x{rows}:{pitch}:{}",
+                        spec_length(*dot_diameter_m)
+                    )
+                }
+            }
+            Target::SingleCircle { diameter_m } => format!("circle:{}", spec_length(*diameter_m)),
+            Target::SquareGrid {
+                cols,
+                rows,
+                side_m,
+                pitch_m,
+            } => format!(
+                "squares:{cols}x{rows}:{}:{}",
+                spec_length(*side_m),
+                spec_length(*pitch_m)
+            ),
+        }
+    }
+
     /// Check sizes and counts; returns the target unchanged when valid.
     pub fn validated(self) -> Result<Target> {
         let (cols, rows, min) = match &self {
@@ -480,6 +539,23 @@ fn parse_grid(text: &str) -> Result<(usize, usize)> {
     Ok((c.parse().map_err(|_| err())?, r.parse().map_err(|_| err())?))
 }
 
+/// Most decimals a spec length is written with in millimetres (a
+/// nanometre); a length that needs more is written in metres.
+const SPEC_MM_DECIMALS: usize = 6;
+
+/// A length for a spec: millimetres with the fewest decimals that
+/// [`parse_length`] reads back to exactly `m`, else metres (Rust's shortest
+/// round-trip decimal).
+fn spec_length(m: f64) -> String {
+    for decimals in 0..=SPEC_MM_DECIMALS {
+        let text = format!("{:.*}", decimals, m * 1000.0);
+        if parse_length(&format!("{text}mm")).ok() == Some(m) {
+            return format!("{text}mm");
+        }
+    }
+    format!("{m}m")
+}
+
 fn parse_length(text: &str) -> Result<f64> {
     let (number, exponent) = if let Some(n) = text.strip_suffix("mm") {
         (n, -3)
@@ -504,6 +580,8 @@ fn parse_length(text: &str) -> Result<f64> {
     Ok(format!("{number}e{exponent}").parse::<f64>().ok()
         .unwrap_or(v * 10f64.powi(exponent)))
 }
+
+pub mod svg;
 
 #[cfg(test)]
 mod tests;

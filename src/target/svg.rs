@@ -1,0 +1,494 @@
+//! The printable board: one SVG sheet at true scale for every [`Target`].
+//!
+//! The sheet's `width` and `height` are in millimetres and its `viewBox` is
+//! the same numbers, so one user unit is one millimetre on paper when the
+//! file is printed at 100 %. The board is drawn as the synthetic renderer
+//! ([`crate::synth::render`]) draws it, the look the detectors are tested
+//! on: the same quiet zone around the points, top-left chessboard square
+//! dark, circle-grid circles half a grid unit across. Below the board: a
+//! 100 mm check bar with the words to measure it, and the target's spec
+//! ([`Target::to_spec`]) with the board frame, so a print can be checked
+//! and typed back in.
+//!
+//! Point 0 (the board origin) is at the board's top left; x runs to the
+//! right and y down, as in the module docs of [`crate::target`].
+
+use super::{Polarity, Target};
+use std::fmt::Write;
+
+/// White paper around everything on the sheet, mm.
+const PAGE_MARGIN_MM: f64 = 10.0;
+/// Length of the check bar, mm.
+const CHECK_BAR_MM: f64 = 100.0;
+/// Thickness of the check bar, mm.
+const CHECK_BAR_HEIGHT_MM: f64 = 3.0;
+/// Space between the board and the check bar, mm.
+const GAP_MM: f64 = 8.0;
+/// Font size of the sheet's text, mm.
+const TEXT_MM: f64 = 3.5;
+/// Baseline-to-baseline distance of the text lines, mm.
+const LINE_MM: f64 = 5.5;
+/// The text column's width, mm: the sheet is at least this wide inside its
+/// margins, so the longest line (about 75 characters of `TEXT_MM` type) fits.
+const TEXT_WIDTH_MM: f64 = 150.0;
+/// A circle grid's circle diameter over its grid unit (the renderer's
+/// `RenderOptions::circle_diameter_ratio` default, what the detector is
+/// tested on).
+const CIRCLE_DIAMETER_RATIO: f64 = 0.5;
+/// Decimals of the coordinates written, mm (a tenth of a micrometre).
+const COORD_DECIMALS: usize = 4;
+
+/// The board in millimetres, in board coordinates (point 0 at (0, 0)).
+struct Board {
+    /// `(x0, y0, x1, y1)`: the printed area, quiet zone included.
+    extent: (f64, f64, f64, f64),
+    /// Light circles on a dark area instead of dark marks on white.
+    light_on_dark: bool,
+    /// Dark squares `(x, y, side)` (chessboards and square grids).
+    squares: Vec<(f64, f64, f64)>,
+    /// Circles `(cx, cy, r)` (circle grids, dot plates, the single circle).
+    circles: Vec<(f64, f64, f64)>,
+}
+
+/// The board's marks and extent; see the module docs for the look.
+fn board(target: &Target) -> Board {
+    let mm = |m: f64| m * 1000.0;
+    let unit = mm(target.unit_m());
+    let points: Vec<(f64, f64)> = target
+        .grid_coords()
+        .into_iter()
+        .map(|(i, j)| (f64::from(i) * unit, f64::from(j) * unit))
+        .collect();
+    let max_x = points.iter().map(|p| p.0).fold(0.0, f64::max);
+    let max_y = points.iter().map(|p| p.1).fold(0.0, f64::max);
+    let dots = |r: f64| points.iter().map(|&(x, y)| (x, y, r)).collect();
+    match target {
+        Target::Chessboard { cols, rows, .. } => {
+            // (cols + 1) x (rows + 1) squares; square (i, j) spans
+            // [(i - 1) s, i s), and the top-left one (i + j even) is dark.
+            let s = unit;
+            let mut squares = Vec::new();
+            for j in 0..=*rows {
+                for i in 0..=*cols {
+                    if (i + j) % 2 == 0 {
+                        squares.push(((i as f64 - 1.0) * s, (j as f64 - 1.0) * s, s));
+                    }
+                }
+            }
+            Board {
+                extent: (-2.0 * s, -2.0 * s, max_x + 2.0 * s, max_y + 2.0 * s),
+                light_on_dark: false,
+                squares,
+                circles: Vec::new(),
+            }
+        }
+        Target::CircleGrid { polarity, .. } => Board {
+            extent: (-unit, -unit, max_x + unit, max_y + unit),
+            light_on_dark: match polarity {
+                Polarity::DarkOnLight => false,
+                Polarity::LightOnDark => true,
+            },
+            squares: Vec::new(),
+            circles: dots(0.5 * CIRCLE_DIAMETER_RATIO * unit),
+        },
+        Target::DotPlate { dot_diameter_m, .. } => Board {
+            extent: (-unit, -unit, max_x + unit, max_y + unit),
+            light_on_dark: false,
+            squares: Vec::new(),
+            circles: dots(0.5 * mm(*dot_diameter_m)),
+        },
+        Target::SingleCircle { diameter_m } => {
+            let d = mm(*diameter_m);
+            Board {
+                extent: (-2.0 * d, -2.0 * d, 2.0 * d, 2.0 * d),
+                light_on_dark: false,
+                squares: Vec::new(),
+                circles: vec![(0.0, 0.0, 0.5 * d)],
+            }
+        }
+        Target::SquareGrid { side_m, .. } => {
+            let side = mm(*side_m);
+            Board {
+                extent: (-unit, -unit, max_x + side + unit, max_y + side + unit),
+                light_on_dark: false,
+                squares: points.iter().map(|&(x, y)| (x, y, side)).collect(),
+                circles: Vec::new(),
+            }
+        }
+    }
+}
+
+/// What the target is, in words with millimetres, for the sheet.
+fn description(target: &Target) -> String {
+    let mm = |m: f64| format!("{} mm", num(m * 1000.0));
+    match target {
+        Target::Chessboard {
+            cols,
+            rows,
+            square_m,
+        } => format!(
+            "{cols} x {rows} inner corners ({} x {} squares of {})",
+            cols + 1,
+            rows + 1,
+            mm(*square_m)
+        ),
+        Target::CircleGrid {
+            cols,
+            rows,
+            spacing_m,
+            asymmetric,
+            polarity,
+        } => format!(
+            "{cols} x {rows} circles, {}, {}, grid unit {}, circles {} across",
+            if *asymmetric {
+                "asymmetric"
+            } else {
+                "symmetric"
+            },
+            match polarity {
+                Polarity::DarkOnLight => "dark on light",
+                Polarity::LightOnDark => "light on dark",
+            },
+            mm(*spacing_m),
+            mm(CIRCLE_DIAMETER_RATIO * spacing_m)
+        ),
+        Target::DotPlate {
+            cols,
+            rows,
+            pitch_m,
+            dot_diameter_m,
+        } => format!(
+            "{cols} x {rows} dots, pitch {}, dots {} across",
+            mm(*pitch_m),
+            mm(*dot_diameter_m)
+        ),
+        Target::SingleCircle { diameter_m } => {
+            format!("one circle {} across", mm(*diameter_m))
+        }
+        Target::SquareGrid {
+            cols,
+            rows,
+            side_m,
+            pitch_m,
+        } => format!(
+            "{cols} x {rows} separate squares, side {}, pitch {}",
+            mm(*side_m),
+            mm(*pitch_m)
+        ),
+    }
+}
+
+/// A coordinate in mm with at most [`COORD_DECIMALS`] decimals, no trailing
+/// zeros (`30`, `22.5778`).
+fn num(x: f64) -> String {
+    let text = format!("{:.*}", COORD_DECIMALS, x);
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    match text {
+        "-0" => "0".to_string(),
+        t => t.to_string(),
+    }
+}
+
+/// `text` with the XML specials escaped.
+fn xml(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The printable sheet of `target` as an SVG document (see the module docs).
+///
+/// Board marks carry `class="square"` or `class="circle"`, the check bar
+/// `class="check-bar"`, so a reader can count and measure them.
+pub fn board_svg(target: &Target) -> String {
+    let b = board(target);
+    let spec = target.to_spec();
+    // 1. Sheet layout, mm: the board at the top left inside the margin, then
+    //    the check bar, then four lines of text.
+    let (x0, y0, x1, y1) = b.extent;
+    let (board_w, board_h) = (x1 - x0, y1 - y0);
+    let (dx, dy) = (PAGE_MARGIN_MM - x0, PAGE_MARGIN_MM - y0);
+    let bar_y = PAGE_MARGIN_MM + board_h + GAP_MM;
+    let text_y = bar_y + CHECK_BAR_HEIGHT_MM + LINE_MM;
+    let lines = [
+        format!("This bar is {CHECK_BAR_MM} mm long. Measure it on the print: if it is not {CHECK_BAR_MM} mm,"),
+        "print again at 100 % scale (actual size, no fit to page or scaling).".to_string(),
+        format!("robocal target {spec}"),
+        format!(
+            "{}. Point 0 at the top left, x to the right, y down.",
+            description(target)
+        ),
+    ];
+    let width = 2.0 * PAGE_MARGIN_MM + board_w.max(TEXT_WIDTH_MM).max(CHECK_BAR_MM);
+    let height = text_y + (lines.len() as f64 - 1.0) * LINE_MM + PAGE_MARGIN_MM;
+    let (w, h) = (num(width), num(height));
+
+    // 2. The document: paper, board area, marks, bar, text. `write!` into a
+    //    String cannot fail.
+    let (paper, area, mark) = if b.light_on_dark {
+        ("#fff", "#000", "#fff")
+    } else {
+        ("#fff", "#fff", "#000")
+    };
+    let mut s = String::new();
+    let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}mm" height="{h}mm" viewBox="0 0 {w} {h}">"#
+    );
+    let _ = writeln!(
+        s,
+        "<title>robocal target {}: print at 100 % scale, then measure the {CHECK_BAR_MM} mm bar</title>",
+        xml(&spec)
+    );
+    let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="{paper}"/>"#);
+    let _ = writeln!(
+        s,
+        r#"<rect class="board" x="{}" y="{}" width="{}" height="{}" fill="{area}"/>"#,
+        num(PAGE_MARGIN_MM),
+        num(PAGE_MARGIN_MM),
+        num(board_w),
+        num(board_h)
+    );
+    if !b.squares.is_empty() {
+        let _ = writeln!(s, r#"<g fill="{mark}" shape-rendering="crispEdges">"#);
+    }
+    for (x, y, side) in &b.squares {
+        let _ = writeln!(
+            s,
+            r#"<rect class="square" x="{}" y="{}" width="{}" height="{}"/>"#,
+            num(x + dx),
+            num(y + dy),
+            num(*side),
+            num(*side)
+        );
+    }
+    if !b.squares.is_empty() {
+        let _ = writeln!(s, "</g>");
+    }
+    if !b.circles.is_empty() {
+        let _ = writeln!(s, r#"<g fill="{mark}">"#);
+    }
+    for (x, y, r) in &b.circles {
+        let _ = writeln!(
+            s,
+            r#"<circle class="circle" cx="{}" cy="{}" r="{}"/>"#,
+            num(x + dx),
+            num(y + dy),
+            num(*r)
+        );
+    }
+    if !b.circles.is_empty() {
+        let _ = writeln!(s, "</g>");
+    }
+    let _ = writeln!(
+        s,
+        r##"<rect class="check-bar" x="{}" y="{}" width="{}" height="{}" fill="#000"/>"##,
+        num(PAGE_MARGIN_MM),
+        num(bar_y),
+        num(CHECK_BAR_MM),
+        num(CHECK_BAR_HEIGHT_MM)
+    );
+    let _ = writeln!(
+        s,
+        r##"<g font-family="sans-serif" font-size="{}" fill="#000">"##,
+        num(TEXT_MM)
+    );
+    for (k, line) in lines.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}">{}</text>"#,
+            num(PAGE_MARGIN_MM),
+            num(text_y + k as f64 * LINE_MM),
+            xml(line)
+        );
+    }
+    let _ = writeln!(s, "</g>");
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    //! Exact checks: the sheet's numbers are sums of the spec's millimetres
+    //! and the named layout constants, written with 4 decimals, so they are
+    //! compared as text or to 1e-9 mm.
+    use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    fn target(spec: &str) -> Target {
+        Target::parse_spec(spec).unwrap()
+    }
+
+    /// The value of attribute `name` in the first tag containing `tag`.
+    fn attr(svg: &str, tag: &str, name: &str) -> String {
+        let start = svg.find(tag).unwrap_or_else(|| panic!("no {tag}"));
+        let rest = &svg[start..];
+        let rest = &rest[..rest.find('>').unwrap()];
+        let key = format!(" {name}=\"");
+        let at = rest
+            .find(&key)
+            .unwrap_or_else(|| panic!("no {name} in {rest}"))
+            + key.len();
+        rest[at..at + rest[at..].find('"').unwrap()].to_string()
+    }
+
+    fn mm(svg: &str, tag: &str, name: &str) -> f64 {
+        attr(svg, tag, name).trim_end_matches("mm").parse().unwrap()
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn chessboard_sheet_is_true_scale_with_every_square() {
+        let svg = board_svg(&target("chessboard:9x6:30mm"));
+        // Board 9 + 1 + 2 quiet squares wide = 12 * 30 = 360 mm, 9 * 30 = 270 mm high.
+        assert_eq!(
+            mm(&svg, "<rect class=\"board\"", "width"),
+            360.0,
+            "board width, mm"
+        );
+        assert_eq!(
+            mm(&svg, "<rect class=\"board\"", "height"),
+            270.0,
+            "board height, mm"
+        );
+        let (w, h) = (mm(&svg, "<svg", "width"), mm(&svg, "<svg", "height"));
+        assert_eq!(w, 360.0 + 2.0 * PAGE_MARGIN_MM, "sheet width, mm");
+        let expected_h =
+            PAGE_MARGIN_MM + 270.0 + GAP_MM + CHECK_BAR_HEIGHT_MM + 4.0 * LINE_MM + PAGE_MARGIN_MM;
+        assert!(
+            (h - expected_h).abs() < 1e-9,
+            "sheet height {h} mm, expected {expected_h} mm"
+        );
+        assert!(attr(&svg, "<svg", "width").ends_with("mm"));
+        assert_eq!(
+            attr(&svg, "<svg", "viewBox"),
+            format!("0 0 {} {}", num(w), num(h))
+        );
+        // 10 x 7 squares, half of them (rounded up: the top-left is dark) printed.
+        assert_eq!(svg.matches("class=\"square\"").count(), 35);
+        // The first dark square sits one quiet square in: at the margin + 30 mm.
+        assert_eq!(mm(&svg, "class=\"square\"", "x"), PAGE_MARGIN_MM + 30.0);
+        assert_eq!(mm(&svg, "class=\"square\"", "width"), 30.0);
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn check_bar_is_100_mm_with_words_and_spec() {
+        for spec in [
+            "chessboard:9x6:30mm",
+            "circles:4x11:20mm:asymmetric:light-on-dark",
+            "dots:7x7:25mm:10mm",
+            "circle:10mm",
+            "squares:8x8:12.7mm:22.5778mm",
+        ] {
+            let svg = board_svg(&target(spec));
+            assert_eq!(
+                mm(&svg, "class=\"check-bar\"", "width"),
+                100.0,
+                "{spec}: bar, mm"
+            );
+            assert!(
+                svg.contains("This bar is 100 mm long. Measure it"),
+                "{spec}"
+            );
+            assert!(
+                svg.contains(&format!("robocal target {spec}</text>")),
+                "{spec}: spec on the sheet"
+            );
+            // The sheet is wide enough for the bar and the text column.
+            assert!(
+                mm(&svg, "<svg", "width") >= TEXT_WIDTH_MM + 2.0 * PAGE_MARGIN_MM,
+                "{spec}"
+            );
+        }
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn circle_grids_count_circles_and_keep_polarity() {
+        let svg = board_svg(&target("circles:4x11:20mm:asymmetric"));
+        assert_eq!(svg.matches("class=\"circle\"").count(), 44);
+        assert_eq!(
+            mm(&svg, "class=\"circle\"", "r"),
+            5.0,
+            "radius = 0.25 unit, mm"
+        );
+        // Asymmetric: x up to (2 * 3 + 1) * 20 = 140 mm, plus a unit each side.
+        assert_eq!(mm(&svg, "<rect class=\"board\"", "width"), 180.0);
+        assert_eq!(mm(&svg, "<rect class=\"board\"", "height"), 240.0);
+        assert_eq!(attr(&svg, "<rect class=\"board\"", "fill"), "#fff");
+        let light = board_svg(&target("circles:4x5:20mm:light-on-dark"));
+        assert_eq!(light.matches("class=\"circle\"").count(), 20);
+        assert_eq!(attr(&light, "<rect class=\"board\"", "fill"), "#000");
+        assert!(
+            light.contains("<g fill=\"#fff\">\n<circle"),
+            "light circles"
+        );
+        assert!(light.contains("symmetric, light on dark"));
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn dot_plates_single_circles_and_square_grids() {
+        let dots = board_svg(&target("dots:7x7:25mm:12.5mm"));
+        assert_eq!(dots.matches("class=\"circle\"").count(), 49);
+        assert_eq!(mm(&dots, "class=\"circle\"", "r"), 6.25);
+        assert_eq!(mm(&dots, "<rect class=\"board\"", "width"), 200.0);
+
+        let one = board_svg(&target("circle:10mm"));
+        assert_eq!(one.matches("class=\"circle\"").count(), 1);
+        assert_eq!(mm(&one, "class=\"circle\"", "r"), 5.0);
+        assert_eq!(mm(&one, "class=\"circle\"", "cx"), PAGE_MARGIN_MM + 20.0);
+        assert_eq!(mm(&one, "<rect class=\"board\"", "width"), 40.0);
+
+        let zhang = board_svg(&target("squares:8x8:12.7mm:22.5778mm"));
+        assert_eq!(zhang.matches("class=\"square\"").count(), 64);
+        assert_eq!(attr(&zhang, "class=\"square\"", "width"), "12.7");
+        // 7 pitches + a side + a pitch of quiet zone on each side.
+        let w = mm(&zhang, "<rect class=\"board\"", "width");
+        assert!(
+            (w - (9.0 * 22.5778 + 12.7)).abs() < 1e-9,
+            "board width {w} mm"
+        );
+        assert_eq!(
+            attr(&zhang, "class=\"square\"", "x"),
+            num(PAGE_MARGIN_MM + 22.5778)
+        );
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn specs_round_trip_through_to_spec() {
+        for spec in [
+            "chessboard:9x6:30mm",
+            "chessboard:7x5:0.5mm",
+            "circles:4x11:20mm:asymmetric",
+            "circles:4x5:20.1mm:light-on-dark",
+            "circles:4x11:20mm:asymmetric:light-on-dark",
+            "dots:7x7:25mm",
+            "dots:7x7:25mm:10mm",
+            "circle:10mm",
+            "squares:8x8:12.7mm:22.5778mm",
+        ] {
+            let t = target(spec);
+            assert_eq!(t.to_spec(), spec);
+            assert_eq!(target(&t.to_spec()), t, "{spec}");
+        }
+        // Other spellings come back in the canonical one, to the bit.
+        assert_eq!(target("circle:0.7cm").to_spec(), "circle:7mm");
+        assert_eq!(
+            target("circles:4x5:2cm:symmetric:dark-on-light").to_spec(),
+            "circles:4x5:20mm"
+        );
+        // A length with no short millimetre decimal is written in metres.
+        let odd = Target::SingleCircle {
+            diameter_m: 0.1 / 3.0,
+        };
+        assert_eq!(odd.to_spec(), "circle:0.03333333333333333m");
+        assert_eq!(target(&odd.to_spec()), odd);
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn text_is_escaped() {
+        assert_eq!(xml("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
+        assert_eq!(num(-0.00001), "0");
+        assert_eq!(num(12.70000), "12.7");
+    }
+}
