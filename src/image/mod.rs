@@ -23,6 +23,9 @@ use ::image::{DynamicImage, ImageDecoder, ImageError, ImageReader, Limits};
 use serde::Serialize;
 use std::io::Cursor;
 
+#[cfg(test)]
+mod format_tests;
+
 /// Largest image accepted by default, in pixels: a 100 MP sensor natively
 /// (twice the 50 MP the detectors are specified for), 64 MP in wasm.
 #[cfg(not(target_arch = "wasm32"))]
@@ -202,8 +205,12 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     let mut decoder = reader.into_decoder().map_err(|e| image_error(format, e, options))?;
     let (width, height) = decoder.dimensions();
     check_size(width, height, options)?;
-    decoder
-        .set_limits(limits(options))
+    // The output buffer counts against the allocation limit too; what is
+    // left of it bounds the decoder's own working memory.
+    let mut limits = limits(options);
+    limits
+        .reserve(decoder.total_bytes())
+        .and_then(|()| decoder.set_limits(limits))
         .map_err(|e| image_error(format, e, options))?;
     let color = decoder.original_color_type();
     let channels = color.channel_count();
@@ -308,13 +315,22 @@ fn check_size(width: u32, height: u32, options: &DecodeOptions) -> Result<()> {
     if pixels > options.max_pixels {
         return Err(Error::Image {
             message: format!(
-                "image is {width}x{height} = {:.1} MP, more than the limit of {:.1} MP: downscale it first",
-                pixels as f64 / 1e6,
-                options.max_pixels as f64 / 1e6
+                "image is {width}x{height} = {}, more than the limit of {}: downscale it first",
+                pixel_count(pixels),
+                pixel_count(options.max_pixels)
             ),
         });
     }
     Ok(())
+}
+
+/// A pixel count as people say it: "12.3 MP", or "3015 pixels" when small.
+fn pixel_count(n: u64) -> String {
+    if n >= 100_000 {
+        format!("{:.1} MP", n as f64 / 1e6)
+    } else {
+        format!("{n} pixels")
+    }
 }
 
 /// `image`'s error as ours, naming the format and what to do.
