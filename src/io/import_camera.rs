@@ -167,9 +167,11 @@ fn distortion_from_opencv(d: &[f64], fisheye: bool) -> Result<Distortion> {
 
 /// The numbers of the `data` list that follows the line `key:` (YAML).
 fn yaml_data(text: &str, keys: &[&str]) -> Option<Vec<f64>> {
-    let start = text.lines().scan(0usize, |offset, line| {
+    // Offsets from the lines with their terminators (`lines()` also drops
+    // "\r", so counting `len() + 1` drifts off char boundaries on CRLF text).
+    let start = text.split_inclusive('\n').scan(0usize, |offset, line| {
         let here = *offset;
-        *offset += line.len() + 1;
+        *offset += line.len();
         Some((here, line))
     });
     for (offset, line) in start {
@@ -181,7 +183,8 @@ fn yaml_data(text: &str, keys: &[&str]) -> Option<Vec<f64>> {
         let open = rest.find("data:")? + 5;
         let body = &rest[open..];
         let lb = body.find('[')?;
-        let rb = body.find(']')?;
+        // The first ']' after the '[' (one before it is not the list's end).
+        let rb = lb + body[lb..].find(']')?;
         return body[lb + 1..rb]
             .split(',')
             .map(|s| s.trim().parse::<f64>().ok())
