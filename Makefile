@@ -10,7 +10,7 @@ WASM_FILE := target/$(WASM_TARGET)/wasm/robocal.wasm
 CLI := target/release/robocal
 PORT ?= 8080
 
-.PHONY: serve test setup wasm web pkg cli test-native test-wasm test-node test-e2e check-wasm-core bench clean-web
+.PHONY: serve test setup wasm web pkg cli test-native test-wasm test-node test-e2e check-wasm-core bench clean-web fuzz
 
 setup:
 	tools/setup.sh build
@@ -59,3 +59,23 @@ test: test-native check-wasm-core test-wasm test-node test-e2e
 
 bench:
 	cargo bench
+
+# Fuzzing (not part of `make test`): every target in fuzz/ for FUZZ_S seconds,
+# one after another (one fuzzer process at a time), on a seed corpus written
+# into fuzz/corpus/<target>/ from fixtures/ and small renders. No sanitizer:
+# the crate has no unsafe code, and panics, hangs (-timeout) and memory
+# blow-ups (-rss_limit_mb) are what is looked for. A failing input lands in
+# fuzz/artifacts/<target>/; it then belongs in fixtures/fuzz/<target>/
+# (replayed by tests/fuzz_regressions.rs). RELIABILITY.md has the record.
+FUZZ_S ?= 60
+FUZZ_TARGETS := image_decode detect robot_poses camera_files targets_detections calib_json handeye_json workflows
+FUZZ_FLAGS := -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
+
+fuzz:
+	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz
+	cargo +nightly fuzz build -s none
+	cargo run --release --manifest-path fuzz/Cargo.toml -p robocal-fuzz-seeds -- . fuzz/corpus
+	for t in $(FUZZ_TARGETS); do \
+		cargo +nightly fuzz run -s none $$t fuzz/corpus/$$t -- -max_total_time=$(FUZZ_S) $(FUZZ_FLAGS) || exit 1; \
+	done
+	@echo "make fuzz: $(FUZZ_TARGETS): no failure in $(FUZZ_S) s each"

@@ -1,0 +1,73 @@
+//! Every input the fuzzers found to crash, hang or exhaust memory, replayed
+//! through the same function the fuzz target calls (`fuzz/src/cases.rs`):
+//! `fixtures/fuzz/<target>/<name>` is one input of fuzz target `<target>`.
+//! A case passes when the entry points return (Ok or Err) without a panic,
+//! and within [`TIME_LIMIT`] (the fuzzers' -timeout is 10 s on an
+//! instrumented build; fixed hangs return in milliseconds).
+
+#[path = "../fuzz/src/cases.rs"]
+mod cases;
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// Wall-clock bound of one case in the debug test build (opt-level 1).
+const TIME_LIMIT: Duration = Duration::from_secs(10);
+
+/// Replays every file of `fixtures/fuzz/<target>/`; returns how many ran.
+fn replay(target: &str, case: fn(&[u8])) -> usize {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/fuzz").join(target);
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return 0;
+    };
+    let mut paths: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    paths.sort();
+    for path in &paths {
+        let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let start = Instant::now();
+        case(&bytes);
+        let took = start.elapsed();
+        assert!(took < TIME_LIMIT, "{}: took {took:?} (limit {TIME_LIMIT:?})", path.display());
+    }
+    paths.len()
+}
+
+#[test]
+fn image_decode() {
+    replay("image_decode", cases::image_decode);
+}
+
+#[test]
+fn detect() {
+    replay("detect", cases::detect);
+}
+
+#[test]
+fn robot_poses() {
+    replay("robot_poses", cases::robot_poses);
+}
+
+#[test]
+fn camera_files() {
+    replay("camera_files", cases::camera_files);
+}
+
+#[test]
+fn targets_detections() {
+    replay("targets_detections", cases::targets_detections);
+}
+
+#[test]
+fn calib_json() {
+    replay("calib_json", cases::calib_json);
+}
+
+#[test]
+fn handeye_json() {
+    replay("handeye_json", cases::handeye_json);
+}
+
+#[test]
+fn workflows() {
+    replay("workflows", cases::workflows);
+}
