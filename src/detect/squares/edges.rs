@@ -113,7 +113,11 @@ pub(super) fn refine_square(
                 let cos = d.dot(&along).clamp(-0.99, 0.99);
                 let sin = (1.0 - cos * cos).sqrt();
                 let reach = search + half_window + 1.0;
-                ((half_window + reach * cos.max(0.0)) / sin + 1.0).clamp(2.0, 0.3 * len)
+                // At least 2 px, at most 0.3 of the side (which wins on
+                // sides under 6.7 px: `clamp` would panic there).
+                ((half_window + reach * cos.max(0.0)) / sin + 1.0)
+                    .max(2.0)
+                    .min(0.3 * len)
             };
             let e0 = excl(k, corners[(k + 3) % 4].0);
             let e1 = excl((k + 1) % 4, corners[(k + 2) % 4].0);
