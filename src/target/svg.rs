@@ -200,7 +200,10 @@ fn xml(text: &str) -> String {
 /// The printable sheet of `target` as an SVG document (see the module docs).
 ///
 /// Board marks carry `class="square"` or `class="circle"`, the check bar
-/// `class="check-bar"`, so a reader can count and measure them.
+/// `class="check-bar"`, so a reader can count and measure them. The marks
+/// sit in `<g class="marks" transform="translate(X Y)">` with coordinates in
+/// board millimetres: `(X, Y)` is where point 0 (the board origin) lies on
+/// the sheet, in mm from its top-left corner.
 pub fn board_svg(target: &Target) -> String {
     let b = board(target);
     let spec = target.to_spec();
@@ -251,37 +254,39 @@ pub fn board_svg(target: &Target) -> String {
         num(board_w),
         num(board_h)
     );
-    if !b.squares.is_empty() {
-        let _ = writeln!(s, r#"<g fill="{mark}" shape-rendering="crispEdges">"#);
-    }
+    // The marks in board coordinates (mm, point 0 at the origin), moved
+    // onto the sheet by the group's translation.
+    let crisp = if b.squares.is_empty() {
+        ""
+    } else {
+        r#" shape-rendering="crispEdges""#
+    };
+    let _ = writeln!(
+        s,
+        r#"<g class="marks" transform="translate({} {})" fill="{mark}"{crisp}>"#,
+        num(dx),
+        num(dy)
+    );
     for (x, y, side) in &b.squares {
         let _ = writeln!(
             s,
             r#"<rect class="square" x="{}" y="{}" width="{}" height="{}"/>"#,
-            num(x + dx),
-            num(y + dy),
+            num(*x),
+            num(*y),
             num(*side),
             num(*side)
         );
-    }
-    if !b.squares.is_empty() {
-        let _ = writeln!(s, "</g>");
-    }
-    if !b.circles.is_empty() {
-        let _ = writeln!(s, r#"<g fill="{mark}">"#);
     }
     for (x, y, r) in &b.circles {
         let _ = writeln!(
             s,
             r#"<circle class="circle" cx="{}" cy="{}" r="{}"/>"#,
-            num(x + dx),
-            num(y + dy),
+            num(*x),
+            num(*y),
             num(*r)
         );
     }
-    if !b.circles.is_empty() {
-        let _ = writeln!(s, "</g>");
-    }
+    let _ = writeln!(s, "</g>");
     let _ = writeln!(
         s,
         r##"<rect class="check-bar" x="{}" y="{}" width="{}" height="{}" fill="#000"/>"##,
@@ -367,8 +372,13 @@ mod tests {
         );
         // 10 x 7 squares, half of them (rounded up: the top-left is dark) printed.
         assert_eq!(svg.matches("class=\"square\"").count(), 35);
-        // The first dark square sits one quiet square in: at the margin + 30 mm.
-        assert_eq!(mm(&svg, "class=\"square\"", "x"), PAGE_MARGIN_MM + 30.0);
+        // Point 0 lies two squares (quiet zone + first square) inside the
+        // board area; the first dark square starts a square before it.
+        assert_eq!(
+            attr(&svg, "<g class=\"marks\"", "transform"),
+            "translate(70 70)"
+        );
+        assert_eq!(mm(&svg, "class=\"square\"", "x"), -30.0);
         assert_eq!(mm(&svg, "class=\"square\"", "width"), 30.0);
     }
 
@@ -419,8 +429,9 @@ mod tests {
         let light = board_svg(&target("circles:4x5:20mm:light-on-dark"));
         assert_eq!(light.matches("class=\"circle\"").count(), 20);
         assert_eq!(attr(&light, "<rect class=\"board\"", "fill"), "#000");
-        assert!(
-            light.contains("<g fill=\"#fff\">\n<circle"),
+        assert_eq!(
+            attr(&light, "<g class=\"marks\"", "fill"),
+            "#fff",
             "light circles"
         );
         assert!(light.contains("symmetric, light on dark"));
@@ -436,7 +447,11 @@ mod tests {
         let one = board_svg(&target("circle:10mm"));
         assert_eq!(one.matches("class=\"circle\"").count(), 1);
         assert_eq!(mm(&one, "class=\"circle\"", "r"), 5.0);
-        assert_eq!(mm(&one, "class=\"circle\"", "cx"), PAGE_MARGIN_MM + 20.0);
+        assert_eq!(mm(&one, "class=\"circle\"", "cx"), 0.0);
+        assert_eq!(
+            attr(&one, "<g class=\"marks\"", "transform"),
+            "translate(30 30)"
+        );
         assert_eq!(mm(&one, "<rect class=\"board\"", "width"), 40.0);
 
         let zhang = board_svg(&target("squares:8x8:12.7mm:22.5778mm"));
@@ -448,9 +463,10 @@ mod tests {
             (w - (9.0 * 22.5778 + 12.7)).abs() < 1e-9,
             "board width {w} mm"
         );
+        assert_eq!(attr(&zhang, "class=\"square\"", "x"), "0");
         assert_eq!(
-            attr(&zhang, "class=\"square\"", "x"),
-            num(PAGE_MARGIN_MM + 22.5778)
+            attr(&zhang, "<g class=\"marks\"", "transform"),
+            format!("translate({0} {0})", num(PAGE_MARGIN_MM + 22.5778))
         );
     }
 
