@@ -1,15 +1,16 @@
-//! The `robocal` command-line tool: argument parsing and file I/O only; every
-//! computation is a call into the library.
+//! The `robocal` command-line tool: argument parsing (clap) and file I/O
+//! only; every computation is a call into the library.
 
 mod cli;
 
+use clap::Parser;
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    match cli::run(&args) {
-        Ok(()) => {}
-        Err(e) => {
-            eprintln!("robocal: {e}");
-            std::process::exit(e.exit_code());
-        }
+    // clap prints --help and --version (exit 0) and its own usage errors
+    // (exit 2) itself.
+    let args = cli::Cli::parse();
+    if let Err(e) = cli::run(args) {
+        eprintln!("robocal: {e}");
+        std::process::exit(e.exit_code());
     }
 }

@@ -63,7 +63,7 @@ fn export_errors_say_what_to_fix() {
         (code, err.as_str()),
         (
             2,
-            "robocal: unknown command 'frobnicate'; run 'robocal --help' for the list\n"
+            "error: unrecognized subcommand 'frobnicate'\n\nUsage: robocal [COMMAND]\n\nFor more information, try '--help'.\n"
         )
     );
 }

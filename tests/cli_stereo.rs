@@ -92,9 +92,13 @@ fn rendered_pairs(dir: &Path) -> (Vec<String>, Vec<String>, Pose) {
     }
     assert!(lf.len() >= 6, "only {} usable pairs", lf.len());
     let blank = GrayImage::new(640, 480, vec![120; 640 * 480]).expect("image");
-    let path = dir.join("right_blank.png");
+    // Pair 99: a good left image with a blank right one (pairing is by the
+    // number in the file names, as in the page).
+    let path = dir.join("right99_blank.png");
     std::fs::write(&path, encode_png(&blank).expect("png")).expect("write");
-    lf.push(lf[0].clone());
+    let left99 = dir.join("left99.png");
+    std::fs::copy(&lf[0], &left99).expect("copy");
+    lf.push(left99.to_string_lossy().into_owned());
     rf.push(path.to_string_lossy().into_owned());
     (lf, rf, right_from_left)
 }
@@ -113,7 +117,7 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
     let (code, _, err) = robocal(&args);
     assert_eq!(code, 0, "{err}");
     assert!(
-        err.contains("pair dropped") && err.contains("right_blank.png"),
+        err.contains("pair dropped") && err.contains("right99_blank.png"),
         "{err}"
     );
     let report: Value =

@@ -1,30 +1,19 @@
-//! `robocal detect`: find a calibration target in images, in parallel.
+//! `robocal detect`: find a calibration target in images, in parallel
+//! (rayon), with a progress bar on a terminal (indicatif).
 
-use super::args::{Args, Spec};
-use super::{read_file, CliError};
+use super::{parse_target, read_file, CliError};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
 use robocal::detect::{detect, DetectOptions};
 use robocal::target::{Detection, Target};
 use serde_json::json;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::io::IsTerminal;
 use std::time::Instant;
 
-pub const HELP: &str = "robocal detect - find a calibration target in images
-
-Usage: robocal detect --target SPEC [-o FILE] [--threads N] IMAGES...
-
-Options:
-  --target SPEC   the target: chessboard:COLSxROWS:SQUARE (inner corners),
-                  circles:COLSxROWS:SPACING[:asymmetric][:light-on-dark],
-                  dots:COLSxROWS:PITCH[:DIAMETER], circle:DIAMETER,
-                  squares:COLSxROWS:SIDE:PITCH (separate dark squares, 4
-                  corners each, e.g. Zhang's squares:8x8:12.7mm:22.5778mm)
-                  (lengths with mm, cm or m), or a target JSON object
-  -o FILE         write the JSON result to FILE (default: standard output)
-  --threads N     images processed in parallel (default: all cores)
-  --max-side N    long side of the pyramid level searched, pixels
-                  (default 256; corners are always refined at full size)
-
-Output: {\"robocal_version\", \"target\", \"images\": [{\"file\",
+#[derive(clap::Args)]
+#[command(
+    about = "find a calibration target (chessboard, circles, dots) in images",
+    after_help = "Output: {\"robocal_version\", \"target\", \"images\": [{\"file\",
 \"detection\": {image_size_px, target, points: [{id, x_px, y_px}]},
 \"detect_ms\"} or {\"file\", \"error\": {\"kind\", \"message\"}}]} in the order
 the files were given (see docs/detection-json.md). Failures are also
@@ -36,7 +25,32 @@ Examples:
   robocal detect --target circles:4x11:20mm:asymmetric acircles*.png
   robocal detect --target dots:7x7:25mm plate.tiff
   robocal detect --target squares:8x8:12.7mm:22.5778mm image*.gif
-  robocal detect --target circle:10mm --threads 1 table_*.png";
+  robocal detect --target circle:10mm --threads 1 table_*.png",
+    args_override_self = true
+)]
+pub struct DetectArgs {
+    /// The target: chessboard:COLSxROWS:SQUARE (inner corners),
+    /// circles:COLSxROWS:SPACING[:asymmetric][:light-on-dark],
+    /// dots:COLSxROWS:PITCH[:DIAMETER], circle:DIAMETER,
+    /// squares:COLSxROWS:SIDE:PITCH (separate dark squares, 4 corners each,
+    /// e.g. Zhang's squares:8x8:12.7mm:22.5778mm) (lengths with mm, cm or m),
+    /// or a target JSON object
+    #[arg(long, value_name = "SPEC")]
+    target: Option<String>,
+    /// Write the JSON result to FILE (default: standard output)
+    #[arg(short = 'o', long, value_name = "FILE")]
+    output: Option<String>,
+    /// Images processed in parallel (default: all cores)
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    /// Long side of the pyramid level searched, pixels (default 256; corners
+    /// are always refined at full size)
+    #[arg(long, value_name = "N")]
+    max_side: Option<u32>,
+    /// The images
+    #[arg(value_name = "IMAGES")]
+    images: Vec<String>,
+}
 
 /// One image's outcome (also used by `robocal intrinsics`).
 pub(super) enum Outcome {
@@ -45,28 +59,24 @@ pub(super) enum Outcome {
     Failed(String, String),
 }
 
-pub fn run(raw: &[String]) -> Result<(), CliError> {
-    let spec = Spec {
-        command: "detect",
-        valued: &["target", "output", "threads", "max-side"],
-        switches: &[],
+pub fn run(args: DetectArgs) -> Result<(), CliError> {
+    let Some(text) = args.target.as_deref() else {
+        return Err(CliError::usage(
+            "detect",
+            "--target is required, e.g. --target chessboard:9x6:30mm",
+        ));
     };
-    let args = Args::parse(raw, &spec)?;
-    let target = parse_target(&args)?;
-    if args.positionals.is_empty() {
+    let target = parse_target("detect", text)?;
+    if args.images.is_empty() {
         return Err(CliError::usage("detect", "give at least one image file"));
     }
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let threads: usize = args.parsed("detect", "threads", cores)?;
     let options = DetectOptions {
-        max_working_side_px: args.parsed(
-            "detect",
-            "max-side",
-            DetectOptions::default().max_working_side_px,
-        )?,
+        max_working_side_px: args
+            .max_side
+            .unwrap_or(DetectOptions::default().max_working_side_px),
     };
-    let files = &args.positionals;
-    let outcomes = run_all(files, &target, &options, threads.max(1));
+    let files = &args.images;
+    let outcomes = run_all(files, &target, &options, args.threads)?;
     let mut images = Vec::with_capacity(files.len());
     let mut found = 0;
     for (file, outcome) in files.iter().zip(outcomes) {
@@ -88,7 +98,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         "images": images,
     });
     let text = serde_json::to_string_pretty(&doc).map_err(|e| CliError::Io(e.to_string()))?;
-    match args.value("output") {
+    match &args.output {
         Some(path) => std::fs::write(path, text + "\n")
             .map_err(|e| CliError::Io(format!("cannot write '{path}': {e}")))?,
         None => println!("{text}"),
@@ -105,100 +115,63 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     Ok(())
 }
 
-fn parse_target(args: &Args) -> Result<Target, CliError> {
-    let Some(text) = args.value("target") else {
-        return Err(CliError::usage(
-            "detect",
-            "--target is required, e.g. --target chessboard:9x6:30mm",
-        ));
-    };
-    if text.trim_start().starts_with('{') {
-        let t: Target = serde_json::from_str(text)
-            .map_err(|e| CliError::usage("detect", format!("--target JSON: {e}")))?;
-        return Ok(t.validated()?);
+/// `robocal [#########...............]  9/20 left09.jpg`: the bar's layout.
+const PROGRESS_TEMPLATE: &str = "robocal [{bar:24}] {pos:>3}/{len} {wide_msg}";
+
+/// A progress bar over `total` images on a terminal's stderr; a hidden one
+/// when stderr is piped or logged, or for a single image.
+fn progress(total: usize) -> ProgressBar {
+    if total < 2 || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
     }
-    Target::parse_spec(text).map_err(|e| CliError::usage("detect", e.to_string()))
+    let style = ProgressStyle::with_template(PROGRESS_TEMPLATE)
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("#.");
+    ProgressBar::new(total as u64).with_style(style)
 }
 
-/// Columns of the terminal progress line.
-const PROGRESS_WIDTH: usize = 79;
-
-/// `robocal [#########...........]  9/20 left09.jpg`, at most
-/// [`PROGRESS_WIDTH`] columns, the file name cut from the left when long.
-fn progress_bar(done: usize, total: usize, file: &str) -> String {
-    const BAR: usize = 24;
-    let filled = if total == 0 { BAR } else { done * BAR / total };
-    let count = format!("{done:>w$}/{total}", w = total.to_string().len());
-    let head = format!(
-        "robocal [{}{}] {count} ",
-        "#".repeat(filled),
-        ".".repeat(BAR - filled)
-    );
-    let room = PROGRESS_WIDTH.saturating_sub(head.chars().count());
-    let name: Vec<char> = file.chars().collect();
-    let shown: String = if name.len() > room {
-        name[name.len() - room..].iter().collect()
-    } else {
-        file.to_string()
-    };
-    format!("{head}{shown:<room$}")
-}
-
-/// Detect in every file with `threads` workers pulling from a shared index.
+/// Detect in every file on `threads` workers (default: rayon's, one per
+/// core); the outcomes are in the order of `files`.
 pub(super) fn run_all(
     files: &[String],
     target: &Target,
     options: &DetectOptions,
-    threads: usize,
-) -> Vec<Outcome> {
-    let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    // A progress line on a terminal; nothing when stderr is piped or logged.
-    let progress = files.len() > 1 && std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let mut results: Vec<(usize, Outcome)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..threads.min(files.len()))
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, Ordering::Relaxed);
-                        let Some(file) = files.get(i) else { break };
-                        mine.push((i, one(file, target, options)));
-                        let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
-                        if progress {
-                            eprint!("\r{}", progress_bar(finished, files.len(), file));
-                        }
-                    }
-                    mine
-                })
+    threads: Option<usize>,
+) -> Result<Vec<Outcome>, CliError> {
+    // `--threads 0` has always meant one thread; rayon reads 0 as "default".
+    let threads = threads.map_or(0, |n| n.max(1));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| CliError::Io(format!("cannot start the detection threads: {e}")))?;
+    let bar = progress(files.len());
+    let outcomes = pool.install(|| {
+        files
+            .par_iter()
+            .map(|file| {
+                let outcome = guarded(file, target, options);
+                bar.set_message(file.clone());
+                bar.inc(1);
+                outcome
             })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap_or_else(|_| vec![]))
             .collect()
     });
-    if progress {
-        // Clear the bar: the summary that follows starts on a clean line.
-        eprint!("\r{:width$}\r", "", width = PROGRESS_WIDTH);
-    }
-    results.sort_by_key(|r| r.0);
-    // A worker that panicked leaves holes: report them rather than lose them.
-    let mut slots: Vec<Option<Outcome>> = (0..files.len()).map(|_| None).collect();
-    for (i, o) in results {
-        slots[i] = Some(o);
-    }
-    slots
-        .into_iter()
-        .map(|o| {
-            o.unwrap_or_else(|| {
-                Outcome::Failed(
-                    "internal".into(),
-                    "the detector crashed on this image".into(),
-                )
-            })
+    // The summary that follows starts on a clean line.
+    bar.finish_and_clear();
+    Ok(outcomes)
+}
+
+/// [`one`], with a panic of the detector reported as this image's failure
+/// instead of ending the run (nothing shared is mutated inside, so the
+/// `AssertUnwindSafe` holds).
+fn guarded(file: &str, target: &Target, options: &DetectOptions) -> Outcome {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| one(file, target, options)))
+        .unwrap_or_else(|_| {
+            Outcome::Failed(
+                "internal".into(),
+                "the detector crashed on this image".into(),
+            )
         })
-        .collect()
 }
 
 fn one(file: &str, target: &Target, options: &DetectOptions) -> Outcome {
@@ -222,14 +195,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn progress_bar_fills_in_proportion_and_keeps_its_width() {
-        let line = progress_bar(5, 20, "left05.jpg");
-        assert!(line.starts_with("robocal [######..................]  5/20 left05.jpg"));
-        assert_eq!(line.chars().count(), PROGRESS_WIDTH);
-        let long = format!("/data/{}/view.png", "x".repeat(100));
-        let line = progress_bar(20, 20, &long);
-        assert!(line.starts_with("robocal [########################] 20/20 "));
-        assert!(line.ends_with("xx/view.png"));
-        assert_eq!(line.chars().count(), PROGRESS_WIDTH);
+    fn the_progress_template_parses() {
+        assert!(ProgressStyle::with_template(PROGRESS_TEMPLATE).is_ok());
+    }
+
+    #[test]
+    fn outcomes_come_in_input_order_on_many_threads() {
+        let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+        let files: Vec<String> = (0..12).map(|i| format!("/nonexistent/view{i}.png")).collect();
+        let outcomes = run_all(&files, &target, &DetectOptions::default(), Some(4)).unwrap();
+        assert_eq!(outcomes.len(), files.len());
+        for (file, o) in files.iter().zip(&outcomes) {
+            match o {
+                Outcome::Failed(kind, message) => {
+                    assert_eq!(kind, "io");
+                    assert!(message.contains(file.as_str()), "{message} for {file}");
+                }
+                Outcome::Found(..) => panic!("{file} does not exist"),
+            }
+        }
     }
 }

@@ -1,61 +1,102 @@
 //! `robocal handeye`: read the pose files, call the library, write the report.
 
-use super::args::{Args, Spec};
 use super::handeye_images::{image_pairs, read_robot_poses, RobotPoses};
-use super::{read_file, CliError};
+use super::{parse_target, read_file, CliError};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
 use robocal::handeye::pose_text::{parse_pose_text, PoseTextFormat};
 use robocal::handeye::refined::{apply_refinement, RefineMode};
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
-use robocal::target::Target;
 
-/// Help text.
-pub const HELP: &str = "robocal handeye - hand-eye calibration (camera on or beside a robot)
+#[derive(clap::Args)]
+#[command(
+    about = "hand-eye calibration from robot poses and camera poses",
+    long_about = "hand-eye calibration (camera on or beside a robot)
 
-Usage:
   robocal handeye --setup eye-in-hand|eye-to-hand --poses FILE [--pose-format NAME]
                   --camera camera.json --target SPEC IMAGES... [--refine MODE] [--threads N]
                   [--method all|NAME] [--bootstrap N] [--seed N] [--lenient] -o handeye.json
   robocal handeye --setup ... --poses FILE [--pose-format NAME]
-                  --camera-poses FILE [--camera-pose-format NAME] [...] -o handeye.json
-
-  --poses FILE          robot poses base_from_gripper, one per view: any robot pose file
-                        (CSV/TSV/text/JSON with a header such as x,y,z,rx,ry,rz; 16 numbers
-                        a line = row-major 4x4 in metres); an 'image' column pairs poses
-                        with images by file name, otherwise poses and images pair by order
-  --pose-format NAME    a pose-file format (ur, kuka, abb, fanuc, xyz_quat_xyzw, matrix4, ...)
-                        or a line format: matrix (16 or 12 numbers), xyz-quaternion-xyzw,
-                        xyz-quaternion-wxyz. Without it an ambiguous file is read every
-                        plausible way and the reading that fits the camera motion is used
-                        (with a warning)
-  --camera FILE         the camera (robocal camera JSON or calibration report, OpenCV
-                        YAML/XML, ROS camera_info)
-  --target SPEC         the board, e.g. chessboard:9x6:30mm
-  IMAGES                one image per pose; images whose detection fails are dropped with
-                        their pose (the report's 'pairs' lists every pair and why)
-  --refine MODE         trusted (default with images), stochastic (robot pose noise
-                        estimated), joint_intrinsics (camera refined too) or none
-  --threads N           images detected in parallel (default: all cores)
-  --camera-poses FILE   camera_from_target per view instead of images (line formats of
-                        --pose-format), paired by order
-  --method NAME         all (default) or one of: tsai-lenz, park-martin, horaud, andreff,
-                        daniilidis, chou-kamel, shah, li
-  --bootstrap N         bootstrap resamples for repeatability (default 100, 0 = off)
-  --lenient             report suspected input mistakes (units, inverted or shifted poses)
-                        as warnings instead of failing
-  -o FILE               write the JSON report there (default: standard output)
-
-Output JSON: gripper_from_camera or base_from_camera, base_from_target or
+                  --camera-poses FILE [--camera-pose-format NAME] [...] -o handeye.json",
+    after_help = "Output JSON: gripper_from_camera or base_from_camera, base_from_target or
 gripper_from_target (each {matrix_row_major, translation_m, quaternion_xyzw}),
 methods, errors {translation_rms_mm, translation_max_mm, rotation_rms_deg,
 rotation_max_deg, reprojection_rms_px}, per_view, motion, repeatability, warnings,
 and with images: pairs [{pose_index, image, used, view, reason, pose_fit_rms_px}] and
 refinement. With refinement the main transform is the refined one (method
-'refined from <closed form>'); methods still lists every closed form.";
+'refined from <closed form>'); methods still lists every closed form.
 
-fn pose_format(args: &Args, flag: &str) -> Result<Option<PoseTextFormat>, CliError> {
-    args.value(flag)
+Examples:
+  robocal handeye --setup eye-in-hand --poses robot.csv --camera camera.json \\
+                  --target chessboard:9x6:30mm view*.png -o handeye.json
+  robocal handeye --setup eye-in-hand --poses robot.csv --camera-poses cam.txt -o handeye.json
+  robocal export handeye.json --format urdf",
+    args_override_self = true
+)]
+pub struct HandeyeArgs {
+    /// eye-in-hand (camera on the gripper) or eye-to-hand (camera beside the robot)
+    #[arg(long, value_name = "SETUP")]
+    setup: Option<String>,
+    /// Robot poses base_from_gripper, one per view: any robot pose file
+    /// (CSV/TSV/text/JSON with a header such as x,y,z,rx,ry,rz; 16 numbers a
+    /// line = row-major 4x4 in metres); an 'image' column pairs poses with
+    /// images by file name, otherwise poses and images pair by order
+    #[arg(long, value_name = "FILE")]
+    poses: Option<String>,
+    /// A pose-file format (ur, kuka, abb, fanuc, xyz_quat_xyzw, matrix4, ...)
+    /// or a line format: matrix (16 or 12 numbers), xyz-quaternion-xyzw,
+    /// xyz-quaternion-wxyz. Without it an ambiguous file is read every
+    /// plausible way and the reading that fits the camera motion is used (with
+    /// a warning)
+    #[arg(long, value_name = "NAME")]
+    pose_format: Option<String>,
+    /// The camera (robocal camera JSON or calibration report, OpenCV YAML/XML,
+    /// ROS camera_info)
+    #[arg(long, value_name = "FILE")]
+    camera: Option<String>,
+    /// The board, e.g. chessboard:9x6:30mm
+    #[arg(long, value_name = "SPEC")]
+    target: Option<String>,
+    /// trusted (default with images), stochastic (robot pose noise
+    /// estimated), joint_intrinsics (camera refined too) or none
+    #[arg(long, value_name = "MODE")]
+    refine: Option<String>,
+    /// Images detected in parallel (default: all cores)
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    /// camera_from_target per view instead of images (line formats of
+    /// --pose-format), paired by order
+    #[arg(long, value_name = "FILE")]
+    camera_poses: Option<String>,
+    /// The line format of --camera-poses (matrix, xyz-quaternion-xyzw,
+    /// xyz-quaternion-wxyz)
+    #[arg(long, value_name = "NAME")]
+    camera_pose_format: Option<String>,
+    /// all (default) or one of: tsai-lenz, park-martin, horaud, andreff,
+    /// daniilidis, chou-kamel, shah, li
+    #[arg(long, value_name = "NAME")]
+    method: Option<String>,
+    /// Bootstrap resamples for repeatability (0 = off)
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    bootstrap: usize,
+    /// Seed of the bootstrap resampling
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    seed: u64,
+    /// Report suspected input mistakes (units, inverted or shifted poses) as
+    /// warnings instead of failing
+    #[arg(long)]
+    lenient: bool,
+    /// Write the JSON report there (default: standard output)
+    #[arg(short = 'o', long, value_name = "FILE")]
+    output: Option<String>,
+    /// One image per pose; images whose detection fails are dropped with their
+    /// pose (the report's 'pairs' lists every pair and why)
+    #[arg(value_name = "IMAGES")]
+    images: Vec<String>,
+}
+
+fn pose_format(value: Option<&str>) -> Result<Option<PoseTextFormat>, CliError> {
+    value
         .map(|v| v.parse::<PoseTextFormat>().map_err(CliError::from))
         .transpose()
 }
@@ -66,56 +107,38 @@ fn read_text(path: &str) -> Result<String, CliError> {
 }
 
 /// Run `robocal handeye`.
-pub fn run(raw: &[String]) -> Result<(), CliError> {
-    let spec = Spec {
-        command: "handeye",
-        valued: &[
-            "setup",
-            "poses",
-            "pose-format",
-            "camera-poses",
-            "camera-pose-format",
-            "method",
-            "bootstrap",
-            "seed",
-            "camera",
-            "target",
-            "refine",
-            "threads",
-            "output",
-        ],
-        switches: &["lenient"],
-    };
-    let args = Args::parse(raw, &spec)?;
+pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     let setup: Setup = args
-        .value("setup")
+        .setup
+        .as_deref()
         .ok_or_else(|| CliError::usage("handeye", "--setup eye-in-hand|eye-to-hand is required"))?
         .parse()?;
     let poses_path = args
-        .value("poses")
+        .poses
+        .as_deref()
         .ok_or_else(|| CliError::usage("handeye", "--poses FILE is required"))?;
     let mut options = HandEyeOptions {
-        strict_checks: !args.switch("lenient"),
-        bootstrap_samples: args.parsed("handeye", "bootstrap", 100usize)?,
-        seed: args.parsed("handeye", "seed", 1u64)?,
+        strict_checks: !args.lenient,
+        bootstrap_samples: args.bootstrap,
+        seed: args.seed,
         ..Default::default()
     };
-    match args.value("method") {
+    match args.method.as_deref() {
         None | Some("all") => {}
         Some(name) => options.methods = vec![name.parse::<HandEyeMethod>()?],
     }
     let poses_text = read_text(poses_path)?;
     let mut pairs = Vec::new();
     let mut pre_warnings = Vec::new();
-    let (input, images) = match (args.value("camera-poses"), args.value("camera")) {
+    let (input, images) = match (args.camera_poses.as_deref(), args.camera.as_deref()) {
         (Some(camera_path), None) => {
-            if !args.positionals.is_empty() {
+            if !args.images.is_empty() {
                 return Err(CliError::usage(
                     "handeye",
                     "images need --camera and --target, not --camera-poses",
                 ));
             }
-            let robot = match read_robot_poses(&poses_text, args.value("pose-format"))? {
+            let robot = match read_robot_poses(&poses_text, args.pose_format.as_deref())? {
                 RobotPoses::Known(p) => p,
                 RobotPoses::Ambiguous(_) => {
                     return Err(CliError::usage(
@@ -126,7 +149,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             };
             let camera_from_target = parse_pose_text(
                 &read_text(camera_path)?,
-                pose_format(&args, "camera-pose-format")?,
+                pose_format(args.camera_pose_format.as_deref())?,
             )?;
             let input = HandEyeInput {
                 setup,
@@ -140,17 +163,21 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             let value = serde_json::from_str(&camera_text)
                 .unwrap_or(serde_json::Value::String(camera_text));
             let camera = camera_from_json(&value)?;
-            let target = parse_target(&args)?;
-            if args.positionals.is_empty() {
+            let text = args.target.as_deref().ok_or_else(|| {
+                CliError::usage(
+                    "handeye",
+                    "--target SPEC is required with images, e.g. chessboard:9x6:30mm",
+                )
+            })?;
+            let target = parse_target("handeye", text)?;
+            if args.images.is_empty() {
                 return Err(CliError::usage(
                     "handeye",
                     "give the images after the options",
                 ));
             }
-            let robot = read_robot_poses(&poses_text, args.value("pose-format"))?;
-            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-            let threads: usize = args.parsed("handeye", "threads", cores)?;
-            let found = image_pairs(setup, robot, &args.positionals, &camera, &target, threads)?;
+            let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())?;
+            let found = image_pairs(setup, robot, &args.images, &camera, &target, args.threads)?;
             pairs = found.pairs;
             pre_warnings = found.warnings;
             let input = HandEyeInput {
@@ -173,7 +200,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             ))
         }
     };
-    let mode = match (args.value("refine"), &images) {
+    let mode = match (args.refine.as_deref(), &images) {
         (Some(name), _) => name.parse::<RefineMode>()?,
         (None, Some(_)) => RefineMode::Trusted,
         (None, None) => RefineMode::None,
@@ -203,7 +230,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     report.pairs = pairs;
     let json = serde_json::to_string_pretty(&report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
-    match args.value("output") {
+    match &args.output {
         Some(path) => std::fs::write(path, json + "\n")
             .map_err(|e| CliError::Io(format!("cannot write '{path}': {e}")))?,
         None => println!("{json}"),
@@ -212,19 +239,4 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     Ok(())
-}
-
-fn parse_target(args: &Args) -> Result<Target, CliError> {
-    let text = args.value("target").ok_or_else(|| {
-        CliError::usage(
-            "handeye",
-            "--target SPEC is required with images, e.g. chessboard:9x6:30mm",
-        )
-    })?;
-    if text.trim_start().starts_with('{') {
-        let t: Target = serde_json::from_str(text)
-            .map_err(|e| CliError::usage("handeye", format!("--target JSON: {e}")))?;
-        return Ok(t.validated()?);
-    }
-    Target::parse_spec(text).map_err(|e| CliError::usage("handeye", e.to_string()))
 }

@@ -148,11 +148,11 @@ pub(super) fn image_pairs(
     images: &[String],
     camera: &Camera,
     target: &Target,
-    threads: usize,
+    threads: Option<usize>,
 ) -> Result<ImagePairs, CliError> {
     let mut warnings = Vec::new();
     let pairing = pair_images(robot.first(), images)?;
-    let outcomes = run_all(images, target, &DetectOptions::default(), threads.max(1));
+    let outcomes = run_all(images, target, &DetectOptions::default(), threads)?;
     let mut fitted: Vec<Result<(ViewPoints, Pose, f64), String>> = Vec::new();
     for outcome in outcomes {
         fitted.push(match outcome {

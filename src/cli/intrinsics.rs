@@ -1,7 +1,6 @@
 //! `robocal intrinsics`: calibrate a camera from images or from the
 //! detections `robocal detect` wrote.
 
-use super::args::{Args, Spec};
 use super::detect::{run_all, Outcome};
 use super::{read_text, write_output, CliError};
 use robocal::calib::compare::ComparisonRow;
@@ -12,46 +11,77 @@ use robocal::detect::DetectOptions;
 use robocal::target::{Detection, Target};
 use serde::Deserialize;
 
-pub const HELP: &str = "robocal intrinsics - calibrate a camera (intrinsics and lens distortion)
+#[derive(clap::Args)]
+#[command(
+    about = "calibrate a camera (Zhang, DLT, Tsai, EKF) from images or detections",
+    long_about = "calibrate a camera (intrinsics and lens distortion)
 
-Usage: robocal intrinsics --target SPEC IMAGES... [options] -o camera.json
-       robocal intrinsics --detections detections.json [options] -o camera.json
-
-Options:
-  --target SPEC           the target, as for 'robocal detect' (chessboard:9x6:30mm,
-                          circles:4x11:20mm:asymmetric, dots:7x7:25mm,
-                          squares:8x8:12.7mm:22.5778mm); required
-                          with images, checked against the file with --detections
-  --detections FILE       use the JSON written by 'robocal detect' instead of images
-  --model NAME            brown (default: k1 k2 p1 p2 k3; also called brown5, OpenCV's
-                          5 coefficients), radial_k1_k2_k5, rational, division,
-                          kannala_brandt, eucm, none
-  --method NAME           zhang (default), dlt (non-coplanar points), tsai, ekf, or
-                          all (every method side by side, as seed 000's Table II; the
-                          report is Zhang's, the comparison goes to standard error)
-  --fix-principal-point   hold the principal point at the image centre
-  --fix-aspect-ratio      hold fy/fx at its closed-form value
-  --aspect-ratio R        hold fx/fy at R exactly (1 = square pixels, fx = fy); as
-                          OpenCV's CALIB_FIX_ASPECT_RATIO with aspectRatio R (the
-                          OpenCV calibration sample's -a), implies --fix-aspect-ratio
-  --free-skew             estimate the skew (default: held at 0, as OpenCV)
-  --fix NAME              hold a distortion coefficient at 0 (repeatable: --fix k3)
-  --robust                Huber loss and rejection of points beyond 3 robust sigmas
-  --threads N             images detected in parallel (default: all cores)
-  --repeat N              benchmarking: solve N times and print the median solve time
-                          (detections in, report out; no file or detection time) on
-                          standard error (default 1: no timing line)
-  -o FILE                 write the report there (default: standard output)
+  robocal intrinsics --target SPEC IMAGES... [options] -o camera.json
+  robocal intrinsics --detections detections.json [options] -o camera.json
 
 Images where the target is not found are listed on standard error and skipped.
 The report (JSON) has camera_matrix, distortion, rms_px, std, per-view residuals,
-correlations, projection uncertainty and warnings; 'robocal export' converts it.
-
-Examples:
+correlations, projection uncertainty and warnings; 'robocal export' converts it.",
+    after_help = "Examples:
   robocal intrinsics --target chessboard:9x6:25mm left*.jpg -o camera.json
   robocal intrinsics --detections detections.json --fix-aspect-ratio --fix k3 -o camera.json
   robocal intrinsics --target chessboard:9x6:25mm --method all --robust left*.jpg
-  robocal export camera.json --format opencv-yaml -o camera.yaml";
+  robocal export camera.json --format opencv-yaml -o camera.yaml",
+    args_override_self = true
+)]
+pub struct IntrinsicsArgs {
+    /// The target, as for 'robocal detect' (chessboard:9x6:30mm,
+    /// circles:4x11:20mm:asymmetric, dots:7x7:25mm, squares:8x8:12.7mm:22.5778mm);
+    /// required with images, checked against the file with --detections
+    #[arg(long, value_name = "SPEC")]
+    target: Option<String>,
+    /// Use the JSON written by 'robocal detect' instead of images
+    #[arg(long, value_name = "FILE")]
+    detections: Option<String>,
+    /// brown (default: k1 k2 p1 p2 k3; also called brown5, OpenCV's 5
+    /// coefficients), radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none
+    #[arg(long, value_name = "NAME")]
+    model: Option<String>,
+    /// zhang (default), dlt (non-coplanar points), tsai, ekf, or all (every
+    /// method side by side, as seed 000's Table II; the report is Zhang's, the
+    /// comparison goes to standard error)
+    #[arg(long, value_name = "NAME")]
+    method: Option<String>,
+    /// Hold the principal point at the image centre
+    #[arg(long)]
+    fix_principal_point: bool,
+    /// Hold fy/fx at its closed-form value
+    #[arg(long)]
+    fix_aspect_ratio: bool,
+    /// Hold fx/fy at R exactly (1 = square pixels, fx = fy); as OpenCV's
+    /// CALIB_FIX_ASPECT_RATIO with aspectRatio R (the OpenCV calibration
+    /// sample's -a), implies --fix-aspect-ratio
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    aspect_ratio: Option<f64>,
+    /// Estimate the skew (default: held at 0, as OpenCV)
+    #[arg(long)]
+    free_skew: bool,
+    /// Hold a distortion coefficient at 0 (repeatable: --fix k3)
+    #[arg(long, value_name = "NAME")]
+    fix: Vec<String>,
+    /// Huber loss and rejection of points beyond 3 robust sigmas
+    #[arg(long)]
+    robust: bool,
+    /// Images detected in parallel (default: all cores)
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    /// Benchmarking: solve N times and print the median solve time (detections
+    /// in, report out; no file or detection time) on standard error (1: no
+    /// timing line)
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    repeat: usize,
+    /// Write the report there (default: standard output)
+    #[arg(short = 'o', long, value_name = "FILE")]
+    output: Option<String>,
+    /// The images (instead of --detections)
+    #[arg(value_name = "IMAGES")]
+    images: Vec<String>,
+}
 
 /// One entry of `robocal detect`'s output.
 #[derive(Deserialize)]
@@ -67,35 +97,14 @@ struct DetectionsFile {
     images: Vec<DetectedImage>,
 }
 
-pub fn run(raw: &[String]) -> Result<(), CliError> {
-    let spec = Spec {
-        command: "intrinsics",
-        valued: &[
-            "target",
-            "detections",
-            "model",
-            "method",
-            "fix",
-            "threads",
-            "aspect-ratio",
-            "repeat",
-            "output",
-        ],
-        switches: &[
-            "fix-principal-point",
-            "fix-aspect-ratio",
-            "free-skew",
-            "robust",
-        ],
-    };
-    let args = Args::parse(raw, &spec)?;
-    let target = match args.value("target") {
+pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
+    let target = match args.target.as_deref() {
         Some(t) => {
             Some(Target::parse_spec(t).map_err(|e| CliError::usage("intrinsics", e.to_string()))?)
         }
         None => None,
     };
-    let views = match (args.value("detections"), args.positionals.is_empty()) {
+    let views = match (args.detections.as_deref(), args.images.is_empty()) {
         (Some(_), false) => {
             return Err(CliError::usage(
                 "intrinsics",
@@ -110,9 +119,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
                     "--target is required with images, e.g. --target chessboard:9x6:30mm",
                 )
             })?;
-            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-            let threads: usize = args.parsed("intrinsics", "threads", cores)?;
-            views_from_images(&args.positionals, &target, threads.max(1))
+            views_from_images(&args.images, &target, args.threads)?
         }
         (None, true) => {
             return Err(CliError::usage(
@@ -122,25 +129,21 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         }
     };
     let input = CalibrationInput {
-        model: args.value("model").unwrap_or("brown").to_string(),
-        method: args.value("method").unwrap_or("zhang").to_string(),
+        model: args.model.unwrap_or_else(|| "brown".to_string()),
+        method: args.method.unwrap_or_else(|| "zhang".to_string()),
         options: JsonOptions {
-            fix_principal_point: args.switch("fix-principal-point"),
-            fix_aspect_ratio: args.switch("fix-aspect-ratio"),
-            aspect_ratio: match args.value("aspect-ratio") {
-                Some(_) => Some(args.parsed("intrinsics", "aspect-ratio", 1.0)?),
-                None => None,
-            },
-            zero_skew: !args.switch("free-skew"),
-            robust: args.switch("robust"),
-            fixed_coefficients: args.values("fix").iter().map(|s| s.to_string()).collect(),
+            fix_principal_point: args.fix_principal_point,
+            fix_aspect_ratio: args.fix_aspect_ratio,
+            aspect_ratio: args.aspect_ratio,
+            zero_skew: !args.free_skew,
+            robust: args.robust,
+            fixed_coefficients: args.fix,
         },
         views,
         image_size_px: None,
     };
-    let repeat: usize = args.parsed("intrinsics", "repeat", 1)?;
-    let output = if repeat > 1 {
-        timed(&input, repeat)?
+    let output = if args.repeat > 1 {
+        timed(&input, args.repeat)?
     } else {
         calibrate_input(&input)?
     };
@@ -163,7 +166,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     }
     let text = serde_json::to_string_pretty(&output.report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
-    write_output(args.value("output"), &(text + "\n"))
+    write_output(args.output.as_deref(), &(text + "\n"))
 }
 
 /// Solve `repeat` times; the median wall time of one solve goes to
@@ -217,8 +220,12 @@ fn views_from_file(file: &str, target: Option<&Target>) -> Result<Vec<JsonView>,
     Ok(views)
 }
 
-fn views_from_images(files: &[String], target: &Target, threads: usize) -> Vec<JsonView> {
-    let outcomes = run_all(files, target, &DetectOptions::default(), threads);
+fn views_from_images(
+    files: &[String],
+    target: &Target,
+    threads: Option<usize>,
+) -> Result<Vec<JsonView>, CliError> {
+    let outcomes = run_all(files, target, &DetectOptions::default(), threads)?;
     let mut views = vec![];
     for (file, outcome) in files.iter().zip(outcomes) {
         match outcome {
@@ -233,7 +240,7 @@ fn views_from_images(files: &[String], target: &Target, threads: usize) -> Vec<J
             }
         }
     }
-    views
+    Ok(views)
 }
 
 fn comparison_table(rows: &[ComparisonRow]) -> String {

@@ -1,17 +1,27 @@
-//! Subcommand dispatch, help texts and the CLI's error type.
+//! The command line: the clap definitions of every subcommand, dispatch, the
+//! shared file helpers and the CLI's error type.
+//!
+//! clap reads the arguments (unknown flags, missing values and values that
+//! do not parse are its usage errors, exit 2); the checks that need more than
+//! one flag stay in each subcommand's `run`, with messages that say what to
+//! change. Every subcommand accepts a flag again and keeps the last value
+//! (`args_override_self`), as scripts that append an override expect.
 
-pub mod args;
 mod detect;
 mod export;
 mod handeye;
 mod handeye_images;
+mod info;
 mod intrinsics;
 mod planar;
 mod render;
 mod serve;
 mod stereo;
+mod target;
 mod xytable;
 
+use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
+use robocal::target::Target;
 use std::fmt;
 
 /// An error of the command line: a usage mistake (exit 2) or a failure (exit 1).
@@ -58,72 +68,103 @@ impl From<robocal::Error> for CliError {
     }
 }
 
-const HELP: &str = "robocal - camera and robot hand-eye calibration
+/// `robocal`: camera and robot hand-eye calibration.
+#[derive(Parser)]
+#[command(
+    name = "robocal",
+    version = robocal::VERSION,
+    about = "robocal - camera and robot hand-eye calibration",
+    propagate_version = true,
+    after_help = "Run 'robocal <command> --help' for the options and examples of each command."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
 
-Usage: robocal <command> [options]
+// The variants carry no doc comments: each subcommand's about, long_about
+// and examples are on its own Args struct, beside the flags they describe.
+#[derive(Subcommand)]
+enum Command {
+    Serve(serve::ServeArgs),
+    Export(export::ExportArgs),
+    Handeye(handeye::HandeyeArgs),
+    Detect(detect::DetectArgs),
+    Intrinsics(intrinsics::IntrinsicsArgs),
+    Stereo(stereo::StereoArgs),
+    Info(info::InfoArgs),
+    Render(render::RenderArgs),
+    Planar(planar::PlanarArgs),
+    Xytable(xytable::XytableArgs),
+    Target(target::TargetArgs),
+    Completions(CompletionsArgs),
+}
 
-Commands:
-  serve       serve the web app (a static folder) on http://127.0.0.1:8080
-  export      convert a calibration report into OpenCV, ROS, Kalibr, mrcal, Halcon,
-              MATLAB, URDF, robot-controller and other formats
-  handeye     hand-eye calibration from robot poses and camera poses
-  detect      find a calibration target (chessboard, circles, dots) in images
-  intrinsics  calibrate a camera (Zhang, DLT, Tsai, EKF) from images or detections
-  stereo      calibrate a stereo pair (both cameras and right_from_left) from paired images
-  info        decode images and print their format and size
-  render      synthetic target images with exact ground truth (and the demo session)
-  planar      eye-to-hand calibration at any height (plate corners per height)
-  xytable     camera over an XY-table with one circular target (batch DLT and
-              Kalman filter); --known-motion: camera-to-reference frame
+/// The shells `robocal completions` writes scripts for.
+#[derive(Clone, Copy, ValueEnum)]
+enum Shell {
+    Bash,
+    Zsh,
+    Fish,
+}
 
-Run 'robocal <command> --help' for the options of each command.
-Options common to all commands: --help, --version.";
+#[derive(clap::Args)]
+#[command(
+    about = "print a shell completion script (bash, zsh or fish) to standard output",
+    after_help = "Examples:
+  robocal completions bash > ~/.local/share/bash-completion/completions/robocal
+  robocal completions zsh > \"${fpath[1]}/_robocal\"
+  robocal completions fish > ~/.config/fish/completions/robocal.fish"
+)]
+struct CompletionsArgs {
+    /// The shell
+    shell: Shell,
+}
 
-/// Run the command line `args` (without the program name).
-pub fn run(args: &[String]) -> Result<(), CliError> {
-    let Some((command, rest)) = args.split_first() else {
-        println!("{HELP}");
-        return Ok(());
+/// Run the parsed command line.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    let Some(command) = cli.command else {
+        // No subcommand: the overview, as `robocal --help` (exit 0).
+        return Cli::command()
+            .print_help()
+            .map_err(|e| CliError::Io(format!("cannot write to stdout: {e}")));
     };
-    let wants_help = rest.iter().any(|a| a == "--help" || a == "-h");
-    match command.as_str() {
-        "--help" | "-h" | "help" => {
-            println!("{HELP}");
-            Ok(())
-        }
-        "--version" | "-V" => {
-            println!("robocal {}", robocal::VERSION);
-            Ok(())
-        }
-        "render" if wants_help => print_help(render::HELP),
-        "render" => render::run(rest),
-        "serve" if wants_help => print_help(serve::HELP),
-        "serve" => serve::run(rest),
-        "intrinsics" if wants_help => print_help(intrinsics::HELP),
-        "intrinsics" => intrinsics::run(rest),
-        "stereo" if wants_help => print_help(stereo::HELP),
-        "stereo" => stereo::run(rest),
-        "export" if wants_help => print_help(export::HELP),
-        "export" => export::run(rest),
-        "handeye" if wants_help => print_help(handeye::HELP),
-        "handeye" => handeye::run(rest),
-        "detect" if wants_help => print_help(detect::HELP),
-        "detect" => detect::run(rest),
-        "info" if wants_help => print_help(INFO_HELP),
-        "info" => info(rest),
-        "planar" if wants_help => print_help(planar::HELP),
-        "planar" => planar::run(rest),
-        "xytable" if wants_help => print_help(xytable::HELP),
-        "xytable" => xytable::run(rest),
-        other => Err(CliError::Usage(format!(
-            "unknown command '{other}'; run 'robocal --help' for the list"
-        ))),
+    match command {
+        Command::Serve(a) => serve::run(a),
+        Command::Export(a) => export::run(a),
+        Command::Handeye(a) => handeye::run(a),
+        Command::Detect(a) => detect::run(a),
+        Command::Intrinsics(a) => intrinsics::run(a),
+        Command::Stereo(a) => stereo::run(a),
+        Command::Info(a) => info::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Planar(a) => planar::run(a),
+        Command::Xytable(a) => xytable::run(a),
+        Command::Target(a) => target::run(a),
+        Command::Completions(a) => completions(a.shell),
     }
 }
 
-fn print_help(text: &str) -> Result<(), CliError> {
-    println!("{text}");
-    Ok(())
+fn completions(shell: Shell) -> Result<(), CliError> {
+    let shell = match shell {
+        Shell::Bash => clap_complete::Shell::Bash,
+        Shell::Zsh => clap_complete::Shell::Zsh,
+        Shell::Fish => clap_complete::Shell::Fish,
+    };
+    let mut script = Vec::new();
+    clap_complete::generate(shell, &mut Cli::command(), "robocal", &mut script);
+    write_output(None, &String::from_utf8_lossy(&script))
+}
+
+/// The target of `--target TEXT`: a spec (`chessboard:9x6:30mm`) or a target
+/// JSON object; mistakes are usage errors of `command`.
+pub fn parse_target(command: &str, text: &str) -> Result<Target, CliError> {
+    if text.trim_start().starts_with('{') {
+        let t: Target = serde_json::from_str(text)
+            .map_err(|e| CliError::usage(command, format!("--target JSON: {e}")))?;
+        return Ok(t.validated()?);
+    }
+    Target::parse_spec(text).map_err(|e| CliError::usage(command, e.to_string()))
 }
 
 /// Read a whole text file, with an error that names it.
@@ -151,49 +192,12 @@ pub fn read_file(path: &str) -> Result<Vec<u8>, CliError> {
     std::fs::read(path).map_err(|e| CliError::Io(format!("cannot read '{path}': {e}")))
 }
 
-const INFO_HELP: &str = "robocal info - decode images and print what they are
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-Usage: robocal info IMAGES...
-
-Prints one JSON object per line: {\"file\", \"format\", \"width\", \"height\",
-\"channels\", \"bits_per_channel\"} or {\"file\", \"error\"} for files that are not
-supported images. Exits with 1 if any file failed.
-
-Example:
-  robocal info left01.jpg board.tiff";
-
-fn info(raw: &[String]) -> Result<(), CliError> {
-    let spec = args::Spec {
-        command: "info",
-        valued: &[],
-        switches: &[],
-    };
-    let parsed = args::Args::parse(raw, &spec)?;
-    if parsed.positionals.is_empty() {
-        return Err(CliError::usage("info", "give at least one image file"));
+    #[test]
+    fn the_clap_definitions_are_consistent() {
+        Cli::command().debug_assert();
     }
-    let mut failed = 0;
-    for file in &parsed.positionals {
-        let line = match read_file(file)
-            .and_then(|b| robocal::image::decode(&b, &Default::default()).map_err(CliError::from))
-        {
-            Ok(d) => {
-                let mut v = serde_json::to_value(&d.info).unwrap_or_default();
-                v["file"] = serde_json::Value::String(file.clone());
-                v
-            }
-            Err(e) => {
-                failed += 1;
-                serde_json::json!({ "file": file, "error": e.to_string() })
-            }
-        };
-        println!("{line}");
-    }
-    if failed > 0 {
-        return Err(CliError::Io(format!(
-            "{failed} of {} files could not be decoded",
-            parsed.positionals.len()
-        )));
-    }
-    Ok(())
 }

@@ -1,6 +1,5 @@
 //! `robocal planar fit|solve`: eye-to-hand calibration at any height (seed 001).
 
-use super::args::{Args, Spec};
 use super::{read_text, write_output, CliError};
 use robocal::io::workflow_csv::{parse_planar_matrices, parse_planar_points};
 use robocal::workflows::planar::TransformKind;
@@ -9,10 +8,13 @@ use robocal::workflows::planar_api::{
 };
 use robocal::workflows::planar_solve::PlanarSolveOptions;
 
-pub const HELP: &str = "robocal planar - eye-to-hand calibration at any height (planar plate)
+#[derive(clap::Args)]
+#[command(
+    about = "eye-to-hand calibration at any height (plate corners per height)",
+    long_about = "eye-to-hand calibration at any height (planar plate)
 
-Usage: robocal planar fit MATRICES.csv [options]
-       robocal planar solve POINTS.csv [--transform rigid|similarity|affine] [options]
+  robocal planar fit MATRICES.csv [options]
+  robocal planar solve POINTS.csv [--transform rigid|similarity|affine] [options]
 
 'fit' takes one 2x3 image->robot matrix per calibration height, header
   height_mm,a11,a12,tx,a21,a22,ty
@@ -36,69 +38,69 @@ residuals_mm, rms_mm), 'pixel_density', 'density_fit', and 'exact_family'
 {projection_matrix, rms_px}: the physically exact alternative (the 3x4
 projection of robot (x, y, z = height) in mm fitted by the 12-parameter DLT;
 the image of each plane is a homography, linear in height; needs >= 6
-points) with 'exact_predictions_mm' for the --point pixels.
-
-Options:
-  --transform KIND      solve: rigid, similarity or affine (default: affine,
-                        the model of the seed article's Table 4)
-  --reject SIGMA        reject heights whose residual exceeds SIGMA standard
-                        deviations (externally studentized, per parameter,
-                        at most a quarter of them), then refit
-  --camera FILE         solve: a calibrated camera (robocal JSON, OpenCV
-                        YAML/XML or ROS camera_info); the image points are
-                        undistorted with it first
-  --plate-size-mm L,W   solve: plate length |AB| and width |BC| for the pixel
-                        density (default: from the robot coordinates)
-  --predict HEIGHT_MM   map pixels at this height (with --point)
-  --point U,V           the pixel to map (repeatable); prints robot_mm and a
-                        one-sigma std_mm from the fitted lines
-  -o FILE               write the JSON to FILE instead of stdout
-
-Examples:
+points) with 'exact_predictions_mm' for the --point pixels.",
+    after_help = "Examples:
   robocal planar fit fixtures/seed001/table4_matrices.csv --predict 60 --point 2000,1500
-  robocal planar solve corners.csv --transform similarity --reject 3 -o planar.json";
+  robocal planar solve corners.csv --transform similarity --reject 3 -o planar.json",
+    args_override_self = true
+)]
+pub struct PlanarArgs {
+    /// fit (one 2x3 matrix per height) or solve (point pairs per height)
+    #[arg(value_name = "fit|solve")]
+    mode: Option<Mode>,
+    /// MATRICES.csv for fit, POINTS.csv for solve
+    #[arg(value_name = "FILE")]
+    file: Option<String>,
+    /// solve: rigid, similarity or affine (default: affine, the model of the
+    /// seed article's Table 4)
+    #[arg(long, value_name = "KIND")]
+    transform: Option<String>,
+    /// Reject heights whose residual exceeds SIGMA standard deviations
+    /// (externally studentized, per parameter, at most a quarter of them),
+    /// then refit
+    #[arg(long, value_name = "SIGMA", allow_negative_numbers = true)]
+    reject: Option<f64>,
+    /// solve: a calibrated camera (robocal JSON, OpenCV YAML/XML or ROS
+    /// camera_info); the image points are undistorted with it first
+    #[arg(long, value_name = "FILE")]
+    camera: Option<String>,
+    /// solve: plate length |AB| and width |BC| for the pixel density
+    /// (default: from the robot coordinates)
+    #[arg(long, value_name = "L,W", allow_hyphen_values = true)]
+    plate_size_mm: Option<String>,
+    /// Map pixels at this height (with --point)
+    #[arg(long, value_name = "HEIGHT_MM", allow_negative_numbers = true)]
+    predict: Option<f64>,
+    /// The pixel to map (repeatable); prints robot_mm and a one-sigma std_mm
+    /// from the fitted lines
+    #[arg(long, value_name = "U,V", allow_hyphen_values = true)]
+    point: Vec<String>,
+    /// Write the JSON to FILE instead of stdout
+    #[arg(short = 'o', long, value_name = "FILE")]
+    output: Option<String>,
+}
 
-pub fn run(raw: &[String]) -> Result<(), CliError> {
-    let spec = Spec {
-        command: "planar",
-        valued: &[
-            "transform",
-            "reject",
-            "plate-size-mm",
-            "camera",
-            "predict",
-            "point",
-        ],
-        switches: &[],
-    };
-    let args = Args::parse(raw, &spec)?;
-    let (sub, file) = match args.positionals.as_slice() {
-        [sub, file] => (sub.as_str(), file.as_str()),
-        [] | [_] => {
-            return Err(CliError::usage(
-                "planar",
-                "give 'fit MATRICES.csv' or 'solve POINTS.csv'",
-            ))
-        }
-        [_, _, extra, ..] => {
-            return Err(CliError::usage(
-                "planar",
-                format!("unexpected argument '{extra}'"),
-            ))
-        }
-    };
-    let reject = match args.value("reject") {
-        None => None,
-        Some(_) => Some(args.parsed("planar", "reject", 3.0)?),
+/// What `robocal planar` does with the file.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Mode {
+    /// Fit one 2x3 image->robot matrix per height against height
+    Fit,
+    /// Fit the transform per height from point pairs, then against height
+    Solve,
+}
+
+pub fn run(args: PlanarArgs) -> Result<(), CliError> {
+    let (Some(mode), Some(file)) = (args.mode, args.file.as_deref()) else {
+        return Err(CliError::usage(
+            "planar",
+            "give 'fit MATRICES.csv' or 'solve POINTS.csv'",
+        ));
     };
     let predict = predictions(&args)?;
     let text = read_text(file)?;
-    let json = match sub {
-        "fit" => {
-            if ["transform", "plate-size-mm", "camera"]
-                .iter()
-                .any(|f| args.value(f).is_some())
-            {
+    let json = match mode {
+        Mode::Fit => {
+            if args.transform.is_some() || args.plate_size_mm.is_some() || args.camera.is_some() {
                 return Err(CliError::usage(
                     "planar",
                     "--transform, --plate-size-mm and --camera belong to 'solve'",
@@ -106,17 +108,17 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             }
             let request = PlanarFitRequest {
                 matrices: parse_planar_matrices(&text).map_err(|e| in_file(file, e))?,
-                reject_threshold: reject,
+                reject_threshold: args.reject,
                 predict,
             };
             serde_json::to_string_pretty(&planar_fit(&request)?)
         }
-        "solve" => {
-            let transform = match args.value("transform") {
+        Mode::Solve => {
+            let transform = match args.transform.as_deref() {
                 Some(t) => TransformKind::parse(t)?,
                 None => TransformKind::Affine,
             };
-            let camera = match args.value("camera") {
+            let camera = match args.camera.as_deref() {
                 None => None,
                 Some(path) => Some(
                     robocal::io::import_camera::import_camera(&read_text(path)?)
@@ -125,14 +127,15 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
                 ),
             };
             let plate_size_mm = args
-                .value("plate-size-mm")
+                .plate_size_mm
+                .as_deref()
                 .map(|v| pair(v, "plate-size-mm"))
                 .transpose()?;
             let request = PlanarSolveRequest {
                 points: parse_planar_points(&text).map_err(|e| in_file(file, e))?,
                 options: PlanarSolveOptions {
                     transform,
-                    reject_threshold: reject,
+                    reject_threshold: args.reject,
                     plate_size_mm,
                     camera,
                 },
@@ -140,15 +143,9 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             };
             serde_json::to_string_pretty(&planar_solve(&request)?)
         }
-        other => {
-            return Err(CliError::usage(
-                "planar",
-                format!("unknown subcommand '{other}' (expected fit or solve)"),
-            ))
-        }
     }
     .map_err(|e| CliError::Io(format!("cannot encode the result as JSON: {e}")))?;
-    write_output(args.value("output"), &format!("{json}\n"))
+    write_output(args.output.as_deref(), &format!("{json}\n"))
 }
 
 /// Prefix a parse error with the file name.
@@ -156,9 +153,8 @@ fn in_file(file: &str, e: robocal::Error) -> CliError {
     CliError::Io(format!("{file}: {e}"))
 }
 
-fn predictions(args: &Args) -> Result<Vec<PredictRequest>, CliError> {
-    let points = args.values("point");
-    match (args.value("predict"), points.is_empty()) {
+fn predictions(args: &PlanarArgs) -> Result<Vec<PredictRequest>, CliError> {
+    match (args.predict, args.point.is_empty()) {
         (None, true) => Ok(Vec::new()),
         (None, false) => Err(CliError::usage(
             "planar",
@@ -168,18 +164,16 @@ fn predictions(args: &Args) -> Result<Vec<PredictRequest>, CliError> {
             "planar",
             "--predict needs at least one --point U,V",
         )),
-        (Some(_), false) => {
-            let height_mm: f64 = args.parsed("planar", "predict", 0.0)?;
-            points
-                .iter()
-                .map(|p| {
-                    pair(p, "point").map(|image_px| PredictRequest {
-                        height_mm,
-                        image_px,
-                    })
+        (Some(height_mm), false) => args
+            .point
+            .iter()
+            .map(|p| {
+                pair(p, "point").map(|image_px| PredictRequest {
+                    height_mm,
+                    image_px,
                 })
-                .collect()
-        }
+            })
+            .collect(),
     }
 }
 

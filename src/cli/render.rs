@@ -1,7 +1,6 @@
 //! `robocal render`: synthetic calibration images from the project's seeded
 //! generator, with their exact ground truth.
 
-use super::args::{Args, Spec};
 use super::CliError;
 use robocal::camera::Camera;
 use robocal::io::export_transform::transform_json;
@@ -10,11 +9,14 @@ use robocal::synth::{render, RenderOptions, Scene};
 use robocal::target::Target;
 use std::path::Path;
 
-pub const HELP: &str = "robocal render - synthetic target images with exact ground truth
+#[derive(clap::Args)]
+#[command(
+    about = "synthetic target images with exact ground truth (and the demo session)",
+    long_about = "synthetic target images with exact ground truth
 
-Usage: robocal render --out DIR [--target SPEC] [--views N] [--seed N]
-                      [--camera camera.json] [--noise GREY] [--blur PX]
-       robocal render --out DIR --demo [--seed N]
+  robocal render --out DIR [--target SPEC] [--views N] [--seed N]
+                 [--camera camera.json] [--noise GREY] [--blur PX]
+  robocal render --out DIR --demo [--seed N]
 
 Renders N views of the target (random poses: tilt up to 45 degrees, the
 target spanning 35-60 % of the image width) through the camera, supersampled,
@@ -26,64 +28,69 @@ coordinates).
 
 --demo writes the web app's demo session instead: 12 chessboard images, the
 robot poses that go with them (DIR/poses.csv, Universal Robots format with an
-image column) and truth.json with gripper_from_camera and base_from_target.
-
-Options:
-  --target SPEC     chessboard:9x6:30mm (default), circles:..., dots:...,
-                    squares:...
-  --views N         number of images (default 12)
-  --seed N          random seed (default 1); equal seeds give equal files
-  --camera FILE     the camera (robocal/OpenCV/ROS camera file; default: a
-                    1024x768 camera with barrel distortion)
-  --noise GREY      grey-level noise sigma (default 2)
-  --blur PX         Gaussian blur sigma in pixels (default 0.7)
-
-Examples:
+image column) and truth.json with gripper_from_camera and base_from_target.",
+    after_help = "Examples:
   robocal render --out renders --views 20 --seed 7
-  robocal render --out demo --demo";
+  robocal render --out demo --demo",
+    args_override_self = true
+)]
+pub struct RenderArgs {
+    /// The folder to write into (created if missing)
+    #[arg(long, value_name = "DIR")]
+    out: Option<String>,
+    /// chessboard:9x6:30mm (default), circles:..., dots:..., squares:...
+    #[arg(long, value_name = "SPEC")]
+    target: Option<String>,
+    /// Number of images
+    #[arg(long, value_name = "N", default_value_t = 12)]
+    views: usize,
+    /// Random seed; equal seeds give equal files
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    seed: u64,
+    /// The camera (robocal/OpenCV/ROS camera file; default: a 1024x768 camera
+    /// with barrel distortion)
+    #[arg(long, value_name = "FILE")]
+    camera: Option<String>,
+    /// Grey-level noise sigma
+    #[arg(long, value_name = "GREY", default_value_t = 2.0)]
+    noise: f64,
+    /// Gaussian blur sigma in pixels
+    #[arg(long, value_name = "PX", default_value_t = 0.7)]
+    blur: f64,
+    /// Write the web app's demo session instead
+    #[arg(long)]
+    demo: bool,
+}
 
-pub fn run(raw: &[String]) -> Result<(), CliError> {
-    let spec = Spec {
-        command: "render",
-        valued: &["out", "target", "views", "seed", "camera", "noise", "blur"],
-        switches: &["demo"],
-    };
-    let args = Args::parse(raw, &spec)?;
-    if let Some(extra) = args.positionals.first() {
-        return Err(CliError::usage(
-            "render",
-            format!("unexpected argument '{extra}'"),
-        ));
-    }
+pub fn run(args: RenderArgs) -> Result<(), CliError> {
     let out = args
-        .value("out")
+        .out
+        .as_deref()
         .ok_or_else(|| CliError::usage("render", "--out DIR is required"))?;
-    let seed: u64 = args.parsed("render", "seed", 1)?;
     std::fs::create_dir_all(out)
         .map_err(|e| CliError::Io(format!("cannot create '{out}': {e}")))?;
     let out = Path::new(out);
-    if args.switch("demo") {
-        return write_demo(out, seed);
+    if args.demo {
+        return write_demo(out, args.seed);
     }
-    let target = Target::parse_spec(args.value("target").unwrap_or("chessboard:9x6:30mm"))?;
-    let views: usize = args.parsed("render", "views", 12)?;
-    if views == 0 || views > 1000 {
+    let target = Target::parse_spec(args.target.as_deref().unwrap_or("chessboard:9x6:30mm"))?;
+    if args.views == 0 || args.views > 1000 {
         return Err(CliError::usage(
             "render",
             "--views must be between 1 and 1000",
         ));
     }
-    let camera = match args.value("camera") {
+    let camera = match args.camera.as_deref() {
         Some(file) => robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0,
         None => demo_camera(),
     };
     let options = RenderOptions {
-        noise_sigma: args.parsed("render", "noise", 2.0)?,
-        blur_sigma_px: args.parsed("render", "blur", 0.7)?,
+        noise_sigma: args.noise,
+        blur_sigma_px: args.blur,
         vignetting: 0.2,
         ..RenderOptions::default()
     };
-    write_set(out, &camera, &target, views, seed, &options)
+    write_set(out, &camera, &target, args.views, args.seed, &options)
 }
 
 /// Grid of the target's points, as the scene generator places poses.

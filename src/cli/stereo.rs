@@ -1,100 +1,83 @@
 //! `robocal stereo`: calibrate a stereo pair from paired images of a board.
 
-use super::args::{Args, Spec};
 use super::detect::{run_all, Outcome};
 use super::{write_output, CliError};
 use robocal::calib::json_api::model_from_name;
 use robocal::calib::stereo::calibrate_stereo;
 use robocal::calib::{CalibrationOptions, View};
 use robocal::detect::DetectOptions;
+use robocal::io::pairing::{pair_by_number, PairedBy};
 use robocal::target::{Detection, Target};
 
-pub const HELP: &str =
-    "robocal stereo - calibrate a stereo camera pair (both cameras and right_from_left)
+// No `args_override_self`: a second --left or --right is an error (clap's),
+// not a replacement of the first list; the single-valued flags override
+// themselves one by one instead.
+#[derive(clap::Args)]
+#[command(
+    about = "calibrate a stereo pair (both cameras and right_from_left) from paired images",
+    long_about = "calibrate a stereo camera pair (both cameras and right_from_left)
 
-Usage: robocal stereo --target SPEC --left IMAGES... --right IMAGES... [options] -o stereo.json
-
-Options:
-  --target SPEC      the target, as for 'robocal detect' (chessboard:9x6:30mm, ...)
-  --left IMAGES...   the left camera's images (every argument up to the next option)
-  --right IMAGES...  the right camera's images, paired with --left by order
-  --model NAME       lens model of both cameras: brown (default), radial_k1_k2_k5,
-                     rational, division, kannala_brandt, eucm, none
-  --threads N        images detected in parallel (default: all cores)
-  -o FILE            write the report there (default: standard output)
+Left and right images are paired by the number in their file names: the last
+run of digits in the name without folders and extension (left07.png pairs with
+right07.png, or with r/cam_7.jpg), whatever the order they are given in. Every
+image must then have a number, unique on its side, and a partner on the other
+side. When no name has a number, the images are paired by order (and the
+command says so).
 
 Each camera is calibrated alone (Zhang), right_from_left is averaged over the
 pairs (seed 000: R = R_R R_L^-1, T = T_R - R T_L), then everything is refined
 jointly. Pairs where the target is not found in either image are dropped and
 listed on standard error. The report (JSON) has left, right (camera reports),
 right_from_left and initial_right_from_left ({matrix_row_major, translation_m,
-quaternion_xyzw}), baseline_m, right_from_left_std and rms_px.
-
-Examples:
+quaternion_xyzw}), baseline_m, right_from_left_std and rms_px.",
+    after_help = "Examples:
   robocal stereo --target chessboard:9x6:25mm --left left*.jpg --right right*.jpg -o stereo.json
   robocal stereo --target chessboard:9x6:25mm --model radial_k1_k2_k5 --left l/*.png --right r/*.png
-  robocal export stereo.json --format xyz-quat-xyzw";
-
-/// Split `--left A B --right C D` lists out of the arguments.
-fn split_lists(raw: &[String]) -> (Vec<String>, Vec<String>, Vec<String>, usize, usize) {
-    let (mut rest, mut left, mut right) = (vec![], vec![], vec![]);
-    let (mut n_left_flags, mut n_right_flags) = (0, 0);
-    let mut current: Option<bool> = None;
-    for a in raw {
-        match a.as_str() {
-            "--left" => {
-                current = Some(true);
-                n_left_flags += 1;
-            }
-            "--right" => {
-                current = Some(false);
-                n_right_flags += 1;
-            }
-            s if s.starts_with('-') && s.len() > 1 => {
-                current = None;
-                rest.push(a.clone());
-            }
-            _ => match current {
-                Some(true) => left.push(a.clone()),
-                Some(false) => right.push(a.clone()),
-                None => rest.push(a.clone()),
-            },
-        }
-    }
-    (rest, left, right, n_left_flags, n_right_flags)
+  robocal export stereo.json --format xyz-quat-xyzw"
+)]
+pub struct StereoArgs {
+    /// The target, as for 'robocal detect' (chessboard:9x6:30mm, ...)
+    #[arg(long, value_name = "SPEC", overrides_with = "target")]
+    target: Option<String>,
+    /// The left camera's images (every argument up to the next option)
+    #[arg(long, value_name = "IMAGES", num_args = 1.., action = clap::ArgAction::Set)]
+    left: Option<Vec<String>>,
+    /// The right camera's images, paired with --left by the number in their
+    /// names (by order when no name has a number)
+    #[arg(long, value_name = "IMAGES", num_args = 1.., action = clap::ArgAction::Set)]
+    right: Option<Vec<String>>,
+    /// Lens model of both cameras: brown (default), radial_k1_k2_k5, rational,
+    /// division, kannala_brandt, eucm, none
+    #[arg(long, value_name = "NAME", overrides_with = "model")]
+    model: Option<String>,
+    /// Images detected in parallel (default: all cores)
+    #[arg(long, value_name = "N", overrides_with = "threads")]
+    threads: Option<usize>,
+    /// Write the report there (default: standard output)
+    #[arg(short = 'o', long, value_name = "FILE", overrides_with = "output")]
+    output: Option<String>,
 }
 
-pub fn run(raw: &[String]) -> Result<(), CliError> {
-    let (rest, left_files, right_files, nl, nr) = split_lists(raw);
-    let spec = Spec {
-        command: "stereo",
-        valued: &["target", "model", "threads", "output"],
-        switches: &[],
-    };
-    let args = Args::parse(&rest, &spec)?;
-    if let Some(p) = args.positionals.first() {
-        return Err(CliError::usage(
-            "stereo",
-            format!("'{p}' is neither after --left nor after --right"),
-        ));
-    }
-    if nl != 1 || nr != 1 || left_files.is_empty() || right_files.is_empty() {
+pub fn run(args: StereoArgs) -> Result<(), CliError> {
+    let (Some(left_files), Some(right_files)) = (args.left, args.right) else {
         return Err(CliError::usage(
             "stereo",
             "give --left IMAGES... and --right IMAGES... once each",
         ));
+    };
+    // 1. Pair the files (by name numbers, else by order).
+    let pairing = {
+        let left: Vec<&str> = left_files.iter().map(String::as_str).collect();
+        let right: Vec<&str> = right_files.iter().map(String::as_str).collect();
+        pair_by_number(&left, &right).map_err(|e| match e {
+            robocal::Error::Invalid { message, .. } => CliError::usage("stereo", message),
+            other => other.into(),
+        })?
+    };
+    if pairing.paired_by == PairedBy::Order {
+        eprintln!("robocal stereo: no file name has a number: images paired by order");
     }
-    if left_files.len() != right_files.len() {
-        return Err(CliError::usage(
-            "stereo",
-            format!(
-                "images are paired by order: {} left but {} right",
-                left_files.len(),
-                right_files.len()
-            ),
-        ));
-    }
-    let target = args.value("target").ok_or_else(|| {
+    let target = args.target.as_deref().ok_or_else(|| {
         CliError::usage(
             "stereo",
             "--target is required, e.g. --target chessboard:9x6:30mm",
@@ -103,27 +86,33 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     let target =
         Target::parse_spec(target).map_err(|e| CliError::usage("stereo", e.to_string()))?;
     let options = CalibrationOptions {
-        model: model_from_name(args.value("model").unwrap_or("brown"))?,
+        model: model_from_name(args.model.as_deref().unwrap_or("brown"))?,
         ..CalibrationOptions::default()
     };
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let threads: usize = args.parsed("stereo", "threads", cores)?;
+    // 2. Detect in every image of both sides at once.
     let files: Vec<String> = left_files.iter().chain(&right_files).cloned().collect();
-    let mut outcomes = run_all(&files, &target, &DetectOptions::default(), threads.max(1));
-    let right_outcomes = outcomes.split_off(left_files.len());
+    let mut outcomes: Vec<Option<Outcome>> =
+        run_all(&files, &target, &DetectOptions::default(), args.threads)?
+            .into_iter()
+            .map(Some)
+            .collect();
+    // 3. Views of the pairs where both images gave a detection.
     let (mut left, mut right) = (vec![], vec![]);
     let (mut left_size, mut right_size) = (None, None);
-    let pairs = left_files.iter().zip(&right_files);
-    for ((lf, rf), (lo, ro)) in pairs.zip(outcomes.into_iter().zip(right_outcomes)) {
+    for &(l, r) in &pairing.pairs {
+        let (lf, rf) = (&left_files[l], &right_files[r]);
+        let lo = outcomes[l].take();
+        let ro = outcomes[left_files.len() + r].take();
         match (lo, ro) {
-            (Outcome::Found(ld, _), Outcome::Found(rd, _)) => {
+            (Some(Outcome::Found(ld, _)), Some(Outcome::Found(rd, _))) => {
                 left.push(view(lf, &ld, &mut left_size)?);
                 right.push(view(rf, &rd, &mut right_size)?);
             }
             (lo, ro) => {
-                let why = |f: &str, o: Outcome| match o {
-                    Outcome::Failed(_, m) => format!("{f}: {m}"),
-                    Outcome::Found(..) => format!("{f}: found"),
+                let why = |f: &str, o: Option<Outcome>| match o {
+                    Some(Outcome::Failed(_, m)) => format!("{f}: {m}"),
+                    Some(Outcome::Found(..)) => format!("{f}: found"),
+                    None => format!("{f}: in another pair too"),
                 };
                 eprintln!(
                     "robocal stereo: pair dropped ({}; {})",
@@ -138,6 +127,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             "stereo: the target was found in no pair of images".into(),
         ));
     };
+    // 4. Solve and report.
     let report = calibrate_stereo(&left, &right, ls, rs, &options)?;
     let t = report.right_from_left.translation_m;
     eprintln!(
@@ -153,7 +143,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
     );
     let text = serde_json::to_string_pretty(&report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
-    write_output(args.value("output"), &(text + "\n"))
+    write_output(args.output.as_deref(), &(text + "\n"))
 }
 
 /// The view of a detection; all images of one camera must share a size.

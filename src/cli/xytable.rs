@@ -2,18 +2,19 @@
 //! (seed 002), and `--known-motion` for the camera-to-reference frame from
 //! known motions of one point (seed 000, Eq. 27-28).
 
-use super::args::{Args, Spec};
 use super::{read_text, write_output, CliError};
 use robocal::calib::dlt_kalman::KalmanMode;
 use robocal::io::workflow_csv::{parse_known_motion, parse_xytable_with};
 use robocal::workflows::known_motion::solve_known_motion;
 use robocal::workflows::xytable::solve_xytable;
 
-pub const HELP: &str =
-    "robocal xytable - calibrate a camera over an XY-table with one circular target
+#[derive(clap::Args)]
+#[command(
+    about = "camera over an XY-table with one circular target (batch DLT and Kalman filter); --known-motion: camera-to-reference frame",
+    long_about = "calibrate a camera over an XY-table with one circular target
 
-Usage: robocal xytable POSITIONS.csv [--noise-px SIGMA] [--kalman extended|linearized] [-o FILE]
-       robocal xytable --known-motion MOTIONS.csv [--start-mm X,Y,Z] [-o FILE]
+  robocal xytable POSITIONS.csv [--noise-px SIGMA] [--kalman extended|linearized] [-o FILE]
+  robocal xytable --known-motion MOTIONS.csv [--start-mm X,Y,Z] [-o FILE]
 
 POSITIONS.csv: the target centre at N >= 6 non-coplanar stage positions,
 header
@@ -44,42 +45,45 @@ two directions). Prints camera_from_reference {translation_m,
 quaternion_xyzw}, start_camera_mm, residuals_mm, rms_mm. Only the rotation
 and the start point in the camera frame are observable; the translation
 needs the start position in the reference frame (--start-mm), otherwise the
-reference origin is placed at the start (reference_origin_given: false).
-
-Options:
-  --noise-px SIGMA      measurement noise std (px) when there are no 'still'
-                        rows (default: from the batch residuals)
-  --kalman MODE         extended (default: EKF once the state is determined)
-                        or linearized (the DLT constraint throughout)
-  --known-motion        solve the seed-000 frame from MOTIONS.csv instead
-  --start-mm X,Y,Z      known-motion: the start position in the reference frame
-  --target SPEC         the target in image files (default circle:10mm)
-  -o FILE               write the JSON to FILE instead of stdout
-
-Examples:
+reference origin is placed at the start (reference_origin_given: false).",
+    after_help = "Examples:
   robocal xytable positions.csv --kalman extended -o xytable.json
-  robocal xytable --known-motion motions.csv --start-mm 100,-50,20";
+  robocal xytable --known-motion motions.csv --start-mm 100,-50,20",
+    args_override_self = true
+)]
+pub struct XytableArgs {
+    /// POSITIONS.csv, or MOTIONS.csv with --known-motion
+    #[arg(value_name = "FILE")]
+    file: Option<String>,
+    /// Measurement noise std (px) when there are no 'still' rows (default:
+    /// from the batch residuals)
+    #[arg(long, value_name = "SIGMA", allow_negative_numbers = true)]
+    noise_px: Option<f64>,
+    /// extended (default: EKF once the state is determined) or linearized (the
+    /// DLT constraint throughout)
+    #[arg(long, value_name = "MODE")]
+    kalman: Option<String>,
+    /// Solve the seed-000 frame from MOTIONS.csv instead
+    #[arg(long)]
+    known_motion: bool,
+    /// known-motion: the start position in the reference frame
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    start_mm: Option<String>,
+    /// The target in image files (default circle:10mm)
+    #[arg(long, value_name = "SPEC")]
+    target: Option<String>,
+    /// Write the JSON to FILE instead of stdout
+    #[arg(short = 'o', long, value_name = "FILE")]
+    output: Option<String>,
+}
 
-pub fn run(raw: &[String]) -> Result<(), CliError> {
-    let spec = Spec {
-        command: "xytable",
-        valued: &["noise-px", "kalman", "start-mm", "target"],
-        switches: &["known-motion"],
-    };
-    let args = Args::parse(raw, &spec)?;
-    let file = match args.positionals.as_slice() {
-        [file] => file.as_str(),
-        [] => return Err(CliError::usage("xytable", "give the positions file")),
-        [_, extra, ..] => {
-            return Err(CliError::usage(
-                "xytable",
-                format!("unexpected argument '{extra}'"),
-            ))
-        }
+pub fn run(args: XytableArgs) -> Result<(), CliError> {
+    let Some(file) = args.file.as_deref() else {
+        return Err(CliError::usage("xytable", "give the positions file"));
     };
     let text = read_text(file)?;
-    let json = if args.switch("known-motion") {
-        if args.value("noise-px").is_some() || args.value("kalman").is_some() {
+    let json = if args.known_motion {
+        if args.noise_px.is_some() || args.kalman.is_some() {
             return Err(CliError::usage(
                 "xytable",
                 "--noise-px and --kalman do not apply to --known-motion",
@@ -87,16 +91,16 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         }
         let mut request =
             parse_known_motion(&text).map_err(|e| CliError::Io(format!("{file}: {e}")))?;
-        request.start_reference_mm = args.value("start-mm").map(triple).transpose()?;
+        request.start_reference_mm = args.start_mm.as_deref().map(triple).transpose()?;
         serde_json::to_string_pretty(&solve_known_motion(&request)?)
     } else {
-        if args.value("start-mm").is_some() {
+        if args.start_mm.is_some() {
             return Err(CliError::usage(
                 "xytable",
                 "--start-mm belongs to --known-motion",
             ));
         }
-        let target = match args.value("target") {
+        let target = match args.target.as_deref() {
             Some(spec) => robocal::target::Target::parse_spec(spec)?,
             None => robocal::target::Target::SingleCircle { diameter_m: 0.01 },
         };
@@ -120,8 +124,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         };
         let mut request = parse_xytable_with(&text, &mut centre_of)
             .map_err(|e| CliError::Io(format!("{file}: {e}")))?;
-        if args.value("noise-px").is_some() {
-            let sigma: f64 = args.parsed("xytable", "noise-px", 0.0)?;
+        if let Some(sigma) = args.noise_px {
             if !(sigma >= 0.0 && sigma.is_finite()) {
                 return Err(CliError::usage(
                     "xytable",
@@ -130,7 +133,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
             }
             request.measurement_noise_px2 = Some([[sigma * sigma, 0.0], [0.0, sigma * sigma]]);
         }
-        request.kalman_mode = match args.value("kalman") {
+        request.kalman_mode = match args.kalman.as_deref() {
             None | Some("extended") => KalmanMode::Extended,
             Some("linearized") => KalmanMode::Linearized,
             Some(other) => {
@@ -143,7 +146,7 @@ pub fn run(raw: &[String]) -> Result<(), CliError> {
         serde_json::to_string_pretty(&solve_xytable(&request)?)
     }
     .map_err(|e| CliError::Io(format!("cannot encode the result as JSON: {e}")))?;
-    write_output(args.value("output"), &format!("{json}\n"))
+    write_output(args.output.as_deref(), &format!("{json}\n"))
 }
 
 fn triple(text: &str) -> Result<[f64; 3], CliError> {

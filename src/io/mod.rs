@@ -12,6 +12,7 @@ pub mod export_camera;
 mod export_camera_tools;
 pub mod export_transform;
 pub mod import_camera;
+pub mod pairing;
 mod pose_candidates;
 mod pose_formats;
 mod pose_json;

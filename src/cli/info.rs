@@ -1,0 +1,51 @@
+//! `robocal info`: decode images and print their format and size.
+
+use super::{read_file, CliError};
+
+#[derive(clap::Args)]
+#[command(
+    about = "decode images and print their format and size",
+    long_about = "decode images and print what they are
+
+Prints one JSON object per line: {\"file\", \"format\", \"width\", \"height\",
+\"channels\", \"bits_per_channel\"} or {\"file\", \"error\"} for files that are not
+supported images. Exits with 1 if any file failed.",
+    after_help = "Example:
+  robocal info left01.jpg board.tiff",
+    args_override_self = true
+)]
+pub struct InfoArgs {
+    /// Image files
+    #[arg(value_name = "IMAGES")]
+    files: Vec<String>,
+}
+
+pub fn run(args: InfoArgs) -> Result<(), CliError> {
+    if args.files.is_empty() {
+        return Err(CliError::usage("info", "give at least one image file"));
+    }
+    let mut failed = 0;
+    for file in &args.files {
+        let line = match read_file(file)
+            .and_then(|b| robocal::image::decode(&b, &Default::default()).map_err(CliError::from))
+        {
+            Ok(d) => {
+                let mut v = serde_json::to_value(&d.info).unwrap_or_default();
+                v["file"] = serde_json::Value::String(file.clone());
+                v
+            }
+            Err(e) => {
+                failed += 1;
+                serde_json::json!({ "file": file, "error": e.to_string() })
+            }
+        };
+        println!("{line}");
+    }
+    if failed > 0 {
+        return Err(CliError::Io(format!(
+            "{failed} of {} files could not be decoded",
+            args.files.len()
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,58 @@
+//! `robocal target`: a target spec read back as JSON, or its printable sheet.
+
+use super::{parse_target, write_output, CliError};
+use robocal::target::svg::board_svg;
+
+#[derive(clap::Args)]
+#[command(
+    about = "print a target's JSON, or write its printable board (SVG at true scale)",
+    long_about = "print a target's JSON, or write its printable board
+
+Without --svg, prints the target as robocal reads it (the JSON object that
+'robocal detect' writes as \"target\"). With --svg, writes one sheet at true
+scale (width and height in millimetres): the board, a 100 mm check bar with
+the words to measure it, and the spec, so a print can be checked and typed
+back in. Print it at 100 % (actual size, no fit to page).",
+    after_help = "Examples:
+  robocal target chessboard:9x6:30mm
+  robocal target chessboard:9x6:30mm --svg board.svg
+  robocal target circles:4x11:20mm:asymmetric --svg acircles.svg",
+    args_override_self = true
+)]
+pub struct TargetArgs {
+    /// The target, as for 'robocal detect' (chessboard:9x6:30mm,
+    /// circles:4x11:20mm:asymmetric, dots:7x7:25mm, circle:10mm,
+    /// squares:8x8:12.7mm:22.5778mm) or a target JSON object
+    #[arg(value_name = "SPEC")]
+    spec: Option<String>,
+    /// Write the printable sheet there (SVG; '-' for standard output)
+    #[arg(long, value_name = "FILE")]
+    svg: Option<String>,
+}
+
+pub fn run(args: TargetArgs) -> Result<(), CliError> {
+    let Some(spec) = args.spec.as_deref() else {
+        return Err(CliError::usage(
+            "target",
+            "give the target, e.g. robocal target chessboard:9x6:30mm",
+        ));
+    };
+    let target = parse_target("target", spec)?;
+    match args.svg.as_deref() {
+        None => {
+            let json = serde_json::to_string_pretty(&target)
+                .map_err(|e| CliError::Io(format!("cannot encode the target as JSON: {e}")))?;
+            write_output(None, &format!("{json}\n"))
+        }
+        Some(path) => {
+            write_output(Some(path), &board_svg(&target))?;
+            if path != "-" {
+                eprintln!(
+                    "robocal target: wrote {path}: the {} sheet at true scale; print at 100 % and measure the 100 mm bar",
+                    target.to_spec()
+                );
+            }
+            Ok(())
+        }
+    }
+}
