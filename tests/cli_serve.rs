@@ -1,10 +1,25 @@
-//! `robocal serve`: MIME types, index.html, 404 for traversal, unknown paths
-//! and folders without index, loopback-only binding.
+//! `robocal serve`: MIME types, index.html, HEAD, 404 for traversal, unknown
+//! paths and folders without index, loopback-only binding; and the bounds
+//! (src/cli/serve_http.rs): 431 for an oversized head, 408 for a client that
+//! sends nothing while others are still served, 503 beyond the worker pool
+//! and its queue. Correctness only: the load test is bench/serve_load.py.
+//!
+//! Times: the server gives a request head 5 s from accept (its default
+//! `head_deadline`); every client read here times out after `HANG_GUARD`, so a
+//! server that stops answering fails the test instead of hanging it.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+/// The server's defaults (serve_http.rs `Limits::default()`).
+const WORKERS: usize = 16;
+const QUEUE: usize = 64;
+const MAX_HEAD_BYTES: usize = 8 * 1024;
+/// Far above the 5 s head deadline.
+const HANG_GUARD: Duration = Duration::from_secs(30);
 
 struct Server {
     child: Child,
@@ -18,8 +33,9 @@ impl Drop for Server {
     }
 }
 
-fn site() -> PathBuf {
-    let base = std::env::temp_dir().join(format!("robocal-serve-{}", std::process::id()));
+/// A served folder per test (tests run in parallel), with a secret beside it.
+fn site(test: &str) -> PathBuf {
+    let base = std::env::temp_dir().join(format!("robocal-serve-{}-{test}", std::process::id()));
     let root = base.join("www");
     std::fs::create_dir_all(root.join("sub")).unwrap();
     std::fs::create_dir_all(root.join("app")).unwrap();
@@ -27,8 +43,10 @@ fn site() -> PathBuf {
     std::fs::write(root.join("app/index.html"), "app").unwrap();
     std::fs::write(root.join("m.wasm"), b"\0asm\x01\0\0\0").unwrap();
     std::fs::write(root.join("x.js"), "export {}").unwrap();
+    std::fs::write(root.join("w.mjs"), "export {}").unwrap();
     std::fs::write(root.join("a b.css"), "body{}").unwrap();
     std::fs::write(base.join("secret.txt"), "outside the served folder").unwrap();
+    std::fs::write(base.join("Cargo.toml"), "[package]").unwrap();
     #[cfg(unix)]
     {
         let _ = std::os::unix::fs::symlink(base.join("secret.txt"), root.join("link.txt"));
@@ -55,62 +73,168 @@ fn start(root: &PathBuf) -> Server {
     Server { child, addr }
 }
 
-/// Sends a raw request line; returns (status, content-type, body).
-fn request(server: &Server, method: &str, target: &str) -> (u16, String, Vec<u8>) {
-    let mut s = TcpStream::connect(&server.addr).unwrap();
-    write!(s, "{method} {target} HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
+fn connect(server: &Server) -> TcpStream {
+    let s = TcpStream::connect(&server.addr).unwrap();
+    s.set_read_timeout(Some(HANG_GUARD)).unwrap();
+    s
+}
+
+/// A response: status, the head's lines, body.
+struct Response {
+    status: u16,
+    head: String,
+    body: Vec<u8>,
+}
+
+impl Response {
+    fn header(&self, name: &str) -> &str {
+        self.head
+            .lines()
+            .find_map(|l| l.strip_prefix(name)?.strip_prefix(": "))
+            .unwrap_or("")
+    }
+}
+
+/// Reads a whole response (the server closes every connection).
+fn read_response(mut s: TcpStream) -> Response {
     let mut raw = Vec::new();
     s.read_to_end(&mut raw).unwrap();
-    let split = raw.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
+    let split = raw
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .unwrap_or_else(|| panic!("no response head in {:?}", String::from_utf8_lossy(&raw)));
     let head = String::from_utf8_lossy(&raw[..split]).to_string();
     let status = head.split_whitespace().nth(1).unwrap().parse().unwrap();
-    let ctype = head
-        .lines()
-        .find_map(|l| l.strip_prefix("Content-Type: "))
-        .unwrap_or("")
-        .to_string();
-    (status, ctype, raw[split + 4..].to_vec())
+    Response {
+        status,
+        head,
+        body: raw[split + 4..].to_vec(),
+    }
+}
+
+/// Sends raw bytes as the request; returns the response.
+fn send(server: &Server, raw: &[u8]) -> Response {
+    let mut s = connect(server);
+    s.write_all(raw).unwrap();
+    read_response(s)
+}
+
+fn request(server: &Server, method: &str, target: &str) -> Response {
+    send(server, format!("{method} {target} HTTP/1.1\r\nHost: x\r\n\r\n").as_bytes())
 }
 
 #[test]
 fn serves_files_with_mime_types_and_refuses_escapes() {
-    let root = site();
+    let root = site("files");
     let server = start(&root);
-    let (status, ctype, body) = request(&server, "GET", "/");
-    assert_eq!((status, ctype.as_str()), (200, "text/html; charset=utf-8"));
-    assert_eq!(body, b"<!doctype html><title>t</title>");
-    assert_eq!(request(&server, "GET", "/m.wasm").1, "application/wasm");
-    assert_eq!(
-        request(&server, "GET", "/x.js?v=1").1,
-        "text/javascript; charset=utf-8"
-    );
-    assert_eq!(request(&server, "GET", "/a%20b.css").0, 200);
-    assert_eq!(request(&server, "GET", "/app/").2, b"app");
-    // HEAD: headers only.
-    let (status, _, body) = request(&server, "HEAD", "/index.html");
-    assert_eq!((status, body.len()), (200, 0));
+    let index = request(&server, "GET", "/");
+    assert_eq!((index.status, index.header("Content-Type")), (200, "text/html; charset=utf-8"));
+    assert_eq!(index.body, b"<!doctype html><title>t</title>");
+    assert_eq!(index.header("Connection"), "close");
+    for (target, mime) in [
+        ("/m.wasm", "application/wasm"),
+        ("/x.js?v=1", "text/javascript; charset=utf-8"),
+        ("/w.mjs", "text/javascript; charset=utf-8"),
+        ("/a%20b.css", "text/css; charset=utf-8"),
+    ] {
+        let r = request(&server, "GET", target);
+        assert_eq!((r.status, r.header("Content-Type")), (200, mime), "{target}");
+    }
+    assert_eq!(request(&server, "GET", "/m.wasm").body, b"\0asm\x01\0\0\0");
+    assert_eq!(request(&server, "GET", "/app/").body, b"app");
+    // HEAD: the GET's headers, no body.
+    let head = request(&server, "HEAD", "/index.html");
+    assert_eq!((head.status, head.body.len()), (200, 0));
+    assert_eq!(head.header("Content-Length"), "31");
+    let head = request(&server, "HEAD", "/missing");
+    assert_eq!((head.status, head.body.len()), (404, 0));
     // Unknown paths, folders without index.html (no listing), traversal in
     // every spelling, and a symlink out of the folder: all 404.
     for target in [
         "/missing.html",
         "/sub/",
         "/sub",
+        "/../Cargo.toml",
         "/../secret.txt",
-        "/%2e%2e/secret.txt",
+        "/%2e%2e/Cargo.toml",
+        "/%2E%2E/secret.txt",
         "/sub/../../secret.txt",
+        "/sub/%2e%2e/%2e%2e/Cargo.toml",
         "/..%2fsecret.txt",
         "/%2e%2e%2fsecret.txt",
+        "/..%5csecret.txt",
         "//etc/passwd",
         "/link.txt",
         "/%00",
         "/%zz",
         "relative",
+        "http://x/../secret.txt",
     ] {
-        let (status, _, body) = request(&server, "GET", target);
-        assert_eq!(status, 404, "{target} must be 404");
-        assert_eq!(body, b"not found\n", "{target}");
+        let r = request(&server, "GET", target);
+        assert_eq!(r.status, 404, "{target} must be 404");
+        assert_eq!(r.body, b"not found\n", "{target}");
     }
-    assert_eq!(request(&server, "POST", "/").0, 405);
+    for method in ["POST", "PUT", "DELETE", "OPTIONS"] {
+        let r = request(&server, method, "/");
+        assert_eq!((r.status, r.header("Allow")), (405, "GET, HEAD"), "{method}");
+    }
+    assert_eq!(send(&server, b"GET / HTTP/9.9\r\n\r\n").status, 400);
+    assert_eq!(send(&server, b"\x16\x03\x01\x00\xa5\x01\x00\x00\xa1\x03\x03").status, 400, "a TLS hello");
+}
+
+#[test]
+fn oversized_heads_get_431_and_the_server_goes_on() {
+    let root = site("431");
+    let server = start(&root);
+    let long = format!("GET / HTTP/1.1\r\nHost: x\r\nX-Big: {}\r\n\r\n", "a".repeat(2 * MAX_HEAD_BYTES));
+    let many: String = (0..100).map(|i| format!("X-{i}: v\r\n")).collect();
+    let many = format!("GET / HTTP/1.1\r\n{many}\r\n");
+    let endless_line = "G".repeat(4 * MAX_HEAD_BYTES);
+    for (what, raw) in [("a long header", long), ("100 headers", many), ("a line without end", endless_line)] {
+        let r = send(&server, raw.as_bytes());
+        assert_eq!(r.status, 431, "{what}");
+        assert_eq!(r.body, b"request header fields too large\n", "{what}");
+        assert_eq!(request(&server, "GET", "/x.js").status, 200, "the request after {what}");
+    }
+    // Just under the cap is still a request.
+    let filler = "a".repeat(MAX_HEAD_BYTES - 100);
+    let fits = format!("GET /x.js HTTP/1.1\r\nX-Fill: {filler}\r\n\r\n");
+    assert_eq!(send(&server, fits.as_bytes()).status, 200);
+}
+
+#[test]
+fn idle_clients_are_cut_off_while_others_are_served() {
+    let root = site("idle");
+    let server = start(&root);
+    // More idle clients than workers (all under the queue's bound): silent
+    // ones, and slow ones stuck half-way through a request line.
+    let mut idle: Vec<TcpStream> = (0..WORKERS + 8).map(|_| connect(&server)).collect();
+    for s in idle.iter_mut().step_by(2) {
+        s.write_all(b"GET /index.ht").unwrap();
+    }
+    let r = request(&server, "GET", "/index.html");
+    assert_eq!(r.status, 200, "a normal GET behind {} idle clients", idle.len());
+    assert_eq!(r.body, b"<!doctype html><title>t</title>");
+    for (i, s) in idle.into_iter().enumerate() {
+        let r = read_response(s);
+        assert_eq!((r.status, r.body.as_slice()), (408, &b"request timeout\n"[..]), "idle client {i}");
+    }
+}
+
+#[test]
+fn clients_beyond_the_pool_and_queue_get_503() {
+    let root = site("503");
+    let server = start(&root);
+    // Workers and queue hold at most WORKERS + QUEUE idle clients until the
+    // head deadline; every connection over that is refused at once.
+    let over = 8;
+    let clients: Vec<TcpStream> = (0..WORKERS + QUEUE + over).map(|_| connect(&server)).collect();
+    let statuses: Vec<u16> = clients.into_iter().map(|s| read_response(s).status).collect();
+    let busy = statuses.iter().filter(|&&s| s == 503).count();
+    assert!(busy >= over, "{busy} of {} refused with 503, expected at least {over}", statuses.len());
+    assert!(statuses.iter().all(|&s| s == 503 || s == 408), "only 503 or 408: {statuses:?}");
+    // Once the idle clients are gone, service is back.
+    assert_eq!(request(&server, "GET", "/").status, 200);
 }
 
 #[test]
@@ -130,7 +254,7 @@ fn refuses_non_loopback_bind_without_public() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr)
-        .contains("unknown option --bogus (known: --dir, --host, --port, --public)"));
+        .contains("error: unexpected argument '--bogus' found"));
 }
 
 #[test]

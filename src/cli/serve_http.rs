@@ -1,0 +1,536 @@
+//! The HTTP side of `robocal serve`: a static file server with fixed bounds.
+//!
+//! Why a server of our own and not a crate: tiny_http 0.12, the small
+//! maintained choice, starts a new thread whenever its pool is busy, reads a
+//! header line until CRLF without a length limit and sets no socket timeouts,
+//! so every slow or oversized client costs a thread and unbounded memory, and
+//! none of that is configurable; hyper bounds all of it but brings the tokio
+//! runtime for a server of a handful of files. So the untrusted bytes are
+//! parsed by `httparse` (hyper's own request parser) and this file keeps only
+//! the bounds, each a field of [`Limits`]:
+//!
+//! - a fixed pool of `workers` threads fed by an accept queue of `queue`
+//!   connections; a connection beyond both is answered 503 and closed;
+//! - the request line and headers within `max_head_bytes` and [`MAX_HEADERS`]
+//!   headers, else 431;
+//! - the whole request head within `head_deadline` of the accept, else 408,
+//!   so a client that sends nothing, or a byte at a time (slowloris), holds a
+//!   worker for at most that long, queued time included;
+//! - every write within `write_stall`, the whole response within
+//!   `response_deadline`; files are streamed in [`CHUNK`]-sized pieces.
+//!
+//! Threads are `workers + 1`, memory about `workers * (max_head_bytes +
+//! CHUNK)` plus the queued sockets, whatever the load. The price of blocking
+//! workers: a flood of more than `workers + queue` slow clients per
+//! `head_deadline` is answered 503 while it lasts, and service is back within
+//! one `head_deadline` after it (BENCHMARKS.md, "robocal serve under load").
+//!
+//! GET and HEAD only (405 otherwise), `Connection: close` on every response,
+//! no directory listing, 404 for anything outside the served folder.
+
+use std::fs::File;
+use std::io::{self, ErrorKind, Read, Write};
+use std::net::{Shutdown, TcpListener, TcpStream};
+use std::panic::{self, AssertUnwindSafe};
+use std::path::{Component, Path, PathBuf};
+use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+/// Most headers one request may carry (431 beyond).
+pub const MAX_HEADERS: usize = 64;
+/// Bytes of a file read and written at a time, per worker.
+pub const CHUNK: usize = 64 * 1024;
+/// After refusing a request that was not read to its end, at most this many
+/// more bytes are read and dropped, within [`LINGER_TIME`], before closing:
+/// closing with unread input makes the kernel reset the connection, which
+/// can destroy the refusal before the client reads it.
+const LINGER_BYTES: usize = 64 * 1024;
+/// See [`LINGER_BYTES`].
+const LINGER_TIME: Duration = Duration::from_secs(1);
+/// Pause after a failed accept (out of descriptors), so the loop never spins.
+const ACCEPT_BACKOFF: Duration = Duration::from_millis(10);
+
+/// The server's bounds. `Limits::default()` is what `robocal serve` uses.
+#[derive(Debug, Clone)]
+pub struct Limits {
+    /// Worker threads answering requests (default 16). Each holds one
+    /// connection at a time.
+    pub workers: usize,
+    /// Accepted connections waiting for a worker (default 64); beyond it the
+    /// connection gets 503.
+    pub queue: usize,
+    /// Bytes of request line plus headers (default 8 KiB, like common
+    /// servers' default); beyond it 431.
+    pub max_head_bytes: usize,
+    /// Time from accept to the end of the request head (default 5 s; a
+    /// browser on the same network sends it in milliseconds); then 408.
+    pub head_deadline: Duration,
+    /// Longest a single write may wait for the client to read (default 10 s).
+    pub write_stall: Duration,
+    /// Longest one response may take in total (default 60 s: a 2 MB wasm
+    /// file at 35 kB/s).
+    pub response_deadline: Duration,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            workers: 16,
+            queue: 64,
+            max_head_bytes: 8 * 1024,
+            head_deadline: Duration::from_secs(5),
+            write_stall: Duration::from_secs(10),
+            response_deadline: Duration::from_secs(60),
+        }
+    }
+}
+
+/// Serves the files under `root` (a canonical folder path) on `listener`
+/// until accepting fails for good. Returns only on an error.
+pub fn serve(listener: TcpListener, root: PathBuf, limits: Limits) -> io::Result<()> {
+    let limits = Arc::new(limits);
+    let root = Arc::new(root);
+    let (queue, jobs) = mpsc::sync_channel::<Accepted>(limits.queue);
+    let jobs = Arc::new(Mutex::new(jobs));
+    for i in 0..limits.workers {
+        let (jobs, root, limits) = (jobs.clone(), root.clone(), limits.clone());
+        std::thread::Builder::new()
+            .name(format!("serve-worker-{i}"))
+            .spawn(move || work(&jobs, &root, &limits))?;
+    }
+    for stream in listener.incoming() {
+        match stream {
+            Ok(stream) => admit(&queue, stream)?,
+            Err(_) => std::thread::sleep(ACCEPT_BACKOFF),
+        }
+    }
+    Ok(())
+}
+
+/// A connection and when it was accepted (its deadlines count from then).
+struct Accepted {
+    stream: TcpStream,
+    at: Instant,
+}
+
+/// Queues a connection for the workers, or answers 503 when the queue is full.
+fn admit(queue: &SyncSender<Accepted>, stream: TcpStream) -> io::Result<()> {
+    let job = Accepted {
+        stream,
+        at: Instant::now(),
+    };
+    match queue.try_send(job) {
+        Ok(()) => Ok(()),
+        Err(TrySendError::Full(job)) => {
+            // Non-blocking: a reply of a few hundred bytes fits the empty
+            // send buffer of a new connection, and the accept loop never waits.
+            if job.stream.set_nonblocking(true).is_ok() {
+                let _ = (&job.stream).write_all(&status_page(Status::Busy, false));
+            }
+            Ok(())
+        }
+        Err(TrySendError::Disconnected(_)) => Err(io::Error::other("every serve worker has stopped")),
+    }
+}
+
+/// One worker: takes connections off the queue, one at a time, forever.
+fn work(jobs: &Mutex<Receiver<Accepted>>, root: &Path, limits: &Limits) {
+    let mut head = vec![0u8; limits.max_head_bytes];
+    let mut chunk = vec![0u8; CHUNK];
+    loop {
+        // The lock is held only while waiting (the guard ends with this
+        // statement), and nothing can panic while holding it.
+        let next = jobs.lock().unwrap_or_else(PoisonError::into_inner).recv();
+        let Ok(job) = next else { return };
+        // A panic would lose one connection, never a worker: the pool stays
+        // at its size.
+        let _ = panic::catch_unwind(AssertUnwindSafe(|| {
+            handle(job, root, limits, &mut head, &mut chunk)
+        }));
+    }
+}
+
+/// The answers this server gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Status {
+    Ok,
+    BadRequest,
+    NotFound,
+    MethodNotAllowed,
+    RequestTimeout,
+    HeadTooLarge,
+    Busy,
+}
+
+impl Status {
+    fn code_and_reason(self) -> (u16, &'static str) {
+        match self {
+            Status::Ok => (200, "OK"),
+            Status::BadRequest => (400, "Bad Request"),
+            Status::NotFound => (404, "Not Found"),
+            Status::MethodNotAllowed => (405, "Method Not Allowed"),
+            Status::RequestTimeout => (408, "Request Timeout"),
+            Status::HeadTooLarge => (431, "Request Header Fields Too Large"),
+            Status::Busy => (503, "Service Unavailable"),
+        }
+    }
+
+    /// The plain-text body of a refusal.
+    fn body(self) -> &'static [u8] {
+        match self {
+            Status::Ok => b"",
+            Status::BadRequest => b"bad request\n",
+            Status::NotFound => b"not found\n",
+            Status::MethodNotAllowed => b"method not allowed\n",
+            Status::RequestTimeout => b"request timeout\n",
+            Status::HeadTooLarge => b"request header fields too large\n",
+            Status::Busy => b"busy, retry shortly\n",
+        }
+    }
+
+    /// Extra header lines (each ending in CRLF).
+    fn extra_headers(self) -> &'static str {
+        match self {
+            Status::MethodNotAllowed => "Allow: GET, HEAD\r\n",
+            Status::Busy => "Retry-After: 1\r\n",
+            Status::Ok
+            | Status::BadRequest
+            | Status::NotFound
+            | Status::RequestTimeout
+            | Status::HeadTooLarge => "",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Method {
+    Get,
+    Head,
+}
+
+/// A request head that passed every bound.
+#[derive(Debug, PartialEq, Eq)]
+struct Request {
+    method: Method,
+    target: String,
+}
+
+/// Why a connection yielded no request.
+#[derive(Debug, PartialEq, Eq)]
+enum NoRequest {
+    /// The client closed or reset the connection: nobody to answer.
+    Gone,
+    /// The client is answered with this status, then the connection closed.
+    Refused(Status),
+}
+
+fn handle(
+    job: Accepted,
+    root: &Path,
+    limits: &Limits,
+    head: &mut [u8],
+    chunk: &mut [u8],
+) -> io::Result<()> {
+    let Accepted { mut stream, at } = job;
+    let request = read_head(&mut stream, at + limits.head_deadline, head);
+    let writer = Deadline::new(limits);
+    match request {
+        Ok(request) => answer(&mut stream, &request, root, &writer, chunk),
+        Err(NoRequest::Gone) => Ok(()),
+        Err(NoRequest::Refused(Status::RequestTimeout)) => {
+            writer.write(&mut stream, &status_page(Status::RequestTimeout, false))
+        }
+        Err(NoRequest::Refused(status)) => {
+            writer.write(&mut stream, &status_page(status, false))?;
+            linger(&mut stream);
+            Ok(())
+        }
+    }
+}
+
+/// Reads the request head into `buf` until it is complete, too large, late
+/// (`deadline`) or malformed.
+fn read_head(stream: &mut TcpStream, deadline: Instant, buf: &mut [u8]) -> Result<Request, NoRequest> {
+    let mut len = 0;
+    loop {
+        let remaining = deadline
+            .checked_duration_since(Instant::now())
+            .filter(|d| !d.is_zero())
+            .ok_or(NoRequest::Refused(Status::RequestTimeout))?;
+        stream
+            .set_read_timeout(Some(remaining))
+            .map_err(|_| NoRequest::Gone)?;
+        let n = match stream.read(&mut buf[len..]) {
+            Ok(0) => return Err(NoRequest::Gone),
+            Ok(n) => n,
+            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+                return Err(NoRequest::Refused(Status::RequestTimeout))
+            }
+            Err(_) => return Err(NoRequest::Gone),
+        };
+        len += n;
+        match parse_head(&buf[..len]) {
+            Ok(Some(request)) => return Ok(request),
+            Ok(None) if len == buf.len() => return Err(NoRequest::Refused(Status::HeadTooLarge)),
+            Ok(None) => {}
+            Err(status) => return Err(NoRequest::Refused(status)),
+        }
+    }
+}
+
+/// Parses a request head: `Ok(None)` while it is incomplete.
+fn parse_head(bytes: &[u8]) -> Result<Option<Request>, Status> {
+    let mut headers = [httparse::EMPTY_HEADER; MAX_HEADERS];
+    let mut parsed = httparse::Request::new(&mut headers);
+    match parsed.parse(bytes) {
+        Ok(httparse::Status::Partial) => Ok(None),
+        Ok(httparse::Status::Complete(_)) => {
+            let method = match parsed.method {
+                Some("GET") => Method::Get,
+                Some("HEAD") => Method::Head,
+                _ => return Err(Status::MethodNotAllowed),
+            };
+            let target = parsed.path.ok_or(Status::BadRequest)?.to_string();
+            Ok(Some(Request { method, target }))
+        }
+        Err(httparse::Error::TooManyHeaders) => Err(Status::HeadTooLarge),
+        Err(_) => Err(Status::BadRequest),
+    }
+}
+
+/// Answers a request with the file it names, or 404.
+fn answer(
+    stream: &mut TcpStream,
+    request: &Request,
+    root: &Path,
+    writer: &Deadline,
+    chunk: &mut [u8],
+) -> io::Result<()> {
+    let head_only = request.method == Method::Head;
+    let found = resolve(root, &request.target)
+        .and_then(|path| File::open(&path).ok().map(|file| (path, file)))
+        .and_then(|(path, file)| Some((file.metadata().ok()?.len(), path, file)));
+    let Some((len, path, file)) = found else {
+        return writer.write(stream, &status_page(Status::NotFound, head_only));
+    };
+    writer.write(stream, head_lines(Status::Ok, mime_type(&path), len).as_bytes())?;
+    if head_only {
+        return Ok(());
+    }
+    // `take`: a file that grows while being sent never overruns its
+    // Content-Length.
+    let mut file = file.take(len);
+    loop {
+        let n = file.read(chunk)?;
+        if n == 0 {
+            return Ok(());
+        }
+        writer.write(stream, &chunk[..n])?;
+    }
+}
+
+/// Writes bounded by the per-write stall and the response's deadline.
+struct Deadline {
+    stall: Duration,
+    end: Instant,
+}
+
+impl Deadline {
+    fn new(limits: &Limits) -> Self {
+        Deadline {
+            stall: limits.write_stall,
+            end: Instant::now() + limits.response_deadline,
+        }
+    }
+
+    fn write(&self, stream: &mut TcpStream, bytes: &[u8]) -> io::Result<()> {
+        let remaining = self
+            .end
+            .checked_duration_since(Instant::now())
+            .filter(|d| !d.is_zero())
+            .ok_or_else(|| io::Error::from(ErrorKind::TimedOut))?;
+        stream.set_write_timeout(Some(remaining.min(self.stall)))?;
+        stream.write_all(bytes)
+    }
+}
+
+/// Closes the sending side, then reads and drops what the client still sends
+/// (bounded by [`LINGER_BYTES`] and [`LINGER_TIME`]), so the refusal arrives.
+fn linger(stream: &mut TcpStream) {
+    let _ = stream.shutdown(Shutdown::Write);
+    let end = Instant::now() + LINGER_TIME;
+    let mut sink = [0u8; 4096];
+    let mut drained = 0;
+    while drained < LINGER_BYTES {
+        let Some(remaining) = end.checked_duration_since(Instant::now()).filter(|d| !d.is_zero()) else {
+            return;
+        };
+        if stream.set_read_timeout(Some(remaining)).is_err() {
+            return;
+        }
+        match stream.read(&mut sink) {
+            Ok(0) | Err(_) => return,
+            Ok(n) => drained += n,
+        }
+    }
+}
+
+/// The status line and headers of a response whose body is `len` bytes.
+fn head_lines(status: Status, mime: &str, len: u64) -> String {
+    let (code, reason) = status.code_and_reason();
+    format!(
+        "HTTP/1.1 {code} {reason}\r\nContent-Type: {mime}\r\nContent-Length: {len}\r\n{}\
+         Cache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+        status.extra_headers()
+    )
+}
+
+/// A whole refusal (head and, unless `head_only`, its text body).
+fn status_page(status: Status, head_only: bool) -> Vec<u8> {
+    let body = status.body();
+    let mut page = head_lines(status, "text/plain; charset=utf-8", body.len() as u64).into_bytes();
+    if !head_only {
+        page.extend_from_slice(body);
+    }
+    page
+}
+
+/// Map a request target to a file inside `root`, or `None` (answered 404).
+/// Rejects `..`, absolute components, NUL bytes, backslashes, malformed
+/// percent escapes, and anything whose real path (after symlinks) leaves
+/// `root`. A folder stands for its index.html.
+pub fn resolve(root: &Path, target: &str) -> Option<PathBuf> {
+    let path = target.split(['?', '#']).next().unwrap_or("");
+    let decoded = percent_decode(path)?;
+    if !decoded.starts_with('/') || decoded.contains('\0') || decoded.contains('\\') {
+        return None;
+    }
+    let mut candidate = root.to_path_buf();
+    for component in Path::new(&decoded[1..]).components() {
+        match component {
+            Component::Normal(part) => candidate.push(part),
+            Component::CurDir => {}
+            Component::ParentDir | Component::RootDir | Component::Prefix(_) => return None,
+        }
+    }
+    let mut real = std::fs::canonicalize(&candidate).ok()?;
+    if real.is_dir() {
+        real = std::fs::canonicalize(real.join("index.html")).ok()?;
+    }
+    (real.starts_with(root) && real.is_file()).then_some(real)
+}
+
+/// Strict `%XX` decoding of a URL path: a malformed escape or a result that
+/// is not UTF-8 is `None` (the percent-encoding crate passes those through
+/// unchanged, which would let `%zz` name a file).
+fn percent_decode(s: &str) -> Option<String> {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = s.get(i + 1..i + 3)?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// The Content-Type for a file, from its extension.
+pub fn mime_type(path: &Path) -> &'static str {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "html" | "htm" => "text/html; charset=utf-8",
+        "js" | "mjs" => "text/javascript; charset=utf-8",
+        "css" => "text/css; charset=utf-8",
+        "wasm" => "application/wasm",
+        "json" | "map" => "application/json",
+        "webmanifest" => "application/manifest+json",
+        "svg" => "image/svg+xml",
+        "png" => "image/png",
+        "jpg" | "jpeg" => "image/jpeg",
+        "gif" => "image/gif",
+        "webp" => "image/webp",
+        "bmp" => "image/bmp",
+        "tif" | "tiff" => "image/tiff",
+        "ico" => "image/x-icon",
+        "woff2" => "font/woff2",
+        "txt" | "md" | "csv" => "text/plain; charset=utf-8",
+        "yml" | "yaml" => "text/yaml; charset=utf-8",
+        _ => "application/octet-stream",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn get(target: &str) -> Request {
+        Request {
+            method: Method::Get,
+            target: target.to_string(),
+        }
+    }
+
+    #[test]
+    fn heads_parse_or_are_refused_with_their_status() {
+        assert_eq!(parse_head(b"GET /a.js?v=1 HTTP/1.1\r\nHost: x\r\n\r\n"), Ok(Some(get("/a.js?v=1"))));
+        assert_eq!(
+            parse_head(b"HEAD / HTTP/1.0\r\n\r\n").map(|r| r.map(|r| r.method)),
+            Ok(Some(Method::Head))
+        );
+        assert_eq!(parse_head(b"GET / HTTP/1.1\r\nHost: x\r\n"), Ok(None), "no blank line yet");
+        assert_eq!(parse_head(b""), Ok(None));
+        assert_eq!(parse_head(b"POST / HTTP/1.1\r\n\r\n"), Err(Status::MethodNotAllowed));
+        assert_eq!(parse_head(b"GET / HTTP/9.9\r\n\r\n"), Err(Status::BadRequest));
+        assert_eq!(parse_head(b"\x16\x03\x01\x02\x00\x01\x00\x01\xfc\x03\x03"), Err(Status::BadRequest), "a TLS hello");
+        let mut many = b"GET / HTTP/1.1\r\n".to_vec();
+        for i in 0..=MAX_HEADERS {
+            many.extend_from_slice(format!("X-{i}: v\r\n").as_bytes());
+        }
+        many.extend_from_slice(b"\r\n");
+        assert_eq!(parse_head(&many), Err(Status::HeadTooLarge));
+    }
+
+    #[test]
+    fn percent_decoding_is_strict() {
+        assert_eq!(percent_decode("/a%20b.css").as_deref(), Some("/a b.css"));
+        assert_eq!(percent_decode("/%2e%2E/x").as_deref(), Some("/../x"));
+        assert_eq!(percent_decode("/%zz"), None);
+        assert_eq!(percent_decode("/%2"), None);
+        assert_eq!(percent_decode("/%ff"), None, "not UTF-8");
+    }
+
+    #[test]
+    fn mime_types_follow_the_web_platform() {
+        for (name, mime) in [
+            ("m.wasm", "application/wasm"),
+            ("w.mjs", "text/javascript; charset=utf-8"),
+            ("APP.JS", "text/javascript; charset=utf-8"),
+            ("index.html", "text/html; charset=utf-8"),
+            ("noext", "application/octet-stream"),
+        ] {
+            assert_eq!(mime_type(Path::new(name)), mime, "{name}");
+        }
+    }
+
+    #[test]
+    fn every_refusal_says_its_length_and_closes() {
+        let page = String::from_utf8(status_page(Status::HeadTooLarge, false)).unwrap_or_default();
+        assert!(page.starts_with("HTTP/1.1 431 Request Header Fields Too Large\r\n"), "{page}");
+        assert!(page.contains("Content-Length: 32\r\n") && page.contains("Connection: close\r\n"), "{page}");
+        assert!(page.ends_with("\r\n\r\nrequest header fields too large\n"), "{page}");
+        let head = String::from_utf8(status_page(Status::MethodNotAllowed, true)).unwrap_or_default();
+        assert!(head.contains("Allow: GET, HEAD\r\n") && head.ends_with("\r\n\r\n"), "{head}");
+    }
+}
