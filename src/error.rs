@@ -158,14 +158,3 @@ mod tests {
         assert_eq!(Error::too_few("views", 3, 1).kind(), "too_few");
     }
 }
-
-/// A required field of a hand-written `Deserialize` impl (an internally
-/// tagged or untagged form read through a plain struct of optional fields):
-/// serde's own "missing field `name`" error when absent.
-#[doc(hidden)]
-pub fn serde_field<T, E: serde::de::Error>(
-    value: Option<T>,
-    name: &'static str,
-) -> std::result::Result<T, E> {
-    value.ok_or_else(|| E::missing_field(name))
-}

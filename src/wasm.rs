@@ -1,16 +1,22 @@
 //! The WebAssembly boundary: the only file with `#[wasm_bindgen]`.
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
-//! errors as `JsError` whose message is the library's error text.
+//! errors as `JsError` whose message is the library's error text. Pixels
+//! come out as the host's `ImageData` (web-sys), ready for `putImageData`
+//! and structured clone; node has no `ImageData`, so node callers set
+//! `globalThis.ImageData` first (pkg-config/README.md) and get a clear
+//! error otherwise.
 //!
 //! wasm32-unknown-unknown aborts on panic (a `RuntimeError: unreachable` in
 //! JS). The module holds no state across calls, so the instance stays usable;
-//! a panic hook records the message so the JS side can show it
-//! ([`last_panic_message`]) instead of a dead worker.
+//! a panic hook writes the message to `console.error` and records it so the
+//! JS side can show it ([`last_panic_message`]) instead of a dead worker.
 
 use crate::image::{decode, DecodeOptions};
+use crate::target::Target;
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
+use web_sys::ImageData;
 
 fn js_error(e: crate::Error) -> JsError {
     JsError::new(&e.to_string())
@@ -20,12 +26,14 @@ thread_local! {
     static LAST_PANIC: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) };
 }
 
-/// Install the panic hook that records panic messages. Called once by the JS
-/// side after instantiating the module; calling it again is harmless.
+/// Install the panic hook: it writes the panic message to `console.error`
+/// and records it for [`last_panic_message`]. Called once by the JS side
+/// after instantiating the module; calling it again is harmless.
 #[wasm_bindgen]
 pub fn init() {
     std::panic::set_hook(Box::new(|info| {
         let text = info.to_string();
+        web_sys::console::error_1(&JsValue::from_str(&format!("robocal panicked: {text}")));
         LAST_PANIC.with(|p| *p.borrow_mut() = text);
     }));
 }
@@ -43,36 +51,50 @@ pub fn version() -> String {
     crate::VERSION.to_string()
 }
 
-/// A decoded image's description plus an RGBA preview for thumbnails.
+/// RGBA pixels (row-major, `4 * width * height` bytes) as the host's
+/// `ImageData`. The bytes are copied into a JS-owned `Uint8ClampedArray`
+/// first: an `ImageData` over a view of wasm memory (what
+/// `new_with_u8_clamped_array_and_sh` makes) would be detached when the
+/// memory grows, overwritten by the next call, and structured-clone the
+/// whole wasm memory (wasm-bindgen issue 4815).
+fn image_data(rgba: &[u8], width: u32, height: u32) -> Result<ImageData, JsError> {
+    let global = js_sys::global();
+    if !js_sys::Reflect::has(&global, &JsValue::from_str("ImageData")).unwrap_or(false) {
+        return Err(JsError::new(
+            "this JavaScript host has no ImageData (node has none): set globalThis.ImageData to a class whose constructor takes (data: Uint8ClampedArray, width, height) first, e.g. the ImageData of @napi-rs/canvas or the one in robocal's README",
+        ));
+    }
+    let data = js_sys::Uint8ClampedArray::from(rgba);
+    ImageData::new_with_js_u8_clamped_array_and_sh(&data, width, height).map_err(|e| {
+        let why = e
+            .dyn_ref::<js_sys::Error>()
+            .map(|e| String::from(e.message()))
+            .unwrap_or_else(|| format!("{e:?}"));
+        JsError::new(&format!(
+            "ImageData of {width}x{height} px could not be made: {why}"
+        ))
+    })
+}
+
+/// A decoded image's description plus a preview for thumbnails.
 #[wasm_bindgen]
 pub struct ImagePreview {
     info_json: String,
-    rgba: Vec<u8>,
-    width: u32,
-    height: u32,
+    image: ImageData,
 }
 
 #[wasm_bindgen]
 impl ImagePreview {
-    /// JSON: `{format, width, height, channels, bits_per_channel}`.
+    /// JSON: `{format, format_name, width, height, channels,
+    /// bits_per_channel}` of the full image.
     #[wasm_bindgen(getter)]
     pub fn info_json(&self) -> String {
         self.info_json.clone()
     }
-    /// Preview pixels, RGBA, row-major.
+    /// The preview as `ImageData` (RGBA; its own `width` and `height`, px).
     #[wasm_bindgen(getter)]
-    pub fn rgba(&self) -> Vec<u8> {
-        self.rgba.clone()
-    }
-    /// Preview width in pixels.
-    #[wasm_bindgen(getter)]
-    pub fn width(&self) -> u32 {
-        self.width
-    }
-    /// Preview height in pixels.
-    #[wasm_bindgen(getter)]
-    pub fn height(&self) -> u32 {
-        self.height
+    pub fn image(&self) -> ImageData {
+        self.image.clone()
     }
 }
 
@@ -101,8 +123,9 @@ impl InfoJson {
     }
 }
 
-/// Decode image bytes (PNG, JPEG, TIFF, BMP, PNM, GIF); return its
-/// description and a preview whose longer side is at most `max_side` px.
+/// Decode image bytes (PNG, JPEG, TIFF, BMP, PNM, GIF, WebP); return its
+/// description and a preview (`ImageData`) whose longer side is at most
+/// `max_side` px.
 #[wasm_bindgen]
 pub fn decode_image_preview(bytes: &[u8], max_side: u32) -> Result<ImagePreview, JsError> {
     let options = DecodeOptions {
@@ -115,12 +138,8 @@ pub fn decode_image_preview(bytes: &[u8], max_side: u32) -> Result<ImagePreview,
     let preview = decoded
         .preview
         .ok_or_else(|| JsError::new("no preview was produced"))?;
-    Ok(ImagePreview {
-        info_json,
-        rgba: preview.pixels,
-        width: preview.width,
-        height: preview.height,
-    })
+    let image = image_data(&preview.pixels, preview.width, preview.height)?;
+    Ok(ImagePreview { info_json, image })
 }
 
 /// Decode image bytes and return only the description as JSON.
@@ -130,20 +149,72 @@ pub fn image_info(bytes: &[u8]) -> Result<String, JsError> {
     serde_json::to_string(&InfoJson::of(&decoded.info)).map_err(|e| JsError::new(&e.to_string()))
 }
 
+/// A target from a CLI spec (`chessboard:9x6:30mm`,
+/// `circles:4x11:20mm:asymmetric`, `dots:7x7:25mm`, `circle:10mm`,
+/// `squares:8x8:12.7mm:22.5778mm`) or a target JSON object, validated.
+fn target_from(spec_or_json: &str) -> Result<Target, JsError> {
+    if spec_or_json.trim_start().starts_with('{') {
+        serde_json::from_str::<Target>(spec_or_json)
+            .map_err(|e| JsError::new(&format!("target JSON: {e}")))?
+            .validated()
+            .map_err(js_error)
+    } else {
+        Target::parse_spec(spec_or_json).map_err(js_error)
+    }
+}
+
+/// The target of a CLI spec or target JSON, checked by the core: the target
+/// JSON (`{"kind": "chessboard", "cols", "rows", "square_m"}`, ...; kinds
+/// and metres as in `docs/detection-json.md`), or the core's error.
+#[wasm_bindgen]
+pub fn parse_target(spec_or_json: &str) -> Result<String, JsError> {
+    let target = target_from(spec_or_json)?;
+    serde_json::to_string(&target).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// The canonical CLI spec of a target (spec or JSON): what
+/// `robocal detect --target` takes, e.g. `chessboard:9x6:30mm`.
+#[wasm_bindgen]
+pub fn target_spec(spec_or_json: &str) -> Result<String, JsError> {
+    Ok(target_from(spec_or_json)?.to_spec())
+}
+
+/// The board points of a target (spec or JSON) in id order: a JSON array of
+/// `{"id", "x_m", "y_m"}`, metres in the board frame (z = 0 on the board).
+#[wasm_bindgen]
+pub fn target_points(spec_or_json: &str) -> Result<String, JsError> {
+    #[derive(Serialize)]
+    struct Point {
+        id: usize,
+        x_m: f64,
+        y_m: f64,
+    }
+    let points: Vec<Point> = target_from(spec_or_json)?
+        .object_points()
+        .into_iter()
+        .map(|(id, p)| Point {
+            id,
+            x_m: p.x,
+            y_m: p.y,
+        })
+        .collect();
+    serde_json::to_string(&points).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// The printable sheet of a target (spec or JSON) as SVG text, at true
+/// scale in millimetres, with a 100 mm check bar and the spec printed on
+/// it (`robocal::target::svg::board_svg`).
+#[wasm_bindgen]
+pub fn target_svg(spec_or_json: &str) -> Result<String, JsError> {
+    Ok(crate::target::svg::board_svg(&target_from(spec_or_json)?))
+}
+
 /// Detect a calibration target in image bytes. `target_spec_or_json` is a
-/// CLI spec (`chessboard:9x6:30mm`, `circles:4x11:20mm:asymmetric`,
-/// `dots:7x7:25mm`, `circle:10mm`) or a target JSON object. Returns the
+/// CLI spec (see [`parse_target`]) or a target JSON object. Returns the
 /// Detection JSON (see `docs/detection-json.md`).
 #[wasm_bindgen]
 pub fn detect_target(bytes: &[u8], target_spec_or_json: &str) -> Result<String, JsError> {
-    let target = if target_spec_or_json.trim_start().starts_with('{') {
-        serde_json::from_str::<crate::target::Target>(target_spec_or_json)
-            .map_err(|e| JsError::new(&format!("target JSON: {e}")))?
-            .validated()
-            .map_err(js_error)?
-    } else {
-        crate::target::Target::parse_spec(target_spec_or_json).map_err(js_error)?
-    };
+    let target = target_from(target_spec_or_json)?;
     let image = crate::image::decode_gray(bytes).map_err(js_error)?;
     let detection =
         crate::detect::detect(&image, &target, &crate::detect::DetectOptions::default())
@@ -388,24 +459,19 @@ pub fn calibrate_stereo(input_json: &str) -> Result<String, JsError> {
 
 /// An undistorted preview of image bytes taken by `camera_json` (the
 /// `camera` object of a calibration report): resampled through the same
-/// camera without distortion, longer side at most `max_side` px. `info_json`
-/// is `{"width", "height"}` of the preview.
+/// camera without distortion, longer side at most `max_side` px, as grey
+/// `ImageData` (RGBA with r = g = b, alpha 255).
 #[wasm_bindgen]
 pub fn undistort_preview(
     bytes: &[u8],
     camera_json: &str,
     max_side: u32,
-) -> Result<ImagePreview, JsError> {
+) -> Result<ImageData, JsError> {
     let camera: crate::camera::Camera = serde_json::from_str(camera_json)
         .map_err(|e| JsError::new(&format!("camera JSON: {e}")))?;
     let image = crate::image::decode_gray(bytes).map_err(js_error)?;
     let preview = camera.pinhole_preview(max_side).map_err(js_error)?;
     let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
-    let rgba = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();
-    Ok(ImagePreview {
-        info_json: format!(r#"{{"width":{},"height":{}}}"#, out.width, out.height),
-        rgba,
-        width: out.width,
-        height: out.height,
-    })
+    let rgba: Vec<u8> = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();
+    image_data(&rgba, out.width, out.height)
 }

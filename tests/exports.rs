@@ -116,7 +116,7 @@ fn bad_requests_say_what_to_fix() {
     .to_string();
     assert_eq!(
         err,
-        "base_from_camera: expected matrix_row_major with 4 rows of 4 numbers"
+        "base_from_camera: expected matrix_row_major with 4 rows of 4 numbers (or 16 numbers), got 2 numbers"
     );
     let err = export("{", "json", None).unwrap_err().to_string();
     assert!(

@@ -6,7 +6,7 @@ use super::residuals::{distortion_field, view_residuals, DistortionField, PixelV
 use super::CalibrationOptions;
 use crate::camera::Camera;
 use crate::error::Result;
-use crate::geometry::{matrix4_from_pose, quaternion_xyzw_from_rotation, Pose};
+use crate::geometry::{Pose, PoseJson};
 use crate::optim::{BlockProblem, LmResult, Termination};
 use nalgebra::{DMatrix, Point2, Point3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -33,17 +33,6 @@ pub struct Outlier {
     pub reason: String,
 }
 
-/// A pose in the report: 4x4 matrix, translation and quaternion.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PoseReport {
-    /// Homogeneous 4x4 matrix, rows.
-    pub matrix_row_major: [[f64; 4]; 4],
-    /// Translation, metres.
-    pub translation_m: [f64; 3],
-    /// Rotation as a unit quaternion, x y z w.
-    pub quaternion_xyzw: [f64; 4],
-}
-
 /// Per-view results.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ViewReport {
@@ -54,7 +43,7 @@ pub struct ViewReport {
     /// Points used.
     pub n_points: usize,
     /// Pose of the target in the camera frame.
-    pub camera_from_target: PoseReport,
+    pub camera_from_target: PoseJson,
     /// Points dropped as outliers.
     pub outliers: Vec<Outlier>,
     /// Observed minus predicted pixel of every point (outliers included),
@@ -191,7 +180,7 @@ pub(crate) fn build_report(
             name: view.name.clone(),
             rms_px: (squared[v] / counts[v].max(1) as f64).sqrt(),
             n_points: counts[v],
-            camera_from_target: pose_report(&poses[v]),
+            camera_from_target: PoseJson::from(&poses[v]),
             outliers,
             residuals_px: view_residuals(&camera, &poses[v], view),
         })
@@ -254,16 +243,6 @@ fn correlation(names: &[String], c: &DMatrix<f64>) -> Correlation {
     Correlation {
         names: names.to_vec(),
         matrix,
-    }
-}
-
-pub(crate) fn pose_report(pose: &Pose) -> PoseReport {
-    let m = matrix4_from_pose(pose);
-    let t = pose.translation.vector;
-    PoseReport {
-        matrix_row_major: [0, 1, 2, 3].map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)], m[(r, 3)]]),
-        translation_m: [t.x, t.y, t.z],
-        quaternion_xyzw: quaternion_xyzw_from_rotation(&pose.rotation),
     }
 }
 

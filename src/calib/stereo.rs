@@ -8,14 +8,14 @@
 //! `right_from_left * left_from_target`).
 
 use super::refine::{block_from_pose, CalibProblem};
-use super::report::{build_report, pose_report};
+use super::report::build_report;
 use super::stereo_problem::StereoProblem;
 use super::zhang::lm_options;
-use super::{calibrate, CalibrationOptions, CameraCalibration, PoseReport, View};
+use super::{calibrate, CalibrationOptions, CameraCalibration, View};
 use crate::error::{Error, Result};
-use crate::geometry::{average_rotations_quaternion, pose_from_matrix4, Pose};
+use crate::geometry::{average_rotations_quaternion, Pose, PoseJson};
 use crate::optim::{solve, BlockParams, BlockProblem, LmOptions, Termination};
-use nalgebra::{Matrix4, Translation3, Vector3};
+use nalgebra::{Translation3, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// Standard deviations of right_from_left from the joint covariance.
@@ -37,9 +37,9 @@ pub struct StereoCalibration {
     /// is `right_from_left * left camera_from_target`.
     pub right: CameraCalibration,
     /// The refined transform: `p_right = right_from_left * p_left`.
-    pub right_from_left: PoseReport,
+    pub right_from_left: PoseJson,
     /// The averaged single-camera estimate the refinement started from.
-    pub initial_right_from_left: PoseReport,
+    pub initial_right_from_left: PoseJson,
     /// Distance between the camera centres, metres.
     pub baseline_m: f64,
     /// Standard deviations of right_from_left (`None` when singular).
@@ -151,8 +151,8 @@ pub fn calibrate_stereo(
     Ok(StereoCalibration {
         left: left_report,
         right: right_report,
-        right_from_left: pose_report(&rfl),
-        initial_right_from_left: pose_report(&initial),
+        right_from_left: PoseJson::from(&rfl),
+        initial_right_from_left: PoseJson::from(&initial),
         baseline_m: rfl.inverse().translation.vector.norm(),
         right_from_left_std,
         rms_px: (squared / blocks.len().max(1) as f64).sqrt(),
@@ -202,10 +202,7 @@ fn report_poses(report: &CameraCalibration) -> Result<Vec<Pose>> {
     report
         .views
         .iter()
-        .map(|v| {
-            let m = v.camera_from_target.matrix_row_major;
-            pose_from_matrix4(&Matrix4::from_fn(|r, c| m[r][c]))
-        })
+        .map(|v| v.camera_from_target.to_pose())
         .collect()
 }
 

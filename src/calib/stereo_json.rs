@@ -133,9 +133,9 @@ fn side_size(side: &str, views: &[JsonView], given: Option<[u32; 2]>) -> Result<
 mod tests {
     use super::*;
     use crate::camera::Camera;
-    use crate::geometry::{pose_from_matrix4, rotation_from_rotvec, Pose};
+    use crate::geometry::{rotation_from_rotvec, Pose};
     use crate::synth::Scene;
-    use nalgebra::{Matrix4, Translation3, Vector3};
+    use nalgebra::{Translation3, Vector3};
     use wasm_bindgen_test::wasm_bindgen_test;
 
     /// Noise-free pair: the left views of a seeded scene and the same board
@@ -195,8 +195,7 @@ mod tests {
         let out: StereoCalibration =
             serde_json::from_str(&calibrate_stereo_json(&text).expect("solve")).expect("parse");
         // Noise-free correspondences: the optimum is the truth to solver precision.
-        let m = out.right_from_left.matrix_row_major;
-        let got = pose_from_matrix4(&Matrix4::from_fn(|r, c| m[r][c])).expect("pose");
+        let got = out.right_from_left.to_pose().expect("pose");
         assert!((got.translation.vector - truth.translation.vector).norm() < 1e-9);
         assert!(got.rotation.angle_to(&truth.rotation) < 1e-9);
         assert!((out.baseline_m - truth.inverse().translation.vector.norm()).abs() < 1e-9);

@@ -4,9 +4,9 @@ use super::stereo::{calibrate_stereo, initial_right_from_left};
 use super::{CalibrationOptions, View};
 use crate::camera::Camera;
 use crate::error::Error;
-use crate::geometry::{pose_from_matrix4, rotation_from_rotvec, Pose};
+use crate::geometry::{rotation_from_rotvec, Pose};
 use crate::synth::{Rng, Scene};
-use nalgebra::{Matrix4, Point2, Translation3, Vector3};
+use nalgebra::{Point2, Translation3, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
 
 struct Pair {
@@ -63,10 +63,6 @@ fn pair(seed: u64, noise_px: f64) -> Pair {
     }
 }
 
-fn pose_of(m: [[f64; 4]; 4]) -> Pose {
-    pose_from_matrix4(&Matrix4::from_fn(|r, c| m[r][c])).expect("pose")
-}
-
 #[wasm_bindgen_test(unsupported = test)]
 fn noise_free_pair_gives_the_true_cameras_and_transform() {
     let p = pair(7, 0.0);
@@ -79,7 +75,7 @@ fn noise_free_pair_gives_the_true_cameras_and_transform() {
         &CalibrationOptions::default(),
     )
     .expect("stereo");
-    let rfl = pose_of(s.right_from_left.matrix_row_major);
+    let rfl = s.right_from_left.to_pose().expect("pose");
     let err = p.right_from_left.inverse() * rfl;
     assert!(
         err.rotation.angle() < 1e-9,
@@ -87,7 +83,7 @@ fn noise_free_pair_gives_the_true_cameras_and_transform() {
         err.rotation.angle()
     );
     assert!(err.translation.vector.norm() < 1e-9);
-    let init = pose_of(s.initial_right_from_left.matrix_row_major);
+    let init = s.initial_right_from_left.to_pose().expect("pose");
     // The single-camera solutions are exact too, so the seed's closed form is.
     assert!((p.right_from_left.inverse() * init).rotation.angle() < 1e-8);
     assert!(s.rms_px < 1e-8, "rms {}", s.rms_px);
@@ -96,8 +92,8 @@ fn noise_free_pair_gives_the_true_cameras_and_transform() {
     assert!((s.right.camera.cx - p.right_camera.cx).abs() < 1e-6);
     assert!((s.baseline_m - p.right_from_left.translation.vector.norm()).abs() < 1e-9);
     // The right view poses are right_from_left * left poses.
-    let l0 = pose_of(s.left.views[0].camera_from_target.matrix_row_major);
-    let r0 = pose_of(s.right.views[0].camera_from_target.matrix_row_major);
+    let l0 = s.left.views[0].camera_from_target.to_pose().expect("pose");
+    let r0 = s.right.views[0].camera_from_target.to_pose().expect("pose");
     assert!(((rfl * l0).inverse() * r0).translation.vector.norm() < 1e-12);
 }
 
@@ -119,7 +115,7 @@ fn noisy_pair_is_within_bounds_of_the_noise() {
     let expected = std::f64::consts::SQRT_2 * sigma;
     assert!((s.rms_px / expected - 1.0).abs() < 0.15, "rms {}", s.rms_px);
     let std = s.right_from_left_std.clone().expect("std");
-    let rfl = pose_of(s.right_from_left.matrix_row_major);
+    let rfl = s.right_from_left.to_pose().expect("pose");
     let err_t = rfl.translation.vector - p.right_from_left.translation.vector;
     let err_r = (rfl.rotation * p.right_from_left.rotation.inverse()).scaled_axis();
     // Each component within 4 of its reported std (a Gaussian estimate

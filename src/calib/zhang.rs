@@ -217,9 +217,9 @@ fn validate(views: &[View], image_size_px: (u32, u32), options: &CalibrationOpti
             return Err(Error::invalid(
                 "fixed_coefficients",
                 format!(
-                    "the {} model has no coefficient '{name}' (it has {:?})",
+                    "the {} model has no coefficient '{name}' (it has {})",
                     options.model.model_name(),
-                    options.model.coefficient_names()
+                    options.model.coefficient_names().join(", ")
                 ),
             ));
         }

@@ -12,9 +12,11 @@ use serde::{Deserialize, Serialize};
 /// coefficient order of [`Distortion::coefficients`] is the order of
 /// [`Distortion::coefficient_names`].
 ///
-/// In JSON: `{"model": "brown", "k1": -0.2, ...}` (read through
-/// [`DistortionFields`], not serde's buffering internally tagged form).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// In JSON: `{"model": "brown", "k1": -0.2, ...}`, tagged by `model` and
+/// read by serde's derive (an unknown model is "unknown variant `x`,
+/// expected one of `none`, `brown`, ..."; a missing coefficient "missing
+/// field `k3`").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "model", rename_all = "snake_case")]
 pub enum Distortion {
     /// The ideal pinhole camera.
@@ -105,94 +107,6 @@ pub enum Distortion {
         /// Ellipsoid shape (1 = sphere, the unified model).
         beta: f64,
     },
-}
-
-#[derive(Clone, Copy, Deserialize)]
-enum Model {
-    #[serde(rename = "none")]
-    None,
-    #[serde(rename = "brown")]
-    Brown,
-    #[serde(rename = "rational")]
-    Rational,
-    #[serde(rename = "division")]
-    Division,
-    #[serde(rename = "radial_k1_k2_k5")]
-    RadialK1K2K5,
-    #[serde(rename = "kannala_brandt")]
-    KannalaBrandt,
-    #[serde(rename = "eucm")]
-    Eucm,
-}
-
-/// Every coefficient of every model; `model` picks which are needed.
-#[derive(Deserialize)]
-struct DistortionFields {
-    model: Option<Model>,
-    k1: Option<f64>,
-    k2: Option<f64>,
-    k3: Option<f64>,
-    k4: Option<f64>,
-    k5: Option<f64>,
-    k6: Option<f64>,
-    p1: Option<f64>,
-    p2: Option<f64>,
-    s1: Option<f64>,
-    s2: Option<f64>,
-    s3: Option<f64>,
-    s4: Option<f64>,
-    kappa: Option<f64>,
-    alpha: Option<f64>,
-    beta: Option<f64>,
-}
-
-impl<'de> Deserialize<'de> for Distortion {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
-        use crate::error::serde_field as f;
-        let c = DistortionFields::deserialize(d)?;
-        Ok(match f(c.model, "model")? {
-            Model::None => Distortion::None,
-            Model::Brown => Distortion::Brown {
-                k1: f(c.k1, "k1")?,
-                k2: f(c.k2, "k2")?,
-                k3: f(c.k3, "k3")?,
-                p1: f(c.p1, "p1")?,
-                p2: f(c.p2, "p2")?,
-            },
-            Model::Rational => Distortion::Rational {
-                k1: f(c.k1, "k1")?,
-                k2: f(c.k2, "k2")?,
-                k3: f(c.k3, "k3")?,
-                k4: f(c.k4, "k4")?,
-                k5: f(c.k5, "k5")?,
-                k6: f(c.k6, "k6")?,
-                p1: f(c.p1, "p1")?,
-                p2: f(c.p2, "p2")?,
-                s1: f(c.s1, "s1")?,
-                s2: f(c.s2, "s2")?,
-                s3: f(c.s3, "s3")?,
-                s4: f(c.s4, "s4")?,
-            },
-            Model::Division => Distortion::Division {
-                kappa: f(c.kappa, "kappa")?,
-            },
-            Model::RadialK1K2K5 => Distortion::RadialK1K2K5 {
-                k1: f(c.k1, "k1")?,
-                k2: f(c.k2, "k2")?,
-                k5: f(c.k5, "k5")?,
-            },
-            Model::KannalaBrandt => Distortion::KannalaBrandt {
-                k1: f(c.k1, "k1")?,
-                k2: f(c.k2, "k2")?,
-                k3: f(c.k3, "k3")?,
-                k4: f(c.k4, "k4")?,
-            },
-            Model::Eucm => Distortion::Eucm {
-                alpha: f(c.alpha, "alpha")?,
-                beta: f(c.beta, "beta")?,
-            },
-        })
-    }
 }
 
 /// A ray's distorted normalised point and its derivatives.

@@ -16,6 +16,8 @@
 //!   [`rotation_from_euler`], [`euler_from_rotation`];
 //! - 4x4 homogeneous matrices with validation: [`pose_from_matrix4`],
 //!   [`matrix4_from_pose`];
+//! - the one JSON shape of a pose, [`PoseJson`] (written by every report)
+//!   and [`PoseInput`] (what JSON inputs may give), in [`pose_serde`];
 //! - dual quaternions ([`DualQuaternion`]) for screw-motion solvers;
 //! - [`nearest_rotation`] (SVD projection of a noisy 3x3),
 //!   [`rotation_angle_between`], and rotation averaging
@@ -26,6 +28,8 @@ mod dual_quaternion;
 mod euler;
 pub mod pose_serde;
 mod rotation;
+
+pub use pose_serde::{PoseInput, PoseJson};
 
 pub use average::{average_rotations_chordal, average_rotations_quaternion};
 pub use dual_quaternion::DualQuaternion;

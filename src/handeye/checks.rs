@@ -225,7 +225,8 @@ pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
             found.push(format!(
                 "the robot poses look inverted: read as gripper_from_base they fit the camera \
                  motion with rotation RMS {:.3} deg, against {off:.3} deg as base_from_gripper: \
-                 invert them (or choose the pose format that gives base_from_gripper)",
+                 invert them (or choose the pose format that gives base_from_gripper), or check \
+                 the setup: eye-in-hand and eye-to-hand read the robot poses the other way round",
                 alt.rotation_rms_deg
             ));
         }

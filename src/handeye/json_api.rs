@@ -4,8 +4,9 @@
 //! Input: `{"setup": "eye-in-hand" | "eye-to-hand", "base_from_gripper":
 //! [pose...], "camera_from_target": [pose...], "method": "all" | NAME,
 //! "bootstrap_samples": 100, "seed": 1, "strict_checks": true}` where a pose
-//! is `{"matrix_row_major": [[4 numbers] x 4]}` or `{"translation_m": [x, y,
-//! z], "quaternion_xyzw": [x, y, z, w]}` (metres). Output: the
+//! is a [`PoseInput`]: `{"matrix_row_major": [[4 numbers] x 4]}`,
+//! `{"translation_m": [x, y, z], "quaternion_xyzw": [x, y, z, w]}` (metres)
+//! or all three (a report's [`crate::geometry::PoseJson`]). Output: the
 //! [`super::output::HandEyeReport`] JSON.
 //!
 //! Image points (optional): `"camera"` (a camera JSON: the robocal camera
@@ -28,49 +29,13 @@ use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SA
 use super::{HandEyeMethod, Pose, Setup};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::geometry::{pose_from_matrix4, rotation_from_quaternion_xyzw};
+use crate::geometry::PoseInput;
 use crate::target::Detection;
-use nalgebra::{Matrix4, Point2, Point3, Translation3, Vector3};
+use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 
 /// Default expected pixel noise of the refinement (px).
 pub const DEFAULT_PIXEL_SIGMA_PX: f64 = 0.5;
-
-/// A pose in JSON: `{"matrix_row_major": [[..4]; 4]}` or `{"translation_m",
-/// "quaternion_xyzw"}`. Read through [`PoseFields`] (serde's untagged form
-/// buffers every object and is a large part of the wasm module).
-enum PoseIn {
-    Matrix {
-        matrix_row_major: [[f64; 4]; 4],
-    },
-    Quaternion {
-        translation_m: [f64; 3],
-        quaternion_xyzw: [f64; 4],
-    },
-}
-
-#[derive(Deserialize)]
-struct PoseFields {
-    matrix_row_major: Option<[[f64; 4]; 4]>,
-    translation_m: Option<[f64; 3]>,
-    quaternion_xyzw: Option<[f64; 4]>,
-}
-
-impl<'de> Deserialize<'de> for PoseIn {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
-        let p = PoseFields::deserialize(d)?;
-        match (p.matrix_row_major, p.translation_m, p.quaternion_xyzw) {
-            (Some(matrix_row_major), _, _) => Ok(PoseIn::Matrix { matrix_row_major }),
-            (None, Some(translation_m), Some(quaternion_xyzw)) => Ok(PoseIn::Quaternion {
-                translation_m,
-                quaternion_xyzw,
-            }),
-            _ => Err(serde::de::Error::custom(
-                "data did not match any variant of untagged enum PoseIn",
-            )),
-        }
-    }
-}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -83,9 +48,9 @@ struct ViewIn {
 #[serde(deny_unknown_fields)]
 struct InputJson {
     setup: Setup,
-    base_from_gripper: Vec<PoseIn>,
+    base_from_gripper: Vec<PoseInput>,
     #[serde(default)]
-    camera_from_target: Option<Vec<PoseIn>>,
+    camera_from_target: Option<Vec<PoseInput>>,
     #[serde(default)]
     camera: Option<serde_json::Value>,
     #[serde(default)]
@@ -106,23 +71,9 @@ struct InputJson {
     strict_checks: Option<bool>,
 }
 
-fn to_pose(p: &PoseIn, field: &str, index: usize) -> Result<Pose> {
-    let located = |e: Error| Error::invalid(format!("{field}[{index}]"), e.to_string());
-    match p {
-        PoseIn::Matrix {
-            matrix_row_major: m,
-        } => {
-            let flat: Vec<f64> = m.iter().flatten().copied().collect();
-            pose_from_matrix4(&Matrix4::from_row_slice(&flat)).map_err(located)
-        }
-        PoseIn::Quaternion {
-            translation_m: t,
-            quaternion_xyzw: q,
-        } => {
-            let r = rotation_from_quaternion_xyzw(*q).map_err(located)?;
-            Ok(Pose::from_parts(Translation3::from(Vector3::from(*t)), r))
-        }
-    }
+fn to_pose(p: &PoseInput, field: &str, index: usize) -> Result<Pose> {
+    p.to_pose()
+        .map_err(|e| Error::invalid(format!("{field}[{index}]"), e.to_string()))
 }
 
 /// A camera from JSON: the [`Camera`] serde form, a calibration report
@@ -192,7 +143,7 @@ fn views_from_detections(list: &[Detection]) -> Vec<ViewPoints> {
 #[serde(deny_unknown_fields)]
 struct CandidateIn {
     name: String,
-    base_from_gripper: Vec<PoseIn>,
+    base_from_gripper: Vec<PoseInput>,
 }
 
 #[derive(Deserialize)]
@@ -200,7 +151,7 @@ struct CandidateIn {
 struct RankInput {
     setup: Setup,
     candidates: Vec<CandidateIn>,
-    camera_from_target: Vec<PoseIn>,
+    camera_from_target: Vec<PoseInput>,
 }
 
 /// The answer of [`rank_candidates_json`].
@@ -257,7 +208,7 @@ pub fn rank_candidates_json(input_json: &str) -> Result<String> {
 pub fn solve_handeye_json(input_json: &str) -> Result<String> {
     let input: InputJson = serde_json::from_str(input_json)
         .map_err(|e| Error::parse(e.line(), e.column(), e.to_string()))?;
-    let poses = |list: &[PoseIn], field: &str| -> Result<Vec<Pose>> {
+    let poses = |list: &[PoseInput], field: &str| -> Result<Vec<Pose>> {
         list.iter()
             .enumerate()
             .map(|(i, p)| to_pose(p, field, i))

@@ -9,37 +9,8 @@ use super::repeat::Repeatability;
 use super::report::{Errors, MotionResidual, ViewResidual};
 use super::solve::HandEyeResult;
 use super::{Pose, Setup};
+use crate::geometry::PoseJson;
 use serde::{Deserialize, Serialize};
-
-/// A transform as JSON: row-major 4x4, translation (m), quaternion (x, y, z, w).
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-pub struct PoseJson {
-    /// The 4x4 homogeneous matrix, row by row.
-    pub matrix_row_major: [[f64; 4]; 4],
-    /// Translation (metres).
-    pub translation_m: [f64; 3],
-    /// Rotation quaternion, order x, y, z, w.
-    pub quaternion_xyzw: [f64; 4],
-}
-
-impl From<&Pose> for PoseJson {
-    fn from(p: &Pose) -> Self {
-        let m = p.to_homogeneous();
-        let mut rows = [[0.0; 4]; 4];
-        for (r, row) in rows.iter_mut().enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v = m[(r, c)];
-            }
-        }
-        let t = p.translation.vector;
-        let q = p.rotation;
-        PoseJson {
-            matrix_row_major: rows,
-            translation_m: [t.x, t.y, t.z],
-            quaternion_xyzw: [q.i, q.j, q.k, q.w],
-        }
-    }
-}
 
 /// One robot pose and the image paired with it.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]

@@ -65,12 +65,34 @@ pub fn parse_pose_text(text: &str, format: Option<PoseTextFormat>) -> Result<Vec
         }
         poses.push(pose_from_values(&values, format, line_no)?);
     }
+    if poses.is_empty() {
+        return Err(Error::parse(
+            0,
+            0,
+            "the pose file has no poses: expected one pose per line",
+        ));
+    }
     Ok(poses)
 }
 
 fn pose_from_values(v: &[f64], format: Option<PoseTextFormat>, line: usize) -> Result<Pose> {
     match (v.len(), format) {
         (16 | 12, None | Some(PoseTextFormat::Matrix)) => {
+            let bottom_off = v[12..]
+                .iter()
+                .zip([0.0, 0.0, 0.0, 1.0])
+                .any(|(a, b)| !((a - b).abs() <= ORTHONORMAL_TOLERANCE));
+            if v.len() == 16 && bottom_off {
+                return Err(Error::parse(
+                    line,
+                    0,
+                    format!(
+                        "the bottom row of the 4x4 matrix is [{} {} {} {}], expected [0 0 0 1]: \
+                         write the matrix row by row",
+                        v[12], v[13], v[14], v[15]
+                    ),
+                ));
+            }
             let r = Matrix3::new(v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10]);
             let err = (r.transpose() * r - Matrix3::identity()).abs().max();
             if err > ORTHONORMAL_TOLERANCE || r.determinant() < 0.0 {

@@ -212,22 +212,16 @@ mod tests {
     use super::super::refine_tests::{camera, looking_scene};
     use super::super::Setup;
     use super::*;
+    use crate::geometry::PoseJson;
     use crate::synth::handeye::project_grid;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     fn pose_json(p: &Pose) -> serde_json::Value {
-        let t = p.translation.vector;
-        let q = p.rotation;
-        serde_json::json!({"translation_m": [t.x, t.y, t.z], "quaternion_xyzw": [q.i, q.j, q.k, q.w]})
+        serde_json::to_value(PoseJson::from(p)).unwrap()
     }
 
     fn pose_of(v: &serde_json::Value) -> Pose {
-        let t: [f64; 3] = serde_json::from_value(v["translation_m"].clone()).unwrap();
-        let q: [f64; 4] = serde_json::from_value(v["quaternion_xyzw"].clone()).unwrap();
-        Pose::from_parts(
-            nalgebra::Translation3::from(nalgebra::Vector3::from(t)),
-            crate::geometry::rotation_from_quaternion_xyzw(q).unwrap(),
-        )
+        PoseJson::deserialize(v).unwrap().to_pose().unwrap()
     }
 
     #[wasm_bindgen_test(unsupported = test)]

@@ -347,6 +347,8 @@ fn image_error(format: ImageFormat, e: ImageError, options: &DecodeOptions) -> E
         ImageError::Parameter(e) => format!("corrupt or truncated {name} file: {e}"),
         ImageError::Encoding(e) => format!("corrupt {name} file: {e}"),
     };
+    // Some decoders end their text with a newline (JPEG's I/O errors).
+    let message = message.trim_end().to_string();
     Error::Image { message }
 }
 

@@ -3,15 +3,15 @@
 //!
 //! A report is the JSON of a camera calibration (top-level `image_size_px`,
 //! `model`, `camera_matrix`, `distortion`, `rms_px`) or of a hand-eye
-//! calibration (transforms such as `gripper_from_camera` as
-//! `{matrix_row_major, translation_m, quaternion_xyzw}`), or both.
+//! calibration (transforms such as `gripper_from_camera` in the one pose
+//! shape, [`crate::geometry::PoseJson`]), or both.
 
 use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
 use super::export_transform::{export_transform, FrameNames, TransformFormat};
 use super::import_camera::import_camera;
 use crate::error::{Error, Result};
-use crate::geometry::{pose_from_matrix4, Pose};
-use nalgebra::Matrix4;
+use crate::geometry::{Pose, PoseInput};
+use serde::Deserialize;
 
 /// Transforms looked for, in order, when the caller names none.
 pub const DEFAULT_TRANSFORMS: [&str; 4] = [
@@ -97,16 +97,15 @@ pub fn export(report_json: &str, format: &str, transform: Option<&str>) -> Resul
     ))
 }
 
-/// Read the transform `name` (`{matrix_row_major: 4 rows of 4, or 16
-/// numbers}`) from a report.
+/// Read the transform `name` from a report: any [`PoseInput`] (the matrix
+/// as 4 rows of 4 or 16 numbers, translation and quaternion, or all three).
 pub fn pose_from_report(report: &serde_json::Value, name: &str) -> Result<Pose> {
     let entry = report
         .get(name)
         .ok_or_else(|| Error::invalid("transform", format!("the report has no '{name}'")))?;
-    let m = super::json_matrix_numbers(&entry["matrix_row_major"])
-        .filter(|m| m.len() == 16)
-        .ok_or_else(|| {
-            Error::invalid(name, "expected matrix_row_major with 4 rows of 4 numbers")
-        })?;
-    pose_from_matrix4(&Matrix4::from_row_slice(&m))
+    let located = |message: String| Error::invalid(name, message);
+    PoseInput::deserialize(entry)
+        .map_err(|e| located(e.to_string()))?
+        .to_pose()
+        .map_err(|e| located(e.to_string()))
 }

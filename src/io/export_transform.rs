@@ -8,7 +8,7 @@
 use crate::error::{Error, Result};
 use crate::geometry::{
     euler_from_rotation, matrix4_from_pose, quaternion_wxyz_from_rotation,
-    quaternion_xyzw_from_rotation, rotvec_from_rotation, EulerKind, EulerOrder, Pose,
+    quaternion_xyzw_from_rotation, rotvec_from_rotation, EulerKind, EulerOrder, Pose, PoseJson,
 };
 use crate::io::export_camera::float;
 
@@ -283,14 +283,10 @@ pub fn export_transform(pose: &Pose, names: &FrameNames, format: TransformFormat
     }
 }
 
-/// The transform as `{matrix_row_major (4 rows of 4), translation_m,
-/// quaternion_xyzw}`, the JSON shape every report uses.
+/// The transform's [`PoseJson`] (the one pose shape of every report) as a
+/// JSON value, for building documents with `serde_json::json!`.
 pub fn transform_json(pose: &Pose) -> serde_json::Value {
-    let m = matrix4_from_pose(pose);
-    let t = pose.translation.vector;
-    serde_json::json!({
-        "matrix_row_major": (0..4).map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)], m[(r, 3)]]).collect::<Vec<[f64; 4]>>(),
-        "translation_m": [t.x, t.y, t.z],
-        "quaternion_xyzw": quaternion_xyzw_from_rotation(&pose.rotation),
-    })
+    // A struct of numbers serialises to a `Value` without error (non-finite
+    // numbers become null, as `json!` would write them).
+    serde_json::to_value(PoseJson::from(pose)).unwrap_or(serde_json::Value::Null)
 }

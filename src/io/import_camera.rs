@@ -47,7 +47,7 @@ fn from_json(text: &str) -> Result<Camera> {
     let size = v["image_size_px"]
         .as_array()
         .filter(|a| a.len() == 2)
-        .ok_or_else(|| missing("image_size_px"))?;
+        .ok_or_else(|| missing("image_size_px", IMAGE_SIZE))?;
     let dim = |i: usize| {
         size[i]
             .as_u64()
@@ -55,13 +55,15 @@ fn from_json(text: &str) -> Result<Camera> {
             .map(|d| d as u32)
     };
     let (width, height) = (
-        dim(0).ok_or_else(|| missing("image_size_px"))?,
-        dim(1).ok_or_else(|| missing("image_size_px"))?,
+        dim(0).ok_or_else(|| missing("image_size_px", IMAGE_SIZE))?,
+        dim(1).ok_or_else(|| missing("image_size_px", IMAGE_SIZE))?,
     );
     let k: Vec<f64> = super::json_matrix_numbers(&v["camera_matrix"])
         .filter(|k| k.len() == 9)
-        .ok_or_else(|| missing("camera_matrix (3 rows of 3 numbers)"))?;
-    let model = v["model"].as_str().ok_or_else(|| missing("model"))?;
+        .ok_or_else(|| missing("camera_matrix", "3 rows of 3 numbers [[fx, s, cx], [0, fy, cy], [0, 0, 1]]"))?;
+    let model = v["model"]
+        .as_str()
+        .ok_or_else(|| missing("model", "the lens model's name, e.g. \"brown\""))?;
     let template = distortion_template(model)?;
     let coeffs = template
         .coefficient_names()
@@ -70,7 +72,7 @@ fn from_json(text: &str) -> Result<Camera> {
             v["distortion"][*name].as_f64().ok_or_else(|| {
                 Error::invalid(
                     "distortion",
-                    format!("the {model} model needs coefficient '{name}'"),
+                    format!("the {model} model needs coefficient '{name}' (a number)"),
                 )
             })
         })
@@ -79,8 +81,11 @@ fn from_json(text: &str) -> Result<Camera> {
     camera_from_k(&k, width, height, distortion)
 }
 
-fn missing(key: &str) -> Error {
-    Error::invalid(key, format!("the camera JSON has no valid '{key}'"))
+/// What a camera JSON's `image_size_px` must be.
+const IMAGE_SIZE: &str = "[width, height]: two whole numbers of pixels, both > 0";
+
+fn missing(key: &str, expected: &str) -> Error {
+    Error::invalid(key, format!("the camera JSON needs {expected}"))
 }
 
 /// A model with zero coefficients, from its name.
@@ -97,6 +102,12 @@ pub fn distortion_template(model: &str) -> Result<Distortion> {
 }
 
 fn camera_from_k(k: &[f64], width: u32, height: u32, distortion: Distortion) -> Result<Camera> {
+    if let Some(bad) = k.iter().find(|v| !v.is_finite()) {
+        return Err(Error::invalid(
+            "camera_matrix",
+            format!("every entry must be a finite number, got {bad}"),
+        ));
+    }
     if k[3] != 0.0 || k[6] != 0.0 || k[7] != 0.0 || (k[8] - 1.0).abs() > 1e-12 {
         return Err(Error::invalid(
             "camera_matrix",

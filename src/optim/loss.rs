@@ -6,9 +6,9 @@ use serde::{Deserialize, Serialize};
 /// The scale is in residual units (pixels for reprojection errors): blocks
 /// with norm below it count as in plain least squares.
 ///
-/// In JSON `{"kind": "huber", "scale": 1.0}` (read through a plain struct,
-/// not serde's buffering internally tagged form).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+/// In JSON `{"kind": "huber", "scale": 1.0}`, tagged by `kind` (serde's
+/// derive).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Loss {
     /// Plain least squares: `rho(s) = s`.
@@ -23,36 +23,6 @@ pub enum Loss {
         /// The scale c, in residual units.
         scale: f64,
     },
-}
-
-#[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
-enum LossKind {
-    Squared,
-    Huber,
-    Cauchy,
-}
-
-#[derive(Deserialize)]
-struct LossFields {
-    kind: Option<LossKind>,
-    scale: Option<f64>,
-}
-
-impl<'de> Deserialize<'de> for Loss {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use crate::error::serde_field as f;
-        let l = LossFields::deserialize(d)?;
-        Ok(match f(l.kind, "kind")? {
-            LossKind::Squared => Loss::Squared,
-            LossKind::Huber => Loss::Huber {
-                scale: f(l.scale, "scale")?,
-            },
-            LossKind::Cauchy => Loss::Cauchy {
-                scale: f(l.scale, "scale")?,
-            },
-        })
-    }
 }
 
 impl Loss {

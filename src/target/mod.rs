@@ -58,20 +58,19 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "snake_case")]
 pub enum Polarity {
     /// Dark circles on a light background (the usual print).
-    #[serde(rename = "dark_on_light")]
     DarkOnLight,
     /// Light circles on a dark background.
-    #[serde(rename = "light_on_dark")]
     LightOnDark,
 }
 
 /// A calibration target's geometry (see the module docs for the point order).
 ///
 /// In JSON an object tagged by `kind` (`{"kind": "chessboard", "cols": 9,
-/// ...}`). Deserialized through [`TargetFields`] rather than serde's
-/// internally tagged form, which buffers every object (a large part of the
-/// wasm module); the accepted JSON and the error texts are the same.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// ...}`), read and written by serde's derives: an unknown kind is
+/// "unknown variant `x`, expected one of `chessboard`, ...", a missing
+/// field "missing field `cols`". Reading does not check sizes and counts
+/// (a detection file is read as written); [`Target::validated`] does.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Target {
     /// A chessboard, counted by inner corners (a 10 x 7 squares board is 9 x 6).
@@ -128,72 +127,6 @@ pub enum Target {
         /// than the side: the squares do not touch).
         pitch_m: f64,
     },
-}
-
-#[derive(Clone, Copy, Deserialize)]
-enum TargetKind {
-    #[serde(rename = "chessboard")]
-    Chessboard,
-    #[serde(rename = "circle_grid")]
-    CircleGrid,
-    #[serde(rename = "dot_plate")]
-    DotPlate,
-    #[serde(rename = "single_circle")]
-    SingleCircle,
-    #[serde(rename = "square_grid")]
-    SquareGrid,
-}
-
-/// Every field of every [`Target`] variant; the tag picks which are needed.
-#[derive(Deserialize)]
-struct TargetFields {
-    kind: Option<TargetKind>,
-    cols: Option<usize>,
-    rows: Option<usize>,
-    square_m: Option<f64>,
-    spacing_m: Option<f64>,
-    asymmetric: Option<bool>,
-    polarity: Option<Polarity>,
-    pitch_m: Option<f64>,
-    dot_diameter_m: Option<f64>,
-    diameter_m: Option<f64>,
-    side_m: Option<f64>,
-}
-
-impl<'de> Deserialize<'de> for Target {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
-        use crate::error::serde_field as f;
-        let t = TargetFields::deserialize(d)?;
-        Ok(match f(t.kind, "kind")? {
-            TargetKind::Chessboard => Target::Chessboard {
-                cols: f(t.cols, "cols")?,
-                rows: f(t.rows, "rows")?,
-                square_m: f(t.square_m, "square_m")?,
-            },
-            TargetKind::CircleGrid => Target::CircleGrid {
-                cols: f(t.cols, "cols")?,
-                rows: f(t.rows, "rows")?,
-                spacing_m: f(t.spacing_m, "spacing_m")?,
-                asymmetric: f(t.asymmetric, "asymmetric")?,
-                polarity: f(t.polarity, "polarity")?,
-            },
-            TargetKind::DotPlate => Target::DotPlate {
-                cols: f(t.cols, "cols")?,
-                rows: f(t.rows, "rows")?,
-                pitch_m: f(t.pitch_m, "pitch_m")?,
-                dot_diameter_m: f(t.dot_diameter_m, "dot_diameter_m")?,
-            },
-            TargetKind::SingleCircle => Target::SingleCircle {
-                diameter_m: f(t.diameter_m, "diameter_m")?,
-            },
-            TargetKind::SquareGrid => Target::SquareGrid {
-                cols: f(t.cols, "cols")?,
-                rows: f(t.rows, "rows")?,
-                side_m: f(t.side_m, "side_m")?,
-                pitch_m: f(t.pitch_m, "pitch_m")?,
-            },
-        })
-    }
 }
 
 /// One detected target point in pixels.

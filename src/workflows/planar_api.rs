@@ -10,57 +10,14 @@ use crate::error::Result;
 use serde::{Deserialize, Serialize};
 
 /// One per-height matrix, as in the article's Table 4. In JSON one flat
-/// object `{"height_mm", "a11", "a12", "tx", "a21", "a22", "ty"}` (through
-/// [`HeightMatrixRow`]: serde's `flatten` buffers the object).
+/// object `{"height_mm", "a11", "a12", "tx", "a21", "a22", "ty"}`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(from = "HeightMatrixRow", into = "HeightMatrixRow")]
 pub struct HeightMatrix {
     /// Calibration height, mm.
     pub height_mm: f64,
     /// The matrix `robot_from_image` at that height.
+    #[serde(flatten)]
     pub robot_from_image: PlanarMatrix,
-}
-
-#[derive(Clone, Copy, Serialize, Deserialize)]
-struct HeightMatrixRow {
-    height_mm: f64,
-    a11: f64,
-    a12: f64,
-    tx: f64,
-    a21: f64,
-    a22: f64,
-    ty: f64,
-}
-
-impl From<HeightMatrixRow> for HeightMatrix {
-    fn from(r: HeightMatrixRow) -> Self {
-        HeightMatrix {
-            height_mm: r.height_mm,
-            robot_from_image: PlanarMatrix {
-                a11: r.a11,
-                a12: r.a12,
-                tx: r.tx,
-                a21: r.a21,
-                a22: r.a22,
-                ty: r.ty,
-            },
-        }
-    }
-}
-
-impl From<HeightMatrix> for HeightMatrixRow {
-    fn from(h: HeightMatrix) -> Self {
-        let m = h.robot_from_image;
-        HeightMatrixRow {
-            height_mm: h.height_mm,
-            a11: m.a11,
-            a12: m.a12,
-            tx: m.tx,
-            a21: m.a21,
-            a22: m.a22,
-            ty: m.ty,
-        }
-    }
 }
 
 /// A pixel to map at some height.
