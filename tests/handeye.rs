@@ -10,8 +10,8 @@ mod support;
 
 use nalgebra::Matrix4;
 use robocal::geometry::pose_from_matrix4;
-use robocal::handeye::pose_text::parse_pose_text;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, Pose, Setup};
+use robocal::io::pose_text::parse_pose_text;
 use std::path::PathBuf;
 
 fn dataset(name: &str) -> Option<PathBuf> {

@@ -47,7 +47,10 @@ pub fn image_decode(data: &[u8]) {
     if let Ok(decoded) = robocal::image::decode(data, &options) {
         let g = &decoded.gray;
         assert_eq!(g.pixels.len(), g.width as usize * g.height as usize);
-        assert_eq!((g.width, g.height), (decoded.info.width, decoded.info.height));
+        assert_eq!(
+            (g.width, g.height),
+            (decoded.info.width, decoded.info.height)
+        );
         assert!(g.width as u64 * g.height as u64 <= FUZZ_MAX_PIXELS);
         if let Some(p) = &decoded.preview {
             assert_eq!(p.pixels.len(), 4 * p.width as usize * p.height as usize);
@@ -66,8 +69,16 @@ pub fn detect_target_spec(kind: u8, a: u8, b: u8) -> String {
     match kind % 5 {
         0 => format!("chessboard:{cols}x{rows}:30mm"),
         1 => {
-            let layout = if a & 8 != 0 { "asymmetric" } else { "symmetric" };
-            let polarity = if a & 16 != 0 { "light-on-dark" } else { "dark-on-light" };
+            let layout = if a & 8 != 0 {
+                "asymmetric"
+            } else {
+                "symmetric"
+            };
+            let polarity = if a & 16 != 0 {
+                "light-on-dark"
+            } else {
+                "dark-on-light"
+            };
             format!("circles:{cols}x{rows}:20mm:{layout}:{polarity}")
         }
         2 => format!("dots:{cols}x{rows}:25mm:12.5mm"),
@@ -90,7 +101,13 @@ pub fn detect_side_byte(side: u32) -> u8 {
 /// The [`detect`] input for a target header and an image of at most
 /// 128 x 128 pixels (the seed generator writes renders with it).
 pub fn detect_input(kind: u8, a: u8, b: u8, image: &GrayImage) -> Vec<u8> {
-    let mut out = vec![kind, a, b, detect_side_byte(image.width), detect_side_byte(image.height)];
+    let mut out = vec![
+        kind,
+        a,
+        b,
+        detect_side_byte(image.width),
+        detect_side_byte(image.height),
+    ];
     out.extend_from_slice(&image.pixels);
     out
 }
@@ -171,7 +188,7 @@ pub fn robot_poses(data: &[u8]) {
     if let Ok(parsed) = robocal::io::parse_poses(text, &options) {
         pose_round_trip(&parsed);
     }
-    use robocal::handeye::pose_text::{parse_pose_text, PoseTextFormat};
+    use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
     let text_format = match (unit_byte >> 5) & 3 {
         1 => Some(PoseTextFormat::Matrix),
         2 => Some(PoseTextFormat::XyzQuaternionXyzw),

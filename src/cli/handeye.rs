@@ -4,9 +4,9 @@ use super::handeye_images::{image_pairs, read_robot_poses, RobotPoses};
 use super::{parse_target, read_file, CliError};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
-use robocal::handeye::pose_text::{parse_pose_text, PoseTextFormat};
-use robocal::handeye::refined::{apply_refinement, RefineMode};
+use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
+use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 
 #[derive(clap::Args)]
 #[command(

@@ -23,8 +23,8 @@
 
 use super::checks::{rank_pose_candidates, recommend_candidate, CandidateScore};
 use super::output::HandEyeReport;
-use super::refine::ViewPoints;
-use super::refined::{apply_refinement, RefineMode};
+use super::refine_closed_form::{apply_refinement, RefineMode};
+use super::reprojection_refine::ViewPoints;
 use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
 use super::{HandEyeMethod, Pose, Setup};
 use crate::camera::Camera;

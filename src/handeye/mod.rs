@@ -32,7 +32,10 @@
 //! Pipeline: [`checks`] catches degenerate data and input mistakes before
 //! solving, [`solve`] runs the closed forms, [`report`] measures closure
 //! residuals and motion diversity, [`repeat`] gives leave-one-out and
-//! bootstrap repeatability.
+//! bootstrap repeatability. [`reprojection_refine`] is the image-based
+//! maximum-likelihood problem (reprojection error over X, the target pose
+//! and optionally the intrinsics); [`refine_closed_form`] applies it to a
+//! closed-form result and makes the refined transform the primary one.
 
 pub mod axxb;
 pub mod axzb;
@@ -43,16 +46,15 @@ pub mod math;
 pub mod motion;
 pub mod output;
 pub mod pnp;
-pub mod pose_text;
-pub mod refine;
-pub mod refined;
+pub mod refine_closed_form;
 pub mod repeat;
 pub mod report;
+pub mod reprojection_refine;
 pub mod scara;
 pub mod solve;
 
 #[cfg(test)]
-mod refine_tests;
+mod reprojection_refine_tests;
 #[cfg(test)]
 mod solver_tests;
 

@@ -4,7 +4,7 @@
 //! motion statistics and repeatability.
 
 use super::motion::MotionStats;
-use super::refined::RefinementSummary;
+use super::refine_closed_form::RefinementSummary;
 use super::repeat::Repeatability;
 use super::report::{Errors, MotionResidual, ViewResidual};
 use super::solve::HandEyeResult;

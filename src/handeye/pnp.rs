@@ -5,7 +5,7 @@
 //! Levenberg-Marquardt ([`crate::optim`]) minimises the reprojection error
 //! over the 6 pose parameters.
 
-use super::refine::ViewPoints;
+use super::reprojection_refine::ViewPoints;
 use super::Pose;
 use crate::calib::{homography, pose_from_homography};
 use crate::camera::Camera;

@@ -96,8 +96,8 @@ pub struct HandEyeResult {
     /// Everything the user should know.
     pub warnings: Vec<String>,
     /// The image-based refinement, when run
-    /// ([`super::refined::apply_refinement`]).
-    pub refinement: Option<super::refined::RefinementSummary>,
+    /// ([`super::refine_closed_form::apply_refinement`]).
+    pub refinement: Option<super::refine_closed_form::RefinementSummary>,
 }
 
 /// Solve one method on a chain; returns `(x, y, unobservable directions)`.

@@ -208,7 +208,7 @@ fn input_mistakes_are_named() {
         .collect();
     let msg = err(&inverted);
     assert!(
-        msg.starts_with("robot poses: the robot poses look inverted: read as gripper_from_base they fit the camera motion with rotation RMS 0.000 deg"),
+        msg.starts_with("robot poses: these poses fit eye-to-hand (the camera fixed, the target on the gripper), not the eye-in-hand chosen: as eye-to-hand they fit the camera motion with rotation RMS 0.000 deg"),
         "{msg}"
     );
     let mut shifted = input(&scene);

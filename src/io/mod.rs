@@ -4,7 +4,8 @@
 //! Robot poses: [`parse_poses`] (format named, from a header, or unique by
 //! value count), [`parse_pose_candidates`] (every plausible reading, ranked),
 //! [`format_poses`] (the inverse). See [`PoseFormat`] for each vendor's
-//! convention and formula.
+//! convention and formula. Camera poses as plain text (`--camera-poses`,
+//! camera_from_target per view): [`pose_text`].
 
 pub mod csv_table;
 pub mod export;
@@ -17,6 +18,7 @@ mod pose_candidates;
 mod pose_formats;
 mod pose_json;
 mod pose_table;
+pub mod pose_text;
 mod pose_writer;
 mod poses;
 pub mod poses_api;

@@ -1,8 +1,8 @@
 //! Reprojection refinement on a seeded scene whose camera looks at a 9x6
 //! grid (0.03 m pitch) from about 0.6 m.
 
-use super::refine::{refine, RefineOptions, RobotNoise, ViewPoints};
 use super::report::pose_difference;
+use super::reprojection_refine::{refine, RefineOptions, RobotNoise, ViewPoints};
 use super::solve::solve_method;
 use super::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
 use crate::camera::Camera;

@@ -4,10 +4,10 @@
 //! semicolons; `#` starts a comment. Units: metres.
 //!
 //! This is the `--camera-poses` format (camera_from_target per view); the
-//! robot pose parsers of `crate::io` cover controller-specific formats.
+//! robot pose parsers beside it in `crate::io` cover controller-specific formats.
 
-use super::Pose;
 use crate::error::{Error, Result};
+use crate::geometry::Pose;
 use nalgebra::{Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion};
 
 /// How to read a line.

@@ -1,4 +1,4 @@
-//! The image-based refinement ([`super::refine`]) applied to a closed-form
+//! The image-based refinement ([`super::reprojection_refine`]) applied to a closed-form
 //! [`HandEyeResult`]: the best closed form seeds the reprojection
 //! Levenberg-Marquardt, the refined transforms become the primary result
 //! (`method` = `refined from <closed form>`), `errors.reprojection_rms_px` is
@@ -6,8 +6,8 @@
 //! reprojection RMS.
 
 use super::motion::build_motions;
-use super::refine::{refine, RefineOptions, RobotNoise, ViewPoints};
 use super::report::{errors, motion_residuals, pose_difference, view_residuals};
+use super::reprojection_refine::{refine, RefineOptions, RobotNoise, ViewPoints};
 use super::solve::{HandEyeInput, HandEyeResult};
 use super::{Chain, MotionPairs, Pose};
 use crate::camera::Camera;
@@ -209,7 +209,7 @@ pub fn apply_refinement(
 #[cfg(test)]
 mod tests {
     use super::super::json_api::solve_handeye_json;
-    use super::super::refine_tests::{camera, looking_scene};
+    use super::super::reprojection_refine_tests::{camera, looking_scene};
     use super::super::Setup;
     use super::*;
     use crate::geometry::PoseJson;
