@@ -26,11 +26,22 @@ thread_local! {
     static LAST_PANIC: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) };
 }
 
+/// Installs the panic hook when the module is instantiated, in every host
+/// (the page's worker, node, a bundler): no caller has to remember [`init`].
+#[wasm_bindgen(start)]
+fn start() {
+    install_panic_hook();
+}
+
 /// Install the panic hook: it writes the panic message to `console.error`
-/// and records it for [`last_panic_message`]. Called once by the JS side
-/// after instantiating the module; calling it again is harmless.
+/// and records it for [`last_panic_message`]. The module installs it itself
+/// when instantiated; calling this again is harmless.
 #[wasm_bindgen]
 pub fn init() {
+    install_panic_hook();
+}
+
+fn install_panic_hook() {
     std::panic::set_hook(Box::new(|info| {
         let text = info.to_string();
         web_sys::console::error_1(&JsValue::from_str(&format!("robocal panicked: {text}")));
@@ -123,14 +134,49 @@ impl InfoJson {
     }
 }
 
+/// The options JSON of the image entries ([`decode_image_preview`],
+/// [`image_info`], [`detect_target`], [`undistort_preview`]): absent, empty
+/// or `{"max_pixels": N}`. `max_pixels` is the largest image accepted, in
+/// pixels; default `robocal::image::DEFAULT_MAX_PIXELS` (64 MP in wasm).
+/// Over the limit the error names the image size and the limit.
+#[derive(serde::Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct ImageOptions {
+    max_pixels: Option<u64>,
+}
+
+fn decode_options(options_json: Option<String>) -> Result<DecodeOptions, JsError> {
+    let text = options_json.unwrap_or_default();
+    let options: ImageOptions = if text.trim().is_empty() {
+        ImageOptions::default()
+    } else {
+        serde_json::from_str(&text)
+            .map_err(|e| JsError::new(&format!("image options JSON: {e}")))?
+    };
+    let mut decode = DecodeOptions::default();
+    if let Some(max_pixels) = options.max_pixels {
+        if max_pixels == 0 {
+            return Err(JsError::new(
+                "image options JSON: max_pixels must be at least 1",
+            ));
+        }
+        decode.max_pixels = max_pixels;
+    }
+    Ok(decode)
+}
+
 /// Decode image bytes (PNG, JPEG, TIFF, BMP, PNM, GIF, WebP); return its
 /// description and a preview (`ImageData`) whose longer side is at most
-/// `max_side` px.
+/// `max_side` px. `options_json`: see [`ImageOptions`] (`{"max_pixels"}`).
 #[wasm_bindgen]
-pub fn decode_image_preview(bytes: &[u8], max_side: u32) -> Result<ImagePreview, JsError> {
+pub fn decode_image_preview(
+    bytes: &[u8],
+    max_side: u32,
+    options_json: Option<String>,
+) -> Result<ImagePreview, JsError> {
     let options = DecodeOptions {
         preview_max_side: Some(max_side),
-        ..Default::default()
+        ..decode_options(options_json)?
     };
     let decoded = decode(bytes, &options).map_err(js_error)?;
     let info_json = serde_json::to_string(&InfoJson::of(&decoded.info))
@@ -143,10 +189,36 @@ pub fn decode_image_preview(bytes: &[u8], max_side: u32) -> Result<ImagePreview,
 }
 
 /// Decode image bytes and return only the description as JSON.
+/// `options_json`: see [`ImageOptions`] (`{"max_pixels"}`).
 #[wasm_bindgen]
-pub fn image_info(bytes: &[u8]) -> Result<String, JsError> {
-    let decoded = decode(bytes, &DecodeOptions::default()).map_err(js_error)?;
+pub fn image_info(bytes: &[u8], options_json: Option<String>) -> Result<String, JsError> {
+    let decoded = decode(bytes, &decode_options(options_json)?).map_err(js_error)?;
     serde_json::to_string(&InfoJson::of(&decoded.info)).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// Pair stereo images by file name, the rule of `robocal stereo`
+/// (`robocal::io::pairing`): the last run of digits in each stem pairs left
+/// `n` with right `n`; when no name has a number, by order; otherwise an
+/// error naming the files. In: two JSON arrays of file names; out:
+/// `{"paired_by": "number" | "order", "pairs": [[left_index, right_index], ...]}`
+/// in left order.
+#[wasm_bindgen]
+pub fn pair_images(left_names_json: &str, right_names_json: &str) -> Result<String, JsError> {
+    let names = |what: &str, json: &str| -> Result<Vec<String>, JsError> {
+        serde_json::from_str(json).map_err(|e| {
+            JsError::new(&format!(
+                "{what} names: expected a JSON array of file names: {e}"
+            ))
+        })
+    };
+    let (left, right) = (
+        names("left", left_names_json)?,
+        names("right", right_names_json)?,
+    );
+    let left: Vec<&str> = left.iter().map(String::as_str).collect();
+    let right: Vec<&str> = right.iter().map(String::as_str).collect();
+    let pairing = crate::io::pairing::pair_by_number(&left, &right).map_err(js_error)?;
+    serde_json::to_string(&pairing).map_err(|e| JsError::new(&e.to_string()))
 }
 
 /// A target from a CLI spec (`chessboard:9x6:30mm`,
@@ -213,9 +285,15 @@ pub fn target_svg(spec_or_json: &str) -> Result<String, JsError> {
 /// CLI spec (see [`parse_target`]) or a target JSON object. Returns the
 /// Detection JSON (see `docs/detection-json.md`).
 #[wasm_bindgen]
-pub fn detect_target(bytes: &[u8], target_spec_or_json: &str) -> Result<String, JsError> {
+pub fn detect_target(
+    bytes: &[u8],
+    target_spec_or_json: &str,
+    options_json: Option<String>,
+) -> Result<String, JsError> {
     let target = target_from(target_spec_or_json)?;
-    let image = crate::image::decode_gray(bytes).map_err(js_error)?;
+    let image = decode(bytes, &decode_options(options_json)?)
+        .map_err(js_error)?
+        .gray;
     let detection =
         crate::detect::detect(&image, &target, &crate::detect::DetectOptions::default())
             .map_err(js_error)?;
@@ -460,16 +538,20 @@ pub fn calibrate_stereo(input_json: &str) -> Result<String, JsError> {
 /// An undistorted preview of image bytes taken by `camera_json` (the
 /// `camera` object of a calibration report): resampled through the same
 /// camera without distortion, longer side at most `max_side` px, as grey
-/// `ImageData` (RGBA with r = g = b, alpha 255).
+/// `ImageData` (RGBA with r = g = b, alpha 255). `options_json`: see
+/// [`ImageOptions`] (`{"max_pixels"}`).
 #[wasm_bindgen]
 pub fn undistort_preview(
     bytes: &[u8],
     camera_json: &str,
     max_side: u32,
+    options_json: Option<String>,
 ) -> Result<ImageData, JsError> {
     let camera: crate::camera::Camera = serde_json::from_str(camera_json)
         .map_err(|e| JsError::new(&format!("camera JSON: {e}")))?;
-    let image = crate::image::decode_gray(bytes).map_err(js_error)?;
+    let image = decode(bytes, &decode_options(options_json)?)
+        .map_err(js_error)?
+        .gray;
     let preview = camera.pinhole_preview(max_side).map_err(js_error)?;
     let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
     let rgba: Vec<u8> = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();

@@ -91,7 +91,7 @@ async function main() {
   if (fragment) return openShared(fragment);
   const versionPromise = engineVersion();
   await store.load();
-  initTarget(store);
+  initTarget(store, engine);
   // Decoding and detection use up to 4 workers (one per core).
   const pool = new EnginePool(engine, Math.min(4, navigator.hardwareConcurrency || 1));
   const images = new ImagesView(store, engine, pool);
@@ -121,7 +121,7 @@ async function main() {
       $('engine-status').textContent = 'Rendering the demo images…';
       const demo = await engine.call('demo', { seed: 1 });
       const t = demo.target;
-      store.session.target = { ...store.session.target, kind: 'chessboard', cols: t.cols, rows: t.rows, size_mm: t.square_m * 1000 };
+      store.session.target = t; // the core's target JSON
       store.changed('target-loaded');
       await images.addBytes(demo.images);
       Object.assign(store.session.robot, { fileName: 'demo_poses.csv', text: demo.poses_csv, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper' });

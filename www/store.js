@@ -7,7 +7,7 @@ const DB_VERSION = 1;
 export function defaultSession() {
   return {
     schema: 1,
-    target: { kind: 'chessboard', cols: 9, rows: 6, size_mm: 30, layout: 'symmetric', polarity: 'dark', diameter_mm: 12.5, side_mm: 15 },
+    target: { kind: 'chessboard', cols: 9, rows: 6, square_m: 0.03 }, // the core's target JSON (views/target.js)
     images: [], // { id, name, size, included, status, info, detection, error }
     camera: { model: 'brown', method: 'zhang', options: {}, result: null, comparison: null },
     robot: { fileName: null, text: null, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper', parsed: null },

@@ -1,6 +1,9 @@
 // The calibration engine's thread: loads the wasm once and answers requests,
 // so the page never freezes. Every request gets exactly one reply, success or
-// error; a Rust panic becomes an error reply, never a dead worker.
+// error. A wasm trap (a Rust panic, out of memory) leaves the instance
+// unusable: the reply says `trapped`, every later request is handed back
+// unrun (`bounced`, with its buffers) and engine.js moves them to a fresh
+// worker.
 import init, * as robocal from './pkg/robocal.js';
 
 const ready = init().then(() => {
@@ -8,29 +11,44 @@ const ready = init().then(() => {
   return robocal.version();
 });
 
-function errorText(err) {
-  if (err instanceof WebAssembly.RuntimeError) {
-    const panic = robocal.last_panic_message();
-    return `internal error (${panic || err.message}); please report it with the file that caused it`;
-  }
-  return err && err.message ? err.message : String(err);
+let trapped = null; // the message of the trap that broke this instance
+
+function trapText(err) {
+  let panic = '';
+  try { panic = robocal.last_panic_message(); } catch (e) { /* the instance may be too broken to ask */ }
+  return panic || err.message;
 }
+
+/** `{"max_pixels": N}` for the image entries, or undefined for the defaults. */
+const imageOptions = (maxPixels) => (maxPixels ? JSON.stringify({ max_pixels: maxPixels }) : undefined);
 
 const handlers = {
   async version() {
     return { version: await ready };
   },
-  async preview({ bytes, maxSide }) {
+  async preview({ bytes, maxSide, maxPixels }) {
     await ready;
-    const p = robocal.decode_image_preview(new Uint8Array(bytes), maxSide);
-    const reply = { info: JSON.parse(p.info_json), width: p.width, height: p.height, rgba: p.rgba.buffer };
+    const p = robocal.decode_image_preview(new Uint8Array(bytes), maxSide, imageOptions(maxPixels));
+    // `image` is an ImageData (structured clone), ready for putImageData.
+    const reply = { info: JSON.parse(p.info_json), image: p.image };
     p.free();
-    return { value: reply, transfer: [reply.rgba] };
+    return reply;
   },
-  async detect({ bytes, spec }) {
+  async detect({ bytes, spec, maxPixels }) {
     await ready;
-    requireFn('detect_target');
-    return JSON.parse(robocal.detect_target(new Uint8Array(bytes), spec));
+    return JSON.parse(robocal.detect_target(new Uint8Array(bytes), spec, imageOptions(maxPixels)));
+  },
+  /** Everything the target step shows, from the core: the target JSON, its CLI spec, its points and its printable sheet. */
+  async target({ spec }) {
+    await ready;
+    const target = JSON.parse(robocal.parse_target(spec));
+    const json = JSON.stringify(target);
+    return { target, spec: robocal.target_spec(json), points: JSON.parse(robocal.target_points(json)), svg: robocal.target_svg(json) };
+  },
+  /** Stereo pairing by file name: the rule of `robocal stereo` (io::pairing). */
+  async pair({ left, right }) {
+    await ready;
+    return JSON.parse(robocal.pair_images(JSON.stringify(left), JSON.stringify(right)));
   },
 };
 
@@ -46,13 +64,11 @@ handlers.poses = async ({ text, options }) => {
 
 handlers.calibrate = async ({ input }) => {
   await ready;
-  requireFn('calibrate_camera');
   return JSON.parse(robocal.calibrate_camera(input));
 };
 
 handlers.handeye = async ({ input }) => {
   await ready;
-  requireFn('solve_handeye');
   return JSON.parse(robocal.solve_handeye(input));
 };
 
@@ -80,31 +96,28 @@ handlers.demo = async ({ seed }) => {
 
 handlers.conventions = async ({ input }) => {
   await ready;
-  requireFn('rank_pose_conventions');
   return JSON.parse(robocal.rank_pose_conventions(input));
 };
 
-handlers.undistort = async ({ bytes, camera, maxSide }) => {
+handlers.undistort = async ({ bytes, camera, maxSide, maxPixels }) => {
   await ready;
-  requireFn('undistort_preview');
-  const p = robocal.undistort_preview(new Uint8Array(bytes), camera, maxSide);
-  const reply = { width: p.width, height: p.height, rgba: p.rgba.buffer };
-  p.free();
-  return { value: reply, transfer: [reply.rgba] };
+  return { image: robocal.undistort_preview(new Uint8Array(bytes), camera, maxSide, imageOptions(maxPixels)) };
 };
 
 handlers.stereo = async ({ input }) => {
   await ready;
-  requireFn('calibrate_stereo');
   return JSON.parse(robocal.calibrate_stereo(input));
 };
 
-function requireFn(name) {
-  if (typeof robocal[name] !== 'function') throw new Error(`this build of the engine has no ${name}`);
-}
+/** The ArrayBuffers in a request's arguments (handed back with a bounced request). */
+const buffersOf = (args) => Object.values(args || {}).filter((v) => v instanceof ArrayBuffer);
 
 self.onmessage = async (event) => {
   const { id, op, args } = event.data;
+  if (trapped) {
+    self.postMessage({ id, ok: false, bounced: true, args }, buffersOf(args));
+    return;
+  }
   try {
     const handler = handlers[op];
     if (!handler) throw new Error(`unknown request '${op}'`);
@@ -113,6 +126,11 @@ self.onmessage = async (event) => {
     const moves = out !== null && typeof out === 'object' && 'transfer' in out;
     self.postMessage({ id, ok: true, value: moves ? out.value : out }, moves ? out.transfer : []);
   } catch (err) {
-    self.postMessage({ id, ok: false, error: errorText(err) });
+    if (err instanceof WebAssembly.RuntimeError) {
+      trapped = trapText(err);
+      self.postMessage({ id, ok: false, trapped: true, error: trapped });
+    } else {
+      self.postMessage({ id, ok: false, error: err && err.message ? err.message : String(err) });
+    }
   }
 };

@@ -2,6 +2,11 @@
 // images in Rust and shows thumbnails, and shows an error card for a file
 // that is not an image.
 import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { root } from './harness.mjs';
 import { makePng, makeBmp, checker } from '../support/images.mjs';
 
 export const tests = [
@@ -63,41 +68,74 @@ tests.push(
     await page.reload();
     await page.waitForFunction(() => /^0 files/.test(document.getElementById('image-summary').textContent), null, { timeout: 30000 });
   }],
-  ['target form draws the board and makes a printable SVG at true scale', async (page, { url, shot }) => {
+  ['target form asks the core: its spec, its errors, and the sheet of robocal target --svg', async (page, { url, shot }) => {
     await page.goto(`${url}#target`);
-    await page.selectOption('#target-kind', 'circles');
+    await page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
+    // The default target, spelled by the core.
+    await page.waitForFunction(() => /^Target spec: chessboard:9x6:30mm /.test(document.getElementById('target-spec').textContent), null, { timeout: 10000 });
+    await page.selectOption('#target-kind', 'circle_grid');
     await page.fill('input[name=cols]', '4');
     await page.fill('input[name=rows]', '11');
-    await page.fill('input[name=size_mm]', '20');
-    await page.selectOption('select[name=layout]', 'asymmetric');
-    assert.match(await page.textContent('#target-spec'), /^Target spec: circles:4x11:20mm:asymmetric /);
+    await page.fill('input[name=spacing_mm]', '20');
+    await page.selectOption('select[name=asymmetric]', 'true');
+    await page.waitForFunction(() => /^Target spec: circles:4x11:20mm:asymmetric /.test(document.getElementById('target-spec').textContent), null, { timeout: 10000 });
+    await page.waitForFunction(() => document.getElementById('target-canvas').dataset.spec === 'circles:4x11:20mm:asymmetric', null, { timeout: 10000 });
     await shot('circles');
-    const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
-    const svg = (await (await dl.createReadStream()).toArray()).join('');
-    // 4 columns asymmetric: x from 0 to (2*3+1)*20 = 140 mm plus 20 mm margins.
-    assert.match(svg, /<svg xmlns="http:\/\/www.w3.org\/2000\/svg" width="180mm" height="240mm" viewBox="0 0 180 240">/);
-    assert.equal((svg.match(/<circle /g) || []).length, 44);
+    // The drawing is the core's sheet: not blank, origin marker (blue) drawn.
+    const blue = await page.$eval('#target-canvas', (c) => {
+      const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (d[i] === 0x1f && d[i + 1] === 0x77 && d[i + 2] === 0xb4) n++;
+      return n;
+    });
+    assert.ok(blue > 20, `origin marker pixels: ${blue}`);
+    const download = async () => {
+      const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
+      return { name: dl.suggestedFilename(), svg: (await (await dl.createReadStream()).toArray()).join('') };
+    };
+    const cliSvg = (spec) => {
+      const dir = mkdtempSync(join(tmpdir(), 'robocal-target-'));
+      try {
+        execFileSync(join(root, 'target/release/robocal'), ['target', spec, '--svg', join(dir, 'board.svg')]);
+        return readFileSync(join(dir, 'board.svg'), 'utf8');
+      } finally { rmSync(dir, { recursive: true, force: true }); }
+    };
+    const circles = await download();
+    assert.equal(circles.name, 'robocal-target-circles_4x11_20mm_asymmetric.svg');
+    // Byte for byte the CLI's sheet: true scale, 44 circles, the 100 mm bar, the spec.
+    assert.equal(circles.svg, cliSvg('circles:4x11:20mm:asymmetric'));
+    assert.match(circles.svg, /<svg xmlns="http:\/\/www.w3.org\/2000\/svg" width="200mm" height="293mm" viewBox="0 0 200 293">/);
+    assert.equal((circles.svg.match(/<circle /g) || []).length, 44);
+    assert.match(circles.svg, /<rect class="check-bar" x="10" y="[\d.]+" width="100" height="3"/);
+    assert.match(circles.svg, />robocal target circles:4x11:20mm:asymmetric</);
+    // The core's validation message, and no sheet for an invalid target.
     await page.fill('input[name=cols]', '1');
-    assert.equal(await page.textContent('#target-error'), 'Columns must be a whole number from 2 to 100.');
+    await page.waitForFunction(() => document.getElementById('target-error').textContent !== '', null, { timeout: 10000 });
+    assert.equal(await page.textContent('#target-error'), 'target: a grid needs 2 to 100000 points with at least 2 per side, got 1x11');
     assert.equal(await page.isDisabled('#print-target'), true);
-    // Zhang's grid of separate squares: the spec the CLI takes, 64 squares
-    // at true scale (7 pitches + side + two pitches of margin).
-    await page.selectOption('#target-kind', 'squares');
+    // Zhang's grid of separate squares: only its fields are shown; 22.5778 mm
+    // crosses as the same metres as the CLI's spec (decimal shift, not / 1000).
+    await page.selectOption('#target-kind', 'square_grid');
     await page.fill('input[name=cols]', '8');
     await page.fill('input[name=rows]', '8');
-    await page.fill('input[name=size_mm]', '22.5');
-    await page.fill('input[name=side_mm]', '12.5');
-    assert.match(await page.textContent('#target-spec'), /^Target spec: squares:8x8:12.5mm:22.5mm /);
-    // Only the fields of this kind are shown (the circle-grid and dot fields were visible before).
-    for (const name of ['layout', 'polarity', 'diameter_mm']) assert.equal(await page.isVisible(`#target-form [name=${name}]`), false, `${name} shown for squares`);
+    await page.fill('input[name=side_mm]', '12.7');
+    await page.fill('input[name=pitch_mm]', '22.5778');
+    await page.waitForFunction(() => /^Target spec: squares:8x8:12.7mm:22.5778mm /.test(document.getElementById('target-spec').textContent), null, { timeout: 10000 });
+    for (const name of ['asymmetric', 'polarity', 'dot_diameter_mm', 'spacing_mm', 'square_mm']) assert.equal(await page.isVisible(`#target-form [name=${name}]`), false, `${name} shown for square_grid`);
     assert.equal(await page.isVisible('#target-form [name=side_mm]'), true);
-    assert.equal(await page.textContent('#size-label'), 'Square pitch (mm)');
     await shot('squares');
-    const [dl2] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
-    const svg2 = (await (await dl2.createReadStream()).toArray()).join('');
-    assert.match(svg2, /width="215mm" height="215mm" viewBox="0 0 215 215">/);
-    assert.equal((svg2.match(/<rect /g) || []).length, 65);
+    const squares = await download();
+    assert.equal(squares.svg, cliSvg('squares:8x8:12.7mm:22.5778mm'));
+    assert.equal((squares.svg.match(/<rect class="square" /g) || []).length, 64);
     await page.fill('input[name=side_mm]', '30');
-    assert.equal(await page.textContent('#target-error'), 'The square side must be smaller than the pitch (the squares must not touch).');
+    await page.waitForFunction(() => document.getElementById('target-error').textContent !== '', null, { timeout: 10000 });
+    assert.equal(await page.textContent('#target-error'), 'target: the square side must be smaller than the pitch (the squares must not touch)');
+    // The session holds the core's JSON: after a reload the form shows the last valid target.
+    await page.fill('input[name=side_mm]', '12.7');
+    await page.waitForFunction(() => document.getElementById('target-error').textContent === '', null, { timeout: 10000 });
+    await page.waitForTimeout(500);
+    await page.reload();
+    await page.waitForFunction(() => /^Target spec: squares:8x8:12.7mm:22.5778mm /.test(document.getElementById('target-spec').textContent), null, { timeout: 30000 });
+    assert.equal(await page.inputValue('input[name=pitch_mm]'), '22.5778');
   }],
 );

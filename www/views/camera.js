@@ -32,9 +32,9 @@ const OPTIONS = [
 const UNDISTORT_SIDE = 480;
 
 function putPixels(canvas, p) {
-  canvas.width = p.width;
-  canvas.height = p.height;
-  canvas.getContext('2d').putImageData(new ImageData(new Uint8ClampedArray(p.rgba), p.width, p.height), 0, 0);
+  canvas.width = p.image.width;
+  canvas.height = p.image.height;
+  canvas.getContext('2d').putImageData(p.image, 0, 0); // the core's ImageData
 }
 
 /** The form's options as the core's JSON options (square pixels = aspect_ratio 1). */
@@ -193,7 +193,7 @@ export class CameraView {
       ]);
       putPixels(before, orig);
       putPixels(after, und);
-      status.textContent = `${img.name}: undistorted at ${und.width}×${und.height} px (preview).`;
+      status.textContent = `${img.name}: undistorted at ${und.image.width}×${und.image.height} px (preview).`;
     } catch (err) {
       status.textContent = `${img.name}: ${err.message}`;
     } finally {

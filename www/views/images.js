@@ -23,7 +23,7 @@ export class ImagesView {
     this.engine = engine;
     this.pool = pool;
     this.lanes = pool.size || 1;
-    this.previews = new Map(); // id -> { width, height, rgba, scale }
+    this.previews = new Map(); // id -> { image: ImageData, scale }
     this.cards = new Map(); // id -> { li, canvas, meta, toggle }
     this.cancelled = false;
     this.busy = false;
@@ -107,10 +107,10 @@ export class ImagesView {
   async preview(img) {
     try {
       const bytes = this.store.bytes.get(img.id).slice(0);
-      const p = await this.pool.call('preview', { bytes, maxSide: THUMB_SIDE }, [bytes]);
+      const p = await this.pool.call('preview', { bytes, maxSide: THUMB_SIDE, name: img.name }, [bytes]);
       img.info = p.info;
       if (img.status === 'pending') img.status = 'decoded';
-      this.previews.set(img.id, { width: p.width, height: p.height, rgba: p.rgba, scale: p.width / p.info.width });
+      this.previews.set(img.id, { image: p.image, scale: p.image.width / p.info.width });
     } catch (err) {
       img.status = 'error';
       img.error = err.message;
@@ -141,7 +141,7 @@ export class ImagesView {
       if (card) card.meta.textContent = 'detecting…';
       try {
         const bytes = this.store.bytes.get(img.id).slice(0);
-        img.detection = await this.pool.call('detect', { bytes, spec }, [bytes]);
+        img.detection = await this.pool.call('detect', { bytes, spec, name: img.name }, [bytes]);
         img.status = 'detected';
         img.error = null;
         img.detectError = false;
@@ -228,7 +228,7 @@ export class ImagesView {
       const bytes = this.store.bytes.get(img.id).slice(0);
       const side = Math.max(img.info.width, img.info.height);
       this.full = await this.engine.call('preview', { bytes, maxSide: Math.min(side, 4096) }, [bytes]);
-      this.full.scale = this.full.width / img.info.width;
+      this.full.scale = this.full.image.width / img.info.width;
     } catch (err) {
       $('inspector-info').textContent = err.message;
       return;
@@ -259,11 +259,12 @@ function describe(info) {
 
 /** Draw a preview with its points (pixel coordinates of the full image) at `zoom`. */
 function drawImage(canvas, p, points, scale, zoom, residuals = []) {
-  canvas.width = Math.round(p.width * zoom);
-  canvas.height = Math.round(p.height * zoom);
+  const { width, height } = p.image; // the core's ImageData, put as it came
+  canvas.width = Math.round(width * zoom);
+  canvas.height = Math.round(height * zoom);
   const ctx = canvas.getContext('2d');
-  const tmp = new OffscreenCanvas(p.width, p.height);
-  tmp.getContext('2d').putImageData(new ImageData(new Uint8ClampedArray(p.rgba), p.width, p.height), 0, 0);
+  const tmp = new OffscreenCanvas(width, height);
+  tmp.getContext('2d').putImageData(p.image, 0, 0);
   ctx.imageSmoothingEnabled = zoom < 2;
   ctx.drawImage(tmp, 0, 0, canvas.width, canvas.height);
   const k = scale * zoom;

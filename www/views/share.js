@@ -99,49 +99,73 @@ export class ShareView {
     }
   }
 
-  downloadReport() {
-    download('robocal-report.html', reportHtml(this.store.session, this.version, this.plotsProvider()), 'text/html');
+  async downloadReport() {
+    download('robocal-report.html', await reportHtml(this.store.session, this.version, this.plotsProvider()), 'text/html');
   }
 }
 
-const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[c]));
+/** The report's style sheet: allowed by its hash in the report's CSP. */
+const REPORT_STYLE = `body{font-family:system-ui,sans-serif;max-width:960px;margin:2rem auto;padding:0 1rem;color:#1b1d21}
+table{border-collapse:collapse}td,th{border-bottom:1px solid #ccc;padding:.2rem .6rem;text-align:right}
+td:first-child,th:first-child{text-align:left}.warn{background:#fff3cd;padding:.4rem}img{max-width:100%}pre{white-space:pre-wrap}`;
 
-/** A self-contained HTML report: tables, warnings and plots as PNG images; no scripts. */
-export function reportHtml(session, version, canvases) {
-  const parts = [];
-  const tableHtml = (el) => el.outerHTML;
+async function sha256Base64(text) {
+  const digest = new Uint8Array(await crypto.subtle.digest('SHA-256', new TextEncoder().encode(text)));
+  return btoa(String.fromCharCode(...digest));
+}
+
+/**
+ * A self-contained HTML report: tables, warnings and plots as PNG images; no
+ * scripts. Built as a DOM (every value a text node or an attribute set by
+ * setAttribute, so a crafted share link's strings stay text) and serialised.
+ * Its own CSP: nothing loads, nothing runs; only its style (by hash) and
+ * its embedded data: images.
+ */
+export async function reportHtml(session, version, canvases) {
+  const doc = document.implementation.createHTMLDocument('robocal calibration report');
+  const el = (tag, attrs = {}, ...children) => {
+    const e = doc.createElement(tag);
+    for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, String(v));
+    for (const c of children.flat()) if (c !== null && c !== undefined) e.append(typeof c === 'object' && 'nodeType' in c ? c : doc.createTextNode(String(c)));
+    return e;
+  };
+  const adopt = (node) => doc.importNode(node, true);
+  const text = (w) => (typeof w === 'string' ? w : w && typeof w.message === 'string' ? w.message : JSON.stringify(w));
+  const csp = `default-src 'none'; style-src 'sha256-${await sha256Base64(REPORT_STYLE)}'; img-src data:; base-uri 'none'; form-action 'none'`;
+  doc.documentElement.setAttribute('lang', 'en');
+  doc.head.prepend(el('meta', { charset: 'utf-8' }), el('meta', { 'http-equiv': 'Content-Security-Policy', content: csp }));
+  doc.head.append(el('style', {}, REPORT_STYLE));
+  const body = doc.body;
+  body.append(el('h1', {}, 'robocal calibration report'),
+    el('p', {}, `robocal ${version} · generated in the browser; no data left the machine.`));
   const cam = session.camera.result;
   if (cam) {
-    const k = cam.camera_matrix.flat();
+    const k = (cam.camera_matrix || []).flat();
     const rows = [['fx', k[0]], ['fy', k[4]], ['cx', k[2]], ['cy', k[5]], ['skew', k[1]], ...Object.entries(cam.distortion || {})]
       .map(([n, v]) => [n, num(v, 6), num((cam.std || {})[n], 3)]);
-    parts.push(`<h2>Camera (${esc(cam.model)})</h2><p>RMS reprojection error ${num(cam.rms_px, 4)} px over ${(cam.views || []).length} views.</p>`);
-    parts.push(tableHtml(table(['parameter', 'value', 'std'], rows)));
-    for (const w of cam.warnings || []) parts.push(`<p class="warn">${esc(typeof w === 'string' ? w : w.message)}</p>`);
+    body.append(el('h2', {}, `Camera (${cam.model})`),
+      el('p', {}, `RMS reprojection error ${num(cam.rms_px, 4)} px over ${Array.isArray(cam.views) ? cam.views.length : 0} views.`),
+      adopt(table(['parameter', 'value', 'std'], rows)));
+    for (const w of Array.isArray(cam.warnings) ? cam.warnings : []) body.append(el('p', { class: 'warn' }, text(w)));
   }
   const he = session.handeye.result;
   if (he) {
-    parts.push(`<h2>Hand-eye (${esc(session.handeye.setup)})</h2>`);
+    body.append(el('h2', {}, `Hand-eye (${session.handeye.setup})`));
     for (const key of ['gripper_from_camera', 'base_from_camera', 'base_from_target', 'gripper_from_target']) {
       if (!he[key]) continue;
-      const t = he[key].translation_m.map((v) => num(v * 1000, 3)).join(', ');
-      const q = he[key].quaternion_xyzw.map((v) => num(v, 6)).join(', ');
-      parts.push(`<p><b>${key}</b>: translation (mm) [${t}], quaternion xyzw [${q}]</p>`);
+      const list = (a, f) => (Array.isArray(a) ? a.map(f).join(', ') : '—');
+      const t = list(he[key].translation_m, (v) => num(v * 1000, 3));
+      const q = list(he[key].quaternion_xyzw, (v) => num(v, 6));
+      body.append(el('p', {}, el('b', {}, key), `: translation (mm) [${t}], quaternion xyzw [${q}]`));
     }
-    if (he.errors) parts.push(tableHtml(table(['error', 'value'], Object.entries(he.errors).map(([n, v]) => [n, num(v, 4)]))));
-    for (const w of he.warnings || []) parts.push(`<p class="warn">${esc(typeof w === 'string' ? w : w.message)}</p>`);
+    if (he.errors && typeof he.errors === 'object') body.append(adopt(table(['error', 'value'], Object.entries(he.errors).map(([n, v]) => [n, num(v, 4)]))));
+    for (const w of Array.isArray(he.warnings) ? he.warnings : []) body.append(el('p', { class: 'warn' }, text(w)));
   }
   for (const c of canvases || []) {
-    try { parts.push(`<figure><img alt="${esc(c.getAttribute('aria-label') || 'plot')}" src="${c.toDataURL('image/png')}"></figure>`); } catch (e) { /* a tainted canvas is skipped */ }
+    let src;
+    try { src = c.toDataURL('image/png'); } catch (e) { continue; } // a tainted canvas is skipped
+    body.append(el('figure', {}, el('img', { alt: c.getAttribute('aria-label') || 'plot', src })));
   }
-  return `<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>robocal calibration report</title>
-<style>body{font-family:system-ui,sans-serif;max-width:960px;margin:2rem auto;padding:0 1rem;color:#1b1d21}
-table{border-collapse:collapse}td,th{border-bottom:1px solid #ccc;padding:.2rem .6rem;text-align:right}
-td:first-child,th:first-child{text-align:left}.warn{background:#fff3cd;padding:.4rem}img{max-width:100%}</style></head>
-<body><h1>robocal calibration report</h1><p>robocal ${esc(version)} · generated in the browser; no data left the machine.</p>
-${parts.join('\n')}
-<h2>Full results (JSON)</h2><pre>${esc(JSON.stringify(combinedReport(session), null, 2))}</pre>
-</body></html>
-`;
+  body.append(el('h2', {}, 'Full results (JSON)'), el('pre', {}, JSON.stringify(combinedReport(session), null, 2)));
+  return `<!doctype html>\n${doc.documentElement.outerHTML}\n`;
 }

@@ -1,6 +1,6 @@
 // Stereo: two image sets (left and right camera) of the target from step 1,
-// paired by the number in the file names (left01 with right01) or else by
-// order; detection in the worker, then one joint calibration of both cameras
+// paired by the core's rule (robocal::io::pairing, as `robocal stereo`);
+// detection in the worker, then one joint calibration of both cameras
 // and right_from_left (the same core as `robocal stereo`). The images, their
 // detections and the result are kept in the session (IndexedDB).
 import { $, h, fill, table, num, message } from '../lib/dom.js';
@@ -8,31 +8,26 @@ import { targetSpec } from './target.js';
 import { MODELS } from './camera.js';
 
 const byName = (a, b) => a.name.localeCompare(b.name, undefined, { numeric: true });
-const numberIn = (name) => { const m = /(\d+)(?!.*\d)/.exec(name.replace(/\.[^.]*$/, '')); return m ? Number(m[1]) : null; };
 
-/** Pairs of left/right files: by the last number in the names when both sides have unique ones, else by order. */
-export function pairFiles(left, right) {
+/**
+ * Pairs of left/right files by the core's rule, the one of `robocal stereo`
+ * (robocal::io::pairing): the last number in each name pairs left n with
+ * right n; when no name has a number, by order (here: names sorted). A
+ * mismatch (a name without a number, a number twice, a file without a
+ * partner) rejects with the core's message naming the files.
+ */
+export async function pairFiles(engine, left, right) {
   const L = [...left].sort(byName);
   const R = [...right].sort(byName);
-  const keys = (list) => list.map((f) => numberIn(f.name));
-  const [kl, kr] = [keys(L), keys(R)];
-  const unique = (k) => k.every((x) => x !== null) && new Set(k).size === k.length;
-  if (unique(kl) && unique(kr)) {
-    const rightOf = new Map(R.map((f, i) => [kr[i], f]));
-    const leftKeys = new Set(kl);
-    const pairs = L.map((f, i) => ({ left: f, right: rightOf.get(kl[i]) || null }));
-    for (const [k, f] of rightOf) if (!leftKeys.has(k)) pairs.push({ left: null, right: f });
-    return { how: 'number', pairs };
-  }
-  const n = Math.max(L.length, R.length);
-  return { how: 'order', pairs: Array.from({ length: n }, (_, i) => ({ left: L[i] || null, right: R[i] || null })) };
+  const { paired_by: how, pairs } = await engine.call('pair', { left: L.map((f) => f.name), right: R.map((f) => f.name) });
+  return { how, pairs: pairs.map(([l, r]) => ({ left: L[l], right: R[r] })) };
 }
 
 export class StereoView {
   constructor(store, engine) {
     this.store = store;
     this.engine = engine;
-    this.pairing = { how: 'order', pairs: [] };
+    this.pairing = { how: 'order', pairs: [], error: null };
     this.render();
   }
 
@@ -61,7 +56,7 @@ export class StereoView {
     this.progress = h('p', { id: 'stereo-progress', class: 'hint', 'aria-live': 'polite' });
     this.out = h('div', { id: 'stereo-results', 'aria-live': 'polite' });
     fill($('stereo-panel'),
-      h('p', { class: 'hint' }, 'Two cameras that saw the same target poses at the same moments. The target is the one of step 1. Images are paired by the number in their names (left01 with right01), or else by order.'),
+      h('p', { class: 'hint' }, 'Two cameras that saw the same target poses at the same moments. The target is the one of step 1. Images are paired as robocal stereo pairs them: by the last number in their names (left01 with right1), or by order (sorted names) when no name has a number.'),
       h('div', { class: 'form', id: 'stereo-form' }, input('left'), input('right'), h('label', {}, 'Lens model (both cameras) ', model)),
       h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'stereo-clear', onclick: () => this.clear() }, 'Remove the images')),
       this.progress, this.pairsOut, this.out);
@@ -87,17 +82,32 @@ export class StereoView {
     this.showPairs();
   }
 
-  showPairs() {
-    this.pairing = pairFiles(this.left, this.right);
-    const { how, pairs } = this.pairing;
-    const complete = pairs.filter((p) => p.left && p.right).length;
-    this.solveButton.disabled = complete < 3;
-    if (!pairs.length) { fill(this.pairsOut, message('info', 'Load the left and the right camera\'s images (at least 3 pairs).')); return; }
-    const status = (f) => (!f ? '—' : f.error ? f.error : f.detection ? `${f.detection.points.length} points` : 'not detected yet');
-    const rows = pairs.map((p, i) => [String(i + 1), p.left ? p.left.name : '— (missing)', status(p.left), p.right ? p.right.name : '— (missing)', status(p.right)]);
+  async showPairs() {
+    const asked = (this.asked = (this.asked || 0) + 1);
+    this.solveButton.disabled = true;
+    if (!this.left.length && !this.right.length) {
+      this.pairing = { how: 'order', pairs: [], error: null };
+      fill(this.pairsOut, message('info', 'Load the left and the right camera\'s images (at least 3 pairs).'));
+      return;
+    }
+    let pairing;
+    try {
+      pairing = { ...(await pairFiles(this.engine, this.left, this.right)), error: null };
+    } catch (err) {
+      pairing = { how: null, pairs: [], error: err.message };
+    }
+    if (asked !== this.asked) return; // a newer call is showing its answer
+    this.pairing = pairing;
+    if (pairing.error) {
+      fill(this.pairsOut, h('p', { id: 'stereo-pairing', class: 'msg msg-error', role: 'alert' }, `The images cannot be paired: ${pairing.error}`));
+      return;
+    }
+    const { how, pairs } = pairing;
+    this.solveButton.disabled = pairs.length < 3;
+    const status = (f) => (f.error ? f.error : f.detection ? `${f.detection.points.length} points` : 'not detected yet');
+    const rows = pairs.map((p, i) => [String(i + 1), p.left.name, status(p.left), p.right.name, status(p.right)]);
     fill(this.pairsOut,
-      h('p', { id: 'stereo-pairing' }, `${complete} pair${complete === 1 ? '' : 's'}, paired ${how === 'number' ? 'by the number in the file names' : 'by order (sorted names)'}.`),
-      pairs.length > complete ? message('warning', `${pairs.length - complete} image${pairs.length - complete === 1 ? ' has' : 's have'} no partner and will not be used.`) : null,
+      h('p', { id: 'stereo-pairing' }, `${pairs.length} pair${pairs.length === 1 ? '' : 's'}, paired ${how === 'number' ? 'by the number in the file names' : 'by order (sorted names)'}.`),
       table(['pair', 'left', 'left detection', 'right', 'right detection'], rows, { id: 'stereo-pair-table', class: 'scroll' }));
   }
 
@@ -119,7 +129,7 @@ export class StereoView {
   async solve() {
     let spec;
     try { spec = targetSpec(this.store.session.target); } catch (err) { fill(this.out, message('error', err.message)); return; }
-    const pairs = this.pairing.pairs.filter((p) => p.left && p.right);
+    const pairs = this.pairing.pairs;
     this.solveButton.disabled = true;
     try {
       let done = 0;

@@ -1,174 +1,156 @@
-// Step 1: the target. A form, a live drawing with origin and axes, and a
-// printable SVG at true scale.
+// Step 1: the target. The page keeps no target model of its own: the form's
+// fields are the core's target JSON (kinds and fields of
+// docs/detection-json.md, lengths typed in millimetres), and the core (in
+// the worker) checks it, spells its CLI spec, lists its points and draws
+// the printable sheet (robocal::target::svg, the sheet of `robocal target
+// SPEC --svg`). The drawing on the page is that sheet with the origin and
+// axes over it.
 import { $, download } from '../lib/dom.js';
 
-/** Board points in millimetres, in the detector's order (row by row from
- * the origin; square grids: square by square, each square's four corners
- * clockwise from the one nearest the origin). */
-export function targetPoints(t) {
-  const pts = [];
-  const s = Number(t.size_mm);
-  if (t.kind === 'circle') return [[0, 0]];
-  const side = Number(t.side_mm);
-  for (let r = 0; r < t.rows; r++) {
-    for (let c = 0; c < t.cols; c++) {
-      if (t.kind === 'circles' && t.layout === 'asymmetric') pts.push([(2 * c + (r % 2)) * s, r * s]);
-      else if (t.kind === 'squares') for (const [u, v] of [[0, 0], [1, 0], [1, 1], [0, 1]]) pts.push([c * s + u * side, r * s + v * side]);
-      else pts.push([c * s, r * s]);
-    }
-  }
-  return pts;
-}
+/** Lengths between millimetres (form) and metres (core) by shifting the
+ * decimal, so 33.3 mm is the double nearest 0.0333, as the core's spec
+ * parser makes it (not 33.3 / 1000). */
+const mToMm = (m) => Number(`${m}e3`);
+const mmToM = (mm) => Number(`${String(mm).trim()}e-3`);
 
-/** The CLI/engine spec string: chessboard:9x6:30mm, circles:4x11:20mm:asymmetric, dots:7x7:25mm, squares:8x8:12.7mm:22.5778mm (side, pitch), circle:10mm. */
+/**
+ * The target as the engine's detect request takes it (a CLI spec or target
+ * JSON): the JSON text of the session's target. Sessions saved by earlier
+ * versions of the page hold `{kind: 'chessboard'|'circles'|..., size_mm, ...}`;
+ * those are read as the CLI spec they meant.
+ */
 export function targetSpec(t) {
+  if (typeof t === 'string') return t;
+  if (t && 'size_mm' in t) return legacySpec(t);
+  return JSON.stringify(t);
+}
+
+/** An earlier page's target object as a CLI spec (migration only). */
+function legacySpec(t) {
   const mm = (x) => `${Number(x)}mm`;
+  const grid = `${t.cols}x${t.rows}`;
   switch (t.kind) {
-    case 'chessboard': return `chessboard:${t.cols}x${t.rows}:${mm(t.size_mm)}`;
-    case 'circles': return `circles:${t.cols}x${t.rows}:${mm(t.size_mm)}${t.layout === 'asymmetric' ? ':asymmetric' : ''}${t.polarity === 'light' ? ':light-on-dark' : ''}`;
-    case 'dots': return `dots:${t.cols}x${t.rows}:${mm(t.size_mm)}:${mm(t.diameter_mm)}`;
-    case 'squares': return `squares:${t.cols}x${t.rows}:${mm(t.side_mm)}:${mm(t.size_mm)}`;
+    case 'chessboard': return `chessboard:${grid}:${mm(t.size_mm)}`;
+    case 'circles': return `circles:${grid}:${mm(t.size_mm)}${t.layout === 'asymmetric' ? ':asymmetric' : ''}${t.polarity === 'light' ? ':light-on-dark' : ''}`;
+    case 'dots': return `dots:${grid}:${mm(t.size_mm)}:${mm(t.diameter_mm)}`;
+    case 'squares': return `squares:${grid}:${mm(t.side_mm)}:${mm(t.size_mm)}`;
     case 'circle': return `circle:${mm(t.diameter_mm)}`;
-    default: throw new Error(`unknown target kind ${t.kind}`);
+    default: return String(t.kind);
   }
 }
 
-/** Checks the form values; returns an error sentence or ''. */
-export function validateTarget(t) {
-  if (t.kind !== 'circle') {
-    if (!(Number.isInteger(t.cols) && t.cols >= 2 && t.cols <= 100)) return 'Columns must be a whole number from 2 to 100.';
-    if (!(Number.isInteger(t.rows) && t.rows >= 2 && t.rows <= 100)) return 'Rows must be a whole number from 2 to 100.';
-    if (!(t.size_mm > 0)) return 'The size must be a positive number of millimetres.';
-  }
-  if ((t.kind === 'dots' || t.kind === 'circle') && !(t.diameter_mm > 0)) return 'The diameter must be a positive number of millimetres.';
-  if (t.kind === 'dots' && t.diameter_mm >= t.size_mm) return 'The dot diameter must be smaller than the pitch.';
-  if (t.kind === 'squares' && !(t.side_mm > 0)) return 'The square side must be a positive number of millimetres.';
-  if (t.kind === 'squares' && t.side_mm >= t.size_mm) return 'The square side must be smaller than the pitch (the squares must not touch).';
-  if (t.kind === 'chessboard' && t.cols === t.rows) return '';
-  return '';
+/** The form's controls that belong to `kind` (their `data-for` names it). */
+function fieldsOf(form, kind) {
+  return [...form.querySelectorAll('[data-for]')].filter((label) => label.dataset.for.split(' ').includes(kind))
+    .map((label) => label.querySelector('input, select'));
 }
 
-/** Board drawing primitives in millimetres: { width, height, origin:[x,y], rects:[[x,y,w,h]], circles:[[x,y,r]], dark:'#000' } */
-export function boardLayout(t) {
-  const s = Number(t.size_mm);
-  if (t.kind === 'chessboard') {
-    const margin = s;
-    const rects = [];
-    for (let r = 0; r < t.rows + 1; r++) {
-      for (let c = 0; c < t.cols + 1; c++) if ((r + c) % 2 === 0) rects.push([margin + c * s, margin + r * s, s, s]);
-    }
-    return { width: (t.cols + 3) * s, height: (t.rows + 3) * s, origin: [margin + s, margin + s], rects, circles: [], light: false };
+/** The form as target JSON text (names ending in _mm become _m in metres). */
+function readForm(form) {
+  const kind = form.elements.kind.value;
+  const t = { kind };
+  for (const el of fieldsOf(form, kind)) {
+    const v = el.value;
+    if (el.name.endsWith('_mm')) t[el.name.replace(/_mm$/, '_m')] = v.trim() === '' ? null : mmToM(v);
+    else if (el.name === 'cols' || el.name === 'rows') t[el.name] = v.trim() === '' ? null : Number(v);
+    else if (el.name === 'asymmetric') t.asymmetric = v === 'true';
+    else t[el.name] = v;
   }
-  if (t.kind === 'squares') {
-    // One pitch of margin; origin at square 0's first corner.
-    const side = Number(t.side_mm);
-    const rects = [];
-    for (let r = 0; r < t.rows; r++) for (let c = 0; c < t.cols; c++) rects.push([s + c * s, s + r * s, side, side]);
-    return { width: (t.cols + 1) * s + side, height: (t.rows + 1) * s + side, origin: [s, s], rects, circles: [], light: false };
-  }
-  if (t.kind === 'circle') {
-    const d = Number(t.diameter_mm);
-    return { width: 3 * d, height: 3 * d, origin: [1.5 * d, 1.5 * d], rects: [], circles: [[0, 0, d / 2]], light: false };
-  }
-  const pts = targetPoints(t);
-  const radius = t.kind === 'dots' ? Number(t.diameter_mm) / 2 : (t.layout === 'asymmetric' ? 0.35 : 0.25) * s;
-  const maxX = Math.max(...pts.map((p) => p[0]));
-  const maxY = Math.max(...pts.map((p) => p[1]));
-  const margin = s;
-  return {
-    width: maxX + 2 * margin, height: maxY + 2 * margin, origin: [margin, margin], rects: [],
-    circles: pts.map(([x, y]) => [x, y, radius]), light: t.kind === 'circles' && t.polarity === 'light',
-  };
+  return JSON.stringify(t);
 }
 
-export function drawTarget(canvas, t) {
+/** Put a core target JSON into the form. */
+function writeForm(form, t) {
+  form.elements.kind.value = t.kind;
+  for (const el of fieldsOf(form, t.kind)) {
+    const key = el.name.replace(/_mm$/, '_m');
+    if (!(key in t)) continue;
+    el.value = el.name.endsWith('_mm') ? String(mToMm(t[key])) : String(t[key]);
+  }
+}
+
+function showFields(form) {
+  const kind = form.elements.kind.value;
+  for (const label of form.querySelectorAll('[data-for]')) label.hidden = !label.dataset.for.split(' ').includes(kind);
+}
+
+/**
+ * Draw the core's sheet scaled into the canvas, with point 0 and the board
+ * axes over it. Point 0 sits where the sheet's `<g class="marks"
+ * transform="translate(X Y)">` puts it; `points` are the core's (metres).
+ */
+export async function drawSheet(canvas, svg, points) {
+  const doc = new DOMParser().parseFromString(svg, 'image/svg+xml');
+  const [, , width, height] = doc.documentElement.getAttribute('viewBox').split(/\s+/).map(Number);
+  const m = /translate\(([-\d.e]+)[ ,]+([-\d.e]+)\)/.exec(doc.querySelector('g.marks').getAttribute('transform'));
+  const origin = [Number(m[1]), Number(m[2])];
+  const url = URL.createObjectURL(new Blob([svg], { type: 'image/svg+xml' }));
+  const image = new Image();
+  try {
+    image.src = url;
+    await image.decode();
+  } finally {
+    URL.revokeObjectURL(url);
+  }
   const ctx = canvas.getContext('2d');
-  const L = boardLayout(t);
-  const scale = Math.min((canvas.width - 20) / L.width, (canvas.height - 20) / L.height);
-  const ox = (canvas.width - L.width * scale) / 2;
-  const oy = (canvas.height - L.height * scale) / 2;
+  const scale = Math.min((canvas.width - 10) / width, (canvas.height - 10) / height);
+  const ox = (canvas.width - width * scale) / 2;
+  const oy = (canvas.height - height * scale) / 2;
   ctx.clearRect(0, 0, canvas.width, canvas.height);
-  ctx.fillStyle = L.light ? '#111' : '#fff';
-  ctx.fillRect(ox, oy, L.width * scale, L.height * scale);
-  ctx.fillStyle = L.light ? '#fff' : '#111';
-  for (const [x, y, w, hh] of L.rects) ctx.fillRect(ox + x * scale, oy + y * scale, w * scale, hh * scale);
-  for (const [x, y, r] of L.circles) {
-    ctx.beginPath();
-    ctx.arc(ox + (L.origin[0] + x) * scale, oy + (L.origin[1] + y) * scale, r * scale, 0, 2 * Math.PI);
-    ctx.fill();
-  }
-  // Origin and axes: x along the columns (red), y along the rows (green).
-  const [px, py] = [ox + L.origin[0] * scale, oy + L.origin[1] * scale];
-  const len = Math.max(Number(t.size_mm) * scale * 1.5, 24);
-  const arrow = (dx, dy, color, label) => {
+  ctx.drawImage(image, ox, oy, width * scale, height * scale);
+  const at = ([x, y]) => [ox + (origin[0] + x) * scale, oy + (origin[1] + y) * scale];
+  const [px, py] = at([0, 0]);
+  // Axis length: the board's extent along x and y, at least 24 px.
+  const mm = points.map((p) => [mToMm(p.x_m), mToMm(p.y_m)]);
+  const reach = (k) => Math.max(24, Math.max(...mm.map((p) => p[k])) * scale * 0.5);
+  const arrow = (dx, dy, len, color, label) => {
     ctx.strokeStyle = color; ctx.fillStyle = color; ctx.lineWidth = 3;
     ctx.beginPath(); ctx.moveTo(px, py); ctx.lineTo(px + dx * len, py + dy * len); ctx.stroke();
     ctx.font = 'bold 14px system-ui'; ctx.fillText(label, px + dx * (len + 6) - 4, py + dy * (len + 14) + 4);
   };
-  arrow(1, 0, '#d62728', 'x');
-  arrow(0, 1, '#2ca02c', 'y');
+  arrow(1, 0, reach(0), '#d62728', 'x');
+  arrow(0, 1, reach(1), '#2ca02c', 'y');
   ctx.fillStyle = '#1f77b4';
   ctx.beginPath(); ctx.arc(px, py, 5, 0, 2 * Math.PI); ctx.fill();
+  return { width_mm: width, height_mm: height, origin_mm: origin };
 }
 
-/** A printable SVG at true scale (width/height in mm). */
-export function targetSvg(t) {
-  const L = boardLayout(t);
-  const f = (x) => Number(x.toFixed(4));
-  const dark = L.light ? '#fff' : '#000';
-  const parts = [
-    `<?xml version="1.0" encoding="UTF-8"?>`,
-    `<svg xmlns="http://www.w3.org/2000/svg" width="${f(L.width)}mm" height="${f(L.height)}mm" viewBox="0 0 ${f(L.width)} ${f(L.height)}">`,
-    `<title>robocal target ${targetSpec(t)}: print at 100 % scale (no fit-to-page), then measure a square</title>`,
-    `<rect x="0" y="0" width="${f(L.width)}" height="${f(L.height)}" fill="${L.light ? '#000' : '#fff'}"/>`,
-    ...L.rects.map(([x, y, w, hh]) => `<rect x="${f(x)}" y="${f(y)}" width="${f(w)}" height="${f(hh)}" fill="${dark}"/>`),
-    ...L.circles.map(([x, y, r]) => `<circle cx="${f(L.origin[0] + x)}" cy="${f(L.origin[1] + y)}" r="${f(r)}" fill="${dark}"/>`),
-    `<text x="${f(L.width / 2)}" y="${f(L.height - Number(t.size_mm || t.diameter_mm) * 0.3)}" font-size="${f(Math.max(L.height * 0.025, 2))}" text-anchor="middle" fill="#888">${targetSpec(t)}</text>`,
-    `</svg>`,
-  ];
-  return parts.join('\n') + '\n';
-}
-
-function readForm(form) {
-  const v = (n) => form.elements[n].value;
-  return {
-    kind: v('kind'), cols: Number(v('cols')), rows: Number(v('rows')), size_mm: Number(v('size_mm')),
-    layout: v('layout'), polarity: v('polarity'), diameter_mm: Number(v('diameter_mm')), side_mm: Number(v('side_mm')),
-  };
-}
-
-function writeForm(form, t) {
-  for (const [k, val] of Object.entries(t)) if (form.elements[k]) form.elements[k].value = val;
-}
-
-export function initTarget(store) {
+export function initTarget(store, engine) {
   const form = $('target-form');
-  const update = (fromForm) => {
-    const t = fromForm ? readForm(form) : store.session.target;
-    if (!fromForm) writeForm(form, t);
-    for (const el of form.querySelectorAll('[data-for]')) {
-      const kinds = el.dataset.for.split(' ');
-      el.hidden = !kinds.includes(t.kind) && !(kinds.includes('grid') && t.kind !== 'circle');
+  let asked = 0; // the latest request: older replies are dropped
+  let sheet = null; // { spec, svg } of the target shown
+  const show = async (json, fromForm) => {
+    const mine = ++asked;
+    let reply;
+    try {
+      reply = await engine.call('target', { spec: json });
+    } catch (err) {
+      if (mine !== asked) return;
+      sheet = null;
+      $('target-error').textContent = err.message;
+      $('print-target').disabled = true;
+      return;
     }
-    $('size-label').textContent = `${{ chessboard: 'Square size', circles: 'Circle spacing', dots: 'Dot pitch', squares: 'Square pitch', circle: 'Size' }[t.kind]} (mm)`;
-    form.elements.size_mm.closest('label').hidden = t.kind === 'circle';
-    const err = validateTarget(t);
-    $('target-error').textContent = err;
-    $('print-target').disabled = !!err;
-    if (err) return;
-    $('target-spec').textContent = `Target spec: ${targetSpec(t)} (the same spelling works in the CLI: robocal detect --target ${targetSpec(t)})`;
-    drawTarget($('target-canvas'), t);
-    if (fromForm) {
-      store.session.target = t;
-      store.changed('target');
-    }
+    if (mine !== asked) return;
+    sheet = reply;
+    $('target-error').textContent = '';
+    $('print-target').disabled = false;
+    if (!fromForm) { writeForm(form, reply.target); showFields(form); }
+    $('target-spec').textContent = `Target spec: ${reply.spec} (the same spelling works in the CLI: robocal detect --target ${reply.spec}; robocal target ${reply.spec} --svg board.svg prints this sheet)`;
+    await drawSheet($('target-canvas'), reply.svg, reply.points);
+    $('target-canvas').dataset.spec = reply.spec;
+    // The session keeps the core's JSON (a session of an earlier page is
+    // converted here, once).
+    store.session.target = reply.target;
+    if (fromForm) store.changed('target');
   };
-  form.addEventListener('input', () => update(true));
+  form.addEventListener('input', () => { showFields(form); show(readForm(form), true); });
   form.addEventListener('submit', (e) => e.preventDefault());
   $('print-target').addEventListener('click', () => {
-    const t = store.session.target;
-    download(`robocal-target-${targetSpec(t).replace(/[:]/g, '_')}.svg`, targetSvg(t), 'image/svg+xml');
+    if (!sheet) return;
+    download(`robocal-target-${sheet.spec.replace(/[:]/g, '_')}.svg`, sheet.svg, 'image/svg+xml');
   });
-  store.onChange((what) => { if (what === 'all' || what === 'target-loaded') update(false); });
-  update(false);
+  const fromSession = () => show(targetSpec(store.session.target), false);
+  store.onChange((what) => { if (what === 'all' || what === 'target-loaded') fromSession(); });
+  return fromSession();
 }
