@@ -120,7 +120,10 @@ fn send(server: &Server, raw: &[u8]) -> Response {
 }
 
 fn request(server: &Server, method: &str, target: &str) -> Response {
-    send(server, format!("{method} {target} HTTP/1.1\r\nHost: x\r\n\r\n").as_bytes())
+    send(
+        server,
+        format!("{method} {target} HTTP/1.1\r\nHost: x\r\n\r\n").as_bytes(),
+    )
 }
 
 #[test]
@@ -128,7 +131,10 @@ fn serves_files_with_mime_types_and_refuses_escapes() {
     let root = site("files");
     let server = start(&root);
     let index = request(&server, "GET", "/");
-    assert_eq!((index.status, index.header("Content-Type")), (200, "text/html; charset=utf-8"));
+    assert_eq!(
+        (index.status, index.header("Content-Type")),
+        (200, "text/html; charset=utf-8")
+    );
     assert_eq!(index.body, b"<!doctype html><title>t</title>");
     assert_eq!(index.header("Connection"), "close");
     for (target, mime) in [
@@ -138,7 +144,11 @@ fn serves_files_with_mime_types_and_refuses_escapes() {
         ("/a%20b.css", "text/css; charset=utf-8"),
     ] {
         let r = request(&server, "GET", target);
-        assert_eq!((r.status, r.header("Content-Type")), (200, mime), "{target}");
+        assert_eq!(
+            (r.status, r.header("Content-Type")),
+            (200, mime),
+            "{target}"
+        );
     }
     assert_eq!(request(&server, "GET", "/m.wasm").body, b"\0asm\x01\0\0\0");
     assert_eq!(request(&server, "GET", "/app/").body, b"app");
@@ -176,25 +186,44 @@ fn serves_files_with_mime_types_and_refuses_escapes() {
     }
     for method in ["POST", "PUT", "DELETE", "OPTIONS"] {
         let r = request(&server, method, "/");
-        assert_eq!((r.status, r.header("Allow")), (405, "GET, HEAD"), "{method}");
+        assert_eq!(
+            (r.status, r.header("Allow")),
+            (405, "GET, HEAD"),
+            "{method}"
+        );
     }
     assert_eq!(send(&server, b"GET / HTTP/9.9\r\n\r\n").status, 400);
-    assert_eq!(send(&server, b"\x16\x03\x01\x00\xa5\x01\x00\x00\xa1\x03\x03").status, 400, "a TLS hello");
+    assert_eq!(
+        send(&server, b"\x16\x03\x01\x00\xa5\x01\x00\x00\xa1\x03\x03").status,
+        400,
+        "a TLS hello"
+    );
 }
 
 #[test]
 fn oversized_heads_get_431_and_the_server_goes_on() {
     let root = site("431");
     let server = start(&root);
-    let long = format!("GET / HTTP/1.1\r\nHost: x\r\nX-Big: {}\r\n\r\n", "a".repeat(2 * MAX_HEAD_BYTES));
+    let long = format!(
+        "GET / HTTP/1.1\r\nHost: x\r\nX-Big: {}\r\n\r\n",
+        "a".repeat(2 * MAX_HEAD_BYTES)
+    );
     let many: String = (0..100).map(|i| format!("X-{i}: v\r\n")).collect();
     let many = format!("GET / HTTP/1.1\r\n{many}\r\n");
     let endless_line = "G".repeat(4 * MAX_HEAD_BYTES);
-    for (what, raw) in [("a long header", long), ("100 headers", many), ("a line without end", endless_line)] {
+    for (what, raw) in [
+        ("a long header", long),
+        ("100 headers", many),
+        ("a line without end", endless_line),
+    ] {
         let r = send(&server, raw.as_bytes());
         assert_eq!(r.status, 431, "{what}");
         assert_eq!(r.body, b"request header fields too large\n", "{what}");
-        assert_eq!(request(&server, "GET", "/x.js").status, 200, "the request after {what}");
+        assert_eq!(
+            request(&server, "GET", "/x.js").status,
+            200,
+            "the request after {what}"
+        );
     }
     // Just under the cap is still a request.
     let filler = "a".repeat(MAX_HEAD_BYTES - 100);
@@ -213,11 +242,20 @@ fn idle_clients_are_cut_off_while_others_are_served() {
         s.write_all(b"GET /index.ht").unwrap();
     }
     let r = request(&server, "GET", "/index.html");
-    assert_eq!(r.status, 200, "a normal GET behind {} idle clients", idle.len());
+    assert_eq!(
+        r.status,
+        200,
+        "a normal GET behind {} idle clients",
+        idle.len()
+    );
     assert_eq!(r.body, b"<!doctype html><title>t</title>");
     for (i, s) in idle.into_iter().enumerate() {
         let r = read_response(s);
-        assert_eq!((r.status, r.body.as_slice()), (408, &b"request timeout\n"[..]), "idle client {i}");
+        assert_eq!(
+            (r.status, r.body.as_slice()),
+            (408, &b"request timeout\n"[..]),
+            "idle client {i}"
+        );
     }
 }
 
@@ -228,11 +266,23 @@ fn clients_beyond_the_pool_and_queue_get_503() {
     // Workers and queue hold at most WORKERS + QUEUE idle clients until the
     // head deadline; every connection over that is refused at once.
     let over = 8;
-    let clients: Vec<TcpStream> = (0..WORKERS + QUEUE + over).map(|_| connect(&server)).collect();
-    let statuses: Vec<u16> = clients.into_iter().map(|s| read_response(s).status).collect();
+    let clients: Vec<TcpStream> = (0..WORKERS + QUEUE + over)
+        .map(|_| connect(&server))
+        .collect();
+    let statuses: Vec<u16> = clients
+        .into_iter()
+        .map(|s| read_response(s).status)
+        .collect();
     let busy = statuses.iter().filter(|&&s| s == 503).count();
-    assert!(busy >= over, "{busy} of {} refused with 503, expected at least {over}", statuses.len());
-    assert!(statuses.iter().all(|&s| s == 503 || s == 408), "only 503 or 408: {statuses:?}");
+    assert!(
+        busy >= over,
+        "{busy} of {} refused with 503, expected at least {over}",
+        statuses.len()
+    );
+    assert!(
+        statuses.iter().all(|&s| s == 503 || s == 408),
+        "only 503 or 408: {statuses:?}"
+    );
     // Once the idle clients are gone, service is back.
     assert_eq!(request(&server, "GET", "/").status, 200);
 }
@@ -253,8 +303,9 @@ fn refuses_non_loopback_bind_without_public() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr)
-        .contains("error: unexpected argument '--bogus' found"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("error: unexpected argument '--bogus' found")
+    );
 }
 
 #[test]

@@ -15,7 +15,12 @@
 //!   headers, else 431;
 //! - the whole request head within `head_deadline` of the accept, else 408,
 //!   so a client that sends nothing, or a byte at a time (slowloris), holds a
-//!   worker for at most that long, queued time included;
+//!   worker for at most that long, queued time included; a head that arrived
+//!   in full while its connection was queued is still answered;
+//! - a refusal (400, 405, 408, 431) is followed by a bounded linger (the
+//!   sending side closed, what the client still sends read and dropped for
+//!   at most [`LINGER_TIME`]), because closing a socket with unread input
+//!   makes the kernel send a reset that can destroy the refusal unread;
 //! - every write within `write_stall`, the whole response within
 //!   `response_deadline`; files are streamed in [`CHUNK`]-sized pieces.
 //!
@@ -48,6 +53,9 @@ pub const CHUNK: usize = 64 * 1024;
 const LINGER_BYTES: usize = 64 * 1024;
 /// See [`LINGER_BYTES`].
 const LINGER_TIME: Duration = Duration::from_secs(1);
+/// Past the head deadline, how long the one last read of what has already
+/// arrived may wait (see [`read_head`]).
+const LATE_READ: Duration = Duration::from_millis(1);
 /// Pause after a failed accept (out of descriptors), so the loop never spins.
 const ACCEPT_BACKOFF: Duration = Duration::from_millis(10);
 
@@ -124,13 +132,21 @@ fn admit(queue: &SyncSender<Accepted>, stream: TcpStream) -> io::Result<()> {
         Ok(()) => Ok(()),
         Err(TrySendError::Full(job)) => {
             // Non-blocking: a reply of a few hundred bytes fits the empty
-            // send buffer of a new connection, and the accept loop never waits.
-            if job.stream.set_nonblocking(true).is_ok() {
-                let _ = (&job.stream).write_all(&status_page(Status::Busy, false));
-            }
+            // send buffer of a new connection, and the accept loop never
+            // waits. It cannot linger either, so it drops what has already
+            // arrived and sends a FIN; a request still in flight when the
+            // socket closes makes the kernel reset it, and that client sees
+            // a reset instead of the 503 (both mean "retry").
+            let mut stream = job.stream;
+            drain_pending(&mut stream);
+            let _ = stream.write_all(&status_page(Status::Busy, false));
+            let _ = stream.shutdown(Shutdown::Write);
+            drain_pending(&mut stream);
             Ok(())
         }
-        Err(TrySendError::Disconnected(_)) => Err(io::Error::other("every serve worker has stopped")),
+        Err(TrySendError::Disconnected(_)) => {
+            Err(io::Error::other("every serve worker has stopped"))
+        }
     }
 }
 
@@ -236,30 +252,41 @@ fn handle(
     let request = read_head(&mut stream, at + limits.head_deadline, head);
     let writer = Deadline::new(limits);
     match request {
-        Ok(request) => answer(&mut stream, &request, root, &writer, chunk),
-        Err(NoRequest::Gone) => Ok(()),
-        Err(NoRequest::Refused(Status::RequestTimeout)) => {
-            writer.write(&mut stream, &status_page(Status::RequestTimeout, false))
+        Ok(request) => {
+            let answered = answer(&mut stream, &request, root, &writer, chunk);
+            // The head was read to its end; drop anything sent after it
+            // that has already arrived, so closing does not reset.
+            drain_pending(&mut stream);
+            answered
         }
+        Err(NoRequest::Gone) => Ok(()),
         Err(NoRequest::Refused(status)) => {
-            writer.write(&mut stream, &status_page(status, false))?;
+            let written = writer.write(&mut stream, &status_page(status, false));
+            // The request was not read to its end (a 408 may not have read
+            // a byte of it): close only once the client stops sending.
             linger(&mut stream);
-            Ok(())
+            written
         }
     }
 }
 
 /// Reads the request head into `buf` until it is complete, too large, late
 /// (`deadline`) or malformed.
+///
+/// The deadline bounds how long a worker waits for the client, not how long
+/// the connection waited in the queue: past the deadline whatever has
+/// already arrived is still read once (waiting at most [`LATE_READ`]), so a
+/// client whose whole head came while it was queued behind slow clients is
+/// answered, not refused.
 fn read_head(stream: &mut TcpStream, deadline: Instant, buf: &mut [u8]) -> Result<Request, NoRequest> {
     let mut len = 0;
     loop {
         let remaining = deadline
             .checked_duration_since(Instant::now())
-            .filter(|d| !d.is_zero())
-            .ok_or(NoRequest::Refused(Status::RequestTimeout))?;
+            .filter(|d| !d.is_zero());
+        let late = remaining.is_none();
         stream
-            .set_read_timeout(Some(remaining))
+            .set_read_timeout(Some(remaining.unwrap_or(LATE_READ)))
             .map_err(|_| NoRequest::Gone)?;
         let n = match stream.read(&mut buf[len..]) {
             Ok(0) => return Err(NoRequest::Gone),
@@ -274,6 +301,7 @@ fn read_head(stream: &mut TcpStream, deadline: Instant, buf: &mut [u8]) -> Resul
         match parse_head(&buf[..len]) {
             Ok(Some(request)) => return Ok(request),
             Ok(None) if len == buf.len() => return Err(NoRequest::Refused(Status::HeadTooLarge)),
+            Ok(None) if late => return Err(NoRequest::Refused(Status::RequestTimeout)),
             Ok(None) => {}
             Err(status) => return Err(NoRequest::Refused(status)),
         }
@@ -315,7 +343,10 @@ fn answer(
     let Some((len, path, file)) = found else {
         return writer.write(stream, &status_page(Status::NotFound, head_only));
     };
-    writer.write(stream, head_lines(Status::Ok, mime_type(&path), len).as_bytes())?;
+    writer.write(
+        stream,
+        head_lines(Status::Ok, mime_type(&path), len).as_bytes(),
+    )?;
     if head_only {
         return Ok(());
     }
@@ -357,7 +388,11 @@ impl Deadline {
 }
 
 /// Closes the sending side, then reads and drops what the client still sends
-/// (bounded by [`LINGER_BYTES`] and [`LINGER_TIME`]), so the refusal arrives.
+/// (bounded by [`LINGER_BYTES`] and [`LINGER_TIME`]), so the refusal arrives:
+/// closing a socket with unread input, or input arriving after the close,
+/// makes the kernel answer with a reset, and a reset can destroy a response
+/// the client has not read yet. A client that closes on our FIN ends the
+/// linger at once.
 fn linger(stream: &mut TcpStream) {
     let _ = stream.shutdown(Shutdown::Write);
     let end = Instant::now() + LINGER_TIME;
@@ -365,14 +400,37 @@ fn linger(stream: &mut TcpStream) {
     let mut drained = 0;
     while drained < LINGER_BYTES {
         let Some(remaining) = end.checked_duration_since(Instant::now()).filter(|d| !d.is_zero()) else {
-            return;
+            break;
         };
         if stream.set_read_timeout(Some(remaining)).is_err() {
             return;
         }
         match stream.read(&mut sink) {
-            Ok(0) | Err(_) => return,
+            Ok(0) => return,
+            Err(e) if e.kind() == ErrorKind::Interrupted => {}
+            Err(_) => return,
             Ok(n) => drained += n,
+        }
+    }
+    // Out of time or bytes: what is still buffered goes now, so that the
+    // close itself sends a FIN, not a reset, unless the client keeps sending.
+    drain_pending(stream);
+}
+
+/// Reads and drops, without waiting, the input that has already arrived (at
+/// most [`LINGER_BYTES`]).
+fn drain_pending(stream: &mut TcpStream) {
+    if stream.set_nonblocking(true).is_err() {
+        return;
+    }
+    let mut sink = [0u8; 4096];
+    let mut drained = 0;
+    while drained < LINGER_BYTES {
+        match stream.read(&mut sink) {
+            Ok(0) => return,
+            Ok(n) => drained += n,
+            Err(e) if e.kind() == ErrorKind::Interrupted => {}
+            Err(_) => return,
         }
     }
 }
@@ -484,16 +542,33 @@ mod tests {
 
     #[test]
     fn heads_parse_or_are_refused_with_their_status() {
-        assert_eq!(parse_head(b"GET /a.js?v=1 HTTP/1.1\r\nHost: x\r\n\r\n"), Ok(Some(get("/a.js?v=1"))));
+        assert_eq!(
+            parse_head(b"GET /a.js?v=1 HTTP/1.1\r\nHost: x\r\n\r\n"),
+            Ok(Some(get("/a.js?v=1")))
+        );
         assert_eq!(
             parse_head(b"HEAD / HTTP/1.0\r\n\r\n").map(|r| r.map(|r| r.method)),
             Ok(Some(Method::Head))
         );
-        assert_eq!(parse_head(b"GET / HTTP/1.1\r\nHost: x\r\n"), Ok(None), "no blank line yet");
+        assert_eq!(
+            parse_head(b"GET / HTTP/1.1\r\nHost: x\r\n"),
+            Ok(None),
+            "no blank line yet"
+        );
         assert_eq!(parse_head(b""), Ok(None));
-        assert_eq!(parse_head(b"POST / HTTP/1.1\r\n\r\n"), Err(Status::MethodNotAllowed));
-        assert_eq!(parse_head(b"GET / HTTP/9.9\r\n\r\n"), Err(Status::BadRequest));
-        assert_eq!(parse_head(b"\x16\x03\x01\x02\x00\x01\x00\x01\xfc\x03\x03"), Err(Status::BadRequest), "a TLS hello");
+        assert_eq!(
+            parse_head(b"POST / HTTP/1.1\r\n\r\n"),
+            Err(Status::MethodNotAllowed)
+        );
+        assert_eq!(
+            parse_head(b"GET / HTTP/9.9\r\n\r\n"),
+            Err(Status::BadRequest)
+        );
+        assert_eq!(
+            parse_head(b"\x16\x03\x01\x02\x00\x01\x00\x01\xfc\x03\x03"),
+            Err(Status::BadRequest),
+            "a TLS hello"
+        );
         let mut many = b"GET / HTTP/1.1\r\n".to_vec();
         for i in 0..=MAX_HEADERS {
             many.extend_from_slice(format!("X-{i}: v\r\n").as_bytes());
@@ -527,10 +602,23 @@ mod tests {
     #[test]
     fn every_refusal_says_its_length_and_closes() {
         let page = String::from_utf8(status_page(Status::HeadTooLarge, false)).unwrap_or_default();
-        assert!(page.starts_with("HTTP/1.1 431 Request Header Fields Too Large\r\n"), "{page}");
-        assert!(page.contains("Content-Length: 32\r\n") && page.contains("Connection: close\r\n"), "{page}");
-        assert!(page.ends_with("\r\n\r\nrequest header fields too large\n"), "{page}");
-        let head = String::from_utf8(status_page(Status::MethodNotAllowed, true)).unwrap_or_default();
-        assert!(head.contains("Allow: GET, HEAD\r\n") && head.ends_with("\r\n\r\n"), "{head}");
+        assert!(
+            page.starts_with("HTTP/1.1 431 Request Header Fields Too Large\r\n"),
+            "{page}"
+        );
+        assert!(
+            page.contains("Content-Length: 32\r\n") && page.contains("Connection: close\r\n"),
+            "{page}"
+        );
+        assert!(
+            page.ends_with("\r\n\r\nrequest header fields too large\n"),
+            "{page}"
+        );
+        let head =
+            String::from_utf8(status_page(Status::MethodNotAllowed, true)).unwrap_or_default();
+        assert!(
+            head.contains("Allow: GET, HEAD\r\n") && head.ends_with("\r\n\r\n"),
+            "{head}"
+        );
     }
 }
