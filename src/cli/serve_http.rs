@@ -26,9 +26,11 @@
 //!
 //! Threads are `workers + 1`, memory about `workers * (max_head_bytes +
 //! CHUNK)` plus the queued sockets, whatever the load. The price of blocking
-//! workers: a flood of more than `workers + queue` slow clients per
-//! `head_deadline` is answered 503 while it lasts, and service is back within
-//! one `head_deadline` after it (BENCHMARKS.md, "robocal serve under load").
+//! workers: a slow client holds a worker for up to `head_deadline` plus
+//! [`LINGER_TIME`], so behind slow clients a normal one waits seconds, and a
+//! flood of more than `workers + queue` slow clients is answered 503 while it
+//! lasts; service is back within one `head_deadline` after it (measured with
+//! bench/serve_load.py: BENCHMARKS.md, "robocal serve under load").
 //!
 //! GET and HEAD only (405 otherwise), `Connection: close` on every response,
 //! no directory listing, 404 for anything outside the served folder.
