@@ -1092,8 +1092,8 @@ export interface RobocalJson {
   calibrate_camera: [CalibrationInput, CalibrationOutput];
   /** `calibrate_stereo(input)` -> the stereo report. */
   calibrate_stereo: [StereoInput, StereoCalibration];
-  /** `undistort_preview(bytes, JSON.stringify(camera), max_side).info_json` -> `{width, height}`. */
-  undistort_preview: [Camera, UndistortPreviewInfo];
+  /** `undistort_preview(bytes, JSON.stringify(camera), max_side)` returns an `ImageData` (grey RGBA), not JSON. */
+  undistort_preview: [Camera, never];
   /** `solve_handeye(input)` -> the hand-eye report. */
   solve_handeye: [HandEyeInput, HandEyeReport];
   /** `rank_pose_conventions(input)` -> scores, best first. */
@@ -1116,6 +1116,37 @@ export interface RobocalJson {
   workflow_csv: [never, WorkflowCsvKinds[WorkflowCsvKind]];
   /** `render_demo(seed).json` -> the demo index. */
   render_demo: [never, DemoIndex];
+  /** `parse_target(spec or JSON.stringify(target))` -> the target, checked by the core. */
+  parse_target: [Target, Target];
+  /** `target_points(spec or target JSON)` -> the board points in id order, metres. */
+  target_points: [Target, TargetPoint[]];
+  /** `target_svg(spec or target JSON)` returns the printable sheet (SVG text, mm at true scale), not JSON. */
+  target_svg: [Target, never];
+  /** `pair_images(JSON.stringify(leftNames), JSON.stringify(rightNames))` -> the pairs (robocal::io::pairing). */
+  pair_images: [string[], ImagePairing];
+}
+
+/** One board point of `target_points`: id and position in the board frame (z = 0), metres. */
+export interface TargetPoint {
+  id: number;
+  x_m: number;
+  y_m: number;
+}
+
+/** What `pair_images` returns: how the names paired and `[left index, right index]` pairs in left order. */
+export interface ImagePairing {
+  paired_by: 'number' | 'order';
+  pairs: [number, number][];
+}
+
+/**
+ * The optional last argument of `image_info`, `decode_image_preview`,
+ * `detect_target` and `undistort_preview`, as JSON text: the largest image
+ * accepted, pixels (default 64 MP in wasm). Over it the error names the
+ * image size and the limit.
+ */
+export interface ImageOptions {
+  max_pixels?: number;
 }
 
 /** A function that exchanges JSON. */

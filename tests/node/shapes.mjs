@@ -11,6 +11,9 @@ import { createRequire } from 'node:module';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
+// Node has no ImageData; the previews need one (pkg-config/README.md).
+globalThis.ImageData = class ImageData { constructor(data, width, height) { Object.assign(this, { data, width, height }); } };
+
 const here = dirname(fileURLToPath(import.meta.url));
 const root = join(here, '..', '..');
 const work = process.argv[2];
@@ -24,7 +27,7 @@ const program = ts.createProgram([dts], {
   strict: true,
   noEmit: true,
   target: ts.ScriptTarget.ES2022,
-  lib: ['lib.es2022.d.ts', 'lib.esnext.disposable.d.ts'],
+  lib: ['lib.es2022.d.ts', 'lib.esnext.disposable.d.ts', 'lib.dom.d.ts'],
 });
 const diagnostics = ts.getPreEmitDiagnostics(program);
 assert.equal(diagnostics.length, 0, ts.formatDiagnostics(diagnostics, ts.createCompilerHost({})));
@@ -147,7 +150,10 @@ const pairs = views.slice(0, 4).map((v) => ({ name: v.name, object_m: board(v.de
 call('calibrate_camera', { model: 'kannala_brandt', method: 'zhang', views: pairs, image_size_px: [1024, 768] }, 'calibrate_camera points');
 call('calibrate_stereo', { model: 'division', left: views, right: views });
 const report = all.report;
-output('undistort_preview', JSON.parse(robocal.undistort_preview(png(meta.images[0]), JSON.stringify(input('undistort_preview', report.camera)), 200).info_json));
+{
+  const image = robocal.undistort_preview(png(meta.images[0]), JSON.stringify(input('undistort_preview', report.camera)), 200);
+  if (image.width !== 200 || image.data.length !== 4 * image.width * image.height) throw new Error(`undistort_preview: ${image.width}x${image.height}`);
+}
 
 const poses = JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', {}))));
 output('read_robot_poses', poses);

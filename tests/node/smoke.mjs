@@ -49,9 +49,27 @@ assert.ok(yaml.startsWith('%YAML:1.0'), yaml.slice(0, 40));
 assert.match(yaml, /camera_matrix: !!opencv-matrix/);
 // The undistorted preview of a demo image through the calibrated camera (1024x768 -> 256x192).
 const first = meta.images[0];
+// Node has no ImageData: without one the call says what to do; with the README's class it works.
+assert.throws(() => robocal.undistort_preview(all.subarray(first.offset, first.offset + first.length), JSON.stringify(report.camera), 256), { message: "this JavaScript host has no ImageData (node has none): set globalThis.ImageData to a class whose constructor takes (data: Uint8ClampedArray, width, height) first, e.g. the ImageData of @napi-rs/canvas or the one in robocal's README" });
+globalThis.ImageData = class ImageData { constructor(data, width, height) { this.data = data; this.width = width; this.height = height; } };
 const preview = robocal.undistort_preview(all.subarray(first.offset, first.offset + first.length), JSON.stringify(report.camera), 256);
-assert.deepEqual([preview.width, preview.height, preview.rgba.length], [256, 192, 256 * 192 * 4]);
-assert.deepEqual(JSON.parse(preview.info_json), { width: 256, height: 192 });
+assert.deepEqual([preview.width, preview.height, preview.data.length], [256, 192, 256 * 192 * 4]);
+// The target calls of the page: the core's JSON, spec, points and printable sheet.
+assert.deepEqual(JSON.parse(robocal.parse_target('chessboard:9x6:30mm')), { kind: 'chessboard', cols: 9, rows: 6, square_m: 0.03 });
+assert.equal(robocal.target_spec('{"kind":"square_grid","cols":8,"rows":8,"side_m":0.0127,"pitch_m":0.0225778}'), 'squares:8x8:12.7mm:22.5778mm');
+const points = JSON.parse(robocal.target_points('chessboard:9x6:30mm'));
+assert.deepEqual([points.length, points[10]], [54, { id: 10, x_m: 0.03, y_m: 0.03 }]);
+const svg = robocal.target_svg('chessboard:9x6:30mm');
+assert.match(svg, /<rect class="check-bar" x="10" y="[0-9.]+" width="100" height="3"/);
+assert.match(svg, />robocal target chessboard:9x6:30mm</);
+assert.throws(() => robocal.parse_target('chessboard:1x6:30mm'), { message: 'target: a grid needs 2 to 100000 points with at least 2 per side, got 1x6' });
+// Stereo pairing, the rule of robocal stereo.
+assert.deepEqual(JSON.parse(robocal.pair_images('["l10.png","l2.png"]', '["r2.png","r010.png"]')), { paired_by: 'number', pairs: [[0, 1], [1, 0]] });
+assert.throws(() => robocal.pair_images('["l1.png"]', '["r1.png","r2.png"]'), { message: 'images: images are paired by the last number in their file names; no partner for: r2.png (right, number 2)' });
+// max_pixels: over the limit the error names the image size and the limit.
+assert.throws(() => robocal.image_info(readFileSync(new URL('./board.png', import.meta.url)), JSON.stringify({ max_pixels: 1000 })), { message: 'image is 64x48 = 3072 pixels, more than the limit of 1000 pixels: downscale it first' });
+// The panic hook is installed by the module itself: last_panic_message is empty, and a trap is a RuntimeError.
+assert.equal(robocal.last_panic_message(), '');
 assert.throws(() => robocal.undistort_preview(readFileSync(new URL('./board.png', import.meta.url)), JSON.stringify(report.camera), 256), { message: 'image: the image is 64x48 px but the camera was calibrated on 1024x768 px images' });
 // Stereo through the JSON API: the same views on both sides are a pair with
 // right_from_left = identity (baseline 0 to solver precision).

@@ -42,7 +42,7 @@ const wrongSize: Detection = { ...detectionLiteral, image_size_px: [640, 480, 3]
 const info: ImageInfo = { format: 'png', format_name: 'PNG', width: 64, height: 48, channels: 3, bits_per_channel: 8 };
 // @ts-expect-error: formats are lower case
 const wrongFormat: ImageInfo = { ...info, format: 'PNG' };
-const preview: JsonOutput<'undistort_preview'> = JSON.parse(robocal.undistort_preview(png, '{}', 256).info_json);
+const preview: ImageData = robocal.undistort_preview(png, '{}', 256);
 
 // --- Cameras and calibration
 const brown: Distortion = { model: 'brown', k1: -0.18, k2: 0.05, k3: 0, p1: 0.0005, p2: -0.0003 };
