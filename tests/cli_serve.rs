@@ -55,8 +55,14 @@ fn site(test: &str) -> PathBuf {
 }
 
 fn start(root: &PathBuf) -> Server {
+    start_with(root, "--dir")
+}
+
+/// `flag` is "--dir", or "" for the positional folder (`robocal serve DIR`).
+fn start_with(root: &PathBuf, flag: &str) -> Server {
     let mut child = Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(["serve", "--port", "0", "--dir"])
+        .args(["serve", "--port", "0"])
+        .args((!flag.is_empty()).then_some(flag))
         .arg(root)
         .stdout(Stdio::piped())
         .spawn()
@@ -198,6 +204,15 @@ fn serves_files_with_mime_types_and_refuses_escapes() {
         400,
         "a TLS hello"
     );
+}
+
+#[test]
+fn the_folder_may_be_given_positionally() {
+    let root = site("positional");
+    let server = start_with(&root, "");
+    let index = request(&server, "GET", "/");
+    assert_eq!((index.status, index.body.as_slice()), (200, &b"<!doctype html><title>t</title>"[..]));
+    assert_eq!(request(&server, "GET", "/../secret.txt").status, 404);
 }
 
 #[test]
