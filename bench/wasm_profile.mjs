@@ -9,6 +9,9 @@
 // repetition by repetition (A B C A B C ...), so that they are compared in
 // the same run; the demo images and detections all come from the first
 // build. Prints medians in ms, one column per build.
+// Builds whose decode_image_preview returns a web_sys::ImageData (issue 16
+// on) need an `ImageData` class, which node lacks: a minimal stand-in with
+// the constructor (data, width, height) is installed when there is none.
 import { createRequire } from 'node:module';
 import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -23,6 +26,15 @@ if (args[0] === '--repeat') {
 const pkgPaths = [];
 while (args[0] && args[0].endsWith('.js')) pkgPaths.push(args.shift());
 if (pkgPaths.length === 0) pkgPaths.push('pkg/node/robocal.js');
+if (typeof globalThis.ImageData === 'undefined') {
+  globalThis.ImageData = class ImageData {
+    constructor(data, width, height) {
+      this.data = data;
+      this.width = width;
+      this.height = height;
+    }
+  };
+}
 const require = createRequire(import.meta.url);
 const builds = pkgPaths.map((p) => require(resolve(p)));
 const first = builds[0];
@@ -59,6 +71,9 @@ const views = images.map((x, i) => ({ name: `v${i}`, detection: JSON.parse(first
 const request = JSON.stringify({ model: 'brown', method: 'zhang', views });
 const [calibMs, calibs] = medians((b) => JSON.parse(b.calibrate_camera(request)));
 rows.push(['calibrate_camera (12 views, brown, zhang)', calibMs]);
+const requestAll = JSON.stringify({ model: 'brown', method: 'all', views });
+const [calibAllMs] = medians((b) => JSON.parse(b.calibrate_camera(requestAll)));
+rows.push(['calibrate_camera (12 views, brown, all 4 methods)', calibAllMs]);
 if (args.length > 0) {
   const files = args.map((f) => readFileSync(f));
   const [jpegMs, found] = medians((b) =>
