@@ -82,3 +82,31 @@ fn detect_reports_the_bad_file_and_keeps_going() {
     let text = std::fs::read_to_string(&out_json).unwrap_or_default() + &out + &err;
     assert!(text.contains("corrupt or truncated JPEG file"), "{text}");
 }
+
+#[test]
+fn max_pixels_lowers_and_raises_the_size_limit() {
+    let dir = temp_dir("bad-images", "max-pixels");
+    let png = dir.join("board.png");
+    let image = robocal::image::GrayImage::new(400, 300, vec![128; 400 * 300]).unwrap();
+    std::fs::write(&png, robocal::image::encode_png(&image).unwrap()).unwrap();
+    let file = png.to_str().unwrap();
+    let (code, out, err) = robocal(&["info", "--max-pixels", "100000", file]);
+    assert_eq!(code, 1, "stdout {out} stderr {err}");
+    assert!(
+        out.contains("image is 400x300 = 120000 pixels, more than the limit of 100000 pixels: downscale it first, or raise the limit (--max-pixels in the CLI, \\\"max_pixels\\\" in the JSON options)"),
+        "{out}"
+    );
+    let (code, out, _) = robocal(&["info", "--max-pixels", "1MP", file]);
+    assert_eq!(code, 0);
+    assert!(out.contains("\"height\":300,\"width\":400"), "{out}");
+    // detect carries the limit to every image it decodes.
+    let (code, out, _) = robocal(&["detect", "--target", "chessboard:9x6:30mm", "--max-pixels", "1000", file]);
+    assert_eq!(code, 1);
+    assert!(out.contains("more than the limit of 1000 pixels"), "{out}");
+    let (code, _, err) = robocal(&["info", "--max-pixels", "lots", file]);
+    assert_eq!(code, 2);
+    assert!(
+        err.starts_with("error: invalid value 'lots' for '--max-pixels <N>': 'lots' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP"),
+        "{err}"
+    );
+}

@@ -1,7 +1,8 @@
 //! `robocal detect`: find a calibration target in images, in parallel
 //! (rayon), with a progress bar on a terminal (indicatif).
 
-use super::{parse_target, read_file, CliError};
+use super::{parse_target, read_file, CliError, ImageLimits};
+use robocal::image::DecodeOptions;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use robocal::detect::{detect, DetectOptions};
@@ -47,6 +48,8 @@ pub struct DetectArgs {
     /// are always refined at full size)
     #[arg(long, value_name = "N")]
     max_side: Option<u32>,
+    #[command(flatten)]
+    limits: ImageLimits,
     /// The images
     #[arg(value_name = "IMAGES")]
     images: Vec<String>,
@@ -76,7 +79,8 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
             .unwrap_or(DetectOptions::default().max_working_side_px),
     };
     let files = &args.images;
-    let outcomes = run_all(files, &target, &options, args.threads)?;
+    let decode = args.limits.decode_options();
+    let outcomes = run_all(files, &target, &options, &decode, args.threads)?;
     let mut images = Vec::with_capacity(files.len());
     let mut found = 0;
     for (file, outcome) in files.iter().zip(outcomes) {
@@ -136,6 +140,7 @@ pub(super) fn run_all(
     files: &[String],
     target: &Target,
     options: &DetectOptions,
+    decode: &DecodeOptions,
     threads: Option<usize>,
 ) -> Result<Vec<Outcome>, CliError> {
     // `--threads 0` has always meant one thread; rayon reads 0 as "default".
@@ -149,7 +154,7 @@ pub(super) fn run_all(
         files
             .par_iter()
             .map(|file| {
-                let outcome = guarded(file, target, options);
+                let outcome = guarded(file, target, options, decode);
                 bar.set_message(file.clone());
                 bar.inc(1);
                 outcome
@@ -164,8 +169,8 @@ pub(super) fn run_all(
 /// [`one`], with a panic of the detector reported as this image's failure
 /// instead of ending the run (nothing shared is mutated inside, so the
 /// `AssertUnwindSafe` holds).
-fn guarded(file: &str, target: &Target, options: &DetectOptions) -> Outcome {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| one(file, target, options)))
+fn guarded(file: &str, target: &Target, options: &DetectOptions, decode: &DecodeOptions) -> Outcome {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| one(file, target, options, decode)))
         .unwrap_or_else(|_| {
             Outcome::Failed(
                 "internal".into(),
@@ -174,13 +179,13 @@ fn guarded(file: &str, target: &Target, options: &DetectOptions) -> Outcome {
         })
 }
 
-fn one(file: &str, target: &Target, options: &DetectOptions) -> Outcome {
+fn one(file: &str, target: &Target, options: &DetectOptions, decode: &DecodeOptions) -> Outcome {
     let bytes = match read_file(file) {
         Ok(b) => b,
         Err(e) => return Outcome::Failed("io".into(), e.to_string()),
     };
-    let image = match robocal::image::decode_gray(&bytes) {
-        Ok(i) => i,
+    let image = match robocal::image::decode(&bytes, decode) {
+        Ok(d) => d.gray,
         Err(e) => return Outcome::Failed(e.kind().into(), e.to_string()),
     };
     let start = Instant::now();
@@ -202,8 +207,10 @@ mod tests {
     #[test]
     fn outcomes_come_in_input_order_on_many_threads() {
         let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
-        let files: Vec<String> = (0..12).map(|i| format!("/nonexistent/view{i}.png")).collect();
-        let outcomes = run_all(&files, &target, &DetectOptions::default(), Some(4)).unwrap();
+        let files: Vec<String> = (0..12)
+            .map(|i| format!("/nonexistent/view{i}.png"))
+            .collect();
+        let outcomes = run_all(&files, &target, &DetectOptions::default(), &DecodeOptions::default(), Some(4)).unwrap();
         assert_eq!(outcomes.len(), files.len());
         for (file, o) in files.iter().zip(&outcomes) {
             match o {

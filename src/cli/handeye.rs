@@ -64,6 +64,8 @@ pub struct HandeyeArgs {
     /// Images detected in parallel (default: all cores)
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
+    #[command(flatten)]
+    limits: super::ImageLimits,
     /// camera_from_target per view instead of images (line formats of
     /// --pose-format), paired by order
     #[arg(long, value_name = "FILE")]
@@ -177,7 +179,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                 ));
             }
             let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())?;
-            let found = image_pairs(setup, robot, &args.images, &camera, &target, args.threads)?;
+            let found = image_pairs(setup, robot, &args.images, &camera, &target, &args.limits, args.threads)?;
             pairs = found.pairs;
             pre_warnings = found.warnings;
             let input = HandEyeInput {

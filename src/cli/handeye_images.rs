@@ -148,11 +148,12 @@ pub(super) fn image_pairs(
     images: &[String],
     camera: &Camera,
     target: &Target,
+    limits: &super::ImageLimits,
     threads: Option<usize>,
 ) -> Result<ImagePairs, CliError> {
     let mut warnings = Vec::new();
     let pairing = pair_images(robot.first(), images)?;
-    let outcomes = run_all(images, target, &DetectOptions::default(), threads)?;
+    let outcomes = run_all(images, target, &DetectOptions::default(), &limits.decode_options(), threads)?;
     let mut fitted: Vec<Result<(ViewPoints, Pose, f64), String>> = Vec::new();
     for outcome in outcomes {
         fitted.push(match outcome {

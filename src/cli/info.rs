@@ -11,13 +11,16 @@ Prints one JSON object per line: {\"file\", \"format\", \"width\", \"height\",
 \"channels\", \"bits_per_channel\"} or {\"file\", \"error\"} for files that are not
 supported images. Exits with 1 if any file failed.",
     after_help = "Example:
-  robocal info left01.jpg board.tiff",
+  robocal info left01.jpg board.tiff
+  robocal info --max-pixels 250MP wafer_scan.tiff",
     args_override_self = true
 )]
 pub struct InfoArgs {
     /// Image files
     #[arg(value_name = "IMAGES")]
     files: Vec<String>,
+    #[command(flatten)]
+    limits: super::ImageLimits,
 }
 
 pub fn run(args: InfoArgs) -> Result<(), CliError> {
@@ -27,7 +30,7 @@ pub fn run(args: InfoArgs) -> Result<(), CliError> {
     let mut failed = 0;
     for file in &args.files {
         let line = match read_file(file)
-            .and_then(|b| robocal::image::decode(&b, &Default::default()).map_err(CliError::from))
+            .and_then(|b| robocal::image::decode(&b, &args.limits.decode_options()).map_err(CliError::from))
         {
             Ok(d) => {
                 let mut v = serde_json::to_value(&d.info).unwrap_or_default();

@@ -70,6 +70,8 @@ pub struct IntrinsicsArgs {
     /// Images detected in parallel (default: all cores)
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
+    #[command(flatten)]
+    limits: super::ImageLimits,
     /// Benchmarking: solve N times and print the median solve time (detections
     /// in, report out; no file or detection time) on standard error (1: no
     /// timing line)
@@ -119,7 +121,7 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
                     "--target is required with images, e.g. --target chessboard:9x6:30mm",
                 )
             })?;
-            views_from_images(&args.images, &target, args.threads)?
+            views_from_images(&args.images, &target, &args.limits, args.threads)?
         }
         (None, true) => {
             return Err(CliError::usage(
@@ -223,9 +225,10 @@ fn views_from_file(file: &str, target: Option<&Target>) -> Result<Vec<JsonView>,
 fn views_from_images(
     files: &[String],
     target: &Target,
+    limits: &super::ImageLimits,
     threads: Option<usize>,
 ) -> Result<Vec<JsonView>, CliError> {
-    let outcomes = run_all(files, target, &DetectOptions::default(), threads)?;
+    let outcomes = run_all(files, target, &DetectOptions::default(), &limits.decode_options(), threads)?;
     let mut views = vec![];
     for (file, outcome) in files.iter().zip(outcomes) {
         match outcome {

@@ -156,6 +156,53 @@ fn completions(shell: Shell) -> Result<(), CliError> {
     write_output(None, &String::from_utf8_lossy(&script))
 }
 
+/// `--max-pixels N`: the decoder's size limit, shared by every command that
+/// reads images.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct ImageLimits {
+    /// Refuse images with more than N pixels (width x height), checked from
+    /// the file header before decoding; the decoder's memory limit grows
+    /// with it (default 100000000 = 100 MP, with 1 GiB of decoder memory;
+    /// a suffix MP counts megapixels: 250MP)
+    #[arg(long, value_name = "N", value_parser = parse_pixel_count)]
+    max_pixels: Option<u64>,
+}
+
+/// Bytes the decoder may allocate per allowed pixel: a 16-bit RGBA file
+/// (8 bytes a pixel) decoded and converted to grey (1 more) fits.
+const ALLOC_BYTES_PER_PIXEL: u64 = 10;
+
+impl ImageLimits {
+    /// The decode options these flags ask for.
+    pub fn decode_options(&self) -> robocal::image::DecodeOptions {
+        let mut options = robocal::image::DecodeOptions::default();
+        if let Some(n) = self.max_pixels {
+            options.max_pixels = n;
+            options.max_alloc_bytes = options
+                .max_alloc_bytes
+                .max(n.saturating_mul(ALLOC_BYTES_PER_PIXEL));
+        }
+        options
+    }
+}
+
+/// A pixel count: digits, or digits with the suffix MP (megapixels).
+fn parse_pixel_count(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let (digits, scale) = match t.strip_suffix("MP").or_else(|| t.strip_suffix("mp")) {
+        Some(d) => (d.trim(), 1_000_000),
+        None => (t, 1),
+    };
+    match digits.parse::<u64>() {
+        Ok(n) if n > 0 => n
+            .checked_mul(scale)
+            .ok_or_else(|| format!("'{text}' is too large")),
+        _ => Err(format!(
+            "'{text}' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP"
+        )),
+    }
+}
+
 /// The target of `--target TEXT`: a spec (`chessboard:9x6:30mm`) or a target
 /// JSON object; mistakes are usage errors of `command`.
 pub fn parse_target(command: &str, text: &str) -> Result<Target, CliError> {
@@ -199,5 +246,19 @@ mod tests {
     #[test]
     fn the_clap_definitions_are_consistent() {
         Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn pixel_counts_parse_with_and_without_mp() {
+        assert_eq!(parse_pixel_count("150000000"), Ok(150_000_000));
+        assert_eq!(parse_pixel_count("250MP"), Ok(250_000_000));
+        assert_eq!(
+            parse_pixel_count("0"),
+            Err("'0' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP".into())
+        );
+        let raised = ImageLimits { max_pixels: Some(300_000_000) }.decode_options();
+        assert_eq!((raised.max_pixels, raised.max_alloc_bytes), (300_000_000, 3_000_000_000));
+        let lowered = ImageLimits { max_pixels: Some(1000) }.decode_options();
+        assert_eq!(lowered.max_alloc_bytes, robocal::image::DEFAULT_MAX_ALLOC_BYTES);
     }
 }

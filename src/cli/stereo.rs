@@ -53,6 +53,8 @@ pub struct StereoArgs {
     /// Images detected in parallel (default: all cores)
     #[arg(long, value_name = "N", overrides_with = "threads")]
     threads: Option<usize>,
+    #[command(flatten)]
+    limits: super::ImageLimits,
     /// Write the report there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE", overrides_with = "output")]
     output: Option<String>,
@@ -92,7 +94,7 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
     // 2. Detect in every image of both sides at once.
     let files: Vec<String> = left_files.iter().chain(&right_files).cloned().collect();
     let mut outcomes: Vec<Option<Outcome>> =
-        run_all(&files, &target, &DetectOptions::default(), args.threads)?
+        run_all(&files, &target, &DetectOptions::default(), &args.limits.decode_options(), args.threads)?
             .into_iter()
             .map(Some)
             .collect();

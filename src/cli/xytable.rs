@@ -75,6 +75,8 @@ pub struct XytableArgs {
     /// Write the JSON to FILE instead of stdout
     #[arg(short = 'o', long, value_name = "FILE")]
     output: Option<String>,
+    #[command(flatten)]
+    limits: super::ImageLimits,
 }
 
 pub fn run(args: XytableArgs) -> Result<(), CliError> {
@@ -108,11 +110,12 @@ pub fn run(args: XytableArgs) -> Result<(), CliError> {
             .parent()
             .map(|p| p.to_path_buf())
             .unwrap_or_default();
+        let decode = args.limits.decode_options();
         // Image names are relative to the CSV's folder.
         let mut centre_of = |name: &str| -> robocal::Result<[f64; 2]> {
             let bytes = std::fs::read(base.join(name))
                 .map_err(|e| robocal::Error::invalid("image", format!("cannot read it: {e}")))?;
-            let gray = robocal::image::decode_gray(&bytes)?;
+            let gray = robocal::image::decode(&bytes, &decode)?.gray;
             let detection = robocal::detect::detect(&gray, &target, &Default::default())?;
             let p = detection
                 .points

@@ -56,7 +56,12 @@ fn encode_with_image(format: ::image::ImageFormat, img: DynamicImage) -> Vec<u8>
     out.into_inner()
 }
 
-fn png_with(color: png::ColorType, depth: png::BitDepth, palette: Option<Vec<u8>>, data: &[u8]) -> Vec<u8> {
+fn png_with(
+    color: png::ColorType,
+    depth: png::BitDepth,
+    palette: Option<Vec<u8>>,
+    data: &[u8],
+) -> Vec<u8> {
     let mut out = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut out, W, H);
@@ -75,7 +80,10 @@ fn png_with(color: png::ColorType, depth: png::BitDepth, palette: Option<Vec<u8>
 fn png_grey_rgb_16bit_and_palette_are_exact() {
     let gray = card_gray();
     let d = decoded(&encode_png(&GrayImage::new(W, H, gray.clone()).expect("size")).expect("png"));
-    assert_eq!((d.info.format, d.info.channels, d.info.bits_per_channel), (ImageFormat::Png, 1, 8));
+    assert_eq!(
+        (d.info.format, d.info.channels, d.info.bits_per_channel),
+        (ImageFormat::Png, 1, 8)
+    );
     assert_eq!(d.gray.pixels, gray);
 
     let rgb = png_with(png::ColorType::Rgb, png::BitDepth::Eight, None, &card_rgb());
@@ -84,22 +92,42 @@ fn png_grey_rgb_16bit_and_palette_are_exact() {
     assert_eq!(d.gray.pixels, gray);
 
     // 16-bit grey: v * 257 scales back to exactly v.
-    let be16: Vec<u8> = gray.iter().flat_map(|&v| (v as u16 * 257).to_be_bytes()).collect();
-    let d = decoded(&png_with(png::ColorType::Grayscale, png::BitDepth::Sixteen, None, &be16));
+    let be16: Vec<u8> = gray
+        .iter()
+        .flat_map(|&v| (v as u16 * 257).to_be_bytes())
+        .collect();
+    let d = decoded(&png_with(
+        png::ColorType::Grayscale,
+        png::BitDepth::Sixteen,
+        None,
+        &be16,
+    ));
     assert_eq!((d.info.channels, d.info.bits_per_channel), (1, 16));
     assert_eq!(d.gray.pixels, gray);
 
     // Palette of the 256 grey levels: indices are the levels.
     let palette: Vec<u8> = (0..=255u8).flat_map(|v| [v, v, v]).collect();
-    let d = decoded(&png_with(png::ColorType::Indexed, png::BitDepth::Eight, Some(palette), &gray));
+    let d = decoded(&png_with(
+        png::ColorType::Indexed,
+        png::BitDepth::Eight,
+        Some(palette),
+        &gray,
+    ));
     assert_eq!(d.gray.pixels, gray);
 }
 
 /// An Adam7-interlaced 8-bit grey PNG, written by hand: no encoder on the
 /// registries writes interlacing. Deflate as stored blocks.
 fn interlaced_png(gray: &[u8]) -> Vec<u8> {
-    const PASSES: [(u32, u32, u32, u32); 7] =
-        [(0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2)];
+    const PASSES: [(u32, u32, u32, u32); 7] = [
+        (0, 0, 8, 8),
+        (4, 0, 8, 8),
+        (0, 4, 4, 8),
+        (2, 0, 4, 4),
+        (0, 2, 2, 4),
+        (1, 0, 2, 2),
+        (0, 1, 1, 2),
+    ];
     let mut raw = Vec::new();
     for (x0, y0, dx, dy) in PASSES {
         let cols = (x0..W).step_by(dx as usize).count();
@@ -155,7 +183,8 @@ fn jpeg_with(color: jpeg_encoder::ColorType, data: &[u8], progressive: bool) -> 
     let mut out = Vec::new();
     let mut enc = jpeg_encoder::Encoder::new(&mut out, 95);
     enc.set_progressive(progressive);
-    enc.encode(data, W as u16, H as u16, color).expect("jpeg encode");
+    enc.encode(data, W as u16, H as u16, color)
+        .expect("jpeg encode");
     out
 }
 
@@ -165,16 +194,25 @@ fn jpeg_baseline_progressive_and_cmyk_are_close() {
     let rgb = card_rgb();
     for progressive in [false, true] {
         let d = decoded(&jpeg_with(jpeg_encoder::ColorType::Rgb, &rgb, progressive));
-        assert_eq!((d.info.format, d.info.width, d.info.height), (ImageFormat::Jpeg, W, H));
+        assert_eq!(
+            (d.info.format, d.info.width, d.info.height),
+            (ImageFormat::Jpeg, W, H)
+        );
         let e = mean_abs_diff(&d.gray.pixels, &gray);
-        assert!(e < 2.0, "progressive {progressive}: mean error {e} grey levels");
+        assert!(
+            e < 2.0,
+            "progressive {progressive}: mean error {e} grey levels"
+        );
     }
     let d = decoded(&jpeg_with(jpeg_encoder::ColorType::Luma, &gray, false));
     assert_eq!(d.info.channels, 1);
     assert!(mean_abs_diff(&d.gray.pixels, &gray) < 2.0);
     // CMYK with no black: C, M, Y = 255 - R, G, B (Adobe-inverted storage
     // is the encoder's business; the decoder must give back the colours).
-    let cmyk: Vec<u8> = rgb.chunks(3).flat_map(|p| [255 - p[0], 255 - p[1], 255 - p[2], 0]).collect();
+    let cmyk: Vec<u8> = rgb
+        .chunks(3)
+        .flat_map(|p| [255 - p[0], 255 - p[1], 255 - p[2], 0])
+        .collect();
     let d = decoded(&jpeg_with(jpeg_encoder::ColorType::Cmyk, &cmyk, false));
     let e = mean_abs_diff(&d.gray.pixels, &gray);
     assert!(e < 3.0, "CMYK: mean error {e} grey levels");
@@ -183,12 +221,16 @@ fn jpeg_baseline_progressive_and_cmyk_are_close() {
 fn tiff_with(compression: tiff::encoder::Compression, gray16: bool, gray: &[u8]) -> Vec<u8> {
     use tiff::encoder::{colortype, TiffEncoder};
     let mut out = Cursor::new(Vec::new());
-    let mut enc = TiffEncoder::new(&mut out).expect("tiff").with_compression(compression);
+    let mut enc = TiffEncoder::new(&mut out)
+        .expect("tiff")
+        .with_compression(compression);
     if gray16 {
         let wide: Vec<u16> = gray.iter().map(|&v| v as u16 * 257).collect();
-        enc.write_image::<colortype::Gray16>(W, H, &wide).expect("tiff 16");
+        enc.write_image::<colortype::Gray16>(W, H, &wide)
+            .expect("tiff 16");
     } else {
-        enc.write_image::<colortype::Gray8>(W, H, gray).expect("tiff 8");
+        enc.write_image::<colortype::Gray8>(W, H, gray)
+            .expect("tiff 8");
     }
     out.into_inner()
 }
@@ -222,7 +264,11 @@ fn tiled_tiff(gray: &[u8]) -> Vec<u8> {
         for tx in 0..across {
             for y in ty * T..(ty + 1) * T {
                 for x in tx * T..(tx + 1) * T {
-                    tiles.push(if x < W && y < H { gray[(y * W + x) as usize] } else { 0 });
+                    tiles.push(if x < W && y < H {
+                        gray[(y * W + x) as usize]
+                    } else {
+                        0
+                    });
                 }
             }
         }
@@ -278,10 +324,26 @@ fn gif_bmp_pnm_and_webp_round_trip() {
     let rgb = ::image::RgbImage::from_raw(W, H, card_rgb()).expect("card size");
     let luma = ::image::GrayImage::from_raw(W, H, gray.clone()).expect("card size");
     for (format, ours, img) in [
-        (F::Bmp, ImageFormat::Bmp, DynamicImage::ImageRgb8(rgb.clone())),
-        (F::Pnm, ImageFormat::Pnm, DynamicImage::ImageRgb8(rgb.clone())),
-        (F::Pnm, ImageFormat::Pnm, DynamicImage::ImageLuma8(luma.clone())),
-        (F::WebP, ImageFormat::WebP, DynamicImage::ImageRgb8(rgb.clone())),
+        (
+            F::Bmp,
+            ImageFormat::Bmp,
+            DynamicImage::ImageRgb8(rgb.clone()),
+        ),
+        (
+            F::Pnm,
+            ImageFormat::Pnm,
+            DynamicImage::ImageRgb8(rgb.clone()),
+        ),
+        (
+            F::Pnm,
+            ImageFormat::Pnm,
+            DynamicImage::ImageLuma8(luma.clone()),
+        ),
+        (
+            F::WebP,
+            ImageFormat::WebP,
+            DynamicImage::ImageRgb8(rgb.clone()),
+        ),
     ] {
         let d = decoded(&encode_with_image(format, img));
         assert_eq!(d.info.format, ours);
@@ -289,7 +351,10 @@ fn gif_bmp_pnm_and_webp_round_trip() {
     }
     // GIF quantises to a palette: grey levels survive exactly when the
     // picture has at most 256 of them (a grey picture).
-    let d = decoded(&encode_with_image(F::Gif, DynamicImage::ImageLuma8(luma).into_rgba8().into()));
+    let d = decoded(&encode_with_image(
+        F::Gif,
+        DynamicImage::ImageLuma8(luma).into_rgba8().into(),
+    ));
     assert_eq!(d.info.format, ImageFormat::Gif);
     assert!(mean_abs_diff(&d.gray.pixels, &gray) < 1.0);
 }
@@ -344,7 +409,11 @@ pub(crate) fn tiff_huge_tiles() -> Vec<u8> {
 #[wasm_bindgen_test(unsupported = test)]
 fn tiff_with_huge_tiles_is_refused_without_allocating() {
     let err = decode_gray(&tiff_huge_tiles()).unwrap_err().to_string();
-    assert!(err.starts_with("corrupt or truncated TIFF file") || err.starts_with("TIFF image too large"), "{err}");
+    assert!(
+        err.starts_with("corrupt or truncated TIFF file")
+            || err.starts_with("TIFF image too large"),
+        "{err}"
+    );
 }
 
 #[wasm_bindgen_test(unsupported = test)]
@@ -356,11 +425,17 @@ fn the_memory_limit_names_the_limit() {
         ..Default::default()
     };
     let err = decode(&bytes, &options).unwrap_err().to_string();
-    assert_eq!(err, "PNG image too large to decode within the memory limit (1000 bytes)");
+    assert_eq!(
+        err,
+        "PNG image too large to decode within the memory limit (1000 bytes)"
+    );
     let options = DecodeOptions {
         max_pixels: 3000,
         ..Default::default()
     };
     let err = decode(&bytes, &options).unwrap_err().to_string();
-    assert_eq!(err, "image is 67x45 = 3015 pixels, more than the limit of 3000 pixels: downscale it first");
+    assert_eq!(
+        err,
+        "image is 67x45 = 3015 pixels, more than the limit of 3000 pixels: downscale it first, or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)"
+    );
 }

@@ -202,7 +202,9 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     // the claimed size); the pixel limit is checked next, by `check_size`,
     // so that the message can name the size; the decode runs under `limits`.
     reader.no_limits();
-    let mut decoder = reader.into_decoder().map_err(|e| image_error(format, e, options))?;
+    let mut decoder = reader
+        .into_decoder()
+        .map_err(|e| image_error(format, e, options))?;
     let (width, height) = decoder.dimensions();
     check_size(width, height, options)?;
     // The output buffer counts against the allocation limit too; what is
@@ -315,19 +317,23 @@ fn check_size(width: u32, height: u32, options: &DecodeOptions) -> Result<()> {
     if pixels > options.max_pixels {
         return Err(Error::Image {
             message: format!(
-                "image is {width}x{height} = {}, more than the limit of {}: downscale it first",
-                pixel_count(pixels),
-                pixel_count(options.max_pixels)
+                "image is {width}x{height} = {}, more than the limit of {}: downscale it first, \
+                 or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)",
+                pixel_count(pixels, options.max_pixels),
+                pixel_count(options.max_pixels, pixels)
             ),
         });
     }
     Ok(())
 }
 
-/// A pixel count as people say it: "12.3 MP", or "3015 pixels" when small.
-fn pixel_count(n: u64) -> String {
-    if n >= 100_000 {
-        format!("{:.1} MP", n as f64 / 1e6)
+/// A pixel count as people say it: "12.3 MP", or "3015 pixels" when small
+/// or when "MP" would print it the same as `other` (the count it is set
+/// against in the message).
+fn pixel_count(n: u64, other: u64) -> String {
+    let mp = |n: u64| format!("{:.1} MP", n as f64 / 1e6);
+    if n >= 100_000 && mp(n) != mp(other) {
+        mp(n)
     } else {
         format!("{n} pixels")
     }
@@ -364,7 +370,12 @@ pub fn encode_png(img: &GrayImage) -> Result<Vec<u8>> {
     use ::image::ImageEncoder;
     let mut out = Vec::new();
     ::image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(&img.pixels, img.width, img.height, ::image::ExtendedColorType::L8)
+        .write_image(
+            &img.pixels,
+            img.width,
+            img.height,
+            ::image::ExtendedColorType::L8,
+        )
         .map_err(|e| Error::Image {
             message: format!("could not encode PNG: {e}"),
         })?;
@@ -443,10 +454,15 @@ mod tests {
         // A PGM header announcing 20000 x 20000 pixels with no data behind it.
         let bytes = b"P5\n20000 20000\n255\n".to_vec();
         let err = decode_gray(&bytes).unwrap_err().to_string();
+        // 100 MP natively, 64 MP in wasm.
+        let limit = if cfg!(target_arch = "wasm32") { "64.0 MP" } else { "100.0 MP" };
         assert_eq!(
             err,
-            "image is 20000x20000 = 400.0 MP, more than the limit of 100.0 MP: downscale it first"
+            format!("image is 20000x20000 = 400.0 MP, more than the limit of {limit}: downscale it first, or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)")
         );
+        // Counts that print alike in megapixels are given exactly.
+        assert_eq!(pixel_count(120_000, 100_000), "120000 pixels");
+        assert_eq!(pixel_count(12_300_000, 100_000_000), "12.3 MP");
     }
 
     #[wasm_bindgen_test(unsupported = test)]

@@ -67,7 +67,7 @@ assert.throws(() => robocal.parse_target('chessboard:1x6:30mm'), { message: 'tar
 assert.deepEqual(JSON.parse(robocal.pair_images('["l10.png","l2.png"]', '["r2.png","r010.png"]')), { paired_by: 'number', pairs: [[0, 1], [1, 0]] });
 assert.throws(() => robocal.pair_images('["l1.png"]', '["r1.png","r2.png"]'), { message: 'images: images are paired by the last number in their file names; no partner for: r2.png (right, number 2)' });
 // max_pixels: over the limit the error names the image size and the limit.
-assert.throws(() => robocal.image_info(readFileSync(new URL('./board.png', import.meta.url)), JSON.stringify({ max_pixels: 1000 })), { message: 'image is 64x48 = 3072 pixels, more than the limit of 1000 pixels: downscale it first' });
+assert.throws(() => robocal.image_info(readFileSync(new URL('./board.png', import.meta.url)), JSON.stringify({ max_pixels: 1000 })), { message: 'image is 64x48 = 3072 pixels, more than the limit of 1000 pixels: downscale it first, or raise the limit (--max-pixels in the CLI, "max_pixels" in the JSON options)' });
 // The panic hook is installed by the module itself: last_panic_message is empty, and a trap is a RuntimeError.
 assert.equal(robocal.last_panic_message(), '');
 assert.throws(() => robocal.undistort_preview(readFileSync(new URL('./board.png', import.meta.url)), JSON.stringify(report.camera), 256), { message: 'image: the image is 64x48 px but the camera was calibrated on 1024x768 px images' });
