@@ -216,10 +216,17 @@ fn aspect_ratio_holds_fx_equal_fy_and_repeat_times_the_solve() {
     assert_eq!(report["options"]["fix_aspect_ratio"], true);
     assert_eq!(report["options"]["aspect_ratio"], 1.0);
     for (value, message) in [
-        ("0", "robocal: aspect_ratio: fx / fy must be finite and > 0, got 0\n"),
-        ("x", "error: invalid value 'x' for '--aspect-ratio <R>': invalid float literal\n"),
+        (
+            "0",
+            "robocal: aspect_ratio: fx / fy must be finite and > 0, got 0\n",
+        ),
+        (
+            "x",
+            "error: invalid value 'x' for '--aspect-ratio <R>': invalid float literal\n",
+        ),
     ] {
-        let (code, _, stderr) = robocal(&["intrinsics", "--detections", d, "--aspect-ratio", value]);
+        let (code, _, stderr) =
+            robocal(&["intrinsics", "--detections", d, "--aspect-ratio", value]);
         assert_ne!(code, 0);
         // The line of the error: robocal's start with "robocal: ", clap's
         // usage errors with "error: " (and end with a hint to --help).

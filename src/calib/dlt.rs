@@ -82,9 +82,7 @@ pub fn projection_dlt(
     // Null vector of A: the eigenvector of A^T A with the smallest eigenvalue.
     let eig = (a.transpose() * &a).symmetric_eigen();
     let mut order: Vec<usize> = (0..12).collect();
-    order.sort_by(|&i, &j| {
-        eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j])
-    });
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
     let (smallest2, largest) = (
         eig.eigenvalues[order[1]].max(0.0),
         eig.eigenvalues[order[11]],

@@ -292,7 +292,10 @@ fn check_detection(field: &str, d: &Detection) -> Result<()> {
         if std::mem::replace(&mut seen[p.id], true) {
             return Err(Error::invalid(
                 field,
-                format!("point id {} is listed twice: each target point is detected once", p.id),
+                format!(
+                    "point id {} is listed twice: each target point is detected once",
+                    p.id
+                ),
             ));
         }
         if !(inside(p.x_px, w) && inside(p.y_px, h)) {

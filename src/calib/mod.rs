@@ -34,9 +34,7 @@ mod zhang;
 
 pub use closed_form::{intrinsics_from_homographies, pose_from_homography};
 pub use homography::homography;
-pub use report::{
-    CameraCalibration, Correlation, Outlier, ProjectionUncertainty, ViewReport,
-};
+pub use report::{CameraCalibration, Correlation, Outlier, ProjectionUncertainty, ViewReport};
 pub use residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
 pub use tsai::calibrate_tsai;
 pub use zhang::{calibrate, CalibrationOptions};

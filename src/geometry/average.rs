@@ -50,9 +50,7 @@ pub fn average_rotations_quaternion(
     }
     let eig = m.symmetric_eigen();
     let mut order: Vec<usize> = (0..4).collect();
-    order.sort_by(|&a, &b| {
-        eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a])
-    });
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
     let (l1, l2) = (eig.eigenvalues[order[0]], eig.eigenvalues[order[1]]);
     if l1 - l2 <= 1e-12 * l1.abs().max(f64::MIN_POSITIVE) {
         return Err(Error::degenerate(

@@ -187,12 +187,17 @@ impl PoseInput {
 }
 
 /// Writes a pose as [`PoseJson`].
-pub fn serialize<S: Serializer>(pose: &Pose, serializer: S) -> std::result::Result<S::Ok, S::Error> {
+pub fn serialize<S: Serializer>(
+    pose: &Pose,
+    serializer: S,
+) -> std::result::Result<S::Ok, S::Error> {
     PoseJson::from(pose).serialize(serializer)
 }
 
 /// Reads a pose as [`PoseInput`].
-pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> std::result::Result<Pose, D::Error> {
+pub fn deserialize<'de, D: Deserializer<'de>>(
+    deserializer: D,
+) -> std::result::Result<Pose, D::Error> {
     PoseInput::deserialize(deserializer)?
         .to_pose()
         .map_err(serde::de::Error::custom)
@@ -233,7 +238,11 @@ mod tests {
                 r#""translation_m":[1.0,2.0,0.5],"quaternion_xyzw":[0.0,0.0,1.0,6.123233995736766e-17]}}"#
             )
         );
-        assert_eq!(read(&json).unwrap(), h, "a written pose reads back bit for bit");
+        assert_eq!(
+            read(&json).unwrap(),
+            h,
+            "a written pose reads back bit for bit"
+        );
         let bad = r#"{"base_from_gripper":{"translation_m":[0,0,0],"quaternion_xyzw":[0,0,0,0]}}"#;
         let err = read(bad).unwrap_err();
         assert!(
@@ -246,10 +255,14 @@ mod tests {
     fn every_accepted_form_reads_and_contradictions_are_refused() {
         let p = half_turn();
         let rows = r#"{"base_from_gripper":{"matrix_row_major":[[-1,0,0,1],[0,-1,0,2],[0,0,1,0.5],[0,0,0,1]]}}"#;
-        let flat = r#"{"base_from_gripper":{"matrix_row_major":[-1,0,0,1,0,-1,0,2,0,0,1,0.5,0,0,0,1]}}"#;
+        let flat =
+            r#"{"base_from_gripper":{"matrix_row_major":[-1,0,0,1,0,-1,0,2,0,0,1,0.5,0,0,0,1]}}"#;
         for json in [rows, flat] {
             let got = read(json).unwrap().base_from_gripper;
-            assert!((got.to_homogeneous() - p.to_homogeneous()).amax() < 1e-12, "{json}");
+            assert!(
+                (got.to_homogeneous() - p.to_homogeneous()).amax() < 1e-12,
+                "{json}"
+            );
         }
         let err = read(r#"{"base_from_gripper":{"matrix_row_major":[1,2]}}"#).unwrap_err();
         assert!(

@@ -87,7 +87,11 @@ pub fn pair_by_number(left: &[&str], right: &[&str]) -> Result<Pairing> {
         return Err(invalid(format!(
             "images are paired by the last number in their file names, but {} no number: {} \
              (number every file, e.g. left01.png with right01.png, or none to pair by order)",
-            if without.len() == 1 { "this name has" } else { "these names have" },
+            if without.len() == 1 {
+                "this name has"
+            } else {
+                "these names have"
+            },
             without.join(", ")
         )));
     }
@@ -165,7 +169,11 @@ mod tests {
     #[test]
     fn the_number_is_the_last_run_of_digits_in_the_stem() {
         assert_eq!(number_in_name("left07.png"), Some("7"));
-        assert_eq!(number_in_name("cam2/left.png"), None, "folders do not count");
+        assert_eq!(
+            number_in_name("cam2/left.png"),
+            None,
+            "folders do not count"
+        );
         assert_eq!(number_in_name("C:\\cam2\\img_3_b.jpg"), Some("3"));
         assert_eq!(number_in_name("view12.v2"), Some("12"), "nor the extension");
         assert_eq!(number_in_name("shot_000.png"), Some("0"));
@@ -201,9 +209,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.ends_with(
-                "no partner for: left2.png (left, number 2), right3.png (right, number 3)"
-            ),
+            e.ends_with("no partner for: left2.png (left, number 2), right3.png (right, number 3)"),
             "{e}"
         );
         let e = pair_by_number(&["left1.png"], &["right1.png", "blank.png"])

@@ -8,9 +8,7 @@ pub mod render;
 pub mod rng;
 pub mod scene;
 
-
 pub use scene::Scene;
-
 
 pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
 pub use rng::Rng;

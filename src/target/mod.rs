@@ -502,7 +502,9 @@ fn parse_length(text: &str) -> Result<f64> {
             format!("length '{text}' needs a unit: mm, cm or m (e.g. 30mm)"),
         ));
     };
-    let v = number.parse::<f64>().ok()
+    let v = number
+        .parse::<f64>()
+        .ok()
         .ok_or_else(|| Error::invalid("target", format!("'{text}' is not a length")))?;
     // The decimal shifted to metres and rounded once (22.5778mm -> the
     // double nearest 0.0225778, not 22.5778 * 0.001 = 0.022577800000000002),
@@ -510,7 +512,9 @@ fn parse_length(text: &str) -> Result<f64> {
     if exponent == 0 || number.contains(['e', 'E']) {
         return Ok(v * 10f64.powi(exponent));
     }
-    Ok(format!("{number}e{exponent}").parse::<f64>().ok()
+    Ok(format!("{number}e{exponent}")
+        .parse::<f64>()
+        .ok()
         .unwrap_or(v * 10f64.powi(exponent)))
 }
 
