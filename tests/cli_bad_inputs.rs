@@ -229,6 +229,38 @@ const CASES: &[Case] = &[
         stream: Stream::Stderr,
         message: "robocal: cannot read 'r.json': No such file or directory (os error 2)",
     },
+    Case {
+        name: "poses-count-mismatch",
+        files: &[("p.csv", b"x,y,z,qx,qy,qz,qw\n0,0,0,0,0,0,1\n0,0,1,0,0,0,1\n0,1,0,0,0,0,1\n"), ("c.txt", b"0 0 0 0 0 0 1\n0 0 1 0 0 0 1\n")],
+        args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.csv", "--camera-poses", "c.txt", "--camera-pose-format", "xyz-quaternion-xyzw"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: poses: 3 robot poses but 2 camera poses: they must pair up one to one",
+    },
+    Case {
+        name: "detections-no-views",
+        files: &[("d.json", b"{\"images\":[]}\n")],
+        args: &["intrinsics", "--target", "chessboard:9x6:30mm", "--detections", "d.json"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: requires at least 3 views, got 0",
+    },
+    Case {
+        name: "export-empty-report",
+        files: &[("r.json", b"")],
+        args: &["export", "r.json", "--format", "urdf"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: line 1: the report is not valid JSON: EOF while parsing a value at line 1 column 0",
+    },
+    Case {
+        name: "poses-inf",
+        files: &[("p.csv", b"x,y,z,qx,qy,qz,qw\n0,0,inf,0,0,0,1\n")],
+        args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.csv", "--camera-poses", "p.csv"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: line 2, column 3: 'inf' is not a number",
+    },
 ];
 
 /// Runs `robocal args` in `dir`: (exit code, stdout, stderr).
