@@ -219,16 +219,17 @@ pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
     let better = |alt: &Consistency| {
         off > MISTAKE_MIN_ROTATION_DEG && alt.rotation_rms_deg * MISTAKE_RATIO < off
     };
-    let inverted: Vec<Pose> = bfg.iter().map(|p| p.inverse()).collect();
-    if let Ok(alt) = consistency(input.setup, &inverted, cft) {
+    // Inverting every robot pose is, for the chain, the same as swapping
+    // eye-in-hand and eye-to-hand; so a fit of the inverted poses usually
+    // means the setup was chosen wrong, not the file. Say that first: the
+    // inverted reading gives the same numbers under a physically wrong name.
+    let other = match input.setup {
+        Setup::EyeInHand => Setup::EyeToHand,
+        Setup::EyeToHand => Setup::EyeInHand,
+    };
+    if let Ok(alt) = consistency(other, bfg, cft) {
         if better(&alt) {
-            found.push(format!(
-                "the robot poses look inverted: read as gripper_from_base they fit the camera \
-                 motion with rotation RMS {:.3} deg, against {off:.3} deg as base_from_gripper: \
-                 invert them (or choose the pose format that gives base_from_gripper), or check \
-                 the setup: eye-in-hand and eye-to-hand read the robot poses the other way round",
-                alt.rotation_rms_deg
-            ));
+            found.push(setup_message(input.setup, other, alt.rotation_rms_deg, off));
         }
     }
     let n = bfg.len();
@@ -273,6 +274,25 @@ pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
     Ok(found)
 }
 
+/// The message for poses that fit the other setup: name the setup that
+/// fits, and why inverting the poses instead would mislead.
+fn setup_message(chosen: Setup, fits: Setup, fit_deg: f64, given_deg: f64) -> String {
+    let what = match fits {
+        Setup::EyeInHand => "the camera on the gripper",
+        Setup::EyeToHand => "the camera fixed, the target on the gripper",
+    };
+    let key = fits.camera_key();
+    format!(
+        "these poses fit {fits} ({what}), not the {chosen} chosen: as {fits} they fit the camera \
+         motion with rotation RMS {fit_deg:.3} deg, against {given_deg:.3} deg as {chosen}: \
+         choose the setup {fits}, which solves {key}. Inverting the poses instead would give \
+         the same numbers under the wrong frame names; do that only if the setup really is \
+         {chosen} and the file holds gripper_from_base",
+        fits = fits.name(),
+        chosen = chosen.name(),
+    )
+}
+
 /// The warning for parallel rotation axes (SCARA).
 pub fn scara_message(setup: Setup, axis: &Vector3<f64>, spread_deg: f64) -> String {
     let frame = match setup {
@@ -289,4 +309,48 @@ pub fn scara_message(setup: Setup, axis: &Vector3<f64>, spread_deg: f64) -> Stri
         axis.y,
         axis.z
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::handeye::{handeye_scene, HandEyeSceneConfig};
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn wrong_setup_is_named_as_the_setup_that_fits_not_as_inverted_poses() {
+        // Eye-in-hand data solved as eye-to-hand: the inverted poses fit
+        // exactly, but the right advice is the setup, not the inversion.
+        for (truth, chosen) in [
+            (Setup::EyeInHand, Setup::EyeToHand),
+            (Setup::EyeToHand, Setup::EyeInHand),
+        ] {
+            let scene = handeye_scene(&HandEyeSceneConfig::noise_free(truth, 8), 4);
+            let input = HandEyeInput {
+                setup: chosen,
+                base_from_gripper: scene.base_from_gripper.clone(),
+                camera_from_target: scene.camera_from_target.clone(),
+            };
+            let found = mistakes(&input).unwrap();
+            assert_eq!(found.len(), 1, "{found:?}");
+            let expected = format!("these poses fit {}", truth.name());
+            assert!(found[0].starts_with(&expected), "{}", found[0]);
+            assert!(
+                found[0].contains(&format!(
+                    "choose the setup {}, which solves {}",
+                    truth.name(),
+                    truth.camera_key()
+                )),
+                "{}",
+                found[0]
+            );
+            assert!(found[0].contains("rotation RMS 0.000 deg"), "{}", found[0]);
+            // As given (right setup): no mistake reported.
+            let right = HandEyeInput {
+                setup: truth,
+                ..input
+            };
+            assert!(mistakes(&right).unwrap().is_empty());
+        }
+    }
 }
