@@ -16,7 +16,9 @@ const TIME_LIMIT: Duration = Duration::from_secs(10);
 
 /// Replays every file of `fixtures/fuzz/<target>/`; returns how many ran.
 fn replay(target: &str, case: fn(&[u8])) -> usize {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/fuzz").join(target);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/fuzz")
+        .join(target);
     let Ok(entries) = std::fs::read_dir(&dir) else {
         return 0;
     };
@@ -27,7 +29,11 @@ fn replay(target: &str, case: fn(&[u8])) -> usize {
         let start = Instant::now();
         case(&bytes);
         let took = start.elapsed();
-        assert!(took < TIME_LIMIT, "{}: took {took:?} (limit {TIME_LIMIT:?})", path.display());
+        assert!(
+            took < TIME_LIMIT,
+            "{}: took {took:?} (limit {TIME_LIMIT:?})",
+            path.display()
+        );
     }
     paths.len()
 }

@@ -60,7 +60,12 @@ fn from_json(text: &str) -> Result<Camera> {
     );
     let k: Vec<f64> = super::json_matrix_numbers(&v["camera_matrix"])
         .filter(|k| k.len() == 9)
-        .ok_or_else(|| missing("camera_matrix", "3 rows of 3 numbers [[fx, s, cx], [0, fy, cy], [0, 0, 1]]"))?;
+        .ok_or_else(|| {
+            missing(
+                "camera_matrix",
+                "3 rows of 3 numbers [[fx, s, cx], [0, fy, cy], [0, 0, 1]]",
+            )
+        })?;
     let model = v["model"]
         .as_str()
         .ok_or_else(|| missing("model", "the lens model's name, e.g. \"brown\""))?;
