@@ -52,7 +52,7 @@ export interface PoseReport {
   quaternion_xyzw: Vec4;
 }
 
-/** A rigid transform without the matrix (`geometry::pose_serde`): metres, quaternion x y z w. */
+/** A rigid transform without the matrix: metres, quaternion x y z w (an input form of `geometry::pose_serde::PoseInput`; reports write `PoseReport`). */
 export interface PoseQuaternion {
   /** Translation, metres. */
   translation_m: Vec3;
@@ -724,8 +724,8 @@ export interface RobotPose {
   name: string | null;
   /** 1-based line of a text file, or 1-based element of a JSON array. */
   line: number;
-  /** The gripper (TCP) pose in the robot base frame, metres. */
-  base_from_gripper: PoseQuaternion;
+  /** The gripper (TCP) pose in the robot base frame (`geometry::pose_serde::PoseJson`): matrix, translation in metres, quaternion x y z w with w >= 0. */
+  base_from_gripper: PoseReport;
 }
 
 /** Poses and everything assumed to read them. */
@@ -989,7 +989,7 @@ export interface XyTableMethodResult {
   /** K, px. */
   camera_matrix: Matrix3Flat;
   /** The stage frame in the camera frame, metres. */
-  camera_from_world: PoseQuaternion;
+  camera_from_world: PoseReport;
   /** Per calibration position: projected minus measured, px. */
   residuals_px: Vec2[];
   rms_px: number;
@@ -1035,7 +1035,7 @@ export interface KnownMotionRequest {
 /** The output JSON of `known_motion_solve`. */
 export interface KnownMotionReport {
   /** The reference frame in the camera frame: translation in metres. */
-  camera_from_reference: PoseQuaternion;
+  camera_from_reference: PoseReport;
   /** The start point in the camera frame, mm. */
   start_camera_mm: Vec3;
   /** The start point in the reference frame, mm (zero when not given). */
@@ -1122,6 +1122,8 @@ export interface RobocalJson {
   target_points: [Target, TargetPoint[]];
   /** `target_svg(spec or target JSON)` returns the printable sheet (SVG text, mm at true scale), not JSON. */
   target_svg: [Target, never];
+  /** `target_spec(spec or target JSON)` returns the canonical CLI spec (e.g. `chessboard:9x6:30mm`), not JSON. */
+  target_spec: [Target, never];
   /** `pair_images(JSON.stringify(leftNames), JSON.stringify(rightNames))` -> the pairs (robocal::io::pairing). */
   pair_images: [string[], ImagePairing];
 }

@@ -224,6 +224,32 @@ check('workflow_csv known-motion', motionRequest, propertyType(declared('Workflo
 call('known_motion_solve', motionRequest);
 call('known_motion_solve', { ...motionRequest, start_reference_mm: [1, 2, 3] }, 'known_motion_solve start');
 
+// Targets: every kind through parse_target and target_points; the text
+// functions (target_svg, target_spec) read the same target JSON.
+const targets = [
+  meta.target,
+  { kind: 'chessboard', cols: 9, rows: 6, square_m: 0.03 },
+  { kind: 'circle_grid', cols: 4, rows: 11, spacing_m: 0.02, asymmetric: true, polarity: 'dark_on_light' },
+  { kind: 'dot_plate', cols: 7, rows: 7, pitch_m: 0.025, dot_diameter_m: 0.0125 },
+  { kind: 'single_circle', diameter_m: 0.01 },
+  { kind: 'square_grid', cols: 8, rows: 8, side_m: 0.0127, pitch_m: 0.0225778 },
+];
+for (const t of targets) {
+  const parsed = call('parse_target', t, `parse_target ${t.kind}`);
+  assert.equal(parsed.kind, t.kind);
+  const pts = call('target_points', t, `target_points ${t.kind}`);
+  assert.ok(pts.length >= 1 && pts[0].id === 0, `${t.kind}: points in id order`);
+  assert.match(robocal.target_svg(JSON.stringify(input('target_svg', t))), /^<\?xml|<svg/);
+  assert.equal(robocal.parse_target(robocal.target_spec(JSON.stringify(input('target_spec', t)))), JSON.stringify(parsed), `${t.kind}: the spec reads back`);
+}
+// Stereo pairing: by number, and by order when no name has one.
+const pairLeft = input('pair_images', ['cam_L_10.png', 'cam_L_2.png']);
+const pairRight = input('pair_images', ['cam_R_2.png', 'cam_R_010.png']);
+const byNumber = output('pair_images', JSON.parse(robocal.pair_images(JSON.stringify(pairLeft), JSON.stringify(pairRight))), 'pair_images number');
+assert.deepEqual(byNumber, { paired_by: 'number', pairs: [[0, 1], [1, 0]] });
+const byOrder = output('pair_images', JSON.parse(robocal.pair_images('["left.png","l.png"]', '["right.png","r.png"]')), 'pair_images order');
+assert.deepEqual(byOrder, { paired_by: 'order', pairs: [[0, 0], [1, 1]] });
+
 // The checker itself: it must reject what the declarations do not allow.
 const rejects = (what, value, type) => {
   const e = [];
@@ -250,7 +276,8 @@ for (const fn of fns) {
   if (!never(mapped(fn, 0))) assert.ok(checked.input.has(fn), `no input of ${fn} was checked`);
   if (!never(mapped(fn, 1))) assert.ok(checked.output.has(fn), `no output of ${fn} was checked`);
 }
-const plain = new Set(['init', 'last_panic_message', 'version', 'ImagePreview', 'DemoData']);
+// `start` is the #[wasm_bindgen(start)] hook (installs the panic hook; wasm-bindgen exports it).
+const plain = new Set(['init', 'start', 'last_panic_message', 'version', 'ImagePreview', 'DemoData']);
 const missing = Object.keys(robocal).filter((n) => !plain.has(n) && !fns.includes(n));
 assert.deepEqual(missing, [], 'package functions without a RobocalJson entry');
 console.log(`shapes ok: ${fns.length} functions, ${checked.input.size} inputs and ${checked.output.size} outputs match index.d.ts`);

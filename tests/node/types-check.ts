@@ -112,6 +112,7 @@ const wrongPoseFormat: PoseFileOptions = { format: 'xyz_euler_zyx' };
 const reading: PoseReading = JSON.parse(robocal.read_robot_poses('X,Y,Z,A,B,C\n100,0,500,90,0,0\n', JSON.stringify(options)));
 if (reading.parsed) {
   const first = reading.parsed.poses[0].base_from_gripper.translation_m;
+  const matrix = reading.parsed.poses[0].base_from_gripper.matrix_row_major;
 } else {
   const why: string = reading.ambiguity;
   const best = reading.candidates[0]?.format;
@@ -119,8 +120,10 @@ if (reading.parsed) {
 const ambiguous: PoseReading = {
   parsed: null,
   ambiguity: 'the file has 6 values per row and no header',
-  candidates: [{ format: 'ur', length_unit: 'm', angle_unit: 'rad', poses: [{ name: null, line: 1, base_from_gripper: { translation_m: [0.1, 0, 0.5], quaternion_xyzw: [0, 0, 0, 1] } }], same_as: ['xyz_rotvec'], penalty: 0, reasons: [] }],
+  candidates: [{ format: 'ur', length_unit: 'm', angle_unit: 'rad', poses: [{ name: null, line: 1, base_from_gripper: pose }], same_as: ['xyz_rotvec'], penalty: 0, reasons: [] }],
 };
+// @ts-expect-error: read poses are written with their matrix (geometry::pose_serde::PoseJson)
+const noMatrix: JsonOutput<'read_robot_poses'> = { ...ambiguous, candidates: [{ ...ambiguous.candidates[0], poses: [{ name: null, line: 1, base_from_gripper: { translation_m: [0.1, 0, 0.5], quaternion_xyzw: [0, 0, 0, 1] } }] }] };
 const handeyeInput: HandEyeInput = {
   setup: 'eye-in-hand',
   base_from_gripper: [pose, { translation_m: [0.1, 0, 0.5], quaternion_xyzw: [0, 0, 0, 1] }],
@@ -205,7 +208,7 @@ const solvedPlanar: PlanarSolveResponse = {
 };
 const xyRequest: XyTableRequest = { observations: [{ stage_mm: [0, 0, 0], image_px: [640, 480] }], still_target_px: [[640.1, 480]], kalman_mode: 'linearized' };
 const xyStep = { observation: 0, projection_row_major: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1] as JsonOutput<'xytable_solve'>['batch']['projection_matrix'], rms_px: 0.1, covariance_trace: 3 };
-const xyMethod = { projection_matrix: xyStep.projection_row_major, camera_matrix: [1200, 0, 640, 0, 1200, 480, 0, 0, 1] as JsonOutput<'xytable_solve'>['batch']['camera_matrix'], camera_from_world: { translation_m: [0.01, -0.005, 0.6] as [number, number, number], quaternion_xyzw: [1, 0, 0, 0] as [number, number, number, number] }, residuals_px: [], rms_px: 0.1 };
+const xyMethod = { projection_matrix: xyStep.projection_row_major, camera_matrix: [1200, 0, 640, 0, 1200, 480, 0, 0, 1] as JsonOutput<'xytable_solve'>['batch']['camera_matrix'], camera_from_world: pose, residuals_px: [], rms_px: 0.1 };
 const xyReport: XyTableReport = {
   batch: xyMethod, kalman: { ...xyMethod, history: [xyStep] }, measurement_noise_px2: [[0.01, 0], [0, 0.01]], noise_source: 'still_target', verification: null,
   input: { observations: xyRequest.observations, verification: [], still_target_px: [], measurement_noise_px2: null, kalman_mode: 'extended' },
@@ -214,7 +217,7 @@ const xyReport: XyTableReport = {
 const noHistory: XyTableReport = { ...xyReport, kalman: xyMethod };
 const motion: KnownMotionRequest = { increments_mm: [[0, 0, 0], [50, 0, 0], [0, 50, 0]], points_camera_mm: [[100, 200, 1000], [100, 250, 1000], [50, 200, 1000]] };
 const motionReport: KnownMotionReport = {
-  camera_from_reference: { translation_m: [0.1, 0.2, 1], quaternion_xyzw: [0, 0, 0.7071, 0.7071] }, start_camera_mm: [100, 200, 1000], start_reference_mm: [0, 0, 0],
+  camera_from_reference: pose, start_camera_mm: [100, 200, 1000], start_reference_mm: [0, 0, 0],
   reference_origin_given: false, residuals_mm: [[0, 0, 0]], rms_mm: 0, input: { ...motion, start_reference_mm: null },
 };
 
