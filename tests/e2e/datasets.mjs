@@ -57,7 +57,7 @@ async function setTarget(page, cols, rows, sizeMm) {
   await page.selectOption('#target-kind', 'chessboard');
   await page.fill('input[name=cols]', String(cols));
   await page.fill('input[name=rows]', String(rows));
-  await page.fill('input[name=size_mm]', String(sizeMm));
+  await page.fill('input[name=square_mm]', String(sizeMm));
   assert.match(await page.textContent('#target-spec'), new RegExp(`^Target spec: chessboard:${cols}x${rows}:${sizeMm}mm`));
 }
 

@@ -67,20 +67,25 @@ function zyxAngles(R) {
 }
 
 export const tests = [
-  ['stereo page: pairs by the number in the names, refuses fewer than 3 pairs', async (page, { url, shot }) => {
+  ['stereo page: pairs by the number in the names (an unpaired file is the core\'s error), refuses fewer than 3 pairs', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);
     await ready(page);
     assert.equal(await page.isDisabled('#stereo-solve'), true);
     const png = (name) => ({ name, mimeType: 'image/png', buffer: makePng(40, 30, checker(5)) });
     await page.setInputFiles('#stereo-left-input', [png('cam_L_2.png'), png('cam_L_10.png')]);
     await page.setInputFiles('#stereo-right-input', [png('cam_R_10.png'), png('cam_R_2.png'), png('cam_R_7.png')]);
-    await page.waitForFunction(() => /^2 pairs, paired by the number in the file names\.$/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
-    const rows = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [tr.cells[1].textContent, tr.cells[3].textContent]));
-    assert.deepEqual(rows, [['cam_L_2.png', 'cam_R_2.png'], ['cam_L_10.png', 'cam_R_10.png'], ['— (missing)', 'cam_R_7.png']]);
-    assert.equal(await page.textContent('#stereo-pairs .msg-warning'), '1 image has no partner and will not be used.');
+    // The core's rule (robocal::io::pairing): a file without a partner is an
+    // error naming it, not a warning; nothing is paired and the solve stays off.
+    await page.waitForFunction(() => document.querySelector('#stereo-pairing.msg-error'), null, { timeout: 10000 });
+    assert.match(await page.textContent('#stereo-pairing'), /^The images cannot be paired: .*no partner for: cam_R_7\.png \(right, number 7\)$/);
+    assert.equal(await page.$('#stereo-pair-table'), null);
     assert.equal(await page.isDisabled('#stereo-solve'), true);
+    // The full numbered set pairs left n with right n, in left (numeric) order.
     await page.setInputFiles('#stereo-left-input', [png('cam_L_7.png')]);
-    await page.waitForFunction(() => /^3 pairs/.test(document.getElementById('stereo-pairing').textContent), null, { timeout: 10000 });
+    await page.waitForFunction(() => /^3 pairs, paired by the number in the file names\.$/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
+    const rows = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [tr.cells[1].textContent, tr.cells[3].textContent]));
+    assert.deepEqual(rows, [['cam_L_2.png', 'cam_R_2.png'], ['cam_L_7.png', 'cam_R_7.png'], ['cam_L_10.png', 'cam_R_10.png']]);
+    assert.equal(await page.$('#stereo-pairs .msg-error'), null);
     assert.equal(await page.isDisabled('#stereo-solve'), false);
     // Without a chessboard in the images, the solve says why instead of hanging.
     await page.click('#stereo-solve');
