@@ -166,8 +166,11 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
         });
     }
     let method = Method::from_name(&input.method)?;
+    let mut report = calibrate_with(method, &views, size, &options)?;
+    let advice = super::model_advice::advise_model(&views, size, &options, &report);
+    report.warnings.extend(advice);
     Ok(CalibrationOutput {
-        report: calibrate_with(method, &views, size, &options)?,
+        report,
         comparison: None,
     })
 }

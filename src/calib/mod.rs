@@ -21,6 +21,7 @@ mod homography;
 pub mod json_api;
 #[cfg(test)]
 mod json_api_tests;
+pub mod model_advice;
 mod refine;
 mod report;
 mod residuals;
