@@ -100,7 +100,14 @@ fn max_pixels_lowers_and_raises_the_size_limit() {
     assert_eq!(code, 0);
     assert!(out.contains("\"height\":300,\"width\":400"), "{out}");
     // detect carries the limit to every image it decodes.
-    let (code, out, _) = robocal(&["detect", "--target", "chessboard:9x6:30mm", "--max-pixels", "1000", file]);
+    let (code, out, _) = robocal(&[
+        "detect",
+        "--target",
+        "chessboard:9x6:30mm",
+        "--max-pixels",
+        "1000",
+        file,
+    ]);
     assert_eq!(code, 1);
     assert!(out.contains("more than the limit of 1000 pixels"), "{out}");
     let (code, _, err) = robocal(&["info", "--max-pixels", "lots", file]);

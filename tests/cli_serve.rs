@@ -211,7 +211,10 @@ fn the_folder_may_be_given_positionally() {
     let root = site("positional");
     let server = start_with(&root, "");
     let index = request(&server, "GET", "/");
-    assert_eq!((index.status, index.body.as_slice()), (200, &b"<!doctype html><title>t</title>"[..]));
+    assert_eq!(
+        (index.status, index.body.as_slice()),
+        (200, &b"<!doctype html><title>t</title>"[..])
+    );
     assert_eq!(request(&server, "GET", "/../secret.txt").status, 404);
 }
 

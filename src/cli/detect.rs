@@ -2,10 +2,10 @@
 //! (rayon), with a progress bar on a terminal (indicatif).
 
 use super::{parse_target, read_file, CliError, ImageLimits};
-use robocal::image::DecodeOptions;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use robocal::detect::{detect, DetectOptions};
+use robocal::image::DecodeOptions;
 use robocal::target::{Detection, Target};
 use serde_json::json;
 use std::io::IsTerminal;
@@ -169,14 +169,21 @@ pub(super) fn run_all(
 /// [`one`], with a panic of the detector reported as this image's failure
 /// instead of ending the run (nothing shared is mutated inside, so the
 /// `AssertUnwindSafe` holds).
-fn guarded(file: &str, target: &Target, options: &DetectOptions, decode: &DecodeOptions) -> Outcome {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| one(file, target, options, decode)))
-        .unwrap_or_else(|_| {
-            Outcome::Failed(
-                "internal".into(),
-                "the detector crashed on this image".into(),
-            )
-        })
+fn guarded(
+    file: &str,
+    target: &Target,
+    options: &DetectOptions,
+    decode: &DecodeOptions,
+) -> Outcome {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        one(file, target, options, decode)
+    }))
+    .unwrap_or_else(|_| {
+        Outcome::Failed(
+            "internal".into(),
+            "the detector crashed on this image".into(),
+        )
+    })
 }
 
 fn one(file: &str, target: &Target, options: &DetectOptions, decode: &DecodeOptions) -> Outcome {
@@ -210,7 +217,14 @@ mod tests {
         let files: Vec<String> = (0..12)
             .map(|i| format!("/nonexistent/view{i}.png"))
             .collect();
-        let outcomes = run_all(&files, &target, &DetectOptions::default(), &DecodeOptions::default(), Some(4)).unwrap();
+        let outcomes = run_all(
+            &files,
+            &target,
+            &DetectOptions::default(),
+            &DecodeOptions::default(),
+            Some(4),
+        )
+        .unwrap();
         assert_eq!(outcomes.len(), files.len());
         for (file, o) in files.iter().zip(&outcomes) {
             match o {

@@ -179,7 +179,15 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                 ));
             }
             let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())?;
-            let found = image_pairs(setup, robot, &args.images, &camera, &target, &args.limits, args.threads)?;
+            let found = image_pairs(
+                setup,
+                robot,
+                &args.images,
+                &camera,
+                &target,
+                &args.limits,
+                args.threads,
+            )?;
             pairs = found.pairs;
             pre_warnings = found.warnings;
             let input = HandEyeInput {

@@ -153,7 +153,13 @@ pub(super) fn image_pairs(
 ) -> Result<ImagePairs, CliError> {
     let mut warnings = Vec::new();
     let pairing = pair_images(robot.first(), images)?;
-    let outcomes = run_all(images, target, &DetectOptions::default(), &limits.decode_options(), threads)?;
+    let outcomes = run_all(
+        images,
+        target,
+        &DetectOptions::default(),
+        &limits.decode_options(),
+        threads,
+    )?;
     let mut fitted: Vec<Result<(ViewPoints, Pose, f64), String>> = Vec::new();
     for outcome in outcomes {
         fitted.push(match outcome {

@@ -29,9 +29,9 @@ pub fn run(args: InfoArgs) -> Result<(), CliError> {
     }
     let mut failed = 0;
     for file in &args.files {
-        let line = match read_file(file)
-            .and_then(|b| robocal::image::decode(&b, &args.limits.decode_options()).map_err(CliError::from))
-        {
+        let line = match read_file(file).and_then(|b| {
+            robocal::image::decode(&b, &args.limits.decode_options()).map_err(CliError::from)
+        }) {
             Ok(d) => {
                 let mut v = serde_json::to_value(&d.info).unwrap_or_default();
                 v["file"] = serde_json::Value::String(file.clone());

@@ -254,11 +254,25 @@ mod tests {
         assert_eq!(parse_pixel_count("250MP"), Ok(250_000_000));
         assert_eq!(
             parse_pixel_count("0"),
-            Err("'0' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP".into())
+            Err(
+                "'0' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP".into()
+            )
         );
-        let raised = ImageLimits { max_pixels: Some(300_000_000) }.decode_options();
-        assert_eq!((raised.max_pixels, raised.max_alloc_bytes), (300_000_000, 3_000_000_000));
-        let lowered = ImageLimits { max_pixels: Some(1000) }.decode_options();
-        assert_eq!(lowered.max_alloc_bytes, robocal::image::DEFAULT_MAX_ALLOC_BYTES);
+        let raised = ImageLimits {
+            max_pixels: Some(300_000_000),
+        }
+        .decode_options();
+        assert_eq!(
+            (raised.max_pixels, raised.max_alloc_bytes),
+            (300_000_000, 3_000_000_000)
+        );
+        let lowered = ImageLimits {
+            max_pixels: Some(1000),
+        }
+        .decode_options();
+        assert_eq!(
+            lowered.max_alloc_bytes,
+            robocal::image::DEFAULT_MAX_ALLOC_BYTES
+        );
     }
 }

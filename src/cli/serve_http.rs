@@ -280,7 +280,11 @@ fn handle(
 /// already arrived is still read once (waiting at most [`LATE_READ`]), so a
 /// client whose whole head came while it was queued behind slow clients is
 /// answered, not refused.
-fn read_head(stream: &mut TcpStream, deadline: Instant, buf: &mut [u8]) -> Result<Request, NoRequest> {
+fn read_head(
+    stream: &mut TcpStream,
+    deadline: Instant,
+    buf: &mut [u8],
+) -> Result<Request, NoRequest> {
     let mut len = 0;
     loop {
         let remaining = deadline
@@ -401,7 +405,10 @@ fn linger(stream: &mut TcpStream) {
     let mut sink = [0u8; 4096];
     let mut drained = 0;
     while drained < LINGER_BYTES {
-        let Some(remaining) = end.checked_duration_since(Instant::now()).filter(|d| !d.is_zero()) else {
+        let Some(remaining) = end
+            .checked_duration_since(Instant::now())
+            .filter(|d| !d.is_zero())
+        else {
             break;
         };
         if stream.set_read_timeout(Some(remaining)).is_err() {

@@ -93,11 +93,16 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
     };
     // 2. Detect in every image of both sides at once.
     let files: Vec<String> = left_files.iter().chain(&right_files).cloned().collect();
-    let mut outcomes: Vec<Option<Outcome>> =
-        run_all(&files, &target, &DetectOptions::default(), &args.limits.decode_options(), args.threads)?
-            .into_iter()
-            .map(Some)
-            .collect();
+    let mut outcomes: Vec<Option<Outcome>> = run_all(
+        &files,
+        &target,
+        &DetectOptions::default(),
+        &args.limits.decode_options(),
+        args.threads,
+    )?
+    .into_iter()
+    .map(Some)
+    .collect();
     // 3. Views of the pairs where both images gave a detection.
     let (mut left, mut right) = (vec![], vec![]);
     let (mut left_size, mut right_size) = (None, None);

@@ -455,7 +455,11 @@ mod tests {
         let bytes = b"P5\n20000 20000\n255\n".to_vec();
         let err = decode_gray(&bytes).unwrap_err().to_string();
         // 100 MP natively, 64 MP in wasm.
-        let limit = if cfg!(target_arch = "wasm32") { "64.0 MP" } else { "100.0 MP" };
+        let limit = if cfg!(target_arch = "wasm32") {
+            "64.0 MP"
+        } else {
+            "100.0 MP"
+        };
         assert_eq!(
             err,
             format!("image is 20000x20000 = 400.0 MP, more than the limit of {limit}: downscale it first, or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)")
