@@ -76,7 +76,10 @@ export const tests = [
     await page.setInputFiles('#stereo-right-input', [png('cam_R_10.png'), png('cam_R_2.png'), png('cam_R_7.png')]);
     // The core's rule (robocal::io::pairing): a file without a partner is an
     // error naming it, not a warning; nothing is paired and the solve stays off.
-    await page.waitForFunction(() => document.querySelector('#stereo-pairing.msg-error'), null, { timeout: 10000 });
+    // Wait for the right-hand files too: after the left ones alone the page
+    // already shows an error (their partners are missing), which is not the
+    // one under test.
+    await page.waitForFunction(() => /cam_R_7\.png/.test(document.querySelector('#stereo-pairing.msg-error')?.textContent || ''), null, { timeout: 10000 });
     assert.match(await page.textContent('#stereo-pairing'), /^The images cannot be paired: .*no partner for: cam_R_7\.png \(right, number 7\)$/);
     assert.equal(await page.$('#stereo-pair-table'), null);
     assert.equal(await page.isDisabled('#stereo-solve'), true);
