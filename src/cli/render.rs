@@ -52,10 +52,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE")]
     camera: Option<String>,
     /// Grey-level noise sigma
-    #[arg(long, value_name = "GREY", default_value_t = 2.0)]
+    #[arg(long, value_name = "GREY", default_value_t = 2.0, allow_negative_numbers = true)]
     noise: f64,
     /// Gaussian blur sigma in pixels
-    #[arg(long, value_name = "PX", default_value_t = 0.7)]
+    #[arg(long, value_name = "PX", default_value_t = 0.7, allow_negative_numbers = true)]
     blur: f64,
     /// Write the web app's demo session instead
     #[arg(long)]
@@ -79,6 +79,14 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
             "render",
             "--views must be between 1 and 1000",
         ));
+    }
+    for (flag, value, unit) in [("--noise", args.noise, "grey levels"), ("--blur", args.blur, "px")] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(CliError::usage(
+                "render",
+                format!("{flag} must be a sigma >= 0 in {unit}, got {value}"),
+            ));
+        }
     }
     let camera = match args.camera.as_deref() {
         Some(file) => robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0,
