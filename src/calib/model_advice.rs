@@ -6,7 +6,12 @@
 //!   when the RMS residual is above [`RESIDUAL_ALERT_PX`], far above what
 //!   detection noise gives (about 0.02-0.2 px for the project's detectors),
 //!   every other model is fitted to the same views; one that halves the RMS
-//!   or better is named, with both figures and the switch to make.
+//!   or better is named, with both figures and the switch to make. The same
+//!   when the residuals grow with the distance from the principal point
+//!   (RMS in the outer third of the radius more than [`RADIAL_GROWTH`] times
+//!   the inner third's and above [`RADIAL_ALERT_PX`]): the signature of a
+//!   radial model that cannot follow the lens, even when the overall RMS
+//!   looks small.
 //! - **Too many parameters for the views** (the rational model on a dozen
 //!   views): when the chosen model has more coefficients than another that
 //!   fits the same views as well (RMS within [`SAME_FIT_RATIO`] plus
@@ -25,6 +30,42 @@ use super::View;
 
 /// RMS residual (px) above which the other models are tried.
 pub const RESIDUAL_ALERT_PX: f64 = 0.5;
+/// Outer-third RMS (px) above which growth with the radius counts.
+pub const RADIAL_ALERT_PX: f64 = 0.3;
+/// Outer-third RMS over inner-third RMS that counts as growth.
+pub const RADIAL_GROWTH: f64 = 3.0;
+/// Points needed in each third to judge growth.
+const RADIAL_MIN_POINTS: usize = 20;
+
+/// The RMS residual (px) of the points in the inner and the outer third of
+/// the radius from the principal point, when the outer one is over
+/// [`RADIAL_ALERT_PX`] and [`RADIAL_GROWTH`] times the inner one.
+pub fn residuals_grow_with_radius(report: &CameraCalibration) -> Option<(f64, f64)> {
+    let (cx, cy) = (report.camera_matrix[0][2], report.camera_matrix[1][2]);
+    let points: Vec<(f64, f64)> = report
+        .views
+        .iter()
+        .flat_map(|v| v.residuals_px.iter())
+        .map(|r| ((r.x - cx).hypot(r.y - cy), r.dx * r.dx + r.dy * r.dy))
+        .filter(|(radius, sq)| radius.is_finite() && sq.is_finite())
+        .collect();
+    let r_max = points.iter().map(|p| p.0).fold(0.0, f64::max);
+    if !(r_max > 0.0) {
+        return None;
+    }
+    let rms = |lo: f64, hi: f64| {
+        let sel: Vec<f64> = points
+            .iter()
+            .filter(|p| p.0 >= lo * r_max && p.0 <= hi * r_max)
+            .map(|p| p.1)
+            .collect();
+        (sel.len() >= RADIAL_MIN_POINTS)
+            .then(|| (sel.iter().sum::<f64>() / sel.len() as f64).sqrt())
+    };
+    let (inner, outer) = (rms(0.0, 1.0 / 3.0)?, rms(2.0 / 3.0, 1.0)?);
+    (outer > RADIAL_ALERT_PX && outer > RADIAL_GROWTH * inner).then_some((inner, outer))
+}
+
 /// Another model "fits as well" when its RMS is at most this times the
 /// chosen model's, plus [`SAME_FIT_PX`].
 pub const SAME_FIT_RATIO: f64 = 1.02;
@@ -62,7 +103,8 @@ pub fn advise_model(
 ) -> Vec<String> {
     let chosen = report.model.as_str();
     let n_chosen = coefficient_count(chosen);
-    let far_off = report.rms_px > RESIDUAL_ALERT_PX;
+    let radial = residuals_grow_with_radius(report);
+    let far_off = report.rms_px > RESIDUAL_ALERT_PX || radial.is_some();
     let simpler_exists = MODELS.iter().any(|(m, _)| coefficient_count(m) < n_chosen);
     if !far_off && !simpler_exists {
         return Vec::new();
@@ -88,6 +130,24 @@ pub fn advise_model(
         }
     }
     let mut advice = Vec::new();
+    if let (Some((inner, outer)), false) = (radial, report.rms_px > RESIDUAL_ALERT_PX) {
+        let best = fits
+            .iter()
+            .filter(|f| f.1 <= 0.7 * report.rms_px)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some(&(name, rms, _)) = best {
+            advice.push(format!(
+                "the residuals grow with the distance from the image centre (rms {outer:.3} px \
+                 in the outer third against {inner:.3} px in the centre): the {} model does \
+                 not follow this lens; {} fits the same views at {rms:.3} px against {:.3} px: \
+                 switch the model to {name} (CLI: --model {name})",
+                label(chosen),
+                label(name),
+                report.rms_px
+            ));
+        }
+        return advice;
+    }
     if far_off {
         let best = fits
             .iter()
@@ -167,6 +227,51 @@ mod tests {
             .map(|w| w.as_str().unwrap().to_string())
             .collect();
         (list, report["rms_px"].as_f64().unwrap())
+    }
+
+    #[test]
+    fn growth_with_the_radius_is_measured_from_the_principal_point() {
+        let scene = Scene::calibration(7, &Camera::example_brown(), (9, 6), 0.03, 6, 0.0).unwrap();
+        let views: Vec<Value> = scene
+            .views
+            .iter()
+            .map(|v| {
+                json!({
+                    "name": v.name,
+                    "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        let input = json!({"model": "brown", "views": views, "image_size_px": [1024, 768]});
+        let out: Value =
+            serde_json::from_str(&calibrate_json(&input.to_string()).unwrap()).unwrap();
+        let mut report: CameraCalibration = serde_json::from_value(out["report"].clone()).unwrap();
+        // Noise-free: no growth.
+        assert_eq!(residuals_grow_with_radius(&report), None);
+        // Residuals of 0.1 px inside, 1 px outside (radius from cx, cy).
+        let (cx, cy) = (report.camera_matrix[0][2], report.camera_matrix[1][2]);
+        let r_max = report
+            .views
+            .iter()
+            .flat_map(|v| v.residuals_px.iter())
+            .map(|r| (r.x - cx).hypot(r.y - cy))
+            .fold(0.0, f64::max);
+        for v in &mut report.views {
+            for r in &mut v.residuals_px {
+                let radius = (r.x - cx).hypot(r.y - cy);
+                (r.dx, r.dy) = if radius > 2.0 / 3.0 * r_max {
+                    (1.0, 0.0)
+                } else {
+                    (0.1, 0.0)
+                };
+            }
+        }
+        let (inner, outer) = residuals_grow_with_radius(&report).expect("growth");
+        assert!(
+            (inner - 0.1).abs() < 1e-12 && (outer - 1.0).abs() < 1e-12,
+            "{inner} {outer}"
+        );
     }
 
     #[test]
