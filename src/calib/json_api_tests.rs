@@ -12,7 +12,9 @@ fn scene(noise_px: f64) -> Scene {
     Scene::calibration(21, &Camera::example_brown(), (9, 6), 0.03, 8, noise_px).expect("scene")
 }
 
-fn point_views(scene: &Scene) -> Value {
+/// The scene's views as the JSON API's point views (also used by the
+/// model-advice tests).
+pub(super) fn point_views(scene: &Scene) -> Value {
     scene
         .views
         .iter()

@@ -196,6 +196,7 @@ pub fn advise_model(
 mod tests {
     use super::*;
     use crate::calib::json_api::calibrate_json;
+    use crate::calib::json_api_tests::point_views;
     use crate::camera::Camera;
     use crate::synth::Scene;
     use serde_json::{json, Value};
@@ -204,17 +205,7 @@ mod tests {
     /// with `model`, and its rms.
     fn warnings(truth: &Camera, model: &str, n: usize) -> (Vec<String>, f64) {
         let scene = Scene::calibration(7, truth, (9, 6), 0.03, n, 0.1).expect("scene");
-        let views: Vec<Value> = scene
-            .views
-            .iter()
-            .map(|v| {
-                json!({
-                    "name": v.name,
-                    "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
-                })
-            })
-            .collect();
+        let views = point_views(&scene);
         let [w, h] = [truth.width, truth.height];
         let input = json!({"model": model, "views": views, "image_size_px": [w, h]});
         let out: Value =
@@ -232,17 +223,7 @@ mod tests {
     #[test]
     fn growth_with_the_radius_is_measured_from_the_principal_point() {
         let scene = Scene::calibration(7, &Camera::example_brown(), (9, 6), 0.03, 6, 0.0).unwrap();
-        let views: Vec<Value> = scene
-            .views
-            .iter()
-            .map(|v| {
-                json!({
-                    "name": v.name,
-                    "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
-                })
-            })
-            .collect();
+        let views = point_views(&scene);
         let input = json!({"model": "brown", "views": views, "image_size_px": [1024, 768]});
         let out: Value =
             serde_json::from_str(&calibrate_json(&input.to_string()).unwrap()).unwrap();

@@ -52,10 +52,20 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE")]
     camera: Option<String>,
     /// Grey-level noise sigma
-    #[arg(long, value_name = "GREY", default_value_t = 2.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "GREY",
+        default_value_t = 2.0,
+        allow_negative_numbers = true
+    )]
     noise: f64,
     /// Gaussian blur sigma in pixels
-    #[arg(long, value_name = "PX", default_value_t = 0.7, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "PX",
+        default_value_t = 0.7,
+        allow_negative_numbers = true
+    )]
     blur: f64,
     /// Write the web app's demo session instead
     #[arg(long)]
@@ -80,7 +90,10 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
             "--views must be between 1 and 1000",
         ));
     }
-    for (flag, value, unit) in [("--noise", args.noise, "grey levels"), ("--blur", args.blur, "px")] {
+    for (flag, value, unit) in [
+        ("--noise", args.noise, "grey levels"),
+        ("--blur", args.blur, "px"),
+    ] {
         if !(value.is_finite() && value >= 0.0) {
             return Err(CliError::usage(
                 "render",

@@ -8,8 +8,10 @@ use super::CliError;
 use std::io::Write;
 use std::net::{IpAddr, SocketAddr, TcpListener};
 
-// A sibling file rather than a `mod` line in cli/mod.rs, so the serving
-// internals stay one file beside the argument code that calls them.
+// Sibling files rather than a `mod` line in cli/mod.rs, so the serving
+// internals stay beside the argument code that calls them.
+#[path = "serve_files.rs"]
+mod files;
 #[path = "serve_http.rs"]
 mod http;
 
