@@ -3,16 +3,8 @@
 //! message. A row fails when the message changes: update docs/bad-inputs.md
 //! with it.
 
-use std::path::Path;
-use std::process::Command;
-
-/// Which output carries the message: `info` writes one JSON line per file
-/// to stdout; every other failure is one line on stderr.
-#[derive(Clone, Copy)]
-enum Stream {
-    Stdout,
-    Stderr,
-}
+mod support;
+use support::catalogue::{check_all, strings, Row, Stream};
 
 /// One catalogue row: a name (also the scratch folder), the files written
 /// into that folder, the arguments (run in that folder), the exit code and
@@ -27,6 +19,24 @@ struct Case {
 }
 
 const NOT_UTF8: &[u8] = b"\xff\xfe\x00";
+
+/// A PNG of 100000 x 100000 pixels (header, an empty IDAT, IEND; CRCs valid).
+const PNG_HUGE: &[u8] = b"\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x01\x86\xa0\x00\x01\x86\xa0\x08\x00\x00\x00\x00\x8d\x39\x54\x14\x00\x00\x00\x08\x49\x44\x41\x54\x78\x9c\x03\x00\x00\x00\x00\x01\x48\x06\x89\xd2\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82";
+
+/// A PNG header with width 0.
+const PNG_ZERO_WIDTH: &[u8] = b"\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x00\x00\x00\x00\x00\x01\xe0\x08\x00\x00\x00\x00\xae\xd3\x33\xf8\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82";
+
+/// The 28-byte JPEG of issue 16 (a DHT whose code counts overrun its table).
+const JPEG_28: &[u8] =
+    b"\xff\xd8\xff\xc4\x00\x16\x00\x02\x01\0\0\0\0\0\0\0\0\0\0\0\0\0\0\x00\x01\x02\xff\xd9";
+
+/// An OpenCV YAML camera file without its camera_matrix.
+const CV_YAML_NO_MATRIX: &[u8] = b"%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n\
+distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]\n";
+
+/// A ROS camera_info YAML whose camera_matrix has 8 numbers.
+const ROS_YAML_K8: &[u8] = b"image_width: 640\nimage_height: 480\ncamera_name: cam\ncamera_matrix:\n  rows: 3\n  cols: 3\n\
+  data: [560, 0, 319.5, 0, 560, 239.5, 0, 0]\ndistortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n";
 
 const CASES: &[Case] = &[
     Case {
@@ -179,7 +189,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.csv", "--camera-poses", "c.csv"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: requires at least 1 poses, got 0",
+        message: "robocal: 'p.csv': poses: the file holds no poses (it is empty, or only a header and comments): give one pose per line, e.g. x,y,z,qx,qy,qz,qw",
     },
     Case {
         name: "poses-not-utf8",
@@ -195,7 +205,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.csv", "--camera-poses", "p.csv"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: line 2, column 3: 'NaN' is not a number",
+        message: "robocal: 'p.csv': line 2, column 3: 'NaN' is not a number",
     },
     Case {
         name: "poses-zero-quaternion",
@@ -203,7 +213,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.csv", "--camera-poses", "p.csv"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: line 2, column 4: quaternion has norm 0: not a rotation",
+        message: "robocal: 'p.csv': line 2, column 4: quaternion has norm 0: not a rotation",
     },
     Case {
         name: "poses-unknown-header",
@@ -211,7 +221,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.csv", "--camera-poses", "p.csv"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: line 1: the header 'x y z' names no known pose format; name the format, or use column names such as x,y,z,qx,qy,qz,qw or X,Y,Z,A,B,C",
+        message: "robocal: 'p.csv': line 1: the header 'x y z' names no known pose format; name the format, or use column names such as x,y,z,qx,qy,qz,qw or X,Y,Z,A,B,C",
     },
     Case {
         name: "handeye-unknown-setup",
@@ -243,7 +253,7 @@ const CASES: &[Case] = &[
         args: &["intrinsics", "--target", "chessboard:9x6:30mm", "--detections", "d.json"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: requires at least 3 views, got 0",
+        message: "robocal: 'd.json' lists no images: write it with 'robocal detect --target SPEC IMAGES... -o d.json'",
     },
     Case {
         name: "export-empty-report",
@@ -259,7 +269,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.csv", "--camera-poses", "p.csv"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: line 2, column 3: 'inf' is not a number",
+        message: "robocal: 'p.csv': line 2, column 3: 'inf' is not a number",
     },
     Case {
         name: "handeye-one-pose",
@@ -275,7 +285,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "three.txt", "--camera-poses", "three.txt"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: line 1: 3 values, but pose formats have 6, 7 or 16 values a line",
+        message: "robocal: 'three.txt': line 1: 3 values, but pose formats have 6, 7 or 16 values a line",
     },
     Case {
         name: "poses-not-a-rotation",
@@ -286,7 +296,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "scaled.txt", "--camera-poses", "scaled.txt"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: line 1: 4x4 matrix rotation block is not orthonormal: largest |RᵀR - I| entry is 3.000e0, tolerance 1e-3",
+        message: "robocal: 'scaled.txt': line 1: 4x4 matrix rotation block is not orthonormal: largest |RᵀR - I| entry is 3.000e0, tolerance 1e-3",
     },
     Case {
         name: "detections-nan-as-text",
@@ -363,45 +373,138 @@ const CASES: &[Case] = &[
         stream: Stream::Stderr,
         message: "robocal: render: --blur must be a sigma >= 0 in px, got NaN (see 'robocal render --help')",
     },
+    Case {
+        name: "image-png-huge",
+        files: &[("huge.png", PNG_HUGE)],
+        args: &["info", "huge.png"],
+        code: 1,
+        stream: Stream::Stdout,
+        message: r#"{"error":"image is 100000x100000 = 10000.0 MP, more than the limit of 100.0 MP: downscale it first, or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)","file":"huge.png"}"#,
+    },
+    Case {
+        name: "image-png-zero-width",
+        files: &[("zero.png", PNG_ZERO_WIDTH)],
+        args: &["info", "zero.png"],
+        code: 1,
+        stream: Stream::Stdout,
+        message: r#"{"error":"corrupt or truncated PNG file: Format error decoding Png: Invalid image dimensions","file":"zero.png"}"#,
+    },
+    Case {
+        name: "image-bmp-truncated",
+        files: &[("t.bmp", b"BM\0\0\0\0\0\0\0\0\0\0")],
+        args: &["info", "t.bmp"],
+        code: 1,
+        stream: Stream::Stdout,
+        message: r#"{"error":"corrupt or truncated BMP file: failed to fill whole buffer","file":"t.bmp"}"#,
+    },
+    Case {
+        name: "image-tiff-truncated",
+        files: &[("t.tif", b"II*\0\x08\0\0\0\x01\0")],
+        args: &["info", "t.tif"],
+        code: 1,
+        stream: Stream::Stdout,
+        message: r#"{"error":"corrupt or truncated TIFF file: failed to fill whole buffer","file":"t.tif"}"#,
+    },
+    Case {
+        name: "image-jpeg-28-bytes",
+        files: &[("tiny.jpg", JPEG_28)],
+        args: &["info", "tiny.jpg"],
+        code: 1,
+        stream: Stream::Stdout,
+        message: r#"{"error":"corrupt or truncated JPEG file: Format error decoding Jpeg: Error decoding huffman values: Bad Huffman Table","file":"tiny.jpg"}"#,
+    },
+    Case {
+        name: "camera-json-no-model",
+        files: &[("cam.json", br#"{"image_size_px":[640,480],"camera_matrix":[[560,0,319.5],[0,560,239.5],[0,0,1]]}"#)],
+        args: &["render", "--out", "o", "--views", "1", "--camera", "cam.json"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: r#"robocal: model: the camera JSON needs the lens model's name, e.g. "brown""#,
+    },
+    Case {
+        name: "camera-json-negative-focal",
+        files: &[("cam.json", br#"{"model":"brown","image_size_px":[640,480],"camera_matrix":[[-560,0,319.5],[0,560,239.5],[0,0,1]],"distortion":{"k1":0,"k2":0,"p1":0,"p2":0,"k3":0}}"#)],
+        args: &["render", "--out", "o", "--views", "1", "--camera", "cam.json"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: camera_matrix: focal lengths must be positive, got fx -560 fy 560",
+    },
+    Case {
+        name: "camera-opencv-yaml-no-matrix",
+        files: &[("cv.yaml", CV_YAML_NO_MATRIX)],
+        args: &["render", "--out", "o", "--views", "1", "--camera", "cv.yaml"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: camera_matrix: the file has no camera matrix (camera_matrix or K with 9 numbers): give a robocal camera JSON, an OpenCV YAML/XML calibration or a ROS camera_info YAML",
+    },
+    Case {
+        name: "camera-ros-yaml-eight-values",
+        files: &[("ros.yaml", ROS_YAML_K8)],
+        args: &["render", "--out", "o", "--views", "1", "--camera", "ros.yaml"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: camera_matrix: the camera_matrix has 8 numbers, a 3x3 matrix needs 9 (fx 0 cx 0 fy cy 0 0 1): the file is truncated or not a camera file",
+    },
+    Case {
+        name: "camera-opencv-xml-truncated",
+        files: &[("cv.xml", b"<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>\n<camera_matrix type_id=\"opencv-matrix\"><rows>3</rows><cols>3</cols>")],
+        args: &["render", "--out", "o", "--views", "1", "--camera", "cv.xml"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: camera_matrix: the file has no camera matrix (camera_matrix or K with 9 numbers): give a robocal camera JSON, an OpenCV YAML/XML calibration or a ROS camera_info YAML",
+    },
+    Case {
+        name: "poses-unknown-format-name",
+        files: &[("p.txt", b"0 0 0 0 0 0 1\n")],
+        args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.txt", "--pose-format", "furlong", "--camera-poses", "p.txt"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "robocal: handeye: --pose-format: unknown pose format 'furlong' (valid: ur, kuka, abb, fanuc, yaskawa, staubli, xyz_quat_xyzw, xyz_quat_wxyz, xyz_rotvec, matrix4, xyz_euler_intrinsic_ORDER or xyz_euler_extrinsic_ORDER with ORDER such as zyx, or the line formats matrix, xyz-quaternion-xyzw, xyz-quaternion-wxyz) (see 'robocal handeye --help')",
+    },
+    Case {
+        name: "xytable-empty-csv",
+        files: &[("empty.csv", b"\n")],
+        args: &["xytable", "empty.csv"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: empty.csv: the file is empty: expected a CSV header line",
+    },
+    Case {
+        name: "planar-wrong-header",
+        files: &[("bad.csv", b"a,b\n1,2\n")],
+        args: &["planar", "solve", "bad.csv"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: bad.csv: line 1: missing column(s) height_mm, u_px, v_px, x_mm, y_mm (expected header height_mm,u_px,v_px,x_mm,y_mm, got a,b)",
+    },
+    Case {
+        name: "detect-misspelled-flag",
+        files: &[],
+        args: &["detect", "--targett", "chessboard:9x6:30mm", "a.png"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "error: unexpected argument '--targett' found",
+    },
 ];
-
-/// Runs `robocal args` in `dir`: (exit code, stdout, stderr).
-fn run_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run robocal");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 #[test]
 fn every_bad_input_gets_its_exact_message() {
-    let root = std::env::temp_dir().join(format!("robocal-bad-inputs-{}", std::process::id()));
-    let mut failures = Vec::new();
-    for case in CASES {
-        let dir = root.join(case.name);
-        std::fs::create_dir_all(&dir).expect("scratch folder");
-        for (name, bytes) in case.files {
-            std::fs::write(dir.join(name), bytes).expect("write input");
-        }
-        let (code, out, err) = run_in(&dir, case.args);
-        let text = match case.stream {
-            Stream::Stdout => &out,
-            Stream::Stderr => &err,
-        };
-        let first = text.lines().next().unwrap_or("");
-        if code != case.code || first != case.message {
-            failures.push(format!(
-                "{}: exit {code} (want {}), message\n  got  {first}\n  want {}\nstdout {out}\nstderr {err}",
-                case.name, case.code, case.message
-            ));
-        }
-    }
-    let _ = std::fs::remove_dir_all(&root);
-    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+    let rows: Vec<Row> = CASES
+        .iter()
+        .map(|case| Row {
+            name: case.name.to_string(),
+            files: case
+                .files
+                .iter()
+                .map(|(name, bytes)| (name.to_string(), bytes.to_vec()))
+                .collect(),
+            setup: Vec::new(),
+            args: strings(case.args),
+            code: case.code,
+            stream: case.stream,
+            message: case.message.to_string(),
+            last_line: false,
+        })
+        .collect();
+    check_all("bad-inputs", &rows);
 }

@@ -291,15 +291,15 @@ fn camera_uses(camera: &robocal::Camera) {
     }
 }
 
-/// Targets and detections: selector % 3 = 0 a CLI target spec, 1 a target
+/// Targets and detections: selector % 4 = 0 a CLI target spec, 1 a target
 /// JSON object (both then checked to round-trip through `to_spec`, listed
 /// and drawn as SVG), 2 a detections JSON (`robocal detect`'s file, or one
-/// detection) read into calibration views.
+/// detection) read into calibration views, 3 stereo pairing by file names.
 pub fn targets_detections(data: &[u8]) {
     let Some((selector, text)) = selector_and_text(data) else {
         return;
     };
-    match selector % 3 {
+    match selector % 4 {
         0 => {
             if let Ok(target) = Target::parse_spec(text) {
                 target_uses(&target);
@@ -311,7 +311,25 @@ pub fn targets_detections(data: &[u8]) {
                 target_uses(&target);
             }
         }
-        _ => detections(text),
+        2 => detections(text),
+        _ => pairing(text),
+    }
+}
+
+/// Stereo pairing by file name (`robocal stereo` and the page's
+/// `pair_images`): the text's lines split at the first empty line into left
+/// and right names. A pairing names each image at most once, in range.
+fn pairing(text: &str) {
+    let (left, right) = text.split_once("\n\n").unwrap_or((text, ""));
+    let left: Vec<&str> = left.lines().collect();
+    let right: Vec<&str> = right.lines().collect();
+    if let Ok(found) = robocal::io::pairing::pair_by_number(&left, &right) {
+        let mut seen_left = vec![false; left.len()];
+        let mut seen_right = vec![false; right.len()];
+        for &(l, r) in &found.pairs {
+            assert!(!std::mem::replace(&mut seen_left[l], true), "left {l} paired twice");
+            assert!(!std::mem::replace(&mut seen_right[r], true), "right {r} paired twice");
+        }
     }
 }
 

@@ -143,7 +143,18 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     // 1. The views and the image size.
     let views = views_of(&input.views)?;
     if views.len() < MIN_VIEWS {
-        return Err(Error::too_few("views", MIN_VIEWS, views.len()));
+        return Err(Error::invalid(
+            "views",
+            format!(
+                "{} with the target found, a calibration needs at least {MIN_VIEWS} (10 or more \
+                 from varied angles are recommended): add images in which the whole target is \
+                 found, or check the target's size (inner corners for a chessboard)",
+                match views.len() {
+                    1 => "1 view".to_string(),
+                    n => format!("{n} views"),
+                }
+            ),
+        ));
     }
     let size = image_size(input)?;
     // 2. The options.

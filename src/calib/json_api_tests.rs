@@ -157,7 +157,9 @@ fn bad_input_gives_clear_errors() {
     let two = json!([views[0], views[1]]);
     assert_eq!(
         error(json!({"views": two, "image_size_px": [1280, 960]})),
-        "requires at least 3 views, got 2"
+        "views: 2 views with the target found, a calibration needs at least 3 (10 or more from \
+         varied angles are recommended): add images in which the whole target is found, or check \
+         the target's size (inner corners for a chessboard)"
     );
     assert_eq!(
         error(json!({"views": views, "image_size_px": [1280, 960], "model": "fisheye"})),

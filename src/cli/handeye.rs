@@ -140,7 +140,9 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                     "images need --camera and --target, not --camera-poses",
                 ));
             }
-            let robot = match read_robot_poses(&poses_text, args.pose_format.as_deref())? {
+            let robot = match read_robot_poses(&poses_text, args.pose_format.as_deref())
+                .map_err(|e| e.in_file(poses_path))?
+            {
                 RobotPoses::Known(p) => p,
                 RobotPoses::Ambiguous(_) => {
                     return Err(CliError::usage(
@@ -152,7 +154,8 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
             let camera_from_target = parse_pose_text(
                 &read_text(camera_path)?,
                 pose_format(args.camera_pose_format.as_deref())?,
-            )?;
+            )
+            .map_err(|e| CliError::from(e).in_file(camera_path))?;
             let input = HandEyeInput {
                 setup,
                 base_from_gripper: robot.iter().map(|p| p.base_from_gripper).collect(),
@@ -178,7 +181,8 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                     "give the images after the options",
                 ));
             }
-            let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())?;
+            let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())
+                .map_err(|e| e.in_file(poses_path))?;
             let found = image_pairs(
                 setup,
                 robot,

@@ -59,7 +59,22 @@ pub(super) fn read_robot_poses(text: &str, format: Option<&str>) -> Result<Robot
             };
             return Ok(RobotPoses::Known(parse_poses(text, &options)?.poses));
         }
-        let f = name.parse::<PoseTextFormat>()?;
+        let Ok(f) = name.parse::<PoseTextFormat>() else {
+            let named: Vec<String> = PoseFormat::all()
+                .iter()
+                .filter(|f| !matches!(f, PoseFormat::XyzEuler { .. }))
+                .map(|f| f.name())
+                .collect();
+            return Err(CliError::usage(
+                "handeye",
+                format!(
+                    "--pose-format: unknown pose format '{name}' (valid: {}, \
+                     xyz_euler_intrinsic_ORDER or xyz_euler_extrinsic_ORDER with ORDER such as \
+                     zyx, or the line formats matrix, xyz-quaternion-xyzw, xyz-quaternion-wxyz)",
+                    named.join(", ")
+                ),
+            ));
+        };
         return Ok(RobotPoses::Known(plain(parse_pose_text(text, Some(f))?)));
     }
     let options = PoseFileOptions::default();

@@ -195,6 +195,11 @@ fn views_from_file(file: &str, target: Option<&Target>) -> Result<Vec<JsonView>,
             "'{file}' is not a 'robocal detect' output (an object with \"images\"): {e}"
         ))
     })?;
+    if parsed.images.is_empty() {
+        return Err(CliError::Io(format!(
+            "'{file}' lists no images: write it with 'robocal detect --target SPEC IMAGES... -o {file}'"
+        )));
+    }
     let mut views = vec![];
     for image in parsed.images {
         let Some(detection) = image.detection else {

@@ -44,6 +44,14 @@ impl CliError {
         ))
     }
 
+    /// The same error, naming the file it came from: `'p.csv': line 2, ...`.
+    pub fn in_file(self, path: &str) -> Self {
+        match self {
+            CliError::Robocal(e) => CliError::Io(format!("'{path}': {e}")),
+            other => other,
+        }
+    }
+
     /// The process exit code for this error.
     pub fn exit_code(&self) -> i32 {
         match self {

@@ -242,12 +242,22 @@ fn size_from(w: Option<String>, h: Option<String>) -> Result<(u32, u32)> {
 
 /// The camera matrix's numbers, when the file had exactly 9 of them.
 fn nine_numbers(k: Option<Vec<f64>>) -> Result<Vec<f64>> {
-    k.filter(|k| k.len() == 9).ok_or_else(|| {
-        Error::invalid(
+    match k {
+        Some(k) if k.len() == 9 => Ok(k),
+        Some(k) => Err(Error::invalid(
             "camera_matrix",
-            "no 3x3 camera_matrix with 9 numbers in the file",
-        )
-    })
+            format!(
+                "the camera_matrix has {} numbers, a 3x3 matrix needs 9 (fx 0 cx 0 fy cy 0 0 1): \
+                 the file is truncated or not a camera file",
+                k.len()
+            ),
+        )),
+        None => Err(Error::invalid(
+            "camera_matrix",
+            "the file has no camera matrix (camera_matrix or K with 9 numbers): give a robocal \
+             camera JSON, an OpenCV YAML/XML calibration or a ROS camera_info YAML",
+        )),
+    }
 }
 
 fn from_yaml(text: &str, ros: bool) -> Result<Camera> {

@@ -7,10 +7,10 @@ use serde::{Deserialize, Serialize};
 use super::pose_formats::{short, AngleUnit, LengthUnit, PoseFormat, RotationLayout};
 use super::pose_table::Table;
 use super::poses::{
-    first_row_value_count, header_reading, read_rows, table_from_input, PoseFileOptions, Reading,
-    RobotPose,
+    first_row_value_count, header_reading, no_poses, read_rows, table_from_input, PoseFileOptions,
+    Reading, RobotPose,
 };
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geometry::rotation_angle_between;
 
 /// One reading of a pose file.
@@ -72,7 +72,7 @@ pub fn parse_pose_candidates(text: &str, options: &PoseFileOptions) -> Result<Ve
         }
         None => {
             let Some(n) = first_row_value_count(&table) else {
-                return Err(Error::too_few("poses", 1, 0));
+                return Err(no_poses());
             };
             for format in PoseFormat::all()
                 .into_iter()
@@ -167,7 +167,7 @@ fn rank(table: &Table, readings: &[Reading], options: &PoseFileOptions) -> Resul
         }
     }
     if out.is_empty() {
-        return Err(first_error.unwrap_or_else(|| Error::too_few("poses", 1, 0)));
+        return Err(first_error.unwrap_or_else(|| no_poses()));
     }
     // Equal penalties: the order of PoseFormat::all() (vendor presets first).
     let all = PoseFormat::all();

@@ -197,7 +197,8 @@ fn errors_say_where_and_what() {
         "line 1: the header 'a b c' names no known pose format; name the format, or use column names such as x,y,z,qx,qy,qz,qw or X,Y,Z,A,B,C");
     assert_eq!(
         err("# nothing\n\n", &PoseFileOptions::default()),
-        "requires at least 1 poses, got 0"
+        "poses: the file holds no poses (it is empty, or only a header and comments): give one \
+         pose per line, e.g. x,y,z,qx,qy,qz,qw"
     );
     assert_eq!(
         err("1 2 3 nan 5 6", &opts(PoseFormat::Fanuc)),

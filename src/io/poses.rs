@@ -177,12 +177,21 @@ pub(crate) fn first_row_value_count(table: &Table) -> Option<usize> {
     Some(row.fields.len() - usize::from(named))
 }
 
+/// The error for a pose file without a single pose.
+pub(crate) fn no_poses() -> Error {
+    Error::invalid(
+        "poses",
+        "the file holds no poses (it is empty, or only a header and comments): give one pose \
+         per line, e.g. x,y,z,qx,qy,qz,qw",
+    )
+}
+
 fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
     let (format, header, mut notes) = match header_reading(table, options)? {
         Some(found) => found,
         None => {
             let Some(n) = first_row_value_count(table) else {
-                return Err(Error::too_few("poses", 1, 0));
+                return Err(no_poses());
             };
             let fits: Vec<PoseFormat> = PoseFormat::all()
                 .into_iter()
@@ -306,7 +315,7 @@ pub(crate) fn read_rows(
     direction: PoseDirection,
 ) -> Result<Vec<RobotPose>> {
     if rows.is_empty() {
-        return Err(Error::too_few("poses", 1, 0));
+        return Err(no_poses());
     }
     let mut poses = Vec::with_capacity(rows.len());
     for row in rows {

@@ -4,6 +4,8 @@
 
 #![allow(dead_code)] // each test crate uses a different subset
 
+pub mod catalogue;
+
 use std::path::PathBuf;
 use std::process::Command;
 
