@@ -56,3 +56,21 @@ export function download(name, text, type = 'text/plain') {
 export function message(kind, text) {
   return h('p', { class: `msg msg-${kind}`, role: kind === 'error' ? 'alert' : 'status' }, text);
 }
+
+/**
+ * The text of a user's file, strictly as UTF-8 (File.text() would turn bytes
+ * that are not UTF-8 into U+FFFD, and the reader would then blame the wrong
+ * thing). Rejects an empty file and one that is not UTF-8 with a message
+ * that says what to do; `what` names the content, e.g. "one robot pose a line".
+ */
+export async function readTextFile(file, what) {
+  const bytes = new Uint8Array(await file.arrayBuffer());
+  let text;
+  try {
+    text = new TextDecoder('utf-8', { fatal: true }).decode(bytes);
+  } catch (e) {
+    throw new Error('the file is not UTF-8 text: save it as UTF-8 (or plain ASCII) and load it again');
+  }
+  if (!text.trim()) throw new Error(`the file is empty${bytes.length ? ' (only white space)' : ''}: expected ${what}`);
+  return text;
+}

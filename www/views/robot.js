@@ -1,7 +1,7 @@
 // Step 4: robot poses. Drop a pose file; see how it was read (format, units,
 // direction: editable, with vendor presets), the parsed poses, and which
 // pose goes with which image.
-import { $, h, fill, table, num, message } from '../lib/dom.js';
+import { $, h, fill, table, num, message, readTextFile } from '../lib/dom.js';
 
 export const PRESETS = [
   ['auto', 'Detect from the file'],
@@ -42,9 +42,18 @@ export class RobotView {
     input.addEventListener('change', async () => {
       const f = input.files[0];
       if (!f) return;
-      st.fileName = f.name;
-      st.text = await f.text();
       input.value = '';
+      st.fileName = f.name;
+      try {
+        st.text = await readTextFile(f, 'one robot pose a line, one per image');
+      } catch (err) {
+        // Nothing of this file is used: the poses of an earlier file are not
+        // shown under its name.
+        Object.assign(st, { text: '', reading: null, parsed: null, error: err.message });
+        this.store.changed('robot');
+        this.show();
+        return;
+      }
       await this.parse();
     });
     const form = h('div', { class: 'form', id: 'pose-form' },

@@ -108,6 +108,7 @@ export class StereoView {
     const rows = pairs.map((p, i) => [String(i + 1), p.left.name, status(p.left), p.right.name, status(p.right)]);
     fill(this.pairsOut,
       h('p', { id: 'stereo-pairing' }, `${pairs.length} pair${pairs.length === 1 ? '' : 's'}, paired ${how === 'number' ? 'by the number in the file names' : 'by order (sorted names)'}.`),
+      pairs.length < 3 ? h('p', { id: 'stereo-too-few', class: 'msg msg-info', role: 'status' }, `A stereo calibration needs at least 3 pairs: add ${3 - pairs.length} more pair${3 - pairs.length === 1 ? '' : 's'} (a left and a right image each) to solve.`) : null,
       table(['pair', 'left', 'left detection', 'right', 'right detection'], rows, { id: 'stereo-pair-table', class: 'scroll' }));
   }
 

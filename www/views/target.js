@@ -10,8 +10,14 @@ import { $, download } from '../lib/dom.js';
 /** Lengths between millimetres (form) and metres (core) by shifting the
  * decimal, so 33.3 mm is the double nearest 0.0333, as the core's spec
  * parser makes it (not 33.3 / 1000). */
-const mToMm = (m) => Number(`${m}e3`);
-const mmToM = (mm) => Number(`${String(mm).trim()}e-3`);
+const mToMm = (m) => shiftDecimal(m, 3);
+const mmToM = (mm) => shiftDecimal(mm, -3);
+
+/** `x` (a number or its text) times 10^k, by moving the exponent: "3e1" -> 3e-2 for k = -3. */
+function shiftDecimal(x, k) {
+  const m = /^([^e]*)(?:e([-+]?\d+))?$/i.exec(String(x).trim());
+  return m ? Number(`${m[1]}e${Number(m[2] || 0) + k}`) : NaN;
+}
 
 /**
  * The target as the engine's detect request takes it (a CLI spec or target
@@ -45,14 +51,26 @@ function fieldsOf(form, kind) {
     .map((label) => label.querySelector('input, select'));
 }
 
+/**
+ * A number field's value, or an error naming the field: an empty field, or
+ * one the browser could not read as a number (its value is then ''), would
+ * otherwise reach the core as null ("invalid type: null, expected f64").
+ */
+function numberField(el, unit) {
+  const v = el.value.trim();
+  if (v !== '' && Number.isFinite(Number(v))) return v;
+  const label = el.parentElement.firstChild.textContent.trim();
+  throw new Error(`${label}: the field is empty or not a number; enter ${unit}`);
+}
+
 /** The form as target JSON text (names ending in _mm become _m in metres). */
 function readForm(form) {
   const kind = form.elements.kind.value;
   const t = { kind };
   for (const el of fieldsOf(form, kind)) {
     const v = el.value;
-    if (el.name.endsWith('_mm')) t[el.name.replace(/_mm$/, '_m')] = v.trim() === '' ? null : mmToM(v);
-    else if (el.name === 'cols' || el.name === 'rows') t[el.name] = v.trim() === '' ? null : Number(v);
+    if (el.name.endsWith('_mm')) t[el.name.replace(/_mm$/, '_m')] = mmToM(numberField(el, 'a size in millimetres, e.g. 30'));
+    else if (el.name === 'cols' || el.name === 'rows') t[el.name] = Number(numberField(el, 'a whole number of points, at least 2'));
     else if (el.name === 'asymmetric') t.asymmetric = v === 'true';
     else t[el.name] = v;
   }
@@ -119,16 +137,18 @@ export function initTarget(store, engine) {
   const form = $('target-form');
   let asked = 0; // the latest request: older replies are dropped
   let sheet = null; // { spec, svg } of the target shown
+  const refuse = (text) => {
+    sheet = null;
+    $('target-error').textContent = text;
+    $('print-target').disabled = true;
+  };
   const show = async (json, fromForm) => {
     const mine = ++asked;
     let reply;
     try {
       reply = await engine.call('target', { spec: json });
     } catch (err) {
-      if (mine !== asked) return;
-      sheet = null;
-      $('target-error').textContent = err.message;
-      $('print-target').disabled = true;
+      if (mine === asked) refuse(err.message);
       return;
     }
     if (mine !== asked) return;
@@ -144,7 +164,18 @@ export function initTarget(store, engine) {
     store.session.target = reply.target;
     if (fromForm) store.changed('target');
   };
-  form.addEventListener('input', () => { showFields(form); show(readForm(form), true); });
+  form.addEventListener('input', () => {
+    showFields(form);
+    let json;
+    try {
+      json = readForm(form);
+    } catch (err) {
+      asked++; // a reply still on its way is older than this
+      refuse(err.message);
+      return;
+    }
+    show(json, true);
+  });
   form.addEventListener('submit', (e) => e.preventDefault());
   $('print-target').addEventListener('click', () => {
     if (!sheet) return;

@@ -1,15 +1,27 @@
 // Step 6: the industrial workflows of the seed papers. Planar eye-to-hand
 // calibration at any height (seed 001) and XY-table calibration with one
 // target (seed 002). Same CSV files as `robocal planar` / `robocal xytable`.
-import { $, h, fill, table, num, message } from '../lib/dom.js';
+import { $, h, fill, table, num, message, readTextFile } from '../lib/dom.js';
 import { lines, bars } from '../lib/plot.js';
 
 const PARAMS = ['a11', 'a12', 'tx', 'a21', 'a22', 'ty'];
 
-function csvInput(id, label, onText) {
+/** A CSV file input and a text area; a file that is empty or not UTF-8 goes to `onError` (and leaves the text area as it was). */
+function csvInput(id, label, header, onText, onError) {
   const area = h('textarea', { id: `${id}-csv`, rows: 6, cols: 60, 'aria-label': `${label} (CSV)`, spellcheck: 'false' });
   const file = h('input', { type: 'file', id: `${id}-file`, accept: '.csv,.txt,text/csv' });
-  file.addEventListener('change', async () => { if (file.files[0]) { area.value = await file.files[0].text(); file.value = ''; onText(); } });
+  file.addEventListener('change', async () => {
+    const f = file.files[0];
+    if (!f) return;
+    file.value = '';
+    try {
+      area.value = await readTextFile(f, `a CSV file with the header ${header}`);
+    } catch (err) {
+      onError(`${f.name}: ${err.message}`);
+      return;
+    }
+    onText();
+  });
   return { area, node: h('div', { class: 'form' }, h('label', {}, `${label}: file `, file), h('label', {}, 'or paste CSV', area)) };
 }
 
@@ -21,7 +33,8 @@ export class WorkflowsView {
   }
 
   render() {
-    const planarIn = csvInput('planar', 'Point pairs (height_mm,u_px,v_px,x_mm,y_mm)', () => this.solvePlanar());
+    const planarIn = csvInput('planar', 'Point pairs (height_mm,u_px,v_px,x_mm,y_mm)', 'height_mm,u_px,v_px,x_mm,y_mm',
+      () => this.solvePlanar(), (text) => fill(this.planarOut, message('error', text)));
     const transform = h('select', { id: 'planar-transform', 'aria-label': 'transform per height' },
       ['affine', 'similarity', 'rigid'].map((t) => h('option', { value: t }, t)));
     this.planarOut = h('div', { id: 'planar-results', 'aria-live': 'polite' });
@@ -30,7 +43,8 @@ export class WorkflowsView {
     const predictU = h('input', { type: 'number', id: 'predict-u', value: 1000, step: 'any', 'aria-label': 'u (px)' });
     const predictV = h('input', { type: 'number', id: 'predict-v', value: 1000, step: 'any', 'aria-label': 'v (px)' });
     this.predictOut = h('p', { id: 'predict-result', 'aria-live': 'polite' });
-    const xyIn = csvInput('xytable', 'Stage positions (x_mm,y_mm,z_mm,u_px,v_px[,role])', () => this.solveXy());
+    const xyIn = csvInput('xytable', 'Stage positions (x_mm,y_mm,z_mm,u_px,v_px[,role])', 'x_mm,y_mm,z_mm,u_px,v_px[,role]',
+      () => this.solveXy(), (text) => fill(this.xyOut, message('error', text)));
     this.xyArea = xyIn.area;
     this.xyOut = h('div', { id: 'xytable-results', 'aria-live': 'polite' });
     fill($('workflows-panel'),

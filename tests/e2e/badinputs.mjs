@@ -1,0 +1,476 @@
+// A catalogue of bad inputs through the page (issue 17, part 3): each test
+// gives the page one bad input where a user would give it, asserts the exact
+// message the page shows, that what was loaded before is still there, and
+// that a later good input still works. docs/bad-inputs-page.md lists the rows
+// (same test names); docs/bad-inputs.md is the CLI's catalogue of the same
+// inputs. The harness fails a test on any uncaught page error.
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, readdirSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { crc32 } from 'node:zlib';
+import { root } from './harness.mjs';
+import { makePng, makeBmp, checker } from '../support/images.mjs';
+
+const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
+
+/** The image cards as {name, cls, meta}. */
+const cards = (page) => page.$$eval('.card', (els) => els.map((el) => ({
+  name: el.querySelector('.name').textContent, cls: el.className, meta: el.querySelector('.meta').textContent,
+})));
+
+/**
+ * Wait until there are `n` cards, each finished: not decoded (class error),
+ * decoded without the target (class warn), or decoded with its points (a
+ * card that is still decoding is pending; one being detected says
+ * 'detecting…' and one between the two has no points yet).
+ */
+const settled = (page, n) => page.waitForFunction((n) => {
+  const all = [...document.querySelectorAll('.card')];
+  return all.length === n && all.every((c) => /\b(error|warn)\b/.test(c.className) || / \d+ points$/.test(c.querySelector('.meta').textContent));
+}, n, { timeout: 60000 });
+
+/**
+ * A 9x6 inner-corner chessboard (10x7 squares of 24 px) in a `w` x `h` white
+ * image, its top-left square at (`x`, `y`): the page's default target.
+ */
+function board({ x = 36, y = 36, w = 312, h = 240 } = {}) {
+  const s = 24;
+  return makePng(w, h, (px, py) => {
+    const [i, j] = [Math.floor((px - x) / s), Math.floor((py - y) / s)];
+    const inside = px >= x && py >= y && i < 10 && j < 7;
+    const v = inside && (i + j) % 2 === 0 ? 0 : 255;
+    return [v, v, v];
+  });
+}
+
+const png = (name, buffer) => ({ name, mimeType: 'image/png', buffer });
+const text = (name, content) => ({ name, mimeType: 'text/plain', buffer: Buffer.isBuffer(content) ? content : Buffer.from(content) });
+const BOARD_META = 'PNG · 312×240 px · RGB, 8-bit · 54 points';
+
+/** A real PNG whose IHDR (with a right CRC) claims `width` x `height` pixels. */
+function pngClaiming(width, height) {
+  const bytes = Buffer.from(makePng(4, 3, checker(1)));
+  bytes.writeUInt32BE(width, 16);
+  bytes.writeUInt32BE(height, 20);
+  bytes.writeUInt32BE(crc32(bytes.subarray(12, 29)), 29);
+  return bytes;
+}
+
+/** The demo session as `robocal render --demo` writes it (the page's demo button renders the same): rendered once. */
+let demoFiles = null;
+function demo() {
+  if (demoFiles) return demoFiles;
+  const dir = mkdtempSync(join(tmpdir(), 'robocal-badinputs-'));
+  try {
+    execFileSync(join(root, 'target/release/robocal'), ['render', '--out', dir, '--demo'], { stdio: 'ignore' });
+    const images = readdirSync(dir).filter((f) => f.endsWith('.png')).sort().map((f) => png(f, readFileSync(join(dir, f))));
+    demoFiles = { images, poses: readFileSync(join(dir, 'poses.csv'), 'utf8') };
+  } finally {
+    rmSync(dir, { recursive: true, force: true });
+  }
+  return demoFiles;
+}
+
+/** The demo's pose file without its name column: poses pair with the images by order. */
+const namelessPoses = () => demo().poses.trim().split('\n').map((l) => l.split(',').slice(1).join(','));
+
+async function loadBoard(page, url, hash = '') {
+  await page.goto(`${url}${hash}`);
+  await ready(page);
+  await page.click('a[data-step=images]');
+  await page.setInputFiles('#file-input', [png('board.png', board())]);
+  await settled(page, 1);
+  assert.deepEqual((await cards(page)).map((c) => c.meta), [BOARD_META]);
+}
+
+/** Images: board.png detected, then the bad file gets an error card; board.png stays; a later good image detects. */
+function imageCase(file, message, { cls = 'card error' } = {}) {
+  return async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.setInputFiles('#file-input', [file]);
+    await settled(page, 2);
+    const [kept, bad] = await cards(page);
+    assert.deepEqual(bad, { name: file.name, cls, meta: message });
+    assert.deepEqual([kept.name, kept.meta], ['board.png', BOARD_META]);
+    await shot('bad');
+    await page.setInputFiles('#file-input', [png('later.png', board({ x: 40, y: 30 }))]);
+    await settled(page, 3);
+    const later = (await cards(page))[2];
+    assert.deepEqual([later.name, later.meta], ['later.png', BOARD_META]);
+    assert.equal((await cards(page))[0].meta, BOARD_META);
+  };
+}
+
+async function solveCamera(page) {
+  await page.click('a[data-step=camera]');
+  await page.evaluate(() => document.getElementById('camera-results').replaceChildren());
+  await page.click('#solve-camera');
+  await page.waitForFunction(() => document.querySelector('#camera-params, #camera-results .msg-error'), null, { timeout: 60000 });
+  const error = await page.$('#camera-results .msg-error');
+  return error ? error.textContent() : null;
+}
+
+async function loadDemoImages(page, url, extra = [], only = null) {
+  await page.goto(url);
+  await ready(page);
+  const images = only ? demo().images.slice(0, only) : demo().images;
+  await page.setInputFiles('#file-input', [...images, ...extra]);
+  await settled(page, images.length + extra.length);
+}
+
+/** Robot poses: a good file read, then the bad one refused with `message`, the image kept, then the good file again. */
+const GOOD_POSES = 'x,y,z,qx,qy,qz,qw\n0.1,0.2,0.3,0,0,0,1\n0.2,0.2,0.3,0,0,0.1,0.995\n0.3,0.1,0.3,0.1,0,0,0.995\n';
+function posesCase(file, message) {
+  return async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.click('a[data-step=robot]');
+    await page.setInputFiles('#pose-input', text('good.csv', GOOD_POSES));
+    await page.waitForFunction(() => /^good\.csv: 3 poses read as /.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    await page.setInputFiles('#pose-input', file);
+    await page.locator('#pose-results .msg-error').waitFor({ timeout: 20000 });
+    assert.equal(await page.textContent('#pose-results'), `${file.name}: ${message}`);
+    // Nothing of the bad file is used, nothing of the good one shown under its name.
+    assert.equal(await page.$('#pose-table'), null);
+    assert.equal(await page.textContent('#pose-pairing'), 'No poses yet.');
+    await shot('bad');
+    await page.click('a[data-step=images]');
+    assert.deepEqual((await cards(page)).map((c) => c.meta), [BOARD_META]);
+    await page.click('a[data-step=robot]');
+    await page.setInputFiles('#pose-input', text('good.csv', GOOD_POSES));
+    await page.waitForFunction(() => /^good\.csv: 3 poses read as /.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    assert.equal(await page.$('#pose-results .msg-error'), null);
+    assert.equal(await page.$$eval('#pose-table tbody tr', (trs) => trs.length), 3);
+  };
+}
+
+/** Hand-eye on the demo: camera solved, the good solve first, then `spoil` makes the solve fail with `message`; `mend` makes it solve again. */
+function handeyeCase(spoil, message, mend) {
+  return async (page, { url, shot }) => {
+    await page.goto(url);
+    await ready(page);
+    await page.click('#demo-button');
+    await page.waitForFunction(() => /^Demo loaded/.test(document.getElementById('engine-status').textContent), null, { timeout: 180000 });
+    assert.equal(await solveCamera(page), null);
+    const handeye = async () => {
+      await page.click('a[data-step=handeye]');
+      await page.evaluate(() => document.getElementById('handeye-results').replaceChildren());
+      await page.click('#solve-handeye');
+      await page.waitForFunction(() => document.querySelector('#handeye-errors, #handeye-results .msg-error'), null, { timeout: 60000 });
+      const error = await page.$('#handeye-results .msg-error');
+      return error ? error.textContent() : null;
+    };
+    assert.equal(await handeye(), null);
+    await spoil(page);
+    assert.equal(await handeye(), message);
+    await shot('bad');
+    // The camera result and the images are kept.
+    await page.click('a[data-step=camera]');
+    assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
+    assert.match(await page.textContent('#image-summary'), /^12 files, 12 decoded, 12 with the target$/);
+    await mend(page);
+    assert.equal(await handeye(), null);
+    assert.match(await page.textContent('#handeye-results h3'), /^Result \(/);
+  };
+}
+
+const select = (id, value) => async (page) => {
+  await page.click(`a[data-step=${id.startsWith('handeye') ? 'handeye' : 'robot'}]`);
+  await page.selectOption(`#${id}`, value);
+  if (!id.startsWith('handeye')) await page.waitForFunction(() => !document.querySelector('#pose-results .msg-error') && document.getElementById('pose-format-used'), null, { timeout: 20000 });
+};
+
+/** Target form: a good target, board.png detected with it, then a bad field value refused; the target in use and the detection kept. */
+function targetCase(field, value, message) {
+  return async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.click('a[data-step=target]');
+    const spec = 'Target spec: chessboard:9x6:30mm (the same spelling works in the CLI: robocal detect --target chessboard:9x6:30mm; robocal target chessboard:9x6:30mm --svg board.svg prints this sheet)';
+    assert.equal(await page.textContent('#target-spec'), spec);
+    await page.fill(`#target-form input[name=${field}]`, value);
+    await page.waitForFunction((m) => document.getElementById('target-error').textContent === m, message, { timeout: 10000 });
+    assert.equal(await page.isDisabled('#print-target'), true);
+    await shot('bad');
+    // The target in use is still the good one: a new image is detected with it.
+    assert.equal(await page.textContent('#target-spec'), spec);
+    await page.click('a[data-step=images]');
+    await page.setInputFiles('#file-input', [png('later.png', board({ x: 40, y: 30 }))]);
+    await settled(page, 2);
+    assert.deepEqual((await cards(page)).map((c) => c.meta), [BOARD_META, BOARD_META]);
+    // A good value again: the sheet follows it.
+    await page.click('a[data-step=target]');
+    await page.fill('#target-form input[name=cols]', '9');
+    await page.fill('#target-form input[name=square_mm]', '25');
+    await page.waitForFunction(() => /^Target spec: chessboard:9x6:25mm /.test(document.getElementById('target-spec').textContent), null, { timeout: 10000 });
+    assert.equal(await page.textContent('#target-error'), '');
+    assert.equal(await page.isDisabled('#print-target'), false);
+  };
+}
+
+/**
+ * Workflows, planar: the seed-001 points solved, then the bad CSV (pasted
+ * text, or {file} through the file input) refused with `message`, then the
+ * good CSV solves again.
+ */
+function planarCase(csv, message) {
+  return async (page, { url, shot }) => {
+    const good = readFileSync(join(root, 'fixtures/seed001/table3_four_points.csv'), 'utf8');
+    await page.goto(`${url}#workflows`);
+    await ready(page);
+    await page.fill('#planar-csv', good);
+    await page.click('#planar-solve');
+    await page.locator('#planar-fit').waitFor({ timeout: 20000 });
+    const fit = await page.textContent('#planar-fit');
+    if (typeof csv === 'string') {
+      await page.fill('#planar-csv', csv);
+      await page.click('#planar-solve');
+    } else {
+      await page.setInputFiles('#planar-file', csv.file);
+      // The text area keeps the points it had.
+    }
+    await page.locator('#planar-results .msg-error').waitFor({ timeout: 20000 });
+    if (typeof csv !== 'string') assert.equal(await page.inputValue('#planar-csv'), good);
+    assert.equal(await page.textContent('#planar-results'), message);
+    await shot('bad');
+    await page.fill('#planar-csv', good);
+    await page.click('#planar-solve');
+    await page.locator('#planar-fit').waitFor({ timeout: 20000 });
+    assert.equal(await page.textContent('#planar-fit'), fit);
+  };
+}
+
+/** Eight stage positions on two levels seen by an exact pinhole (f 1000 px, 500 mm above the table): an XY-table CSV that solves. */
+function stageCsv() {
+  let csv = 'x_mm,y_mm,z_mm,u_px,v_px\n';
+  for (const z of [0, 30]) for (const [x, y] of [[-90, -60], [80, -70], [70, 65], [-85, 55]]) {
+    const u = 640 + (1000 * x) / (500 - z);
+    const v = 480 - (1000 * y) / (500 - z);
+    csv += `${x},${y},${z},${u},${v}\n`;
+  }
+  return csv;
+}
+
+/** Stereo: files added side by side; returns the pairing text once it names `expect`. */
+async function stereoAdd(page, left, right, expect) {
+  const mk = (names) => names.map((n) => png(n, makePng(40, 30, checker(5))));
+  if (left.length) await page.setInputFiles('#stereo-left-input', mk(left));
+  if (right.length) await page.setInputFiles('#stereo-right-input', mk(right));
+  await page.waitForFunction((e) => (document.getElementById('stereo-pairing')?.textContent || '').includes(e), expect, { timeout: 10000 });
+  return page.textContent('#stereo-pairing');
+}
+
+const MESSAGES = {
+  empty: 'not an image: the file is empty',
+  magic: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP',
+};
+
+export const tests = [
+  // ---- step 2, images: an error card, the other images kept ----
+  ['image-empty', imageCase(png('empty.png', Buffer.alloc(0)), MESSAGES.empty)],
+  ['image-wrong-magic', imageCase(png('text.png', Buffer.from('hello, this is text\n')), MESSAGES.magic)],
+  ['image-png-signature-only', imageCase(png('sig.png', board().subarray(0, 8)), 'corrupt or truncated PNG file: unexpected end of file')],
+  ['image-gif-truncated', imageCase({ name: 't.gif', mimeType: 'image/gif', buffer: Buffer.from('GIF89a\x10\x00\x10\x00\x80\x00\x00', 'latin1') },
+    'corrupt or truncated GIF file: Format error decoding Gif: Unexpected End of File')],
+  ['image-png-huge-header', imageCase(png('huge.png', pngClaiming(100000, 100000)),
+    'PNG image too large to decode within the memory limit (536870912 bytes)')],
+  ['image-pgm-huge-header', imageCase({ name: 'huge.pgm', mimeType: 'image/x-portable-graymap', buffer: Buffer.from('P5\n20000 20000\n255\n') },
+    'image is 20000x20000 = 400.0 MP, more than the limit of 64.0 MP: downscale it first, or raise the limit (--max-pixels in the CLI, "max_pixels" in the JSON options)')],
+  ['image-bmp-truncated', imageCase({ name: 'cut.bmp', mimeType: 'image/bmp', buffer: makeBmp(40, 30, checker(5)).subarray(0, 60) },
+    'corrupt or truncated BMP file: failed to fill whole buffer')],
+  ['image-tiff-truncated', imageCase({ name: 'cut.tif', mimeType: 'image/tiff', buffer: Buffer.from([0x49, 0x49, 0x2a, 0x00, 0x08, 0x00, 0x00, 0x00, 0x0a, 0x00]) },
+    'corrupt or truncated TIFF file: failed to fill whole buffer')],
+  ['image-no-target', imageCase(png('blank.png', makePng(64, 48, () => [255, 255, 255])),
+    'PNG · 64×48 px · RGB, 8-bit · board not found: no 9x6 chessboard corners', { cls: 'card warn' })],
+
+  // ---- step 3, camera: the solve refuses, the images stay, a fix solves ----
+  ['camera-one-view', async (page, { url, shot }) => {
+    await loadDemoImages(page, url, [], 1);
+    assert.equal(await solveCamera(page), 'requires at least 3 views, got 1');
+    await shot('bad');
+    await page.click('a[data-step=images]');
+    await page.setInputFiles('#file-input', demo().images.slice(1));
+    await settled(page, 12);
+    assert.equal((await cards(page))[0].name, 'demo_00.png');
+    assert.equal(await solveCamera(page), null);
+    assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
+  }],
+  ['camera-same-image-twice', async (page, { url, shot }) => {
+    await loadDemoImages(page, url, [png('copy_of_demo_03.png', demo().images[3].buffer)]);
+    assert.equal(await solveCamera(page), 'views: views 3 (demo_03.png) and 12 (copy_of_demo_03.png) have identical image points: the same image was given twice; remove one of them');
+    await shot('bad');
+    await page.click('a[data-step=images]');
+    await page.click('input[aria-label="use copy_of_demo_03.png in the calibration"]');
+    assert.equal(await solveCamera(page), null);
+    assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
+  }],
+  ['camera-two-sizes', async (page, { url, shot }) => {
+    await loadDemoImages(page, url, [png('board.png', board())]);
+    assert.equal((await cards(page))[12].meta, BOARD_META);
+    assert.equal(await solveCamera(page), 'image_size_px: the detections disagree: 1024x768 and 312x240 (board.png): one calibration takes the images of one camera at one resolution');
+    await shot('bad');
+    await page.click('a[data-step=images]');
+    await page.click('input[aria-label="use board.png in the calibration"]');
+    assert.equal(await solveCamera(page), null);
+    assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
+  }],
+
+  // ---- step 4, robot poses: the file refused with the line, the images kept ----
+  ['poses-empty', posesCase(text('empty.csv', ''), 'the file is empty: expected one robot pose a line, one per image')],
+  ['poses-blank-lines', posesCase(text('blank.csv', '\n  \n\t\n'), 'the file is empty (only white space): expected one robot pose a line, one per image')],
+  ['poses-not-utf8', posesCase(text('latin1.csv', Buffer.from('x,y,z,qx,qy,qz,qw\n0,0,0,0,0,0,1 # d\xe9j\xe0 vu\n', 'latin1')),
+    'the file is not UTF-8 text: save it as UTF-8 (or plain ASCII) and load it again')],
+  ['poses-nan', posesCase(text('nan.csv', 'x,y,z,qx,qy,qz,qw\n0.1,NaN,0.3,0,0,0,1\n'), "line 2, column 2: 'NaN' is not a number")],
+  ['poses-inf', posesCase(text('inf.csv', 'x,y,z,qx,qy,qz,qw\n0.1,inf,0.3,0,0,0,1\n'), "line 2, column 2: 'inf' is not a number")],
+  ['poses-zero-quaternion', posesCase(text('zeroq.csv', 'x,y,z,qx,qy,qz,qw\n0.1,0.2,0.3,0,0,0,0\n'), 'line 2, column 4: quaternion has norm 0: not a rotation')],
+  ['poses-unknown-header', posesCase(text('header.csv', 'x y z\n1 2 3\n'),
+    "line 1: the header 'x y z' names no known pose format; name the format, or use column names such as x,y,z,qx,qy,qz,qw or X,Y,Z,A,B,C")],
+  ['poses-three-values', posesCase(text('three.txt', '1 2 3\n4 5 6\n'), 'line 1: 3 values, but pose formats have 6, 7 or 16 values a line')],
+  ['poses-not-a-rotation', posesCase(text('scaled.txt', '2 0 0 0.1 0 2 0 0.2 0 0 2 0.3 0 0 0 1\n'),
+    'line 1: 4x4 matrix rotation block is not orthonormal: largest |RᵀR - I| entry is 3.000e0, tolerance 1e-3')],
+  ['poses-count-mismatch', async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.setInputFiles('#file-input', [png('second.png', board({ x: 40, y: 30 }))]);
+    await settled(page, 2);
+    await page.click('a[data-step=robot]');
+    await page.setInputFiles('#pose-input', text('three.csv', GOOD_POSES));
+    await page.locator('#pose-pairing .msg-warning').waitFor({ timeout: 20000 });
+    assert.equal(await page.textContent('#pose-pairing .msg-warning'), '3 poses but 2 images: pairing by order leaves some unpaired. Check that the pose file matches the images.');
+    assert.deepEqual(await page.$$eval('#pairing-table tbody tr', (trs) => trs.map((tr) => tr.cells[3].textContent)), ['used', 'used', 'no image']);
+    await shot('bad');
+    await page.setInputFiles('#pose-input', text('two.csv', GOOD_POSES.split('\n').slice(0, 3).join('\n')));
+    await page.waitForFunction(() => /^Paired by order .*: 2 pairs usable\.$/.test(document.querySelector('#pose-pairing p').textContent), null, { timeout: 20000 });
+    assert.equal(await page.$('#pose-pairing .msg-warning'), null);
+  }],
+
+  // ---- step 5, hand-eye on the demo: the consistency checks name the mistake ----
+  ['handeye-metres-read-as-mm', handeyeCase(select('pose-length', 'mm'),
+    'robot poses: the robot translations fit the camera motion only when scaled by 999.8486: the camera poses look like millimetres while the robot poses are metres: convert the camera translations to metres (divide by 1000)',
+    select('pose-length', 'auto'))],
+  ['handeye-radians-read-as-degrees', async (page, { url, shot }) => {
+    // Not refused: the rotations, 57 times too small, are solved with a
+    // warning only (reported to the core's owner; see docs/bad-inputs-page.md).
+    await page.goto(url);
+    await ready(page);
+    await page.click('#demo-button');
+    await page.waitForFunction(() => /^Demo loaded/.test(document.getElementById('engine-status').textContent), null, { timeout: 180000 });
+    assert.equal(await solveCamera(page), null);
+    await select('pose-angle', 'deg')(page);
+    assert.equal(await page.textContent('#pose-format-used'), 'demo_poses.csv: 12 poses read as ur, lengths in m, angles in deg, the file holds base_from_gripper.');
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-errors').waitFor({ timeout: 60000 });
+    const warnings = await page.$$eval('#handeye-results .msg', (e) => e.map((x) => [x.className, x.textContent]));
+    assert.deepEqual(warnings, [['msg msg-warning', '31 of 66 motion pairs were discarded because they rotate less than 2 deg']]);
+    // ... and the result is far off (the right reading closes to 0.005 deg).
+    const rotationRms = await page.$eval('#handeye-errors', (t) => [...t.rows].find((r) => r.cells[0].textContent === 'rotation RMS').cells[1].textContent);
+    assert.ok(Number(rotationRms.replace(/ deg$/, '')) > 10, rotationRms);
+    await shot('bad');
+    await select('pose-angle', 'auto')(page);
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.waitForFunction(() => document.getElementById('handeye-errors') && !document.querySelector('#handeye-results .msg'), null, { timeout: 60000 });
+    const mended = await page.$eval('#handeye-errors', (t) => [...t.rows].find((r) => r.cells[0].textContent === 'rotation RMS').cells[1].textContent);
+    assert.ok(Number(mended.replace(/ deg$/, '')) < 0.1, mended);
+    // The camera result is kept throughout.
+    assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
+  }],
+  ['handeye-poses-inverted', handeyeCase(select('pose-direction', 'gripper_from_base'),
+    'robot poses: these poses fit eye-to-hand (the camera fixed, the target on the gripper), not the eye-in-hand chosen: as eye-to-hand they fit the camera motion with rotation RMS 0.006 deg, against 22.972 deg as eye-in-hand: choose the setup eye-to-hand, which solves base_from_camera. Inverting the poses instead would give the same numbers under the wrong frame names; do that only if the setup really is eye-in-hand and the file holds gripper_from_base',
+    select('pose-direction', 'base_from_gripper'))],
+  ['handeye-wrong-setup', handeyeCase(select('handeye-setup', 'eye-to-hand'),
+    'robot poses: these poses fit eye-in-hand (the camera on the gripper), not the eye-to-hand chosen: as eye-in-hand they fit the camera motion with rotation RMS 0.006 deg, against 22.972 deg as eye-to-hand: choose the setup eye-in-hand, which solves gripper_from_camera. Inverting the poses instead would give the same numbers under the wrong frame names; do that only if the setup really is eye-to-hand and the file holds gripper_from_base',
+    select('handeye-setup', 'eye-in-hand'))],
+  ['handeye-pairing-shifted', handeyeCase(async (page) => {
+    const [head, , ...rest] = namelessPoses();
+    await page.click('a[data-step=robot]');
+    await page.setInputFiles('#pose-input', text('shifted.csv', `${[head, ...rest].join('\n')}\n`));
+    await page.waitForFunction(() => /^shifted\.csv: 11 poses read as ur/.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    assert.equal(await page.textContent('#pose-pairing .msg-warning'), '11 poses but 12 images: pairing by order leaves some unpaired. Check that the pose file matches the images.');
+  }, 'robot poses: the pose file looks shifted by one against the images: pairing robot pose i with image i+1 fits with rotation RMS 0.007 deg, against 46.638 deg as given: remove the extra first image so that the lists pair up',
+  async (page) => {
+    // The fix the message names: without the extra first image the lists pair up.
+    await page.click('a[data-step=images]');
+    await page.click('input[aria-label="use demo_00.png in the calibration"]');
+    assert.equal(await solveCamera(page), null);
+  })],
+
+  // ---- step 7, stereo: the pairing refuses with the core's message ----
+  ['stereo-too-few-pairs', async (page, { url, shot }) => {
+    await page.goto(`${url}#stereo`);
+    await ready(page);
+    assert.equal(await stereoAdd(page, ['l1.png', 'l2.png'], ['r1.png', 'r2.png'], '2 pairs'), '2 pairs, paired by the number in the file names.');
+    assert.equal(await page.textContent('#stereo-too-few'), 'A stereo calibration needs at least 3 pairs: add 1 more pair (a left and a right image each) to solve.');
+    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    await shot('bad');
+    assert.equal(await stereoAdd(page, ['l3.png'], ['r3.png'], '3 pairs'), '3 pairs, paired by the number in the file names.');
+    assert.equal(await page.$('#stereo-too-few'), null);
+    assert.equal(await page.isDisabled('#stereo-solve'), false);
+  }],
+  ['stereo-number-twice', async (page, { url, shot }) => {
+    await page.goto(`${url}#stereo`);
+    await ready(page);
+    await stereoAdd(page, ['l1.png', 'l2.png', 'l3.png'], ['r1.png', 'r2.png', 'r3.png'], '3 pairs');
+    const error = await stereoAdd(page, ['l01.png'], [], 'cannot be paired');
+    assert.equal(error, 'The images cannot be paired: images: images are paired by the last number in their file names, but number 1 is in two left images: l1.png, l01.png');
+    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    await shot('bad');
+    // The files are kept (the message names them); removing them and loading a clean set pairs.
+    await page.click('#stereo-clear');
+    assert.equal(await stereoAdd(page, ['l1.png', 'l2.png', 'l3.png'], ['r1.png', 'r2.png', 'r3.png'], '3 pairs'), '3 pairs, paired by the number in the file names.');
+  }],
+  ['stereo-count-by-order', async (page, { url, shot }) => {
+    await page.goto(`${url}#stereo`);
+    await ready(page);
+    const error = await stereoAdd(page, ['a.png', 'b.png', 'c.png'], ['x.png', 'y.png'], 'cannot be paired');
+    assert.equal(error, 'The images cannot be paired: images: images are paired by order: 3 left but 2 right');
+    await shot('bad');
+    assert.equal(await stereoAdd(page, [], ['z.png'], '3 pairs'), '3 pairs, paired by order (sorted names).');
+    assert.equal(await page.isDisabled('#stereo-solve'), false);
+  }],
+
+  // ---- step 1, target: the field refused, the target in use kept ----
+  ['spec-zero-size', targetCase('square_mm', '0', 'target: sizes must be positive metres')],
+  ['spec-negative-size', targetCase('square_mm', '-30', 'target: sizes must be positive metres')],
+  ['spec-empty-size', targetCase('square_mm', '', 'Square size (mm): the field is empty or not a number; enter a size in millimetres, e.g. 30')],
+  // The browser cannot hold 1e400 in a number field: its value is ''.
+  ['spec-overflowing-size', targetCase('square_mm', '1e400', 'Square size (mm): the field is empty or not a number; enter a size in millimetres, e.g. 30')],
+  // 1e-400 mm is 0 as a double.
+  ['spec-underflowing-size', targetCase('square_mm', '1e-400', 'target: sizes must be positive metres')],
+  ['spec-one-column', targetCase('cols', '1', 'target: a grid needs 2 to 100000 points with at least 2 per side, got 1x6')],
+  ['spec-size-in-exponent-form (a good input the page refused)', async (page, { url }) => {
+    // "3e1" mm reached the core as null ("target JSON: invalid type: null,
+    // expected f64"): the page appended "e-3" to the text.
+    await page.goto(`${url}#target`);
+    await ready(page);
+    await page.fill('#target-form input[name=square_mm]', '3e1');
+    await page.waitForFunction(() => /^Target spec: chessboard:9x6:30mm /.test(document.getElementById('target-spec').textContent), null, { timeout: 10000 });
+    await page.fill('#target-form input[name=square_mm]', '2.5e+1');
+    await page.waitForFunction(() => /^Target spec: chessboard:9x6:25mm /.test(document.getElementById('target-spec').textContent), null, { timeout: 10000 });
+    assert.equal(await page.textContent('#target-error'), '');
+  }],
+
+  // ---- step 6, workflows: the CSV refused with line and column ----
+  ['planar-csv-empty', planarCase('', 'the file is empty: expected a CSV header line')],
+  ['planar-csv-missing-columns', planarCase('a,b\n1,2\n', 'line 1: missing column(s) height_mm, u_px, v_px, x_mm, y_mm (expected header height_mm,u_px,v_px,x_mm,y_mm, got a,b)')],
+  ['planar-csv-not-a-number', planarCase('height_mm,u_px,v_px,x_mm,y_mm\n10,abc,3,4,5\n', "line 2, column 2: u_px: expected a finite number, got 'abc'")],
+  ['planar-file-empty', planarCase({ file: text('points.csv', '') }, 'points.csv: the file is empty: expected a CSV file with the header height_mm,u_px,v_px,x_mm,y_mm')],
+  ['planar-file-not-utf8', planarCase({ file: text('points.csv', Buffer.from('height_mm,u_px,v_px,x_mm,y_mm\n10,1,2,3,4 # \xb5m\n', 'latin1')) },
+    'points.csv: the file is not UTF-8 text: save it as UTF-8 (or plain ASCII) and load it again')],
+  ['xytable-too-few-positions', async (page, { url, shot }) => {
+    await page.goto(`${url}#workflows`);
+    await ready(page);
+    await page.fill('#xytable-csv', stageCsv());
+    await page.click('#xytable-solve');
+    await page.waitForFunction(() => /^Batch least squares \(RMS /.test(document.querySelector('#xytable-results h4')?.textContent || ''), null, { timeout: 20000 });
+    await page.fill('#xytable-csv', 'x_mm,y_mm,z_mm,u_px,v_px\n1,2,3,4,5\n');
+    await page.click('#xytable-solve');
+    await page.locator('#xytable-results .msg-error').waitFor({ timeout: 20000 });
+    assert.equal(await page.textContent('#xytable-results'), 'requires at least 6 3-D/2-D point pairs, got 1');
+    await shot('bad');
+    await page.fill('#xytable-csv', stageCsv());
+    await page.click('#xytable-solve');
+    await page.waitForFunction(() => /^Batch least squares \(RMS /.test(document.querySelector('#xytable-results h4')?.textContent || ''), null, { timeout: 20000 });
+  }],
+  ['planar-csv-short-row', planarCase('height_mm,u_px,v_px,x_mm,y_mm\n10,1,2,3\n', 'line 2: expected 5 comma-separated fields like the header, got 4')],
+];
