@@ -175,10 +175,14 @@ function handeyeCase(spoil, message, mend) {
   };
 }
 
+/** Choose `value` in the select `id` (step 4's reading of the pose file, or step 5's setup); a new reading is waited for. */
 const select = (id, value) => async (page) => {
-  await page.click(`a[data-step=${id.startsWith('handeye') ? 'handeye' : 'robot'}]`);
+  const handeye = id.startsWith('handeye');
+  await page.click(`a[data-step=${handeye ? 'handeye' : 'robot'}]`);
+  const before = handeye ? null : await page.textContent('#pose-format-used');
   await page.selectOption(`#${id}`, value);
-  if (!id.startsWith('handeye')) await page.waitForFunction(() => !document.querySelector('#pose-results .msg-error') && document.getElementById('pose-format-used'), null, { timeout: 20000 });
+  // The poses are read again in the worker: wait for the line that says how.
+  if (!handeye) await page.waitForFunction((b) => !document.querySelector('#pose-results .msg-error') && document.getElementById('pose-format-used')?.textContent !== b, before, { timeout: 20000 });
 };
 
 /** Target form: a good target, board.png detected with it, then a bad field value refused; the target in use and the detection kept. */
@@ -422,7 +426,8 @@ export const tests = [
   ['stereo-count-by-order', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);
     await ready(page);
-    const error = await stereoAdd(page, ['a.png', 'b.png', 'c.png'], ['x.png', 'y.png'], 'cannot be paired');
+    // (After the left files alone the page already shows '3 left but 0 right'.)
+    const error = await stereoAdd(page, ['a.png', 'b.png', 'c.png'], ['x.png', 'y.png'], '3 left but 2 right');
     assert.equal(error, 'The images cannot be paired: images: images are paired by order: 3 left but 2 right');
     await shot('bad');
     assert.equal(await stereoAdd(page, [], ['z.png'], '3 pairs'), '3 pairs, paired by order (sorted names).');
