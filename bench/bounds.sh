@@ -1,32 +1,95 @@
 #!/usr/bin/env bash
-# Bounded time and memory of decode + detect (issue 17 §2): times the release
-# CLI on blank and noise images up to 50 MP, median of RUNS runs, with peak RSS
-# (GNU time %M). Usage: bench/bounds.sh [CLI] (default target/release/robocal).
-# Prints a markdown table. Not a test: the machine is shared and noisy.
+# Bounded time and memory (issue 17 §2): times the release CLI, median of RUNS
+# runs, with peak RSS (GNU time %M), on
+#  - blank and noise images of 4, 50 and 99 MP (the native pixel limit is 100
+#    MP) for every target kind;
+#  - progressive JPEGs with 5,000 and 50,000 scans (bench/progressive_jpeg.py,
+#    needs bench/.venv: created on first use);
+#  - camera calibrations of 100 to 10,000 views (detections JSON of a 9x6
+#    board, random poses), and the refusal above calib::json_api::MAX_VIEWS.
+# Usage: bench/bounds.sh [CLI] (default target/release/robocal). Prints
+# markdown tables. Not a test: the machine is shared and noisy.
 set -euo pipefail
-CLI=${1:-target/release/robocal}
+CLI=$(realpath "${1:-target/release/robocal}")
 RUNS=${RUNS:-3}
+HERE=$(dirname "$(realpath "$0")")
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+
+# time_row LABEL COMMAND...: one table row, the median time and the peak RSS.
+time_row() {
+  local label=$1; shift
+  local times=() rss=0 out r
+  for _ in $(seq "$RUNS"); do
+    /usr/bin/time -o "$dir/t" -f "%e %M" "$@" >/dev/null 2>&1 || true
+    out=$(tail -1 "$dir/t")
+    times+=("${out% *}"); r=${out#* }; (( r > rss )) && rss=$r
+  done
+  local med
+  med=$(printf '%s\n' "${times[@]}" | sort -g | sed -n "$(( (RUNS + 1) / 2 ))p")
+  echo "$label | $med | $((rss / 1024)) |"
+}
+
 python3 - "$dir" <<'P'
 import os, sys
 d = sys.argv[1]
 for name, side, noise in [("blank-4mp", 2000, False), ("noise-4mp", 2000, True),
-                          ("blank-50mp", 7072, False), ("noise-50mp", 7072, True)]:
+                          ("blank-50mp", 7072, False), ("noise-50mp", 7072, True),
+                          ("blank-99mp", 9950, False), ("noise-99mp", 9950, True)]:
     px = os.urandom(side * side) if noise else b"\x80" * (side * side)
     open(f"{d}/{name}.pgm", "wb").write(b"P5 %d %d 255\n" % (side, side) + px)
 P
+
+echo "## Images"
+echo
 echo "| image | command | median s | peak RSS MB |"
 echo "|---|---|---|---|"
-for img in blank-4mp noise-4mp blank-50mp noise-50mp; do
-  for cmd in "info" "detect --target chessboard:9x6:30mm -o /dev/null" "detect --target circles:4x11:20mm:asymmetric -o /dev/null"; do
-    times=(); rss=0
-    for _ in $(seq "$RUNS"); do
-      /usr/bin/time -o "$dir/t" -f "%e %M" $CLI $cmd "$dir/$img.pgm" >/dev/null 2>&1 || true
-      out=$(tail -1 "$dir/t")
-      times+=("${out% *}"); r=${out#* }; (( r > rss )) && rss=$r
-    done
-    med=$(printf '%s\n' "${times[@]}" | sort -g | sed -n "$(( (RUNS + 1) / 2 ))p")
-    echo "| $img | ${cmd%% -o*} | $med | $((rss / 1024)) |"
+targets=("chessboard:9x6:30mm" "circles:4x11:20mm:asymmetric" "dots:7x7:25mm" "squares:8x8:12.7mm:22.5778mm" "circle:10mm")
+for img in blank-4mp noise-4mp blank-50mp noise-50mp blank-99mp noise-99mp; do
+  time_row "| $img | info" "$CLI" info "$dir/$img.pgm"
+  for t in "${targets[@]}"; do
+    time_row "| $img | detect --target $t" "$CLI" detect --target "$t" -o /dev/null "$dir/$img.pgm"
   done
 done
+(cd "$HERE" && python3 progressive_jpeg.py "$dir/prog-5k.jpg" 4000 5000 >&2 && python3 progressive_jpeg.py "$dir/prog-50k.jpg" 4000 50000 >&2 \
+  && python3 progressive_jpeg.py "$dir/prog-99mp-5k.jpg" 9900 5000 >&2)
+for img in prog-5k prog-50k prog-99mp-5k; do
+  time_row "| $img.jpg | detect --target chessboard:9x6:30mm" "$CLI" detect --target chessboard:9x6:30mm -o /dev/null "$dir/$img.jpg"
+done
+
+echo
+echo "## Camera calibration (robocal intrinsics --detections, 9x6 board, Brown model)"
+echo
+echo "| views | median s | peak RSS MB |"
+echo "|---|---|---|"
+for n in 100 1000 5000 10000 100000; do
+  python3 - "$dir/d$n.json" "$n" <<'P'
+import json, math, random, sys
+out, n = sys.argv[1], int(sys.argv[2])
+random.seed(n)
+f, cx, cy, W, H = 900.0, 639.5, 479.5, 1280, 960
+def rot(a, b, c):
+    ca, sa, cb, sb, cc, sc = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c)
+    return [[cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa],
+            [sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa],
+            [-sb, cb * sa, cb * ca]]
+images = []
+while len(images) < n:
+    R = rot(random.uniform(-.6, .6), random.uniform(-.6, .6), random.uniform(-.3, .3))
+    t = [random.uniform(-.15, .05), random.uniform(-.1, .02), random.uniform(.45, .7)]
+    pts = []
+    for j in range(6):
+        for i in range(9):
+            X = (i * 0.03, j * 0.03, 0.0)
+            P = [sum(R[a][b] * X[b] for b in range(3)) + t[a] for a in range(3)]
+            pts.append({"id": i + 9 * j, "x_px": f * P[0] / P[2] + cx + random.gauss(0, 0.1),
+                        "y_px": f * P[1] / P[2] + cy + random.gauss(0, 0.1)})
+    if all(0 <= p["x_px"] < W - 1 and 0 <= p["y_px"] < H - 1 for p in pts):
+        images.append({"file": f"v{len(images)}.png", "detection": {"image_size_px": [W, H],
+            "target": {"kind": "chessboard", "cols": 9, "rows": 6, "square_m": 0.03}, "points": pts}})
+json.dump({"images": images}, open(out, "w"))
+P
+  time_row "| $n" "$CLI" intrinsics --detections "$dir/d$n.json" -o /dev/null
+done
+echo
+echo "100000 views: $("$CLI" intrinsics --detections "$dir/d100000.json" -o /dev/null 2>&1 | tail -1)"

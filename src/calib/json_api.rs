@@ -36,6 +36,48 @@ use serde::{Deserialize, Serialize};
 /// Fewest views the JSON API accepts (Zhang's closed form with free skew
 /// needs 3; fewer views leave the focal length poorly determined anyway).
 pub const MIN_VIEWS: usize = 3;
+/// Most views (or stereo pairs) one calibration takes: time and memory grow
+/// linearly, 10,000 views of 54 points took 19 s and 560 MB natively
+/// (docs/bounds.md); a browser worker has at most 4 GiB.
+pub const MAX_VIEWS: usize = 5000;
+/// Most target points over all views of one calibration (memory, as above).
+pub const MAX_POINTS: usize = 500_000;
+
+/// Refuse more views or points than [`MAX_VIEWS`] / [`MAX_POINTS`], with the
+/// subset to keep. `what` is "views" or "pairs".
+pub fn check_size(what: &str, views: &[JsonView]) -> Result<()> {
+    let n = views.len();
+    if n > MAX_VIEWS {
+        return Err(Error::invalid(
+            what,
+            format!(
+                "{n} {what}: at most {MAX_VIEWS} are supported in one calibration; keep a subset \
+                 that covers the image and the angles, e.g. one in every {}",
+                n.div_ceil(MAX_VIEWS)
+            ),
+        ));
+    }
+    let points: usize = views
+        .iter()
+        .map(|v| {
+            v.detection
+                .as_ref()
+                .map(|d| d.points.len())
+                .or(v.image_px.as_ref().map(Vec::len))
+                .unwrap_or(0)
+        })
+        .sum();
+    if points > MAX_POINTS {
+        return Err(Error::invalid(
+            what,
+            format!(
+                "{points} target points in {n} {what}: at most {MAX_POINTS} are supported in one \
+                 calibration; use fewer {what} or a target with fewer points"
+            ),
+        ));
+    }
+    Ok(())
+}
 /// Huber threshold of the robust option, px.
 pub const ROBUST_HUBER_PX: f64 = 1.0;
 /// Outlier threshold of the robust option, robust sigmas.
@@ -141,6 +183,7 @@ pub fn calibrate_json(input_json: &str) -> Result<String> {
 /// [`calibrate_json`] on the parsed input.
 pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     // 1. The views and the image size.
+    check_size("views", &input.views)?;
     let views = views_of(&input.views)?;
     if views.len() < MIN_VIEWS {
         return Err(Error::invalid(

@@ -1,7 +1,7 @@
 //! Tests of the calibration JSON API: the contract the web app codes
 //! against (keys, errors), on seeded synthetic scenes.
 
-use super::json_api::calibrate_json;
+use super::json_api::{calibrate_json, MAX_POINTS, MAX_VIEWS};
 use crate::camera::Camera;
 use crate::synth::Scene;
 use crate::target::{DetectedPoint, Detection, Target};
@@ -252,5 +252,36 @@ fn dlt_on_a_3d_rig_is_exact_and_refused_on_planar_views() {
     assert!(
         (rows[2]["fx"].as_f64().expect("fx") - 1000.0).abs() < 20.0,
         "px"
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn too_many_views_or_points_are_refused_with_the_subset_to_keep() {
+    let s = scene(0.0);
+    let views = point_views(&s).as_array().expect("views").clone();
+    let many: Vec<_> = views.iter().cycle().take(MAX_VIEWS + 1).cloned().collect();
+    assert_eq!(
+        error(json!({"views": many, "image_size_px": [1280, 960]})),
+        "views: 5001 views: at most 5000 are supported in one calibration; keep a subset that \
+         covers the image and the angles, e.g. one in every 2"
+    );
+    // Fewer views, but more points than MAX_POINTS in all: each view's
+    // points four times over (refused before they are looked at).
+    let mut big = views[0].clone();
+    for key in ["object_m", "image_px"] {
+        let list = big[key].as_array().expect("points").clone();
+        big[key] = json!([list.clone(), list.clone(), list.clone(), list].concat());
+    }
+    let per_view = big["object_m"].as_array().expect("object_m").len();
+    let n = MAX_POINTS / per_view + 1;
+    assert!(n < MAX_VIEWS);
+    let heavy = vec![big; n];
+    assert_eq!(
+        error(json!({"views": heavy, "image_size_px": [1280, 960]})),
+        format!(
+            "views: {} target points in {n} views: at most 500000 are supported in one \
+             calibration; use fewer views or a target with fewer points",
+            n * per_view
+        )
     );
 }

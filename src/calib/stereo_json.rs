@@ -23,7 +23,9 @@
 //! `right_from_left`, `initial_right_from_left`, `baseline_m`,
 //! `right_from_left_std`, `rms_px`, ...), the report `robocal stereo` writes.
 
-use super::json_api::{calibration_options, views_of, JsonOptions, JsonView, MIN_VIEWS};
+use super::json_api::{
+    calibration_options, check_size, views_of, JsonOptions, JsonView, MIN_VIEWS,
+};
 use super::stereo::{calibrate_stereo, StereoCalibration};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -79,6 +81,8 @@ pub fn calibrate_stereo_input(input: &StereoInput) -> Result<StereoCalibration> 
     if input.left.len() < MIN_VIEWS {
         return Err(Error::too_few("pairs", MIN_VIEWS, input.left.len()));
     }
+    check_size("pairs", &input.left)?;
+    check_size("pairs", &input.right)?;
     let left_size = side_size("left", &input.left, input.left_image_size_px)?;
     let right_size = side_size("right", &input.right, input.right_image_size_px)?;
     let left = views_of(&input.left).map_err(|e| within("left", e))?;
