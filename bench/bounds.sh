@@ -93,3 +93,30 @@ P
 done
 echo
 echo "100000 views: $("$CLI" intrinsics --detections "$dir/d100000.json" -o /dev/null 2>&1 | tail -1)"
+
+echo
+echo "## Workflows (seed 001 planar solve, seed 003 XY table)"
+echo
+echo "| command | points | median s | peak RSS MB |"
+echo "|---|---|---|---|"
+for n in 10000 100000; do
+  python3 - "$dir" "$n" <<'P'
+import random, sys
+d, n = sys.argv[1], int(sys.argv[2])
+random.seed(n)
+with open(f"{d}/planar{n}.csv", "w") as f:
+    f.write("height_mm,u_px,v_px,x_mm,y_mm\n")
+    for _ in range(n):
+        x, y, h = random.uniform(0, 500), random.uniform(0, 400), random.choice([0, 50])
+        f.write(f"{h},{2 * x + random.gauss(0, .1)},{2 * y + random.gauss(0, .1)},{x},{y}\n")
+with open(f"{d}/xy{n}.csv", "w") as f:
+    f.write("x_mm,y_mm,z_mm,u_px,v_px\n")
+    for _ in range(n):
+        x, y, z = random.uniform(-200, 200), random.uniform(-150, 150), random.uniform(0, 100)
+        f.write(f"{x},{y},{z},{800 * x / (1000 + z) + 640 + random.gauss(0, .1)},{800 * y / (1000 + z) + 480 + random.gauss(0, .1)}\n")
+P
+  time_row "| planar solve | $n" "$CLI" planar solve "$dir/planar$n.csv" -o /dev/null
+  time_row "| xytable | $n" "$CLI" xytable "$dir/xy$n.csv" -o /dev/null
+done
+echo
+echo "xytable, 100000 positions: $("$CLI" xytable "$dir/xy100000.csv" -o /dev/null 2>&1 | tail -1)"

@@ -22,6 +22,12 @@ use crate::geometry::Pose;
 use nalgebra::{Matrix2, Matrix3x4, Matrix4, Point2, Point3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+/// Most stage positions one XY-table calibration takes. The Kalman history
+/// reports the RMS over all positions after every update, which grows with
+/// the square of the count: 10,000 positions take 0.3 s, 100,000 took 30 s
+/// (docs/bounds.md). Seed 003's tables have tens of positions.
+pub const MAX_POSITIONS: usize = 10_000;
+
 /// One stage position and the target's image centre there.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StageObservation {
@@ -127,6 +133,17 @@ pub struct XyTableReport {
 
 /// Solve both methods and the verification point.
 pub fn solve_xytable(request: &XyTableRequest) -> Result<XyTableReport> {
+    let n = request.observations.len();
+    if n > MAX_POSITIONS {
+        return Err(Error::invalid(
+            "positions",
+            format!(
+                "{n} stage positions: at most {MAX_POSITIONS} are supported; keep a subset spread \
+                 over the stage's volume, e.g. one in every {}",
+                n.div_ceil(MAX_POSITIONS)
+            ),
+        ));
+    }
     // 1. World points in metres inside, pixels as given.
     let world: Vec<Point3<f64>> = request
         .observations

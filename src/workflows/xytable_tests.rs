@@ -131,4 +131,13 @@ fn bad_input_is_refused_clearly() {
         solve_xytable(&req).unwrap_err().to_string(),
         "the stage diagonals AC and BD are parallel: give A, B, C, D in order around the quadrilateral"
     );
+    // More positions than the bound: refused before any solving.
+    let mut req = request(&mut || 0.0);
+    let one = req.observations[0].clone();
+    req.observations = vec![one; MAX_POSITIONS + 1];
+    assert_eq!(
+        solve_xytable(&req).unwrap_err().to_string(),
+        "positions: 10001 stage positions: at most 10000 are supported; keep a subset spread \
+         over the stage's volume, e.g. one in every 2"
+    );
 }
