@@ -9,7 +9,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, readdirSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { crc32 } from 'node:zlib';
+import { crc32, deflateRawSync } from 'node:zlib';
 import { root } from './harness.mjs';
 import { makePng, makeBmp, checker } from '../support/images.mjs';
 
@@ -255,6 +255,30 @@ function stageCsv() {
   return csv;
 }
 
+/**
+ * A share link whose fragment is `fragment`: the page says what is wrong in
+ * its banner, and the user's own session (board.png) is untouched.
+ */
+function shareCase(fragment, message) {
+  return async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.waitForTimeout(500); // the store saves the session 300 ms after the last change (as in pages.mjs)
+    await page.goto(`${url}#share=${fragment}`);
+    await page.reload(); // a new fragment alone does not reload the page
+    await page.locator('#readonly-banner:not([hidden])').waitFor({ timeout: 30000 });
+    await page.waitForFunction(() => !/^You are viewing shared results/.test(document.getElementById('readonly-banner').textContent), null, { timeout: 10000 });
+    assert.equal(await page.textContent('#readonly-banner'), `${message}. Start your own session at /.`);
+    await shot('bad');
+    await page.goto(url);
+    await page.reload();
+    await ready(page);
+    await page.click('a[data-step=images]');
+    await settled(page, 1);
+    assert.deepEqual((await cards(page)).map((c) => [c.name, c.meta]), [['board.png', BOARD_META]]);
+  };
+}
+const shareText = (bytes) => deflateRawSync(Buffer.from(bytes)).toString('base64url');
+
 /** Stereo: files added side by side; returns the pairing text once it names `expect`. */
 async function stereoAdd(page, left, right, expect) {
   const mk = (names) => names.map((n) => png(n, makePng(40, 30, checker(5))));
@@ -398,6 +422,40 @@ export const tests = [
     await page.click('input[aria-label="use demo_00.png in the calibration"]');
     assert.equal(await solveCamera(page), null);
   })],
+
+  ['handeye-before-camera', async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-results .msg-error').waitFor({ timeout: 10000 });
+    assert.equal(await page.textContent('#handeye-results'), 'solve the camera first (step 3): hand-eye uses the target pose of every view');
+    await shot('bad');
+    assert.deepEqual((await cards(page)).map((c) => c.meta), [BOARD_META]);
+  }],
+  ['handeye-without-poses', async (page, { url, shot }) => {
+    await loadDemoImages(page, url);
+    assert.equal(await solveCamera(page), null);
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-results .msg-error').waitFor({ timeout: 10000 });
+    assert.equal(await page.textContent('#handeye-results'), 'load the robot poses first (step 4)');
+    await shot('bad');
+    await page.click('a[data-step=robot]');
+    await page.setInputFiles('#pose-input', text('poses.csv', demo().poses));
+    await page.waitForFunction(() => /^poses\.csv: 12 poses read as ur/.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-errors').waitFor({ timeout: 60000 });
+    assert.equal(await page.$('#handeye-results .msg-error'), null);
+    assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
+  }],
+
+  // ---- a share link (#share=...): the banner says what is wrong, the own session is kept ----
+  ['share-link-damaged', shareCase(shareText(JSON.stringify({ kind: 'robocal-share', schema: 1 })).slice(0, 12),
+    'this share link is damaged (it may have been cut off when it was copied)')],
+  ['share-link-not-robocal', shareCase(shareText(JSON.stringify({ hello: 1 })), 'this link does not hold robocal results')],
+  ['share-link-not-json', shareCase(shareText('not json'), 'this link does not hold robocal results (its content is not JSON)')],
+  ['share-link-null', shareCase(shareText('null'), 'this link does not hold robocal results')],
 
   // ---- step 7, stereo: the pairing refuses with the core's message ----
   ['stereo-too-few-pairs', async (page, { url, shot }) => {

@@ -36,8 +36,14 @@ export async function decodeShare(text) {
   } catch (e) {
     throw new Error('this share link is damaged (it may have been cut off when it was copied)');
   }
-  const payload = JSON.parse(new TextDecoder().decode(bytes));
-  if (payload.kind !== 'robocal-share' || payload.schema !== 1) throw new Error('this link does not hold robocal results');
+  let payload;
+  try {
+    payload = JSON.parse(new TextDecoder().decode(bytes));
+  } catch (e) {
+    // It decompresses, but to no JSON (JSON.parse's own words name a token, not the link).
+    throw new Error('this link does not hold robocal results (its content is not JSON)');
+  }
+  if (!payload || payload.kind !== 'robocal-share' || payload.schema !== 1) throw new Error('this link does not hold robocal results');
   return payload;
 }
 
