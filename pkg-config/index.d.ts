@@ -397,8 +397,10 @@ export interface ComparisonRow {
 export interface CalibrationOutput {
   /** The report of the chosen method (Zhang's for `all`). */
   report: CameraCalibration;
-  /** With method `all`: one row per method; otherwise null. */
+  /** With method `all`: one row per method that applies; otherwise null. */
   comparison: ComparisonRow[] | null;
+  /** With method `all`: why methods were left out of `comparison` (the DLT when every view is a flat board); absent when none was. */
+  comparison_note?: string;
 }
 
 /** The input JSON of `calibrate_stereo`: `left[i]` and `right[i]` saw the same board pose. */

@@ -177,17 +177,48 @@ impl ComparisonRow {
     }
 }
 
-/// Run every method on the same views: each method's outcome, in the order
-/// of [`Method::ALL`].
+/// Run every method that applies to the views: each one's outcome, in the
+/// order of [`Method::ALL`]. The DLT is left out when every view is a flat
+/// board (see [`left_out`]).
 pub fn compare_methods(
     views: &[View],
     image_size_px: (u32, u32),
     options: &CalibrationOptions,
 ) -> Vec<(Method, Result<CameraCalibration>)> {
+    let flat = all_views_planar(views);
     Method::ALL
         .into_iter()
+        .filter(|m| !(flat && *m == Method::Dlt))
         .map(|m| (m, calibrate_with(m, views, image_size_px, options)))
         .collect()
+}
+
+/// Why [`compare_methods`] leaves methods out, said once for the whole
+/// table: `None` when every method ran.
+pub fn left_out(views: &[View]) -> Option<String> {
+    all_views_planar(views).then(|| {
+        "dlt left out: the 12-parameter DLT needs target points off one plane (a 3-D target \
+         or XY-table positions), and every view here is a flat board"
+            .to_string()
+    })
+}
+
+/// Whether the target points of every view lie in one plane: the smallest
+/// eigenvalue of their scatter is at most 1e-12 of the largest.
+pub fn all_views_planar(views: &[View]) -> bool {
+    views.iter().all(|v| {
+        let n = v.object_m.len().max(1) as f64;
+        let mean = v
+            .object_m
+            .iter()
+            .fold(nalgebra::Vector3::zeros(), |a, p| a + p.coords)
+            / n;
+        let scatter = v.object_m.iter().fold(Matrix3::zeros(), |a, p| {
+            a + (p.coords - mean) * (p.coords - mean).transpose()
+        });
+        let eig = scatter.symmetric_eigenvalues();
+        eig.min() <= 1e-12 * eig.max().max(f64::MIN_POSITIVE)
+    })
 }
 
 /// Sample standard deviations of the u and v residuals of the points used

@@ -168,6 +168,10 @@ pub struct CalibrationOutput {
     pub report: CameraCalibration,
     /// With method `all`: every method's row; otherwise `None` (JSON null).
     pub comparison: Option<Vec<ComparisonRow>>,
+    /// With method `all`: why methods were left out of `comparison` (the
+    /// DLT on flat boards), said once; absent when none was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub comparison_note: Option<String>,
 }
 
 /// Calibrate from the JSON input described in the module docs; returns the
@@ -217,6 +221,7 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
         return Ok(CalibrationOutput {
             report,
             comparison: Some(comparison),
+            comparison_note: super::compare::left_out(&views),
         });
     }
     let method = Method::from_name(&input.method)?;
@@ -226,6 +231,7 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     Ok(CalibrationOutput {
         report,
         comparison: None,
+        comparison_note: None,
     })
 }
 

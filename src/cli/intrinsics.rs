@@ -152,6 +152,9 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
     if let Some(rows) = &output.comparison {
         eprint!("{}", comparison_table(rows));
     }
+    if let Some(note) = &output.comparison_note {
+        eprintln!("robocal intrinsics: {note}");
+    }
     let r = &output.report;
     eprintln!(
         "robocal intrinsics: {} views, {} points, rms {:.4} px, fx {:.3} fy {:.3} cx {:.3} cy {:.3}",

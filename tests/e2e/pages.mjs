@@ -129,6 +129,14 @@ export const tests = [
     assert.ok(diff > 2, `undistortion changed nothing (mean difference ${diff})`);
     await page.locator('#undistort-after').scrollIntoViewIfNeeded();
     await shot('undistorted');
+    // All methods side by side on the demo's flat board: the DLT cannot apply
+    // and is left out, with the core's note said once under the table.
+    await page.selectOption('#camera-method', 'all');
+    await page.click('#solve-camera');
+    await page.locator('#camera-methods-note').waitFor({ timeout: 120000 });
+    const methods = await page.$$eval('#camera-methods tbody tr', (trs) => trs.map((tr) => tr.cells[0].textContent));
+    assert.deepEqual(methods, ['zhang', 'tsai', 'ekf']);
+    assert.equal(await page.textContent('#camera-methods-note'), 'dlt left out: the 12-parameter DLT needs target points off one plane (a 3-D target or XY-table positions), and every view here is a flat board');
   }],
   ['robot page: the convention check names the right reading', async (page, { url, shot }) => {
     // The demo's poses (UR: metres, rotation vectors), rewritten as a bare

@@ -72,7 +72,7 @@ export class CameraView {
     if (this.readonly) fill($('camera-panel'), this.out);
     else fill($('camera-panel'), form, this.out);
     this.summarise();
-    if (st.result) this.show(st.result, st.comparison);
+    if (st.result) this.show(st.result, st.comparison, st.comparisonNote);
   }
 
   readForm(form) {
@@ -107,14 +107,15 @@ export class CameraView {
       const result = await this.engine.call('calibrate', { input: JSON.stringify(input) });
       st.result = result.report || result;
       st.comparison = result.comparison || null;
+      st.comparisonNote = result.comparison_note || null; // e.g. why the DLT was left out
       this.store.changed('camera-result');
-      this.show(st.result, st.comparison);
+      this.show(st.result, st.comparison, st.comparisonNote);
     } catch (err) {
       fill(this.out, message('error', err.message));
     }
   }
 
-  show(r, comparison) {
+  show(r, comparison, comparisonNote) {
     const names = ['fx', 'fy', 'cx', 'cy', 'skew', ...Object.keys(r.distortion || {})];
     const k = r.camera_matrix.flat();
     const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
@@ -154,7 +155,7 @@ export class CameraView {
       h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat)),
       h('div', { class: 'plots' }, vec, unc, dist),
       this.undistortSection(r),
-      comparison ? this.comparisonTable(comparison) : null,
+      comparison ? this.comparisonTable(comparison, comparisonNote) : null,
       r.correlation && r.correlation.matrix ? this.correlationNote(r.correlation) : null);
   }
 
@@ -201,11 +202,13 @@ export class CameraView {
     }
   }
 
-  comparisonTable(methods) {
+  /** The `method: "all"` rows, and the core's note on methods it left out (said once). */
+  comparisonTable(methods, note) {
     return h('div', {}, h('h3', {}, 'Methods side by side'),
       table(['method', 'fx', 'fy', 'cx', 'cy', 'k1', 'std u (px)', 'std v (px)', 'RMS (px)'],
         methods.map((m) => [m.method, num(m.fx, 3), num(m.fy, 3), num(m.cx, 3), num(m.cy, 3), num(m.k1, 5),
-          num(m.std_u_px, 4), num(m.std_v_px, 4), m.error ? m.error : num(m.rms_px, 4)]), { id: 'camera-methods' }));
+          num(m.std_u_px, 4), num(m.std_v_px, 4), m.error ? m.error : num(m.rms_px, 4)]), { id: 'camera-methods' }),
+      note ? h('p', { id: 'camera-methods-note', class: 'note' }, note) : null);
   }
 
   correlationNote({ names, matrix }) {
