@@ -81,7 +81,8 @@ fn image_row(name: &str, setup: Vec<Vec<String>>, args: &[&str], message: &str) 
         code: if args[0] == "stereo" { 2 } else { 1 },
         stream: Stream::Stderr,
         message: message.into(),
-        last_line: true,
+        // detect names each image's problem first, then sums up.
+        last_line: args[0] != "detect",
     }
 }
 
@@ -158,6 +159,12 @@ fn image_rows() -> Vec<Row> {
             vec![render("a", "3", &["--target", "circles:4x11:20mm:asymmetric"])],
             &["intrinsics", "--target", target, "a/view_000.png", "a/view_001.png", "a/view_002.png"],
             "robocal: views: 0 views with the target found, a calibration needs at least 3 (10 or more from varied angles are recommended): add images in which the whole target is found, or check the target's size (inner corners for a chessboard)",
+        ),
+        image_row(
+            "detect-squares-counted-not-corners",
+            vec![render("a", "2", &[])],
+            &["detect", "--target", "chessboard:10x7:30mm", "a/view_001.png"],
+            "robocal detect: a/view_001.png: found 9x6 inner corners, not the 10x7 of the target: the spec counts inner corners (a board of 10x7 squares has 9x6): use chessboard:9x6:SIZE",
         ),
         image_row(
             "stereo-names-do-not-pair",

@@ -355,6 +355,15 @@ fn partial_message(
             }
         }
     }
+    // A whole grid one corner short each way: the spec counted squares.
+    let (c, r) = (cols.saturating_sub(1), rows.saturating_sub(1));
+    let whole = found == span_a * span_b;
+    if sides.is_empty() && whole && ((span_a, span_b) == (c, r) || (span_a, span_b) == (r, c)) {
+        return format!(
+            "found {c}x{r} inner corners, not the {cols}x{rows} of the target: the spec counts \
+             inner corners (a board of {cols}x{rows} squares has {c}x{r}): use chessboard:{c}x{r}:SIZE"
+        );
+    }
     if sides.is_empty() {
         format!("found {found} of {n} corners: the board may be partly occluded, blurred or unevenly lit")
     } else {
