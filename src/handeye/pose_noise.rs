@@ -43,6 +43,9 @@ pub const MIN_POSES_FOR_NOISE_ESTIMATE: usize = 8;
 /// finite on noise-free data.
 const VARIANCE_FLOOR: f64 = 1e-24;
 
+/// Median of chi-squared with 6 degrees of freedom.
+const CHI2_6_MEDIAN: f64 = 5.348;
+
 /// Noise levels (standard deviations) of the robot and camera poses.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NoiseLevels {
@@ -157,6 +160,30 @@ impl NoiseModel {
             .iter()
             .zip(&self.variances)
             .fold(Matrix6::zeros(), |acc, (m, s)| acc + m * *s)
+    }
+
+    /// Scale every level by one factor so that the median squared whitened
+    /// norm `norms2` matches chi-squared(6)'s median (5.348): a robust first
+    /// step when the current levels are far off (then every view looks like
+    /// an outlier and none would take part in [`NoiseModel::update`]).
+    pub fn rescale_to_median(&mut self, norms2: &[f64]) {
+        if norms2.is_empty() {
+            return;
+        }
+        let mut sorted = norms2.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let n = sorted.len();
+        let median = if n % 2 == 1 {
+            sorted[n / 2]
+        } else {
+            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+        };
+        let f = median / CHI2_6_MEDIAN;
+        if f.is_finite() && f > 0.0 {
+            for v in &mut self.variances {
+                *v = (*v * f).max(VARIANCE_FLOOR);
+            }
+        }
     }
 
     /// Re-estimate the levels from residuals at a solution: `lins` per

@@ -206,6 +206,33 @@ fn translation_basis(axis: Option<Vector3<f64>>) -> Matrix3<f64> {
     Matrix3::from_columns(&[u, v, k])
 }
 
+/// One re-estimation of the levels at `(x, y)`: when fewer than half the
+/// views are inliers under the current levels (they are far off, e.g. the
+/// defaults on a noisier robot), first one robust common scale from the
+/// median whitened norm; then the variance-component update over inliers.
+#[allow(clippy::too_many_arguments)]
+fn noise_round(
+    setup: Setup,
+    views: &[PoseMeasurement],
+    noise: &mut NoiseModel,
+    x: &Pose,
+    y: &Pose,
+    lins: &[ViewLinearisation],
+    basis: &Matrix3<f64>,
+    held: bool,
+) -> Result<()> {
+    let (mut norms, _) = evaluate(setup, views, noise, x, y)?;
+    if norms.iter().filter(|n| **n <= HUBER_SCALE).count() * 2 < views.len() {
+        noise.rescale_to_median(&norms.iter().map(|n| n * n).collect::<Vec<_>>());
+        norms = evaluate(setup, views, noise, x, y)?.0;
+    }
+    let inlier: Vec<bool> = norms.iter().map(|n| *n <= HUBER_SCALE).collect();
+    let cov = parameter_covariance(lins, noise, basis, held)
+        .ok_or_else(|| Error::degenerate("the pose refinement's information matrix is singular"))?;
+    noise.update(lins, &inlier, &cov);
+    Ok(())
+}
+
 /// One noise re-estimation at a fixed `(x, y)` (e.g. a closed form), so
 /// that closed forms can be compared under levels fitted to the data.
 pub fn estimate_noise(
@@ -221,12 +248,7 @@ pub fn estimate_noise(
     // Twice: the first pass moves the levels from the defaults to the data,
     // the second judges inliers with those levels.
     for _ in 0..2 {
-        let (norms, _) = evaluate(setup, views, noise, x, y)?;
-        let inlier: Vec<bool> = norms.iter().map(|n| *n <= HUBER_SCALE).collect();
-        let cov = parameter_covariance(&lins, noise, &basis, axis.is_some()).ok_or_else(|| {
-            Error::degenerate("the pose refinement's information matrix is singular")
-        })?;
-        noise.update(&lins, &inlier, &cov);
+        noise_round(setup, views, noise, x, y, &lins, &basis, axis.is_some())?;
     }
     Ok(())
 }
@@ -262,13 +284,8 @@ pub fn refine(
     for _ in 0..NOISE_ROUNDS {
         // Noise levels at the current solution, then a solve with them.
         let lins = lin_all(&x, &y);
-        let (norms, _) = evaluate(setup, views, &noise, &x, &y)?;
-        let inlier: Vec<bool> = norms.iter().map(|n| *n <= HUBER_SCALE).collect();
-        let cov = parameter_covariance(&lins, &noise, &basis, held).ok_or_else(|| {
-            Error::degenerate("the pose refinement's information matrix is singular")
-        })?;
         let before = noise.variances.clone();
-        noise.update(&lins, &inlier, &cov);
+        noise_round(setup, views, &mut noise, &x, &y, &lins, &basis, held)?;
         let whiten = lins
             .iter()
             .enumerate()
