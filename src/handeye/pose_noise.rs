@@ -20,7 +20,8 @@
 //! is what the weighting needs.
 
 use super::pose_residual::ViewLinearisation;
-use nalgebra::{Matrix6, SMatrix};
+use super::math::skew;
+use nalgebra::{Matrix6, SMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// How the camera pose noise is modelled.
@@ -92,6 +93,14 @@ pub struct NoiseModel {
     /// `[robot rot, robot trans, camera...]`: 8 values (diagonal) or 3
     /// (per-view scale), in rad^2 and m^2.
     pub variances: Vec<f64>,
+    /// Diagonal model only: per view, the pivot of the camera's rotation
+    /// noise in the camera frame (`R_c p` for a target point `p`), empty for
+    /// the target origin. PnP tilts a board about its centre, not about its
+    /// origin (often a corner): rotating about the origin would make the
+    /// translation noise strongly correlated with the tilts, which a diagonal
+    /// cannot hold. With a pivot, a rotation `w` moves the origin by
+    /// `(R_c p) x w`.
+    pub pivot_levers: Vec<Vector3<f64>>,
 }
 
 impl NoiseModel {
@@ -112,7 +121,11 @@ impl NoiseModel {
             }
             CameraNoise::PerView(_) => variances.push(0.04),
         }
-        NoiseModel { camera, variances }
+        NoiseModel {
+            camera,
+            variances,
+            pivot_levers: Vec::new(),
+        }
     }
 
     /// The levels as standard deviations in report units.
@@ -139,8 +152,17 @@ impl NoiseModel {
         let mut out = vec![outer(&lin.jac_robot, 0..3), outer(&lin.jac_robot, 3..6)];
         match &self.camera {
             CameraNoise::Diagonal => {
+                // Noise [w, v_pivot] -> origin noise [w, v_pivot + [R_c p]x w].
+                let jc = match self.pivot_levers.get(view) {
+                    Some(lever) => {
+                        let mut t = Matrix6::identity();
+                        t.fixed_view_mut::<3, 3>(3, 0).copy_from(&skew(lever));
+                        lin.jac_camera * t
+                    }
+                    None => lin.jac_camera,
+                };
                 for k in 0..6 {
-                    out.push(outer(&lin.jac_camera, k..k + 1));
+                    out.push(outer(&jc, k..k + 1));
                 }
             }
             CameraNoise::PerView(covariances) => {

@@ -39,6 +39,23 @@ const ROBOT: (f64, f64) = (0.02, 0.1e-3);
 const CAMERA_ROT_DEG: [f64; 3] = [0.05, 0.05, 0.005];
 const CAMERA_T_M: [f64; 3] = [0.05e-3, 0.05e-3, 0.4e-3];
 
+/// The grid centre (target frame), where the test camera looks: PnP-like
+/// noise tilts the board about it.
+const CENTRE: Vector3<f64> = Vector3::new(0.12, 0.075, 0.0);
+
+/// A camera pose with noise rotating the board about its centre.
+fn pnp_like(rng: &mut Rng, p: &Pose) -> Pose {
+    let noisy = perturbed(rng, p, CAMERA_ROT_DEG.map(f64::to_radians), CAMERA_T_M);
+    let d = difference(p, &noisy);
+    let w = Vector3::new(d[0], d[1], d[2]);
+    let lever = p.rotation * CENTRE;
+    let mut pivoted = d;
+    pivoted
+        .fixed_rows_mut::<3>(3)
+        .copy_from(&(d.fixed_rows::<3>(3) + lever.cross(&w)));
+    super::pose_residual::perturb(p, &pivoted)
+}
+
 fn noisy_input(scene: &LookingScene, rng: &mut Rng) -> HandEyeInput {
     let r = ROBOT.0.to_radians();
     HandEyeInput {
@@ -51,13 +68,18 @@ fn noisy_input(scene: &LookingScene, rng: &mut Rng) -> HandEyeInput {
         camera_from_target: scene
             .camera_from_target
             .iter()
-            .map(|p| perturbed(rng, p, CAMERA_ROT_DEG.map(f64::to_radians), CAMERA_T_M))
+            .map(|p| pnp_like(rng, p))
             .collect(),
     }
 }
 
-fn true_model() -> NoiseModel {
+fn true_model(scene: &LookingScene) -> NoiseModel {
     let mut m = NoiseModel::new(CameraNoise::Diagonal);
+    m.pivot_levers = scene
+        .camera_from_target
+        .iter()
+        .map(|c| c.rotation * CENTRE)
+        .collect();
     m.variances = vec![ROBOT.0.to_radians().powi(2), ROBOT.1.powi(2)];
     m.variances
         .extend(CAMERA_ROT_DEG.iter().map(|d| d.to_radians().powi(2)));
@@ -128,7 +150,7 @@ fn noisy_poses_reach_the_bound_and_the_reported_std_covers_the_truth() {
             sum_t += e.fixed_rows::<3>(3).norm_squared();
             let truth = measurements(&truth_input(&scene));
             let crb =
-                fisher_information(setup, &truth, &true_model(), &scene.x_true, &scene.y_true)
+                fisher_information(setup, &truth, &true_model(&scene), &scene.x_true, &scene.y_true)
                     .try_inverse()
                     .unwrap();
             bound_rot += crb.fixed_view::<3, 3>(0, 0).trace();

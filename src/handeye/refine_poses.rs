@@ -21,6 +21,7 @@ use super::report::{errors, motion_residuals, pose_difference, view_residuals};
 use super::solve::{HandEyeInput, HandEyeResult};
 use super::{Chain, MotionPairs, Pose};
 use crate::error::Result;
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// Per-axis standard deviations of one transform.
@@ -85,6 +86,34 @@ pub fn measurements(input: &HandEyeInput) -> Vec<PoseMeasurement> {
         .collect()
 }
 
+/// Where the camera looks on the target: the mean intersection of the
+/// optical axes with the target plane z = 0 (target frame), the pivot of
+/// the diagonal camera noise model ([`NoiseModel::pivot_levers`]). `None`
+/// when an axis is nearly parallel to the plane or the mean is not finite
+/// (then the target origin is the pivot).
+pub fn board_pivot(views: &[PoseMeasurement]) -> Option<Vector3<f64>> {
+    let mut sum = Vector3::zeros();
+    for m in views {
+        let target_from_camera = m.camera_from_target.inverse();
+        let origin = target_from_camera.translation.vector;
+        let axis = target_from_camera.rotation * Vector3::z();
+        if axis.z.abs() < 0.1 {
+            return None;
+        }
+        sum += origin - axis * (origin.z / axis.z);
+    }
+    let p = sum / views.len().max(1) as f64;
+    p.iter().all(|v| v.is_finite()).then_some(p)
+}
+
+/// `R_c p` per view for a pivot `p` (target frame).
+pub fn pivot_levers(views: &[PoseMeasurement], pivot: &Vector3<f64>) -> Vec<Vector3<f64>> {
+    views
+        .iter()
+        .map(|m| m.camera_from_target.rotation * pivot)
+        .collect()
+}
+
 /// Score every closed form, refine from the best, make the refined
 /// transforms primary. A refinement that fails leaves the closed form
 /// primary with a warning (never an error: the closed forms stand).
@@ -105,7 +134,13 @@ pub fn apply_pose_refinement(
         CameraNoise::Diagonal => "diagonal",
         CameraNoise::PerView(_) => "per_view",
     };
+    let diagonal = matches!(camera_noise, CameraNoise::Diagonal);
     let mut noise = NoiseModel::new(camera_noise);
+    if diagonal {
+        if let Some(p) = board_pivot(&views) {
+            noise.pivot_levers = pivot_levers(&views, &p);
+        }
+    }
     if let Err(e) = estimate_noise(setup, &views, &mut noise, &result.x, &result.y, axis) {
         result
             .warnings
