@@ -642,6 +642,8 @@ export interface PoseRefinementSummary {
   cost: number;
   camera_noise_model: 'diagonal' | 'per_view';
   noise: PoseNoiseLevels;
+  /** Diagonal model: target point (m, target frame) the camera rotation noise pivots about, when chosen over the origin. */
+  camera_noise_pivot_m?: Vec3;
   /** False with fewer than 8 inlier poses: the default levels were scaled by one factor. */
   noise_estimated_per_component: boolean;
   /** Of gripper_from_camera / base_from_camera. */

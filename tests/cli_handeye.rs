@@ -291,14 +291,18 @@ fn camera_poses_are_refined_by_default_and_no_refine_keeps_the_closed_form() {
     let method = refined["method"].as_str().unwrap();
     assert!(method.starts_with("refined from "), "{method}");
     let p = &refined["pose_refinement"];
-    let std_mm = p["camera_transform_std"]["translation_mm"][0].as_f64().unwrap();
+    let std_mm = p["camera_transform_std"]["translation_mm"][0]
+        .as_f64()
+        .unwrap();
     // A 15-pose calibration at this noise: the camera's translation to a
     // fraction of a millimetre, and the truth within 4 reported std.
     assert!(std_mm > 0.01 && std_mm < 1.0, "{std_mm} mm");
     let truth = scene.x_true.to_homogeneous();
     let est = matrix(&refined["gripper_from_camera"]);
     for k in 0..3 {
-        let s = p["camera_transform_std"]["translation_mm"][k].as_f64().unwrap();
+        let s = p["camera_transform_std"]["translation_mm"][k]
+            .as_f64()
+            .unwrap();
         let e = (est[k][3] - truth[(k, 3)]).abs() * 1e3;
         assert!(e < 4.0 * s, "axis {k}: {e} mm vs std {s} mm");
     }

@@ -19,8 +19,8 @@
 //! on the residual and are told apart only through the lever arm; their sum
 //! is what the weighting needs.
 
-use super::pose_residual::ViewLinearisation;
 use super::math::skew;
+use super::pose_residual::ViewLinearisation;
 use nalgebra::{Matrix6, SMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 

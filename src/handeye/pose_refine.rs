@@ -159,6 +159,34 @@ pub fn evaluate(
     Ok((norms, cost))
 }
 
+/// The robust negative log-likelihood `sum_i [0.5 log det C_i + 0.5
+/// rho(|z_i|^2)]` of `(x, y)` under `noise`: compares noise models (whose
+/// levels were fitted to the same data), unlike the cost alone.
+pub fn negative_log_likelihood(
+    setup: Setup,
+    views: &[PoseMeasurement],
+    noise: &NoiseModel,
+    x: &Pose,
+    y: &Pose,
+) -> Result<f64> {
+    let loss = Loss::Huber { scale: HUBER_SCALE };
+    let mut total = 0.0;
+    for (i, m) in views.iter().enumerate() {
+        let lin = linearise(setup, m, x, y);
+        let c = noise.covariance(i, &lin);
+        let l = whitening(&c)
+            .ok_or_else(|| Error::degenerate(format!("view {i}: singular residual covariance")))?;
+        let det = c.determinant();
+        if !(det > 0.0) {
+            return Err(Error::degenerate(format!(
+                "view {i}: singular residual covariance"
+            )));
+        }
+        total += 0.5 * det.ln() + 0.5 * loss.evaluate((l * lin.residual).norm_squared()).0;
+    }
+    Ok(total)
+}
+
 /// `(sum_i w_i J_i^T C_i^-1 J_i)^-1` over the free parameters, embedded in
 /// 12 x 12 and rotated back from `basis`; `w_i` the Huber weights.
 fn parameter_covariance(

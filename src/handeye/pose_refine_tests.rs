@@ -149,10 +149,15 @@ fn noisy_poses_reach_the_bound_and_the_reported_std_covers_the_truth() {
             sum_rot += e.fixed_rows::<3>(0).norm_squared();
             sum_t += e.fixed_rows::<3>(3).norm_squared();
             let truth = measurements(&truth_input(&scene));
-            let crb =
-                fisher_information(setup, &truth, &true_model(&scene), &scene.x_true, &scene.y_true)
-                    .try_inverse()
-                    .unwrap();
+            let crb = fisher_information(
+                setup,
+                &truth,
+                &true_model(&scene),
+                &scene.x_true,
+                &scene.y_true,
+            )
+            .try_inverse()
+            .unwrap();
             bound_rot += crb.fixed_view::<3, 3>(0, 0).trace();
             bound_t += crb.fixed_view::<3, 3>(3, 3).trace();
             let s = result.pose_refinement.unwrap();

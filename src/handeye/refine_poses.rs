@@ -14,7 +14,8 @@
 use super::motion::build_motions;
 use super::pose_noise::{CameraNoise, NoiseLevels, NoiseModel};
 use super::pose_refine::{
-    estimate_noise, evaluate, refine, Covariance12, PoseRefineOptions, HUBER_SCALE,
+    estimate_noise, evaluate, negative_log_likelihood, refine, Covariance12, PoseRefineOptions,
+    HUBER_SCALE,
 };
 use super::pose_residual::PoseMeasurement;
 use super::report::{errors, motion_residuals, pose_difference, view_residuals};
@@ -48,6 +49,12 @@ pub struct PoseRefinementSummary {
     pub camera_noise_model: String,
     /// The estimated noise levels.
     pub noise: NoiseLevels,
+    /// Diagonal model: the target point (metres, target frame) the camera
+    /// rotation noise pivots about, when that fits the data better than the
+    /// target origin (where the optical axes meet the target plane, on
+    /// average); absent: the origin.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub camera_noise_pivot_m: Option<[f64; 3]>,
     /// False when there were too few poses (fewer than 8 inliers): the
     /// documented default levels were then scaled by one common factor.
     pub noise_estimated_per_component: bool,
@@ -135,17 +142,29 @@ pub fn apply_pose_refinement(
         CameraNoise::PerView(_) => "per_view",
     };
     let diagonal = matches!(camera_noise, CameraNoise::Diagonal);
+    let mut pivot = None;
     let mut noise = NoiseModel::new(camera_noise);
-    if diagonal {
-        if let Some(p) = board_pivot(&views) {
-            noise.pivot_levers = pivot_levers(&views, &p);
-        }
-    }
     if let Err(e) = estimate_noise(setup, &views, &mut noise, &result.x, &result.y, axis) {
         result
             .warnings
             .push(format!("pose refinement skipped: {e}"));
         return Ok(());
+    }
+    // The diagonal camera noise about the target origin or about where the
+    // camera looks on the target: the one the data make more likely.
+    if let (true, Some(p)) = (diagonal, board_pivot(&views)) {
+        let mut pivoted = NoiseModel::new(CameraNoise::Diagonal);
+        pivoted.pivot_levers = pivot_levers(&views, &p);
+        let better = estimate_noise(setup, &views, &mut pivoted, &result.x, &result.y, axis)
+            .and_then(|_| {
+                let with = negative_log_likelihood(setup, &views, &pivoted, &result.x, &result.y)?;
+                let without = negative_log_likelihood(setup, &views, &noise, &result.x, &result.y)?;
+                Ok(with < without)
+            });
+        if better.unwrap_or(false) {
+            noise = pivoted;
+            pivot = Some([p.x, p.y, p.z]);
+        }
     }
     // Every closed form under the same noise levels; the lowest seeds.
     let mut start: (f64, String, Pose, Pose) =
@@ -205,6 +224,7 @@ pub fn apply_pose_refinement(
         cost: refined.cost,
         camera_noise_model: model_name.to_string(),
         noise: refined.noise.levels(),
+        camera_noise_pivot_m: pivot,
         noise_estimated_per_component: refined.noise_per_component,
         camera_transform_std: transform_std(&cov, 0),
         target_transform_std: transform_std(&cov, 6),
