@@ -133,8 +133,12 @@ def robocal(binary, setup, robot, camera, tmp):
     with open(out) as f:
         report = json.load(f)
     key = "gripper_from_camera" if setup == "eye-in-hand" else "base_from_camera"
-    return {m["method"]: np.array(m[key]["matrix_row_major"]) for m in report["methods"]
-            if key in m}, report["method"]
+    ours = {m["method"]: np.array(m[key]["matrix_row_major"]) for m in report["methods"]
+            if key in m}
+    # The primary transform is the report's own (the pose refinement's since
+    # issue 19, method 'refined from <closed form>').
+    ours[report["method"]] = np.array(report[key]["matrix_row_major"])
+    return ours, report["method"]
 
 
 def main():

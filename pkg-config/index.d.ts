@@ -483,6 +483,11 @@ export interface HandEyeInputBase {
   seed?: number;
   /** Stop on failed consistency checks (default true). */
   strict_checks?: boolean;
+  /**
+   * Maximum-likelihood pose refinement of the closed forms (default true;
+   * ignored with image points, where `refine` applies).
+   */
+  refine_poses?: boolean;
 }
 
 /**
@@ -520,6 +525,8 @@ export interface HandEyeMethodResult {
   disagreement_rotation_deg?: number;
   /** Why the method failed. */
   error?: string;
+  /** Robust cost of this solution under the pose refinement's noise model (when it ran). */
+  pose_cost?: number;
 }
 
 /** How far `robot[i] * x * camera[i]` lands from the solved target pose. */
@@ -606,6 +613,52 @@ export interface RefinementSummary {
   camera?: Camera;
 }
 
+/** Estimated noise levels (standard deviations) of the robot and camera poses. */
+export interface PoseNoiseLevels {
+  /** Robot rotation noise per axis of base_from_gripper, degrees. */
+  robot_rotation_deg: number;
+  /** Robot translation noise per axis, mm. */
+  robot_translation_mm: number;
+  /** Camera rotation noise about the camera's x, y, z axes, degrees (diagonal model). */
+  camera_rotation_deg?: Vec3;
+  /** Camera translation noise along the camera's x, y, z axes, mm (diagonal model). */
+  camera_translation_mm?: Vec3;
+  /** Per-view model: square root of the estimated covariance scale (px for PnP covariances). */
+  camera_covariance_sigma?: number;
+}
+
+/** Per-axis standard deviations of a refined transform. */
+export interface TransformStd {
+  /** About the x, y, z axes of the transform's left frame, degrees. */
+  rotation_deg: Vec3;
+  /** Of translation_m's x, y, z, mm. */
+  translation_mm: Vec3;
+}
+
+/** What the maximum-likelihood pose refinement did (pose input). */
+export interface PoseRefinementSummary {
+  /** The closed form with the lowest pose_cost, where the refinement started. */
+  started_from: string;
+  closed_form_cost: number;
+  /** 0.5 * sum of Huber(|whitened residual|^2) over the views after refinement. */
+  cost: number;
+  camera_noise_model: 'diagonal' | 'per_view';
+  noise: PoseNoiseLevels;
+  /** Diagonal model: target point (m, target frame) the camera rotation noise pivots about, when chosen over the origin. */
+  camera_noise_pivot_m?: Vec3;
+  /** False with fewer than 8 inlier poses: the default levels were scaled by one factor. */
+  noise_estimated_per_component: boolean;
+  /** Of gripper_from_camera / base_from_camera. */
+  camera_transform_std: TransformStd;
+  /** Of base_from_target / gripper_from_target. */
+  target_transform_std: TransformStd;
+  /** 12 x 12 rows: [camera rx, ry, rz (rad), tx, ty, tz (m), target rx, ry, rz, tx, ty, tz]. */
+  covariance: number[][];
+  whitened_residual_norms: number[];
+  /** Views down-weighted as outliers (whitened residual norm above 4.1). */
+  outlier_views: number[];
+}
+
 /** One robot pose and the image paired with it (`robocal handeye` with images only). */
 export interface PairAudit {
   pose_index: number;
@@ -637,6 +690,8 @@ export interface HandEyeReportBase {
   pairs?: PairAudit[];
   /** Present when a refinement ran (the primary transforms are then the refined ones). */
   refinement?: RefinementSummary;
+  /** Present when the pose refinement ran (pose input; the primary transforms are then the refined ones). */
+  pose_refinement?: PoseRefinementSummary;
   robocal_version: string;
 }
 

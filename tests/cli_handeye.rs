@@ -221,3 +221,97 @@ fn rwhe_cs_synthetic_1_recovers_its_ground_truth_from_the_images() {
         .all(|p| p["used"] == true));
     let _ = std::fs::remove_dir_all(&tmp);
 }
+
+#[test]
+fn camera_poses_are_refined_by_default_and_no_refine_keeps_the_closed_form() {
+    use robocal::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
+    use robocal::synth::Rng;
+    let scene = looking_scene(
+        &LookingConfig {
+            setup: robocal::handeye::Setup::EyeInHand,
+            views: 15,
+            distance_m: 0.5,
+            grid: (9, 6, 0.03),
+            max_tilt_deg: 30.0,
+            max_roll_deg: 60.0,
+        },
+        21,
+    );
+    // Robot 0.1 mm / 0.02 deg, camera 0.05 deg and 0.05 / 0.3 mm (x, y / depth).
+    let mut rng = Rng::new(3);
+    let r = 0.02f64.to_radians();
+    let line = |p: &robocal::handeye::Pose| {
+        let m = p.to_homogeneous();
+        (0..4)
+            .flat_map(|i| (0..4).map(move |j| format!("{:.17e}", m[(i, j)])))
+            .collect::<Vec<_>>()
+            .join(" ")
+            + "\n"
+    };
+    let robot: String = scene
+        .base_from_gripper
+        .iter()
+        .map(|p| line(&perturbed(&mut rng, p, [r; 3], [1e-4; 3])))
+        .collect();
+    let camera: String = scene
+        .camera_from_target
+        .iter()
+        .map(|p| {
+            let c = 0.05f64.to_radians();
+            line(&perturbed(&mut rng, p, [c, c, c / 5.0], [5e-5, 5e-5, 3e-4]))
+        })
+        .collect();
+    let dir = std::env::temp_dir().join(format!("robocal-cli-pose-refine-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (robot_path, camera_path) = (dir.join("robot.txt"), dir.join("camera.txt"));
+    std::fs::write(&robot_path, robot).unwrap();
+    std::fs::write(&camera_path, camera).unwrap();
+    let run = |extra: &[&str]| {
+        let out_path = dir.join("handeye.json");
+        let mut args = vec![
+            "handeye",
+            "--setup",
+            "eye-in-hand",
+            "--poses",
+            robot_path.to_str().unwrap(),
+            "--pose-format",
+            "matrix",
+            "--camera-poses",
+            camera_path.to_str().unwrap(),
+            "--bootstrap",
+            "0",
+            "-o",
+            out_path.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        ok(&robocal(&args));
+        read_json(&out_path)
+    };
+    let refined = run(&[]);
+    let method = refined["method"].as_str().unwrap();
+    assert!(method.starts_with("refined from "), "{method}");
+    let p = &refined["pose_refinement"];
+    let std_mm = p["camera_transform_std"]["translation_mm"][0]
+        .as_f64()
+        .unwrap();
+    // A 15-pose calibration at this noise: the camera's translation to a
+    // fraction of a millimetre, and the truth within 4 reported std.
+    assert!(std_mm > 0.01 && std_mm < 1.0, "{std_mm} mm");
+    let truth = scene.x_true.to_homogeneous();
+    let est = matrix(&refined["gripper_from_camera"]);
+    for k in 0..3 {
+        let s = p["camera_transform_std"]["translation_mm"][k]
+            .as_f64()
+            .unwrap();
+        let e = (est[k][3] - truth[(k, 3)]).abs() * 1e3;
+        assert!(e < 4.0 * s, "axis {k}: {e} mm vs std {s} mm");
+    }
+    assert!(refined["methods"][0]["pose_cost"].as_f64().is_some());
+    let closed = run(&["--no-refine"]);
+    let method = closed["method"].as_str().unwrap();
+    assert!(!method.starts_with("refined"), "{method}");
+    assert!(closed["pose_refinement"].is_null());
+    let help = robocal(&["handeye", "--help"]);
+    assert!(String::from_utf8_lossy(&help.stdout).contains("--no-refine"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -17,7 +17,7 @@ use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
                   --camera camera.json --target SPEC IMAGES... [--refine MODE] [--threads N]
                   [--method all|NAME] [--bootstrap N] [--seed N] [--lenient] -o handeye.json
   robocal handeye --setup ... --poses FILE [--pose-format NAME]
-                  --camera-poses FILE [--camera-pose-format NAME] [...] -o handeye.json",
+                  --camera-poses FILE [--camera-pose-format NAME] [--no-refine] [...] -o handeye.json",
     after_help = "Output JSON: gripper_from_camera or base_from_camera, base_from_target or
 gripper_from_target (each {matrix_row_major, translation_m, quaternion_xyzw}),
 methods, errors {translation_rms_mm, translation_max_mm, rotation_rms_deg,
@@ -25,6 +25,11 @@ rotation_max_deg, reprojection_rms_px}, per_view, motion, repeatability, warning
 and with images: pairs [{pose_index, image, used, view, reason, pose_fit_rms_px}] and
 refinement. With refinement the main transform is the refined one (method
 'refined from <closed form>'); methods still lists every closed form.
+With --camera-poses the closed forms are refined by maximum likelihood over
+the poses (robot and camera pose noise estimated from the data; --no-refine
+keeps the closed form): pose_refinement {started_from, cost, noise,
+camera_transform_std, target_transform_std, covariance, outlier_views} and a
+pose_cost per method.
 
 Examples:
   robocal handeye --setup eye-in-hand --poses robot.csv --camera camera.json \\
@@ -84,6 +89,11 @@ pub struct HandeyeArgs {
     /// Seed of the bootstrap resampling
     #[arg(long, value_name = "N", default_value_t = 1)]
     seed: u64,
+    /// Pose input: report the closed form chosen by the fixed rule instead
+    /// of the maximum-likelihood pose refinement (on by default; with images
+    /// use --refine none)
+    #[arg(long)]
+    no_refine: bool,
     /// Report suspected input mistakes (units, inverted or shifted poses) as
     /// warnings instead of failing
     #[arg(long)]
@@ -123,6 +133,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
         strict_checks: !args.lenient,
         bootstrap_samples: args.bootstrap,
         seed: args.seed,
+        refine_poses: !args.no_refine,
         ..Default::default()
     };
     match args.method.as_deref() {
@@ -199,6 +210,8 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                 base_from_gripper: found.base_from_gripper,
                 camera_from_target: found.camera_from_target,
             };
+            // The refinement over image points (--refine) replaces the pose one.
+            options.refine_poses = false;
             (input, Some((found.views, camera)))
         }
         (Some(_), Some(_)) => {

@@ -3,7 +3,10 @@
 //!
 //! Input: `{"setup": "eye-in-hand" | "eye-to-hand", "base_from_gripper":
 //! [pose...], "camera_from_target": [pose...], "method": "all" | NAME,
-//! "bootstrap_samples": 100, "seed": 1, "strict_checks": true}` where a pose
+//! "bootstrap_samples": 100, "seed": 1, "strict_checks": true, "refine_poses":
+//! true}` (`refine_poses`: the maximum-likelihood pose refinement of
+//! [`super::refine_poses`], on by default for pose input, ignored with image
+//! points) where a pose
 //! is a [`PoseInput`]: `{"matrix_row_major": [[4 numbers] x 4]}`,
 //! `{"translation_m": [x, y, z], "quaternion_xyzw": [x, y, z, w]}` (metres)
 //! or all three (a report's [`crate::geometry::PoseJson`]). Output: the
@@ -69,6 +72,8 @@ struct InputJson {
     seed: Option<u64>,
     #[serde(default)]
     strict_checks: Option<bool>,
+    #[serde(default)]
+    refine_poses: Option<bool>,
 }
 
 fn to_pose(p: &PoseInput, field: &str, index: usize) -> Result<Pose> {
@@ -220,6 +225,10 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         strict_checks: input.strict_checks.unwrap_or(true),
         ..Default::default()
     };
+    // The pose refinement is the pose path's; with image points the
+    // refinement over pixels (`refine`) takes its place.
+    options.refine_poses =
+        input.refine_poses.unwrap_or(true) && input.views.is_none() && input.detections.is_none();
     match input.method.as_deref() {
         None | Some("all") => {}
         Some(name) => options.methods = vec![name.parse::<HandEyeMethod>()?],

@@ -36,6 +36,10 @@
 //! maximum-likelihood problem (reprojection error over X, the target pose
 //! and optionally the intrinsics); [`refine_closed_form`] applies it to a
 //! closed-form result and makes the refined transform the primary one.
+//! [`pose_refine`] is the maximum-likelihood problem over the poses alone
+//! (`A_i X = Z B_i` per view, weighted by robot and camera pose noise
+//! estimated from the data); [`refine_poses`] applies it by default on the
+//! pose path (`HandEyeOptions::refine_poses`).
 
 pub mod axxb;
 pub mod axzb;
@@ -46,7 +50,11 @@ pub mod math;
 pub mod motion;
 pub mod output;
 pub mod pnp;
+pub mod pose_noise;
+pub mod pose_refine;
+pub mod pose_residual;
 pub mod refine_closed_form;
+pub mod refine_poses;
 pub mod repeat;
 pub mod report;
 pub mod reprojection_refine;
@@ -60,6 +68,8 @@ pub mod solve;
 /// Real data sets have 10 to a few hundred poses.
 pub const MAX_POSES: usize = 1000;
 
+#[cfg(test)]
+mod pose_refine_tests;
 #[cfg(test)]
 mod reprojection_refine_tests;
 #[cfg(test)]

@@ -5,6 +5,7 @@
 
 use super::motion::MotionStats;
 use super::refine_closed_form::RefinementSummary;
+use super::refine_poses::PoseRefinementSummary;
 use super::repeat::Repeatability;
 use super::report::{Errors, MotionResidual, ViewResidual};
 use super::solve::HandEyeResult;
@@ -61,6 +62,10 @@ pub struct MethodJson {
     /// Why the method failed.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub error: Option<String>,
+    /// Robust cost of this solution under the pose refinement's estimated
+    /// noise model (the lowest one seeds the refinement), when it ran.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_cost: Option<f64>,
 }
 
 /// The full report.
@@ -111,6 +116,11 @@ pub struct HandEyeReport {
     /// the refined ones).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub refinement: Option<RefinementSummary>,
+    /// The maximum-likelihood pose refinement, when run (the primary
+    /// transforms are then the refined ones): covariance, per-axis std,
+    /// estimated noise levels, outlier views.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_refinement: Option<PoseRefinementSummary>,
     /// robocal version that produced the report.
     pub robocal_version: String,
 }
@@ -148,6 +158,7 @@ impl HandEyeReport {
                     disagreement_translation_mm: m.disagreement.map(|d| d.0),
                     disagreement_rotation_deg: m.disagreement.map(|d| d.1),
                     error: None,
+                    pose_cost: m.pose_cost,
                 };
                 match &m.outcome {
                     Ok((x, y, e)) => {
@@ -193,6 +204,7 @@ impl HandEyeReport {
             warnings: result.warnings.clone(),
             pairs: Vec::new(),
             refinement: result.refinement.clone(),
+            pose_refinement: result.pose_refinement.clone(),
             robocal_version: crate::VERSION.to_string(),
         }
     }

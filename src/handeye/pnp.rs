@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params, rotation_from_rotvec};
 use crate::handeye::math::skew;
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix3, Point2, Translation3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point2, Translation3, Vector3};
 
 /// Largest |z| (relative to the target's extent) for the target to count as planar.
 const PLANAR_TOLERANCE: f64 = 1e-9;
@@ -75,6 +75,40 @@ pub fn camera_from_target(camera: &Camera, view: &ViewPoints) -> Result<(Pose, f
     let pose = pose_from_params(&lm.params.global);
     let rms = (2.0 * lm.cost / n as f64).sqrt();
     Ok((pose, rms))
+}
+
+/// [`camera_from_target`] plus the pose's `(J^T J)^-1` (per pixel
+/// variance) in the convention of [`super::pose_residual`]: rotation
+/// `exp(w) R` and translation `t + v`, both in the camera frame, order
+/// `[w, v]`. Times the pixel variance it is the pose covariance the pose
+/// refinement's [`super::pose_noise::CameraNoise::PerView`] takes.
+pub fn camera_from_target_with_covariance(
+    camera: &Camera,
+    view: &ViewPoints,
+) -> Result<(Pose, f64, Matrix6<f64>)> {
+    let (pose, rms) = camera_from_target(camera, view)?;
+    let problem = PoseProblem { camera, view };
+    let blocks = problem.residuals_and_jacobian(
+        &BlockParams {
+            global: params_from_pose(&pose).to_vec(),
+            blocks: Vec::new(),
+        },
+        true,
+    )?;
+    let mut jtj = Matrix6::zeros();
+    for b in &blocks {
+        let j = nalgebra::SMatrix::<f64, 2, 6>::from_column_slice(b.jac_global.as_slice());
+        jtj += j.transpose() * j;
+    }
+    let inverse = jtj
+        .try_inverse()
+        .ok_or_else(|| Error::degenerate("the target pose is not constrained by its points"))?;
+    // Right perturbation pose * exp(d) = (exp(R d_r) R, t + R d_t).
+    let r = pose.rotation.to_rotation_matrix().into_inner();
+    let mut g = Matrix6::zeros();
+    g.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+    g.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
+    Ok((pose, rms, g * inverse * g.transpose()))
 }
 
 struct PoseProblem<'a> {

@@ -3,6 +3,8 @@
 
 use super::checks;
 use super::motion::{build_motions, motion_stats, MotionStats};
+use super::pose_noise::CameraNoise;
+use super::refine_poses::apply_pose_refinement;
 use super::repeat::{repeatability, Repeatability};
 use super::report::{
     combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
@@ -41,6 +43,10 @@ pub struct HandEyeOptions {
     pub bootstrap_samples: usize,
     /// Seed of the bootstrap resampling.
     pub seed: u64,
+    /// Refine the closed forms by the maximum-likelihood pose refinement
+    /// ([`super::refine_poses`]; default true). The image path turns it off
+    /// and refines over image points instead.
+    pub refine_poses: bool,
 }
 
 impl Default for HandEyeOptions {
@@ -51,6 +57,7 @@ impl Default for HandEyeOptions {
             strict_checks: true,
             bootstrap_samples: DEFAULT_BOOTSTRAP_SAMPLES,
             seed: 1,
+            refine_poses: true,
         }
     }
 }
@@ -64,6 +71,9 @@ pub struct MethodResult {
     pub outcome: std::result::Result<(Pose, Pose, Errors), Error>,
     /// Distance of `x` from the primary solution: (mm, degrees).
     pub disagreement: Option<(f64, f64)>,
+    /// Robust cost of this solution under the pose refinement's noise
+    /// model, when the pose refinement ran.
+    pub pose_cost: Option<f64>,
 }
 
 /// Everything a calibration produces (serialise with
@@ -98,6 +108,8 @@ pub struct HandEyeResult {
     /// The image-based refinement, when run
     /// ([`super::refine_closed_form::apply_refinement`]).
     pub refinement: Option<super::refine_closed_form::RefinementSummary>,
+    /// The pose refinement, when run ([`super::refine_poses`]).
+    pub pose_refinement: Option<super::refine_poses::PoseRefinementSummary>,
 }
 
 /// Solve one method on a chain; returns `(x, y, unobservable directions)`.
@@ -147,7 +159,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             motion.axis_spread_deg,
         ));
         let per_view = view_residuals(&chain, &x, &y);
-        return Ok(HandEyeResult {
+        let mut result = HandEyeResult {
             setup: input.setup,
             method: "scara".to_string(),
             x,
@@ -161,7 +173,17 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             repeatability: None,
             warnings,
             refinement: None,
-        });
+            pose_refinement: None,
+        };
+        if options.refine_poses {
+            apply_pose_refinement(
+                &mut result,
+                input,
+                CameraNoise::Diagonal,
+                options.motion_pairs,
+            )?;
+        }
+        return Ok(result);
     }
     // 3. Every requested method; a failing one is reported, not fatal.
     let mut methods = Vec::new();
@@ -179,6 +201,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             method,
             outcome,
             disagreement: None,
+            pose_cost: None,
         });
     }
     let Some((_, best_index, x, y, unobservable)) = best else {
@@ -209,7 +232,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
     } else {
         None
     };
-    Ok(HandEyeResult {
+    let mut result = HandEyeResult {
         setup: input.setup,
         method: primary.name().to_string(),
         x,
@@ -223,5 +246,15 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         repeatability: repeat,
         warnings,
         refinement: None,
-    })
+        pose_refinement: None,
+    };
+    if options.refine_poses {
+        apply_pose_refinement(
+            &mut result,
+            input,
+            CameraNoise::Diagonal,
+            options.motion_pairs,
+        )?;
+    }
+    Ok(result)
 }

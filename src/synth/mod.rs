@@ -4,6 +4,7 @@
 
 pub mod demo;
 pub mod handeye;
+pub mod handeye_looking;
 pub mod render;
 pub mod rng;
 pub mod scene;

@@ -278,8 +278,9 @@ export const tests = [
       X.translation_m.forEach((t, i) => assertShown(m[1 + i], t * 1000, `${what} gripper_from_camera t[${i}] (mm)`, 3));
       X.quaternion_xyzw.forEach((q, i) => assertShown(m[4 + i], q, `${what} gripper_from_camera q[${i}]`));
     };
-    // Closed forms only: the page equals the CLI on the same camera poses.
-    assertX(await solveShown('none'), cli.gripper_from_camera, 'closed form');
+    // Camera poses only (refine 'none': the pose refinement, the CLI's default
+    // with --camera-poses): the page equals the CLI on the same camera poses.
+    assertX(await solveShown('none'), cli.gripper_from_camera, 'pose refinement');
     assert.equal((/^Result \((.*)\)$/.exec(await page.textContent('#handeye-results h3')) || [])[1], cli.method);
     // Refined over the image points (the page's default).
     const mRefined = await solveShown('trusted');

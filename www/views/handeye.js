@@ -6,12 +6,15 @@ import { bars, boxplot } from '../lib/plot.js';
 import { FrameView } from '../lib/view3d.js';
 import { flat, mul, fromPose, IDENTITY } from '../lib/mat4.js';
 
-// Refinement over the image points (the core's RefineMode names).
+// Refinement over the image points (the core's RefineMode names); 'none'
+// sends the camera poses only, which the core refines by maximum likelihood
+// over the poses (refine_poses); 'closed' turns that off too.
 const REFINE = [
   ['trusted', 'Over the image points, robot poses exact'],
   ['stochastic', 'Over the image points, robot pose noise estimated'],
   ['joint_intrinsics', 'Over the image points, camera intrinsics refined too'],
-  ['none', 'None (closed forms on the camera poses only)'],
+  ['none', 'Over the camera poses only (maximum likelihood, pose noise estimated)'],
+  ['closed', 'None (closed forms on the camera poses only)'],
 ];
 
 const METHODS = [
@@ -67,7 +70,8 @@ export class HandEyeView {
       base_from_gripper: used.map((p) => ({ translation_m: p.pose.base_from_gripper.translation_m, quaternion_xyzw: p.pose.base_from_gripper.quaternion_xyzw })),
       camera_from_target: used.map((p) => ({ matrix_row_major: views.get(p.image.name).camera_from_target.matrix_row_major })),
       // The refinement reads the detected points through the solved camera.
-      ...(refine === 'none' ? {} : { refine, camera: cam.camera, detections: used.map((p) => p.image.detection) }),
+      ...(refine === 'none' || refine === 'closed' ? {} : { refine, camera: cam.camera, detections: used.map((p) => p.image.detection) }),
+      ...(refine === 'closed' ? { refine_poses: false } : {}),
       names: used.map((p) => p.image.name),
     };
   }
@@ -114,6 +118,12 @@ export class HandEyeView {
     const refinement = ref ? h('p', { class: 'hint', id: 'handeye-refinement' },
       `Refined (${ref.mode}) from ${ref.started_from}: reprojection RMS ${num(ref.reprojection_rms_px, 4)} px (closed form ${num(ref.closed_form_reprojection_rms_px, 4)} px) over ${(ref.per_view_reprojection_rms_px || []).length} views` +
       (ref.camera ? `; camera refined too: fx ${num(ref.camera.fx, 3)}, fy ${num(ref.camera.fy, 3)} px.` : '.')) : null;
+    const pr = r.pose_refinement;
+    const std = pr && pr.camera_transform_std;
+    const poseRefinement = pr ? h('p', { class: 'hint', id: 'handeye-pose-refinement' },
+      `Refined over the poses from ${pr.started_from} (maximum likelihood; estimated robot noise ${num(pr.noise.robot_rotation_deg, 4)} deg / ${num(pr.noise.robot_translation_mm, 3)} mm). ` +
+      `${camKey} std: translation ${std.translation_mm.map((v) => num(v, 3)).join(', ')} mm, rotation ${std.rotation_deg.map((v) => num(v, 4)).join(', ')} deg` +
+      (pr.outlier_views.length ? `; outlier views (down-weighted): ${pr.outlier_views.map((v) => v + 1).join(', ')}.` : '.')) : null;
     const motion = r.motion ? h('p', { class: 'hint' }, `${r.motion.motions} motions used (${r.motion.discarded_small_rotation} discarded for too little rotation); rotation angles ${num(r.motion.angle_min_deg, 1)}–${num(r.motion.angle_max_deg, 1)} deg (median ${num(r.motion.angle_median_deg, 1)}), axis spread ${num(r.motion.axis_spread_deg, 1)} deg.`) : null;
     const perMotion = bars(h('canvas', { width: 460, height: 300, role: 'img', 'aria-label': 'closure residual per motion' }),
       (r.per_motion || []).map((m) => ({ label: `${m.from + 1}→${m.to + 1}`, value: m.translation_mm })), { ylabel: 'translation residual (mm)', title: 'Closure residual per motion', threshold: e.translation_rms_mm });
@@ -130,7 +140,7 @@ export class HandEyeView {
     }
     this.plots = plots;
     fill(this.out, h('h3', {}, `Result (${r.method})`), (r.warnings || []).map((w) => message('warning', w)),
-      pose(camKey), pose(tgtKey), refinement, errors, motion, h('h3', {}, 'Methods side by side'), methods,
+      pose(camKey), pose(tgtKey), refinement, poseRefinement, errors, motion, h('h3', {}, 'Methods side by side'), methods,
       h('div', { class: 'plots' }, plots), h('h3', {}, '3-D view'), this.canvas3d);
     this.draw3d(r, camKey, tgtKey, eyeInHand);
   }

@@ -1,0 +1,266 @@
+//! The noise model of the pose refinement: how robot and camera pose noise
+//! propagate to each view's residual covariance, and how the noise levels
+//! are estimated from the residuals.
+//!
+//! Each view's residual covariance is a sum of variance components,
+//! `C_i = sum_k s_k M_ik`: the robot's rotation and translation noise
+//! (isotropic, base frame), and the camera's per-axis rotation and
+//! translation noise (6 values, camera frame) or, when the image path
+//! supplies it, each view's PnP covariance times one scale. The `M_ik` come
+//! from the noise Jacobians of [`super::pose_residual::linearise`].
+//!
+//! The levels `s_k` are estimated by the expectation-maximisation fixed
+//! point of Gaussian variance components: `s_k <- s_k * sum_i tr(W_i M_ik
+//! W_i (r_i r_i^T + J_i P J_i^T)) / sum_i tr(W_i M_ik)` with `W_i = C_i^-1`
+//! and `P` the parameter covariance; the `J P J^T` term undoes the shrinkage
+//! of residuals at the fitted solution (12 unknowns). It keeps every level
+//! positive and its fixed point is the maximum-likelihood one. The isotropic
+//! part of the camera rotation noise and the robot rotation noise act alike
+//! on the residual and are told apart only through the lever arm; their sum
+//! is what the weighting needs.
+
+use super::math::skew;
+use super::pose_residual::ViewLinearisation;
+use nalgebra::{Matrix6, SMatrix, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// How the camera pose noise is modelled.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraNoise {
+    /// Independent per-axis noise in the camera frame (3 rotation, 3
+    /// translation levels), all estimated: for camera poses from any source.
+    Diagonal,
+    /// Each view's camera pose covariance up to one common scale (e.g. PnP's
+    /// `(J^T J)^-1` in the convention of [`super::pose_residual`]), the scale
+    /// estimated (the pixel variance).
+    PerView(Vec<Matrix6<f64>>),
+}
+
+/// Fewer poses than this: the noise levels are not estimated per component
+/// but [`NoiseLevels::default`] is scaled by one common factor.
+pub const MIN_POSES_FOR_NOISE_ESTIMATE: usize = 8;
+
+/// Smallest variance of any component (rad^2 or m^2): keeps the weights
+/// finite on noise-free data.
+const VARIANCE_FLOOR: f64 = 1e-24;
+
+/// Median of chi-squared with 6 degrees of freedom.
+const CHI2_6_MEDIAN: f64 = 5.348;
+
+/// Noise levels (standard deviations) of the robot and camera poses.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NoiseLevels {
+    /// Robot rotation noise per axis of `base_from_gripper` (degrees).
+    pub robot_rotation_deg: f64,
+    /// Robot translation noise per axis (mm).
+    pub robot_translation_mm: f64,
+    /// Camera rotation noise about the camera's x, y, z axes (degrees);
+    /// with per-view covariances, `None`.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub camera_rotation_deg: Option<[f64; 3]>,
+    /// Camera translation noise along x, y, z of the camera frame (mm);
+    /// with per-view covariances, `None`.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub camera_translation_mm: Option<[f64; 3]>,
+    /// With per-view covariances: the estimated scale's square root (px
+    /// when they are PnP's `(J^T J)^-1`).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub camera_covariance_sigma: Option<f64>,
+}
+
+impl Default for NoiseLevels {
+    /// Documented defaults, used as the start and, scaled by one factor,
+    /// when there are fewer than [`MIN_POSES_FOR_NOISE_ESTIMATE`] poses: a
+    /// robot at 0.1 mm / 0.02 deg and a camera pose from PnP of a board at
+    /// about 0.5 m (rotation 0.05 deg about x and y, 0.01 deg about the
+    /// optical axis; translation 0.05 mm in x and y, 0.3 mm in depth).
+    fn default() -> Self {
+        NoiseLevels {
+            robot_rotation_deg: 0.02,
+            robot_translation_mm: 0.1,
+            camera_rotation_deg: Some([0.05, 0.05, 0.01]),
+            camera_translation_mm: Some([0.05, 0.05, 0.3]),
+            camera_covariance_sigma: None,
+        }
+    }
+}
+
+/// The variance components `s_k` for a camera model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoiseModel {
+    /// The camera model.
+    pub camera: CameraNoise,
+    /// `[robot rot, robot trans, camera...]`: 8 values (diagonal) or 3
+    /// (per-view scale), in rad^2 and m^2.
+    pub variances: Vec<f64>,
+    /// Diagonal model only: per view, the pivot of the camera's rotation
+    /// noise in the camera frame (`R_c p` for a target point `p`), empty for
+    /// the target origin. PnP tilts a board about its centre, not about its
+    /// origin (often a corner): rotating about the origin would make the
+    /// translation noise strongly correlated with the tilts, which a diagonal
+    /// cannot hold. With a pivot, a rotation `w` moves the origin by
+    /// `(R_c p) x w`.
+    pub pivot_levers: Vec<Vector3<f64>>,
+}
+
+impl NoiseModel {
+    /// Start from [`NoiseLevels::default`] (per-view: scale 0.2 px squared).
+    pub fn new(camera: CameraNoise) -> NoiseModel {
+        let d = NoiseLevels::default();
+        let r2 = |deg: f64| deg.to_radians().powi(2);
+        let m2 = |mm: f64| (mm * 1e-3).powi(2);
+        let mut variances = vec![r2(d.robot_rotation_deg), m2(d.robot_translation_mm)];
+        match &camera {
+            CameraNoise::Diagonal => {
+                let (r, t) = (
+                    d.camera_rotation_deg.unwrap_or([0.05; 3]),
+                    d.camera_translation_mm.unwrap_or([0.1; 3]),
+                );
+                variances.extend(r.iter().map(|v| r2(*v)));
+                variances.extend(t.iter().map(|v| m2(*v)));
+            }
+            CameraNoise::PerView(_) => variances.push(0.04),
+        }
+        NoiseModel {
+            camera,
+            variances,
+            pivot_levers: Vec::new(),
+        }
+    }
+
+    /// The levels as standard deviations in report units.
+    pub fn levels(&self) -> NoiseLevels {
+        let s: Vec<f64> = self.variances.iter().map(|v| v.sqrt()).collect();
+        let deg = |i: usize| s[i].to_degrees();
+        let mm = |i: usize| s[i] * 1e3;
+        let diagonal = matches!(self.camera, CameraNoise::Diagonal);
+        NoiseLevels {
+            robot_rotation_deg: deg(0),
+            robot_translation_mm: mm(1),
+            camera_rotation_deg: diagonal.then(|| [deg(2), deg(3), deg(4)]),
+            camera_translation_mm: diagonal.then(|| [mm(5), mm(6), mm(7)]),
+            camera_covariance_sigma: (!diagonal).then(|| s[2]),
+        }
+    }
+
+    /// The component matrices `M_ik` of view `i`.
+    pub fn components(&self, view: usize, lin: &ViewLinearisation) -> Vec<Matrix6<f64>> {
+        let outer = |j: &SMatrix<f64, 6, 6>, cols: std::ops::Range<usize>| {
+            let b = j.columns(cols.start, cols.len());
+            b * b.transpose()
+        };
+        let mut out = vec![outer(&lin.jac_robot, 0..3), outer(&lin.jac_robot, 3..6)];
+        match &self.camera {
+            CameraNoise::Diagonal => {
+                // Noise [w, v_pivot] -> origin noise [w, v_pivot + [R_c p]x w].
+                let jc = match self.pivot_levers.get(view) {
+                    Some(lever) => {
+                        let mut t = Matrix6::identity();
+                        t.fixed_view_mut::<3, 3>(3, 0).copy_from(&skew(lever));
+                        lin.jac_camera * t
+                    }
+                    None => lin.jac_camera,
+                };
+                for k in 0..6 {
+                    out.push(outer(&jc, k..k + 1));
+                }
+            }
+            CameraNoise::PerView(covariances) => {
+                let s = covariances
+                    .get(view)
+                    .copied()
+                    .unwrap_or_else(Matrix6::zeros);
+                out.push(lin.jac_camera * s * lin.jac_camera.transpose());
+            }
+        }
+        out
+    }
+
+    /// The residual covariance `C_i = sum_k s_k M_ik` of view `i`.
+    pub fn covariance(&self, view: usize, lin: &ViewLinearisation) -> Matrix6<f64> {
+        self.components(view, lin)
+            .iter()
+            .zip(&self.variances)
+            .fold(Matrix6::zeros(), |acc, (m, s)| acc + m * *s)
+    }
+
+    /// Scale every level by one factor so that the median squared whitened
+    /// norm `norms2` matches chi-squared(6)'s median (5.348): a robust first
+    /// step when the current levels are far off (then every view looks like
+    /// an outlier and none would take part in [`NoiseModel::update`]).
+    pub fn rescale_to_median(&mut self, norms2: &[f64]) {
+        if norms2.is_empty() {
+            return;
+        }
+        let mut sorted = norms2.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let n = sorted.len();
+        let median = if n % 2 == 1 {
+            sorted[n / 2]
+        } else {
+            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+        };
+        let f = median / CHI2_6_MEDIAN;
+        if f.is_finite() && f > 0.0 {
+            for v in &mut self.variances {
+                *v = (*v * f).max(VARIANCE_FLOOR);
+            }
+        }
+    }
+
+    /// Re-estimate the levels from residuals at a solution: `lins` per
+    /// view, `inlier` marks the views that take part (outliers would inflate
+    /// the levels), `param_cov` the 12 x 12 covariance at that solution.
+    /// With fewer than [`MIN_POSES_FOR_NOISE_ESTIMATE`] inliers only a
+    /// common scale of all components is estimated.
+    pub fn update(
+        &mut self,
+        lins: &[ViewLinearisation],
+        inlier: &[bool],
+        param_cov: &SMatrix<f64, 12, 12>,
+    ) {
+        let used = inlier.iter().filter(|u| **u).count();
+        if used == 0 {
+            return;
+        }
+        let per_component = used >= MIN_POSES_FOR_NOISE_ESTIMATE;
+        for _ in 0..if per_component { 30 } else { 1 } {
+            let k = self.variances.len();
+            let (mut num, mut den) = (vec![0.0; k], vec![0.0; k]);
+            let (mut num_all, mut den_all) = (0.0, 0.0);
+            for (i, lin) in lins.iter().enumerate() {
+                if !inlier[i] {
+                    continue;
+                }
+                let comps = self.components(i, lin);
+                let c = comps
+                    .iter()
+                    .zip(&self.variances)
+                    .fold(Matrix6::zeros(), |acc, (m, s)| acc + m * *s);
+                let Some(w) = c.try_inverse() else { continue };
+                let spread = lin.residual * lin.residual.transpose()
+                    + lin.jac_params * param_cov * lin.jac_params.transpose();
+                let wsw = w * spread * w;
+                for (j, m) in comps.iter().enumerate() {
+                    num[j] += (wsw * m).trace();
+                    den[j] += (w * m).trace();
+                }
+                num_all += (w * spread).trace();
+                den_all += 6.0;
+            }
+            if per_component {
+                for j in 0..k {
+                    if den[j] > 0.0 {
+                        self.variances[j] =
+                            (self.variances[j] * num[j] / den[j]).max(VARIANCE_FLOOR);
+                    }
+                }
+            } else if den_all > 0.0 {
+                let f = num_all / den_all;
+                for v in &mut self.variances {
+                    *v = (*v * f).max(VARIANCE_FLOOR);
+                }
+            }
+        }
+    }
+}

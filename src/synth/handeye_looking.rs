@@ -1,0 +1,185 @@
+//! Seeded hand-eye scenes where the camera actually looks at a planar grid
+//! target (unlike [`super::handeye`]'s OpenCV-style random poses): every
+//! camera pose sits at a given distance from the board centre, tilted up to
+//! a given angle and rolled about its optical axis, and the robot poses
+//! follow from the chain `robot[i] * x * camera[i] = y`. Used by the pose
+//! refinement's tests and the Cramér-Rao benchmark (`examples/handeye_crb.rs`).
+//!
+//! Noise is applied the way [`crate::handeye::pose_residual`] models it:
+//! decoupled left perturbations, `R <- exp(w) R`, `t <- t + v`.
+
+use super::Rng;
+use crate::camera::Camera;
+use crate::handeye::pose_residual::perturb;
+use crate::handeye::reprojection_refine::ViewPoints;
+use crate::handeye::{Pose, Setup};
+use nalgebra::{Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
+
+/// What to generate.
+#[derive(Debug, Clone)]
+pub struct LookingConfig {
+    /// Camera on the gripper or fixed.
+    pub setup: Setup,
+    /// Number of views.
+    pub views: usize,
+    /// Camera-to-board-centre distance (metres), varied by +-10 %.
+    pub distance_m: f64,
+    /// Grid: columns, rows, spacing (metres), points at z = 0.
+    pub grid: (usize, usize, f64),
+    /// Largest angle between the optical axis and the board normal (degrees).
+    pub max_tilt_deg: f64,
+    /// Largest roll about the optical axis (degrees, either sign).
+    pub max_roll_deg: f64,
+}
+
+/// The truth of a scene.
+#[derive(Debug, Clone)]
+pub struct LookingScene {
+    /// The setup.
+    pub setup: Setup,
+    /// True `gripper_from_camera` / `base_from_camera`.
+    pub x_true: Pose,
+    /// True `base_from_target` / `gripper_from_target`.
+    pub y_true: Pose,
+    /// True robot poses.
+    pub base_from_gripper: Vec<Pose>,
+    /// True camera poses.
+    pub camera_from_target: Vec<Pose>,
+    /// The grid points (target frame).
+    pub object_points: Vec<Point3<f64>>,
+}
+
+fn random_rotation(rng: &mut Rng, max_angle: f64) -> UnitQuaternion<f64> {
+    let axis = Vector3::new(rng.normal(), rng.normal(), rng.normal()).normalize();
+    UnitQuaternion::from_scaled_axis(axis * rng.range(0.0, max_angle))
+}
+
+/// Generate a scene from a seed.
+pub fn looking_scene(config: &LookingConfig, seed: u64) -> LookingScene {
+    let mut rng = Rng::new(seed);
+    let (cols, rows, spacing) = config.grid;
+    let object_points: Vec<Point3<f64>> = (0..rows)
+        .flat_map(|r| {
+            (0..cols).map(move |c| Point3::new(c as f64 * spacing, r as f64 * spacing, 0.0))
+        })
+        .collect();
+    let centre = Vector3::new(
+        (cols - 1) as f64 * spacing / 2.0,
+        (rows - 1) as f64 * spacing / 2.0,
+        0.0,
+    );
+    // A camera 5-15 cm off the flange (eye-in-hand) or 1-2 m from the base.
+    let x_t = match config.setup {
+        Setup::EyeInHand => Vector3::new(
+            rng.range(-0.1, 0.1),
+            rng.range(-0.1, 0.1),
+            rng.range(0.05, 0.15),
+        ),
+        Setup::EyeToHand => Vector3::new(
+            rng.range(0.8, 1.5),
+            rng.range(-0.5, 0.5),
+            rng.range(0.5, 1.0),
+        ),
+    };
+    let x_true = Pose::from_parts(Translation3::from(x_t), random_rotation(&mut rng, 3.0));
+    let y_t = match config.setup {
+        Setup::EyeInHand => Vector3::new(
+            rng.range(0.5, 1.0),
+            rng.range(-0.3, 0.3),
+            rng.range(-0.2, 0.2),
+        ),
+        Setup::EyeToHand => Vector3::new(
+            rng.range(-0.1, 0.1),
+            rng.range(-0.1, 0.1),
+            rng.range(0.05, 0.2),
+        ),
+    };
+    let y_true = Pose::from_parts(Translation3::from(y_t), random_rotation(&mut rng, 3.0));
+    let mut scene = LookingScene {
+        setup: config.setup,
+        x_true,
+        y_true,
+        base_from_gripper: Vec::new(),
+        camera_from_target: Vec::new(),
+        object_points,
+    };
+    let board = (cols as f64 * spacing).max(rows as f64 * spacing);
+    for _ in 0..config.views {
+        let tilt_axis_angle = rng.range(0.0, std::f64::consts::TAU);
+        let tilt = rng.range(0.0, config.max_tilt_deg.to_radians());
+        let roll = rng.range(-1.0, 1.0) * config.max_roll_deg.to_radians();
+        let tilt_axis = Vector3::new(tilt_axis_angle.cos(), tilt_axis_angle.sin(), 0.0);
+        // Optical axis (target frame): the board normal +z tilted.
+        let z_c = Rotation3::from_scaled_axis(tilt_axis * tilt) * Vector3::z();
+        let aim =
+            centre + Vector3::new(rng.range(-0.05, 0.05), rng.range(-0.05, 0.05), 0.0) * board;
+        let distance = config.distance_m * rng.range(0.9, 1.1);
+        let position = aim - z_c * distance;
+        let x_c0 = Vector3::y().cross(&z_c).normalize();
+        let x_c = Rotation3::from_scaled_axis(z_c * roll) * x_c0;
+        let y_c = z_c.cross(&x_c);
+        let target_from_camera_r =
+            Rotation3::from_matrix_unchecked(nalgebra::Matrix3::from_columns(&[x_c, y_c, z_c]));
+        let target_from_camera = Pose::from_parts(
+            Translation3::from(position),
+            UnitQuaternion::from_rotation_matrix(&target_from_camera_r),
+        );
+        let camera_from_target = target_from_camera.inverse();
+        let robot = y_true * target_from_camera * x_true.inverse();
+        let base_from_gripper = match config.setup {
+            Setup::EyeInHand => robot,
+            Setup::EyeToHand => robot.inverse(),
+        };
+        scene.base_from_gripper.push(base_from_gripper);
+        scene.camera_from_target.push(camera_from_target);
+    }
+    scene
+}
+
+/// A Gaussian decoupled left perturbation: rotation std `sigma_rot` (rad)
+/// and translation std `sigma_t` (m) per axis, each of 3 values.
+pub fn perturbed(rng: &mut Rng, pose: &Pose, sigma_rot: [f64; 3], sigma_t: [f64; 3]) -> Pose {
+    let d = Vector6::new(
+        rng.gaussian(sigma_rot[0]),
+        rng.gaussian(sigma_rot[1]),
+        rng.gaussian(sigma_rot[2]),
+        rng.gaussian(sigma_t[0]),
+        rng.gaussian(sigma_t[1]),
+        rng.gaussian(sigma_t[2]),
+    );
+    perturb(pose, &d)
+}
+
+/// Grid pixels of every view through the true camera poses plus Gaussian
+/// noise `pixel_sigma` per coordinate; points outside the image are left out.
+pub fn grid_pixels(
+    scene: &LookingScene,
+    camera: &Camera,
+    pixel_sigma: f64,
+    rng: &mut Rng,
+) -> Vec<ViewPoints> {
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    scene
+        .camera_from_target
+        .iter()
+        .map(|pose| {
+            let mut view = ViewPoints {
+                object_points: Vec::new(),
+                image_points: Vec::new(),
+            };
+            for p in &scene.object_points {
+                if let Ok(px) = camera.project(&(pose * p)) {
+                    let q = Point2::new(
+                        px.x + rng.gaussian(pixel_sigma),
+                        px.y + rng.gaussian(pixel_sigma),
+                    );
+                    if q.x >= -0.5 && q.y >= -0.5 && q.x <= w - 0.5 && q.y <= h - 0.5 {
+                        view.object_points.push(*p);
+                        view.image_points.push(q);
+                    }
+                }
+            }
+            view
+        })
+        .collect()
+}
