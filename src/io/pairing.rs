@@ -55,8 +55,10 @@ pub fn number_in_name(name: &str) -> Option<&str> {
     let stem = stem(name);
     let end = stem.rfind(|c: char| c.is_ascii_digit())? + 1;
     let start = stem[..end]
-        .rfind(|c: char| !c.is_ascii_digit())
-        .map_or(0, |i| i + 1);
+        .char_indices()
+        .rev()
+        .find(|(_, c)| !c.is_ascii_digit())
+        .map_or(0, |(i, c)| i + c.len_utf8());
     let digits = stem[start..end].trim_start_matches('0');
     Some(if digits.is_empty() {
         &stem[end - 1..end]
@@ -179,6 +181,10 @@ mod tests {
         assert_eq!(number_in_name("shot_000.png"), Some("0"));
         assert_eq!(number_in_name("left"), None);
         assert_eq!(number_in_name("2024-05-01_14"), Some("14"));
+        // A multi-byte character before the digits (found by fuzzing: the
+        // start of the run was taken one byte after the character's start).
+        assert_eq!(number_in_name("spy_px\u{bf}76acing_m"), Some("76"));
+        assert_eq!(number_in_name("Bild_über_12.png"), Some("12"));
     }
 
     #[test]
