@@ -439,3 +439,31 @@ fn the_memory_limit_names_the_limit() {
         "image is 67x45 = 3015 pixels, more than the limit of 3000 pixels: downscale it first, or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)"
     );
 }
+
+#[wasm_bindgen_test(unsupported = test)]
+fn grey_palettes_are_listed_as_grey_true_colour_as_rgb() {
+    use ::image::ImageFormat as F;
+    let gray = card_gray();
+    let luma = ::image::GrayImage::from_raw(W, H, gray.clone()).expect("card size");
+    let rgb = ::image::RgbImage::from_raw(W, H, card_rgb()).expect("card size");
+    // `image` writes a grey image as an 8-bit BMP with a grey palette and
+    // expands the palette to RGB when it reads the file back.
+    let bmp = encode_with_image(F::Bmp, DynamicImage::ImageLuma8(luma.clone()));
+    assert_eq!(u16::from_le_bytes([bmp[28], bmp[29]]), 8, "bits per pixel");
+    let d = decoded(&bmp);
+    assert_eq!((d.info.channels, d.info.bits_per_channel), (1, 8));
+    assert_eq!(d.gray.pixels, gray);
+    let gif = encode_with_image(F::Gif, DynamicImage::ImageLuma8(luma).into_rgba8().into());
+    assert_eq!(decoded(&gif).info.channels, 1);
+    let colour = decoded(&encode_with_image(F::Bmp, DynamicImage::ImageRgb8(rgb)));
+    assert_eq!((colour.info.channels, colour.info.bits_per_channel), (3, 8));
+    // A 24-bit BMP stays RGB even when its pixels are grey: the file is RGB.
+    let grey_rgb =
+        DynamicImage::ImageLuma8(::image::GrayImage::from_raw(W, H, gray).expect("card size"))
+            .into_rgb8();
+    let d = decoded(&encode_with_image(
+        F::Bmp,
+        DynamicImage::ImageRgb8(grey_rgb),
+    ));
+    assert_eq!(d.info.channels, 3);
+}

@@ -215,15 +215,21 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
         .and_then(|()| decoder.set_limits(limits))
         .map_err(|e| image_error(format, e, options))?;
     let color = decoder.original_color_type();
-    let channels = color.channel_count();
+    let mut channels = color.channel_count();
+    let mut bits_per_channel = (color.bits_per_pixel() / channels.max(1) as u16) as u8;
+    let image = DynamicImage::from_decoder(decoder).map_err(|e| image_error(format, e, options))?;
+    if indexed(format, bytes) && all_grey(&image) {
+        // `image` expands palettes to RGB: an 8-bit BMP or a GIF of a mono
+        // camera (a palette of greys) would be listed as "RGB".
+        (channels, bits_per_channel) = (1, 8);
+    }
     let info = ImageInfo {
         format,
         width,
         height,
         channels,
-        bits_per_channel: (color.bits_per_pixel() / channels.max(1) as u16) as u8,
+        bits_per_channel,
     };
-    let image = DynamicImage::from_decoder(decoder).map_err(|e| image_error(format, e, options))?;
     let preview = options.preview_max_side.map(|side| preview(&image, side));
     let luma = image.into_luma8();
     let gray = GrayImage::new(luma.width(), luma.height(), luma.into_raw())?;
@@ -232,6 +238,31 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
         gray,
         preview,
     })
+}
+
+/// Whether the file stores palette indices: every GIF, and a BMP of at most
+/// 8 bits per pixel (the `biBitCount` field at byte 28 of the file; `image`
+/// does not report it).
+fn indexed(format: ImageFormat, bytes: &[u8]) -> bool {
+    match format {
+        ImageFormat::Gif => true,
+        ImageFormat::Bmp => bytes
+            .get(28..30)
+            .is_some_and(|b| u16::from_le_bytes([b[0], b[1]]) <= 8),
+        _ => false,
+    }
+}
+
+/// Whether every pixel of an 8-bit RGB(A) image has R = G = B (and is
+/// opaque): grey content stored as colour.
+fn all_grey(image: &DynamicImage) -> bool {
+    match image {
+        DynamicImage::ImageRgb8(rgb) => rgb.pixels().all(|p| p[0] == p[1] && p[1] == p[2]),
+        DynamicImage::ImageRgba8(rgba) => rgba
+            .pixels()
+            .all(|p| p[0] == p[1] && p[1] == p[2] && p[3] == 255),
+        _ => false,
+    }
 }
 
 fn limits(options: &DecodeOptions) -> Limits {

@@ -7,7 +7,7 @@ import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { root } from './harness.mjs';
-import { makePng, makeBmp, checker } from '../support/images.mjs';
+import { makePng, makeBmp, makeBmp8, checker } from '../support/images.mjs';
 
 export const tests = [
   ['engine loads in a worker', async (page, { url, shot }) => {
@@ -22,12 +22,13 @@ export const tests = [
     await page.setInputFiles('#file-input', [
       { name: 'board.png', mimeType: 'image/png', buffer: makePng(160, 120, checker(20)) },
       { name: 'plate.bmp', mimeType: 'image/bmp', buffer: makeBmp(90, 70, checker(10)) },
+      { name: 'mono.bmp', mimeType: 'image/bmp', buffer: makeBmp8(80, 60, checker(10)) },
       { name: 'broken.jpg', mimeType: 'image/jpeg', buffer: Buffer.from('this is not a jpeg at all') },
     ]);
-    await page.waitForFunction(() => document.querySelectorAll('.card.ok, .card.warn, .card.error').length === 3
+    await page.waitForFunction(() => document.querySelectorAll('.card.ok, .card.warn, .card.error').length === 4
       && !document.querySelector('.card.pending') && !/in progress/.test(document.getElementById('image-summary').textContent), null, { timeout: 30000 });
     await page.locator('#progress-row[hidden]').waitFor({ state: 'attached', timeout: 30000 });
-    await shot('three-cards');
+    await shot('four-cards');
     const cards = await page.$$eval('.card', (els) => els.map((el) => ({
       name: el.querySelector('.name').textContent,
       error: el.classList.contains('error'),
@@ -39,6 +40,8 @@ export const tests = [
     assert.deepEqual(cards, [
       { name: 'board.png', error: false, meta: 'PNG · 160×120 px · RGB, 8-bit', thumb: [160, 120] },
       { name: 'plate.bmp', error: false, meta: 'BMP · 90×70 px · RGB, 8-bit', thumb: [90, 70] },
+      // An 8-bit palette of greys is listed as grey, not as the RGB the palette expands to.
+      { name: 'mono.bmp', error: false, meta: 'BMP · 80×60 px · grey, 8-bit', thumb: [80, 60] },
       { name: 'broken.jpg', error: true, meta: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP', thumb: null },
     ]);
     // The thumbnail holds the decoded pixels: a white square at (30, 10), black at (10, 10).
@@ -47,7 +50,7 @@ export const tests = [
       return [ctx.getImageData(10, 10, 1, 1).data[0], ctx.getImageData(30, 10, 1, 1).data[0]];
     });
     assert.deepEqual(px, [0, 255]);
-    assert.match(await page.textContent('#image-summary'), /^3 files, 2 decoded, 1 failed/);
+    assert.match(await page.textContent("#image-summary"), /^4 files, 3 decoded, 1 failed/);
   }],
 ];
 

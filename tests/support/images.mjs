@@ -69,6 +69,29 @@ export function makeBmp(width, height, pixel) {
   return out;
 }
 
+/** An 8-bit palette BMP of greys (as mono industrial cameras write): 256 palette entries (v, v, v). */
+export function makeBmp8(width, height, pixel) {
+  const stride = Math.ceil(width / 4) * 4;
+  const offset = 54 + 256 * 4;
+  const size = offset + stride * height;
+  const out = Buffer.alloc(size);
+  out.write('BM', 0, 'ascii');
+  out.writeUInt32LE(size, 2);
+  out.writeUInt32LE(offset, 10);
+  out.writeUInt32LE(40, 14);
+  out.writeInt32LE(width, 18);
+  out.writeInt32LE(height, 22);
+  out.writeUInt16LE(1, 26);
+  out.writeUInt16LE(8, 28);
+  out.writeUInt32LE(stride * height, 34);
+  out.writeUInt32LE(256, 46);
+  for (let v = 0; v < 256; v++) out.set([v, v, v, 0], 54 + 4 * v);
+  for (let y = 0; y < height; y++) {
+    for (let x = 0; x < width; x++) out[offset + (height - 1 - y) * stride + x] = pixel(x, y)[0];
+  }
+  return out;
+}
+
 /** A chessboard pattern: squares of `side` px, black and white. */
 export const checker = (side) => (x, y) => {
   const v = (Math.floor(x / side) + Math.floor(y / side)) % 2 ? 255 : 0;
