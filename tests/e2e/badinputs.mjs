@@ -313,7 +313,7 @@ export const tests = [
   // ---- step 3, camera: the solve refuses, the images stay, a fix solves ----
   ['camera-one-view', async (page, { url, shot }) => {
     await loadDemoImages(page, url, [], 1);
-    assert.equal(await solveCamera(page), 'requires at least 3 views, got 1');
+    assert.equal(await solveCamera(page), "views: 1 view with the target found, a calibration needs at least 3 (10 or more from varied angles are recommended): add images in which the whole target is found, or check the target's size (inner corners for a chessboard)");
     await shot('bad');
     await page.click('a[data-step=images]');
     await page.setInputFiles('#file-input', demo().images.slice(1));
