@@ -180,6 +180,16 @@ fn components(mask: &[bool], w: usize, h: usize) -> Vec<Blob> {
     blobs
 }
 
+/// A blob's sub-pixel outline: the ellipse fitted to its edge points, and
+/// the points themselves (full-resolution pixels), which the
+/// perspective-correct centres of [`super::centres`] fit again in board
+/// coordinates.
+#[derive(Debug, Clone)]
+pub(crate) struct Outline {
+    pub ellipse: EllipseFit,
+    pub edges: Vec<Point2<f64>>,
+}
+
 /// Sub-pixel ellipse of a dark blob at full resolution. `centre`/`cov` are
 /// the blob's moments scaled to full resolution; edge points are where each
 /// ray's profile crosses the mid level between the blob's inside and the
@@ -189,7 +199,7 @@ pub(crate) fn refine_blob(
     centre: Point2<f64>,
     cov: &Matrix2<f64>,
     invert: bool,
-) -> Option<EllipseFit> {
+) -> Option<Outline> {
     let plane_at = |x: f64, y: f64| -> f64 {
         let v = bilinear_u8(img, x, y);
         if invert {
@@ -223,7 +233,7 @@ pub(crate) fn refine_blob(
             return None;
         }
         c = f.centre;
-        fit = Some(f);
+        fit = Some(Outline { ellipse: f, edges });
     }
     fit
 }
@@ -338,7 +348,9 @@ mod tests {
         let img = GrayImage::new(w as u32, h as u32, px).unwrap();
         let blobs = find_blobs(&Plane::from_gray(&img), false);
         assert_eq!(blobs.len(), 1);
-        let f = refine_blob(&img, blobs[0].centre, &blobs[0].cov, false).unwrap();
+        let f = refine_blob(&img, blobs[0].centre, &blobs[0].cov, false)
+            .unwrap()
+            .ellipse;
         // Supersampling and 8-bit rounding: truth within ~0.02 px.
         assert!(
             (f.centre.x - cx).abs() < 0.02 && (f.centre.y - cy).abs() < 0.02,

@@ -36,6 +36,7 @@
 //! of two smoothing passes.
 
 mod blobs;
+mod centres;
 pub(crate) mod chessboard;
 mod circles;
 mod ellipse;
@@ -47,6 +48,7 @@ mod squares;
 
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
+pub use crate::target::CentreModel;
 use crate::target::{Detection, Target};
 use filter::Plane;
 
@@ -61,12 +63,18 @@ pub struct DetectOptions {
     /// at least 2048). Corners are
     /// always refined at full resolution.
     pub max_working_side_px: u32,
+    /// Which point of each imaged circle circle grids and dot plates report
+    /// (default [`CentreModel::PerspectivePole`]; `EllipseCentre` turns
+    /// the perspective correction off, for comparison). Recorded in the
+    /// detection as `centre_model`.
+    pub circle_centres: CentreModel,
 }
 
 impl Default for DetectOptions {
     fn default() -> Self {
         DetectOptions {
             max_working_side_px: 256,
+            circle_centres: CentreModel::default(),
         }
     }
 }
@@ -95,6 +103,10 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
         });
     }
     let target = target.clone().validated()?;
+    let centre_model = match &target {
+        Target::CircleGrid { .. } | Target::DotPlate { .. } => Some(options.circle_centres),
+        Target::Chessboard { .. } | Target::SingleCircle { .. } | Target::SquareGrid { .. } => None,
+    };
     let points = match &target {
         Target::Chessboard { cols, rows, .. } => {
             chessboard::detect_chessboard(image, *cols, *rows, options)?
@@ -128,6 +140,7 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
         image_size_px: [w, h],
         target,
         points,
+        centre_model,
     })
 }
 
