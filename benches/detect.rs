@@ -62,9 +62,13 @@ fn scene(
 ) -> robocal::image::GrayImage {
     let target = Target::parse_spec(spec).expect("spec");
     let pose = board_pose(&target, rpy, (0.004, 0.01, z));
-    render(cam, &target, &pose, &RenderOptions::default())
-        .expect("render")
-        .image
+    let r = render(cam, &target, &pose, &RenderOptions::default()).expect("render");
+    assert_eq!(
+        r.points.len(),
+        target.point_count(),
+        "{spec}: whole board in view"
+    );
+    r.image
 }
 
 fn time(
@@ -113,8 +117,8 @@ fn main() {
     }
     let squares = "squares:8x8:12.7mm:22.5778mm";
     for (name, rpy, z) in [
-        ("squares 8x8 VGA, frontal", (0.05, 0.1, 0.02), 0.3),
-        ("squares 8x8 VGA, 40 deg", (0.5, -0.45, 0.1), 0.36),
+        ("squares 8x8 VGA, frontal", (0.05, 0.1, 0.02), 0.42),
+        ("squares 8x8 VGA, 40 deg", (0.5, -0.45, 0.1), 0.48),
     ] {
         time(
             name,

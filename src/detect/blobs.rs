@@ -297,6 +297,14 @@ pub(crate) fn bilinear_u8(img: &GrayImage, x: f64, y: f64) -> f64 {
         img.pixels[yc * w as usize + xc] as f64
     };
     let (xi, yi) = (x0 as isize, y0 as isize);
+    if xi >= 0 && yi >= 0 && xi + 1 < w && yi + 1 < h {
+        // Inside: the four pixels without clamping (the same value).
+        let i = yi as usize * w as usize + xi as usize;
+        let row = &img.pixels[i..i + 2];
+        let next = &img.pixels[i + w as usize..i + w as usize + 2];
+        return (row[0] as f64 * (1.0 - fx) + row[1] as f64 * fx) * (1.0 - fy)
+            + (next[0] as f64 * (1.0 - fx) + next[1] as f64 * fx) * fy;
+    }
     (get(xi, yi) * (1.0 - fx) + get(xi + 1, yi) * fx) * (1.0 - fy)
         + (get(xi, yi + 1) * (1.0 - fx) + get(xi + 1, yi + 1) * fx) * fy
 }
