@@ -106,7 +106,7 @@ pub(crate) fn detect_grid(
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    let centres = circle_centres(&board, &outlines, options.circle_centres);
+    let centres = circle_centres(&board, asymmetric, &outlines, options.circle_centres);
     Ok(outlines
         .iter()
         .zip(centres)
