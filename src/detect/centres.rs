@@ -15,9 +15,9 @@
 //! # How (no camera needed)
 //!
 //! Each circle gets a **local board-to-image map** fitted to the current
-//! centres of the grid points in a window of `2 WINDOW_HALF_CELLS + 1`
-//! lattice cells per axis around it (shifted inside the board at its
-//! edges), so lens distortion, which no global homography follows, enters
+//! centres of the grid points in a window around it (3x3 cells on
+//! symmetric grids and dot plates, +-2 half-pitch cells on asymmetric
+//! ones; shifted inside the board at its edges), so lens distortion, which no global homography follows, enters
 //! only through its variation across one window. The circle's sub-pixel
 //! edge points are pulled back through the map onto the board, where they
 //! lie on a circle; the centre of the ellipse fitted there is mapped
