@@ -13,6 +13,9 @@ time ratio robocal / OpenCV.
 Usage (crate root):
   python3 bench/compare_opencv.py [--quick] [--skip-render] [--repeat N [--interleave]]
 
+Circle sets also get a row for `robocal detect --circle-centres
+ellipse_centre` (the centres without the perspective correction).
+
 --repeat N: run `robocal detect` N times and call each OpenCV function N
 times per image; every time is then the per-image median of N (default 1:
 one cold call each). On a shared machine single calls vary by 2-3x.
@@ -136,6 +139,19 @@ def main():
                     r_times[k] = float(np.median(rt))
                 paired[(first, f)] = float(np.median(ot))
         rows = [summarize("robocal", r_found, r_err, [t for t in r_times if t == t])]
+        if s["target"].startswith("circles"):
+            # The same detector without the perspective correction of circle
+            # centres (issue 20), for comparison.
+            plain_json = os.path.join(OUT, set_name + ".ellipse.robocal.json")
+            subprocess.run([robocal, "detect", "--threads", "1", "--circle-centres", "ellipse_centre",
+                            "--target", s["target"], "-o", plain_json] + files, cwd=ROOT, stderr=subprocess.DEVNULL)
+            e_err, e_times, e_found = [], [], 0
+            for im, gt in zip(json.load(open(plain_json))["images"], gts):
+                if "detection" in im:
+                    e_found += 1
+                    e_err.append(errors([[p["x_px"], p["y_px"]] for p in im["detection"]["points"]], gt))
+                    e_times.append(im["detect_ms"])
+            rows.append(summarize("robocal --circle-centres ellipse_centre", e_found, e_err, e_times))
         ratios = {}
         for mname, fn in methods.items():
             errs, times, found = [], [], 0

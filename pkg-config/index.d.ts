@@ -173,7 +173,16 @@ export interface Detection {
   target: Target;
   /** Detected points, sorted by id; ids missing from a partial detection are absent. */
   points: DetectedPoint[];
+  /**
+   * Circle grids and dot plates: which point of each imaged circle `points` are
+   * (`perspective_pole`, the default: the image of the circle's centre; `local_quadratic`;
+   * `ellipse_centre`: uncorrected). Absent for other targets and in older files.
+   */
+  centre_model?: CentreModel;
 }
+
+/** How circle centres are estimated (docs/detection-json.md). */
+export type CentreModel = 'perspective_pole' | 'local_quadratic' | 'ellipse_centre';
 
 // ---------------------------------------------------------------------------
 // Camera and lens models (src/camera)

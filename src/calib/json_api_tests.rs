@@ -101,6 +101,7 @@ fn detections_carry_the_image_size_and_method_all_adds_the_comparison() {
                 image_size_px: [1280, 960],
                 target: target.clone(),
                 points,
+                centre_model: None,
             };
             json!({"name": v.name, "detection": detection})
         })

@@ -4,7 +4,7 @@
 use super::{parse_target, read_file, CliError, ImageLimits};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use robocal::detect::{detect, DetectOptions};
+use robocal::detect::{detect, CentreModel, DetectOptions};
 use robocal::image::DecodeOptions;
 use robocal::target::{Detection, Target};
 use serde_json::json;
@@ -48,6 +48,12 @@ pub struct DetectArgs {
     /// are always refined at full size)
     #[arg(long, value_name = "N")]
     max_side: Option<u32>,
+    /// Circle grids and dot plates: which point of each imaged circle is
+    /// reported (default perspective_pole: the image of the circle's centre;
+    /// ellipse_centre turns the perspective correction off, for comparison;
+    /// written to each detection as "centre_model")
+    #[arg(long, value_name = "MODEL", value_parser = ["perspective_pole", "local_quadratic", "ellipse_centre"])]
+    circle_centres: Option<String>,
     #[command(flatten)]
     limits: ImageLimits,
     /// The images
@@ -77,6 +83,11 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
         max_working_side_px: args
             .max_side
             .unwrap_or(DetectOptions::default().max_working_side_px),
+        circle_centres: CentreModel::ALL
+            .into_iter()
+            .find(|m| Some(m.name()) == args.circle_centres.as_deref())
+            .unwrap_or_default(),
+        ..DetectOptions::default()
     };
     let files = &args.images;
     let decode = args.limits.decode_options();

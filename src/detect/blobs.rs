@@ -180,6 +180,16 @@ fn components(mask: &[bool], w: usize, h: usize) -> Vec<Blob> {
     blobs
 }
 
+/// A blob's sub-pixel outline: the ellipse fitted to its edge points, and
+/// the points themselves (full-resolution pixels), which the
+/// perspective-correct centres of [`super::centres`] fit again in board
+/// coordinates.
+#[derive(Debug, Clone)]
+pub(crate) struct Outline {
+    pub ellipse: EllipseFit,
+    pub edges: Vec<Point2<f64>>,
+}
+
 /// Sub-pixel ellipse of a dark blob at full resolution. `centre`/`cov` are
 /// the blob's moments scaled to full resolution; edge points are where each
 /// ray's profile crosses the mid level between the blob's inside and the
@@ -189,7 +199,7 @@ pub(crate) fn refine_blob(
     centre: Point2<f64>,
     cov: &Matrix2<f64>,
     invert: bool,
-) -> Option<EllipseFit> {
+) -> Option<Outline> {
     let plane_at = |x: f64, y: f64| -> f64 {
         let v = bilinear_u8(img, x, y);
         if invert {
@@ -223,7 +233,7 @@ pub(crate) fn refine_blob(
             return None;
         }
         c = f.centre;
-        fit = Some(f);
+        fit = Some(Outline { ellipse: f, edges });
     }
     fit
 }
@@ -287,6 +297,14 @@ pub(crate) fn bilinear_u8(img: &GrayImage, x: f64, y: f64) -> f64 {
         img.pixels[yc * w as usize + xc] as f64
     };
     let (xi, yi) = (x0 as isize, y0 as isize);
+    if xi >= 0 && yi >= 0 && xi + 1 < w && yi + 1 < h {
+        // Inside: the four pixels without clamping (the same value).
+        let i = yi as usize * w as usize + xi as usize;
+        let row = &img.pixels[i..i + 2];
+        let next = &img.pixels[i + w as usize..i + w as usize + 2];
+        return (row[0] as f64 * (1.0 - fx) + row[1] as f64 * fx) * (1.0 - fy)
+            + (next[0] as f64 * (1.0 - fx) + next[1] as f64 * fx) * fy;
+    }
     (get(xi, yi) * (1.0 - fx) + get(xi + 1, yi) * fx) * (1.0 - fy)
         + (get(xi, yi + 1) * (1.0 - fx) + get(xi + 1, yi + 1) * fx) * fy
 }
@@ -338,7 +356,9 @@ mod tests {
         let img = GrayImage::new(w as u32, h as u32, px).unwrap();
         let blobs = find_blobs(&Plane::from_gray(&img), false);
         assert_eq!(blobs.len(), 1);
-        let f = refine_blob(&img, blobs[0].centre, &blobs[0].cov, false).unwrap();
+        let f = refine_blob(&img, blobs[0].centre, &blobs[0].cov, false)
+            .unwrap()
+            .ellipse;
         // Supersampling and 8-bit rounding: truth within ~0.02 px.
         assert!(
             (f.centre.x - cx).abs() < 0.02 && (f.centre.y - cy).abs() < 0.02,

@@ -4,6 +4,7 @@
 //! refined at full resolution.
 
 use super::blobs::{find_blobs, refine_blob, Blob};
+use super::centres::circle_centres;
 use super::filter::to_full;
 use super::lattice::{self, PointIndex};
 use super::DetectOptions;
@@ -92,20 +93,26 @@ pub(crate) fn detect_grid(
             return Err(Error::NotFound { message });
         }
     };
-    order
+    let outlines = order
         .iter()
         .enumerate()
         .map(|(id, &i)| {
             let (c, cov) = to_full_blob(&blobs[i], level);
-            let fit = refine_blob(img, c, &cov, invert).ok_or_else(|| Error::NotFound {
+            refine_blob(img, c, &cov, invert).ok_or_else(|| Error::NotFound {
                 message: format!(
                     "circle {id} at ({:.1}, {:.1}) px has no clean edge",
                     c.x, c.y
                 ),
-            })?;
-            Ok(point(id, &fit))
+            })
         })
-        .collect()
+        .collect::<Result<Vec<_>>>()?;
+    let centres = circle_centres(&board, asymmetric, &outlines, options.circle_centres);
+    Ok(outlines
+        .iter()
+        .zip(centres)
+        .enumerate()
+        .map(|(id, (o, c))| point(id, c, &o.ellipse))
+        .collect())
 }
 
 fn describe(target: &Target) -> String {
@@ -130,11 +137,14 @@ fn describe(target: &Target) -> String {
     }
 }
 
-fn point(id: usize, fit: &super::ellipse::EllipseFit) -> DetectedPoint {
+/// A point at `centre` with the covariance of the ellipse fit's centre (the
+/// perspective correction moves the centre by a smooth function of the same
+/// edge points, which leaves the covariance to first order).
+fn point(id: usize, centre: Point2<f64>, fit: &super::ellipse::EllipseFit) -> DetectedPoint {
     DetectedPoint {
         id,
-        x_px: fit.centre.x,
-        y_px: fit.centre.y,
+        x_px: centre.x,
+        y_px: centre.y,
         covariance_px2: Some([
             fit.covariance[(0, 0)],
             fit.covariance[(0, 1)],
@@ -269,5 +279,5 @@ pub(crate) fn detect_single(img: &GrayImage, options: &DetectOptions) -> Result<
             c.x, c.y
         ),
     })?;
-    Ok(point(0, &fit))
+    Ok(point(0, fit.ellipse.centre, &fit.ellipse))
 }

@@ -152,6 +152,11 @@ pub struct Detection {
     pub target: Target,
     /// Detected points, sorted by id.
     pub points: Vec<DetectedPoint>,
+    /// Circle grids and dot plates: which point of each imaged circle the
+    /// points are (absent for other targets and in files written before
+    /// the key existed, whose circle centres are ellipse centres).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre_model: Option<CentreModel>,
 }
 
 impl Detection {
@@ -518,7 +523,10 @@ fn parse_length(text: &str) -> Result<f64> {
         .unwrap_or(v * 10f64.powi(exponent)))
 }
 
+mod centre_model;
 pub mod svg;
+
+pub use centre_model::CentreModel;
 
 #[cfg(test)]
 mod tests;

@@ -147,11 +147,25 @@ fn detection_round_trips_through_json() {
                 covariance_px2: Some([1.0, 0.0, 1.0]),
             },
         ],
+        centre_model: None,
     };
     let json = serde_json::to_string(&d).unwrap();
     assert!(json.contains("\"kind\":\"chessboard\""), "{json}");
+    assert!(!json.contains("centre_model"), "{json}");
     let back: Detection = serde_json::from_str(&json).unwrap();
     assert_eq!(back, d);
+    // A circle grid's centre model round-trips by its name.
+    let circles = Detection {
+        target: Target::parse_spec("circles:4x11:20mm:asymmetric").unwrap(),
+        centre_model: Some(CentreModel::PerspectivePole),
+        ..d.clone()
+    };
+    let json = serde_json::to_string(&circles).unwrap();
+    assert!(
+        json.contains("\"centre_model\":\"perspective_pole\""),
+        "{json}"
+    );
+    assert_eq!(serde_json::from_str::<Detection>(&json).unwrap(), circles);
     let (object, image) = d.correspondences();
     // id 99 does not exist on a 3x2 board and is dropped.
     assert_eq!(object.len(), 1);

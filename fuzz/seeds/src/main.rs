@@ -109,6 +109,9 @@ fn small_renders() -> Res<Vec<Render>> {
                 image_size_px: [w, h],
                 target: target.clone(),
                 points: rendered.points,
+                // Exact projections of the board points (for circle
+                // targets what `perspective_pole` estimates); no model key.
+                centre_model: None,
             };
             out.push(Render {
                 kind,

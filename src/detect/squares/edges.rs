@@ -84,6 +84,7 @@ pub(super) fn refine_square(
     // Curves from the previous pass (sides k = corner k -> k + 1).
     let mut curves: Option<Vec<Curve>> = None;
     let mut half_window = 3.0f64;
+    let mut scratch = Profile::default();
     for pass in 0..PASSES {
         let search = if pass == 0 {
             (0.2 * side_px).min(0.35 * gap_px - half_window).max(1.0)
@@ -134,14 +135,19 @@ pub(super) fn refine_square(
                     None => m + t * u,
                 };
                 if let Some((s, width)) =
-                    edge_on_profile(img, base, nrm, search, half_window, inside)
+                    edge_on_profile(img, base, nrm, search, half_window, inside, &mut scratch)
                 {
                     let e = base + nrm * s;
                     let d = e - m;
                     edge_pts.push((d.dot(&t), d.dot(&nrm)));
                     widths.push(width);
                 }
-                u += PROFILE_SPACING_PX;
+                u += if pass == 0 {
+                    // At least MIN_FIRST_PASS_PROFILES profiles per side.
+                    (len / MIN_FIRST_PASS_PROFILES).clamp(PROFILE_SPACING_PX, FIRST_PASS_SPACING_PX)
+                } else {
+                    PROFILE_SPACING_PX
+                };
             }
             let span = (-0.5 * len + e0, 0.5 * len - e1);
             let f = fit_side(m, t, nrm, &edge_pts, span, model)?;
@@ -164,7 +170,15 @@ pub(super) fn refine_square(
             }
             next.push((c, cov));
         }
+        let moved = next
+            .iter()
+            .zip(&corners)
+            .map(|(a, b)| (a.0 - b.0).norm())
+            .fold(0.0, f64::max);
         corners = next;
+        if pass > 0 && moved <= CONVERGED_PX {
+            break;
+        }
         // The next pass's profiles follow each side's first curve (the two
         // half-side segments of a side nearly coincide).
         curves = Some(fitted.iter().map(|f| f[0].clone()).collect());
@@ -268,6 +282,14 @@ fn fit_poly(
 /// the grey level (dark inside to light outside), then the centroid of the
 /// derivative in a window of half-width `half_window` moved onto it.
 /// Returns the offset `s` and the edge's blur (the derivative's sd).
+/// A profile's samples and derivative, reused from profile to profile (no
+/// allocation per profile).
+#[derive(Default)]
+pub(super) struct Profile {
+    vals: Vec<f64>,
+    deriv: Vec<f64>,
+}
+
 fn edge_on_profile(
     img: &GrayImage,
     base: Point2<f64>,
@@ -275,28 +297,30 @@ fn edge_on_profile(
     search: f64,
     half_window: f64,
     inside: f64,
+    scratch: &mut Profile,
 ) -> Option<(f64, f64)> {
     let reach = search + half_window + 0.5;
     let count = (2.0 * reach / PROFILE_STEP_PX).ceil() as usize + 1;
     let s0 = -reach;
     let at = |k: usize| s0 + k as f64 * PROFILE_STEP_PX;
-    let vals: Vec<f64> = (0..count)
-        .map(|k| {
-            let p = base + n * at(k);
-            bilinear_u8(img, p.x, p.y)
-        })
-        .collect();
-    // Derivative over one pixel (two samples either side), at sample k.
+    let Profile { vals, deriv } = scratch;
+    vals.clear();
+    vals.extend((0..count).map(|k| {
+        let p = base + n * at(k);
+        bilinear_u8(img, p.x, p.y)
+    }));
+    // Derivative over one pixel (the samples half a pixel either side),
+    // at sample k.
     let half = (0.5 / PROFILE_STEP_PX).round() as usize;
-    let deriv: Vec<f64> = (0..count)
-        .map(|k| {
-            if k < half || k + half >= count {
-                0.0
-            } else {
-                vals[k + half] - vals[k - half]
-            }
-        })
-        .collect();
+    deriv.clear();
+    deriv.extend((0..count).map(|k| {
+        if k < half || k + half >= count {
+            0.0
+        } else {
+            vals[k + half] - vals[k - half]
+        }
+    }));
+    let (vals, deriv) = (&vals[..], &deriv[..]);
     let mut best: Option<(usize, f64)> = None;
     for (k, d) in deriv.iter().enumerate() {
         if at(k).abs() <= search && best.map_or(true, |b| *d > b.1) {
@@ -316,7 +340,12 @@ fn edge_on_profile(
     let mut width = 0.0;
     for _ in 0..4 {
         let (mut sw, mut sws, mut swss) = (0.0, 0.0, 0.0);
-        for (k, d) in deriv.iter().enumerate() {
+        // Only the samples near the window (one spare either side; the
+        // test below decides, exactly as over the whole profile).
+        let first = ((centre - half_window - s0) / PROFILE_STEP_PX - 1.0).max(0.0) as usize;
+        let last =
+            (((centre + half_window - s0) / PROFILE_STEP_PX + 2.0).max(0.0) as usize).min(count);
+        for (k, d) in deriv.iter().enumerate().take(last).skip(first) {
             let s = at(k);
             if (s - centre).abs() <= half_window {
                 sw += d;
