@@ -112,7 +112,10 @@ fn method_all_prints_the_comparison_table() {
     ] {
         assert!(stderr.contains(line), "{line} in {stderr}");
     }
-    assert!(!stderr.contains("\ndlt "), "a DLT row on flat boards: {stderr}");
+    assert!(
+        !stderr.contains("\ndlt "),
+        "a DLT row on flat boards: {stderr}"
+    );
 }
 
 #[test]

@@ -327,8 +327,14 @@ fn pairing(text: &str) {
         let mut seen_left = vec![false; left.len()];
         let mut seen_right = vec![false; right.len()];
         for &(l, r) in &found.pairs {
-            assert!(!std::mem::replace(&mut seen_left[l], true), "left {l} paired twice");
-            assert!(!std::mem::replace(&mut seen_right[r], true), "right {r} paired twice");
+            assert!(
+                !std::mem::replace(&mut seen_left[l], true),
+                "left {l} paired twice"
+            );
+            assert!(
+                !std::mem::replace(&mut seen_right[r], true),
+                "right {r} paired twice"
+            );
         }
     }
 }
