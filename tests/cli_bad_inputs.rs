@@ -109,7 +109,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "chessboard:9x6:0mm", "a.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: sizes must be positive metres (see 'robocal detect --help')",
+        message: "robocal: detect: target: the square size must be a positive length, got 0 mm (see 'robocal detect --help')",
     },
     Case {
         name: "spec-nan-size",
@@ -117,7 +117,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "chessboard:9x6:NaNmm", "a.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: sizes must be positive metres (see 'robocal detect --help')",
+        message: "robocal: detect: target: the square size must be a positive length, got NaN (see 'robocal detect --help')",
     },
     Case {
         name: "spec-unknown-kind",
@@ -323,7 +323,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "chessboard:9x6:-30mm", "x.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: sizes must be positive metres (see 'robocal detect --help')",
+        message: "robocal: detect: target: the square size must be a positive length, got -30 mm (see 'robocal detect --help')",
     },
     Case {
         name: "export-empty-file",

@@ -344,21 +344,29 @@ impl Target {
                 ),
             ));
         }
-        let lengths: Vec<f64> = match &self {
-            Target::Chessboard { square_m, .. } => vec![*square_m],
-            Target::CircleGrid { spacing_m, .. } => vec![*spacing_m],
+        let lengths: Vec<(&str, f64)> = match &self {
+            Target::Chessboard { square_m, .. } => vec![("square size", *square_m)],
+            Target::CircleGrid { spacing_m, .. } => vec![("circle spacing", *spacing_m)],
             Target::DotPlate {
                 pitch_m,
                 dot_diameter_m,
                 ..
-            } => vec![*pitch_m, *dot_diameter_m],
-            Target::SingleCircle { diameter_m } => vec![*diameter_m],
+            } => vec![("dot pitch", *pitch_m), ("dot diameter", *dot_diameter_m)],
+            Target::SingleCircle { diameter_m } => vec![("circle diameter", *diameter_m)],
             Target::SquareGrid {
                 side_m, pitch_m, ..
-            } => vec![*side_m, *pitch_m],
+            } => vec![("square side", *side_m), ("square pitch", *pitch_m)],
         };
-        if lengths.iter().any(|l| !l.is_finite() || *l <= 0.0) {
-            return Err(Error::invalid("target", "sizes must be positive metres"));
+        if let Some((name, l)) = lengths.iter().find(|(_, l)| !l.is_finite() || *l <= 0.0) {
+            let got = if l.is_finite() {
+                format!("{} mm", l * 1000.0)
+            } else {
+                l.to_string()
+            };
+            return Err(Error::invalid(
+                "target",
+                format!("the {name} must be a positive length, got {got}"),
+            ));
         }
         if let Target::DotPlate {
             pitch_m,

@@ -492,13 +492,13 @@ export const tests = [
   }],
 
   // ---- step 1, target: the field refused, the target in use kept ----
-  ['spec-zero-size', targetCase('square_mm', '0', 'target: sizes must be positive metres')],
-  ['spec-negative-size', targetCase('square_mm', '-30', 'target: sizes must be positive metres')],
+  ['spec-zero-size', targetCase('square_mm', '0', 'target: the square size must be a positive length, got 0 mm')],
+  ['spec-negative-size', targetCase('square_mm', '-30', 'target: the square size must be a positive length, got -30 mm')],
   ['spec-empty-size', targetCase('square_mm', '', 'Square size (mm): the field is empty or not a number; enter a size in millimetres, e.g. 30')],
   // The browser cannot hold 1e400 in a number field: its value is ''.
   ['spec-overflowing-size', targetCase('square_mm', '1e400', 'Square size (mm): the field is empty or not a number; enter a size in millimetres, e.g. 30')],
   // 1e-400 mm is 0 as a double.
-  ['spec-underflowing-size', targetCase('square_mm', '1e-400', 'target: sizes must be positive metres')],
+  ['spec-underflowing-size', targetCase('square_mm', '1e-400', 'target: the square size must be a positive length, got 0 mm')],
   ['spec-one-column', targetCase('cols', '1', 'target: a grid needs 2 to 100000 points with at least 2 per side, got 1x6')],
   ['a reload right after a change keeps it (the session was lost)', async (page, { url }) => {
     // The store saves 300 ms after the last change; a reload (or a closed
