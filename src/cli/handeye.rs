@@ -5,6 +5,7 @@ use super::{parse_target, read_file, CliError};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
 use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
+use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 
@@ -230,15 +231,28 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     };
     let mut result = calibrate(&input, &options)?;
     match &images {
-        Some((views, camera)) => apply_refinement(
-            &mut result,
-            &input,
-            views,
-            camera,
-            mode,
-            options.motion_pairs,
-            DEFAULT_PIXEL_SIGMA_PX,
-        )?,
+        Some((views, camera)) => {
+            apply_refinement(
+                &mut result,
+                &input,
+                views,
+                camera,
+                mode,
+                options.motion_pairs,
+                DEFAULT_PIXEL_SIGMA_PX,
+            )?;
+            // No refinement over pixels: the pose refinement, with each
+            // view's PnP covariance from its image points.
+            if mode == RefineMode::None && !args.no_refine {
+                apply_pose_refinement_from_views(
+                    &mut result,
+                    &input,
+                    views,
+                    camera,
+                    options.motion_pairs,
+                )?;
+            }
+        }
         None if mode != RefineMode::None => {
             return Err(CliError::usage(
                 "handeye",
