@@ -30,7 +30,8 @@ With --camera-poses the closed forms are refined by maximum likelihood over
 the poses (robot and camera pose noise estimated from the data; --no-refine
 keeps the closed form): pose_refinement {started_from, cost, noise,
 camera_transform_std, target_transform_std, covariance, outlier_views} and a
-pose_cost per method.
+pose_cost per method. With images and --refine none the same refinement runs
+on the PnP poses with each view's PnP covariance (camera_noise_model per_view).
 
 Examples:
   robocal handeye --setup eye-in-hand --poses robot.csv --camera camera.json \\
