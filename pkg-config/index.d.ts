@@ -632,7 +632,7 @@ export interface PoseNoiseLevels {
   camera_rotation_deg?: Vec3;
   /** Camera translation noise along the camera's x, y, z axes, mm (diagonal model). */
   camera_translation_mm?: Vec3;
-  /** Per-view model: square root of the estimated covariance scale (px for PnP covariances). */
+  /** Per-view model: square root of the estimated covariance scale (px for PnP covariances; predicted_pnp: pixel noise over focal length, radians). */
   camera_covariance_sigma?: number;
 }
 
@@ -651,10 +651,13 @@ export interface PoseRefinementSummary {
   closed_form_cost: number;
   /** 0.5 * sum of Huber(|whitened residual|^2) over the views after refinement. */
   cost: number;
-  camera_noise_model: 'diagonal' | 'per_view';
+  /** diagonal or predicted_pnp (chosen by likelihood, pose input); per_view with per-view covariances. */
+  camera_noise_model: 'diagonal' | 'predicted_pnp' | 'per_view';
   noise: PoseNoiseLevels;
   /** Diagonal model: target point (m, target frame) the camera rotation noise pivots about, when chosen over the origin. */
   camera_noise_pivot_m?: Vec3;
+  /** predicted_pnp: the nominal planar target (m, target frame, z = 0) whose PnP covariance shape is predicted per view. */
+  camera_noise_nominal_target_m?: { centre: [number, number]; half_extent: [number, number] };
   /** False with fewer than 8 inlier poses: the default levels were scaled by one factor. */
   noise_estimated_per_component: boolean;
   /** Of gripper_from_camera / base_from_camera. */

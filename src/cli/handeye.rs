@@ -5,6 +5,7 @@ use super::{parse_target, read_file, CliError};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
 use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
+use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 
@@ -29,7 +30,8 @@ With --camera-poses the closed forms are refined by maximum likelihood over
 the poses (robot and camera pose noise estimated from the data; --no-refine
 keeps the closed form): pose_refinement {started_from, cost, noise,
 camera_transform_std, target_transform_std, covariance, outlier_views} and a
-pose_cost per method.
+pose_cost per method. With images and --refine none the same refinement runs
+on the PnP poses with each view's PnP covariance (camera_noise_model per_view).
 
 Examples:
   robocal handeye --setup eye-in-hand --poses robot.csv --camera camera.json \\
@@ -234,15 +236,28 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     };
     let mut result = calibrate(&input, &options)?;
     match &images {
-        Some((views, camera)) => apply_refinement(
-            &mut result,
-            &input,
-            views,
-            camera,
-            mode,
-            options.motion_pairs,
-            DEFAULT_PIXEL_SIGMA_PX,
-        )?,
+        Some((views, camera)) => {
+            apply_refinement(
+                &mut result,
+                &input,
+                views,
+                camera,
+                mode,
+                options.motion_pairs,
+                DEFAULT_PIXEL_SIGMA_PX,
+            )?;
+            // No refinement over pixels: the pose refinement, with each
+            // view's PnP covariance from its image points.
+            if mode == RefineMode::None && !args.no_refine {
+                apply_pose_refinement_from_views(
+                    &mut result,
+                    &input,
+                    views,
+                    camera,
+                    options.motion_pairs,
+                )?;
+            }
+        }
         None if mode != RefineMode::None => {
             return Err(CliError::usage(
                 "handeye",

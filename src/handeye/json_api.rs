@@ -296,6 +296,17 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
             options.motion_pairs,
             input.pixel_sigma_px.unwrap_or(DEFAULT_PIXEL_SIGMA_PX),
         )?;
+        // No refinement over pixels: the pose refinement, with each view's
+        // PnP covariance from its image points.
+        if mode == RefineMode::None && input.refine_poses.unwrap_or(true) {
+            super::refine_poses::apply_pose_refinement_from_views(
+                &mut result,
+                &request,
+                views,
+                camera,
+                options.motion_pairs,
+            )?;
+        }
     }
     serde_json::to_string(&HandEyeReport::new(&result))
         .map_err(|e| Error::invalid("report", e.to_string()))

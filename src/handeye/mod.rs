@@ -53,6 +53,7 @@ pub mod pnp;
 pub mod pose_noise;
 pub mod pose_refine;
 pub mod pose_residual;
+pub mod pose_shape;
 pub mod refine_closed_form;
 pub mod refine_poses;
 pub mod repeat;
@@ -70,6 +71,8 @@ pub const MAX_POSES: usize = 1000;
 
 #[cfg(test)]
 mod pose_refine_tests;
+#[cfg(test)]
+mod pose_shape_tests;
 #[cfg(test)]
 mod reprojection_refine_tests;
 #[cfg(test)]

@@ -55,15 +55,16 @@ pub struct NoiseLevels {
     /// Robot translation noise per axis (mm).
     pub robot_translation_mm: f64,
     /// Camera rotation noise about the camera's x, y, z axes (degrees);
-    /// with per-view covariances, `None`.
+    /// with per-view covariances (given or predicted), `None`.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub camera_rotation_deg: Option<[f64; 3]>,
     /// Camera translation noise along x, y, z of the camera frame (mm);
-    /// with per-view covariances, `None`.
+    /// with per-view covariances (given or predicted), `None`.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub camera_translation_mm: Option<[f64; 3]>,
     /// With per-view covariances: the estimated scale's square root (px
-    /// when they are PnP's `(J^T J)^-1`).
+    /// when they are PnP's `(J^T J)^-1`; pixel noise over focal length for
+    /// the predicted shape of [`super::pose_shape`]).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub camera_covariance_sigma: Option<f64>,
 }

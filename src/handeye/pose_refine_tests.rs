@@ -193,9 +193,26 @@ fn an_outlier_pose_is_flagged_and_does_not_pull_the_estimate() {
         );
     let result = calibrate(&input, &options()).unwrap();
     let s = result.pose_refinement.as_ref().unwrap();
-    assert_eq!(s.outlier_views, vec![7], "{:?}", s.whitened_residual_norms);
+    // View 7 is flagged far above the threshold; a good view may sit just
+    // above it (1 % of good views do, by the threshold's definition).
+    let norms = &s.whitened_residual_norms;
+    assert!(s.outlier_views.contains(&7), "{norms:?}");
     assert!(
-        result.warnings.iter().any(|w| w.contains("view(s) 7 ")),
+        norms[7] > 3.0 * super::pose_refine::HUBER_SCALE,
+        "{norms:?}"
+    );
+    for &v in s.outlier_views.iter().filter(|v| **v != 7) {
+        assert!(
+            norms[v] < 1.2 * super::pose_refine::HUBER_SCALE,
+            "view {v}: {norms:?}"
+        );
+    }
+    assert!(s.outlier_views.len() <= 2, "{:?}", s.outlier_views);
+    assert!(
+        result
+            .warnings
+            .iter()
+            .any(|w| w.contains("view(s) 7 ") || w.contains("view(s) 7, ")),
         "{:?}",
         result.warnings
     );
@@ -309,7 +326,25 @@ fn the_json_option_and_report_keys() {
     assert!(out["method"].as_str().unwrap().starts_with("refined from "));
     let p = &out["pose_refinement"];
     assert_eq!(p["covariance"].as_array().unwrap().len(), 12);
-    assert_eq!(p["camera_noise_model"], "diagonal");
+    // The camera noise model is chosen by likelihood; each name comes with
+    // its own keys.
+    match p["camera_noise_model"].as_str().unwrap() {
+        "diagonal" => assert_eq!(
+            p["noise"]["camera_rotation_deg"].as_array().unwrap().len(),
+            3
+        ),
+        "predicted_pnp" => {
+            assert!(p["noise"]["camera_covariance_sigma"].is_number());
+            assert_eq!(
+                p["camera_noise_nominal_target_m"]["half_extent"]
+                    .as_array()
+                    .unwrap()
+                    .len(),
+                2
+            );
+        }
+        other => panic!("camera_noise_model {other}"),
+    }
     assert_eq!(
         p["camera_transform_std"]["rotation_deg"]
             .as_array()

@@ -12,15 +12,20 @@
 //! and only the observable part is refined.
 
 use super::motion::build_motions;
-use super::pose_noise::{CameraNoise, NoiseLevels, NoiseModel};
+use super::pnp::camera_from_target_with_covariance;
+use super::pose_noise::{CameraNoise, NoiseLevels, NoiseModel, MIN_POSES_FOR_NOISE_ESTIMATE};
 use super::pose_refine::{
     estimate_noise, evaluate, negative_log_likelihood, refine, Covariance12, PoseRefineOptions,
     HUBER_SCALE,
 };
 use super::pose_residual::PoseMeasurement;
+use super::pose_shape::{predicted_covariances, NominalTarget};
 use super::report::{errors, motion_residuals, pose_difference, view_residuals};
+use super::reprojection_refine::ViewPoints;
 use super::solve::{HandEyeInput, HandEyeResult};
+use super::Setup;
 use super::{Chain, MotionPairs, Pose};
+use crate::camera::Camera;
 use crate::error::Result;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -55,6 +60,10 @@ pub struct PoseRefinementSummary {
     /// average); absent: the origin.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub camera_noise_pivot_m: Option<[f64; 3]>,
+    /// `predicted_pnp` model: the nominal planar target whose PnP
+    /// covariance shape was predicted at each view's pose.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub camera_noise_nominal_target_m: Option<NominalTargetReport>,
     /// False when there were too few poses (fewer than 8 inliers): the
     /// documented default levels were then scaled by one common factor.
     pub noise_estimated_per_component: bool,
@@ -70,6 +79,54 @@ pub struct PoseRefinementSummary {
     pub whitened_residual_norms: Vec<f64>,
     /// Views down-weighted as outliers (whitened norm above 4.1).
     pub outlier_views: Vec<usize>,
+}
+
+/// The nominal target of the `predicted_pnp` camera noise model (metres,
+/// target frame, on z = 0).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct NominalTargetReport {
+    /// Centre (x, y).
+    pub centre: [f64; 2],
+    /// Half extents along x and y.
+    pub half_extent: [f64; 2],
+}
+
+/// The likeliest per-view predicted shape ([`super::pose_shape`]) over the
+/// nominal target candidates, if it is more likely than `diagonal` (whose
+/// levels were fitted at `(x, y)`); its levels fitted at `(x, y)` too.
+fn choose_predicted_shape(
+    setup: Setup,
+    views: &[PoseMeasurement],
+    diagonal: &NoiseModel,
+    x: &Pose,
+    y: &Pose,
+    axis: Option<Vector3<f64>>,
+    pivot: Option<Vector3<f64>>,
+) -> Option<(NoiseModel, NominalTarget)> {
+    // Akaike: each estimated level costs 1 in negative log-likelihood; the
+    // diagonal has 8 levels, the predicted shape 3.
+    let mut best_nll = negative_log_likelihood(setup, views, diagonal, x, y).ok()?
+        + diagonal.variances.len() as f64;
+    let mut best = None;
+    for target in NominalTarget::candidates(views, pivot) {
+        let Some(covs) = predicted_covariances(views, &target) else {
+            continue;
+        };
+        let mut model = NoiseModel::new(CameraNoise::PerView(covs));
+        // Start near (0.2 px / 1000 px)^2 in normalised coordinates.
+        model.variances[2] = 4e-8;
+        if estimate_noise(setup, views, &mut model, x, y, axis).is_err() {
+            continue;
+        }
+        if let Ok(nll) = negative_log_likelihood(setup, views, &model, x, y) {
+            let nll = nll + model.variances.len() as f64;
+            if nll < best_nll {
+                best_nll = nll;
+                best = Some((model, target));
+            }
+        }
+    }
+    best
 }
 
 fn transform_std(cov: &Covariance12, offset: usize) -> TransformStd {
@@ -130,13 +187,59 @@ pub fn apply_pose_refinement(
     camera_noise: CameraNoise,
     motion_pairs: MotionPairs,
 ) -> Result<()> {
+    apply_pose_refinement_with(result, input, camera_noise, motion_pairs, true)
+}
+
+/// The pose refinement with each view's PnP covariance from its image
+/// points (`CameraNoise::PerView`, the pixel variance estimated): for image
+/// input whose refinement over pixels is off (`refine` none). A view whose
+/// covariance cannot be computed leaves the predicted/diagonal models of
+/// [`apply_pose_refinement`] in charge, with a warning.
+pub fn apply_pose_refinement_from_views(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[ViewPoints],
+    camera: &Camera,
+    motion_pairs: MotionPairs,
+) -> Result<()> {
+    let covariances: std::result::Result<Vec<_>, String> = views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            camera_from_target_with_covariance(camera, v)
+                .map(|(_, _, c)| c)
+                .map_err(|e| format!("view {i}: {e}"))
+        })
+        .collect();
+    match covariances {
+        Ok(c) if c.len() == input.camera_from_target.len() => {
+            apply_pose_refinement(result, input, CameraNoise::PerView(c), motion_pairs)
+        }
+        other => {
+            let why = other
+                .err()
+                .unwrap_or_else(|| "views and poses differ in number".into());
+            result.warnings.push(format!(
+                "pose refinement: no PnP covariance ({why}); camera noise modelled from the poses"
+            ));
+            apply_pose_refinement(result, input, CameraNoise::Diagonal, motion_pairs)
+        }
+    }
+}
+
+/// [`apply_pose_refinement`]; with `predict_shape` false, a
+/// [`CameraNoise::Diagonal`] request never switches to the predicted
+/// per-view shape (the diagonal model alone, for comparisons).
+pub fn apply_pose_refinement_with(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    camera_noise: CameraNoise,
+    motion_pairs: MotionPairs,
+    predict_shape: bool,
+) -> Result<()> {
     let views = measurements(input);
     let setup = input.setup;
     let axis = result.unobservable_translation.first().copied();
-    let options = PoseRefineOptions {
-        camera_noise: camera_noise.clone(),
-        unobservable_translation: axis,
-    };
     let model_name = match camera_noise {
         CameraNoise::Diagonal => "diagonal",
         CameraNoise::PerView(_) => "per_view",
@@ -166,6 +269,33 @@ pub fn apply_pose_refinement(
             pivot = Some([p.x, p.y, p.z]);
         }
     }
+    // Camera poses without their covariances: a per-view shape predicted
+    // from each pose for a nominal target, when the data make it more
+    // likely than the diagonal (Akaike). With too few poses for the levels
+    // to be estimated the documented diagonal defaults stand.
+    let mut model_name = model_name.to_string();
+    let mut nominal = None;
+    if diagonal && predict_shape && views.len() >= MIN_POSES_FOR_NOISE_ESTIMATE {
+        let shaped = choose_predicted_shape(
+            setup,
+            &views,
+            &noise,
+            &result.x,
+            &result.y,
+            axis,
+            board_pivot(&views),
+        );
+        if let Some((model, target)) = shaped {
+            noise = model;
+            pivot = None;
+            nominal = Some(target);
+            model_name = "predicted_pnp".to_string();
+        }
+    }
+    let options = PoseRefineOptions {
+        camera_noise: noise.camera.clone(),
+        unobservable_translation: axis,
+    };
     // Every closed form under the same noise levels; the lowest seeds.
     let mut start: (f64, String, Pose, Pose) =
         match evaluate(setup, &views, &noise, &result.x, &result.y) {
@@ -222,9 +352,13 @@ pub fn apply_pose_refinement(
         started_from,
         closed_form_cost,
         cost: refined.cost,
-        camera_noise_model: model_name.to_string(),
+        camera_noise_model: model_name,
         noise: refined.noise.levels(),
         camera_noise_pivot_m: pivot,
+        camera_noise_nominal_target_m: nominal.map(|t: NominalTarget| NominalTargetReport {
+            centre: [t.centre.x, t.centre.y],
+            half_extent: t.half,
+        }),
         noise_estimated_per_component: refined.noise_per_component,
         camera_transform_std: transform_std(&cov, 0),
         target_transform_std: transform_std(&cov, 6),
