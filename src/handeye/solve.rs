@@ -159,7 +159,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             motion.axis_spread_deg,
         ));
         let per_view = view_residuals(&chain, &x, &y);
-        let mut result = HandEyeResult {
+        let result = HandEyeResult {
             setup: input.setup,
             method: "scara".to_string(),
             x,
@@ -175,15 +175,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             refinement: None,
             pose_refinement: None,
         };
-        if options.refine_poses {
-            apply_pose_refinement(
-                &mut result,
-                input,
-                CameraNoise::Diagonal,
-                options.motion_pairs,
-            )?;
-        }
-        return Ok(result);
+        return with_pose_refinement(result, input, options);
     }
     // 3. Every requested method; a failing one is reported, not fatal.
     let mut methods = Vec::new();
@@ -232,7 +224,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
     } else {
         None
     };
-    let mut result = HandEyeResult {
+    let result = HandEyeResult {
         setup: input.setup,
         method: primary.name().to_string(),
         x,
@@ -248,6 +240,15 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         refinement: None,
         pose_refinement: None,
     };
+    with_pose_refinement(result, input, options)
+}
+
+/// `result` with the pose refinement applied when `options.refine_poses`.
+fn with_pose_refinement(
+    mut result: HandEyeResult,
+    input: &HandEyeInput,
+    options: &HandEyeOptions,
+) -> Result<HandEyeResult> {
     if options.refine_poses {
         apply_pose_refinement(
             &mut result,

@@ -3,8 +3,7 @@
 //! `robocal render`), then the command under test, and compares the exit
 //! code and the exact first line of the message.
 
-use std::path::Path;
-use std::process::Command;
+use super::robocal_in as run_in;
 
 /// Which output carries the message: `info` writes one JSON line per file
 /// to stdout; every other failure is one line on stderr.
@@ -33,20 +32,6 @@ pub struct Row {
     pub message: String,
     /// Compare the last line of the stream instead of the first.
     pub last_line: bool,
-}
-
-/// Runs `robocal args` in `dir`: (exit code, stdout, stderr).
-pub fn run_in(dir: &Path, args: &[String]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run robocal");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
 }
 
 /// Runs every row; panics with every mismatch (got / want) at once.

@@ -6,13 +6,19 @@
 
 pub mod catalogue;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// Run the `robocal` binary built for this test run: (exit code, stdout, stderr).
 pub fn robocal(args: &[&str]) -> (i32, String, String) {
+    robocal_in(Path::new("."), args)
+}
+
+/// [`robocal`] with `dir` as the working folder.
+pub fn robocal_in(dir: &Path, args: &[impl AsRef<std::ffi::OsStr>]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
         .args(args)
+        .current_dir(dir)
         .output()
         .expect("run robocal");
     (
