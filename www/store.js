@@ -35,9 +35,6 @@ function tx(db, store, mode, fn) {
   return new Promise((resolve, reject) => {
     const t = db.transaction(store, mode);
     const result = fn(t.objectStore(store));
-    // Commit now rather than when the event loop comes back: a save made as
-    // the page goes (pagehide) has no later turn of the loop.
-    if (t.commit) t.commit();
     t.oncomplete = () => resolve(result && 'result' in result ? result.result : undefined);
     t.onerror = () => reject(t.error);
     t.onabort = () => reject(t.error || new Error('storage transaction aborted'));
@@ -52,16 +49,6 @@ export class Store {
     this.listeners = new Set();
     this.saveTimer = null;
     this.persistent = true;
-    // A save still waiting for its timer is done now when the page goes
-    // (a reload or a closed tab right after a change lost that change).
-    if (typeof addEventListener === 'function') addEventListener('pagehide', () => this.flush());
-  }
-
-  /** Save now if a save is pending. */
-  flush() {
-    if (this.saveTimer === null) return;
-    clearTimeout(this.saveTimer);
-    this.save();
   }
 
   async load() {
@@ -99,7 +86,6 @@ export class Store {
   }
 
   async save() {
-    this.saveTimer = null;
     if (!this.db || !this.persistent) return;
     try {
       await tx(this.db, 'session', 'readwrite', (s) => s.put(this.session, 'current'));
