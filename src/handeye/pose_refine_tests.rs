@@ -258,36 +258,7 @@ fn scara_refines_the_observable_part_and_keeps_the_axis_unobservable() {
     // Every gripper pose rotates about the base z axis only: the camera's
     // height on the gripper (along the axis in the gripper frame) is
     // unobservable, so it stays at the closed form's 0 with zero variance.
-    let x = Pose::from_parts(
-        Translation3::new(0.05, -0.03, 0.12),
-        UnitQuaternion::from_scaled_axis(Vector3::new(0.2, -0.1, 0.4)),
-    );
-    let y = Pose::from_parts(
-        Translation3::new(0.6, 0.1, -0.3),
-        UnitQuaternion::from_scaled_axis(Vector3::new(3.0, 0.1, 0.0)),
-    );
-    let robot: Vec<Pose> = (0..12)
-        .map(|i| {
-            let a = 0.2 * i as f64 - 1.0;
-            Pose::from_parts(
-                Translation3::new(
-                    0.4 + 0.05 * (i as f64).sin(),
-                    0.05 * i as f64,
-                    0.2 + 0.01 * i as f64,
-                ),
-                UnitQuaternion::from_scaled_axis(Vector3::z() * a),
-            )
-        })
-        .collect();
-    let cams: Vec<Pose> = robot
-        .iter()
-        .map(|b| x.inverse() * b.inverse() * y)
-        .collect();
-    let input = HandEyeInput {
-        setup: Setup::EyeInHand,
-        base_from_gripper: robot,
-        camera_from_target: cams,
-    };
+    let (x, _, input) = super::solver_tests::scara_scene(12, -1.0, 0.2, 0.05, 0.01);
     let result = calibrate(&input, &options()).unwrap();
     assert_eq!(result.method, "refined from scara");
     let axis = result.unobservable_translation[0];

@@ -224,33 +224,9 @@ fn input_mistakes_are_named() {
 #[wasm_bindgen_test(unsupported = test)]
 fn scara_motion_solves_the_observable_part_and_names_the_axis() {
     // A SCARA arm: every gripper pose rotates about the base z axis only.
-    let x = Pose::from_parts(
-        Translation3::new(0.05, -0.03, 0.12),
-        UnitQuaternion::from_scaled_axis(Vector3::new(0.2, -0.1, 0.4)),
-    );
-    let y = Pose::from_parts(
-        Translation3::new(0.6, 0.1, -0.3),
-        UnitQuaternion::from_scaled_axis(Vector3::new(3.0, 0.1, 0.0)),
-    );
-    let robot: Vec<Pose> = (0..7)
-        .map(|i| {
-            let a = 0.3 * i as f64 - 0.8;
-            Pose::from_parts(
-                Translation3::new(0.4 + 0.05 * (i as f64).sin(), 0.1 * i as f64, 0.2),
-                UnitQuaternion::from_scaled_axis(Vector3::z() * a),
-            )
-        })
-        .collect();
-    let cams: Vec<Pose> = robot
-        .iter()
-        .map(|b| x.inverse() * b.inverse() * y)
-        .collect();
+    let (x, _, input) = scara_scene(7, -0.8, 0.3, 0.1, 0.0);
     let result = calibrate(
-        &HandEyeInput {
-            setup: Setup::EyeInHand,
-            base_from_gripper: robot,
-            camera_from_target: cams,
-        },
+        &input,
         // The closed form itself (the pose refinement of it is tested in
         // pose_refine_tests).
         &HandEyeOptions {
@@ -395,4 +371,43 @@ fn joint_linear_solvers_beat_rotation_only_ones_on_noisy_data() {
             setup.name()
         );
     }
+}
+
+/// A SCARA scene, noise-free: every gripper pose rotates about the base z
+/// axis only (angle `start + step i`), the gripper at
+/// `(0.4 + 0.05 sin i, dy i, 0.2 + dz i)`. Returns `x`, `y` and the input.
+pub(super) fn scara_scene(
+    n: usize,
+    start: f64,
+    step: f64,
+    dy: f64,
+    dz: f64,
+) -> (Pose, Pose, HandEyeInput) {
+    let x = Pose::from_parts(
+        Translation3::new(0.05, -0.03, 0.12),
+        UnitQuaternion::from_scaled_axis(Vector3::new(0.2, -0.1, 0.4)),
+    );
+    let y = Pose::from_parts(
+        Translation3::new(0.6, 0.1, -0.3),
+        UnitQuaternion::from_scaled_axis(Vector3::new(3.0, 0.1, 0.0)),
+    );
+    let robot: Vec<Pose> = (0..n)
+        .map(|i| {
+            let t = i as f64;
+            Pose::from_parts(
+                Translation3::new(0.4 + 0.05 * t.sin(), dy * t, 0.2 + dz * t),
+                UnitQuaternion::from_scaled_axis(Vector3::z() * (start + step * t)),
+            )
+        })
+        .collect();
+    let camera_from_target = robot
+        .iter()
+        .map(|b| x.inverse() * b.inverse() * y)
+        .collect();
+    let input = HandEyeInput {
+        setup: Setup::EyeInHand,
+        base_from_gripper: robot,
+        camera_from_target,
+    };
+    (x, y, input)
 }
