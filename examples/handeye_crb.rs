@@ -19,9 +19,9 @@ use robocal::camera::Camera;
 use robocal::handeye::pnp::camera_from_target_with_covariance;
 use robocal::handeye::pose_noise::{CameraNoise, NoiseModel};
 use robocal::handeye::pose_refine::fisher_information;
-use robocal::handeye::pose_residual::{difference, PoseMeasurement};
+use robocal::handeye::pose_residual::difference;
 use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
-use robocal::handeye::refine_poses::{apply_pose_refinement, apply_pose_refinement_with};
+use robocal::handeye::refine_poses::{apply_pose_refinement, apply_pose_refinement_with, paired};
 use robocal::handeye::report::Errors;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
 use robocal::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
@@ -228,15 +228,7 @@ fn main() {
                 camera_from_target: cams,
             };
             // The bound at the truth.
-            let truth_views: Vec<PoseMeasurement> = scene
-                .base_from_gripper
-                .iter()
-                .zip(&scene.camera_from_target)
-                .map(|(b, c)| PoseMeasurement {
-                    base_from_gripper: *b,
-                    camera_from_target: *c,
-                })
-                .collect();
+            let truth_views = paired(&scene.base_from_gripper, &scene.camera_from_target);
             let mut model = NoiseModel::new(CameraNoise::PerView(true_covs));
             model.variances = vec![sr * sr, st * st, sc.pixel_sigma.powi(2)];
             let crb =

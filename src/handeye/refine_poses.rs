@@ -139,10 +139,14 @@ fn transform_std(cov: &Covariance12, offset: usize) -> TransformStd {
 
 /// The measurements of an input, in order.
 pub fn measurements(input: &HandEyeInput) -> Vec<PoseMeasurement> {
-    input
-        .base_from_gripper
+    paired(&input.base_from_gripper, &input.camera_from_target)
+}
+
+/// Robot and camera poses paired one to one (e.g. a scene's truth).
+pub fn paired(base_from_gripper: &[Pose], camera_from_target: &[Pose]) -> Vec<PoseMeasurement> {
+    base_from_gripper
         .iter()
-        .zip(&input.camera_from_target)
+        .zip(camera_from_target)
         .map(|(b, c)| PoseMeasurement {
             base_from_gripper: *b,
             camera_from_target: *c,
