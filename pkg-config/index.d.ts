@@ -171,7 +171,12 @@ export interface Detection {
   image_size_px: ImageSize;
   /** The target that was searched for. */
   target: Target;
-  /** Detected points, sorted by id; ids missing from a partial detection are absent. */
+  /**
+   * Detected points, sorted by id: any subset of the target's points (ids missing from a
+   * partial detection are absent). The solvers use a view whose points fix a homography
+   * (at least 4, not all but one on a line) and leave the others out with a warning
+   * (docs/detection-json.md, "Partial views").
+   */
   points: DetectedPoint[];
   /**
    * Circle grids and dot plates: which point of each imaged circle `points` are
@@ -313,6 +318,8 @@ export interface CalibrationSolverOptions {
 export interface Outlier {
   /** Index of the point in its view. */
   index: number;
+  /** The target's id of the point (the detection's id; the index for explicit correspondences). */
+  id: number;
   /** Its residual norm when dropped, px. */
   residual_px: number;
   reason: string;
@@ -324,6 +331,8 @@ export interface PixelVector {
   y: number;
   dx: number;
   dy: number;
+  /** Residuals only: the target's id of the point (which corner of the view is off). */
+  id?: number;
 }
 
 /** Per-view results of a calibration. */
@@ -444,6 +453,8 @@ export interface StereoCalibration {
   rms_px: number;
   iterations: number;
   termination: Termination;
+  /** Pairs left out (`pair N left out: left|right NAME: REASON`: a side whose points cannot fix a homography). */
+  warnings: string[];
 }
 
 // ---------------------------------------------------------------------------
@@ -503,6 +514,9 @@ export interface HandEyeInputBase {
  * The input JSON of `solve_handeye` (unknown keys are rejected). Image points
  * are given either as `views` or as `detections` (one `detect_target`
  * Detection per pose, board points from each detection's target), not both.
+ * A view may hold any subset of the board's points; one whose points cannot fix
+ * a pose (fewer than 4, or all but one on a line) is left out with its robot
+ * pose and the warning `view I left out with its robot pose: REASON`.
  */
 export type HandEyeInput =
   | (HandEyeInputBase & { views?: HandEyeView[]; detections?: never })

@@ -41,12 +41,7 @@ fn views(cam: &Camera, spec: &str, options: &DetectOptions) -> Vec<View> {
             assert_eq!(r.points.len(), target.point_count(), "{spec} view {k}");
             let det = detect(&r.image, &target, options)
                 .unwrap_or_else(|e| panic!("{spec} view {k}: {e}"));
-            let (object_m, image_px) = det.correspondences();
-            View {
-                name: format!("view{k}"),
-                object_m,
-                image_px,
-            }
+            View::from_detection(format!("view{k}"), &det)
         })
         .collect()
 }

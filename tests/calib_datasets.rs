@@ -56,6 +56,7 @@ fn fixture_view(fixture: &Value, image: &str, square_m: f64) -> View {
             .iter()
             .map(|c| Point2::new(c[0].as_f64().expect("x"), c[1].as_f64().expect("y")))
             .collect(),
+        point_ids: Vec::new(),
     }
 }
 
@@ -195,6 +196,7 @@ fn parse_calib1(text: &str) -> Result<Calib1, String> {
                     Point2::new(p[0], p[1])
                 })
                 .collect(),
+            point_ids: Vec::new(),
         })
         .collect();
     let intrinsics = take(8)?;

@@ -50,10 +50,12 @@ fn load_views() -> Option<Vec<View>> {
         .collect();
     assert_eq!(model.len(), 256);
     let views: Vec<View> = (1..=5)
-        .map(|k| View {
-            name: format!("image{k}"),
-            object_m: model.clone(),
-            image_px: points(&read(&format!("data{k}.txt"))),
+        .map(|k| {
+            View::new(
+                format!("image{k}"),
+                model.clone(),
+                points(&read(&format!("data{k}.txt"))),
+            )
         })
         .collect();
     Some(views)

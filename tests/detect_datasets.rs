@@ -209,12 +209,7 @@ fn zhang1998_square_grid_found_and_calibrated() {
             "image{k}: median {median} px from Zhang's corners"
         );
         assert!(max <= 0.85, "image{k}: max {max} px from Zhang's corners");
-        let (object_m, image_px) = det.correspondences();
-        views.push(View {
-            name: format!("image{k}"),
-            object_m,
-            image_px,
-        });
+        views.push(View::from_detection(format!("image{k}"), &det));
     }
     // Zhang's model: radial k1 k2, no tangential terms, skew estimated.
     let options = CalibrationOptions {

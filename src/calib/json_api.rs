@@ -25,6 +25,7 @@
 //! [`ComparisonRow`] per method.
 
 use super::compare::{calibrate_with, compare_methods, ComparisonRow, Method};
+use super::usable::{left_out_clause, usable_views, LeftOut};
 use super::{CalibrationOptions, CameraCalibration, View};
 use crate::camera::Distortion;
 use crate::error::{Error, Result};
@@ -188,7 +189,22 @@ pub fn calibrate_json(input_json: &str) -> Result<String> {
 pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     // 1. The views and the image size.
     check_size("views", &input.views)?;
-    let views = views_of(&input.views)?;
+    let (views, left_out) = usable_views(&views_of(&input.views)?);
+    if views.len() < MIN_VIEWS && !left_out.is_empty() {
+        return Err(Error::invalid(
+            "views",
+            format!(
+                "{} whose points fix a homography, a calibration needs at least {MIN_VIEWS} (10 \
+                 or more from varied angles are recommended){}: add images in which more of the \
+                 target is found",
+                match views.len() {
+                    1 => "1 view".to_string(),
+                    n => format!("{n} views"),
+                },
+                left_out_clause(&left_out)
+            ),
+        ));
+    }
     if views.len() < MIN_VIEWS {
         return Err(Error::invalid(
             "views",
@@ -218,6 +234,10 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
             .find(|(m, _)| *m == Method::Zhang)
             .map(|(_, outcome)| outcome)
             .ok_or_else(|| Error::invalid("method", "the comparison has no Zhang row"))??;
+        let mut report = report;
+        report
+            .warnings
+            .extend(left_out.iter().map(LeftOut::warning));
         return Ok(CalibrationOutput {
             report,
             comparison: Some(comparison),
@@ -228,6 +248,9 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     let mut report = calibrate_with(method, &views, size, &options)?;
     let advice = super::model_advice::advise_model(&views, size, &options, &report);
     report.warnings.extend(advice);
+    report
+        .warnings
+        .extend(left_out.iter().map(LeftOut::warning));
     Ok(CalibrationOutput {
         report,
         comparison: None,
@@ -283,12 +306,7 @@ pub fn views_of(views: &[JsonView]) -> Result<Vec<View>> {
             match (&v.detection, &v.object_m, &v.image_px) {
                 (Some(d), None, None) => {
                     check_detection(&format!("views[{i}] ({})", v.name), d)?;
-                    let (object_m, image_px) = d.correspondences();
-                    Ok(View {
-                        name: v.name.clone(),
-                        object_m,
-                        image_px,
-                    })
+                    Ok(View::from_detection(v.name.clone(), d))
                 }
                 (None, Some(object), Some(image)) => {
                     if object.len() != image.len() {
@@ -308,6 +326,7 @@ pub fn views_of(views: &[JsonView]) -> Result<Vec<View>> {
                             .map(|p| Point3::new(p[0], p[1], p[2]))
                             .collect(),
                         image_px: image.iter().map(|p| Point2::new(p[0], p[1])).collect(),
+                        point_ids: Vec::new(),
                     })
                 }
                 _ => Err(Error::invalid(

@@ -31,6 +31,7 @@ mod stereo_problem;
 #[cfg(test)]
 mod stereo_tests;
 mod tsai;
+pub mod usable;
 mod zhang;
 
 pub use closed_form::{intrinsics_from_homographies, pose_from_homography};
@@ -38,13 +39,16 @@ pub use homography::homography;
 pub use report::{CameraCalibration, Correlation, Outlier, ProjectionUncertainty, ViewReport};
 pub use residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
 pub use tsai::calibrate_tsai;
+pub use usable::{homography_problem, usable_views, LeftOut};
 pub use zhang::{calibrate, CalibrationOptions};
 
+use crate::target::Detection;
 use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 
 /// One image's correspondences: target points (target frame, metres; z = 0
-/// for planar targets) and where they were observed (pixels).
+/// for planar targets) and where they were observed (pixels). A view may
+/// hold any subset of the target's points; `point_ids` says which.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct View {
     /// Image name, carried into the report.
@@ -53,4 +57,50 @@ pub struct View {
     pub object_m: Vec<Point3<f64>>,
     /// Observed pixels, same order and count as `object_m`.
     pub image_px: Vec<Point2<f64>>,
+    /// The target's id of each point (a detection's ids), same order as
+    /// `object_m`; empty means the points are numbered by their position.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub point_ids: Vec<usize>,
+}
+
+impl View {
+    /// A view of explicit correspondences, points numbered by position.
+    pub fn new(
+        name: impl Into<String>,
+        object_m: Vec<Point3<f64>>,
+        image_px: Vec<Point2<f64>>,
+    ) -> View {
+        View {
+            name: name.into(),
+            object_m,
+            image_px,
+            point_ids: Vec::new(),
+        }
+    }
+
+    /// The view of a detection: its points (any subset of the target's)
+    /// with their board positions and ids.
+    pub fn from_detection(name: impl Into<String>, detection: &Detection) -> View {
+        // Board points looked up by id (not by position: a board's ids
+        // need not be 0..n); points whose id the target lacks are skipped,
+        // as in `Detection::correspondences`.
+        let mut board = std::collections::BTreeMap::new();
+        for (id, p) in detection.target.object_points() {
+            board.insert(id, p);
+        }
+        let mut view = View::new(name, Vec::new(), Vec::new());
+        for p in &detection.points {
+            if let Some(o) = board.get(&p.id) {
+                view.object_m.push(*o);
+                view.image_px.push(Point2::new(p.x_px, p.y_px));
+                view.point_ids.push(p.id);
+            }
+        }
+        view
+    }
+
+    /// The target's id of the view's `index`-th point.
+    pub fn point_id(&self, index: usize) -> usize {
+        self.point_ids.get(index).copied().unwrap_or(index)
+    }
 }

@@ -27,6 +27,10 @@ const UNCERTAINTY_GRID: (usize, usize) = (9, 7);
 pub struct Outlier {
     /// Index of the point in its view.
     pub index: usize,
+    /// The target's id of the point (the detection's id; the index for
+    /// explicit correspondences).
+    #[serde(default)]
+    pub id: usize,
     /// Its residual norm when it was dropped, px.
     pub residual_px: f64,
     /// Why it was dropped.

@@ -21,6 +21,10 @@ pub struct PixelVector {
     pub dx: f64,
     /// Vector y component, px.
     pub dy: f64,
+    /// The target's id of the point (residuals only; absent in the
+    /// distortion field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<usize>,
 }
 
 /// The lens distortion over the image: at each node of a coarse grid over
@@ -35,19 +39,22 @@ pub struct DistortionField {
 }
 
 /// Observed minus predicted pixel for every point of a view (outliers
-/// included), anchored at the observed pixel, in the view's point order.
-/// A point the camera cannot project (behind it) is left out.
+/// included), anchored at the observed pixel, in the view's point order,
+/// each with the target's id of the point (which corner of which view is
+/// off). A point the camera cannot project (behind it) is left out.
 pub fn view_residuals(camera: &Camera, pose: &Pose, view: &View) -> Vec<PixelVector> {
     view.object_m
         .iter()
         .zip(&view.image_px)
-        .filter_map(|(object, observed)| {
+        .enumerate()
+        .filter_map(|(index, (object, observed))| {
             let predicted = camera.project(&(pose * object)).ok()?;
             Some(PixelVector {
                 x: observed.x,
                 y: observed.y,
                 dx: observed.x - predicted.x,
                 dy: observed.y - predicted.y,
+                id: Some(view.point_id(index)),
             })
         })
         .collect()
@@ -77,6 +84,7 @@ pub fn distortion_field(camera: &Camera) -> DistortionField {
                 y: pixel.y,
                 dx: pixel.x - ideal.x,
                 dy: pixel.y - ideal.y,
+                id: None,
             });
         }
     }
@@ -115,11 +123,11 @@ mod tests {
     fn residuals_are_observed_minus_predicted() {
         let camera = Camera::pinhole(800.0, 800.0, 319.5, 239.5, 640, 480);
         let pose = Pose::from_parts(Translation3::new(0.0, 0.0, 1.0), UnitQuaternion::identity());
-        let view = View {
-            name: "v".into(),
-            object_m: vec![Point3::new(0.0, 0.0, 0.0), Point3::new(0.1, 0.0, 0.0)],
-            image_px: vec![Point2::new(320.5, 239.0), Point2::new(399.5, 239.5)],
-        };
+        let view = View::new(
+            "v",
+            vec![Point3::new(0.0, 0.0, 0.0), Point3::new(0.1, 0.0, 0.0)],
+            vec![Point2::new(320.5, 239.0), Point2::new(399.5, 239.5)],
+        );
         let r = view_residuals(&camera, &pose, &view);
         assert_eq!(r.len(), 2);
         assert!((r[0].dx - 1.0).abs() < 1e-12 && (r[0].dy + 0.5).abs() < 1e-12);

@@ -10,6 +10,7 @@
 use super::refine::{block_from_pose, CalibProblem};
 use super::report::build_report;
 use super::stereo_problem::StereoProblem;
+use super::usable::{usable_views, LeftOut};
 use super::zhang::lm_options;
 use super::{calibrate, CalibrationOptions, CameraCalibration, View};
 use crate::error::{Error, Result};
@@ -50,12 +51,19 @@ pub struct StereoCalibration {
     pub iterations: usize,
     /// Why the joint solver stopped.
     pub termination: Termination,
+    /// Pairs left out (a side whose points cannot fix a homography), with
+    /// the reason; empty when every pair was used.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 /// Calibrate a stereo pair from views paired by index (`left[i]` and
-/// `right[i]` saw the same board pose; their point sets may differ).
-/// `options` apply to both cameras; points a single-camera calibration
-/// rejected as outliers stay out of the joint refinement.
+/// `right[i]` saw the same board pose; their point sets may differ: each
+/// camera's residuals are over its own points, through the shared board
+/// pose, so no point needs to be seen by both). A pair with a side whose
+/// points cannot fix a homography ([`super::usable`]) is left out, with a
+/// warning. `options` apply to both cameras; points a single-camera
+/// calibration rejected as outliers stay out of the joint refinement.
 pub fn calibrate_stereo(
     left: &[View],
     right: &[View],
@@ -73,6 +81,8 @@ pub fn calibrate_stereo(
             ),
         ));
     }
+    let (left, right, warnings) = usable_pairs(left, right, options)?;
+    let (left, right) = (&left[..], &right[..]);
     let single_left = calibrate(left, left_size_px, options)?;
     let single_right = calibrate(right, right_size_px, options)?;
     let left_poses = report_poses(&single_left)?;
@@ -158,7 +168,50 @@ pub fn calibrate_stereo(
         rms_px: (squared / blocks.len().max(1) as f64).sqrt(),
         iterations: result.iterations,
         termination: result.termination,
+        warnings,
     })
+}
+
+/// The pairs whose two views each fix a homography, and a warning per pair
+/// left out; fewer usable pairs than Zhang's closed form needs is an error
+/// naming the pairs left out and why.
+fn usable_pairs(
+    left: &[View],
+    right: &[View],
+    options: &CalibrationOptions,
+) -> Result<(Vec<View>, Vec<View>, Vec<String>)> {
+    let (_, left_out_l) = usable_views(left);
+    let (_, left_out_r) = usable_views(right);
+    let reason =
+        |list: &[LeftOut], i: usize| list.iter().find(|l| l.index == i).map(|l| l.reason.clone());
+    let (mut kept_l, mut kept_r, mut left_out) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, (l, r)) in left.iter().zip(right).enumerate() {
+        let why: Vec<String> = [
+            ("left", &l.name, reason(&left_out_l, i)),
+            ("right", &r.name, reason(&left_out_r, i)),
+        ]
+        .into_iter()
+        .filter_map(|(side, name, why)| why.map(|w| format!("{side} {name}: {w}")))
+        .collect();
+        if why.is_empty() {
+            kept_l.push(l.clone());
+            kept_r.push(r.clone());
+        } else {
+            left_out.push(format!("pair {i} left out: {}", why.join("; ")));
+        }
+    }
+    let required = super::zhang::required_views(options);
+    if kept_l.len() < required && !left_out.is_empty() {
+        return Err(Error::invalid(
+            "pairs",
+            format!(
+                "requires at least {required} pairs whose views fix a homography, got {}; {}",
+                kept_l.len(),
+                left_out.join(", ")
+            ),
+        ));
+    }
+    Ok((kept_l, kept_r, left_out))
 }
 
 /// The seed's closed form per view, averaged: `R_i = R_R R_L^-1`,

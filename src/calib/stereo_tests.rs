@@ -52,6 +52,7 @@ fn pair(seed: u64, noise_px: f64) -> Pair {
                     Point2::new(px.x + rng.gaussian(noise_px), px.y + rng.gaussian(noise_px))
                 })
                 .collect(),
+            point_ids: v.point_ids.clone(),
         })
         .collect();
     Pair {

@@ -6,6 +6,7 @@ use super::closed_form::{intrinsics_from_homographies, pose_from_homography};
 use super::homography::homography;
 use super::refine::{block_from_pose, CalibProblem};
 use super::report::{build_report, Outlier};
+use super::usable::{left_out_clause, usable_views, LeftOut};
 use super::{CameraCalibration, View};
 use crate::camera::{Camera, Distortion, N_PINHOLE_PARAMS};
 use crate::error::{Error, Result};
@@ -13,8 +14,6 @@ use crate::optim::{solve, BlockParams, LmOptions, Loss};
 use nalgebra::{Matrix3, Point2};
 use serde::{Deserialize, Serialize};
 
-/// Points per view below which a view cannot give a homography.
-const MIN_POINTS_PER_VIEW: usize = 4;
 /// |z| above which a target point is not on the z = 0 plane, metres.
 const PLANE_TOLERANCE_M: f64 = 1e-9;
 /// Ratio of the median residual norm to sigma for 2-D Gaussian residuals
@@ -81,14 +80,52 @@ impl Default for CalibrationOptions {
     }
 }
 
-/// Calibrate a camera from planar-target views of one image size.
+/// Calibrate a camera from planar-target views of one image size. A view
+/// may hold any subset of the target's points; views whose points cannot
+/// fix a homography ([`super::usable`]) are left out, each with a warning
+/// in the report; too few remaining views is an error that lists them.
 pub fn calibrate(
     views: &[View],
     image_size_px: (u32, u32),
     options: &CalibrationOptions,
 ) -> Result<CameraCalibration> {
-    // 1. Validate the input.
+    // 1. Validate the input and leave out the views without a homography.
     validate(views, image_size_px, options)?;
+    let (usable, left_out) = usable_views(views);
+    let required = required_views(options);
+    if usable.len() < required {
+        return Err(Error::invalid(
+            "views",
+            format!(
+                "requires at least {required} views whose points fix a homography, got {}{}",
+                usable.len(),
+                left_out_clause(&left_out)
+            ),
+        ));
+    }
+    let mut report = calibrate_usable(&usable, image_size_px, options)?;
+    report
+        .warnings
+        .extend(left_out.iter().map(LeftOut::warning));
+    Ok(report)
+}
+
+/// Fewest views Zhang's closed form takes: 2 with zero skew or a given
+/// start, else 3.
+pub(crate) fn required_views(options: &CalibrationOptions) -> usize {
+    if options.zero_skew || options.initial_camera.is_some() {
+        2
+    } else {
+        3
+    }
+}
+
+/// [`calibrate`] on views that each fix a homography.
+fn calibrate_usable(
+    views: &[View],
+    image_size_px: (u32, u32),
+    options: &CalibrationOptions,
+) -> Result<CameraCalibration> {
     // 2. Homographies and the closed-form start (or the given guess).
     let homographies: Vec<Matrix3<f64>> = views
         .iter()
@@ -158,11 +195,7 @@ fn validate(views: &[View], image_size_px: (u32, u32), options: &CalibrationOpti
             ),
         ));
     }
-    let required = if options.zero_skew || options.initial_camera.is_some() {
-        2
-    } else {
-        3
-    };
+    let required = required_views(options);
     if views.len() < required {
         return Err(Error::too_few("views", required, views.len()));
     }
@@ -175,13 +208,6 @@ fn validate(views: &[View], image_size_px: (u32, u32), options: &CalibrationOpti
                     v.object_m.len(),
                     v.image_px.len()
                 ),
-            ));
-        }
-        if v.object_m.len() < MIN_POINTS_PER_VIEW {
-            return Err(Error::too_few(
-                format!("points in view {}", v.name),
-                MIN_POINTS_PER_VIEW,
-                v.object_m.len(),
             ));
         }
         if let Some(p) = v
@@ -348,6 +374,10 @@ fn classify(
                 };
                 view_outliers.push(Outlier {
                     index,
+                    id: every
+                        .views
+                        .get(outliers.len())
+                        .map_or(index, |v| v.point_id(index)),
                     residual_px: r,
                     reason,
                 });

@@ -1,6 +1,7 @@
 //! `robocal handeye`: read the pose files, call the library, write the report.
 
-use super::handeye_images::{image_pairs, read_robot_poses, RobotPoses};
+use super::detections_file::read_detections;
+use super::handeye_images::{detect_images, image_pairs, read_robot_poses, RobotPoses};
 use super::{parse_target, read_file, CliError};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
@@ -17,6 +18,7 @@ use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
   robocal handeye --setup eye-in-hand|eye-to-hand --poses FILE [--pose-format NAME]
                   --camera camera.json --target SPEC IMAGES... [--refine MODE] [--threads N]
                   [--method all|NAME] [--bootstrap N] [--seed N] [--lenient] -o handeye.json
+  robocal handeye --setup ... --poses FILE --camera camera.json --detections detections.json [...]
   robocal handeye --setup ... --poses FILE [--pose-format NAME]
                   --camera-poses FILE [--camera-pose-format NAME] [--no-refine] [...] -o handeye.json",
     after_help = "Output JSON: gripper_from_camera or base_from_camera, base_from_target or
@@ -32,6 +34,10 @@ keeps the closed form): pose_refinement {started_from, cost, noise,
 camera_transform_std, target_transform_std, covariance, outlier_views} and a
 pose_cost per method. With images and --refine none the same refinement runs
 on the PnP poses with each view's PnP covariance (camera_noise_model per_view).
+A detection may hold any subset of the board's points (a marker board partly out
+of view): each view's pose is fitted to its own points, and a view whose points
+cannot fix a pose (fewer than 4, or all but one on a line) is dropped with its
+robot pose (pairs says why).
 
 Examples:
   robocal handeye --setup eye-in-hand --poses robot.csv --camera camera.json \\
@@ -64,6 +70,11 @@ pub struct HandeyeArgs {
     /// The board, e.g. chessboard:9x6:30mm
     #[arg(long, value_name = "SPEC")]
     target: Option<String>,
+    /// Detections instead of images: a 'robocal detect' output, its file
+    /// names paired with the poses as images are (a detection may hold any
+    /// subset of the board's points)
+    #[arg(long, value_name = "FILE")]
+    detections: Option<String>,
     /// trusted (default with images), stochastic (robot pose noise
     /// estimated), joint_intrinsics (camera refined too) or none
     #[arg(long, value_name = "MODE")]
@@ -147,7 +158,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     let mut pre_warnings = Vec::new();
     let (input, images) = match (args.camera_poses.as_deref(), args.camera.as_deref()) {
         (Some(camera_path), None) => {
-            if !args.images.is_empty() {
+            if !args.images.is_empty() || args.detections.is_some() {
                 return Err(CliError::usage(
                     "handeye",
                     "images need --camera and --target, not --camera-poses",
@@ -181,30 +192,39 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
             let value = serde_json::from_str(&camera_text)
                 .unwrap_or(serde_json::Value::String(camera_text));
             let camera = camera_from_json(&value)?;
-            let text = args.target.as_deref().ok_or_else(|| {
-                CliError::usage(
-                    "handeye",
-                    "--target SPEC is required with images, e.g. chessboard:9x6:30mm",
-                )
-            })?;
-            let target = parse_target("handeye", text)?;
-            if args.images.is_empty() {
-                return Err(CliError::usage(
-                    "handeye",
-                    "give the images after the options",
-                ));
-            }
+            let target = args
+                .target
+                .as_deref()
+                .map(|t| parse_target("handeye", t))
+                .transpose()?;
+            let (images, outcomes) = match (&args.detections, &target) {
+                (Some(_), _) if !args.images.is_empty() => {
+                    return Err(CliError::usage(
+                        "handeye",
+                        "give either IMAGES or --detections FILE, not both",
+                    ))
+                }
+                (Some(file), _) => read_detections("handeye", file, target.as_ref())?,
+                (None, None) => {
+                    return Err(CliError::usage(
+                        "handeye",
+                        "--target SPEC is required with images, e.g. chessboard:9x6:30mm",
+                    ))
+                }
+                (None, Some(_)) if args.images.is_empty() => {
+                    return Err(CliError::usage(
+                        "handeye",
+                        "give the images after the options",
+                    ))
+                }
+                (None, Some(t)) => (
+                    args.images.clone(),
+                    detect_images(&args.images, t, &args.limits, args.threads)?,
+                ),
+            };
             let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())
                 .map_err(|e| e.in_file(poses_path))?;
-            let found = image_pairs(
-                setup,
-                robot,
-                &args.images,
-                &camera,
-                &target,
-                &args.limits,
-                args.threads,
-            )?;
+            let found = image_pairs(setup, robot, &images, outcomes, &camera)?;
             pairs = found.pairs;
             pre_warnings = found.warnings;
             let input = HandEyeInput {
@@ -234,7 +254,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
         (None, Some(_)) => RefineMode::Trusted,
         (None, None) => RefineMode::None,
     };
-    let mut result = calibrate(&input, &options)?;
+    let mut result = calibrate(&input, &options).map_err(|e| with_dropped(e, &pairs))?;
     match &images {
         Some((views, camera)) => {
             apply_refinement(
@@ -281,4 +301,27 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     Ok(())
+}
+
+/// Too few pose pairs after images were dropped: the error lists them and
+/// why (the report that would say so is not written).
+fn with_dropped(e: robocal::Error, pairs: &[robocal::handeye::output::PairAudit]) -> CliError {
+    let dropped: Vec<String> = pairs
+        .iter()
+        .filter(|p| !p.used)
+        .map(|p| {
+            format!(
+                "{} ({})",
+                p.image.as_deref().unwrap_or("no image"),
+                p.reason.as_deref().unwrap_or("unused")
+            )
+        })
+        .collect();
+    match e {
+        robocal::Error::TooFew { .. } if !dropped.is_empty() => CliError::Io(format!(
+            "{e}; dropped with their pose: {}",
+            dropped.join(", ")
+        )),
+        other => other.into(),
+    }
 }

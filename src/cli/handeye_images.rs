@@ -155,26 +155,34 @@ fn pair_images(poses: &[RobotPose], images: &[String]) -> Result<Vec<Option<usiz
     Ok((0..poses.len()).map(Some).collect())
 }
 
-/// Detect the target in every image, fit its pose with the known camera,
-/// pair with the robot poses and audit.
-pub(super) fn image_pairs(
-    setup: Setup,
-    robot: RobotPoses,
+/// Detect the target in every image (on `threads` workers).
+pub(super) fn detect_images(
     images: &[String],
-    camera: &Camera,
     target: &Target,
     limits: &super::ImageLimits,
     threads: Option<usize>,
-) -> Result<ImagePairs, CliError> {
-    let mut warnings = Vec::new();
-    let pairing = pair_images(robot.first(), images)?;
-    let outcomes = run_all(
+) -> Result<Vec<Outcome>, CliError> {
+    run_all(
         images,
         target,
         &DetectOptions::default(),
         &limits.decode_options(),
         threads,
-    )?;
+    )
+}
+
+/// Fit the target's pose in every detected image (`outcomes`, one per
+/// image; a detection may hold any subset of the board's points) with the
+/// known camera, pair with the robot poses and audit.
+pub(super) fn image_pairs(
+    setup: Setup,
+    robot: RobotPoses,
+    images: &[String],
+    outcomes: Vec<Outcome>,
+    camera: &Camera,
+) -> Result<ImagePairs, CliError> {
+    let mut warnings = Vec::new();
+    let pairing = pair_images(robot.first(), images)?;
     let mut fitted: Vec<Result<(ViewPoints, Pose, f64), String>> = Vec::new();
     for outcome in outcomes {
         fitted.push(match outcome {

@@ -2,14 +2,14 @@
 //! detections `robocal detect` wrote.
 
 use super::detect::{run_all, Outcome};
-use super::{read_text, write_output, CliError};
+use super::detections_file::read_detections;
+use super::{write_output, CliError};
 use robocal::calib::compare::ComparisonRow;
 use robocal::calib::json_api::{
     calibrate_input, CalibrationInput, CalibrationOutput, JsonOptions, JsonView,
 };
 use robocal::detect::DetectOptions;
-use robocal::target::{Detection, Target};
-use serde::Deserialize;
+use robocal::target::Target;
 
 #[derive(clap::Args)]
 #[command(
@@ -83,20 +83,6 @@ pub struct IntrinsicsArgs {
     /// The images (instead of --detections)
     #[arg(value_name = "IMAGES")]
     images: Vec<String>,
-}
-
-/// One entry of `robocal detect`'s output.
-#[derive(Deserialize)]
-struct DetectedImage {
-    file: String,
-    #[serde(default)]
-    detection: Option<Detection>,
-}
-
-/// `robocal detect`'s output file.
-#[derive(Deserialize)]
-struct DetectionsFile {
-    images: Vec<DetectedImage>,
 }
 
 pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
@@ -192,36 +178,15 @@ fn timed(input: &CalibrationInput, repeat: usize) -> Result<CalibrationOutput, C
 }
 
 fn views_from_file(file: &str, target: Option<&Target>) -> Result<Vec<JsonView>, CliError> {
-    let text = read_text(file)?;
-    let parsed: DetectionsFile = serde_json::from_str(&text).map_err(|e| {
-        CliError::Io(format!(
-            "'{file}' is not a 'robocal detect' output (an object with \"images\"): {e}"
-        ))
-    })?;
-    if parsed.images.is_empty() {
-        return Err(CliError::Io(format!(
-            "'{file}' lists no images: write it with 'robocal detect --target SPEC IMAGES... -o {file}'"
-        )));
-    }
+    let (names, outcomes) = read_detections("intrinsics", file, target)?;
     let mut views = vec![];
-    for image in parsed.images {
-        let Some(detection) = image.detection else {
-            eprintln!("robocal intrinsics: {}: no detection, skipped", image.file);
+    for (name, outcome) in names.into_iter().zip(outcomes) {
+        let Outcome::Found(detection, _) = outcome else {
+            eprintln!("robocal intrinsics: {name}: no detection, skipped");
             continue;
         };
-        if let Some(t) = target {
-            if *t != detection.target {
-                return Err(CliError::usage(
-                    "intrinsics",
-                    format!(
-                        "--target does not match the target of the detection of '{}'",
-                        image.file
-                    ),
-                ));
-            }
-        }
         views.push(JsonView {
-            name: image.file,
+            name,
             detection: Some(detection),
             object_m: None,
             image_px: None,

@@ -8,6 +8,7 @@
 //! (`args_override_self`), as scripts that append an override expect.
 
 mod detect;
+mod detections_file;
 mod export;
 mod handeye;
 mod handeye_images;

@@ -1,6 +1,7 @@
 //! `robocal stereo`: calibrate a stereo pair from paired images of a board.
 
 use super::detect::{run_all, Outcome};
+use super::detections_file::read_detections;
 use super::{write_output, CliError};
 use robocal::calib::json_api::model_from_name;
 use robocal::calib::stereo::calibrate_stereo;
@@ -27,12 +28,18 @@ command says so).
 Each camera is calibrated alone (Zhang), right_from_left is averaged over the
 pairs (seed 000: R = R_R R_L^-1, T = T_R - R T_L), then everything is refined
 jointly. Pairs where the target is not found in either image are dropped and
-listed on standard error. The report (JSON) has left, right (camera reports),
+listed on standard error. A detection may hold any subset of the board's points
+(a marker board partly out of view): each camera is fitted to its own points, and
+a pair where a side's points cannot fix a homography (fewer than 4, or all but
+one on a line) is left out with a warning (the report's warnings). Instead of
+images, --left-detections and --right-detections read 'robocal detect' outputs.
+The report (JSON) has left, right (camera reports),
 right_from_left and initial_right_from_left ({matrix_row_major, translation_m,
-quaternion_xyzw}), baseline_m, right_from_left_std and rms_px.",
+quaternion_xyzw}), baseline_m, right_from_left_std, rms_px and warnings.",
     after_help = "Examples:
   robocal stereo --target chessboard:9x6:25mm --left left*.jpg --right right*.jpg -o stereo.json
   robocal stereo --target chessboard:9x6:25mm --model radial_k1_k2_k5 --left l/*.png --right r/*.png
+  robocal stereo --left-detections left.json --right-detections right.json -o stereo.json
   robocal export stereo.json --format xyz-quat-xyzw"
 )]
 pub struct StereoArgs {
@@ -46,6 +53,13 @@ pub struct StereoArgs {
     /// names (by order when no name has a number)
     #[arg(long, value_name = "IMAGES", num_args = 1.., action = clap::ArgAction::Set)]
     right: Option<Vec<String>>,
+    /// The left camera's detections, a 'robocal detect' output (instead of
+    /// --left; its file names pair as images do)
+    #[arg(long, value_name = "FILE", overrides_with = "left_detections")]
+    left_detections: Option<String>,
+    /// The right camera's detections (instead of --right)
+    #[arg(long, value_name = "FILE", overrides_with = "right_detections")]
+    right_detections: Option<String>,
     /// Lens model of both cameras: brown (default), radial_k1_k2_k5, rational,
     /// division, kannala_brandt, eucm, none
     #[arg(long, value_name = "NAME", overrides_with = "model")]
@@ -60,13 +74,66 @@ pub struct StereoArgs {
     output: Option<String>,
 }
 
+/// One side's input: images to detect in, or a detections file read back.
+enum Side {
+    Images(Vec<String>),
+    Detections(Vec<String>, Vec<Outcome>),
+}
+
+impl Side {
+    fn files(&self) -> &[String] {
+        match self {
+            Side::Images(f) | Side::Detections(f, _) => f,
+        }
+    }
+}
+
+fn side(
+    name: &str,
+    images: Option<Vec<String>>,
+    detections: Option<&str>,
+    target: Option<&Target>,
+) -> Result<Option<Side>, CliError> {
+    match (images, detections) {
+        (Some(_), Some(_)) => Err(CliError::usage(
+            "stereo",
+            format!("give either --{name} IMAGES... or --{name}-detections FILE, not both"),
+        )),
+        (Some(files), None) => Ok(Some(Side::Images(files))),
+        (None, Some(file)) => {
+            let (files, outcomes) = read_detections("stereo", file, target)?;
+            Ok(Some(Side::Detections(files, outcomes)))
+        }
+        (None, None) => Ok(None),
+    }
+}
+
 pub fn run(args: StereoArgs) -> Result<(), CliError> {
-    let (Some(left_files), Some(right_files)) = (args.left, args.right) else {
+    let target = args
+        .target
+        .as_deref()
+        .map(Target::parse_spec)
+        .transpose()
+        .map_err(|e| CliError::usage("stereo", e.to_string()))?;
+    let left = side(
+        "left",
+        args.left,
+        args.left_detections.as_deref(),
+        target.as_ref(),
+    )?;
+    let right = side(
+        "right",
+        args.right,
+        args.right_detections.as_deref(),
+        target.as_ref(),
+    )?;
+    let (Some(left_side), Some(right_side)) = (left, right) else {
         return Err(CliError::usage(
             "stereo",
             "give --left IMAGES... and --right IMAGES... once each",
         ));
     };
+    let (left_files, right_files) = (left_side.files().to_vec(), right_side.files().to_vec());
     // 1. Pair the files (by name numbers, else by order).
     let pairing = {
         let left: Vec<&str> = left_files.iter().map(String::as_str).collect();
@@ -79,30 +146,44 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
     if pairing.paired_by == PairedBy::Order {
         eprintln!("robocal stereo: no file name has a number: images paired by order");
     }
-    let target = args.target.as_deref().ok_or_else(|| {
-        CliError::usage(
-            "stereo",
-            "--target is required, e.g. --target chessboard:9x6:30mm",
-        )
-    })?;
-    let target =
-        Target::parse_spec(target).map_err(|e| CliError::usage("stereo", e.to_string()))?;
     let options = CalibrationOptions {
         model: model_from_name(args.model.as_deref().unwrap_or("brown"))?,
         ..CalibrationOptions::default()
     };
-    // 2. Detect in every image of both sides at once.
-    let files: Vec<String> = left_files.iter().chain(&right_files).cloned().collect();
-    let mut outcomes: Vec<Option<Outcome>> = run_all(
-        &files,
-        &target,
-        &DetectOptions::default(),
-        &args.limits.decode_options(),
-        args.threads,
-    )?
-    .into_iter()
-    .map(Some)
-    .collect();
+    // 2. Detect in every image of both sides at once (detection files are
+    // read as they are).
+    let images: Vec<String> = [&left_side, &right_side]
+        .into_iter()
+        .flat_map(|s| match s {
+            Side::Images(f) => f.clone(),
+            Side::Detections(..) => Vec::new(),
+        })
+        .collect();
+    let mut detected = if images.is_empty() {
+        Vec::new()
+    } else {
+        let target = target.as_ref().ok_or_else(|| {
+            CliError::usage(
+                "stereo",
+                "--target is required, e.g. --target chessboard:9x6:30mm",
+            )
+        })?;
+        run_all(
+            &images,
+            target,
+            &DetectOptions::default(),
+            &args.limits.decode_options(),
+            args.threads,
+        )?
+    }
+    .into_iter();
+    let mut outcomes: Vec<Option<Outcome>> = Vec::new();
+    for s in [left_side, right_side] {
+        match s {
+            Side::Images(f) => outcomes.extend(detected.by_ref().take(f.len()).map(Some)),
+            Side::Detections(_, o) => outcomes.extend(o.into_iter().map(Some)),
+        }
+    }
     // 3. Views of the pairs where both images gave a detection.
     let (mut left, mut right) = (vec![], vec![]);
     let (mut left_size, mut right_size) = (None, None);
@@ -136,10 +217,13 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
     };
     // 4. Solve and report.
     let report = calibrate_stereo(&left, &right, ls, rs, &options)?;
+    for w in &report.warnings {
+        eprintln!("robocal stereo: warning: {w}");
+    }
     let t = report.right_from_left.translation_m;
     eprintln!(
         "robocal stereo: {} pairs, rms {:.4} px (left {:.4}, right {:.4}), baseline {:.5} m, T [{:.5} {:.5} {:.5}] m",
-        left.len(),
+        report.left.views.len(),
         report.rms_px,
         report.left.rms_px,
         report.right.rms_px,
@@ -168,10 +252,5 @@ fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<View
         }
         _ => *size = Some(s),
     }
-    let (object_m, image_px) = d.correspondences();
-    Ok(View {
-        name: file.to_string(),
-        object_m,
-        image_px,
-    })
+    Ok(View::from_detection(file, &d))
 }

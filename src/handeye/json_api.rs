@@ -144,6 +144,61 @@ fn views_from_detections(list: &[Detection]) -> Vec<ViewPoints> {
         .collect()
 }
 
+/// Views whose planar board points cannot fix a pose (fewer than 4, or all
+/// but one on a line: [`crate::calib::homography_problem`]) are left out
+/// with their robot pose (and given camera pose), each with a warning.
+/// A view list whose length differs from the poses' is kept whole, for the
+/// solver to refuse with its own message.
+fn leave_out_degenerate(
+    views: Vec<ViewPoints>,
+    input: &mut InputJson,
+) -> (Vec<ViewPoints>, Vec<String>) {
+    if views.len() != input.base_from_gripper.len() {
+        return (views, Vec::new());
+    }
+    let problems: Vec<Option<String>> = views
+        .iter()
+        .map(|v| {
+            let planar = v.object_points.iter().all(|p| p.z == 0.0);
+            let board: Vec<Point2<f64>> = v.object_points.iter().map(|p| p.xy()).collect();
+            crate::calib::homography_problem(&board).filter(|_| planar)
+        })
+        .collect();
+    if problems.iter().all(Option::is_none) {
+        return (views, Vec::new());
+    }
+    let keep = |list: &mut Vec<PoseInput>| {
+        let mut i = 0;
+        list.retain(|_| {
+            i += 1;
+            problems.get(i - 1).is_some_and(Option::is_none)
+        });
+    };
+    keep(&mut input.base_from_gripper);
+    if let Some(list) = input
+        .camera_from_target
+        .as_mut()
+        .filter(|l| l.len() == problems.len())
+    {
+        keep(list);
+    }
+    let warnings = problems
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            p.as_ref()
+                .map(|why| format!("view {i} left out with its robot pose: {why}"))
+        })
+        .collect();
+    let kept = views
+        .into_iter()
+        .zip(&problems)
+        .filter(|(_, p)| p.is_none())
+        .map(|(v, _)| v)
+        .collect();
+    (kept, warnings)
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CandidateIn {
@@ -211,7 +266,7 @@ pub fn rank_candidates_json(input_json: &str) -> Result<String> {
 
 /// Solve from input JSON; returns the report JSON.
 pub fn solve_handeye_json(input_json: &str) -> Result<String> {
-    let input: InputJson = serde_json::from_str(input_json)
+    let mut input: InputJson = serde_json::from_str(input_json)
         .map_err(|e| Error::parse(e.line(), e.column(), e.to_string()))?;
     let poses = |list: &[PoseInput], field: &str| -> Result<Vec<Pose>> {
         list.iter()
@@ -243,6 +298,13 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         (Some(list), None) => Some(to_views(list)?),
         (None, Some(list)) => Some(views_from_detections(list)),
         (None, None) => None,
+    };
+    let (views, left_out) = match views {
+        Some(v) => {
+            let (kept, left_out) = leave_out_degenerate(v, &mut input);
+            (Some(kept), left_out)
+        }
+        None => (None, Vec::new()),
     };
     let camera = input.camera.as_ref().map(camera_from_json).transpose()?;
     let mode = match (&input.refine, &views) {
@@ -285,7 +347,13 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         base_from_gripper: poses(&input.base_from_gripper, "base_from_gripper")?,
         camera_from_target,
     };
-    let mut result = calibrate(&request, &options)?;
+    let mut result = calibrate(&request, &options).map_err(|e| match e {
+        Error::TooFew { .. } if !left_out.is_empty() => {
+            Error::invalid("views", format!("{e}; {}", left_out.join(", ")))
+        }
+        other => other,
+    })?;
+    result.warnings.splice(0..0, left_out);
     if let Some((views, camera)) = &images {
         apply_refinement(
             &mut result,

@@ -7,7 +7,7 @@
 
 use super::reprojection_refine::ViewPoints;
 use super::Pose;
-use crate::calib::{homography, pose_from_homography};
+use crate::calib::{homography, homography_problem, pose_from_homography};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params, rotation_from_rotvec};
@@ -47,6 +47,11 @@ pub fn camera_from_target(camera: &Camera, view: &ViewPoints) -> Result<(Pose, f
         ));
     }
     let plane: Vec<Point2<f64>> = view.object_points.iter().map(|p| p.xy()).collect();
+    if let Some(reason) = homography_problem(&plane) {
+        return Err(Error::degenerate(format!(
+            "the view's board points cannot fix a pose: {reason}"
+        )));
+    }
     let normalized = view
         .image_points
         .iter()

@@ -75,6 +75,7 @@ impl Scene {
                 name: format!("view_{v:03}"),
                 object_m: scene.target_points_m.clone(),
                 image_px,
+                point_ids: Vec::new(),
             });
             scene.camera_from_target.push(pose);
         }

@@ -176,6 +176,6 @@ export class StereoView {
       h('p', { class: 'hint' }, 'p_right = R p_left + T (the OpenCV stereoCalibrate R, T convention); R below, row by row.'),
       table(['R', 'col 1', 'col 2', 'col 3'], m.slice(0, 3).map((row, i) => [`row ${i + 1}`, ...row.slice(0, 3).map((v) => num(v, 6))]), { id: 'stereo-rotation' }),
       table(['camera', 'fx', 'fy', 'cx', 'cy', 'k1', 'RMS (px)'], [['left', ...cam(r.left)], ['right', ...cam(r.right)]], { id: 'stereo-cameras' }),
-      [...(r.left.warnings || []).map((w) => message('warning', `left: ${w}`)), ...(r.right.warnings || []).map((w) => message('warning', `right: ${w}`))]);
+      [...(r.warnings || []).map((w) => message('warning', w)), ...(r.left.warnings || []).map((w) => message('warning', `left: ${w}`)), ...(r.right.warnings || []).map((w) => message('warning', `right: ${w}`))]);
   }
 }
