@@ -495,6 +495,12 @@ export interface HandEyeInputBase {
   refine?: RefineMode;
   /** Expected pixel noise of the refinement, px (default 0.5). */
   pixel_sigma_px?: number;
+  /**
+   * The camera calibration's standard deviations, px (e.g. `{fx: 0.5, fy: 0.5, cx: 0.8, cy: 0.7}`;
+   * read from `camera` when that is a calibration report). With `refine: 'joint_intrinsics'`, an
+   * intrinsic moved by more than 10 of them is warned about.
+   */
+  camera_std?: Record<string, number> | null;
   /** One method or `all` (default `all`: every solver side by side). */
   method?: HandEyeMethod | 'all';
   /** Bootstrap resamples for the repeatability (default 100; 0 = none). */

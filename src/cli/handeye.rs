@@ -3,6 +3,7 @@
 use super::detections_file::read_detections;
 use super::handeye_images::{detect_images, image_pairs, read_robot_poses, RobotPoses};
 use super::{parse_target, read_file, CliError};
+use robocal::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
 use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
@@ -156,6 +157,8 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     let poses_text = read_text(poses_path)?;
     let mut pairs = Vec::new();
     let mut pre_warnings = Vec::new();
+    // The camera calibration's standard deviations, when --camera is a report.
+    let mut camera_std = None;
     let (input, images) = match (args.camera_poses.as_deref(), args.camera.as_deref()) {
         (Some(camera_path), None) => {
             if !args.images.is_empty() || args.detections.is_some() {
@@ -192,6 +195,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
             let value = serde_json::from_str(&camera_text)
                 .unwrap_or(serde_json::Value::String(camera_text));
             let camera = camera_from_json(&value)?;
+            camera_std = std_from_json(&value);
             let target = args
                 .target
                 .as_deref()
@@ -266,6 +270,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                 options.motion_pairs,
                 DEFAULT_PIXEL_SIGMA_PX,
             )?;
+            warn_intrinsic_move(&mut result, camera, camera_std.as_ref());
             // No refinement over pixels: the pose refinement, with each
             // view's PnP covariance from its image points.
             if mode == RefineMode::None && !args.no_refine {

@@ -22,6 +22,9 @@ const MIN_TRANSLATION_M: f64 = 1e-3;
 const MISTAKE_RATIO: f64 = 5.0;
 /// ... and the input as given must be off by at least this much (degrees).
 const MISTAKE_MIN_ROTATION_DEG: f64 = 0.5;
+/// A setup judged by the translations (rotations tied) needs the chosen one
+/// off by at least this much (mm).
+const MISTAKE_MIN_TRANSLATION_MM: f64 = 5.0;
 /// Fitted robot-translation scales outside [1/this, this] are a unit mistake.
 const SCALE_TOLERANCE: f64 = 1.5;
 
@@ -131,6 +134,74 @@ pub fn rank_pose_candidates(
         ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
     });
     scores
+}
+
+/// What the other setup says about the candidates: the setup is one of the
+/// candidates, because inverting every robot pose is, for the chain, the same
+/// as swapping eye-in-hand and eye-to-hand (an inverted reading fits a wrong
+/// setup as well as the right reading fits the right one, under the wrong
+/// frame names).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SetupAdvice {
+    /// The candidates fit much better under the other setup (by
+    /// [`MISTAKE_RATIO`], the best as chosen off by at least
+    /// [`MISTAKE_MIN_ROTATION_DEG`]): the message naming the setup that fits.
+    OtherFits(String),
+    /// Another reading fits the other setup as well as the best fits the
+    /// chosen one (within the rotation tie band): a note to append.
+    BothFit(String),
+}
+
+/// The [`SetupAdvice`] for candidates ranked as `chosen` under `setup`, or
+/// `None` when the other setup fits no candidate as well.
+pub fn setup_advice(
+    setup: Setup,
+    candidates: &[(String, Vec<Pose>)],
+    camera_from_target: &[Pose],
+    chosen: &[CandidateScore],
+) -> Option<SetupAdvice> {
+    let best = |scores: &[CandidateScore]| {
+        scores.first().and_then(|c| {
+            let k = c.consistency.as_ref()?;
+            Some((c.name.clone(), k.rotation_rms_deg, k.translation_rms_mm))
+        })
+    };
+    let other = match setup {
+        Setup::EyeInHand => Setup::EyeToHand,
+        Setup::EyeToHand => Setup::EyeInHand,
+    };
+    let (name, off, off_mm) = best(chosen)?;
+    let ranked = rank_pose_candidates(other, candidates, camera_from_target);
+    let (alt_name, alt, alt_mm) = best(&ranked)?;
+    if off > MISTAKE_MIN_ROTATION_DEG && alt * MISTAKE_RATIO < off {
+        return Some(SetupAdvice::OtherFits(setup_message(
+            setup, other, alt, off,
+        )));
+    }
+    // A reading with the rotations transposed fits the rotations of the
+    // wrong setup too; the translations tell them apart.
+    let tie = alt <= ROTATION_TIE_FACTOR * off + ROTATION_TIE_DEG;
+    if tie && off_mm > MISTAKE_MIN_TRANSLATION_MM && alt_mm * MISTAKE_RATIO < off_mm {
+        let fit = format!(
+            "rotation RMS {alt:.3} deg and translation RMS {alt_mm:.2} mm, against {off:.3} deg \
+             and {off_mm:.2} mm"
+        );
+        return Some(SetupAdvice::OtherFits(setup_message_with(
+            setup, other, &fit,
+        )));
+    }
+    (alt_name != name && tie).then(|| {
+        SetupAdvice::BothFit(format!(
+            "'{alt_name}' fits {o} as well (rotation RMS {alt:.3} deg): inverting every robot \
+             pose is the same as swapping eye-in-hand and eye-to-hand, so choose the setup of \
+             the robot cell first ({o}: {what}), then the reading that fits it",
+            o = other.name(),
+            what = match other {
+                Setup::EyeInHand => "the camera on the gripper",
+                Setup::EyeToHand => "the camera fixed, the target on the gripper",
+            },
+        ))
+    })
 }
 
 /// The recommendation message for ranked candidates.
@@ -277,6 +348,16 @@ pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
 /// The message for poses that fit the other setup: name the setup that
 /// fits, and why inverting the poses instead would mislead.
 fn setup_message(chosen: Setup, fits: Setup, fit_deg: f64, given_deg: f64) -> String {
+    setup_message_with(
+        chosen,
+        fits,
+        &format!("rotation RMS {fit_deg:.3} deg, against {given_deg:.3} deg"),
+    )
+}
+
+/// [`setup_message`] with the fit said by `fit` ("rotation RMS a deg,
+/// against b deg").
+fn setup_message_with(chosen: Setup, fits: Setup, fit: &str) -> String {
     let what = match fits {
         Setup::EyeInHand => "the camera on the gripper",
         Setup::EyeToHand => "the camera fixed, the target on the gripper",
@@ -284,7 +365,7 @@ fn setup_message(chosen: Setup, fits: Setup, fit_deg: f64, given_deg: f64) -> St
     let key = fits.camera_key();
     format!(
         "these poses fit {fits} ({what}), not the {chosen} chosen: as {fits} they fit the camera \
-         motion with rotation RMS {fit_deg:.3} deg, against {given_deg:.3} deg as {chosen}: \
+         motion with {fit} as {chosen}: \
          choose the setup {fits}, which solves {key}. Inverting the poses instead would give \
          the same numbers under the wrong frame names; do that only if the setup really is \
          {chosen} and the file holds gripper_from_base",

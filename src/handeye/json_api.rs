@@ -18,13 +18,19 @@
 //! [[x, y, z]...], "image_px": [[u, v]...]}]` (one per pose, same order),
 //! `"refine": "none" | "trusted" | "stochastic" | "joint_intrinsics"`
 //! (default `trusted` when views are given, see [`RefineMode`]) and
-//! `"pixel_sigma_px"` (default 0.5). With views, `camera_from_target` may be
+//! `"pixel_sigma_px"` (default 0.5), and `"camera_std"` (optional, `{"fx": std, ...}` in
+//! pixels; read from `camera` when that is a calibration report): with it, a
+//! joint refinement that moves an intrinsic by many standard deviations is
+//! warned about ([`super::intrinsics_move`]). With views, `camera_from_target` may be
 //! left out: it is then computed per view by [`super::pnp`]. Instead of
 //! `"views"`, `"detections"` may give one detection JSON per pose (the
 //! [`crate::target::Detection`] format, as `detect_target` returns it): the
 //! board points then come from each detection's own target.
 
-use super::checks::{rank_pose_candidates, recommend_candidate, CandidateScore};
+use super::checks::{
+    rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
+};
+use super::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use super::output::HandEyeReport;
 use super::refine_closed_form::{apply_refinement, RefineMode};
 use super::reprojection_refine::ViewPoints;
@@ -56,6 +62,8 @@ struct InputJson {
     camera_from_target: Option<Vec<PoseInput>>,
     #[serde(default)]
     camera: Option<serde_json::Value>,
+    #[serde(default)]
+    camera_std: Option<std::collections::BTreeMap<String, f64>>,
     #[serde(default)]
     views: Option<Vec<ViewIn>>,
     #[serde(default)]
@@ -256,7 +264,14 @@ pub fn rank_candidates_json(input_json: &str) -> Result<String> {
         })
         .collect::<Result<Vec<(String, Vec<Pose>)>>>()?;
     let scores = rank_pose_candidates(input.setup, &candidates, &camera);
-    let recommendation = recommend_candidate(&scores);
+    // A setup that fits better comes first: no reading fixes a wrong setup.
+    let recommendation = match setup_advice(input.setup, &candidates, &camera, &scores) {
+        Some(SetupAdvice::OtherFits(text)) => Some(text),
+        Some(SetupAdvice::BothFit(note)) => {
+            recommend_candidate(&scores).map(|r| format!("{r}; {note}"))
+        }
+        None => recommend_candidate(&scores),
+    };
     serde_json::to_string(&RankedCandidates {
         scores,
         recommendation,
@@ -364,6 +379,9 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
             options.motion_pairs,
             input.pixel_sigma_px.unwrap_or(DEFAULT_PIXEL_SIGMA_PX),
         )?;
+        let std =
+            (input.camera_std.clone()).or_else(|| input.camera.as_ref().and_then(std_from_json));
+        warn_intrinsic_move(&mut result, camera, std.as_ref());
         // No refinement over pixels: the pose refinement, with each view's
         // PnP covariance from its image points.
         if mode == RefineMode::None && input.refine_poses.unwrap_or(true) {
@@ -488,6 +506,30 @@ mod tests {
         let text = out["recommendation"].as_str().unwrap();
         assert!(
             text.starts_with("pose format 'xyz-euler' fits the camera motion best"),
+            "{text}"
+        );
+        // The same candidates with the wrong setup chosen: the inverted
+        // reading fits it, and the right reading fits the other setup as
+        // well: the advice names the setup as a candidate.
+        let mut wrong = input.clone();
+        wrong["setup"] = "eye-to-hand".into();
+        let out: serde_json::Value =
+            serde_json::from_str(&rank_candidates_json(&wrong.to_string()).unwrap()).unwrap();
+        assert_eq!(out["scores"][0]["name"], "inverted");
+        let text = out["recommendation"].as_str().unwrap();
+        assert!(
+            text.contains("; 'xyz-euler' fits eye-in-hand as well (rotation RMS 0."),
+            "{text}"
+        );
+        assert!(text.ends_with("so choose the setup of the robot cell first (eye-in-hand: the camera on the gripper), then the reading that fits it"), "{text}");
+        // Without the inverted reading, only the other setup fits: said first.
+        let mut no_inverse = wrong.clone();
+        no_inverse["candidates"].as_array_mut().unwrap().pop();
+        let out: serde_json::Value =
+            serde_json::from_str(&rank_candidates_json(&no_inverse.to_string()).unwrap()).unwrap();
+        let text = out["recommendation"].as_str().unwrap();
+        assert!(
+            text.starts_with("these poses fit eye-in-hand (the camera on the gripper), not the eye-to-hand chosen"),
             "{text}"
         );
         let empty = r#"{"setup":"eye-in-hand","candidates":[],"camera_from_target":[]}"#;

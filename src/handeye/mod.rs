@@ -45,6 +45,7 @@ pub mod axxb;
 pub mod axzb;
 pub mod checks;
 pub mod daniilidis;
+pub mod intrinsics_move;
 pub mod json_api;
 pub mod math;
 pub mod motion;
