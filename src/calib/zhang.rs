@@ -346,9 +346,12 @@ fn classify(
                 } else {
                     format!("dropped in an earlier round; now {r:.3} px (rejection round limit reached)")
                 };
+                // The position is filled in by the report (it knows the view's pixels).
                 view_outliers.push(Outlier {
                     index,
                     residual_px: r,
+                    x_px: 0.0,
+                    y_px: 0.0,
                     reason,
                 });
             }
