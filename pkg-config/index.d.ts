@@ -322,7 +322,23 @@ export interface Outlier {
   id: number;
   /** Its residual norm when dropped, px. */
   residual_px: number;
+  /** Where it was observed, px. */
+  x_px: number;
+  y_px: number;
   reason: string;
+}
+
+/** With the robust option: the points rejected over all views. */
+export interface RejectedPoints {
+  count: number;
+  /** Points detected (used plus rejected). */
+  of_points: number;
+  /** Views with a rejected point, most rejections first. */
+  views: { name: string; count: number }[];
+  /** Rejected points within 10 % of the image size from an edge. */
+  near_border: number;
+  /** The same in one sentence. */
+  summary: string;
 }
 
 /** A vector anchored at a pixel, px. */
@@ -392,6 +408,8 @@ export interface CameraCalibration {
   n_points: number;
   /** The options used. */
   options: CalibrationSolverOptions;
+  /** Present with the robust option. */
+  rejected?: RejectedPoints;
 }
 
 /** One method's row of the `method: "all"` comparison (values null when it failed). */
@@ -857,7 +875,8 @@ export type CameraExportFormat =
   | 'mrcal' | 'halcon' | 'matlab' | 'text';
 /** Transform formats with a fixed name. */
 export type SimpleTransformFormat =
-  | 'matrix4' | 'xyz-quat-xyzw' | 'xyz-quat-wxyz' | 'urdf' | 'ros2-static-tf'
+  | 'matrix4' | 'xyz-quat-xyzw' | 'xyz-quat-wxyz' | 'urdf' | 'urdf-robot' | 'ros2-static-tf'
+  | 'ros1-static-tf' | 'ros1-launch' | 'ros2-launch'
   | 'ur' | 'kuka' | 'abb-tooldata' | 'abb-wobjdata' | 'fanuc';
 /** Transform formats (need a transform such as `gripper_from_camera`). */
 export type TransformExportFormat =
@@ -873,7 +892,7 @@ export type ExportFormatListEntry =
   | 'euler-<intrinsic|extrinsic>-<order>-<deg|rad>';
 /** A transform key of a report, `parent_from_child` (the `transform` of `export_report`; `""` = the first present of gripper_from_camera, base_from_camera, right_from_left, base_from_target). */
 export type TransformName = `${string}_from_${string}`;
-/** What `export_report` reads: camera formats need a camera report; transform formats a report with the transform. */
+/** What `export_report` reads: camera formats need a camera report; transform formats a report with the transform. An optional `frame_names` object (`{"gripper": "tool0", "camera": "camera_optical_frame"}`) names the frames of a transform's key in the output. */
 export type ExportableReport = CameraCalibration | HandEyeReport | StereoCalibration;
 
 // ---------------------------------------------------------------------------

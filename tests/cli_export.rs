@@ -67,3 +67,43 @@ fn export_errors_say_what_to_fix() {
         )
     );
 }
+
+#[test]
+fn export_names_frames_with_the_frame_flag() {
+    let dir = std::env::temp_dir().join(format!("robocal-export-frames-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let report = dir.join("handeye.json");
+    std::fs::write(
+        &report,
+        r#"{"gripper_from_camera": {"translation_m": [0.03, -0.02, 0.1], "quaternion_xyzw": [0.0, 0.0, 0.0, 1.0]}, "frame_names": {"camera": "cam"}}"#,
+    )
+    .unwrap();
+    let path = report.to_str().unwrap();
+    let (code, out, err) = robocal(&[
+        "export",
+        path,
+        "--format",
+        "ros1-static-tf",
+        "--frame",
+        "gripper=tool0",
+        "--frame",
+        "camera=camera_optical_frame",
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    assert!(
+        out.ends_with("rosrun tf2_ros static_transform_publisher 0.03 -0.02 0.1 0.0 0.0 0.0 1.0 tool0 camera_optical_frame\n"),
+        "{out}"
+    );
+    // Without the flag, the report's frame_names.
+    let (_, out, _) = robocal(&["export", path, "--format", "ros2-static-tf"]);
+    assert!(
+        out.ends_with("--frame-id gripper --child-frame-id cam\n"),
+        "{out}"
+    );
+    let (code, _, err) = robocal(&["export", path, "--format", "urdf", "--frame", "tool0"]);
+    assert_eq!(
+        (code, err.as_str()),
+        (2, "robocal: export: --frame takes ROLE=NAME (e.g. gripper=tool0), got 'tool0' (see 'robocal export --help')\n")
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

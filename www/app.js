@@ -24,12 +24,37 @@ function showStep(readonly) {
   for (const a of links) a.parentElement.hidden = readonly && !READONLY_STEPS.includes(a.dataset.step);
   const allowed = links.filter((a) => !a.parentElement.hidden).map((a) => a.dataset.step);
   const wanted = location.hash.slice(1);
-  const step = allowed.includes(wanted) ? wanted : readonly ? 'camera' : 'images';
+  // A new session opens on step 1 (the target); a session with images on step 2.
+  const step = allowed.includes(wanted) ? wanted : readonly ? 'camera' : store.session.images.length ? 'images' : 'target';
   for (const a of links) {
     if (a.dataset.step === step) a.setAttribute('aria-current', 'step');
     else a.removeAttribute('aria-current');
   }
   for (const s of document.querySelectorAll('section.step')) s.hidden = s.id !== `step-${step}`;
+}
+
+/** Left/right arrow keys (and Home/End) on the step list move between the steps. */
+function stepKeys() {
+  $('step-list').addEventListener('keydown', (e) => {
+    const links = [...document.querySelectorAll('#step-list a')].filter((a) => !a.parentElement.hidden);
+    const i = links.indexOf(document.activeElement);
+    if (i < 0) return;
+    const next = { ArrowRight: i + 1, ArrowDown: i + 1, ArrowLeft: i - 1, ArrowUp: i - 1, Home: 0, End: links.length - 1 }[e.key];
+    if (next === undefined) return;
+    e.preventDefault();
+    const a = links[(next + links.length) % links.length];
+    a.focus();
+    location.hash = a.dataset.step;
+  });
+}
+
+/** A share link pasted into this tab (only the fragment changes): open it. */
+function onHashChange(readonly, openedFragment) {
+  window.addEventListener('hashchange', () => {
+    const fragment = sharedFragment();
+    if (fragment && fragment !== openedFragment) location.reload();
+    else showStep(readonly);
+  });
 }
 
 async function engineVersion() {
@@ -83,14 +108,25 @@ async function openShared(fragment) {
   new ExportView(store, engine);
   new ShareView(store, version, () => camera.plots || []);
   showStep(true);
-  window.addEventListener('hashchange', () => showStep(true));
+  stepKeys();
+  onHashChange(true, fragment);
 }
 
 async function main() {
   const fragment = sharedFragment();
   if (fragment) return openShared(fragment);
   const versionPromise = engineVersion();
+  stepKeys();
   await store.load();
+  // Decoding the thumbnails of a saved session takes seconds: say so on the
+  // step that will open instead of showing a blank panel.
+  showStep(false);
+  const restoring = $('restoring');
+  const saved = store.session.images.length;
+  if (saved || store.session.camera.result) {
+    restoring.textContent = `Restoring your session${saved ? ` (${saved} image${saved === 1 ? '' : 's'})` : ''}…`;
+    restoring.hidden = false;
+  }
   initTarget(store, engine);
   // Decoding and detection use up to 4 workers (one per core).
   const pool = new EnginePool(engine, Math.min(4, navigator.hardwareConcurrency || 1));
@@ -99,17 +135,26 @@ async function main() {
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);
   robotView = robot;
-  new HandEyeView(store, engine, robot);
+  const handeye = new HandEyeView(store, engine, robot);
   new WorkflowsView(store, engine);
   const stereo = new StereoView(store, engine);
   new ExportView(store, engine);
   const version = await versionPromise;
   registerOffline(version);
-  new ShareView(store, version, () => camera.plots || []);
+  new ShareView(store, version, () => [...(camera.plots || []), ...(handeye.plots || [])], async (session) => {
+    // A session file: written to this browser's storage, then the page restarts on it.
+    await store.reset();
+    store.session = { ...defaultSession(), ...session, images: session.images.map((i) => ({ ...i, bytesMissing: true })) };
+    await store.save();
+    location.hash = session.camera && session.camera.result ? 'camera' : 'images';
+    location.reload();
+  });
+  restoring.hidden = true;
   store.onChange((what) => { if (/detections|included|images|all/.test(what)) camera.summarise(); });
   $('new-session').addEventListener('click', async () => {
     if (store.session.images.length && !confirm('Start a new session? Images, detections and results of this session are removed from this browser.')) return;
     await store.reset();
+    location.hash = 'target';
     await images.restore();
     store.changed('target-loaded');
     camera.render();
@@ -127,6 +172,7 @@ async function main() {
       Object.assign(store.session.robot, { fileName: 'demo_poses.csv', text: demo.poses_csv, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper' });
       robotView.render();
       await robotView.parse();
+      if (!location.hash || location.hash === '#target') location.hash = 'images';
       $('engine-status').textContent = `Demo loaded: ${demo.images.length} rendered images of a ${demo.target_spec} board and the robot poses that go with them (eye-in-hand). Solve the camera in step 3, then the hand-eye in step 5.`;
     } catch (err) {
       $('engine-status').textContent = `Demo data could not be made: ${err.message}`;
@@ -134,7 +180,7 @@ async function main() {
       $('demo-button').disabled = false;
     }
   });
-  window.addEventListener('hashchange', () => showStep(false));
+  onHashChange(false, null);
   showStep(false);
 }
 

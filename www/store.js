@@ -58,7 +58,9 @@ export class Store {
       if (saved && saved.schema === 1) this.session = { ...defaultSession(), ...saved };
       for (const img of this.session.images) {
         const buf = await tx(this.db, 'blobs', 'readonly', (s) => s.get(img.id));
-        if (buf) this.bytes.set(img.id, buf);
+        if (buf) { this.bytes.set(img.id, buf); delete img.bytesMissing; }
+        // From a session file: the detection without the image (solves work; detection needs the file).
+        else if (img.detection) img.bytesMissing = true;
         else { img.status = 'error'; img.error = 'the image bytes were not found in this browser\'s storage; add the file again'; }
       }
       const stereo = this.session.stereo;

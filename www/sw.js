@@ -27,6 +27,7 @@ const SHELL = [
   'views/handeye.js',
   'views/images.js',
   'views/robot.js',
+  'views/report.js',
   'views/share.js',
   'views/stereo.js',
   'views/target.js',

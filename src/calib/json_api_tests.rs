@@ -136,6 +136,38 @@ fn robust_option_drops_a_gross_outlier_and_reports_it() {
     let gross: Vec<&Value> = outliers.iter().filter(|o| o["index"] == 17).collect();
     assert_eq!(gross.len(), 1, "{outliers:?}");
     assert!((gross[0]["residual_px"].as_f64().expect("px") - 25.0).abs() < 1.0);
+    // Where: the observed (moved) pixel of point 17 in view 2.
+    let moved = &views[2]["image_px"][17];
+    assert_eq!(gross[0]["x_px"], moved[0], "x px");
+    assert_eq!(gross[0]["y_px"], moved[1], "y px");
+    // How many and where, said once: the count is the views' outliers,
+    // view 2 (with the gross one) among the views named.
+    let rejected = &out["report"]["rejected"];
+    let per_view: Vec<usize> = out["report"]["views"]
+        .as_array()
+        .expect("views")
+        .iter()
+        .map(|v| v["outliers"].as_array().expect("outliers").len())
+        .collect();
+    let total: usize = per_view.iter().sum();
+    let used = out["report"]["n_points"].as_u64().expect("n") as usize;
+    assert_eq!(rejected["count"], total);
+    assert_eq!(rejected["of_points"], total + used);
+    let named = rejected["views"].as_array().expect("views");
+    assert_eq!(named.len(), per_view.iter().filter(|&&n| n > 0).count());
+    let name2 = out["report"]["views"][2]["name"].clone();
+    assert!(named.iter().any(|v| v["name"] == name2), "{rejected}");
+    let counts: Vec<u64> = named
+        .iter()
+        .map(|v| v["count"].as_u64().expect("n"))
+        .collect();
+    assert!(
+        counts.windows(2).all(|w| w[0] >= w[1]),
+        "most first: {counts:?}"
+    );
+    let summary = rejected["summary"].as_str().expect("summary");
+    let head = format!("robust loss: {total} of {} points rejected (", total + used);
+    assert!(summary.starts_with(&head), "{summary}");
     // A 3-sigma cut on 2-D Gaussian residual norms also drops exp(-4.5) =
     // 1.1 % of the inliers, all of them near 3 sigma (0.3 px), none beyond
     // 6 sigma (probability exp(-18) per point).

@@ -23,6 +23,7 @@ pub mod json_api;
 mod json_api_tests;
 pub mod model_advice;
 mod refine;
+mod rejected;
 mod report;
 mod residuals;
 pub mod stereo;
@@ -36,6 +37,7 @@ mod zhang;
 
 pub use closed_form::{intrinsics_from_homographies, pose_from_homography};
 pub use homography::homography;
+pub use rejected::{RejectedInView, RejectedPoints};
 pub use report::{CameraCalibration, Correlation, Outlier, ProjectionUncertainty, ViewReport};
 pub use residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
 pub use tsai::calibrate_tsai;

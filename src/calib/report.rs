@@ -2,6 +2,7 @@
 //! uncertainty and correlation, a projection-uncertainty grid and warnings.
 
 use super::refine::{pose_from_block, CalibProblem};
+use super::rejected::{rejected_points, RejectedPoints};
 use super::residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
 use super::CalibrationOptions;
 use crate::camera::Camera;
@@ -33,6 +34,12 @@ pub struct Outlier {
     pub id: usize,
     /// Its residual norm when it was dropped, px.
     pub residual_px: f64,
+    /// Where it was observed, px (0 in reports written before this field).
+    #[serde(default)]
+    pub x_px: f64,
+    /// Where it was observed, px.
+    #[serde(default)]
+    pub y_px: f64,
     /// Why it was dropped.
     pub reason: String,
 }
@@ -124,6 +131,10 @@ pub struct CameraCalibration {
     pub n_points: usize,
     /// The options used.
     pub options: CalibrationOptions,
+    /// With the robust option: how many points were rejected, in which
+    /// views and where; absent without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rejected: Option<RejectedPoints>,
 }
 
 pub(crate) fn build_report(
@@ -180,15 +191,23 @@ pub(crate) fn build_report(
         .iter()
         .enumerate()
         .zip(outliers)
-        .map(|((v, view), outliers)| ViewReport {
-            name: view.name.clone(),
-            rms_px: (squared[v] / counts[v].max(1) as f64).sqrt(),
-            n_points: counts[v],
-            camera_from_target: PoseJson::from(&poses[v]),
-            outliers,
-            residuals_px: view_residuals(&camera, &poses[v], view),
+        .map(|((v, view), mut outliers)| {
+            for o in &mut outliers {
+                if let Some(p) = view.image_px.get(o.index) {
+                    (o.x_px, o.y_px) = (p.x, p.y);
+                }
+            }
+            ViewReport {
+                name: view.name.clone(),
+                rms_px: (squared[v] / counts[v].max(1) as f64).sqrt(),
+                n_points: counts[v],
+                camera_from_target: PoseJson::from(&poses[v]),
+                outliers,
+                residuals_px: view_residuals(&camera, &poses[v], view),
+            }
         })
-        .collect();
+        .collect::<Vec<ViewReport>>();
+    let rejected = options.outlier_sigma.map(|_| rejected_points(&views, size));
     let mut depths: Vec<f64> = poses.iter().map(|p| p.translation.vector.norm()).collect();
     depths.sort_by(f64::total_cmp);
     let depth = depths.get(depths.len() / 2).copied().unwrap_or(1.0);
@@ -211,6 +230,7 @@ pub(crate) fn build_report(
         n_points,
         options: options.clone(),
         camera,
+        rejected,
     })
 }
 

@@ -372,6 +372,7 @@ fn classify(
                 } else {
                     format!("dropped in an earlier round; now {r:.3} px (rejection round limit reached)")
                 };
+                // The position is filled in by the report (it knows the view's pixels).
                 view_outliers.push(Outlier {
                     index,
                     id: every
@@ -379,6 +380,8 @@ fn classify(
                         .get(outliers.len())
                         .map_or(index, |v| v.point_id(index)),
                     residual_px: r,
+                    x_px: 0.0,
+                    y_px: 0.0,
                     reason,
                 });
             }

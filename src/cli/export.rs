@@ -23,16 +23,27 @@ REPORT.json is the output of 'robocal intrinsics' (a camera) or
 
 Transform formats (of gripper_from_camera, base_from_camera, right_from_left
 or base_from_target, the first present; choose with --transform):
-  matrix4, xyz-quat-xyzw, xyz-quat-wxyz, urdf, ros2-static-tf, ur, kuka,
-  abb-tooldata, abb-wobjdata, fanuc, and euler-<intrinsic|extrinsic>-<order>-<deg|rad>
+  matrix4, xyz-quat-xyzw, xyz-quat-wxyz, urdf (the joint), urdf-robot (a whole
+  .urdf file), ros2-static-tf, ros1-static-tf, ros1-launch (XML), ros2-launch
+  (Python), ur, kuka, abb-tooldata, abb-wobjdata, fanuc, and
+  euler-<intrinsic|extrinsic>-<order>-<deg|rad>
   with order one of xyz xzy yxz yzx zxy zyx xyx xzx yxy yzy zxz zyz.
+
+Frame names: a transform a_from_b is written with parent frame a and child
+frame b (gripper_from_camera: gripper, camera). --frame ROLE=NAME renames a
+role in the output, e.g. --frame gripper=tool0 --frame camera=camera_optical_frame
+--frame base=base_link; a report's \"frame_names\" object does the same
+({\"gripper\": \"tool0\"}), --frame wins. robocal's camera frame is the optical
+frame (z forward, x right, y down): in ROS that is a *_optical_frame, not
+camera_link (x forward).
 
 Output goes to FILE with -o, else to stdout.
 
 Examples:
   robocal export camera.json --format opencv-yaml -o camera.yaml
   robocal export handeye.json --format urdf --transform gripper_from_camera
-  robocal export handeye.json --format euler-extrinsic-xyz-deg",
+  robocal export handeye.json --format euler-extrinsic-xyz-deg
+  robocal export handeye.json --format ros1-launch --frame gripper=tool0 --frame camera=camera_optical_frame",
     args_override_self = true
 )]
 pub struct ExportArgs {
@@ -45,6 +56,9 @@ pub struct ExportArgs {
     /// Which transform of the report to export (default: the first present)
     #[arg(long, value_name = "NAME")]
     transform: Option<String>,
+    /// Name a frame in the output: ROLE=NAME, e.g. gripper=tool0 (repeatable)
+    #[arg(long = "frame", value_name = "ROLE=NAME")]
+    frames: Vec<String>,
     /// Write the export there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE")]
     output: Option<String>,
@@ -58,7 +72,21 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
         .format
         .as_deref()
         .ok_or_else(|| CliError::usage("export", "--format is required"))?;
+    let mut frames = Vec::with_capacity(args.frames.len());
+    for f in &args.frames {
+        let (role, name) = f.split_once('=').ok_or_else(|| {
+            CliError::usage(
+                "export",
+                format!("--frame takes ROLE=NAME (e.g. gripper=tool0), got '{f}'"),
+            )
+        })?;
+        frames.push((role.to_string(), name.to_string()));
+    }
     let text = read_text(report)?;
-    let out = robocal::io::export::export(&text, format, args.transform.as_deref())?;
+    let options = robocal::io::export::ExportOptions {
+        transform: args.transform.as_deref(),
+        frames,
+    };
+    let out = robocal::io::export::export_with(&text, format, &options)?;
     write_output(args.output.as_deref(), &out)
 }

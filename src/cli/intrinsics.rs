@@ -152,6 +152,9 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
         r.camera.cx,
         r.camera.cy
     );
+    if let Some(rejected) = &r.rejected {
+        eprintln!("robocal intrinsics: {}", rejected.summary);
+    }
     for w in &r.warnings {
         eprintln!("robocal intrinsics: warning: {w}");
     }

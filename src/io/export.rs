@@ -36,7 +36,34 @@ pub fn format_names() -> Vec<String> {
 
 /// Write `report_json` in `format`; `transform` picks which transform of a
 /// hand-eye report (default: the first of [`DEFAULT_TRANSFORMS`] present).
+/// Frames are named as the report's `frame_names` say (see [`ExportOptions`]).
 pub fn export(report_json: &str, format: &str, transform: Option<&str>) -> Result<String> {
+    export_with(
+        report_json,
+        format,
+        &ExportOptions {
+            transform,
+            ..ExportOptions::default()
+        },
+    )
+}
+
+/// Choices of [`export_with`].
+#[derive(Debug, Clone, Default)]
+pub struct ExportOptions<'a> {
+    /// Which transform of the report (default: the first of [`DEFAULT_TRANSFORMS`] present).
+    pub transform: Option<&'a str>,
+    /// Names written for the frames of a transform, by role: the two parts
+    /// of its key (`gripper` and `camera` of `gripper_from_camera`), e.g.
+    /// `("gripper", "tool0")`. They override the report's `frame_names`
+    /// object (same shape: `{"gripper": "tool0", "camera": "camera_optical_frame"}`);
+    /// a role named by neither keeps its own name.
+    pub frames: Vec<(String, String)>,
+}
+
+/// [`export`] with frame names.
+pub fn export_with(report_json: &str, format: &str, options: &ExportOptions) -> Result<String> {
+    let transform = options.transform;
     let report: serde_json::Value = serde_json::from_str(report_json).map_err(|e| {
         Error::parse(
             e.line(),
@@ -90,11 +117,53 @@ pub fn export(report_json: &str, format: &str, transform: Option<&str>) -> Resul
             })?,
     };
     let pose = pose_from_report(&report, &name)?;
-    Ok(export_transform(
-        &pose,
-        &FrameNames::from_transform_name(&name)?,
-        transform_format,
-    ))
+    let roles = FrameNames::from_transform_name(&name)?;
+    let names = FrameNames {
+        parent: frame_name(&report, &options.frames, &roles.parent)?,
+        child: frame_name(&report, &options.frames, &roles.child)?,
+        key: name.clone(),
+    };
+    Ok(export_transform(&pose, &names, transform_format))
+}
+
+/// The name written for the frame of `role`: from `frames`, else the
+/// report's `frame_names`, else the role itself. Names go into XML, shell
+/// and Python text, so they are held to what ROS and URDF accept.
+fn frame_name(
+    report: &serde_json::Value,
+    frames: &[(String, String)],
+    role: &str,
+) -> Result<String> {
+    let given = match frames.iter().rev().find(|(r, _)| r == role) {
+        Some((_, name)) => Some(name.clone()),
+        None => match report.get("frame_names").and_then(|m| m.get(role)) {
+            None | Some(serde_json::Value::Null) => None,
+            Some(serde_json::Value::String(name)) => Some(name.clone()),
+            Some(other) => {
+                return Err(Error::invalid(
+                    "frame_names",
+                    format!("'{role}' should name a frame as a string, got {other}"),
+                ))
+            }
+        },
+    };
+    let Some(name) = given else {
+        return Ok(role.to_string());
+    };
+    let valid = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_' || c == '/')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '/');
+    if !valid {
+        return Err(Error::invalid(
+            "frame_names",
+            format!("the {role} frame name '{name}' is not a ROS frame name: use letters, digits, _ and / (starting with a letter, _ or /), e.g. tool0"),
+        ));
+    }
+    Ok(name)
 }
 
 /// Read the transform `name` from a report: any [`PoseInput`] (the matrix

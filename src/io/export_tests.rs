@@ -196,6 +196,87 @@ fn transforms_read_back_to_the_same_pose() {
     );
     assert_eq!(
         TransformFormat::from_name("euler-sideways-xyz-deg").unwrap_err().to_string(),
-        "format: unknown transform format 'euler-sideways-xyz-deg' (known: matrix4, xyz-quat-xyzw, xyz-quat-wxyz, urdf, ros2-static-tf, ur, kuka, abb-tooldata, abb-wobjdata, fanuc, euler-<intrinsic|extrinsic>-<order>-<deg|rad>)"
+        "format: unknown transform format 'euler-sideways-xyz-deg' (known: matrix4, xyz-quat-xyzw, xyz-quat-wxyz, urdf, urdf-robot, ros2-static-tf, ros1-static-tf, ros1-launch, ros2-launch, ur, kuka, abb-tooldata, abb-wobjdata, fanuc, euler-<intrinsic|extrinsic>-<order>-<deg|rad>)"
+    );
+}
+
+/// A hand-eye report with frame names, as the page writes it.
+fn named_report(frame_names: &str) -> String {
+    format!(
+        r#"{{"gripper_from_camera": {{"translation_m": [0.03, -0.02, 0.1], "quaternion_xyzw": [0.0, 0.0, 0.6, 0.8]}}{frame_names}}}"#
+    )
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn ros_exports_put_the_arguments_in_each_versions_order() {
+    use super::export::export;
+    let report =
+        named_report(r#", "frame_names": {"gripper": "tool0", "camera": "camera_optical_frame"}"#);
+    // quaternion (0, 0, 0.6, 0.8): 73.74 deg about z; ROS 1 positional
+    // x y z qx qy qz qw frame_id child_frame_id, ROS 2 named.
+    assert_eq!(
+        export(&report, "ros1-static-tf", None).unwrap(),
+        "# gripper_from_camera (ROS 1): x y z (m) qx qy qz qw parent child\nrosrun tf2_ros static_transform_publisher 0.03 -0.02 0.1 0.0 0.0 0.6 0.8 tool0 camera_optical_frame\n"
+    );
+    assert_eq!(
+        export(&report, "ros2-static-tf", None).unwrap(),
+        "ros2 run tf2_ros static_transform_publisher --x 0.03 --y -0.02 --z 0.1 --qx 0.0 --qy 0.0 --qz 0.6 --qw 0.8 --frame-id tool0 --child-frame-id camera_optical_frame\n"
+    );
+    assert_eq!(
+        export(&report, "ros1-launch", None).unwrap(),
+        "<!-- gripper_from_camera: x y z (m) qx qy qz qw parent child (ROS 1 tf2_ros) -->\n<launch>\n  <node pkg=\"tf2_ros\" type=\"static_transform_publisher\" name=\"tool0_to_camera_optical_frame\" args=\"0.03 -0.02 0.1 0.0 0.0 0.6 0.8 tool0 camera_optical_frame\"/>\n</launch>\n"
+    );
+    let py = export(&report, "ros2-launch", None).unwrap();
+    assert!(py.contains("            arguments=['--x', '0.03', '--y', '-0.02', '--z', '0.1', '--qx', '0.0', '--qy', '0.0', '--qz', '0.6', '--qw', '0.8', '--frame-id', 'tool0', '--child-frame-id', 'camera_optical_frame'],\n"), "{py}");
+    assert!(
+        py.contains("executable='static_transform_publisher'"),
+        "{py}"
+    );
+    let urdf = export(&report, "urdf-robot", None).unwrap();
+    assert!(urdf.starts_with("<?xml version=\"1.0\"?>\n<robot name=\"robocal_calibration\">\n  <link name=\"tool0\"/>\n  <link name=\"camera_optical_frame\"/>\n  <joint name=\"tool0_to_camera_optical_frame\" type=\"fixed\">\n    <parent link=\"tool0\"/>\n"), "{urdf}");
+    assert!(urdf.ends_with("  </joint>\n</robot>\n"), "{urdf}");
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn frame_names_come_from_the_options_then_the_report_then_the_key() {
+    use super::export::{export, export_with, ExportOptions};
+    // No names: the roles of the key, as before.
+    let plain = export(&named_report(""), "urdf", None).unwrap();
+    assert!(plain.starts_with("<joint name=\"gripper_to_camera\" type=\"fixed\">\n  <parent link=\"gripper\"/>\n  <child link=\"camera\"/>"), "{plain}");
+    // The options win over the report; a role named by neither keeps its name.
+    let report = named_report(r#", "frame_names": {"gripper": "tool0", "camera": "cam"}"#);
+    let options = ExportOptions {
+        transform: None,
+        frames: vec![("camera".into(), "camera_optical_frame".into())],
+    };
+    let out = export_with(&report, "ros2-static-tf", &options).unwrap();
+    assert!(
+        out.ends_with("--frame-id tool0 --child-frame-id camera_optical_frame\n"),
+        "{out}"
+    );
+    let only_base = export(
+        &named_report(r#", "frame_names": {"base": "base_link"}"#),
+        "ros2-static-tf",
+        None,
+    )
+    .unwrap();
+    assert!(
+        only_base.ends_with("--frame-id gripper --child-frame-id camera\n"),
+        "{only_base}"
+    );
+    // Names that would break the XML, shell or Python text are refused.
+    assert_eq!(
+        export(&named_report(r#", "frame_names": {"gripper": "tool 0"}"#), "urdf", None).unwrap_err().to_string(),
+        "frame_names: the gripper frame name 'tool 0' is not a ROS frame name: use letters, digits, _ and / (starting with a letter, _ or /), e.g. tool0"
+    );
+    assert_eq!(
+        export(
+            &named_report(r#", "frame_names": {"camera": 3}"#),
+            "urdf",
+            None
+        )
+        .unwrap_err()
+        .to_string(),
+        "frame_names: 'camera' should name a frame as a string, got 3"
     );
 }

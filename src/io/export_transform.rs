@@ -11,6 +11,9 @@ use crate::geometry::{
     quaternion_xyzw_from_rotation, rotvec_from_rotation, EulerKind, EulerOrder, Pose, PoseJson,
 };
 use crate::io::export_camera::float;
+use crate::io::export_ros::{
+    ros1_args, ros1_launch, ros2_args, ros2_launch, urdf_joint, urdf_robot,
+};
 
 /// The transform formats robocal writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -32,8 +35,16 @@ pub enum TransformFormat {
     },
     /// URDF `<joint type="fixed">` with `origin xyz rpy` (rpy = extrinsic XYZ).
     UrdfJoint,
+    /// A whole URDF file (`<robot>` with the two links and the fixed joint).
+    UrdfRobot,
     /// `ros2 run tf2_ros static_transform_publisher ...` command line.
     Ros2StaticTransform,
+    /// `rosrun tf2_ros static_transform_publisher x y z qx qy qz qw parent child` (ROS 1).
+    Ros1StaticTransform,
+    /// A ROS 1 launch file (XML) with the static_transform_publisher node.
+    Ros1Launch,
+    /// A ROS 2 launch file (Python) with the static_transform_publisher node.
+    Ros2Launch,
     /// Universal Robots TCP / feature pose `p[x, y, z, rx, ry, rz]` (m, rotation vector).
     UrPose,
     /// KUKA TOOL_DATA / BASE_DATA frame `{X, Y, Z, A, B, C}` (mm, deg; A about Z, B about Y', C about X'').
@@ -53,6 +64,9 @@ pub struct FrameNames {
     pub parent: String,
     /// The frame whose pose it is (`b` of `a_from_b`).
     pub child: String,
+    /// The transform's key in the report (`gripper_from_camera`), named in
+    /// the comments of the output whatever the frames are called.
+    pub key: String,
 }
 
 impl FrameNames {
@@ -67,16 +81,21 @@ impl FrameNames {
         Ok(FrameNames {
             parent: parent.into(),
             child: child.into(),
+            key: name.into(),
         })
     }
 }
 
-const SIMPLE_FORMATS: [(&str, TransformFormat); 10] = [
+const SIMPLE_FORMATS: [(&str, TransformFormat); 14] = [
     ("matrix4", TransformFormat::Matrix4),
     ("xyz-quat-xyzw", TransformFormat::XyzQuaternionXyzw),
     ("xyz-quat-wxyz", TransformFormat::XyzQuaternionWxyz),
     ("urdf", TransformFormat::UrdfJoint),
+    ("urdf-robot", TransformFormat::UrdfRobot),
     ("ros2-static-tf", TransformFormat::Ros2StaticTransform),
+    ("ros1-static-tf", TransformFormat::Ros1StaticTransform),
+    ("ros1-launch", TransformFormat::Ros1Launch),
+    ("ros2-launch", TransformFormat::Ros2Launch),
     ("ur", TransformFormat::UrPose),
     ("kuka", TransformFormat::KukaFrame),
     ("abb-tooldata", TransformFormat::AbbTooldata),
@@ -163,7 +182,7 @@ pub fn export_transform(pose: &Pose, names: &FrameNames, format: TransformFormat
     let xyz = [t.x, t.y, t.z];
     let mm = [t.x * 1000.0, t.y * 1000.0, t.z * 1000.0];
     let deg = |a: [f64; 3]| a.map(f64::to_degrees);
-    let label = format!("{}_from_{}", names.parent, names.child);
+    let label = &names.key;
     match format {
         TransformFormat::Matrix4 => {
             let m = matrix4_from_pose(pose);
@@ -213,24 +232,17 @@ pub fn export_transform(pose: &Pose, names: &FrameNames, format: TransformFormat
                 list(&angles)
             )
         }
-        TransformFormat::UrdfJoint => {
-            let rpy = euler_from_rotation(&pose.rotation, EulerOrder::XYZ, EulerKind::Extrinsic);
-            format!(
-                "<joint name=\"{p}_to_{c}\" type=\"fixed\">\n  <parent link=\"{p}\"/>\n  <child link=\"{c}\"/>\n  <origin xyz=\"{}\" rpy=\"{}\"/>\n</joint>\n",
-                list(&xyz),
-                list(&rpy),
-                p = names.parent,
-                c = names.child
-            )
-        }
+        TransformFormat::UrdfJoint => urdf_joint(pose, names),
+        TransformFormat::UrdfRobot => urdf_robot(&urdf_joint(pose, names), names),
         TransformFormat::Ros2StaticTransform => {
-            let q = quaternion_xyzw_from_rotation(&pose.rotation);
-            format!(
-                "ros2 run tf2_ros static_transform_publisher --x {} --y {} --z {} --qx {} --qy {} --qz {} --qw {} --frame-id {} --child-frame-id {}\n",
-                float(xyz[0]), float(xyz[1]), float(xyz[2]), float(q[0]), float(q[1]), float(q[2]), float(q[3]),
-                names.parent, names.child
-            )
+            format!("ros2 run tf2_ros static_transform_publisher {}\n", ros2_args(pose, names))
         }
+        TransformFormat::Ros1StaticTransform => format!(
+            "# {label} (ROS 1): x y z (m) qx qy qz qw parent child\nrosrun tf2_ros static_transform_publisher {}\n",
+            ros1_args(pose, names)
+        ),
+        TransformFormat::Ros1Launch => ros1_launch(&label, &ros1_args(pose, names), names),
+        TransformFormat::Ros2Launch => ros2_launch(&label, &ros2_args(pose, names), names),
         TransformFormat::UrPose => {
             let r = rotvec_from_rotation(&pose.rotation);
             let v = fixed(&[xyz[0], xyz[1], xyz[2], r.x, r.y, r.z], 6);

@@ -11,6 +11,7 @@ pub mod csv_table;
 pub mod export;
 pub mod export_camera;
 mod export_camera_tools;
+pub mod export_ros;
 pub mod export_transform;
 pub mod import_camera;
 pub mod pairing;

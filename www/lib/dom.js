@@ -74,3 +74,27 @@ export async function readTextFile(file, what) {
   if (!text.trim()) throw new Error(`the file is empty${bytes.length ? ' (only white space)' : ''}: expected ${what}`);
   return text;
 }
+
+/**
+ * Keep Tab and Shift+Tab inside a modal dialog while it is open (the last
+ * control wraps to the first and back), close it with Escape (the
+ * dialog's own cancel), and give focus back to what opened it.
+ */
+export function trapFocus(dialog) {
+  let opener = null;
+  const focusable = () => [...dialog.querySelectorAll('button, input, select, textarea, a[href], [tabindex]:not([tabindex="-1"])')]
+    .filter((e) => !e.disabled && !e.hidden && e.getClientRects().length);
+  dialog.addEventListener('keydown', (e) => {
+    if (e.key !== 'Tab') return;
+    const items = focusable();
+    if (!items.length) return;
+    const i = items.indexOf(document.activeElement);
+    const next = e.shiftKey ? (i <= 0 ? items.length - 1 : i - 1) : (i === items.length - 1 || i < 0 ? 0 : i + 1);
+    e.preventDefault();
+    items[next].focus();
+  });
+  new MutationObserver(() => {
+    if (dialog.open) opener = opener || document.activeElement;
+    else if (opener) { const o = opener; opener = null; if (o.isConnected) o.focus(); }
+  }).observe(dialog, { attributes: true, attributeFilter: ['open'] });
+}

@@ -1,5 +1,6 @@
-// A small 3-D view of coordinate frames (robot base, gripper, camera, target)
-// on a canvas: drag to rotate, wheel to zoom. Frames are 4x4 row-major
+// A 3-D view of coordinate frames (robot base, gripper, camera, target) on a
+// canvas: drag or arrow keys to rotate, wheel, + / - keys or the buttons
+// (zoomBy) to zoom, 0 to reset. Labels are placed so they do not overlap. Frames are 4x4 row-major
 // matrices in one world frame (metres); each is drawn as an x/y/z triad
 // (red/green/blue) with its name, so a wrong direction is visible at once.
 
@@ -28,12 +29,27 @@ export class FrameView {
     canvas.addEventListener('wheel', (e) => { e.preventDefault(); this.zoom *= e.deltaY < 0 ? 1.1 : 1 / 1.1; this.draw(); }, { passive: false });
     canvas.tabIndex = 0;
     canvas.addEventListener('keydown', (e) => {
+      const zoom = { '+': 1.25, '=': 1.25, '-': 0.8, _: 0.8 }[e.key];
+      if (zoom) { e.preventDefault(); this.zoomBy(zoom); return; }
+      if (e.key === '0') { e.preventDefault(); this.reset(); return; }
       const k = { ArrowLeft: [-0.1, 0], ArrowRight: [0.1, 0], ArrowUp: [0, -0.1], ArrowDown: [0, 0.1] }[e.key];
       if (!k) return;
       e.preventDefault();
       this.yaw += k[0]; this.pitch = Math.max(-1.5, Math.min(1.5, this.pitch + k[1]));
       this.draw();
     });
+  }
+
+  /** Zoom in (f > 1) or out, within 0.2x to 20x. */
+  zoomBy(f) {
+    this.zoom = Math.max(0.2, Math.min(20, this.zoom * f));
+    this.draw();
+  }
+
+  /** The initial view direction and zoom. */
+  reset() {
+    [this.yaw, this.pitch, this.zoom] = [-0.7, 0.5, 1];
+    this.draw();
   }
 
   /** frames: [{name, matrix_row_major, size?}], links: [[nameA, nameB]] drawn as dashed lines. */
@@ -74,6 +90,7 @@ export class FrameView {
     }
     ctx.setLineDash([]);
     const axisLen = this.scale * 0.18;
+    const labels = [];
     for (const f of this.frames) {
       const o = this.project(f.t);
       const L = f.size || axisLen;
@@ -82,10 +99,55 @@ export class FrameView {
         ctx.strokeStyle = c; ctx.lineWidth = 2.5;
         ctx.beginPath(); ctx.moveTo(o[0], o[1]); ctx.lineTo(tip[0], tip[1]); ctx.stroke();
       });
-      ctx.fillStyle = '#222'; ctx.font = '12px system-ui';
-      ctx.fillText(f.name, o[0] + 6, o[1] - 6);
+      labels.push({ name: f.name, at: o });
     }
-    ctx.fillStyle = '#666'; ctx.font = '11px system-ui';
-    ctx.fillText('drag or arrow keys: rotate · wheel: zoom · x red, y green, z blue', 8, this.canvas.height - 8);
+    this.labels = placeLabels(ctx, labels, this.canvas.width, this.canvas.height - 20);
+    for (const l of this.labels) {
+      if (l.leader) {
+        ctx.strokeStyle = '#999'; ctx.lineWidth = 1;
+        ctx.beginPath(); ctx.moveTo(l.at[0], l.at[1]); ctx.lineTo(l.x + (l.x < l.at[0] ? l.w : 0), l.y - 4); ctx.stroke();
+      }
+      ctx.fillStyle = '#222';
+      ctx.fillText(l.name, l.x, l.y);
+    }
+    ctx.fillStyle = '#666'; ctx.font = '12px system-ui';
+    ctx.fillText('drag or arrow keys: rotate · wheel, + / − keys or buttons: zoom · 0: reset · x red, y green, z blue', 8, this.canvas.height - 8);
   }
+}
+
+const LABEL_FONT = '13px system-ui';
+
+/**
+ * Puts each frame's name next to its origin where it overlaps no name
+ * placed before it: the named frames (base, gripper, camera, target) first,
+ * the numbered robot poses after; each tries offsets around its point, then
+ * further out with a leader line. Returns [{name, at, x, y, w, leader}]
+ * (x, y: the text's baseline start).
+ */
+export function placeLabels(ctx, labels, width, height) {
+  ctx.font = LABEL_FONT;
+  const numbered = (l) => /^g\d+$/.test(l.name);
+  const order = [...labels].sort((a, b) => numbered(a) - numbered(b));
+  const placed = [];
+  const box = (x, y, w) => ({ x0: x - 2, y0: y - 12, x1: x + w + 2, y1: y + 3 });
+  const overlap = (a, b) => Math.max(0, Math.min(a.x1, b.x1) - Math.max(a.x0, b.x0)) * Math.max(0, Math.min(a.y1, b.y1) - Math.max(a.y0, b.y0));
+  for (const l of order) {
+    const w = ctx.measureText(l.name).width;
+    const [px, py] = l.at;
+    let best = null;
+    for (const r of [8, 22, 40]) {
+      for (const [dx, dy] of [[1, -1], [1, 1], [-1, -1], [-1, 1], [0, -1.4], [0, 1.6]]) {
+        const x = dx > 0 ? px + r * 0.8 : dx < 0 ? px - r * 0.8 - w : px - w / 2;
+        const y = py + dy * r * 0.8 + (dy > 0 ? 10 : 0);
+        const b = box(x, y, w);
+        const outside = (b.x0 < 0 || b.x1 > width || b.y0 < 0 || b.y1 > height) ? 1e6 : 0;
+        const cost = outside + placed.reduce((s, p) => s + overlap(b, p.box), 0);
+        if (!best || cost < best.cost) best = { x, y, cost, r };
+        if (cost === 0) break;
+      }
+      if (best.cost === 0) break;
+    }
+    placed.push({ name: l.name, at: l.at, x: best.x, y: best.y, w, leader: best.r > 8, box: box(best.x, best.y, w) });
+  }
+  return placed;
 }

@@ -152,6 +152,7 @@ export class CameraView {
     fill(this.out,
       h('h3', {}, `Result: RMS ${num(r.rms_px, 4)} px over ${(r.views || []).length} views`),
       warnings,
+      r.rejected ? this.rejectedNote(r) : null,
       h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat)),
       h('div', { class: 'plots' }, vec, unc, dist),
       this.undistortSection(r),
@@ -209,6 +210,14 @@ export class CameraView {
         methods.map((m) => [m.method, num(m.fx, 3), num(m.fy, 3), num(m.cx, 3), num(m.cy, 3), num(m.k1, 5),
           num(m.std_u_px, 4), num(m.std_v_px, 4), m.error ? m.error : num(m.rms_px, 4)]), { id: 'camera-methods' }),
       note ? h('p', { id: 'camera-methods-note', class: 'note' }, note) : null);
+  }
+
+  /** The robust option's rejections: the core's sentence, and every rejected point with its place in the image. */
+  rejectedNote(r) {
+    const rows = (r.views || []).flatMap((v) => (v.outliers || []).map((o) => [v.name, o.index, `${num(o.x_px, 1)}, ${num(o.y_px, 1)}`, num(o.residual_px, 3)]));
+    return h('div', { id: 'camera-rejected' }, message(rows.length ? 'warning' : 'info', r.rejected.summary),
+      rows.length ? h('details', {}, h('summary', {}, `Where: the ${rows.length} rejected point${rows.length === 1 ? '' : 's'}`),
+        h('div', { class: 'table-scroll' }, table(['view', 'point', 'at x, y (px)', 'residual (px)'], rows, { id: 'camera-rejected-points' }))) : null);
   }
 
   correlationNote({ names, matrix }) {

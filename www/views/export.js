@@ -13,24 +13,41 @@ const CAMERA_FORMATS = [
   ['matlab', 'MATLAB (1-based)', 'camera.m'],
   ['text', '3×3 matrix', 'K.txt'],
 ];
+// [format, label, file name ending]
 const TRANSFORM_FORMATS = [
-  ['matrix4', '4×4 matrix'],
-  ['xyz-quat-xyzw', 'xyz + quaternion (x y z w)'],
-  ['xyz-quat-wxyz', 'xyz + quaternion (w x y z)'],
-  ['urdf', 'URDF joint'],
-  ['ros2-static-tf', 'ROS 2 static_transform_publisher'],
-  ['ur', 'Universal Robots p[…]'],
-  ['kuka', 'KUKA frame {X…C}'],
-  ['abb-tooldata', 'ABB tooldata'],
-  ['abb-wobjdata', 'ABB wobjdata'],
-  ['fanuc', 'FANUC UTOOL/UFRAME'],
+  ['matrix4', '4×4 matrix', 'txt'],
+  ['xyz-quat-xyzw', 'xyz + quaternion (x y z w)', 'txt'],
+  ['xyz-quat-wxyz', 'xyz + quaternion (w x y z)', 'txt'],
+  ['urdf', 'URDF joint', 'joint.xml'],
+  ['urdf-robot', 'URDF file', 'urdf'],
+  ['ros1-static-tf', 'ROS 1 static_transform_publisher', 'sh'],
+  ['ros1-launch', 'ROS 1 launch file', 'launch'],
+  ['ros2-static-tf', 'ROS 2 static_transform_publisher', 'sh'],
+  ['ros2-launch', 'ROS 2 launch file', 'launch.py'],
+  ['ur', 'Universal Robots p[…]', 'txt'],
+  ['kuka', 'KUKA frame {X…C}', 'txt'],
+  ['abb-tooldata', 'ABB tooldata', 'mod'],
+  ['abb-wobjdata', 'ABB wobjdata', 'mod'],
+  ['fanuc', 'FANUC UTOOL/UFRAME', 'txt'],
 ];
+/**
+ * Frame names written into the URDF, ROS and controller exports, by role
+ * (the parts of a transform's key: gripper_from_camera). robocal's camera
+ * frame is the optical frame (z forward), hence camera_optical_frame.
+ */
+export const DEFAULT_FRAMES = { base: 'base_link', gripper: 'tool0', camera: 'camera_optical_frame', target: 'calibration_target' };
+const FRAME_ROLES = [['base', 'Robot base'], ['gripper', 'Gripper / flange'], ['camera', 'Camera (optical frame)'], ['target', 'Target']];
+
+export function frameNames(session) {
+  return { ...DEFAULT_FRAMES, ...(session.handeye.frameNames || {}) };
+}
 const EULER_ORDERS = ['xyz', 'xzy', 'yxz', 'yzx', 'zxy', 'zyx', 'xyx', 'xzx', 'yxy', 'yzy', 'zxz', 'zyz'];
 
 /** The report the exports read: camera keys, hand-eye transforms and the stereo right_from_left at the top level. */
 export function combinedReport(session) {
   const stereo = session.stereo && session.stereo.result ? { right_from_left: session.stereo.result.right_from_left } : {};
-  return { ...(session.camera.result || {}), ...(session.handeye.result || {}), ...stereo };
+  const frames = session.handeye.result ? { frame_names: frameNames(session) } : {};
+  return { ...(session.camera.result || {}), ...(session.handeye.result || {}), ...stereo, ...frames };
 }
 
 export class ExportView {
@@ -66,7 +83,8 @@ export class ExportView {
       hasCamera ? h('div', {}, h('h3', {}, 'Camera'), h('div', { class: 'row', id: 'camera-formats' },
         CAMERA_FORMATS.map(([f, label, file]) => h('button', { type: 'button', dataset: { format: f }, onclick: () => this.show(f, file) }, label)))) : null,
       transforms.length ? h('div', {}, h('h3', {}, 'Transforms'), h('label', {}, 'Transform ', transformPick),
-        h('div', { class: 'row', id: 'transform-formats' }, TRANSFORM_FORMATS.map(([f, label]) => h('button', { type: 'button', dataset: { format: f }, onclick: () => this.show(f, `${$('export-transform').value}.${f}.txt`) }, label))),
+        this.frameFields(),
+        h('div', { class: 'row', id: 'transform-formats' }, TRANSFORM_FORMATS.map(([f, label, ext]) => h('button', { type: 'button', dataset: { format: f }, onclick: () => this.show(f, `${$('export-transform').value}.${ext === 'txt' ? `${f}.txt` : ext}`) }, label))),
         euler) : null,
       h('div', { class: 'row' },
         h('button', { type: 'button', id: 'export-copy', onclick: () => this.copy() }, 'Copy to clipboard'),
@@ -76,7 +94,24 @@ export class ExportView {
     this.show(hasCamera ? 'json' : 'matrix4', hasCamera ? 'camera.json' : 'transform.txt');
   }
 
+  /** Editable frame names (tool0, camera_optical_frame, ...): the core writes them into the exports. */
+  frameFields() {
+    const names = frameNames(this.store.session);
+    const fields = FRAME_ROLES.map(([role, label]) => {
+      const input = h('input', { type: 'text', id: `frame-${role}`, value: names[role], spellcheck: 'false', autocomplete: 'off', size: 18 });
+      input.addEventListener('change', () => {
+        this.store.session.handeye.frameNames = { ...frameNames(this.store.session), [role]: input.value.trim() || DEFAULT_FRAMES[role] };
+        this.store.changed('frame-names');
+        if (this.format) this.show(this.format, this.fileName);
+      });
+      return h('label', {}, `${label} `, input);
+    });
+    return h('fieldset', { id: 'frame-names', class: 'frame-names' }, h('legend', {}, 'Frame names in URDF, ROS and robot exports'), fields,
+      h('p', { class: 'hint' }, 'The camera frame of every result is the optical frame (z forward, x right, y down): in ROS that is a *_optical_frame, not camera_link (x forward).'));
+  }
+
   async show(format, fileName) {
+    this.format = format;
     const report = JSON.stringify(combinedReport(this.store.session));
     const transform = $('export-transform') ? $('export-transform').value : '';
     try {

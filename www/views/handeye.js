@@ -49,7 +49,7 @@ export class HandEyeView {
     });
     form.addEventListener('submit', (e) => { e.preventDefault(); this.solve(); });
     this.out = h('div', { id: 'handeye-results', 'aria-live': 'polite' });
-    this.canvas3d = h('canvas', { width: 560, height: 420, id: 'frames-3d', role: 'img', 'aria-label': '3-D view of the robot, camera and target frames' });
+    this.canvas3d = h('canvas', { width: 900, height: 620, id: 'frames-3d', role: 'img', 'aria-label': '3-D view of the robot, camera and target frames' });
     this.view3d = new FrameView(this.canvas3d);
     fill($('handeye-panel'), this.readonly ? null : form, this.out);
     if (st.result) this.show(st.result);
@@ -141,8 +141,17 @@ export class HandEyeView {
     this.plots = plots;
     fill(this.out, h('h3', {}, `Result (${r.method})`), (r.warnings || []).map((w) => message('warning', w)),
       pose(camKey), pose(tgtKey), refinement, poseRefinement, errors, motion, h('h3', {}, 'Methods side by side'), methods,
-      h('div', { class: 'plots' }, plots), h('h3', {}, '3-D view'), this.canvas3d);
+      h('div', { class: 'plots' }, plots), h('h3', {}, '3-D view'), this.frames3d());
     this.draw3d(r, camKey, tgtKey, eyeInHand);
+  }
+
+  /** The 3-D view with its zoom buttons (keys on the canvas: + - 0, arrows). */
+  frames3d() {
+    const b = (id, label, text, f) => h('button', { type: 'button', id, 'aria-label': label, onclick: f }, text);
+    return h('div', { class: 'frames-3d' },
+      h('div', { class: 'row' }, b('frames-zoom-in', 'zoom in', '+', () => this.view3d.zoomBy(1.25)),
+        b('frames-zoom-out', 'zoom out', '−', () => this.view3d.zoomBy(0.8)), b('frames-reset', 'reset the view', 'Reset view', () => this.view3d.reset())),
+      this.canvas3d);
   }
 
   draw3d(r, camKey, tgtKey, eyeInHand) {

@@ -1,7 +1,7 @@
 // Step 2: images. Load (files or a folder), decode and detect in the worker
 // with progress and cancel, thumbnails with the detected points, an
 // inspector with zoom and residuals, include/exclude, and a coverage map.
-import { $, h, fill } from '../lib/dom.js';
+import { $, h, fill, trapFocus } from '../lib/dom.js';
 import { targetSpec } from './target.js';
 
 const THUMB_SIDE = 320;
@@ -44,9 +44,9 @@ export class ImagesView {
       zone.classList.remove('over');
       this.addFiles(await filesFromDrop(e.dataTransfer));
     });
-    zone.addEventListener('keydown', (e) => {
-      if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); $('file-input').click(); }
-    });
+    // The file fields are hidden (no invisible tab stops): two buttons open them.
+    $('choose-files').addEventListener('click', () => $('file-input').click());
+    $('choose-folder').addEventListener('click', () => $('folder-input').click());
     $('detect-all').addEventListener('click', () => this.detectAll());
     $('cancel-detect').addEventListener('click', () => { this.cancelled = true; $('progress-text').textContent = 'cancelling after the current image…'; });
     $('clear-images').addEventListener('click', async () => {
@@ -57,6 +57,7 @@ export class ImagesView {
       this.refresh();
     });
     $('inspector-close').addEventListener('click', () => $('inspector').close());
+    trapFocus($('inspector'));
     $('inspector-zoom').addEventListener('input', () => this.drawInspector());
   }
 
@@ -120,7 +121,7 @@ export class ImagesView {
 
   async detectAll(subset) {
     if (this.busy) return;
-    const todo = (subset || this.images).filter((i) => i.status !== 'error' || i.detectError);
+    const todo = (subset || this.images).filter((i) => (i.status !== 'error' || i.detectError) && !i.bytesMissing);
     if (!todo.length) return;
     let spec;
     try { spec = targetSpec(this.store.session.target); } catch (e) { return; }
@@ -195,6 +196,7 @@ export class ImagesView {
     const parts = [describe(img.info)];
     if (img.detection) parts.push(`${img.detection.points.length} points`);
     if (img.status === 'error') parts.push(img.error);
+    if (img.bytesMissing) parts.push('from a session file: add the image to see it');
     card.meta.textContent = parts.join(' · ');
   }
 
@@ -297,6 +299,8 @@ function drawImage(canvas, p, points, scale, zoom, residuals = []) {
 }
 
 /** Coverage: every detected point of every included image on one frame. */
+const COVERAGE_WIDTH = 480;
+
 function drawCoverage(canvas, imgs) {
   const ctx = canvas.getContext('2d');
   ctx.fillStyle = '#222';
@@ -308,7 +312,13 @@ function drawCoverage(canvas, imgs) {
     return;
   }
   const [w, hgt] = imgs[0].detection.image_size_px;
-  const s = Math.min(canvas.width / w, canvas.height / hgt);
+  // The canvas takes the image's shape (a fixed 4:3 canvas left a dark band
+  // beside a 5:4 or 16:9 image that read as a region without points).
+  canvas.width = COVERAGE_WIDTH;
+  canvas.height = Math.max(1, Math.round((COVERAGE_WIDTH * hgt) / w));
+  ctx.fillStyle = '#222';
+  ctx.fillRect(0, 0, canvas.width, canvas.height);
+  const s = canvas.width / w;
   // 8x6 cells: cells without any point are marked, so missing corners stand out.
   const cells = new Array(48).fill(0);
   for (const img of imgs) {

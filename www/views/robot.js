@@ -38,12 +38,16 @@ export class RobotView {
   render() {
     const st = this.state;
     const sel = (id, items, value, label) => h('label', {}, label, h('select', { id }, items.map(([v, t]) => h('option', { value: v, selected: v === value }, t))));
-    const input = h('input', { type: 'file', id: 'pose-input', accept: '.csv,.tsv,.txt,.json,.dat,text/*,application/json' });
+    // The native file field would say "No file chosen" once a file is read
+    // (and after a reload): a button opens it, and the loaded file is named.
+    const input = h('input', { type: 'file', id: 'pose-input', 'aria-label': 'pose file', accept: '.csv,.tsv,.txt,.json,.dat,text/*,application/json', hidden: true, tabindex: -1 });
+    const fileName = h('span', { id: 'pose-file-name' }, st.fileName ? `loaded: ${st.fileName}` : 'no file loaded');
     input.addEventListener('change', async () => {
       const f = input.files[0];
       if (!f) return;
       input.value = '';
       st.fileName = f.name;
+      fileName.textContent = `loaded: ${f.name}`;
       try {
         st.text = await readTextFile(f, 'one robot pose a line, one per image');
       } catch (err) {
@@ -57,7 +61,8 @@ export class RobotView {
       await this.parse();
     });
     const form = h('div', { class: 'form', id: 'pose-form' },
-      h('label', {}, 'Pose file ', input),
+      h('div', { class: 'row file-row' }, h('span', {}, 'Pose file'),
+        h('button', { type: 'button', id: 'pose-choose', 'aria-describedby': 'pose-file-name', onclick: () => input.click() }, 'Choose pose file…'), fileName, input),
       sel('pose-format', PRESETS, st.format, 'Format '),
       sel('pose-length', [['auto', 'from the file or preset'], ['mm', 'millimetres'], ['m', 'metres']], st.lengthUnit, 'Lengths '),
       sel('pose-angle', [['auto', 'from the file or preset'], ['deg', 'degrees'], ['rad', 'radians']], st.angleUnit, 'Angles '),

@@ -1,8 +1,9 @@
-// Step 8: share. A link whose URL fragment holds the results (never the
-// images), compressed; the fragment is not sent to any server. And a
-// self-contained HTML report for download (no scripts, plots as images).
-import { $, h, fill, download, message, table, num } from '../lib/dom.js';
-import { combinedReport } from './export.js';
+// Step 9: share. A link whose URL fragment holds the results (never the
+// images or the detections), compressed; the fragment is not sent to any
+// server. A session file (detections, poses, options, results) to save and
+// load. And a self-contained HTML report (views/report.js).
+import { $, h, fill, download, message } from '../lib/dom.js';
+import { reportHtml } from './report.js';
 
 const PREFIX = '#share=';
 
@@ -51,40 +52,113 @@ export function sharedFragment() {
   return location.hash.startsWith(PREFIX) ? location.hash.slice(PREFIX.length) : null;
 }
 
+/** Keys of a result that grow with the number of views or points: left out of a link. */
+const BULKY = new Set(['residuals_px', 'per_motion', 'distortion_field', 'camera_from_target', 'detections', 'per_view_reprojection_rms_px']);
+
+/** Significant digits of the numbers in a link (0.1 µm on a metre, 1e-4 px on 1000 px). */
+const LINK_DIGITS = 7;
+
+/**
+ * A result without its per-point and per-motion data (a few KB): what a
+ * link carries. Arrays of per-run samples (repeatability) go too, and the
+ * matrix of a transform nested below the top level (the methods' rows keep
+ * translation and quaternion); the per-view rows keep their name, RMS and
+ * point counts. Numbers keep LINK_DIGITS significant digits.
+ */
+export function compactResult(value, depth = 0) {
+  if (typeof value === 'number') return Number.isFinite(value) ? Number(value.toPrecision(LINK_DIGITS)) : value;
+  if (Array.isArray(value)) return value.map((v) => compactResult(v, depth + 1));
+  if (!value || typeof value !== 'object') return value;
+  const out = {};
+  const pose = 'translation_m' in value && 'quaternion_xyzw' in value;
+  for (const [k, v] of Object.entries(value)) {
+    if (BULKY.has(k) || k.endsWith('_samples') || (pose && depth > 1 && k === 'matrix_row_major')) continue;
+    out[k] = compactResult(v, depth + 1);
+  }
+  return out;
+}
+
 export function sharePayload(session, version) {
+  const cam = session.camera.result;
+  const he = session.handeye.result;
   return {
     kind: 'robocal-share', schema: 1, robocal_version: version,
     target: session.target,
-    camera: session.camera.result ? { result: session.camera.result, comparison: session.camera.comparison, model: session.camera.model, method: session.camera.method } : null,
-    handeye: session.handeye.result ? { result: session.handeye.result, setup: session.handeye.setup } : null,
-    workflows: session.workflows,
+    camera: cam ? { result: compactResult(cam), comparison: session.camera.comparison, model: session.camera.model, method: session.camera.method } : null,
+    handeye: he ? { result: compactResult(he), setup: session.handeye.setup, frameNames: session.handeye.frameNames } : null,
+    workflows: compactResult(session.workflows),
   };
 }
 
+/** The session file: everything but the image bytes (target, detections, poses, options, results). */
+export function sessionFile(session, version) {
+  return JSON.stringify({ kind: 'robocal-session', schema: 1, robocal_version: version, session }, null, 1);
+}
+
+/** The session a session file holds; throws an Error that says what is wrong. */
+export function readSessionFile(text) {
+  let doc;
+  try { doc = JSON.parse(text); } catch (e) { throw new Error('this file is not a robocal session file (it is not JSON)'); }
+  if (!doc || doc.kind !== 'robocal-session' || doc.schema !== 1 || !doc.session || typeof doc.session !== 'object') {
+    throw new Error('this file is not a robocal session file (save one with "Download session file")');
+  }
+  if (!Array.isArray(doc.session.images)) throw new Error('this session file has no image list');
+  return doc.session;
+}
+
 export class ShareView {
-  constructor(store, version, plotsProvider) {
+  /** `loadSession(session)` replaces this tab's session (absent on a shared, read-only page). */
+  constructor(store, version, plotsProvider, loadSession = null) {
     this.store = store;
     this.version = version;
     this.plotsProvider = plotsProvider;
+    this.loadSession = loadSession;
     this.render();
     store.onChange((what) => { if (/result|all|shared/.test(what)) this.render(); });
   }
 
   render() {
     const s = this.store.session;
+    const sessionTools = this.loadSession ? this.sessionSection() : null;
     if (!s.camera.result && !s.handeye.result) {
-      fill($('share-panel'), message('info', 'Solve a camera or a hand-eye calibration first: the link and the report hold their results.'));
+      fill($('share-panel'), message('info', 'Solve a camera or a hand-eye calibration first: the link and the report hold their results.'), sessionTools);
       return;
     }
     this.link = h('input', { type: 'text', readonly: true, id: 'share-link', 'aria-label': 'share link', class: 'wide' });
     this.status = h('p', { class: 'hint', 'aria-live': 'polite', id: 'share-status' });
     fill($('share-panel'),
-      h('p', {}, 'The link holds the results (not the images) compressed in its fragment (after #), which browsers never send to a server. Whoever opens it sees a read-only results page.'),
+      h('p', {}, 'The link holds the results (camera, transforms, errors; not the images or the detections) compressed in its fragment (after #), which browsers never send to a server. Whoever opens it sees a read-only results page.'),
       h('div', { class: 'row' },
         h('button', { type: 'button', class: 'primary', id: 'make-share', onclick: () => this.makeLink() }, 'Create share link'),
         h('button', { type: 'button', id: 'copy-share', onclick: () => this.copy() }, 'Copy link'),
         h('button', { type: 'button', id: 'download-report', onclick: () => this.downloadReport() }, 'Download HTML report')),
-      this.link, this.status);
+      this.link, this.status, sessionTools);
+  }
+
+  /** Save the whole session (detections, poses, options, results; no image bytes) to a file, or load one. */
+  sessionSection() {
+    const input = h('input', { type: 'file', id: 'session-input', 'aria-label': 'session file', accept: '.json,application/json', hidden: true, tabindex: -1 });
+    const status = h('p', { class: 'hint', id: 'session-status', 'aria-live': 'polite' });
+    input.addEventListener('change', async () => {
+      const file = input.files[0];
+      input.value = '';
+      if (!file) return;
+      try {
+        const session = readSessionFile(await file.text());
+        if (this.store.session.images.length && !confirm('Replace this session with the one in the file? Images, detections and results of this session are removed from this browser.')) return;
+        status.textContent = `Loading ${file.name}…`;
+        await this.loadSession(session);
+      } catch (err) {
+        status.textContent = `${file.name}: ${err.message}`;
+      }
+    });
+    return h('section', { 'aria-labelledby': 'session-title' },
+      h('h3', { id: 'session-title' }, 'Session file'),
+      h('p', { class: 'hint' }, 'A session file holds the target, the detected points of every image, the robot poses, the options and the results (not the images): load it here, in any browser, to carry on.'),
+      h('div', { class: 'row' },
+        h('button', { type: 'button', id: 'download-session', onclick: () => download('robocal-session.json', sessionFile(this.store.session, this.version), 'application/json') }, 'Download session file'),
+        h('button', { type: 'button', id: 'load-session', onclick: () => input.click() }, 'Load session file…'), input),
+      status);
   }
 
   async makeLink() {
@@ -106,72 +180,7 @@ export class ShareView {
   }
 
   async downloadReport() {
-    download('robocal-report.html', await reportHtml(this.store.session, this.version, this.plotsProvider()), 'text/html');
+    const results = JSON.stringify(sharePayload(this.store.session, this.version), null, 1);
+    download('robocal-report.html', await reportHtml(this.store.session, this.version, this.plotsProvider(), results), 'text/html');
   }
-}
-
-/** The report's style sheet: allowed by its hash in the report's CSP. */
-const REPORT_STYLE = `body{font-family:system-ui,sans-serif;max-width:960px;margin:2rem auto;padding:0 1rem;color:#1b1d21}
-table{border-collapse:collapse}td,th{border-bottom:1px solid #ccc;padding:.2rem .6rem;text-align:right}
-td:first-child,th:first-child{text-align:left}.warn{background:#fff3cd;padding:.4rem}img{max-width:100%}pre{white-space:pre-wrap}`;
-
-async function sha256Base64(text) {
-  const digest = new Uint8Array(await crypto.subtle.digest('SHA-256', new TextEncoder().encode(text)));
-  return btoa(String.fromCharCode(...digest));
-}
-
-/**
- * A self-contained HTML report: tables, warnings and plots as PNG images; no
- * scripts. Built as a DOM (every value a text node or an attribute set by
- * setAttribute, so a crafted share link's strings stay text) and serialised.
- * Its own CSP: nothing loads, nothing runs; only its style (by hash) and
- * its embedded data: images.
- */
-export async function reportHtml(session, version, canvases) {
-  const doc = document.implementation.createHTMLDocument('robocal calibration report');
-  const el = (tag, attrs = {}, ...children) => {
-    const e = doc.createElement(tag);
-    for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, String(v));
-    for (const c of children.flat()) if (c !== null && c !== undefined) e.append(typeof c === 'object' && 'nodeType' in c ? c : doc.createTextNode(String(c)));
-    return e;
-  };
-  const adopt = (node) => doc.importNode(node, true);
-  const text = (w) => (typeof w === 'string' ? w : w && typeof w.message === 'string' ? w.message : JSON.stringify(w));
-  const csp = `default-src 'none'; style-src 'sha256-${await sha256Base64(REPORT_STYLE)}'; img-src data:; base-uri 'none'; form-action 'none'`;
-  doc.documentElement.setAttribute('lang', 'en');
-  doc.head.prepend(el('meta', { charset: 'utf-8' }), el('meta', { 'http-equiv': 'Content-Security-Policy', content: csp }));
-  doc.head.append(el('style', {}, REPORT_STYLE));
-  const body = doc.body;
-  body.append(el('h1', {}, 'robocal calibration report'),
-    el('p', {}, `robocal ${version} · generated in the browser; no data left the machine.`));
-  const cam = session.camera.result;
-  if (cam) {
-    const k = (cam.camera_matrix || []).flat();
-    const rows = [['fx', k[0]], ['fy', k[4]], ['cx', k[2]], ['cy', k[5]], ['skew', k[1]], ...Object.entries(cam.distortion || {})]
-      .map(([n, v]) => [n, num(v, 6), num((cam.std || {})[n], 3)]);
-    body.append(el('h2', {}, `Camera (${cam.model})`),
-      el('p', {}, `RMS reprojection error ${num(cam.rms_px, 4)} px over ${Array.isArray(cam.views) ? cam.views.length : 0} views.`),
-      adopt(table(['parameter', 'value', 'std'], rows)));
-    for (const w of Array.isArray(cam.warnings) ? cam.warnings : []) body.append(el('p', { class: 'warn' }, text(w)));
-  }
-  const he = session.handeye.result;
-  if (he) {
-    body.append(el('h2', {}, `Hand-eye (${session.handeye.setup})`));
-    for (const key of ['gripper_from_camera', 'base_from_camera', 'base_from_target', 'gripper_from_target']) {
-      if (!he[key]) continue;
-      const list = (a, f) => (Array.isArray(a) ? a.map(f).join(', ') : '—');
-      const t = list(he[key].translation_m, (v) => num(v * 1000, 3));
-      const q = list(he[key].quaternion_xyzw, (v) => num(v, 6));
-      body.append(el('p', {}, el('b', {}, key), `: translation (mm) [${t}], quaternion xyzw [${q}]`));
-    }
-    if (he.errors && typeof he.errors === 'object') body.append(adopt(table(['error', 'value'], Object.entries(he.errors).map(([n, v]) => [n, num(v, 4)]))));
-    for (const w of Array.isArray(he.warnings) ? he.warnings : []) body.append(el('p', { class: 'warn' }, text(w)));
-  }
-  for (const c of canvases || []) {
-    let src;
-    try { src = c.toDataURL('image/png'); } catch (e) { continue; } // a tainted canvas is skipped
-    body.append(el('figure', {}, el('img', { alt: c.getAttribute('aria-label') || 'plot', src })));
-  }
-  body.append(el('h2', {}, 'Full results (JSON)'), el('pre', {}, JSON.stringify(combinedReport(session), null, 2)));
-  return `<!doctype html>\n${doc.documentElement.outerHTML}\n`;
 }
