@@ -129,6 +129,7 @@ mod tests {
                 .enumerate()
                 .map(|(index, &(x_px, y_px))| Outlier {
                     index,
+                    id: index,
                     residual_px: 2.0,
                     x_px,
                     y_px,
