@@ -13,7 +13,7 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 #[command(
-    about = "find a calibration target (chessboard, circles, dots) in images",
+    about = "find a calibration target (chessboard, circles, dots, ChArUco, AprilGrid) in images",
     after_help = "Output: {\"robocal_version\", \"target\", \"images\": [{\"file\",
 \"detection\": {image_size_px, target, points: [{id, x_px, y_px}]},
 \"detect_ms\"} or {\"file\", \"error\": {\"kind\", \"message\"}}]} in the order
@@ -26,6 +26,8 @@ Examples:
   robocal detect --target circles:4x11:20mm:asymmetric acircles*.png
   robocal detect --target dots:7x7:25mm plate.tiff
   robocal detect --target squares:8x8:12.7mm:22.5778mm image*.gif
+  robocal detect --target charuco:12x9:20mm:15mm:DICT_5X5_100 view*.png
+  robocal detect --target aprilgrid:6x6:88mm:0.3 cam0/*.png
   robocal detect --target circle:10mm --threads 1 table_*.png",
     args_override_self = true
 )]
@@ -34,8 +36,11 @@ pub struct DetectArgs {
     /// circles:COLSxROWS:SPACING[:asymmetric][:light-on-dark],
     /// dots:COLSxROWS:PITCH[:DIAMETER], circle:DIAMETER,
     /// squares:COLSxROWS:SIDE:PITCH (separate dark squares, 4 corners each,
-    /// e.g. Zhang's squares:8x8:12.7mm:22.5778mm) (lengths with mm, cm or m),
-    /// or a target JSON object
+    /// e.g. Zhang's squares:8x8:12.7mm:22.5778mm),
+    /// charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICT[:first=N][:ids=A,B,...][:legacy]
+    /// (OpenCV's ChArUco board; legacy: made before OpenCV 4.6),
+    /// aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO[:first=N] (Kalibr's)
+    /// (lengths with mm, cm or m), or a target JSON object
     #[arg(long, value_name = "SPEC")]
     target: Option<String>,
     /// Write the JSON result to FILE (default: standard output)

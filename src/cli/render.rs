@@ -146,6 +146,21 @@ fn grid_of(target: &Target) -> ((usize, usize), f64) {
             pitch_m,
             ..
         } => ((*cols, *rows), *pitch_m),
+        // Inner corners at one square's pitch.
+        Target::Charuco {
+            squares_x,
+            squares_y,
+            square_m,
+            ..
+        } => ((*squares_x - 1, *squares_y - 1), *square_m),
+        // Tags at the tag pitch.
+        Target::Aprilgrid {
+            tag_cols,
+            tag_rows,
+            tag_m,
+            spacing_ratio,
+            ..
+        } => ((*tag_cols, *tag_rows), (1.0 + spacing_ratio) * tag_m),
     }
 }
 

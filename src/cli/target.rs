@@ -16,13 +16,16 @@ back in. Print it at 100 % (actual size, no fit to page).",
     after_help = "Examples:
   robocal target chessboard:9x6:30mm
   robocal target chessboard:9x6:30mm --svg board.svg
-  robocal target circles:4x11:20mm:asymmetric --svg acircles.svg",
+  robocal target circles:4x11:20mm:asymmetric --svg acircles.svg
+  robocal target charuco:12x9:20mm:15mm:DICT_5X5_100 --svg charuco.svg
+  robocal target aprilgrid:6x6:88mm:0.3 --svg aprilgrid.svg",
     args_override_self = true
 )]
 pub struct TargetArgs {
     /// The target, as for 'robocal detect' (chessboard:9x6:30mm,
     /// circles:4x11:20mm:asymmetric, dots:7x7:25mm, circle:10mm,
-    /// squares:8x8:12.7mm:22.5778mm) or a target JSON object
+    /// squares:8x8:12.7mm:22.5778mm, charuco:12x9:20mm:15mm:DICT_5X5_100,
+    /// aprilgrid:6x6:88mm:0.3) or a target JSON object
     #[arg(value_name = "SPEC")]
     spec: Option<String>,
     /// Write the printable sheet there (SVG; '-' for standard output)

@@ -134,6 +134,14 @@ fn describe(target: &Target) -> String {
         Target::Chessboard { cols, rows, .. } => format!("{cols}x{rows} chessboard"),
         Target::SingleCircle { .. } => "circle".to_string(),
         Target::SquareGrid { cols, rows, .. } => format!("{cols}x{rows} square grid"),
+        Target::Charuco {
+            squares_x,
+            squares_y,
+            ..
+        } => format!("{squares_x}x{squares_y} ChArUco board"),
+        Target::Aprilgrid {
+            tag_cols, tag_rows, ..
+        } => format!("{tag_cols}x{tag_rows} AprilGrid"),
     }
 }
 

@@ -76,6 +76,7 @@ mod circles;
 mod ellipse;
 pub(crate) mod filter;
 mod lattice;
+pub mod markers;
 mod refine;
 mod saddle;
 mod squares;
@@ -119,27 +120,16 @@ impl Default for DetectOptions {
 /// [`Error::NotFound`] when the target is absent or incomplete (the message
 /// gives counts and likely causes), [`Error::Invalid`] for a bad target.
 pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Result<Detection> {
+    check_image(image)?;
     let (w, h) = (image.width, image.height);
-    if w < MIN_IMAGE_SIDE_PX || h < MIN_IMAGE_SIDE_PX {
-        return Err(Error::Image {
-            message: format!(
-                "image is {w}x{h} pixels; detection needs at least {MIN_IMAGE_SIDE_PX}x{MIN_IMAGE_SIDE_PX}"
-            ),
-        });
-    }
-    if image.pixels.len() != w as usize * h as usize {
-        return Err(Error::Image {
-            message: format!(
-                "a {w}x{h} image needs {} bytes, got {}",
-                w as usize * h as usize,
-                image.pixels.len()
-            ),
-        });
-    }
     let target = target.clone().validated()?;
     let centre_model = match &target {
         Target::CircleGrid { .. } | Target::DotPlate { .. } => Some(options.circle_centres),
-        Target::Chessboard { .. } | Target::SingleCircle { .. } | Target::SquareGrid { .. } => None,
+        Target::Chessboard { .. }
+        | Target::SingleCircle { .. }
+        | Target::SquareGrid { .. }
+        | Target::Charuco { .. }
+        | Target::Aprilgrid { .. } => None,
     };
     let points = match &target {
         Target::Chessboard { cols, rows, .. } => {
@@ -169,6 +159,9 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
             side_m,
             pitch_m,
         } => squares::detect_square_grid(image, *cols, *rows, side_m / pitch_m, options)?,
+        Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+            return markers::detect_one(image, &target, options)
+        }
     };
     Ok(Detection {
         image_size_px: [w, h],
@@ -176,6 +169,52 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
         points,
         centre_model,
     })
+}
+
+/// Every board of `target` in `image`: for ChArUco boards and AprilGrids,
+/// one detection per board of the same layout (the target's own ids
+/// first, then boards printed with other blocks of consecutive ids, e.g.
+/// Kalibr's `two_boards` frame with tags 0-35 and 36-71; each detection's
+/// target carries its first id); for other targets the one detection of
+/// [`detect`]. Errors as [`detect`] when there is none.
+pub fn detect_all(
+    image: &GrayImage,
+    target: &Target,
+    options: &DetectOptions,
+) -> Result<Vec<Detection>> {
+    check_image(image)?;
+    match target {
+        Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+            markers::detect_boards(image, target, options)
+        }
+        Target::Chessboard { .. }
+        | Target::CircleGrid { .. }
+        | Target::DotPlate { .. }
+        | Target::SingleCircle { .. }
+        | Target::SquareGrid { .. } => Ok(vec![detect(image, target, options)?]),
+    }
+}
+
+/// Size checks shared by the entry points.
+fn check_image(image: &GrayImage) -> Result<()> {
+    let (w, h) = (image.width, image.height);
+    if w < MIN_IMAGE_SIDE_PX || h < MIN_IMAGE_SIDE_PX {
+        return Err(Error::Image {
+            message: format!(
+                "image is {w}x{h} pixels; detection needs at least {MIN_IMAGE_SIDE_PX}x{MIN_IMAGE_SIDE_PX}"
+            ),
+        });
+    }
+    if image.pixels.len() != w as usize * h as usize {
+        return Err(Error::Image {
+            message: format!(
+                "a {w}x{h} image needs {} bytes, got {}",
+                w as usize * h as usize,
+                image.pixels.len()
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The coarsest pyramid level whose long side is at most `max_side`

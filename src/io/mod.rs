@@ -14,6 +14,7 @@ mod export_camera_tools;
 pub mod export_ros;
 pub mod export_transform;
 pub mod import_camera;
+pub mod kalibr_target;
 pub mod pairing;
 mod pose_candidates;
 mod pose_formats;
@@ -36,6 +37,7 @@ mod pose_tests;
 pub(crate) fn to_string_pretty(value: &serde_json::Value) -> String {
     serde_json::to_string_pretty(value).unwrap_or_else(|_| value.to_string())
 }
+pub use kalibr_target::parse_kalibr_target;
 pub use pose_candidates::{parse_pose_candidates, Candidate};
 pub use pose_formats::{AngleUnit, LengthUnit, PoseFormat, QUATERNION_NORM_TOLERANCE};
 pub use pose_writer::format_poses;

@@ -13,7 +13,10 @@
 //! Board print: chessboards have a white margin one square wide; the outer
 //! square diagonally beyond corner 0 is black (the detector's ordering
 //! rule). Circle grids and dot plates have a one-unit margin, square grids
-//! a one-pitch margin beyond the outer squares. Beyond the
+//! a one-pitch margin beyond the outer squares. ChArUco boards and
+//! AprilGrids are drawn as printed (`crate::target::marker_board`: OpenCV's
+//! and Kalibr's layouts) with a white quiet zone of one square (ChArUco) or
+//! half a tag beyond the corner squares (AprilGrid). Beyond the
 //! print the scene is a uniform grey wall.
 
 use crate::error::{Error, Result};
@@ -258,6 +261,8 @@ struct Albedo {
     extent: (f64, f64, f64, f64),
     /// Largest integer board coordinates (x, y).
     max_coord: (i64, i64),
+    /// Marker boards' print.
+    print: Option<crate::target::marker_board::Print>,
 }
 
 impl Albedo {
@@ -308,6 +313,11 @@ impl Albedo {
                     maxy + side_m + pitch_m,
                 ),
             ),
+            Target::Charuco { .. } | Target::Aprilgrid { .. } => (
+                0.0,
+                crate::target::marker_board::layout(target)
+                    .map_or((0.0, 0.0, 0.0, 0.0), |l| l.extent),
+            ),
         };
         Albedo {
             target: target.clone(),
@@ -320,6 +330,7 @@ impl Albedo {
                 coords.iter().map(|c| c.0).max().unwrap_or(0) as i64,
                 coords.iter().map(|c| c.1).max().unwrap_or(0) as i64,
             ),
+            print: crate::target::marker_board::Print::new(target),
         }
     }
 
@@ -372,6 +383,13 @@ impl Albedo {
                 let (u, v) = (x - i * pitch_m, y - j * pitch_m);
                 let on_grid = i >= 0.0 && j >= 0.0 && i < *cols as f64 && j < *rows as f64;
                 if on_grid && u < *side_m && v < *side_m {
+                    self.black
+                } else {
+                    self.white
+                }
+            }
+            Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+                if self.print.as_ref().is_some_and(|p| p.dark_at(x, y)) {
                     self.black
                 } else {
                     self.white

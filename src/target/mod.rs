@@ -16,6 +16,8 @@
 //! | `dot_plate` | `cols x rows` dots | `(i, j) * pitch_m` |
 //! | `single_circle` | one point, id 0 | `(0, 0)`, the circle centre |
 //! | `square_grid` | `cols x rows` separate squares, 4 corners each: id = `4 (i + j * cols) + k` | square `(i, j)` spans `(i, j) * pitch_m` to that `+ side_m`; corner `k` = 0 `(x0, y0)`, 1 `(x0 + side, y0)`, 2 `(x0 + side, y0 + side)`, 3 `(x0, y0 + side)` |
+//! | `charuco` | `(squares_x - 1) x (squares_y - 1)` inner chessboard corners, id = `i + j (squares_x - 1)` (OpenCV's) | `(i + 1, j + 1) * square_m` |
+//! | `aprilgrid` | 4 corners per tag, Kalibr's ids (row of corners from the bottom) | see [`marker_board`] |
 //!
 //! A square grid's corners run square by square (row by row of squares) and,
 //! within a square, clockwise on screen from the corner nearest the board
@@ -47,7 +49,14 @@
 //! "asymmetric": true, "polarity": "dark_on_light"}`, `{"kind": "dot_plate",
 //! "cols": 7, "rows": 7, "pitch_m": 0.025, "dot_diameter_m": 0.0125}`,
 //! `{"kind": "single_circle", "diameter_m": 0.01}`, `{"kind": "square_grid",
-//! "cols": 8, "rows": 8, "side_m": 0.0127, "pitch_m": 0.0225778}`.
+//! "cols": 8, "rows": 8, "side_m": 0.0127, "pitch_m": 0.0225778}`,
+//! `{"kind": "charuco", "squares_x": 12, "squares_y": 9, "square_m": 0.02,
+//! "marker_m": 0.015, "dictionary": "DICT_5X5_100", "first_id": 0,
+//! "legacy": false}` (optional `"marker_ids": [...]` instead of
+//! `first_id`; `first_id` and `legacy` default to 0 and false),
+//! `{"kind": "aprilgrid", "tag_cols": 6, "tag_rows": 6, "tag_m": 0.088,
+//! "spacing_ratio": 0.3, "first_id": 0}` (`first_id` optional, 0 by default). Marker-board detections may hold any subset of
+//! the points (partial views).
 
 use crate::error::{Error, Result};
 use nalgebra::{Point2, Point3};
@@ -127,6 +136,44 @@ pub enum Target {
         /// than the side: the squares do not touch).
         pitch_m: f64,
     },
+    /// A ChArUco board as OpenCV 4.6+ defines it ([`marker_board`] docs).
+    Charuco {
+        /// Chessboard squares along a row (OpenCV's squaresX).
+        squares_x: usize,
+        /// Chessboard squares along a column (OpenCV's squaresY).
+        squares_y: usize,
+        /// Side of one square, metres.
+        square_m: f64,
+        /// Side of one marker (its black border included), metres.
+        marker_m: f64,
+        /// The markers' dictionary.
+        dictionary: Dictionary,
+        /// Id of the first marker (the others follow); 0 by default.
+        #[serde(default)]
+        first_id: usize,
+        /// Explicit marker ids in board order, instead of `first_id`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        marker_ids: Option<Vec<usize>>,
+        /// The layout of boards made before OpenCV 4.6 (differs for an
+        /// even `squares_y`).
+        #[serde(default)]
+        legacy: bool,
+    },
+    /// A Kalibr AprilGrid of tag36h11 tags ([`marker_board`] docs).
+    Aprilgrid {
+        /// Tags along a row (Kalibr's tagCols).
+        tag_cols: usize,
+        /// Rows of tags (Kalibr's tagRows).
+        tag_rows: usize,
+        /// Side of one tag, edge to edge, metres (Kalibr's tagSize).
+        tag_m: f64,
+        /// Gap between tags over the tag side (Kalibr's tagSpacing).
+        spacing_ratio: f64,
+        /// Id of tag 0 (0 in Kalibr; a second board printed with the next
+        /// ids has `first_id` = the first board's tag count).
+        #[serde(default)]
+        first_id: usize,
+    },
 }
 
 /// One detected target point in pixels.
@@ -179,7 +226,11 @@ impl Target {
     /// Parse a CLI target spec: `chessboard:9x6:30mm`,
     /// `circles:4x11:20mm[:asymmetric][:light-on-dark]`, `dots:7x7:25mm[:12.5mm]`
     /// (dot diameter defaults to half the pitch), `circle:10mm`,
-    /// `squares:8x8:12.7mm:22.5778mm` (squares per row x rows, side, pitch).
+    /// `squares:8x8:12.7mm:22.5778mm` (squares per row x rows, side, pitch),
+    /// `charuco:12x9:20mm:15mm:DICT_5X5_100[:first=N][:ids=A,B,...][:legacy]`
+    /// (squares, square side, marker side, OpenCV dictionary name; first
+    /// marker id, explicit marker ids, the pre-4.6 layout),
+    /// `aprilgrid:6x6:88mm:0.3` (tags, tag size, spacing ratio, as Kalibr).
     /// Lengths take a unit: `mm`, `cm` or `m`.
     pub fn parse_spec(spec: &str) -> Result<Target> {
         let parts: Vec<&str> = spec.trim().split(':').collect();
@@ -249,11 +300,13 @@ impl Target {
                 }
                 .validated()
             }
+            ["charuco", rest @ ..] => marker_board::parse_charuco(spec, rest),
+            ["aprilgrid", rest @ ..] => marker_board::parse_aprilgrid(spec, rest),
             ["squares", ..] => Err(bad(format!(
                 "'{spec}' is not a square-grid spec; expected squares:COLSxROWS:SIDE:PITCH (e.g. squares:8x8:12.7mm:22.5778mm)"
             ))),
             _ => Err(bad(format!(
-                "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
+                "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
             ))),
         }
     }
@@ -314,6 +367,9 @@ impl Target {
                 spec_length(*side_m),
                 spec_length(*pitch_m)
             ),
+            Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+                marker_board::to_spec(self).unwrap_or_default()
+            }
         }
     }
 
@@ -326,10 +382,19 @@ impl Target {
             }
             Target::SingleCircle { .. } => (1, 1, 1),
             Target::SquareGrid { cols, rows, .. } => (*cols, *rows, 2),
+            Target::Charuco {
+                squares_x,
+                squares_y,
+                ..
+            } => (*squares_x, *squares_y, 2),
+            Target::Aprilgrid {
+                tag_cols, tag_rows, ..
+            } => (*tag_cols, *tag_rows, 1),
         };
-        // Square grids have four points per square.
+        // Square grids and AprilGrids have four points per square or tag.
         let per_cell = match &self {
-            Target::SquareGrid { .. } => 4,
+            Target::SquareGrid { .. } | Target::Aprilgrid { .. } => 4,
+            Target::Charuco { .. } => 1,
             Target::Chessboard { .. }
             | Target::CircleGrid { .. }
             | Target::DotPlate { .. }
@@ -356,6 +421,10 @@ impl Target {
             Target::SquareGrid {
                 side_m, pitch_m, ..
             } => vec![("square side", *side_m), ("square pitch", *pitch_m)],
+            Target::Charuco {
+                square_m, marker_m, ..
+            } => vec![("square side", *square_m), ("marker side", *marker_m)],
+            Target::Aprilgrid { tag_m, .. } => vec![("tag size", *tag_m)],
         };
         if let Some((name, l)) = lengths.iter().find(|(_, l)| !l.is_finite() || *l <= 0.0) {
             let got = if l.is_finite() {
@@ -392,6 +461,7 @@ impl Target {
                 ));
             }
         }
+        marker_board::validate(&self)?;
         Ok(self)
     }
 
@@ -403,19 +473,43 @@ impl Target {
             | Target::DotPlate { cols, rows, .. } => cols * rows,
             Target::SingleCircle { .. } => 1,
             Target::SquareGrid { cols, rows, .. } => 4 * cols * rows,
+            Target::Charuco {
+                squares_x,
+                squares_y,
+                ..
+            } => (squares_x.saturating_sub(1)) * (squares_y.saturating_sub(1)),
+            Target::Aprilgrid {
+                tag_cols, tag_rows, ..
+            } => 4 * tag_cols * tag_rows,
         }
     }
 
     /// Integer board coordinates of every point in id order (metres are these
     /// times [`Target::unit_m`]); for square grids, of every square's origin
-    /// in square order (the corners are in [`Target::object_points`]).
+    /// in square order (the corners are in [`Target::object_points`]); for
+    /// AprilGrids, of every tag's top-left corner in units of the tag pitch,
+    /// row by row from the top.
     pub(crate) fn grid_coords(&self) -> Vec<(i32, i32)> {
+        if let Target::Charuco {
+            squares_x,
+            squares_y,
+            ..
+        } = self
+        {
+            let (cols, rows) = (*squares_x as i32 - 1, *squares_y as i32 - 1);
+            return (0..rows)
+                .flat_map(|j| (0..cols).map(move |i| (i + 1, j + 1)))
+                .collect();
+        }
         let (cols, rows) = match self {
             Target::Chessboard { cols, rows, .. }
             | Target::CircleGrid { cols, rows, .. }
             | Target::DotPlate { cols, rows, .. }
             | Target::SquareGrid { cols, rows, .. } => (*cols as i32, *rows as i32),
-            Target::SingleCircle { .. } => (1, 1),
+            Target::Aprilgrid {
+                tag_cols, tag_rows, ..
+            } => (*tag_cols as i32, *tag_rows as i32),
+            Target::SingleCircle { .. } | Target::Charuco { .. } => (1, 1),
         };
         let asymmetric = matches!(
             self,
@@ -444,6 +538,12 @@ impl Target {
             Target::CircleGrid { spacing_m, .. } => *spacing_m,
             Target::DotPlate { pitch_m, .. } | Target::SquareGrid { pitch_m, .. } => *pitch_m,
             Target::SingleCircle { .. } => 1.0,
+            Target::Charuco { square_m, .. } => *square_m,
+            Target::Aprilgrid {
+                tag_m,
+                spacing_ratio,
+                ..
+            } => (1.0 + spacing_ratio) * tag_m,
         }
     }
 
@@ -459,7 +559,26 @@ impl Target {
                 })
                 .enumerate()
                 .collect(),
+            Target::Aprilgrid {
+                tag_cols,
+                tag_rows,
+                tag_m,
+                spacing_ratio,
+                ..
+            } => (0..self.point_count())
+                .map(|id| {
+                    let p = marker_board::aprilgrid_point(
+                        id,
+                        *tag_cols,
+                        *tag_rows,
+                        *tag_m,
+                        *spacing_ratio,
+                    );
+                    (id, p)
+                })
+                .collect(),
             Target::Chessboard { .. }
+            | Target::Charuco { .. }
             | Target::CircleGrid { .. }
             | Target::DotPlate { .. }
             | Target::SingleCircle { .. } => cells
@@ -532,9 +651,12 @@ fn parse_length(text: &str) -> Result<f64> {
 }
 
 mod centre_model;
+pub mod dictionary;
+pub mod marker_board;
 pub mod svg;
 
 pub use centre_model::CentreModel;
+pub use dictionary::Dictionary;
 
 #[cfg(test)]
 mod tests;

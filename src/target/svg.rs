@@ -115,6 +115,52 @@ fn board(target: &Target) -> Board {
                 circles: Vec::new(),
             }
         }
+        Target::Charuco { .. } | Target::Aprilgrid { .. } => marker_board_marks(target),
+    }
+}
+
+/// A ChArUco board or an AprilGrid: its dark squares and every dark cell
+/// of every marker, in millimetres (the layout of
+/// [`super::marker_board`], OpenCV's and Kalibr's prints).
+fn marker_board_marks(target: &Target) -> Board {
+    let mm = |m: f64| m * 1000.0;
+    let Some(layout) = super::marker_board::layout(target) else {
+        return Board {
+            extent: (0.0, 0.0, 0.0, 0.0),
+            light_on_dark: false,
+            squares: Vec::new(),
+            circles: Vec::new(),
+        };
+    };
+    let mut squares: Vec<(f64, f64, f64)> = super::marker_board::dark_squares(target)
+        .into_iter()
+        .map(|(x, y, side)| (mm(x), mm(y), mm(side)))
+        .collect();
+    let bits = layout.dictionary.marker_bits();
+    let n = bits + 2 * layout.border_bits;
+    for m in &layout.markers {
+        let code = layout.dictionary.code(m.id).unwrap_or(0);
+        let [c0, c1, _, c3] = m.corners;
+        let (ex, ey) = ((c1 - c0) / n as f64, (c3 - c0) / n as f64);
+        let cell = mm(ex.norm());
+        for row in 0..n {
+            for col in 0..n {
+                if super::marker_board::marker_cell_dark(code, bits, layout.border_bits, row, col) {
+                    // The cell's two opposite corners on the print; its
+                    // top-left is the smaller of each coordinate.
+                    let a = c0 + ex * col as f64 + ey * row as f64;
+                    let b = a + ex + ey;
+                    squares.push((mm(a.x.min(b.x)), mm(a.y.min(b.y)), cell));
+                }
+            }
+        }
+    }
+    let (x0, y0, x1, y1) = layout.extent;
+    Board {
+        extent: (mm(x0), mm(y0), mm(x1), mm(y1)),
+        light_on_dark: false,
+        squares,
+        circles: Vec::new(),
     }
 }
 
@@ -175,6 +221,44 @@ fn description(target: &Target) -> String {
             mm(*side_m),
             mm(*pitch_m)
         ),
+        Target::Charuco {
+            squares_x,
+            squares_y,
+            square_m,
+            marker_m,
+            dictionary,
+            legacy,
+            ..
+        } => format!(
+            "ChArUco {squares_x} x {squares_y} squares of {}, markers {} {}{}",
+            mm(*square_m),
+            mm(*marker_m),
+            dictionary.name(),
+            if *legacy { ", pre-4.6 layout" } else { "" }
+        ),
+        Target::Aprilgrid {
+            tag_cols,
+            tag_rows,
+            tag_m,
+            spacing_ratio,
+            ..
+        } => format!(
+            "AprilGrid {tag_cols} x {tag_rows} tag36h11, tags {}, spacing {spacing_ratio}",
+            mm(*tag_m)
+        ),
+    }
+}
+
+/// Where the board's point 0 and axes are, for the sheet.
+fn origin_note(target: &Target) -> &'static str {
+    match target {
+        Target::Aprilgrid { .. } => "Tag 0 and point 0 at the bottom left (Kalibr).",
+        Target::Charuco { .. } => "Origin at the top-left corner, x to the right, y down.",
+        Target::Chessboard { .. }
+        | Target::CircleGrid { .. }
+        | Target::DotPlate { .. }
+        | Target::SingleCircle { .. }
+        | Target::SquareGrid { .. } => "Point 0 at the top left, x to the right, y down.",
     }
 }
 
@@ -218,10 +302,7 @@ pub fn board_svg(target: &Target) -> String {
         format!("This bar is {CHECK_BAR_MM} mm long. Measure it on the print: if it is not {CHECK_BAR_MM} mm,"),
         "print again at 100 % scale (actual size, no fit to page or scaling).".to_string(),
         format!("robocal target {spec}"),
-        format!(
-            "{}. Point 0 at the top left, x to the right, y down.",
-            description(target)
-        ),
+        format!("{}. {}", description(target), origin_note(target)),
     ];
     let width = 2.0 * PAGE_MARGIN_MM + board_w.max(TEXT_WIDTH_MM).max(CHECK_BAR_MM);
     let height = text_y + (lines.len() as f64 - 1.0) * LINE_MM + PAGE_MARGIN_MM;

@@ -1,0 +1,148 @@
+//! Reading a candidate quad as a marker: perspective-rectified bit
+//! sampling, a threshold between the dark and light cells (Otsu over the
+//! cell means), the border check and the dictionary's error-correcting
+//! decode.
+
+use super::homography::Homography;
+use super::quads::Quad;
+use crate::image::GrayImage;
+use crate::target::dictionary::Dictionary;
+use nalgebra::Point2;
+
+/// Samples per cell side (the middle of each cell, away from its edges).
+const SAMPLES_PER_CELL: usize = 3;
+/// Fraction of a cell's side the samples spread over, centred.
+const SAMPLE_SPREAD: f64 = 0.5;
+/// Least grey-level difference between the light and dark cells' means.
+const MIN_CONTRAST: f64 = 20.0;
+/// Border cells that may read light, as a fraction of the border (OpenCV's
+/// maxErroneousBitsInBorderRate is 0.35; stricter here, the border is what
+/// rejects false markers).
+const MAX_BORDER_ERROR_RATE: f64 = 0.1;
+
+/// A decoded marker in the image.
+#[derive(Debug, Clone)]
+pub(crate) struct Marker {
+    /// Dictionary id.
+    pub id: usize,
+    /// Corners in the marker's own order (top-left, top-right,
+    /// bottom-right, bottom-left of its rotation 0), pixels.
+    pub corners: [Point2<f64>; 4],
+    /// Bits that differed from the dictionary's marker.
+    pub bit_errors: u32,
+}
+
+/// Read `quad` as a marker of `dictionary` with a `border`-bit black
+/// border, accepting up to `max_bit_errors` wrong bits.
+pub(crate) fn read_marker(
+    img: &GrayImage,
+    quad: &Quad,
+    dictionary: Dictionary,
+    border: usize,
+    max_bit_errors: u32,
+) -> Option<Marker> {
+    let bits = dictionary.marker_bits();
+    let n = bits + 2 * border;
+    let unit = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let pairs: Vec<_> = unit
+        .iter()
+        .zip(&quad.corners)
+        .map(|(&(u, v), c)| (Point2::new(u, v), *c))
+        .collect();
+    let h = Homography::fit(&pairs)?;
+    // 1. Cell means.
+    let mut cells = vec![0.0; n * n];
+    for row in 0..n {
+        for col in 0..n {
+            let mut sum = 0.0;
+            for sy in 0..SAMPLES_PER_CELL {
+                for sx in 0..SAMPLES_PER_CELL {
+                    let off = |s: usize| {
+                        0.5 + SAMPLE_SPREAD * ((s as f64 + 0.5) / SAMPLES_PER_CELL as f64 - 0.5)
+                    };
+                    let u = (col as f64 + off(sx)) / n as f64;
+                    let v = (row as f64 + off(sy)) / n as f64;
+                    let p = h.map(&Point2::new(u, v))?;
+                    sum += bilinear(img, p.x, p.y)?;
+                }
+            }
+            cells[row * n + col] = sum / (SAMPLES_PER_CELL * SAMPLES_PER_CELL) as f64;
+        }
+    }
+    // 2. Threshold and contrast.
+    let t = otsu(&cells)?;
+    let (dark, light): (Vec<f64>, Vec<f64>) = cells.iter().copied().partition(|&v| v < t);
+    if dark.is_empty() || light.is_empty() {
+        return None;
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    if mean(&light) - mean(&dark) < MIN_CONTRAST {
+        return None;
+    }
+    // 3. Border.
+    let is_border =
+        |r: usize, c: usize| r < border || c < border || r >= n - border || c >= n - border;
+    let mut border_cells = 0;
+    let mut border_light = 0;
+    let mut code = 0u64;
+    for r in 0..n {
+        for c in 0..n {
+            let light = cells[r * n + c] >= t;
+            if is_border(r, c) {
+                border_cells += 1;
+                border_light += usize::from(light);
+            } else {
+                code = (code << 1) | u64::from(light);
+            }
+        }
+    }
+    if border_light as f64 > MAX_BORDER_ERROR_RATE * border_cells as f64 {
+        return None;
+    }
+    // 4. Decode; the marker's own top-left is sampled corner `rotation`.
+    let d = dictionary.decode(code, max_bit_errors)?;
+    let corners = [0, 1, 2, 3].map(|j| quad.corners[(d.rotation + j) % 4]);
+    Some(Marker {
+        id: d.id,
+        corners,
+        bit_errors: d.bit_errors,
+    })
+}
+
+fn bilinear(img: &GrayImage, x: f64, y: f64) -> Option<f64> {
+    let (w, h) = (img.width as usize, img.height as usize);
+    if !(x >= 0.0 && y >= 0.0 && x <= (w - 1) as f64 && y <= (h - 1) as f64) {
+        return None;
+    }
+    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+    let (fx, fy) = (x - x0 as f64, y - y0 as f64);
+    let p = |xx: usize, yy: usize| f64::from(img.pixels[yy * w + xx]);
+    Some(
+        (p(x0, y0) * (1.0 - fx) + p(x1, y0) * fx) * (1.0 - fy)
+            + (p(x0, y1) * (1.0 - fx) + p(x1, y1) * fx) * fy,
+    )
+}
+
+/// Otsu's threshold of a few values: the split between sorted values that
+/// maximises the between-class variance (returned as the midpoint).
+fn otsu(values: &[f64]) -> Option<f64> {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let total: f64 = v.iter().sum();
+    let mut best = None;
+    let mut best_score = -1.0;
+    let mut left = 0.0;
+    for k in 1..n {
+        left += v[k - 1];
+        let (n0, n1) = (k as f64, (n - k) as f64);
+        let (m0, m1) = (left / n0, (total - left) / n1);
+        let score = n0 * n1 * (m1 - m0) * (m1 - m0);
+        if score > best_score && v[k] > v[k - 1] {
+            best_score = score;
+            best = Some(0.5 * (v[k] + v[k - 1]));
+        }
+    }
+    best
+}

@@ -1,0 +1,89 @@
+//! Plane-to-image homographies for marker boards: a normalised DLT with
+//! `h33 = 1` (board points near the origin map to finite pixels, so `h33`
+//! is far from 0) solved by least squares over any number of points >= 4.
+
+use nalgebra::{Matrix3, Point2, SMatrix, SVector, Vector3};
+
+/// A homography with its normalisations: `image = T_img^-1 H T_board board`.
+#[derive(Debug, Clone)]
+pub(crate) struct Homography {
+    h: Matrix3<f64>,
+}
+
+impl Homography {
+    /// Fit to `(board, image)` pairs; `None` with fewer than 4 pairs or a
+    /// degenerate configuration.
+    pub fn fit(pairs: &[(Point2<f64>, Point2<f64>)]) -> Option<Homography> {
+        if pairs.len() < 4 {
+            return None;
+        }
+        let (tb, ti) = (
+            normaliser(pairs.iter().map(|p| p.0)),
+            normaliser(pairs.iter().map(|p| p.1)),
+        );
+        let mut ata = SMatrix::<f64, 8, 8>::zeros();
+        let mut atb = SVector::<f64, 8>::zeros();
+        for (b, i) in pairs {
+            let b = tb * Vector3::new(b.x, b.y, 1.0);
+            let u = ti * Vector3::new(i.x, i.y, 1.0);
+            let r1 =
+                SVector::<f64, 8>::from([b.x, b.y, 1.0, 0.0, 0.0, 0.0, -u.x * b.x, -u.x * b.y]);
+            let r2 =
+                SVector::<f64, 8>::from([0.0, 0.0, 0.0, b.x, b.y, 1.0, -u.y * b.x, -u.y * b.y]);
+            ata += r1 * r1.transpose() + r2 * r2.transpose();
+            atb += r1 * u.x + r2 * u.y;
+        }
+        let x = ata.cholesky()?.solve(&atb);
+        let h = Matrix3::new(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], 1.0);
+        let h = ti.try_inverse()? * h * tb;
+        h.iter().all(|v| v.is_finite()).then_some(Homography { h })
+    }
+
+    /// The image of board point `b`; `None` at or behind the horizon.
+    pub fn map(&self, b: &Point2<f64>) -> Option<Point2<f64>> {
+        let w = self.h * Vector3::new(b.x, b.y, 1.0);
+        (w.z.abs() > 1e-12).then(|| Point2::new(w.x / w.z, w.y / w.z))
+    }
+}
+
+/// Similarity moving the points' centroid to 0 and their RMS distance to
+/// sqrt(2).
+fn normaliser(points: impl Iterator<Item = Point2<f64>> + Clone) -> Matrix3<f64> {
+    let n = points.clone().count().max(1) as f64;
+    let c = points
+        .clone()
+        .fold(Vector3::zeros(), |a, p| a + Vector3::new(p.x, p.y, 0.0))
+        / n;
+    let rms = (points
+        .map(|p| (p.x - c.x).powi(2) + (p.y - c.y).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    let s = if rms > 1e-12 {
+        std::f64::consts::SQRT_2 / rms
+    } else {
+        1.0
+    };
+    Matrix3::new(s, 0.0, -s * c.x, 0.0, s, -s * c.y, 0.0, 0.0, 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recovers_a_perspective_map_exactly() {
+        let truth = Matrix3::new(60.0, 8.0, 400.0, -5.0, 45.0, 300.0, 0.04, -0.03, 1.0);
+        let map = |b: Point2<f64>| {
+            let w = truth * Vector3::new(b.x, b.y, 1.0);
+            Point2::new(w.x / w.z, w.y / w.z)
+        };
+        let pairs: Vec<_> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.5, 0.3)]
+            .iter()
+            .map(|&(x, y)| (Point2::new(x, y), map(Point2::new(x, y))))
+            .collect();
+        let h = Homography::fit(&pairs).unwrap();
+        let b = Point2::new(2.0, -1.5);
+        assert!((h.map(&b).unwrap() - map(b)).norm() < 1e-9, "px");
+    }
+}

@@ -1,0 +1,466 @@
+//! Marker boards: ChArUco (OpenCV) and AprilGrid (Kalibr).
+//!
+//! 1. Candidate quads ([`quads`]: adaptive threshold, 4-connected regions,
+//!    convex quadrilaterals, sub-pixel sides) read as markers ([`decode`]:
+//!    rectified bit sampling, black-border check, the dictionary's error
+//!    correction up to [`MarkerOptions::max_bit_errors`]); the same marker
+//!    found at two threshold windows is kept once.
+//! 2. Markers are grouped into boards by id: the board of the target's own
+//!    ids and, for [`detect_boards`], every other block of as many
+//!    consecutive ids (a second board printed with the next ids). Within a
+//!    board, markers that a homography through all of them places more
+//!    than [`OUTLIER_FRACTION`] of their side away are dropped (a
+//!    duplicate id, a false decode, the other ChArUco layout).
+//! 3. Points, measured, never interpolated: each is seeded from the
+//!    markers around it and refined as a saddle point of the image with the
+//!    chessboard detector's sub-pixel fit (`refine.rs`).
+//!    - ChArUco: every inner chessboard corner next to at least one
+//!      detected marker, seeded from each neighbouring marker's own
+//!      homography; a corner whose two neighbouring markers predict it more
+//!      than [`DISAGREE_FRACTION`] of the marker margin apart is dropped.
+//!    - AprilGrid: the four corners of every tag (each is an X-junction with
+//!      Kalibr's corner squares), seeded at the tag's quad corners.
+//!
+//!    Any subset of points may come out (partial views, occlusion).
+
+mod decode;
+mod homography;
+mod quads;
+
+use super::refine::refine_saddle;
+use super::DetectOptions;
+use crate::error::{Error, Result};
+use crate::image::GrayImage;
+use crate::target::marker_board::{self, MarkerLayout};
+use crate::target::{DetectedPoint, Detection, Dictionary, Target};
+use decode::Marker;
+use homography::Homography;
+use nalgebra::Point2;
+use std::collections::HashMap;
+
+/// A marker is an outlier of its board when the board's homography puts
+/// one of its corners further than this fraction of its side away.
+pub const OUTLIER_FRACTION: f64 = 0.3;
+/// Two neighbouring markers disagree on a ChArUco corner when their
+/// predictions differ by more than this fraction of the white margin
+/// around a marker (at least [`MIN_DISAGREE_PX`]).
+pub const DISAGREE_FRACTION: f64 = 0.5;
+/// Floor of the disagreement tolerance, pixels.
+pub const MIN_DISAGREE_PX: f64 = 1.5;
+/// Largest saddle-fit half-window, pixels (the chessboard detector's).
+const MAX_WINDOW_PX: f64 = 6.0;
+/// Smallest saddle-fit half-window, pixels.
+const MIN_WINDOW_PX: f64 = 2.5;
+
+/// Decoding tunables.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MarkerOptions {
+    /// Fraction of the dictionary's maximum correction used (OpenCV's
+    /// errorCorrectionRate, default 0.6): at most
+    /// `floor(rate * max_correction_bits)` wrong bits are corrected.
+    pub error_correction_rate: f64,
+}
+
+impl Default for MarkerOptions {
+    fn default() -> Self {
+        MarkerOptions {
+            error_correction_rate: 0.6,
+        }
+    }
+}
+
+impl MarkerOptions {
+    /// Wrong bits corrected for `dictionary`.
+    pub fn max_bit_errors(&self, dictionary: Dictionary) -> u32 {
+        (self.error_correction_rate.clamp(0.0, 1.0) * f64::from(dictionary.max_correction_bits()))
+            .floor() as u32
+    }
+}
+
+/// Every marker of `dictionary` in `img` (each once).
+pub(crate) fn find_markers(img: &GrayImage, dictionary: Dictionary, border: usize) -> Vec<Marker> {
+    let max_errors = MarkerOptions::default().max_bit_errors(dictionary);
+    let mut found: Vec<Marker> = Vec::new();
+    for q in quads::find_quads(img) {
+        let Some(m) = decode::read_marker(img, &q, dictionary, border, max_errors) else {
+            continue;
+        };
+        let c = centre(&m.corners);
+        let side = mean_side(&m.corners);
+        match found
+            .iter_mut()
+            .find(|f| f.id == m.id && (centre(&f.corners) - c).norm() < 0.5 * side)
+        {
+            Some(f) if m.bit_errors < f.bit_errors => *f = m,
+            Some(_) => {}
+            None => found.push(m),
+        }
+    }
+    found
+}
+
+fn centre(c: &[Point2<f64>; 4]) -> Point2<f64> {
+    Point2::from((c[0].coords + c[1].coords + c[2].coords + c[3].coords) / 4.0)
+}
+
+fn mean_side(c: &[Point2<f64>; 4]) -> f64 {
+    (0..4).map(|k| (c[(k + 1) % 4] - c[k]).norm()).sum::<f64>() / 4.0
+}
+
+/// The target's own board in `image` (see the module docs).
+pub(crate) fn detect_one(
+    image: &GrayImage,
+    target: &Target,
+    options: &DetectOptions,
+) -> Result<Detection> {
+    let boards = detect_boards(image, target, options)?;
+    let others: Vec<String> = boards.iter().map(|d| d.target.to_spec()).collect();
+    boards
+        .into_iter()
+        .find(|d| d.target == *target)
+        .ok_or_else(|| Error::NotFound {
+            message: format!(
+                "found {} with other marker ids ({}), not this board ({}): check the first marker id",
+                if others.len() == 1 { "a board" } else { "boards" },
+                others.join(", "),
+                target.to_spec()
+            ),
+        })
+}
+
+/// Every board of `target`'s layout in `image`: its own ids first, then
+/// other id blocks (see the module docs). Errors when there is none.
+pub fn detect_boards(
+    image: &GrayImage,
+    target: &Target,
+    _options: &DetectOptions,
+) -> Result<Vec<Detection>> {
+    let target = target.clone().validated()?;
+    let Some(layout) = marker_board::layout(&target) else {
+        return Err(Error::invalid(
+            "target",
+            format!("{} is not a marker board", target.to_spec()),
+        ));
+    };
+    let dictionary = layout.dictionary;
+    let markers = find_markers(image, dictionary, layout.border_bits);
+    if markers.is_empty() {
+        return Err(Error::NotFound {
+            message: format!(
+                "no {} markers found: is the board in view, sharp and lit, and the dictionary right?",
+                dictionary.name()
+            ),
+        });
+    }
+    if let Some(e) = other_layout_fits_better(&target, &markers) {
+        return Err(e);
+    }
+    let mut out = Vec::new();
+    for board in candidate_boards(&target, &layout, &markers) {
+        if let Some(d) = assemble(image, &board, &markers) {
+            out.push(d);
+        }
+    }
+    if out.is_empty() {
+        return Err(no_board_error(&target, &markers));
+    }
+    Ok(out)
+}
+
+/// The target and every other block of consecutive ids seen, as targets.
+fn candidate_boards(target: &Target, layout: &MarkerLayout, markers: &[Marker]) -> Vec<Target> {
+    let count = layout.markers.len() as i64;
+    let first = match target {
+        Target::Charuco {
+            first_id,
+            marker_ids: None,
+            ..
+        }
+        | Target::Aprilgrid { first_id, .. } => *first_id as i64,
+        _ => return vec![target.clone()],
+    };
+    let mut blocks: Vec<i64> = markers
+        .iter()
+        .map(|m| (m.id as i64 - first).div_euclid(count))
+        .collect();
+    blocks.sort_unstable_by_key(|b| (*b != 0, *b));
+    blocks.dedup();
+    blocks
+        .into_iter()
+        .filter_map(|b| {
+            let f = first + b * count;
+            let mut t = target.clone();
+            match &mut t {
+                Target::Charuco { first_id, .. } | Target::Aprilgrid { first_id, .. } => {
+                    *first_id = usize::try_from(f).ok()?;
+                }
+                _ => {}
+            }
+            t.validated().ok()
+        })
+        .collect()
+}
+
+/// One board's detection from the markers, `None` when none of its
+/// markers is consistent.
+fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Detection> {
+    let layout = marker_board::layout(board)?;
+    let index: HashMap<usize, usize> = layout
+        .markers
+        .iter()
+        .enumerate()
+        .map(|(k, m)| (m.id, k))
+        .collect();
+    let mut mine: Vec<(usize, &Marker)> = markers
+        .iter()
+        .filter_map(|m| index.get(&m.id).map(|&k| (k, m)))
+        .collect();
+    consistent_markers(&layout, &mut mine);
+    if mine.is_empty() {
+        return None;
+    }
+    let points = match board {
+        Target::Charuco { .. } => charuco_corners(image, board, &layout, &mine),
+        Target::Aprilgrid { .. } => aprilgrid_corners(image, board, &layout, &mine),
+        _ => Vec::new(),
+    };
+    if points.is_empty() {
+        return None;
+    }
+    Some(Detection {
+        image_size_px: [image.width, image.height],
+        target: board.clone(),
+        points,
+        centre_model: None,
+    })
+}
+
+/// Drop the markers a homography through all of them misplaces, worst
+/// first, until every one fits.
+fn consistent_markers(layout: &MarkerLayout, mine: &mut Vec<(usize, &Marker)>) {
+    loop {
+        if mine.len() < 2 {
+            return;
+        }
+        let pairs: Vec<_> = mine
+            .iter()
+            .flat_map(|(k, m)| layout.markers[*k].corners.into_iter().zip(m.corners))
+            .collect();
+        let Some(h) = Homography::fit(&pairs) else {
+            mine.clear();
+            return;
+        };
+        let worst = mine
+            .iter()
+            .enumerate()
+            .map(|(i, (k, m))| {
+                let err = layout.markers[*k]
+                    .corners
+                    .iter()
+                    .zip(&m.corners)
+                    .map(|(b, p)| h.map(b).map_or(f64::INFINITY, |q| (q - p).norm()))
+                    .fold(0.0, f64::max);
+                (i, err / mean_side(&m.corners))
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        match worst {
+            Some((i, e)) if e > OUTLIER_FRACTION => {
+                mine.remove(i);
+            }
+            _ => return,
+        }
+    }
+}
+
+/// The saddle fit of a seed with half-window `window`, or `None`.
+fn refine(image: &GrayImage, seed: Point2<f64>, window: f64) -> Option<Point2<f64>> {
+    let window = window.clamp(MIN_WINDOW_PX, MAX_WINDOW_PX);
+    let fit = refine_saddle(image, seed, window)?;
+    ((fit.pos - seed).norm() <= 0.5 * window + 1.0).then_some(fit.pos)
+}
+
+fn charuco_corners(
+    image: &GrayImage,
+    board: &Target,
+    layout: &MarkerLayout,
+    mine: &[(usize, &Marker)],
+) -> Vec<DetectedPoint> {
+    let Target::Charuco {
+        squares_x,
+        squares_y,
+        square_m,
+        marker_m,
+        ..
+    } = board
+    else {
+        return Vec::new();
+    };
+    // Marker index by its square.
+    let square_of = |k: usize| {
+        let c = centre(&layout.markers[k].corners);
+        (
+            (c.x / square_m).floor() as usize,
+            (c.y / square_m).floor() as usize,
+        )
+    };
+    let detected: HashMap<(usize, usize), (usize, &Marker)> =
+        mine.iter().map(|&(k, m)| (square_of(k), (k, m))).collect();
+    let margin_m = 0.5 * (square_m - marker_m);
+    let mut out = Vec::new();
+    for j in 0..squares_y - 1 {
+        for i in 0..squares_x - 1 {
+            let corner = Point2::new((i + 1) as f64 * square_m, (j + 1) as f64 * square_m);
+            let around = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)];
+            let mut predictions = Vec::new();
+            let mut px_per_m = 0.0;
+            for sq in around {
+                let Some(&(k, m)) = detected.get(&sq) else {
+                    continue;
+                };
+                let pairs: Vec<_> = layout.markers[k]
+                    .corners
+                    .into_iter()
+                    .zip(m.corners)
+                    .collect();
+                if let Some(p) = Homography::fit(&pairs).and_then(|h| h.map(&corner)) {
+                    predictions.push(p);
+                    px_per_m += mean_side(&m.corners) / marker_m;
+                }
+            }
+            if predictions.is_empty() {
+                continue;
+            }
+            px_per_m /= predictions.len() as f64;
+            let margin_px = margin_m * px_per_m;
+            let tol = (DISAGREE_FRACTION * margin_px).max(MIN_DISAGREE_PX);
+            if predictions.len() == 2 && (predictions[0] - predictions[1]).norm() > tol {
+                continue;
+            }
+            let seed = Point2::from(
+                predictions
+                    .iter()
+                    .fold(nalgebra::Vector2::zeros(), |s, p| s + p.coords)
+                    / predictions.len() as f64,
+            );
+            // The fit's weights reach 1.5 windows: stay within the white
+            // margin plus the marker's black border.
+            let border_px = marker_m / (layout.dictionary.marker_bits() + 2) as f64 * px_per_m;
+            if let Some(p) = refine(image, seed, (margin_px + border_px) / 2.0) {
+                out.push(DetectedPoint {
+                    id: i + j * (squares_x - 1),
+                    x_px: p.x,
+                    y_px: p.y,
+                    covariance_px2: None,
+                });
+            }
+        }
+    }
+    out
+}
+
+fn aprilgrid_corners(
+    image: &GrayImage,
+    board: &Target,
+    layout: &MarkerLayout,
+    mine: &[(usize, &Marker)],
+) -> Vec<DetectedPoint> {
+    let Target::Aprilgrid {
+        tag_cols,
+        spacing_ratio,
+        ..
+    } = board
+    else {
+        return Vec::new();
+    };
+    let corner_cols = 2 * tag_cols;
+    let n = layout.dictionary.marker_bits() + 2 * layout.border_bits;
+    let mut out = Vec::new();
+    for &(k, m) in mine {
+        // The tag's OpenCV corners are printed bottom-right, bottom-left,
+        // top-left, top-right: Kalibr's base + 1, base, base + 2 cols,
+        // base + 2 cols + 1.
+        let base = (k / tag_cols) * corner_cols * 2 + (k % tag_cols) * 2;
+        let ids = [base + 1, base, base + corner_cols, base + corner_cols + 1];
+        let side = mean_side(&m.corners);
+        let gap_px = spacing_ratio * side;
+        let border_px = layout.border_bits as f64 * side / n as f64;
+        let window = 0.5 * gap_px.min(border_px);
+        for (id, seed) in ids.into_iter().zip(m.corners) {
+            if let Some(p) = refine(image, seed, window) {
+                out.push(DetectedPoint {
+                    id,
+                    x_px: p.x,
+                    y_px: p.y,
+                    covariance_px2: None,
+                });
+            }
+        }
+    }
+    out.sort_by_key(|p| p.id);
+    out
+}
+
+/// Markers of `board`'s ids that one homography places consistently.
+fn inliers(board: &Target, markers: &[Marker]) -> usize {
+    let Some(layout) = marker_board::layout(board) else {
+        return 0;
+    };
+    let index: HashMap<usize, usize> = layout
+        .markers
+        .iter()
+        .enumerate()
+        .map(|(k, m)| (m.id, k))
+        .collect();
+    let mut mine: Vec<(usize, &Marker)> = markers
+        .iter()
+        .filter_map(|m| index.get(&m.id).map(|&k| (k, m)))
+        .collect();
+    consistent_markers(&layout, &mut mine);
+    mine.len()
+}
+
+/// A ChArUco board with an even number of rows whose markers sit where the
+/// other layout (pre-4.6 or 4.6+) puts them: the error that says so.
+fn other_layout_fits_better(target: &Target, markers: &[Marker]) -> Option<Error> {
+    let Target::Charuco {
+        legacy, squares_y, ..
+    } = target
+    else {
+        return None;
+    };
+    if squares_y % 2 != 0 {
+        return None;
+    }
+    let mut other = target.clone();
+    if let Target::Charuco { legacy: l, .. } = &mut other {
+        *l = !*legacy;
+    }
+    if inliers(&other, markers) <= inliers(target, markers) {
+        return None;
+    }
+    let hint = if *legacy {
+        "the layout of OpenCV 4.6 and later: remove ':legacy' from the spec"
+    } else {
+        "the layout of boards made before OpenCV 4.6: add ':legacy' to the spec"
+    };
+    Some(Error::NotFound {
+        message: format!("the markers do not fit this ChArUco board but fit {hint}"),
+    })
+}
+
+/// Why no board came out: no marker of this board's ids.
+fn no_board_error(target: &Target, markers: &[Marker]) -> Error {
+    let mut ids: Vec<usize> = markers.iter().map(|m| m.id).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    let shown: Vec<String> = ids.iter().take(12).map(|i| i.to_string()).collect();
+    let more = if ids.len() > 12 { ", ..." } else { "" };
+    Error::NotFound {
+        message: format!(
+            "found {} markers (ids {}{more}) but no consistent {} board: check the board size, the first marker id and the marker layout",
+            markers.len(),
+            shown.join(", "),
+            target.to_spec()
+        ),
+    }
+}
