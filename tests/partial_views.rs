@@ -411,3 +411,60 @@ fn handeye_from_partial_views_recovers_x_exactly_in_both_setups() {
         );
     }
 }
+
+/// Tsai's method (principal point at the centre, k1 only) and the EKF
+/// cannot represent the Brown truth exactly: on partial views each must
+/// run and fit about as well as on the full views of the same poses
+/// (RMS within 1.5x of the full views' and below 1 px); Zhang's is exact.
+#[test]
+fn every_planar_method_takes_partial_views() {
+    let truth = truth();
+    let scene = Scene::calibration(25, &truth, (COLS, ROWS), PITCH_M, 12, 0.0).expect("scene");
+    let rows = |views: &[View]| {
+        let mut all = input(views);
+        all.method = "all".into();
+        let out = calibrate_input(&all).unwrap_or_else(|e| panic!("{e}"));
+        out.comparison.expect("rows")
+    };
+    let partial = rows(&partial_views(&scene.views, 10));
+    let full = rows(&scene.views);
+    for (p, f) in partial.iter().zip(&full) {
+        assert_eq!(p.method, f.method);
+        let (Some(rp), Some(rf)) = (p.rms_px, f.rms_px) else {
+            panic!("{}: {:?} / {:?}", p.method, p.error, f.error);
+        };
+        eprintln!("{}: rms {rp:.4} px partial, {rf:.4} px full", p.method);
+        if p.method == "zhang" {
+            assert!(rp < 1e-9, "zhang rms {rp} px");
+        } else {
+            assert!(
+                rp < 1.0 && rp < 1.5 * rf,
+                "{}: rms {rp} px vs {rf} px full",
+                p.method
+            );
+        }
+    }
+}
+
+#[test]
+fn tsai_leaves_out_a_view_of_four_points_with_a_warning() {
+    let truth = truth();
+    let scene = Scene::calibration(26, &truth, (COLS, ROWS), PITCH_M, 8, 0.0).expect("scene");
+    let mut views = partial_views(&scene.views, 11);
+    let mut four = restrict(&scene.views[3], &[0, 8, 45, 53]);
+    four.name = "four_corners".into();
+    views.push(four);
+    let report = robocal::calib::calibrate_tsai(&views, (1280, 960), &brown_options())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(report.views.len(), 8);
+    assert!(
+        report.warnings.contains(
+            &"view four_corners left out: 4 points: Tsai's method needs at least 5".to_string()
+        ),
+        "{:?}",
+        report.warnings
+    );
+    // Zhang's method uses the same view (4 corners of the board fix a homography).
+    let zhang = calibrate(&views, (1280, 960), &brown_options()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(zhang.views.len(), 9);
+}

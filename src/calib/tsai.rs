@@ -28,8 +28,33 @@ const PLANE_TOLERANCE_M: f64 = 1e-9;
 /// Solver iterations of stage 3.
 const MAX_ITERATIONS: usize = 200;
 
-/// Tsai's calibration from planar views.
+/// Tsai's calibration from planar views. A view with fewer than 5 points
+/// (a partial view that still fixes a homography) is left out with a
+/// warning while at least one view remains; otherwise the error names it.
 pub fn calibrate_tsai(
+    views: &[View],
+    image_size_px: (u32, u32),
+    options: &CalibrationOptions,
+) -> Result<CameraCalibration> {
+    let (enough, few): (Vec<View>, Vec<View>) = views
+        .iter()
+        .cloned()
+        .partition(|v| v.object_m.len() >= MIN_POINTS);
+    if enough.is_empty() || few.is_empty() {
+        return calibrate_tsai_views(views, image_size_px, options);
+    }
+    let mut report = calibrate_tsai_views(&enough, image_size_px, options)?;
+    report.warnings.extend(few.iter().map(|v| {
+        format!(
+            "view {} left out: {} points: Tsai's method needs at least {MIN_POINTS}",
+            v.name,
+            v.object_m.len()
+        )
+    }));
+    Ok(report)
+}
+
+fn calibrate_tsai_views(
     views: &[View],
     image_size_px: (u32, u32),
     options: &CalibrationOptions,
