@@ -102,7 +102,17 @@ pub fn advise_model(
     report: &CameraCalibration,
 ) -> Vec<String> {
     let chosen = report.model.as_str();
-    let n_chosen = coefficient_count(chosen);
+    // Coefficients held at 0 are not fitted: they count for nothing.
+    let held = model_from_name(chosen).map_or(0, |d| {
+        let names = d.coefficient_names();
+        let held = &options.fixed_coefficients;
+        names
+            .iter()
+            .filter(|n| held.iter().any(|h| h == *n))
+            .count()
+    });
+    let n_chosen = coefficient_count(chosen) - held;
+    let free = if held > 0 { " free" } else { "" };
     let radial = residuals_grow_with_radius(report);
     let far_off = report.rms_px > RESIDUAL_ALERT_PX || radial.is_some();
     let simpler_exists = MODELS.iter().any(|(m, _)| coefficient_count(m) < n_chosen);
@@ -179,7 +189,7 @@ pub fn advise_model(
         .min_by(|a, b| a.2.cmp(&b.2).then(a.1.total_cmp(&b.1)));
     if let Some(&(name, rms, n)) = simplest {
         advice.push(format!(
-            "too many parameters for these views: the {} model's {n_chosen} coefficients \
+            "too many parameters for these views: the {} model's {n_chosen}{free} coefficients \
              fit at {:.3} px, and {} with {n} fits as well ({:.3} px), so the extra ones fit \
              noise and their values mean nothing: use {name} (CLI: --model {name}), or add \
              views that fill the image corners",
@@ -277,6 +287,30 @@ mod tests {
                 .any(|w| w.starts_with("too many parameters") || w.starts_with("the residuals")),
             "{w:?}"
         );
+    }
+
+    #[test]
+    fn held_coefficients_are_not_counted() {
+        // The rational model with all but k1 k2 held has 2 free coefficients:
+        // not "12", and no model with fewer than 2 but the 1-coefficient division
+        // can be called simpler.
+        let scene = Scene::calibration(7, &Camera::example_brown(), (9, 6), 0.03, 10, 0.1).unwrap();
+        let views = point_views(&scene);
+        let held = ["p1", "p2", "k3", "k4", "k5", "k6", "s1", "s2", "s3", "s4"];
+        let input = json!({"model": "rational", "views": views, "image_size_px": [1024, 768],
+            "options": {"fixed_coefficients": held}});
+        let out: Value =
+            serde_json::from_str(&calibrate_json(&input.to_string()).unwrap()).unwrap();
+        for w in out["report"]["warnings"].as_array().unwrap() {
+            let w = w.as_str().unwrap();
+            assert!(!w.contains("12 coefficients"), "{w}");
+            if w.starts_with("too many parameters") {
+                assert!(
+                    w.contains("the rational model's 2 free coefficients"),
+                    "{w}"
+                );
+            }
+        }
     }
 
     #[test]
