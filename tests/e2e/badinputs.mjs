@@ -116,7 +116,12 @@ async function loadDemoImages(page, url, extra = [], only = null) {
   await page.goto(url);
   await ready(page);
   const images = only ? demo().images.slice(0, only) : demo().images;
-  await page.setInputFiles('#file-input', [...images, ...extra]);
+  // The extra files after the demo's (one upload is sorted by name: the
+  // extras would go first).
+  await page.setInputFiles('#file-input', images);
+  await settled(page, images.length);
+  if (!extra.length) return;
+  await page.setInputFiles('#file-input', extra);
   await settled(page, images.length + extra.length);
 }
 
