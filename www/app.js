@@ -151,18 +151,28 @@ async function main() {
   });
   restoring.hidden = true;
   store.onChange((what) => { if (/detections|included|images|all/.test(what)) camera.summarise(); });
-  $('new-session').addEventListener('click', async () => {
-    if (store.session.images.length && !confirm('Start a new session? Images, detections and results of this session are removed from this browser.')) return;
+  const readyText = () => `Calibration engine ready (robocal ${version}).`;
+  // A new session: nothing of the old one stays, the demo's note included.
+  const newSession = async () => {
     await store.reset();
     location.hash = 'target';
     await images.restore();
     store.changed('target-loaded');
     camera.render();
     stereo.render();
+    $('engine-status').textContent = readyText();
+  };
+  const hasWork = () => store.session.images.length || store.session.robot.text || store.session.camera.result || store.session.stereo.left.length;
+  $('new-session').addEventListener('click', async () => {
+    if (store.session.images.length && !confirm('Start a new session? Images, detections and results of this session are removed from this browser.')) return;
+    await newSession();
   });
   $('demo-button').addEventListener('click', async () => {
+    // The demo is a session of its own: over open work, ask first.
+    if (hasWork() && !confirm('Load the demo data? It starts a new session: the images, poses, detections and results of this session are removed from this browser.')) return;
     $('demo-button').disabled = true;
     try {
+      if (hasWork()) await newSession();
       $('engine-status').textContent = 'Rendering the demo images…';
       const demo = await engine.call('demo', { seed: 1 });
       const t = demo.target;

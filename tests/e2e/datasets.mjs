@@ -262,7 +262,7 @@ export const tests = [
     await page.setInputFiles('#pose-input', poses);
     await page.locator('#pose-table').waitFor({ timeout: 20000 });
     assert.match(await page.textContent('#pose-format-used'), /^RobotPosesVec\.txt: 15 poses read as matrix4, lengths in m/);
-    assert.match(await page.textContent('#pose-pairing'), /by order \(pose i with the i-th included image\): 15 pairs usable/);
+    assert.match(await page.textContent('#pose-pairing'), /by order \(pose i with the i-th image of step 2\): 15 pairs usable/);
     await page.click('a[data-step=handeye]');
     const solveShown = async (refine) => {
       await page.selectOption('#handeye-refine', refine);
@@ -286,7 +286,7 @@ export const tests = [
     const mRefined = await solveShown('trusted');
     await shot('handeye');
     assertX(mRefined, cliRefined.gripper_from_camera, 'refined');
-    assert.match(await page.textContent('#handeye-refinement'), /^Refined \(trusted\) from \S+: reprojection RMS /);
+    assert.match(await page.textContent('#handeye-refinement'), /^Refined \(over the image points, robot poses exact\) from \S+: reprojection RMS /);
     const X = cli.gripper_from_camera;
     // Ground truth (GroundTruth.txt): hand2eye = diag(1, -1, -1), zero
     // translation: quaternion (±1, 0, 0, 0). Rendered corners carry ~0.02 px

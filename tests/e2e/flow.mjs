@@ -48,7 +48,7 @@ export const tests = [
     const t = m.slice(1, 4).map(Number);
     [30, -20, 100].forEach((want, i) => assert.ok(Math.abs(t[i] - want) < 2, `gripper_from_camera ${t} mm`));
     // The default refines over the image points (robot poses trusted).
-    assert.match(await page.textContent('#handeye-refinement'), /^Refined \(trusted\) from \S+: reprojection RMS /);
+    assert.match(await page.textContent('#handeye-refinement'), /^Refined \(over the image points, robot poses exact\) from \S+: reprojection RMS /);
     console.log(`     demo hand-eye (refined): gripper_from_camera ${t.join(', ')} mm (truth 30, -20, 100)`);
     // Every export format comes back from the core without an error.
     await page.click('a[data-step=export]');

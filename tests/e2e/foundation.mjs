@@ -37,12 +37,13 @@ export const tests = [
     })));
     // The images decode (the default 9x6 chessboard is not in them: that is
     // reported on the card, but they are not decode errors).
+    // (In name order, as the page puts one upload.)
     assert.deepEqual(cards, [
       { name: 'board.png', error: false, meta: 'PNG · 160×120 px · RGB, 8-bit', thumb: [160, 120] },
-      { name: 'plate.bmp', error: false, meta: 'BMP · 90×70 px · RGB, 8-bit', thumb: [90, 70] },
+      { name: 'broken.jpg', error: true, meta: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP', thumb: null },
       // An 8-bit palette of greys is listed as grey, not as the RGB the palette expands to.
       { name: 'mono.bmp', error: false, meta: 'BMP · 80×60 px · grey, 8-bit', thumb: [80, 60] },
-      { name: 'broken.jpg', error: true, meta: 'not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP', thumb: null },
+      { name: 'plate.bmp', error: false, meta: 'BMP · 90×70 px · RGB, 8-bit', thumb: [90, 70] },
     ]);
     // The thumbnail holds the decoded pixels: a white square at (30, 10), black at (10, 10).
     const px = await page.$eval('.card canvas', (c) => {

@@ -71,6 +71,15 @@ export function scatter(canvas, points, { xlabel, ylabel, title, symmetric = fal
     [xmin, xmax, ymin, ymax] = [-m, m, -m, m];
   }
   const { ctx, X, Y } = frame(canvas, { xmin, xmax, ymin, ymax, xlabel, ylabel, title, equal: symmetric });
+  // The group of the point nearest canvas (x, y) within 8 px, for click-to-select.
+  canvas.groupAt = (x, y) => {
+    let best = null, bestD = 64;
+    for (const p of points) {
+      const d = (X(p.x) - x) ** 2 + (Y(p.y) - y) ** 2;
+      if (d < bestD) { bestD = d; best = p.group || 0; }
+    }
+    return best;
+  };
   for (const p of points) {
     ctx.fillStyle = color(p.group || 0);
     ctx.globalAlpha = 0.7;
@@ -85,9 +94,15 @@ export function bars(canvas, items, { ylabel, title, threshold } = {}) {
   const ymax = Math.max(1e-9, ...items.map((b) => b.value), threshold || 0) * 1.1;
   const { ctx, X, Y, pw } = frame(canvas, { xmin: 0, xmax: items.length, ymin: 0, ymax, xlabel: '', ylabel, title, categorical: true });
   const bw = (pw / Math.max(items.length, 1)) * 0.7;
-  // Every k-th label when there are more bars than rotated labels fit
-  // (a slanted 10 px label needs about 11 px of axis).
-  const every = Math.max(1, Math.ceil((11 * items.length) / pw));
+  // Every k-th label when there are more bars than slanted labels fit: two
+  // 45-degree labels d px apart along the axis are d / sqrt(2) apart across,
+  // and a 10 px font needs about 12 px there, so d >= 17 px.
+  const every = Math.max(1, Math.ceil((17 * items.length) / pw));
+  // The bar under canvas x (pixels of the canvas), for click-to-select.
+  canvas.barAt = (x) => {
+    const i = Math.floor((x - X(0)) / (pw / Math.max(items.length, 1)));
+    return i >= 0 && i < items.length ? i : null;
+  };
   items.forEach((b, i) => {
     ctx.fillStyle = b.highlight ? '#d62728' : '#1f77b4';
     ctx.fillRect(X(i + 0.5) - bw / 2, Y(b.value), bw, Y(0) - Y(b.value));

@@ -6,14 +6,16 @@ import { $, h, fill, table, num, message } from '../lib/dom.js';
 import { bars, scatter, vectors, heatmap } from '../lib/plot.js';
 
 export const MODELS = [
-  ['brown', 'Brown-Conrady k1 k2 k3 p1 p2 (OpenCV 5, Halcon polynomial)'],
-  ['radial_k1_k2_k5', 'Radial k1 k2 k5 (seed 000)'],
-  ['rational', 'OpenCV rational k1..k6 p1 p2 (+ thin prism)'],
-  ['division', 'Division (Halcon, Fitzgibbon)'],
-  ['kannala_brandt', 'Kannala-Brandt fisheye (OpenCV fisheye)'],
-  ['eucm', 'Enhanced unified (wide angle)'],
+  ['brown', 'Brown-Conrady (radial k1 k2 k3, tangential p1 p2: OpenCV, MATLAB, Bouguet, Kalibr radtan)'],
+  ['radial_k1_k2_k5', 'Brown-Conrady radial only, Bouguet numbering (k1 k2 k5)'],
+  ['rational', 'OpenCV rational (k1..k6, p1 p2, thin prism s1..s4)'],
+  ['division', 'Division (Fitzgibbon, Halcon)'],
+  ['kannala_brandt', 'Kannala-Brandt fisheye (OpenCV fisheye, Kalibr equidistant)'],
+  ['eucm', 'Enhanced unified camera model (EUCM, wide angle)'],
   ['none', 'Pinhole, no distortion'],
 ];
+/** Brown-Conrady as users know it: 2 or 3 radial coefficients, tangential on or off (held at 0 otherwise). */
+const RADIAL = [['3', '3 radial (k1 k2 k3: OpenCV default)'], ['2', '2 radial (k1 k2, k3 held at 0: MATLAB, Bouguet, Kalibr default)']];
 export const METHODS = [
   ['zhang', 'Zhang + bundle adjustment'],
   ['dlt', '12-parameter DLT'],
@@ -37,10 +39,14 @@ function putPixels(canvas, p) {
   canvas.getContext('2d').putImageData(p.image, 0, 0); // the core's ImageData
 }
 
-/** The form's options as the core's JSON options (square pixels = aspect_ratio 1). */
-function jsonOptions(options) {
+/** The form's options as the core's JSON options (square pixels = aspect_ratio 1; Brown-Conrady's held coefficients). */
+function jsonOptions(options, st = {}) {
   const { square_pixels: square, ...rest } = options;
-  return square ? { ...rest, aspect_ratio: 1 } : rest;
+  const fixed = [];
+  if (st.model === 'brown' && st.radial === '2') fixed.push('k3');
+  if (st.model === 'brown' && st.tangential === false) fixed.push('p1', 'p2');
+  const out = square ? { ...rest, aspect_ratio: 1 } : rest;
+  return fixed.length ? { ...out, fixed_coefficients: fixed } : out;
 }
 
 export class CameraView {
@@ -50,6 +56,12 @@ export class CameraView {
     this.images = images;
     this.readonly = readonly;
     this.render();
+    // A result solved from detections of another target is stale: say so on it.
+    store.onChange((what) => {
+      if (what !== 'target' || !this.state.result) return;
+      this.state.stale = 'The target changed after this result was solved: the images are being detected again with the new target; solve again to update the result.';
+      this.show(this.state.result, this.state.comparison, this.state.comparisonNote);
+    });
   }
 
   get state() { return this.store.session.camera; }
@@ -60,8 +72,11 @@ export class CameraView {
       items.map(([v, label]) => h('option', { value: v, selected: v === value }, label)));
     const opts = OPTIONS.map(([key, label, dflt]) => h('label', { class: 'check' },
       h('input', { type: 'checkbox', name: key, checked: st.options[key] ?? !!dflt }), ' ', label));
+    const brown = h('div', { class: 'row', id: 'camera-brown-terms', hidden: st.model !== 'brown' },
+      h('label', {}, 'Radial terms ', select('radial', RADIAL, st.radial || '3')),
+      h('label', { class: 'check' }, h('input', { type: 'checkbox', name: 'tangential', checked: st.tangential !== false }), ' Tangential p1 p2'));
     const form = h('form', { class: 'form', id: 'camera-form' },
-      h('label', {}, 'Lens model', select('model', MODELS, st.model)),
+      h('label', {}, 'Lens model', select('model', MODELS, st.model)), brown,
       h('label', {}, 'Method', select('method', METHODS, st.method)),
       h('fieldset', {}, h('legend', {}, 'Options'), opts),
       h('p', { class: 'hint', id: 'camera-input-summary' }),
@@ -79,6 +94,9 @@ export class CameraView {
     const st = this.state;
     st.model = form.elements.model.value;
     st.method = form.elements.method.value;
+    st.radial = form.elements.radial.value;
+    st.tangential = form.elements.tangential.checked;
+    $('camera-brown-terms').hidden = st.model !== 'brown';
     for (const [key] of OPTIONS) st.options[key] = form.elements[key].checked;
     this.store.changed('camera-options');
   }
@@ -100,7 +118,7 @@ export class CameraView {
     const input = {
       model: st.model,
       method: st.method,
-      options: jsonOptions(st.options),
+      options: jsonOptions(st.options, st),
       views: views.map((i) => ({ name: i.name, detection: i.detection })),
     };
     try {
@@ -108,6 +126,7 @@ export class CameraView {
       st.result = result.report || result;
       st.comparison = result.comparison || null;
       st.comparisonNote = result.comparison_note || null; // e.g. why the DLT was left out
+      st.stale = null;
       this.store.changed('camera-result');
       this.show(st.result, st.comparison, st.comparisonNote);
     } catch (err) {
@@ -121,7 +140,7 @@ export class CameraView {
     const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
     const std = r.std || {};
     const params = table(['parameter', 'value', 'std'], names.map((n) => [n, num(value[n], 6), stdText(std[n])]), { id: 'camera-params' });
-    const warnings = (r.warnings || []).map((w) => message('warning', typeof w === 'string' ? w : w.message));
+    const warnings = (r.warnings || []).map((w) => this.warning(typeof w === 'string' ? w : w.message, r.model));
     const perView = (r.views || []).map((v) => ({ label: v.name, value: v.rms_px, highlight: v.rms_px > 2 * r.rms_px }));
     const residualPoints = [];
     const residualVectors = [];
@@ -149,15 +168,64 @@ export class CameraView {
     }, { title: `Projection uncertainty (1 sigma, points at ${num(pu.reference_depth_m, 2)} m)` }) : null;
     const dist = r.distortion_field ? vectors(canvas('plot-distortion', 'distortion field'), r.distortion_field.vectors, [w, hgt], { title: 'Distortion field', gain: 1 }) : null;
     this.plots = canvases;
+    const picked = h('div', { id: 'camera-view-picked', 'aria-live': 'polite' },
+      this.readonly ? null : h('p', { class: 'hint' }, 'Click a bar (or a point of the residual scatter) to select that view, then exclude it and solve again.'));
+    if (!this.readonly) {
+      viewBars.addEventListener('click', (e) => this.pickView(r, viewBars.barAt?.(e.offsetX * viewBars.width / viewBars.clientWidth), picked));
+      scat.addEventListener('click', (e) => {
+        const g = scat.groupAt?.(e.offsetX * scat.width / scat.clientWidth, e.offsetY * scat.height / scat.clientHeight);
+        this.pickView(r, g, picked);
+      });
+    }
     fill(this.out,
+      this.state.stale && !this.readonly ? message('warning', this.state.stale) : null,
       h('h3', {}, `Result: RMS ${num(r.rms_px, 4)} px over ${(r.views || []).length} views`),
       warnings,
       r.rejected ? this.rejectedNote(r) : null,
-      h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat)),
+      h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat, picked)),
       h('div', { class: 'plots' }, vec, unc, dist),
       this.undistortSection(r),
       comparison ? this.comparisonTable(comparison, comparisonNote) : null,
       r.correlation && r.correlation.matrix ? this.correlationNote(r.correlation) : null);
+  }
+
+  /**
+   * A warning of the report; the core's lens-model advice ("... (CLI: --model
+   * NAME)") comes with a button that switches the model and solves again.
+   */
+  warning(text, chosen) {
+    const m = /\(CLI: --model (\w+)\)/.exec(text);
+    const model = m && MODELS.find(([v]) => v === m[1]);
+    if (this.readonly || !model || m[1] === chosen) return message('warning', text);
+    const button = h('button', { type: 'button', class: 'switch-model', dataset: { model: m[1] } }, `Switch to ${model[1].replace(/ \(.*$/, '')} and solve again`);
+    button.addEventListener('click', () => {
+      this.state.model = m[1];
+      this.store.changed('camera-options');
+      this.render();
+      this.solve();
+    });
+    return h('div', { class: 'msg msg-warning', role: 'status' }, text, ' ', button);
+  }
+
+  /** View `i` of the result selected: its numbers, and a button that excludes it and solves again. */
+  pickView(r, i, out) {
+    const v = r.views && r.views[i];
+    if (!v) return;
+    const img = this.store.session.images.find((x) => x.name === v.name);
+    const exclude = h('button', { type: 'button', id: 'camera-exclude-view' }, `Exclude ${v.name} and solve again`);
+    exclude.addEventListener('click', () => {
+      if (img) {
+        img.included = false;
+        this.images.renderCard(img);
+        this.images.refresh();
+        this.store.changed('included');
+      }
+      this.solve();
+    });
+    const open = h('button', { type: 'button' }, 'Show the image');
+    open.addEventListener('click', () => img && this.images.inspect(img));
+    fill(out, h('p', { id: 'camera-view-selected' }, `View ${i + 1}: ${v.name}, reprojection RMS ${num(v.rms_px, 4)} px (overall ${num(r.rms_px, 4)} px).`),
+      h('div', { class: 'row' }, exclude, img ? open : null));
   }
 
   /** Pick an image and see it as taken and undistorted (the core resamples it in the worker). */

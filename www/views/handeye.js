@@ -17,6 +17,16 @@ const REFINE = [
   ['closed', 'None (closed forms on the camera poses only)'],
 ];
 
+/** What each refinement minimises, in a sentence; the result is shown with it. */
+const REFINE_HELP = {
+  trusted: 'Minimises the reprojection error of every detected target point (px) over the hand-eye and target transforms, taking the robot poses as exact. Use it for an accurate robot (an industrial arm, repeatability 0.1 mm or better): it is the default.',
+  stochastic: 'Minimises the reprojection error (px) plus a small correction per robot pose, weighted by the robot pose noise it estimates from the data. Use it when the robot poses are less accurate than the camera (a cobot, a hand-measured or tracked pose).',
+  joint_intrinsics: 'As the default, with the camera intrinsics (fx, fy, cx, cy) free too. Use it only when the camera may have changed since its calibration; with inaccurate robot poses the intrinsics absorb the robot error (a warning says so).',
+  none: 'Minimises the residuals of A X = Z B per pose, weighted by robot and camera pose noise estimated from the data (maximum likelihood over the poses, no pixels). Use it when only the camera poses are known, not the image points.',
+  closed: 'No refinement: each closed form (Tsai-Lenz, Park-Martin, ...) solves its own algebraic form of A X = X B, rotation first, then translation. For comparison only.',
+};
+const WHICH = 'Which to use: the default, or "robot pose noise estimated" for a less accurate robot. The closure errors below (how far each pose’s robot, hand-eye and camera transforms land from one common target pose) are not what the refinements minimise, so a closed form can show a smaller closure and still be less accurate; compare the reprojection RMS, which every row shows when image points are used.';
+
 const METHODS = [
   ['all', 'All methods (best one refined)'], ['tsai-lenz', 'Tsai-Lenz'], ['park-martin', 'Park-Martin'], ['horaud', 'Horaud'],
   ['andreff', 'Andreff'], ['daniilidis', 'Daniilidis (dual quaternion)'], ['chou-kamel', 'Chou-Kamel'], ['shah', 'Shah (AX = ZB)'], ['li', 'Li (AX = ZB)'],
@@ -40,11 +50,14 @@ export class HandEyeView {
       sel('handeye-setup', [['eye-in-hand', 'Eye-in-hand (camera on the gripper)'], ['eye-to-hand', 'Eye-to-hand (camera fixed, target on the gripper)']], st.setup, 'Setup '),
       sel('handeye-method', METHODS, st.method, 'Method '),
       sel('handeye-refine', REFINE, st.refine || 'trusted', 'Refinement '),
+      h('p', { class: 'hint', id: 'handeye-refine-help' }, REFINE_HELP[st.refine || 'trusted']),
+      h('p', { class: 'hint' }, WHICH),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-handeye' }, 'Solve hand-eye')));
     form.addEventListener('change', () => {
       st.setup = $('handeye-setup').value;
       st.method = $('handeye-method').value;
       st.refine = $('handeye-refine').value;
+      $('handeye-refine-help').textContent = REFINE_HELP[st.refine];
       this.store.changed('handeye-options');
     });
     form.addEventListener('submit', (e) => { e.preventDefault(); this.solve(); });
@@ -59,8 +72,11 @@ export class HandEyeView {
   input() {
     const cam = this.store.session.camera.result;
     if (!cam) throw new Error('solve the camera first (step 3): hand-eye uses the target pose of every view');
-    const pairs = this.robot.pairs().filter((p) => p.image);
-    if (!pairs.length) throw new Error('load the robot poses first (step 4)');
+    const paired = this.robot.pairs().filter((p) => p.image && p.image.included);
+    // A view detected with a larger grid than the target has another origin.
+    const pairs = paired.filter((p) => !p.image.largerGrid);
+    this.leftOut = paired.filter((p) => p.image.largerGrid).map((p) => p.image.name);
+    if (!this.robot.pairs().some((p) => p.image)) throw new Error('load the robot poses first (step 4)');
     const views = new Map((cam.views || []).map((v) => [v.name, v]));
     const used = pairs.filter((p) => views.has(p.image.name));
     const refine = this.state.refine || 'trusted';
@@ -70,7 +86,7 @@ export class HandEyeView {
       base_from_gripper: used.map((p) => ({ translation_m: p.pose.base_from_gripper.translation_m, quaternion_xyzw: p.pose.base_from_gripper.quaternion_xyzw })),
       camera_from_target: used.map((p) => ({ matrix_row_major: views.get(p.image.name).camera_from_target.matrix_row_major })),
       // The refinement reads the detected points through the solved camera.
-      ...(refine === 'none' || refine === 'closed' ? {} : { refine, camera: cam.camera, detections: used.map((p) => p.image.detection) }),
+      ...(refine === 'none' || refine === 'closed' ? {} : { refine, camera: cam.camera, camera_std: intrinsicStd(cam.std), detections: used.map((p) => p.image.detection) }),
       ...(refine === 'closed' ? { refine_poses: false } : {}),
       names: used.map((p) => p.image.name),
     };
@@ -85,11 +101,12 @@ export class HandEyeView {
     try {
       const result = await this.engine.call('handeye', { input: JSON.stringify(input) });
       result.pair_names = names;
+      result.left_out = this.leftOut;
       this.state.result = result;
       this.store.changed('handeye-result');
       this.show(result);
     } catch (err) {
-      fill(this.out, message('error', err.message));
+      fill(this.out, leftOutNote(this.leftOut), message('error', err.message));
     }
   }
 
@@ -107,16 +124,19 @@ export class HandEyeView {
       ['translation RMS', `${num(e.translation_rms_mm, 4)} mm`], ['translation max', `${num(e.translation_max_mm, 4)} mm`],
       ['rotation RMS', `${num(e.rotation_rms_deg, 5)} deg`], ['rotation max', `${num(e.rotation_max_deg, 5)} deg`],
       ['reprojection RMS', e.reprojection_rms_px == null ? '—' : `${num(e.reprojection_rms_px, 4)} px`]], { id: 'handeye-errors' });
-    const methods = table(['method', 'x (mm)', 'y (mm)', 'z (mm)', 'translation RMS (mm)', 'rotation RMS (deg)', 'vs. result (mm / deg)'],
+    const methods = table(['method', 'minimises', 'x (mm)', 'y (mm)', 'z (mm)', 'translation RMS (mm)', 'rotation RMS (deg)', 'reprojection RMS (px)', 'vs. result (mm / deg)'],
       (r.methods || []).map((m) => {
         const p = m[camKey];
-        if (!p) return [m.method, m.error || 'failed', '', '', '', '', ''];
-        return [m.method, ...p.translation_m.map((v) => num(v * 1000, 3)), num(m.errors && m.errors.translation_rms_mm, 4), num(m.errors && m.errors.rotation_rms_deg, 5),
+        if (!p) return [m.method, '', m.error || 'failed', '', '', '', '', '', ''];
+        return [m.method, 'its algebraic A X = X B error (closed form)', ...p.translation_m.map((v) => num(v * 1000, 3)), num(m.errors && m.errors.translation_rms_mm, 4), num(m.errors && m.errors.rotation_rms_deg, 5),
+          m.errors && m.errors.reprojection_rms_px != null ? num(m.errors.reprojection_rms_px, 4) : '—',
           `${num(m.disagreement_translation_mm, 3)} / ${num(m.disagreement_rotation_deg, 4)}`];
       }), { id: 'handeye-methods' });
+    const mode = r.refinement ? r.refinement.mode : r.pose_refinement ? 'none' : 'closed';
+    const measure = h('p', { class: 'hint', id: 'handeye-measure' }, `This result: ${REFINE_HELP[mode].split('. Use it')[0].replace(/\.$/, '')}.`);
     const ref = r.refinement;
     const refinement = ref ? h('p', { class: 'hint', id: 'handeye-refinement' },
-      `Refined (${ref.mode}) from ${ref.started_from}: reprojection RMS ${num(ref.reprojection_rms_px, 4)} px (closed form ${num(ref.closed_form_reprojection_rms_px, 4)} px) over ${(ref.per_view_reprojection_rms_px || []).length} views` +
+      `Refined (${(REFINE.find(([v]) => v === ref.mode) || [, ref.mode])[1].toLowerCase()}) from ${ref.started_from}: reprojection RMS ${num(ref.reprojection_rms_px, 4)} px (closed form ${num(ref.closed_form_reprojection_rms_px, 4)} px) over ${(ref.per_view_reprojection_rms_px || []).length} views` +
       (ref.camera ? `; camera refined too: fx ${num(ref.camera.fx, 3)}, fy ${num(ref.camera.fy, 3)} px.` : '.')) : null;
     const pr = r.pose_refinement;
     const std = pr && pr.camera_transform_std;
@@ -125,9 +145,12 @@ export class HandEyeView {
       `${camKey} std: translation ${std.translation_mm.map((v) => num(v, 3)).join(', ')} mm, rotation ${std.rotation_deg.map((v) => num(v, 4)).join(', ')} deg` +
       (pr.outlier_views.length ? `; outlier views (down-weighted): ${pr.outlier_views.map((v) => v + 1).join(', ')}.` : '.')) : null;
     const motion = r.motion ? h('p', { class: 'hint' }, `${r.motion.motions} motions used (${r.motion.discarded_small_rotation} discarded for too little rotation); rotation angles ${num(r.motion.angle_min_deg, 1)}–${num(r.motion.angle_max_deg, 1)} deg (median ${num(r.motion.angle_median_deg, 1)}), axis spread ${num(r.motion.axis_spread_deg, 1)} deg.`) : null;
-    const perMotion = bars(h('canvas', { width: 460, height: 300, role: 'img', 'aria-label': 'closure residual per motion' }),
-      (r.per_motion || []).map((m) => ({ label: `${m.from + 1}→${m.to + 1}`, value: m.translation_mm })), { ylabel: 'translation residual (mm)', title: 'Closure residual per motion', threshold: e.translation_rms_mm });
-    const plots = [perMotion];
+    // The table's quantity: closure per pose (its RMS and max are the table's).
+    const names = r.pair_names || [];
+    const perPose = bars(h('canvas', { width: 460, height: 300, role: 'img', 'aria-label': 'closure residual per pose', id: 'handeye-per-pose' }),
+      (r.per_view || []).map((v) => ({ label: names[v.view] || `pose ${v.view + 1}`, value: v.translation_mm })),
+      { ylabel: 'translation residual (mm)', title: 'Closure residual per pose (the table\'s RMS and max)', threshold: e.translation_rms_mm });
+    const plots = [perPose];
     if (r.repeatability) {
       const rep = r.repeatability;
       const box = (stats, key) => stats[`${key}_samples`] || boxFromSpread(stats[key]);
@@ -139,8 +162,9 @@ export class HandEyeView {
         { ylabel: 'rotation RMS (deg)', title: 'Repeatability' }));
     }
     this.plots = plots;
-    fill(this.out, h('h3', {}, `Result (${r.method})`), (r.warnings || []).map((w) => message('warning', w)),
-      pose(camKey), pose(tgtKey), refinement, poseRefinement, errors, motion, h('h3', {}, 'Methods side by side'), methods,
+    const leftOut = leftOutNote(r.left_out);
+    fill(this.out, h('h3', {}, `Result (${r.method})`), leftOut, (r.warnings || []).map((w) => message('warning', w)),
+      measure, pose(camKey), pose(tgtKey), refinement, poseRefinement, errors, motion, h('h3', {}, 'Methods side by side'), methods,
       h('div', { class: 'plots' }, plots), h('h3', {}, '3-D view'), this.frames3d());
     this.draw3d(r, camKey, tgtKey, eyeInHand);
   }
@@ -177,6 +201,19 @@ export class HandEyeView {
     }
     this.view3d.set(frames, links);
   }
+}
+
+/** Why views detected with a grid larger than the target are not in the hand-eye calibration. */
+function leftOutNote(names) {
+  if (!names || !names.length) return null;
+  return message('info', `Left out of the hand-eye calibration: ${names.join(', ')}: the grid found there is larger than the target, so its point 0 (the target's origin) need not be the same board corner as in the other views, and hand-eye needs one target frame in every view. Set the target to the board's full inner-corner count to use them.`);
+}
+
+/** The camera's calibrated std of fx, fy, cx, cy (finite ones), for the joint refinement's warning. */
+function intrinsicStd(std) {
+  const out = {};
+  for (const k of ['fx', 'fy', 'cx', 'cy']) if (std && Number.isFinite(std[k])) out[k] = std[k];
+  return Object.keys(out).length ? out : null;
 }
 
 /** Without per-run samples, a box from the median and IQR (whiskers omitted). */

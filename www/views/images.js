@@ -7,6 +7,9 @@ import { targetSpec } from './target.js';
 const THUMB_SIDE = 320;
 const IMAGE_EXT = /\.(png|jpe?g|tiff?|bmp|pgm|ppm|pnm|gif)$/i;
 
+/** File names in natural order: im_2 before im_10 (digits compared as numbers). */
+export const naturalCompare = (a, b) => a.localeCompare(b, undefined, { numeric: true, sensitivity: 'base' });
+
 /** Run `fn` over `items` with at most `k` calls at a time (stops early when `stop()`). */
 async function eachConcurrent(items, k, fn, stop = () => false) {
   let next = 0;
@@ -29,6 +32,28 @@ export class ImagesView {
     this.busy = false;
     this.residuals = new Map(); // image name -> [{x, y, dx, dy}]
     this.wire();
+    store.onChange((what) => { if (what === 'target') this.targetChanged(); });
+  }
+
+  /**
+   * The target changed: every decoded image is detected again (after the
+   * typing stops), its card saying so meanwhile; results solved from the old
+   * detections are marked stale by their steps.
+   */
+  targetChanged() {
+    const decoded = this.images.filter((i) => i.info);
+    if (!decoded.length) return;
+    for (const img of decoded) {
+      const card = this.cards.get(img.id);
+      if (card) card.meta.textContent = 'the target changed: detecting again…';
+    }
+    clearTimeout(this.redetectTimer);
+    this.redetectTimer = setTimeout(() => this.redetect(), 700);
+  }
+
+  async redetect() {
+    if (this.busy) { this.redetectAgain = true; return; }
+    await this.detectAll(this.images.filter((i) => i.info));
   }
 
   get images() { return this.store.session.images; }
@@ -48,6 +73,10 @@ export class ImagesView {
     $('choose-files').addEventListener('click', () => $('file-input').click());
     $('choose-folder').addEventListener('click', () => $('folder-input').click());
     $('detect-all').addEventListener('click', () => this.detectAll());
+    $('sort-images').addEventListener('click', () => {
+      this.images.sort((a, b) => naturalCompare(a.name, b.name));
+      this.reorder();
+    });
     $('cancel-detect').addEventListener('click', () => { this.cancelled = true; $('progress-text').textContent = 'cancelling after the current image…'; });
     $('clear-images').addEventListener('click', async () => {
       await this.store.removeImages(this.images.map((i) => i.id));
@@ -75,7 +104,9 @@ export class ImagesView {
 
   async addFiles(files) {
     const added = [];
-    for (const file of files) {
+    // A file picker may list im_28 first: the session's order (which pairs
+    // images with poses) is the names' natural order, shown on the cards.
+    for (const file of [...files].sort((a, b) => naturalCompare(a.name, b.name))) {
       const img = { id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name: file.name, size: file.size, included: true, status: 'pending', info: null, detection: null, error: null };
       const bytes = await file.arrayBuffer();
       await this.store.addImage(img, bytes);
@@ -115,6 +146,7 @@ export class ImagesView {
     } catch (err) {
       img.status = 'error';
       img.error = err.message;
+      img.included = false; // nothing to use (its pose keeps its place: pairing is by position)
     }
     this.store.changed('images');
   }
@@ -142,7 +174,13 @@ export class ImagesView {
       if (card) card.meta.textContent = 'detecting…';
       try {
         const bytes = this.store.bytes.get(img.id).slice(0);
-        img.detection = await this.pool.call('detect', { bytes, spec, name: img.name }, [bytes]);
+        img.largerGrid = null;
+        try {
+          img.detection = await this.pool.call('detect', { bytes, spec, name: img.name }, [bytes]);
+        } catch (err) {
+          img.detection = await this.largerGrid(img, err);
+        }
+        if (img.status === 'error') img.included = true; // found now (e.g. after a target change)
         img.status = 'detected';
         img.error = null;
         img.detectError = false;
@@ -151,6 +189,7 @@ export class ImagesView {
         img.status = 'error';
         img.error = err.message;
         img.detectError = !!img.info; // decoded fine, the target was not found
+        img.included = false;
       }
       done++;
       running.delete(img.name);
@@ -163,6 +202,32 @@ export class ImagesView {
     this.busy = false;
     setTimeout(() => { if (!this.busy) $('progress-row').hidden = true; }, 1500);
     this.store.changed('detections');
+    if (this.redetectAgain) { this.redetectAgain = false; await this.redetect(); }
+  }
+
+  /**
+   * A chessboard grid larger than the target's (the printed board has more
+   * squares than the spec): the view detected with a target of the found
+   * size, noted on its card; camera calibration uses the whole grid, hand-eye
+   * leaves the view out (its point 0 need not be the same board corner as in
+   * the other views). Any other failure is rethrown.
+   */
+  async largerGrid(img, err) {
+    const m = /^found a (\d+)x(\d+) chessboard grid, larger than the (\d+)x(\d+) target/.exec(err.message);
+    const t = this.store.session.target;
+    if (!m || !t || t.kind !== 'chessboard') throw err;
+    // The core counts the grid along the image axes: turn it the way of the target.
+    let [a, b] = [Number(m[1]), Number(m[2])];
+    if (!(a >= Number(m[3]) && b >= Number(m[4])) && b >= Number(m[3]) && a >= Number(m[4])) [a, b] = [b, a];
+    const bytes = this.store.bytes.get(img.id).slice(0);
+    const spec = JSON.stringify({ ...t, cols: a, rows: b });
+    let detection;
+    try {
+      detection = await this.pool.call('detect', { bytes, spec, name: img.name }, [bytes]);
+    } catch { throw err; }
+    img.largerGrid = `found ${a}x${b} inner corners, more than the ${m[3]}x${m[4]} of the target (the board has more squares than the spec): `
+      + 'the whole grid is used for the camera calibration of this view; hand-eye leaves it out, because its point 0 need not be the same board corner as in the other views';
+    return detection;
   }
 
   makeCard(img) {
@@ -173,10 +238,39 @@ export class ImagesView {
     const open = () => this.inspect(img);
     canvas.addEventListener('click', open);
     canvas.addEventListener('keydown', (e) => { if (e.key === 'Enter') open(); });
+    const order = h('span', { class: 'order', title: 'position: robot poses without names pair with images in this order' });
+    const tool = (label, text, fn) => h('button', { type: 'button', class: 'small', 'aria-label': `${label} ${img.name}`, title: label, onclick: fn }, text);
+    const tools = h('span', { class: 'card-tools' },
+      tool('move earlier:', '◀', () => this.move(img, -1)), tool('move later:', '▶', () => this.move(img, 1)),
+      tool('remove', 'Remove', () => this.remove(img)));
     const li = h('li', { class: 'card pending', dataset: { id: img.id } }, canvas,
-      h('p', { class: 'name' }, img.name), meta, h('label', { class: 'include' }, toggle, ' use'));
+      h('p', { class: 'name' }, img.name), meta, h('div', { class: 'card-row' }, order, h('label', { class: 'include' }, toggle, ' use'), tools));
     $('cards').append(li);
-    this.cards.set(img.id, { li, canvas, meta, toggle });
+    this.cards.set(img.id, { li, canvas, meta, toggle, order });
+  }
+
+  /** Move `img` one place earlier (-1) or later (+1) in the session's order. */
+  move(img, step) {
+    const i = this.images.indexOf(img);
+    const j = i + step;
+    if (i < 0 || j < 0 || j >= this.images.length) return;
+    [this.images[i], this.images[j]] = [this.images[j], this.images[i]];
+    this.reorder();
+  }
+
+  /** The cards in the session's order (robot poses pair with images in it). */
+  reorder() {
+    $('cards').append(...this.images.map((i) => this.cards.get(i.id)?.li).filter(Boolean));
+    this.refresh();
+    this.store.changed('images');
+  }
+
+  async remove(img) {
+    await this.store.removeImages([img.id]);
+    this.previews.delete(img.id);
+    this.cards.get(img.id)?.li.remove();
+    this.cards.delete(img.id);
+    this.refresh();
   }
 
   renderCard(img) {
@@ -195,6 +289,7 @@ export class ImagesView {
     card.li.className = `card ${img.status === 'error' ? 'warn' : 'ok'}${img.included ? '' : ' excluded'}`;
     const parts = [describe(img.info)];
     if (img.detection) parts.push(`${img.detection.points.length} points`);
+    if (img.largerGrid) parts.push(img.largerGrid);
     if (img.status === 'error') parts.push(img.error);
     if (img.bytesMissing) parts.push('from a session file: add the image to see it');
     card.meta.textContent = parts.join(' · ');
@@ -202,6 +297,7 @@ export class ImagesView {
 
   refresh() {
     const imgs = this.images;
+    imgs.forEach((img, i) => { const c = this.cards.get(img.id); if (c) c.order.textContent = `#${i + 1}`; });
     const count = (s) => imgs.filter((i) => i.status === s).length;
     const decoded = imgs.filter((i) => i.info).length;
     const failedDecode = imgs.filter((i) => i.status === 'error' && !i.info).length;
@@ -210,7 +306,7 @@ export class ImagesView {
     if (count('detected')) parts.push(`${count('detected')} with the target`);
     const notFound = imgs.filter((i) => i.status === 'error' && i.info).length;
     if (notFound) parts.push(`${notFound} without the target`);
-    const excluded = imgs.filter((i) => !i.included).length;
+    const excluded = imgs.filter((i) => !i.included && i.status !== 'error').length; // failed ones are counted above
     if (excluded) parts.push(`${excluded} excluded`);
     if (count('pending')) parts.push(`${count('pending')} in progress`);
     $('image-summary').textContent = parts.join(', ');

@@ -140,7 +140,7 @@ export class RobotView {
     if (!cam) { fill(out, message('info', 'Solve the camera first (step 3): the check compares robot motion with camera motion.')); return; }
     const views = new Map((cam.views || []).map((v) => [v.name, v]));
     const r = this.state.reading;
-    const pairs = this.pairs().filter((p) => p.image && views.has(p.image.name));
+    const pairs = this.pairs().filter((p) => p.image && p.image.included && views.has(p.image.name));
     const idx = pairs.map((p) => p.index);
     const input = {
       setup: this.store.session.handeye.setup,
@@ -163,11 +163,16 @@ export class RobotView {
     }
   }
 
-  /** Poses paired with images: by name when the file names images, else by order of the images with a detection. */
+  /**
+   * Poses paired with images: by name when the file names images, else by
+   * position in step 2's order (pose i with the i-th image). An excluded or
+   * failed image keeps its pose (it is not used): excluding a view never
+   * shifts the pairing of the others; removing the image does.
+   */
   pairs() {
     const p = this.state.parsed;
     if (!p) return [];
-    const imgs = this.store.session.images.filter((i) => i.included);
+    const imgs = this.store.session.images;
     const byName = p.poses.some((q) => q.name);
     if (byName) {
       const stem = (s) => s.replace(/\.[^.]*$/, '');
@@ -183,12 +188,12 @@ export class RobotView {
     if (!this.pairing) return;
     const pairs = this.pairs();
     if (!pairs.length) { fill(this.pairing, h('p', { class: 'hint' }, 'No poses yet.')); return; }
-    const used = pairs.filter((q) => q.image && q.image.detection).length;
-    const nImages = this.store.session.images.filter((i) => i.included).length;
+    const used = pairs.filter((q) => q.image && q.image.included && q.image.detection).length;
+    const nImages = this.store.session.images.length;
     const rows = pairs.map((q) => [String(q.index + 1), q.pose.name || '', q.image ? q.image.name : '—',
-      !q.image ? 'no image' : q.image.detection ? 'used' : 'dropped: the target was not found in the image']);
+      !q.image ? 'no image' : !q.image.info ? 'dropped: the image could not be read' : !q.image.detection ? 'dropped: the target was not found in the image' : q.image.included ? 'used' : 'dropped: the image is excluded in step 2']);
     const warn = pairs.length !== nImages ? message('warning', `${pairs.length} poses but ${nImages} images: pairing ${pairs[0].how === 'name' ? 'by name' : 'by order'} leaves some unpaired. Check that the pose file matches the images.`) : null;
-    fill(this.pairing, h('p', {}, `Paired ${pairs[0].how === 'name' ? 'by the name column' : 'by order (pose i with the i-th included image)'}: ${used} pairs usable.`), warn,
+    fill(this.pairing, h('p', {}, `Paired ${pairs[0].how === 'name' ? 'by the name column' : 'by order (pose i with the i-th image of step 2)'}: ${used} pairs usable.`), warn,
       table(['pose', 'name', 'image', 'status'], rows, { id: 'pairing-table' }));
   }
 }

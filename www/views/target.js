@@ -87,9 +87,21 @@ function writeForm(form, t) {
   }
 }
 
+/** What the grid fields count, per kind: a chessboard's are its inner corners, not its squares. */
+const GRID_LABELS = {
+  chessboard: ['Inner corners across ', 'Inner corners down '],
+  square_grid: ['Squares across ', 'Squares down '],
+  circle_grid: ['Circles across ', 'Circles down '],
+  dot_plate: ['Dots across ', 'Dots down '],
+};
+
 function showFields(form) {
   const kind = form.elements.kind.value;
   for (const label of form.querySelectorAll('[data-for]')) label.hidden = !label.dataset.for.split(' ').includes(kind);
+  const [cols, rows] = GRID_LABELS[kind] || ['Columns ', 'Rows '];
+  form.elements.cols.parentElement.firstChild.textContent = cols;
+  form.elements.rows.parentElement.firstChild.textContent = rows;
+  $('target-count-hint').hidden = kind !== 'chessboard';
 }
 
 /**
