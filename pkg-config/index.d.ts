@@ -639,7 +639,12 @@ export interface RunStats {
 
 /** Leave-one-out (jackknife-scaled) and bootstrap. */
 export interface Repeatability {
+  /** The method resampled: `refined from <closed form>` when the pose refinement is on (each resample re-solved the way the main estimate was), else the closed form. */
   method: string;
+  /** Bootstrap resamples drawn (absent in reports before it was added). */
+  bootstrap_samples?: number;
+  /** Seed of the bootstrap resampling (absent in reports before it was added). */
+  seed?: number;
   leave_one_out: RunStats;
   bootstrap: RunStats;
 }

@@ -478,6 +478,14 @@ const CASES: &[Case] = &[
         message: "robocal: bad.csv: line 1: missing column(s) height_mm, u_px, v_px, x_mm, y_mm (expected header height_mm,u_px,v_px,x_mm,y_mm, got a,b)",
     },
     Case {
+        name: "intrinsics-partial-views-unusable",
+        files: &[("partial.json", br#"{"images":[{"file":"a.png","detection":{"image_size_px":[640,480],"target":{"kind":"chessboard","cols":9,"rows":6,"square_m":0.03},"points":[{"id":0,"x_px":100,"y_px":100},{"id":1,"x_px":120,"y_px":100},{"id":9,"x_px":100,"y_px":120}]}},{"file":"b.png","detection":{"image_size_px":[640,480],"target":{"kind":"chessboard","cols":9,"rows":6,"square_m":0.03},"points":[{"id":0,"x_px":103,"y_px":103},{"id":1,"x_px":123,"y_px":103},{"id":2,"x_px":143,"y_px":103},{"id":3,"x_px":163,"y_px":103}]}},{"file":"c.png","detection":{"image_size_px":[640,480],"target":{"kind":"chessboard","cols":9,"rows":6,"square_m":0.03},"points":[{"id":0,"x_px":106,"y_px":106},{"id":1,"x_px":126,"y_px":106},{"id":2,"x_px":146,"y_px":106},{"id":3,"x_px":166,"y_px":106},{"id":12,"x_px":166,"y_px":126}]}}]}"#)],
+        args: &["intrinsics", "--detections", "partial.json"],
+        code: 1,
+        stream: Stream::Stderr,
+        message: "robocal: views: 0 views whose points fix a homography, a calibration needs at least 3 (10 or more from varied angles are recommended); left out: view a.png (3 points: a homography needs at least 4), view b.png (its 4 points lie on one line: a homography needs 4 points with no 3 on one line), view c.png (4 of its 5 points lie on one line: a homography needs 4 points with no 3 on one line): add images in which more of the target is found",
+    },
+    Case {
         name: "detect-misspelled-flag",
         files: &[],
         args: &["detect", "--targett", "chessboard:9x6:30mm", "a.png"],

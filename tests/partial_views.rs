@@ -468,3 +468,45 @@ fn tsai_leaves_out_a_view_of_four_points_with_a_warning() {
     let zhang = calibrate(&views, (1280, 960), &brown_options()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(zhang.views.len(), 9);
 }
+
+#[test]
+fn handeye_with_too_few_usable_views_names_the_views_left_out() {
+    let (mut input, _) = handeye_input("eye-in-hand", robocal::handeye::Setup::EyeInHand, 32);
+    // Keep 4 poses: views 2, 3, 4 (on one line) and 5.
+    for key in ["base_from_gripper", "detections"] {
+        let list = input[key].as_array().expect("list")[2..6].to_vec();
+        input[key] = Value::Array(list);
+    }
+    let column: Vec<Value> = input["detections"][0]["points"]
+        .as_array()
+        .expect("points")
+        .iter()
+        .filter(|p| p["id"].as_u64().is_some_and(|id| id as usize % COLS == 3))
+        .cloned()
+        .collect();
+    input["detections"][0]["points"] = Value::Array(column);
+    let n = input["detections"][0]["points"]
+        .as_array()
+        .map_or(0, Vec::len);
+    assert!(n >= 2, "column 3 keeps {n} points");
+    let e = robocal::handeye::json_api::solve_handeye_json(&input.to_string())
+        .map_err(|e| e.to_string());
+    let reason = |k: usize| {
+        if k < 4 {
+            format!("{k} points: a homography needs at least 4")
+        } else {
+            format!(
+                "its {k} points lie on one line: a homography needs 4 points with no 3 on one line"
+            )
+        }
+    };
+    assert_eq!(
+        e,
+        Err(format!(
+            "views: requires at least 3 pose pairs, got 2; view 0 left out with its robot pose: {}, \
+             view 2 left out with its robot pose: its 6 points lie on one line: a homography needs \
+             4 points with no 3 on one line",
+            reason(n)
+        ))
+    );
+}

@@ -252,5 +252,5 @@ fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<View
         }
         _ => *size = Some(s),
     }
-    Ok(View::from_detection(file, &d))
+    Ok(View::from_detection(file, d))
 }

@@ -20,9 +20,11 @@ use super::pose_refine::{
 };
 use super::pose_residual::PoseMeasurement;
 use super::pose_shape::{predicted_covariances, NominalTarget};
+use super::repeat::{repeatability_with, Repeatability};
 use super::report::{errors, motion_residuals, pose_difference, view_residuals};
 use super::reprojection_refine::ViewPoints;
-use super::solve::{HandEyeInput, HandEyeResult};
+use super::solve::{solve_method, HandEyeInput, HandEyeOptions, HandEyeResult};
+use super::HandEyeMethod;
 use super::Setup;
 use super::{Chain, MotionPairs, Pose};
 use crate::camera::Camera;
@@ -322,6 +324,7 @@ pub fn apply_pose_refinement_with(
         }
     }
     let (closed_form_cost, started_from, x0, y0) = start;
+    let model_for_resamples = noise.clone();
     let refined = match refine(setup, &views, &x0, &y0, noise, &options) {
         Ok(r) => r,
         Err(e) => {
@@ -353,7 +356,7 @@ pub fn apply_pose_refinement_with(
     }
     let cov = refined.covariance;
     result.pose_refinement = Some(PoseRefinementSummary {
-        started_from,
+        started_from: started_from.clone(),
         closed_form_cost,
         cost: refined.cost,
         camera_noise_model: model_name,
@@ -372,5 +375,82 @@ pub fn apply_pose_refinement_with(
         whitened_residual_norms: refined.whitened_norms,
         outlier_views: refined.outliers,
     });
+    if let Some(previous) = &result.repeatability {
+        let resampled = ResampleSetup {
+            setup,
+            views: &views,
+            chain: &chain,
+            noise: &model_for_resamples,
+            options: &options,
+            motion_pairs,
+        };
+        if let Some(r) = resampled.repeatability(previous, &started_from, &result.x, &result.y) {
+            result.repeatability = Some(r);
+        }
+    }
     Ok(())
+}
+
+/// What re-solving a resample of the views with the pose refinement needs.
+struct ResampleSetup<'a> {
+    setup: Setup,
+    views: &'a [PoseMeasurement],
+    chain: &'a Chain,
+    /// The full data's noise model (shape and pivots per view); each
+    /// resample re-estimates the levels from it, as the full solve did.
+    noise: &'a NoiseModel,
+    options: &'a PoseRefineOptions,
+    motion_pairs: MotionPairs,
+}
+
+impl ResampleSetup<'_> {
+    /// The repeatability of the report's main estimate: every resample of
+    /// `previous` (the same leave-one-out runs and seeded bootstrap) solved
+    /// by the closed form the refinement started from, then refined.
+    /// `None` when that closed form is not a method name.
+    fn repeatability(
+        &self,
+        previous: &Repeatability,
+        started_from: &str,
+        x: &Pose,
+        y: &Pose,
+    ) -> Option<Repeatability> {
+        let method: HandEyeMethod = started_from.parse().ok()?;
+        let solve = |indices: &[usize]| -> Result<(Pose, Pose)> {
+            let sub = self.chain.subset(indices);
+            let (x0, y0, _) = solve_method(method, &sub, self.motion_pairs)?;
+            let views: Vec<PoseMeasurement> = indices.iter().map(|&i| self.views[i]).collect();
+            let noise = noise_subset(self.noise, indices);
+            let r = refine(self.setup, &views, &x0, &y0, noise, self.options)?;
+            Ok((r.x, r.y))
+        };
+        let options = HandEyeOptions {
+            bootstrap_samples: previous.bootstrap_samples,
+            seed: previous.seed,
+            motion_pairs: self.motion_pairs,
+            ..HandEyeOptions::default()
+        };
+        let name = format!("refined from {started_from}");
+        Some(repeatability_with(
+            self.chain, &name, &solve, &options, x, y,
+        ))
+    }
+}
+
+/// The noise model of the views at `indices` (its per-view parts picked).
+fn noise_subset(noise: &NoiseModel, indices: &[usize]) -> NoiseModel {
+    fn pick<T: Copy>(list: &[T], indices: &[usize]) -> Vec<T> {
+        indices
+            .iter()
+            .filter_map(|&i| list.get(i).copied())
+            .collect()
+    }
+    NoiseModel {
+        camera: match &noise.camera {
+            CameraNoise::Diagonal => CameraNoise::Diagonal,
+            CameraNoise::PerView(c) => CameraNoise::PerView(pick(c, indices)),
+        },
+        variances: noise.variances.clone(),
+        pivot_levers: pick(&noise.pivot_levers, indices),
+    }
 }

@@ -5,6 +5,7 @@
 use super::report::{errors, pose_difference, view_residuals, Errors};
 use super::solve::{solve_method, HandEyeOptions};
 use super::{Chain, HandEyeMethod, Pose};
+use crate::error::Result;
 use crate::synth::Rng;
 use serde::{Deserialize, Serialize};
 
@@ -71,8 +72,15 @@ pub struct RunStats {
 /// Leave-one-out and bootstrap results.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq, Default)]
 pub struct Repeatability {
-    /// The method resampled.
+    /// The method resampled: a closed form, or `refined from <closed form>`
+    /// when every resample was re-solved with the pose refinement.
     pub method: String,
+    /// Bootstrap resamples drawn.
+    #[serde(default)]
+    pub bootstrap_samples: usize,
+    /// Seed of the bootstrap resampling.
+    #[serde(default)]
+    pub seed: u64,
     /// One run per left-out view; standard deviations use the jackknife
     /// scaling `sqrt((n-1)/n * sum d^2)`, which estimates the full-data spread.
     pub leave_one_out: RunStats,
@@ -130,10 +138,12 @@ fn std_of(samples: &[[f64; 6]], jackknife: bool) -> PoseStd {
     }
 }
 
+/// A solver of the views at the given indices (repeats allowed).
+pub type SubsetSolver<'a> = dyn Fn(&[usize]) -> Result<(Pose, Pose)> + 'a;
+
 fn run_all(
     chain: &Chain,
-    method: HandEyeMethod,
-    options: &HandEyeOptions,
+    solve: &SubsetSolver,
     subsets: &[Vec<usize>],
     reference: (&Pose, &Pose),
     jackknife: bool,
@@ -145,8 +155,8 @@ fn run_all(
     let mut deviations = Vec::new();
     for subset in subsets {
         let sub = chain.subset(subset);
-        match solve_method(method, &sub, options.motion_pairs) {
-            Ok((x, y, _)) => {
+        match solve(subset) {
+            Ok((x, y)) => {
                 errs.push(errors(&view_residuals(&sub, &x, &y)));
                 deviations.push(pose_difference(reference.0, &x));
                 xs.push(pose_params(reference.0, &x));
@@ -188,6 +198,23 @@ pub fn repeatability(
     x: &Pose,
     y: &Pose,
 ) -> Repeatability {
+    let solve = |indices: &[usize]| {
+        solve_method(method, &chain.subset(indices), options.motion_pairs).map(|(x, y, _)| (x, y))
+    };
+    repeatability_with(chain, method.name(), &solve, options, x, y)
+}
+
+/// [`repeatability`] with any solver of a subset of the views, reported
+/// under `method`: the same leave-one-out runs and the same seeded
+/// bootstrap resamples (`options.bootstrap_samples`, `options.seed`).
+pub fn repeatability_with(
+    chain: &Chain,
+    method: &str,
+    solve: &SubsetSolver,
+    options: &HandEyeOptions,
+    x: &Pose,
+    y: &Pose,
+) -> Repeatability {
     let n = chain.len();
     let loo: Vec<Vec<usize>> = (0..n)
         .map(|skip| (0..n).filter(|&i| i != skip).collect())
@@ -201,8 +228,10 @@ pub fn repeatability(
         })
         .collect();
     Repeatability {
-        method: method.name().to_string(),
-        leave_one_out: run_all(chain, method, options, &loo, (x, y), true),
-        bootstrap: run_all(chain, method, options, &boot, (x, y), false),
+        method: method.to_string(),
+        bootstrap_samples: options.bootstrap_samples,
+        seed: options.seed,
+        leave_one_out: run_all(chain, solve, &loo, (x, y), true),
+        bootstrap: run_all(chain, solve, &boot, (x, y), false),
     }
 }

@@ -79,7 +79,7 @@ const calibration: CameraCalibration = {
   distortion: { k1: -0.18, k2: 0.05, p1: 0.0005, p2: -0.0003, k3: 0 },
   rms_px: 0.05,
   std: { fx: 0.1, fy: 0.1, cx: 0.2, cy: 0.2, skew: 0 },
-  views: [{ name: 'demo_00.png', rms_px: 0.05, n_points: 54, camera_from_target: pose, outliers: [{ index: 3, residual_px: 4.2, reason: 'beyond 3 robust sigmas' }], residuals_px: [{ x: 244.2, y: 94.5, dx: 0.01, dy: -0.02 }] }],
+  views: [{ name: 'demo_00.png', rms_px: 0.05, n_points: 54, camera_from_target: pose, outliers: [{ index: 3, id: 3, residual_px: 4.2, reason: 'beyond 3 robust sigmas' }], residuals_px: [{ x: 244.2, y: 94.5, dx: 0.01, dy: -0.02, id: 0 }] }],
   correlation: { names: ['fx', 'fy'], matrix: [[1, 0.99], [0.99, 1]] },
   projection_uncertainty: { reference_depth_m: 0.6, x_px: [0, 1023], y_px: [0, 767], std_px: [[0.1, null], [0.1, 0.2]], max_std_px: 0.2 },
   distortion_field: { vectors: [{ x: 0, y: 0, dx: -30, dy: -22 }] },
@@ -102,6 +102,7 @@ const stereoInput: StereoInput = { model: 'brown', left: calibrationInput.views,
 const stereo: StereoCalibration = {
   left: calibration, right: calibration, right_from_left: pose, initial_right_from_left: pose, baseline_m: 0.1,
   right_from_left_std: null, rms_px: 0.2, iterations: 5, termination: 'gradient_tolerance',
+  warnings: ['pair 3 left out: right r03.png: 3 points: a homography needs at least 4'],
 };
 const fx: number = (JSON.parse(robocal.calibrate_camera(JSON.stringify(calibrationInput))) as JsonOutput<'calibrate_camera'>).report.camera.fx;
 
