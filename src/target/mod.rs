@@ -213,7 +213,13 @@ impl Detection {
         let mut object = Vec::with_capacity(self.points.len());
         let mut image = Vec::with_capacity(self.points.len());
         for p in &self.points {
-            if let Some((_, o)) = board.get(p.id) {
+            // Ids are positions on most targets; a board whose ids start
+            // elsewhere (a marker board's first id) is searched by id.
+            let by_id = board
+                .get(p.id)
+                .filter(|(id, _)| *id == p.id)
+                .or_else(|| board.iter().find(|(id, _)| *id == p.id));
+            if let Some((_, o)) = by_id {
                 object.push(*o);
                 image.push(Point2::new(p.x_px, p.y_px));
             }
