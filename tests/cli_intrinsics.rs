@@ -329,3 +329,45 @@ fn brown5_is_the_issue_spelling_of_brown() {
     assert_eq!(brown.0, "brown");
     assert_eq!(solve("brown5"), brown);
 }
+
+#[test]
+fn robust_option_says_how_many_points_it_rejected() {
+    let dir = temp_dir("intrinsics", "robust");
+    let (detections, _) = detections_file(&dir);
+    let out = dir.join("camera.json");
+    let (code, _, stderr) = robocal(&[
+        "intrinsics",
+        "--detections",
+        detections.to_str().expect("path"),
+        "--target",
+        "chessboard:9x6:30mm",
+        "--robust",
+        "-o",
+        out.to_str().expect("path"),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    // Noise-free views (6 x 54 points): the robust sigma is 0 and nothing is cut.
+    assert!(
+        stderr.contains("robocal intrinsics: robust loss: no point rejected (of 324)\n"),
+        "{stderr}"
+    );
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("report JSON");
+    assert_eq!(report["rejected"]["count"], 0);
+    assert_eq!(report["rejected"]["of_points"], 324);
+    // Without the option the report has no "rejected".
+    let (code, _, stderr) = robocal(&[
+        "intrinsics",
+        "--detections",
+        detections.to_str().expect("path"),
+        "--target",
+        "chessboard:9x6:30mm",
+        "-o",
+        out.to_str().expect("path"),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("robust loss"), "{stderr}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("report JSON");
+    assert!(report.get("rejected").is_none());
+}

@@ -19,6 +19,8 @@ const PLANE_TOLERANCE_M: f64 = 1e-9;
 /// Ratio of the median residual norm to sigma for 2-D Gaussian residuals
 /// (median of a Rayleigh distribution: sqrt(2 ln 2)).
 const RAYLEIGH_MEDIAN: f64 = 1.177_410_022_515_474_6;
+/// Residuals below this (px) are never rejected as outliers.
+const MIN_OUTLIER_PX: f64 = 0.01;
 
 /// What to estimate and how. Defaults: Brown model (k1 k2 p1 p2 k3 from 0),
 /// zero skew, nothing else fixed, squared loss, no outlier rejection.
@@ -353,7 +355,10 @@ fn classify(
         .collect();
     used_norms.sort_by(f64::total_cmp);
     let sigma = used_norms.get(used_norms.len() / 2).copied().unwrap_or(0.0) / RAYLEIGH_MEDIAN;
-    let threshold = k * sigma;
+    // Residuals of exact data are rounding noise (1e-10 px) whose 3 sigma
+    // would still cut a few per cent of perfect points: no residual under
+    // MIN_OUTLIER_PX is an outlier (no detector is that accurate).
+    let threshold = (k * sigma).max(MIN_OUTLIER_PX);
     let mut next = Vec::with_capacity(used.len());
     let mut outliers = Vec::with_capacity(used.len());
     let mut it = norms.iter().zip(used.iter().flatten());
@@ -365,7 +370,7 @@ fn classify(
                 break;
             };
             // Noise-free data has sigma 0: keep everything then.
-            view_next.push(threshold == 0.0 || r <= threshold);
+            view_next.push(r <= threshold);
             if !was_used {
                 let reason = if r > threshold {
                     format!("residual {r:.3} px > {k} x robust sigma {sigma:.3} px")

@@ -268,8 +268,7 @@ function shareCase(fragment, message) {
   return async (page, { url, shot }) => {
     await loadBoard(page, url);
     await page.waitForTimeout(500); // the store saves 300 ms after the last change
-    await page.goto(`${url}#share=${fragment}`);
-    await page.reload(); // a new fragment alone does not reload the page
+    await page.goto(`${url}#share=${fragment}`); // a new share fragment in an open tab reloads the page on it
     await page.locator('#readonly-banner:not([hidden])').waitFor({ timeout: 30000 });
     await page.waitForFunction(() => !/^You are viewing shared results/.test(document.getElementById('readonly-banner').textContent), null, { timeout: 10000 });
     assert.equal(await page.textContent('#readonly-banner'), `${message}. Start your own session at /.`);

@@ -110,7 +110,7 @@ export const tests = [
     await page.waitForFunction(() => /1 with the target/.test(document.getElementById('image-summary').textContent), null, { timeout: 30000 });
     // 640x360 (16:9): the map is 480x270, no dark band under the image.
     assert.deepEqual(await page.$eval('#coverage-canvas', (c) => [c.width, c.height]), [480, 270]);
-    assert.match(await page.textContent('#coverage-legend'), /detected points, one colour per image .* where no point was found yet/s);
+    assert.match(await page.textContent('#coverage-legend'), /detected points, one colour per image .* where no point was found yet.* cells with points$/s);
     await page.locator('#coverage-canvas').scrollIntoViewIfNeeded();
     await shot('coverage');
   }],

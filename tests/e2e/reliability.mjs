@@ -106,6 +106,7 @@ return real_decode_image_preview(bytes, max_side, options);
   assert.equal(trap.meta, 'the calibration engine crashed while decoding trap.png (unreachable); it was restarted and your images and results are kept. Please report this with the file or data of that step.');
   assert.equal(board.meta, 'PNG · 312×240 px · RGB, 8-bit · 54 points');
   // One calibration takes one resolution: the board of another size goes before the demo.
+  await page.click('a[data-step=images]'); // a new session opens on step 1 (the target)
   await page.click('input[aria-label="use board.png in the calibration"]');
   await shot('after-trap');
   // The replaced workers decode, detect and solve as before: the demo,
@@ -235,8 +236,7 @@ export const tests = [
     const link = await page.inputValue('#share-link');
     const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#download-report')]);
     await dl.path();
-    await page.goto(link);
-    await page.reload(); // a new fragment alone does not reload the page
+    await page.goto(link); // a new share fragment in an open tab reloads the page on it
     await page.locator('#readonly-banner:not([hidden])').waitFor({ timeout: 30000 });
     await page.waitForTimeout(500);
     await shot('session-done');

@@ -71,7 +71,7 @@ export class FrameView {
     // World z up on screen: rotate about z (yaw), then tilt about the screen x axis (pitch).
     const x1 = cy * x - sy * y, y1 = sy * x + cy * y;
     const depth = cp * y1 + sp * z, up = -sp * y1 + cp * z;
-    const f = (Math.min(this.canvas.width, this.canvas.height) * 0.4 * this.zoom) / this.scale;
+    const f = (Math.min(this.canvas.width, this.canvas.height) * 0.5 * this.zoom) / this.scale;
     const persp = 1 / (1 + depth / (6 * this.scale));
     return [this.canvas.width / 2 + x1 * f * persp, this.canvas.height / 2 - up * f * persp, depth];
   }
@@ -107,6 +107,8 @@ export class FrameView {
         ctx.strokeStyle = '#999'; ctx.lineWidth = 1;
         ctx.beginPath(); ctx.moveTo(l.at[0], l.at[1]); ctx.lineTo(l.x + (l.x < l.at[0] ? l.w : 0), l.y - 4); ctx.stroke();
       }
+      ctx.fillStyle = 'rgba(250,250,250,0.85)';
+      ctx.fillRect(l.box.x0, l.box.y0, l.box.x1 - l.box.x0, l.box.y1 - l.box.y0);
       ctx.fillStyle = '#222';
       ctx.fillText(l.name, l.x, l.y);
     }

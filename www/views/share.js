@@ -55,7 +55,10 @@ export function sharedFragment() {
 /** Keys of a result that grow with the number of views or points: left out of a link. */
 const BULKY = new Set(['residuals_px', 'per_motion', 'distortion_field', 'camera_from_target', 'detections', 'per_view_reprojection_rms_px']);
 
-/** Significant digits of the numbers in a link (0.1 µm on a metre, 1e-4 px on 1000 px). */
+/** Keys of a result kept with every digit. */
+const EXACT = new Set(['camera', 'camera_matrix', 'distortion', 'rms_px', 'std']);
+
+/** Significant digits of the other numbers in a link (0.1 µm on a metre, 1e-4 px on 1000 px). */
 const LINK_DIGITS = 7;
 
 /**
@@ -73,7 +76,10 @@ export function compactResult(value, depth = 0) {
   const pose = 'translation_m' in value && 'quaternion_xyzw' in value;
   for (const [k, v] of Object.entries(value)) {
     if (BULKY.has(k) || k.endsWith('_samples') || (pose && depth > 1 && k === 'matrix_row_major')) continue;
-    out[k] = compactResult(v, depth + 1);
+    // The results themselves (camera, its matrix and coefficients, the
+    // transforms) keep every digit: the shared page shows and exports them.
+    const exact = depth === 0 && (EXACT.has(k) || (v && typeof v === 'object' && 'translation_m' in v));
+    out[k] = exact ? v : compactResult(v, depth + 1);
   }
   return out;
 }
