@@ -128,7 +128,12 @@ fn every_marker_decodes_in_every_rotation_with_the_documented_bit_errors() {
         let safe = (min_distance(d).saturating_sub(1)) / 2;
         let max = d.max_correction_bits().min(safe);
         if d != Dictionary::DICT_ARUCO_ORIGINAL {
-            assert_eq!(max, d.max_correction_bits(), "{} is not safe to its stated correction", d.name());
+            assert_eq!(
+                max,
+                d.max_correction_bits(),
+                "{} is not safe to its stated correction",
+                d.name()
+            );
         } else {
             assert_eq!(max, 0, "ARUCO_ORIGINAL's safe correction");
         }
@@ -147,7 +152,10 @@ fn every_marker_decodes_in_every_rotation_with_the_documented_bit_errors() {
                     }
                 }
                 let got = d.decode(read, d.max_correction_bits());
-                let what = format!("{} marker {id} turned {rotation} times with {max} bit errors", d.name());
+                let what = format!(
+                    "{} marker {id} turned {rotation} times with {max} bit errors",
+                    d.name()
+                );
                 let got = got.unwrap_or_else(|| panic!("{what}: not decoded"));
                 assert_eq!((got.id, got.bit_errors), (id, max), "{what}");
                 // A marker symmetric under a half turn (ARUCO_ORIGINAL's
