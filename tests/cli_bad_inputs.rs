@@ -125,7 +125,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "foo:9x6:30mm", "a.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: 'foo:9x6:30mm' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
+        message: "robocal: detect: target: 'foo:9x6:30mm' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
     },
     Case {
         name: "spec-missing-size",
@@ -133,7 +133,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "chessboard:9x6", "a.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: 'chessboard:9x6' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
+        message: "robocal: detect: target: 'chessboard:9x6' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
     },
     Case {
         name: "spec-unknown-option",

@@ -309,6 +309,9 @@ mod tests {
             "dots:7x7:25mm",
             "circle:10mm",
             "squares:8x8:12.7mm:22.5778mm",
+            "charuco:5x7:30mm:22mm:DICT_4X4_50",
+            "charuco:4x4:30mm:22mm:DICT_APRILTAG_16h5:legacy",
+            "aprilgrid:3x3:40mm:0.3",
         ];
         for case in 0..24 {
             let w = 16 + rng.below(120) as u32;

@@ -617,3 +617,7 @@ impl Print {
         marker_cell_dark(self.codes[k], bits, self.layout.border_bits, row, col)
     }
 }
+
+#[cfg(test)]
+#[path = "marker_board_tests.rs"]
+mod tests;

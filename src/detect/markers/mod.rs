@@ -8,7 +8,7 @@
 //! 2. Markers are grouped into boards by id: the board of the target's own
 //!    ids and, for [`detect_boards`], every other block of as many
 //!    consecutive ids (a second board printed with the next ids). Within a
-//!    board, markers that a homography through all of them places more
+//!    board, markers that the homography of their neighbours places more
 //!    than [`OUTLIER_FRACTION`] of their side away are dropped (a
 //!    duplicate id, a false decode, the other ChArUco layout).
 //! 3. Points, measured, never interpolated: each is seeded from the
@@ -45,6 +45,9 @@ pub const OUTLIER_FRACTION: f64 = 0.3;
 /// predictions differ by more than this fraction of the white margin
 /// around a marker (at least [`MIN_DISAGREE_PX`]).
 pub const DISAGREE_FRACTION: f64 = 0.5;
+/// Radius of a marker's neighbourhood for the consistency check, in
+/// marker pitches (1.5 marker sides).
+pub const NEIGHBOURHOOD_MARKERS: f64 = 3.0;
 /// Floor of the disagreement tolerance, pixels.
 pub const MIN_DISAGREE_PX: f64 = 1.5;
 /// Largest saddle-fit half-window, pixels (the chessboard detector's).
@@ -235,34 +238,56 @@ fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Det
     })
 }
 
-/// Drop the markers a homography through all of them misplaces, worst
-/// first, until every one fits.
+/// Drop the markers that their neighbours misplace, worst first, until
+/// every one fits: each marker is checked against the homography of the
+/// detected markers within [`NEIGHBOURHOOD_MARKERS`] marker pitches of it on
+/// the board (local, so lens distortion does not count against it); a
+/// marker with fewer than two such neighbours is checked against all the
+/// others.
 fn consistent_markers(layout: &MarkerLayout, mine: &mut Vec<(usize, &Marker)>) {
+    let board_centre = |k: usize| centre(&layout.markers[k].corners);
+    let pitch = layout
+        .markers
+        .first()
+        .map_or(1.0, |m| (m.corners[1] - m.corners[0]).norm())
+        * 1.5;
     loop {
         if mine.len() < 2 {
             return;
         }
-        let pairs: Vec<_> = mine
-            .iter()
-            .flat_map(|(k, m)| layout.markers[*k].corners.into_iter().zip(m.corners))
-            .collect();
-        let Some(h) = Homography::fit(&pairs) else {
-            mine.clear();
-            return;
-        };
-        let worst = mine
-            .iter()
-            .enumerate()
-            .map(|(i, (k, m))| {
-                let err = layout.markers[*k]
-                    .corners
-                    .iter()
-                    .zip(&m.corners)
-                    .map(|(b, p)| h.map(b).map_or(f64::INFINITY, |q| (q - p).norm()))
-                    .fold(0.0, f64::max);
-                (i, err / mean_side(&m.corners))
-            })
-            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let mut worst: Option<(usize, f64)> = None;
+        for (i, (k, m)) in mine.iter().enumerate() {
+            let near: Vec<&(usize, &Marker)> = mine
+                .iter()
+                .filter(|(j, _)| {
+                    *j != *k
+                        && (board_centre(*j) - board_centre(*k)).norm()
+                            <= NEIGHBOURHOOD_MARKERS * pitch
+                })
+                .collect();
+            let others: Vec<&(usize, &Marker)> = if near.len() >= 2 {
+                near
+            } else {
+                mine.iter().filter(|(j, _)| *j != *k).collect()
+            };
+            let pairs: Vec<_> = others
+                .iter()
+                .flat_map(|(j, o)| layout.markers[*j].corners.into_iter().zip(o.corners))
+                .collect();
+            let Some(h) = Homography::fit(&pairs) else {
+                continue;
+            };
+            let err = layout.markers[*k]
+                .corners
+                .iter()
+                .zip(&m.corners)
+                .map(|(b, p)| h.map(b).map_or(f64::INFINITY, |q| (q - p).norm()))
+                .fold(0.0, f64::max)
+                / mean_side(&m.corners);
+            if worst.map_or(true, |(_, e)| err > e) {
+                worst = Some((i, err));
+            }
+        }
         match worst {
             Some((i, e)) if e > OUTLIER_FRACTION => {
                 mine.remove(i);
