@@ -48,7 +48,7 @@
 //! `zhang1998_square_grid_found_and_calibrated`). Corners come with the
 //! covariance propagated from the residuals of their two line fits.
 
-use super::blobs::{bilinear_u8, Blob};
+use super::blobs::{bilinear_line, bilinear_u8, Blob};
 use super::circles::{blobs_at_level, search_grid, GridSearch};
 use super::filter::to_full;
 use super::DetectOptions;
@@ -70,11 +70,17 @@ const FIRST_PASS_SPACING_PX: f64 = 2.0;
 /// Profiles a side gets in the first pass at least (closer than
 /// `FIRST_PASS_SPACING_PX` on short sides).
 const MIN_FIRST_PASS_PROFILES: f64 = 16.0;
-/// Most edge measurement passes (the first with a wide search).
+/// Sample spacing along a profile in the coarse passes, pixels.
+const COARSE_PROFILE_STEP_PX: f64 = 0.5;
+/// The first passes, coarse: samples every `COARSE_PROFILE_STEP_PX`,
+/// profiles every `FIRST_PASS_SPACING_PX` (the first with a wide search).
+const COARSE_PASSES: usize = 2;
+/// Most edge measurement passes (coarse and fine).
 const PASSES: usize = 4;
-/// A refining pass that moves no corner by more than this ends the
-/// refinement, pixels.
-const CONVERGED_PX: f64 = 0.002;
+/// A fine pass that moves no corner by more than this ends the
+/// refinement, pixels (the fine passes agree to ~0.005 px, their
+/// sampling's jitter: a tighter bound only repeats the fine pass).
+const CONVERGED_PX: f64 = 0.05;
 /// Centroid window half-width in standard deviations of the edge's
 /// derivative (plus half a pixel): measured on the distorted renders of the
 /// tests, 2.5 gives the least noise without bias (2.0 biases the fixed
