@@ -17,18 +17,20 @@
 //! # Corners
 //!
 //! Each square's first corners come from its blob centre and the local
-//! lattice steps. Each side is then measured by profiles across it, every
-//! pixel along the side (every 2 px, at least 16 per side, in the first,
-//! wide pass; away from the corners, where the other side's edge would
-//! enter the profile): an edge point is the centroid of the profile's
-//! derivative (the image gradient along the normal) in a window moved onto
-//! it, so the threshold plays no part. A curve is fitted to each side's
-//! edge points, a corner is where the curves of its two sides meet, and
-//! the profiles are measured again across the refined sides (up to four
-//! passes, the first with a wide search; a pass that moves no corner by
-//! 0.002 px ends it). Profiles every half pixel (before issue 20) took
-//! twice the time for the same corners on the renders of the tests.
-//!
+//! lattice steps. Each side is then measured by profiles across it (away
+//! from the corners, where the other side's edge would enter the
+//! profile): an edge point is the centroid of the profile's derivative
+//! (the image gradient along the normal) in a window moved onto it, so the
+//! threshold plays no part. A curve is fitted to each side's edge points,
+//! a corner is where the curves of its two sides meet, and the profiles
+//! are measured again across the refined sides: two coarse passes
+//! (samples every 0.5 px, a profile every 2 px, at least 16 per side; the
+//! first with a wide search), then fine passes (samples every 0.25 px, a
+//! profile per pixel) until one moves no corner by more than 0.05 px
+//! (usually the first: fine passes agree to ~0.005 px), at most four
+//! passes in all. Only the fine passes decide the corners; the coarse ones
+//! bring the sides within the fine search (BENCHMARKS.md, "Square grids").
+
 //! The curve is a straight line over the whole side, chosen by numbers
 //! (test `side_models_compared_on_distorted_renders`: four 1280x960 views
 //! through Zhang's lens, k1 = -0.23, one filling the frame, two tilted
