@@ -101,6 +101,23 @@ fn time(
 }
 
 fn main() {
+    // `cargo bench --bench detect -- NAME [RUNS]`: only the cases whose
+    // name contains NAME, RUNS times each (for callgrind: RUNS = 1).
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let only = args.first().cloned().unwrap_or_default();
+    let runs_override: Option<usize> = args.get(1).and_then(|r| r.parse().ok());
+    let time = |name: &str,
+                img: &robocal::image::GrayImage,
+                spec: &str,
+                options: &DetectOptions,
+                runs: usize| {
+        if name.contains(only.as_str()) {
+            time(name, img, spec, options, runs_override.unwrap_or(runs));
+        }
+    };
     let default = DetectOptions::default();
     for (name, w, h, runs) in [
         ("chessboard VGA 640x480", 640, 480, 31),

@@ -437,6 +437,10 @@ export interface CalibrationOutput {
   comparison: ComparisonRow[] | null;
   /** With method `all`: why methods were left out of `comparison` (the DLT when every view is a flat board); absent when none was. */
   comparison_note?: string;
+  /** Circle grids and dot plates: the centre model of the views' detections (`ellipse_centre` for detections written before the key existed), or `mixed`; absent when no view is a circle or dot detection. */
+  centre_model?: CentreModel | 'mixed';
+  /** With `centre_model` `mixed`: the views of each model. */
+  centre_models?: { centre_model: CentreModel; views: string[] }[];
 }
 
 /** The input JSON of `calibrate_stereo`: `left[i]` and `right[i]` saw the same board pose. */

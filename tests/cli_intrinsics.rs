@@ -371,3 +371,50 @@ fn robust_option_says_how_many_points_it_rejected() {
         serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("report JSON");
     assert!(report.get("rejected").is_none());
 }
+
+#[test]
+fn circle_grid_detections_report_their_centre_model() {
+    // The chessboard scene's points as a symmetric 9x6 circle grid (the
+    // same board points), all with the default centre model.
+    let dir = temp_dir("intrinsics", "centre_model");
+    let (chess, _) = detections_file(&dir);
+    let text = std::fs::read_to_string(&chess).expect("read");
+    let mut doc: Value = serde_json::from_str(&text).expect("JSON");
+    let grid = json!({"kind": "circle_grid", "cols": 9, "rows": 6, "spacing_m": 0.03,
+                      "asymmetric": false, "polarity": "dark_on_light"});
+    doc["target"] = grid.clone();
+    for image in doc["images"].as_array_mut().expect("images") {
+        if let Some(d) = image.get_mut("detection") {
+            d["target"] = grid.clone();
+            d["centre_model"] = json!("perspective_pole");
+        }
+    }
+    let path = dir.join("circles.json");
+    std::fs::write(&path, doc.to_string()).expect("write");
+    let out = dir.join("camera.json");
+    let (code, _, stderr) = robocal(&[
+        "intrinsics",
+        "--detections",
+        path.to_str().expect("path"),
+        "-o",
+        out.to_str().expect("path"),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("robocal intrinsics: circle centres: perspective_pole\n"),
+        "{stderr}"
+    );
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("report JSON");
+    assert_eq!(report["centre_model"], "perspective_pole");
+    assert!(report.get("centre_models").is_none(), "{report}");
+    // The key does not disturb the readers of the report.
+    let (code, yaml, stderr) = robocal(&[
+        "export",
+        out.to_str().expect("path"),
+        "--format",
+        "opencv-yaml",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(yaml.contains("camera_matrix: !!opencv-matrix"), "{yaml}");
+}

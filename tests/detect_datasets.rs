@@ -162,8 +162,8 @@ fn zhang1998_square_grid_found_and_calibrated() {
     // different edge operator), so this is agreement, not error; the
     // largest difference (0.77 px, image2 at (390, 110)) lies in the
     // reflection that crosses that photo. The calibration from robocal's
-    // corners lands within 0.72 of its std of every published value (bound:
-    // 1 std; cy +0.72, the rest within 0.68) with RMS 0.364 px (Zhang's
+    // corners lands within 0.80 of its std of every published value (bound:
+    // 1 std; cy +0.80, the rest within 0.50) with RMS 0.3632 px (Zhang's
     // corners: 0.337 px). The side
     // model is also best here: parabolas per side give RMS 0.407 px,
     // half-side segments 0.385 px (src/detect/squares.rs).

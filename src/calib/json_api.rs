@@ -22,8 +22,12 @@
 //!
 //! Output: `{"report": <CameraCalibration>, "comparison": null | [rows]}`,
 //! the report of the chosen method (Zhang's for `all`) and, for `all`, one
-//! [`ComparisonRow`] per method.
+//! [`ComparisonRow`] per method; with circle-grid or dot-plate detections
+//! also `centre_model` (the views' circle-centre model, or `mixed` with
+//! `centre_models` listing the views of each; see
+//! [`super::centre_models`]).
 
+use super::centre_models::{centre_models, CentreModelViews};
 use super::compare::{calibrate_with, compare_methods, ComparisonRow, Method};
 use super::usable::{left_out_clause, usable_views, LeftOut};
 use super::{CalibrationOptions, CameraCalibration, View};
@@ -173,6 +177,15 @@ pub struct CalibrationOutput {
     /// DLT on flat boards), said once; absent when none was.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub comparison_note: Option<String>,
+    /// Circle grids and dot plates: the centre model of the views'
+    /// detections (`perspective_pole`, `local_quadratic`, `ellipse_centre`
+    /// for files written before detections said it), or `mixed` when the
+    /// views differ; absent when no view is a circle or dot detection.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre_model: Option<String>,
+    /// With `centre_model` `mixed`: the views of each model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre_models: Option<Vec<CentreModelViews>>,
 }
 
 /// Calibrate from the JSON input described in the module docs; returns the
@@ -220,8 +233,9 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
         ));
     }
     let size = image_size(input)?;
-    // 2. The options.
+    // 2. The options, and the circle-centre model the views were detected with.
     let options = calibration_options(&input.model, &input.options)?;
+    let (centre_model, models) = centre_models(&input.views);
     // 3. The method(s).
     if input.method == "all" {
         let outcomes = compare_methods(&views, size, &options);
@@ -242,6 +256,8 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
             report,
             comparison: Some(comparison),
             comparison_note: super::compare::left_out(&views),
+            centre_model,
+            centre_models: models,
         });
     }
     let method = Method::from_name(&input.method)?;
@@ -255,6 +271,8 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
         report,
         comparison: None,
         comparison_note: None,
+        centre_model,
+        centre_models: models,
     })
 }
 

@@ -4,7 +4,7 @@
 use super::json_api::{calibrate_json, MAX_POINTS, MAX_VIEWS};
 use crate::camera::Camera;
 use crate::synth::Scene;
-use crate::target::{DetectedPoint, Detection, Target};
+use crate::target::{CentreModel, DetectedPoint, Detection, Polarity, Target};
 use serde_json::{json, Value};
 use wasm_bindgen_test::wasm_bindgen_test;
 
@@ -317,4 +317,77 @@ fn too_many_views_or_points_are_refused_with_the_subset_to_keep() {
             n * per_view
         )
     );
+}
+
+/// The scene's views as circle-grid detections (a symmetric 9 x 6 grid has
+/// the chessboard's points), each with its centre model.
+fn circle_views(s: &Scene, model_of_view: &dyn Fn(usize) -> Option<CentreModel>) -> Vec<Value> {
+    let target = Target::CircleGrid {
+        cols: 9,
+        rows: 6,
+        spacing_m: 0.03,
+        asymmetric: false,
+        polarity: Polarity::DarkOnLight,
+    };
+    s.views
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let points = v
+                .image_px
+                .iter()
+                .enumerate()
+                .map(|(id, p)| DetectedPoint {
+                    id,
+                    x_px: p.x,
+                    y_px: p.y,
+                    covariance_px2: None,
+                })
+                .collect();
+            let detection = Detection {
+                image_size_px: [1280, 960],
+                target: target.clone(),
+                points,
+                centre_model: model_of_view(k),
+            };
+            json!({"name": v.name, "detection": detection})
+        })
+        .collect()
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_output_says_which_circle_centre_model_the_views_used() {
+    let s = scene(0.0);
+    // One model: named, no per-model list; the calibration is the scene's.
+    let out = run(json!({"views": circle_views(&s, &|_| Some(CentreModel::PerspectivePole))}));
+    assert_eq!(out["centre_model"], "perspective_pole");
+    assert!(out.get("centre_models").is_none(), "{out}");
+    let fx = out["report"]["camera_matrix"][0][0].as_f64().expect("fx");
+    assert!((fx - 1000.0).abs() < 1e-6, "fx {fx} px");
+    // Two views from files without the key (ellipse centres): mixed, with
+    // the views of each model, for method all too.
+    let views = circle_views(&s, &|k| (k >= 2).then_some(CentreModel::PerspectivePole));
+    for method in ["zhang", "all"] {
+        let out = run(json!({"views": views, "method": method}));
+        assert_eq!(out["centre_model"], "mixed", "{method}");
+        let names = |k: usize| -> Vec<Value> {
+            s.views
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| (*i >= 2) == (k == 0))
+                .map(|(_, v)| json!(v.name))
+                .collect()
+        };
+        assert_eq!(
+            out["centre_models"],
+            json!([
+                {"centre_model": "ellipse_centre", "views": names(1)},
+                {"centre_model": "perspective_pole", "views": names(0)},
+            ]),
+            "{method}"
+        );
+    }
+    // No circle or dot detection: no key.
+    let out = run(json!({"views": point_views(&s), "image_size_px": [1280, 960]}));
+    assert!(out.get("centre_model").is_none(), "{out}");
 }

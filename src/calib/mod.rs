@@ -11,6 +11,7 @@
 //! - [`dlt_kalman`]: the recursive Kalman-filter estimate of the same
 //!   12 parameters, with the measurement noise from repeated observations.
 
+pub mod centre_models;
 mod closed_form;
 pub mod compare;
 pub mod dlt;

@@ -158,8 +158,25 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
     for w in &r.warnings {
         eprintln!("robocal intrinsics: warning: {w}");
     }
-    let text = serde_json::to_string_pretty(&output.report)
-        .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
+    // The report, with the circle-centre model of circle and dot views
+    // beside its keys (`centre_model`, and `centre_models` when mixed).
+    let serialise =
+        |e: serde_json::Error| CliError::Io(format!("cannot serialise the report: {e}"));
+    let mut value = serde_json::to_value(&output.report).map_err(serialise)?;
+    if let (Some(model), Some(obj)) = (&output.centre_model, value.as_object_mut()) {
+        eprintln!("robocal intrinsics: circle centres: {model}");
+        obj.insert(
+            "centre_model".into(),
+            serde_json::Value::from(model.as_str()),
+        );
+        if let Some(groups) = &output.centre_models {
+            obj.insert(
+                "centre_models".into(),
+                serde_json::to_value(groups).map_err(serialise)?,
+            );
+        }
+    }
+    let text = serde_json::to_string_pretty(&value).map_err(serialise)?;
     write_output(args.output.as_deref(), &(text + "\n"))
 }
 

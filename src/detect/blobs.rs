@@ -33,39 +33,51 @@ pub(crate) struct Blob {
 /// Dark blobs of `plane` (set `invert` for light blobs), larger first.
 pub(crate) fn find_blobs(plane: &Plane, invert: bool) -> Vec<Blob> {
     let (w, h) = (plane.w, plane.h);
-    let val = |i: usize| {
-        if invert {
-            255.0 - plane.data[i]
-        } else {
-            plane.data[i]
-        }
+    // Values once, inverted for light blobs.
+    let inverted: Vec<f32>;
+    let vals: &[f32] = if invert {
+        inverted = plane.data.iter().map(|v| 255.0 - v).collect();
+        &inverted
+    } else {
+        &plane.data
     };
     // Integral image for the local mean.
     let mut integral = vec![0.0f64; (w + 1) * (h + 1)];
     let mut hist = [0usize; 256];
     for y in 0..h {
         let mut row = 0.0;
-        for x in 0..w {
-            let v = val(y * w + x);
+        let (above, here) = integral.split_at_mut((y + 1) * (w + 1));
+        let above = &above[y * (w + 1)..];
+        for (x, &v) in vals[y * w..(y + 1) * w].iter().enumerate() {
             hist[v.clamp(0.0, 255.0) as usize] += 1;
             row += v as f64;
-            integral[(y + 1) * (w + 1) + x + 1] = integral[y * (w + 1) + x + 1] + row;
+            here[x + 1] = above[x + 1] + row;
         }
     }
     let p5 = percentile(&hist, w * h, 0.05);
     let r = (w.min(h) / 16).max(8);
+    // Each column's window, once.
+    let cols: Vec<(usize, usize, f64)> = (0..w)
+        .map(|x| {
+            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
+            (x0, x1, (x1 - x0) as f64)
+        })
+        .collect();
     let mut mask = vec![false; w * h];
     for y in 0..h {
         let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
-        for x in 0..w {
-            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
-            let s = integral[y1 * (w + 1) + x1]
-                - integral[y0 * (w + 1) + x1]
-                - integral[y1 * (w + 1) + x0]
-                + integral[y0 * (w + 1) + x0];
-            let mean = s / ((y1 - y0) * (x1 - x0)) as f64;
-            let thr = mean - (0.25 * (mean - p5)).max(8.0);
-            mask[y * w + x] = (val(y * w + x) as f64) < thr;
+        let top = &integral[y0 * (w + 1)..(y0 + 1) * (w + 1)];
+        let bottom = &integral[y1 * (w + 1)..(y1 + 1) * (w + 1)];
+        let rows = (y1 - y0) as f64;
+        let row_vals = &vals[y * w..(y + 1) * w];
+        let row_mask = &mut mask[y * w..(y + 1) * w];
+        for ((m, &v), &(x0, x1, width)) in row_mask.iter_mut().zip(row_vals).zip(&cols) {
+            let s = bottom[x1] - top[x1] - bottom[x0] + top[x0];
+            // v < mean - max((mean - p5) / 4, 8), times the window's area
+            // (no division per pixel).
+            let area = rows * width;
+            let drop = (0.25 * (s - p5 * area)).max(8.0 * area);
+            *m = (v as f64) * area < s - drop;
         }
     }
     components(&mask, w, h)
@@ -129,6 +141,11 @@ fn components(mask: &[bool], w: usize, h: usize) -> Vec<Blob> {
             };
         }
     }
+    // Every label straight to its root: a parent is always a smaller
+    // label, so in increasing order each parent is already resolved.
+    for l in 1..parent.len() {
+        parent[l] = parent[parent[l] as usize];
+    }
     let mut moments = vec![Moments::default(); parent.len()];
     for y in 0..h {
         for x in 0..w {
@@ -136,7 +153,7 @@ fn components(mask: &[bool], w: usize, h: usize) -> Vec<Blob> {
             if l == 0 {
                 continue;
             }
-            let root = find(&mut parent, l) as usize;
+            let root = parent[l as usize] as usize;
             let m = &mut moments[root];
             let (fx, fy) = (x as f64, y as f64);
             m.n += 1.0;
@@ -307,6 +324,67 @@ pub(crate) fn bilinear_u8(img: &GrayImage, x: f64, y: f64) -> f64 {
     }
     (get(xi, yi) * (1.0 - fx) + get(xi + 1, yi) * fx) * (1.0 - fy)
         + (get(xi, yi + 1) * (1.0 - fx) + get(xi + 1, yi + 1) * fx) * fy
+}
+
+/// Fraction bits of [`bilinear_line`]'s fixed-point positions.
+const FIXED_BITS: u32 = 20;
+
+/// Bilinear samples of `img` at `base + n * (s0 + k * step)`, `k < count`,
+/// into `out` (cleared first): the values of [`bilinear_u8`] at each point
+/// (to 1e-4 px in position), without its per-sample floor and clamping
+/// when the whole line lies inside the image (the points are monotone in
+/// `k`, so the two ends decide).
+pub(crate) fn bilinear_line(
+    img: &GrayImage,
+    base: Point2<f64>,
+    n: Vector2<f64>,
+    (s0, step): (f64, f64),
+    count: usize,
+    out: &mut Vec<f64>,
+) {
+    out.clear();
+    if count == 0 {
+        return;
+    }
+    let at = |k: usize| base + n * (s0 + k as f64 * step);
+    let (w, h) = (img.width as f64, img.height as f64);
+    // floor(x) >= 0 and floor(x) + 1 < w, as in `bilinear_u8`'s inside test.
+    let inside = |p: Point2<f64>| p.x >= 0.0 && p.y >= 0.0 && p.x < w - 1.0 && p.y < h - 1.0;
+    if !(inside(at(0)) && inside(at(count - 1))) {
+        out.extend((0..count).map(|k| {
+            let p = at(k);
+            bilinear_u8(img, p.x, p.y)
+        }));
+        return;
+    }
+    // Fixed point (1/2^20 px) stepping: the positions drift by at most
+    // count * 2^-21 px (1e-4 px over 200 samples), far below the noise.
+    const ONE: f64 = (1u64 << FIXED_BITS) as f64;
+    let p0 = at(0);
+    let (mut fx_x, mut fx_y) = ((p0.x * ONE) as i64, (p0.y * ONE) as i64);
+    let (dx, dy) = (
+        (n.x * step * ONE).round() as i64,
+        (n.y * step * ONE).round() as i64,
+    );
+    let stride = img.width as usize;
+    let px = &img.pixels[..];
+    let last = (img.width as usize) * (img.height as usize) - 1;
+    let mask = (1i64 << FIXED_BITS) - 1;
+    for _ in 0..count {
+        // Never below 0 (the drift can carry an end at 0 just under it).
+        let (qx, qy) = (fx_x.max(0), fx_y.max(0));
+        let (xi, yi) = ((qx >> FIXED_BITS) as usize, (qy >> FIXED_BITS) as usize);
+        let fx = (qx & mask) as f64 * (1.0 / ONE);
+        let fy = (qy & mask) as f64 * (1.0 / ONE);
+        // The rounding of the step can carry the last sample just past
+        // the last column or row: clamp the index instead of panicking.
+        let i = (yi * stride + xi).min(last.saturating_sub(stride + 1));
+        let (a, b) = (px[i] as f64, px[i + 1] as f64);
+        let (c, d) = (px[i + stride] as f64, px[i + stride + 1] as f64);
+        out.push((a * (1.0 - fx) + b * fx) * (1.0 - fy) + (c * (1.0 - fx) + d * fx) * fy);
+        fx_x += dx;
+        fx_y += dy;
+    }
 }
 
 #[cfg(test)]

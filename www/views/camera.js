@@ -60,7 +60,7 @@ export class CameraView {
     store.onChange((what) => {
       if (what !== 'target' || !this.state.result) return;
       this.state.stale = 'The target changed after this result was solved: the images are being detected again with the new target; solve again to update the result.';
-      this.show(this.state.result, this.state.comparison, this.state.comparisonNote);
+      this.show(this.state.result, this.state.comparison, this.state.comparisonNote, this.state.centre);
     });
   }
 
@@ -87,7 +87,7 @@ export class CameraView {
     if (this.readonly) fill($('camera-panel'), this.out);
     else fill($('camera-panel'), form, this.out);
     this.summarise();
-    if (st.result) this.show(st.result, st.comparison, st.comparisonNote);
+    if (st.result) this.show(st.result, st.comparison, st.comparisonNote, st.centre);
   }
 
   readForm(form) {
@@ -127,14 +127,16 @@ export class CameraView {
       st.comparison = result.comparison || null;
       st.comparisonNote = result.comparison_note || null; // e.g. why the DLT was left out
       st.stale = null;
+      // Circle grids and dot plates: the views' circle-centre model ('mixed' with the views of each).
+      st.centre = result.centre_model ? { model: result.centre_model, groups: result.centre_models || [] } : null;
       this.store.changed('camera-result');
-      this.show(st.result, st.comparison, st.comparisonNote);
+      this.show(st.result, st.comparison, st.comparisonNote, st.centre);
     } catch (err) {
       fill(this.out, message('error', err.message));
     }
   }
 
-  show(r, comparison, comparisonNote) {
+  show(r, comparison, comparisonNote, centre) {
     const names = ['fx', 'fy', 'cx', 'cy', 'skew', ...Object.keys(r.distortion || {})];
     const k = r.camera_matrix.flat();
     const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
@@ -180,6 +182,9 @@ export class CameraView {
     fill(this.out,
       this.state.stale && !this.readonly ? message('warning', this.state.stale) : null,
       h('h3', {}, `Result: RMS ${num(r.rms_px, 4)} px over ${(r.views || []).length} views`),
+      centre ? h('p', { class: 'hint', id: 'centre-model' }, centre.model === 'mixed'
+        ? `Circle centres: mixed models (${centre.groups.map((g) => `${g.centre_model}: ${g.views.length} views`).join(', ')}): detect every image with the same centre model.`
+        : `Circle centres: ${centre.model}.`) : null,
       warnings,
       r.rejected ? this.rejectedNote(r) : null,
       h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat, picked)),

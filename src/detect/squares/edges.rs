@@ -91,6 +91,13 @@ pub(super) fn refine_square(
         } else {
             1.0
         };
+        // Coarse passes only bring the sides near; the fine ones measure.
+        let fine = pass >= COARSE_PASSES;
+        let sample_step = if fine {
+            PROFILE_STEP_PX
+        } else {
+            COARSE_PROFILE_STEP_PX
+        };
         let mut fitted: Vec<[Curve; 2]> = Vec::with_capacity(4);
         let mut widths = Vec::new();
         for k in 0..4 {
@@ -134,19 +141,20 @@ pub(super) fn refine_square(
                     }
                     None => m + t * u,
                 };
+                let window = (search, half_window, sample_step);
                 if let Some((s, width)) =
-                    edge_on_profile(img, base, nrm, search, half_window, inside, &mut scratch)
+                    edge_on_profile(img, base, nrm, window, inside, &mut scratch)
                 {
                     let e = base + nrm * s;
                     let d = e - m;
                     edge_pts.push((d.dot(&t), d.dot(&nrm)));
                     widths.push(width);
                 }
-                u += if pass == 0 {
+                u += if fine {
+                    PROFILE_SPACING_PX
+                } else {
                     // At least MIN_FIRST_PASS_PROFILES profiles per side.
                     (len / MIN_FIRST_PASS_PROFILES).clamp(PROFILE_SPACING_PX, FIRST_PASS_SPACING_PX)
-                } else {
-                    PROFILE_SPACING_PX
                 };
             }
             let span = (-0.5 * len + e0, 0.5 * len - e1);
@@ -176,7 +184,7 @@ pub(super) fn refine_square(
             .map(|(a, b)| (a.0 - b.0).norm())
             .fold(0.0, f64::max);
         corners = next;
-        if pass > 0 && moved <= CONVERGED_PX {
+        if fine && moved <= CONVERGED_PX {
             break;
         }
         // The next pass's profiles follow each side's first curve (the two
@@ -278,81 +286,88 @@ fn fit_poly(
     Some(Curve { m, t, n, c, cov })
 }
 
+/// A profile's samples, reused from profile to profile (no allocation per
+/// profile).
+#[derive(Default)]
+pub(super) struct Profile {
+    vals: Vec<f64>,
+    /// Running sums of the derivative `d`, `d s` and `d s^2` over the
+    /// samples before k (k + 1 entries): a window's centroid in O(1).
+    sums: Vec<[f64; 3]>,
+}
+
 /// Edge on the profile `base + s n`, `|s| <= search`: the strongest rise of
 /// the grey level (dark inside to light outside), then the centroid of the
 /// derivative in a window of half-width `half_window` moved onto it.
 /// Returns the offset `s` and the edge's blur (the derivative's sd).
-/// A profile's samples and derivative, reused from profile to profile (no
-/// allocation per profile).
-#[derive(Default)]
-pub(super) struct Profile {
-    vals: Vec<f64>,
-    deriv: Vec<f64>,
-}
-
 fn edge_on_profile(
     img: &GrayImage,
     base: Point2<f64>,
     n: Vector2<f64>,
-    search: f64,
-    half_window: f64,
+    (search, half_window, step): (f64, f64, f64),
     inside: f64,
     scratch: &mut Profile,
 ) -> Option<(f64, f64)> {
     let reach = search + half_window + 0.5;
-    let count = (2.0 * reach / PROFILE_STEP_PX).ceil() as usize + 1;
+    let count = (2.0 * reach / step).ceil() as usize + 1;
     let s0 = -reach;
-    let at = |k: usize| s0 + k as f64 * PROFILE_STEP_PX;
-    let Profile { vals, deriv } = scratch;
-    vals.clear();
-    vals.extend((0..count).map(|k| {
-        let p = base + n * at(k);
-        bilinear_u8(img, p.x, p.y)
-    }));
+    let at = |k: usize| s0 + k as f64 * step;
+    // Samples half a pixel either side of the derivative's sample.
+    let half = (0.5 / step).round() as usize;
+    bilinear_line(img, base, n, (s0, step), count, &mut scratch.vals);
+    let vals = &scratch.vals[..];
     // Derivative over one pixel (the samples half a pixel either side),
-    // at sample k.
-    let half = (0.5 / PROFILE_STEP_PX).round() as usize;
-    deriv.clear();
-    deriv.extend((0..count).map(|k| {
+    // at sample k; zero where a side is missing.
+    let deriv = |k: usize| {
         if k < half || k + half >= count {
             0.0
         } else {
             vals[k + half] - vals[k - half]
         }
-    }));
-    let (vals, deriv) = (&vals[..], &deriv[..]);
+    };
+    // The samples with |s| <= search: a run around s = 0 (tested exactly,
+    // from one sample before the run's estimated start).
+    let first_in = (((-search - s0) / step).floor() - 1.0).max(0.0) as usize;
     let mut best: Option<(usize, f64)> = None;
-    for (k, d) in deriv.iter().enumerate() {
-        if at(k).abs() <= search && best.map_or(true, |b| *d > b.1) {
-            best = Some((k, *d));
+    for k in first_in..count {
+        let s = at(k);
+        if s > search {
+            break;
+        }
+        let d = deriv(k);
+        if s.abs() <= search && best.map_or(true, |b| d > b.1) {
+            best = Some((k, d));
         }
     }
     let (kb, peak) = best?;
     // The rise must be a real edge: at least a fifth of the contrast
     // between the square's inside and the light just outside this edge.
-    let outside =
-        vals[count - 1].max(vals[(kb + (1.0 / PROFILE_STEP_PX) as usize * 2).min(count - 1)]);
+    let outside = vals[count - 1].max(vals[(kb + 4 * half).min(count - 1)]);
     let contrast = outside - inside;
     if !(contrast > 10.0) || peak < 0.2 * contrast {
         return None;
     }
+    let sums = &mut scratch.sums;
+    sums.clear();
+    sums.push([0.0; 3]);
+    let mut acc = [0.0f64; 3];
+    for k in 0..count {
+        let (d, s) = (deriv(k), at(k));
+        acc = [acc[0] + d, acc[1] + d * s, acc[2] + d * s * s];
+        sums.push(acc);
+    }
     let mut centre = at(kb);
     let mut width = 0.0;
     for _ in 0..4 {
-        let (mut sw, mut sws, mut swss) = (0.0, 0.0, 0.0);
-        // Only the samples near the window (one spare either side; the
-        // test below decides, exactly as over the whole profile).
-        let first = ((centre - half_window - s0) / PROFILE_STEP_PX - 1.0).max(0.0) as usize;
-        let last =
-            (((centre + half_window - s0) / PROFILE_STEP_PX + 2.0).max(0.0) as usize).min(count);
-        for (k, d) in deriv.iter().enumerate().take(last).skip(first) {
-            let s = at(k);
-            if (s - centre).abs() <= half_window {
-                sw += d;
-                sws += d * s;
-                swss += d * s * s;
-            }
+        // The samples with |s - centre| <= half_window: indices lo..hi.
+        let lo = ((centre - half_window - s0) / step).ceil().max(0.0) as usize;
+        let hi = (((centre + half_window - s0) / step).floor() + 1.0).max(0.0) as usize;
+        let hi = hi.min(count);
+        if lo >= hi {
+            return None;
         }
+        let (a, b) = (sums[lo], sums[hi]);
+        let (sw, sws, swss) = (b[0] - a[0], b[1] - a[1], b[2] - a[2]);
         if !(sw > 0.0) {
             return None;
         }

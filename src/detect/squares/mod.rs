@@ -17,18 +17,20 @@
 //! # Corners
 //!
 //! Each square's first corners come from its blob centre and the local
-//! lattice steps. Each side is then measured by profiles across it, every
-//! pixel along the side (every 2 px, at least 16 per side, in the first,
-//! wide pass; away from the corners, where the other side's edge would
-//! enter the profile): an edge point is the centroid of the profile's
-//! derivative (the image gradient along the normal) in a window moved onto
-//! it, so the threshold plays no part. A curve is fitted to each side's
-//! edge points, a corner is where the curves of its two sides meet, and
-//! the profiles are measured again across the refined sides (up to four
-//! passes, the first with a wide search; a pass that moves no corner by
-//! 0.002 px ends it). Profiles every half pixel (before issue 20) took
-//! twice the time for the same corners on the renders of the tests.
-//!
+//! lattice steps. Each side is then measured by profiles across it (away
+//! from the corners, where the other side's edge would enter the
+//! profile): an edge point is the centroid of the profile's derivative
+//! (the image gradient along the normal) in a window moved onto it, so the
+//! threshold plays no part. A curve is fitted to each side's edge points,
+//! a corner is where the curves of its two sides meet, and the profiles
+//! are measured again across the refined sides: two coarse passes
+//! (samples every 0.5 px, a profile every 2 px, at least 16 per side; the
+//! first with a wide search), then fine passes (samples every 0.25 px, a
+//! profile per pixel) until one moves no corner by more than 0.05 px
+//! (usually the first: fine passes agree to ~0.005 px), at most four
+//! passes in all. Only the fine passes decide the corners; the coarse ones
+//! bring the sides within the fine search (BENCHMARKS.md, "Square grids").
+
 //! The curve is a straight line over the whole side, chosen by numbers
 //! (test `side_models_compared_on_distorted_renders`: four 1280x960 views
 //! through Zhang's lens, k1 = -0.23, one filling the frame, two tilted
@@ -48,7 +50,7 @@
 //! `zhang1998_square_grid_found_and_calibrated`). Corners come with the
 //! covariance propagated from the residuals of their two line fits.
 
-use super::blobs::{bilinear_u8, Blob};
+use super::blobs::{bilinear_line, bilinear_u8, Blob};
 use super::circles::{blobs_at_level, search_grid, GridSearch};
 use super::filter::to_full;
 use super::DetectOptions;
@@ -70,11 +72,17 @@ const FIRST_PASS_SPACING_PX: f64 = 2.0;
 /// Profiles a side gets in the first pass at least (closer than
 /// `FIRST_PASS_SPACING_PX` on short sides).
 const MIN_FIRST_PASS_PROFILES: f64 = 16.0;
-/// Most edge measurement passes (the first with a wide search).
+/// Sample spacing along a profile in the coarse passes, pixels.
+const COARSE_PROFILE_STEP_PX: f64 = 0.5;
+/// The first passes, coarse: samples every `COARSE_PROFILE_STEP_PX`,
+/// profiles every `FIRST_PASS_SPACING_PX` (the first with a wide search).
+const COARSE_PASSES: usize = 2;
+/// Most edge measurement passes (coarse and fine).
 const PASSES: usize = 4;
-/// A refining pass that moves no corner by more than this ends the
-/// refinement, pixels.
-const CONVERGED_PX: f64 = 0.002;
+/// A fine pass that moves no corner by more than this ends the
+/// refinement, pixels (the fine passes agree to ~0.005 px, their
+/// sampling's jitter: a tighter bound only repeats the fine pass).
+const CONVERGED_PX: f64 = 0.05;
 /// Centroid window half-width in standard deviations of the edge's
 /// derivative (plus half a pixel): measured on the distorted renders of the
 /// tests, 2.5 gives the least noise without bias (2.0 biases the fixed
