@@ -29,7 +29,11 @@ fn model_of(view: &JsonView) -> Option<CentreModel> {
         Target::CircleGrid { .. } | Target::DotPlate { .. } => {
             Some(d.centre_model.unwrap_or(CentreModel::EllipseCentre))
         }
-        Target::Chessboard { .. } | Target::SingleCircle { .. } | Target::SquareGrid { .. } => None,
+        Target::Chessboard { .. }
+        | Target::SingleCircle { .. }
+        | Target::SquareGrid { .. }
+        | Target::Charuco { .. }
+        | Target::Aprilgrid { .. } => None,
     }
 }
 
