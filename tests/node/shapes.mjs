@@ -235,6 +235,9 @@ const targets = [
   { kind: 'dot_plate', cols: 7, rows: 7, pitch_m: 0.025, dot_diameter_m: 0.0125 },
   { kind: 'single_circle', diameter_m: 0.01 },
   { kind: 'square_grid', cols: 8, rows: 8, side_m: 0.0127, pitch_m: 0.0225778 },
+  { kind: 'charuco', squares_x: 8, squares_y: 6, square_m: 0.03, marker_m: 0.022, dictionary: 'DICT_5X5_100', first_id: 4, legacy: true },
+  { kind: 'charuco', squares_x: 3, squares_y: 3, square_m: 0.02, marker_m: 0.015, dictionary: 'DICT_ARUCO_ORIGINAL', marker_ids: [7, 8, 9, 10] },
+  { kind: 'aprilgrid', tag_cols: 6, tag_rows: 6, tag_m: 0.088, spacing_ratio: 0.3, first_id: 36 },
 ];
 for (const t of targets) {
   const parsed = call('parse_target', t, `parse_target ${t.kind}`);
