@@ -1269,6 +1269,8 @@ export interface RobocalJson {
   render_demo: [never, DemoIndex];
   /** `parse_target(spec or JSON.stringify(target))` -> the target, checked by the core. */
   parse_target: [Target, Target];
+  /** `read_kalibr_target(yamlText)` -> the target of a Kalibr target YAML (`target_type: aprilgrid` or `checkerboard`). */
+  read_kalibr_target: [never, Target];
   /** `target_points(spec or target JSON)` -> the board points in id order, metres. */
   target_points: [Target, TargetPoint[]];
   /** `target_svg(spec or target JSON)` returns the printable sheet (SVG text, mm at true scale), not JSON. */

@@ -244,6 +244,16 @@ pub fn parse_target(spec_or_json: &str) -> Result<String, JsError> {
     serde_json::to_string(&target).map_err(|e| JsError::new(&e.to_string()))
 }
 
+/// A Kalibr calibration-target YAML (`target_type: aprilgrid` with
+/// `tagCols`, `tagRows`, `tagSize`, `tagSpacing`, or `target_type:
+/// checkerboard`) as the target JSON ([`parse_target`]'s output), or the
+/// reader's error naming the line or key.
+#[wasm_bindgen]
+pub fn read_kalibr_target(yaml: &str) -> Result<String, JsError> {
+    let target = crate::io::parse_kalibr_target(yaml).map_err(js_error)?;
+    serde_json::to_string(&target).map_err(|e| JsError::new(&e.to_string()))
+}
+
 /// The canonical CLI spec of a target (spec or JSON): what
 /// `robocal detect --target` takes, e.g. `chessboard:9x6:30mm`.
 #[wasm_bindgen]

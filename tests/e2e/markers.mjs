@@ -15,6 +15,7 @@ import { root } from './harness.mjs';
 const CLI = join(root, 'target/release/robocal');
 const SPEC = 'charuco:8x6:30mm:22mm:DICT_5X5_100';
 const CORNERS = 7 * 5;
+const KALIBR_MISSING = "broken.yaml: Kalibr target: missing key 'tagSize'";
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 
 /** `robocal render --target SPEC --views 8 --noise 2` (seeded): the PNGs and truth.json. */
@@ -127,6 +128,16 @@ export const tests = [
     const [grid] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
     assert.match(readFileSync(await grid.path(), 'utf8'), /robocal target aprilgrid:6x6:88mm:0.3:first=36/);
     await shot('aprilgrid-target');
+
+    // Kalibr's own target file (its april_6x6.yaml template) fills the form.
+    const yaml = (name, text) => ({ name, mimeType: 'text/yaml', buffer: Buffer.from(text) });
+    await page.setInputFiles('#kalibr-input', yaml('april_6x6.yaml', "target_type: 'aprilgrid' #gridtype\ntagCols: 6               #number of apriltags\ntagRows: 5\ntagSize: 0.088           #size of apriltag, edge to edge [m]\ntagSpacing: 0.3          #ratio of space between tags to tagSize\n"));
+    await specShown(/^Target spec: aprilgrid:6x5:88mm:0.3 /);
+    assert.deepEqual(await page.$eval('#target-form', (f) => [f.elements.kind.value, f.elements.tag_cols.value, f.elements.tag_rows.value, f.elements.tag_mm.value, f.elements.spacing_ratio.value, f.elements.first_id.value]),
+      ['aprilgrid', '6', '5', '88', '0.3', '0']);
+    await page.setInputFiles('#kalibr-input', yaml('broken.yaml', "target_type: 'aprilgrid'\ntagCols: 6\ntagRows: 6\ntagSpacing: 0.3\n"));
+    await page.waitForFunction(() => /^broken.yaml: /.test(document.getElementById('target-error').textContent));
+    assert.equal(await page.textContent('#target-error'), KALIBR_MISSING);
   }],
 
   ['ChArUco images: cards with corner counts and ids, a partial view accepted, the camera on the render\'s truth', async (page, { url, shot }) => {

@@ -231,6 +231,25 @@ export function initTarget(store, engine) {
     if (!sheet) return;
     download(`robocal-target-${sheet.spec.replace(/[:]/g, '_')}.svg`, sheet.svg, 'image/svg+xml');
   });
+  // Kalibr's target YAML (aprilgrid or checkerboard): read by the core into
+  // the form, then used as if typed.
+  $('kalibr-target').addEventListener('click', () => $('kalibr-input').click());
+  $('kalibr-input').addEventListener('change', async (e) => {
+    const [file] = e.target.files;
+    e.target.value = '';
+    if (!file) return;
+    asked++;
+    let target;
+    try {
+      target = await engine.call('kalibrTarget', { text: await file.text() });
+    } catch (err) {
+      refuse(`${file.name}: ${err.message}`);
+      return;
+    }
+    writeForm(form, target);
+    showFields(form);
+    show(JSON.stringify(target), true);
+  });
   const fromSession = () => show(targetSpec(store.session.target), false);
   store.onChange((what) => { if (what === 'all' || what === 'target-loaded') fromSession(); });
   return fromSession();
