@@ -293,7 +293,12 @@ pub fn target_svg(spec_or_json: &str) -> Result<String, JsError> {
 
 /// Detect a calibration target in image bytes. `target_spec_or_json` is a
 /// CLI spec (see [`parse_target`]) or a target JSON object. Returns the
-/// Detection JSON (see `docs/detection-json.md`).
+/// Detection JSON (see `docs/detection-json.md`). ChArUco boards and
+/// AprilGrids give the corners seen (any subset) of the board whose
+/// markers carry the target's ids; another board in the same image (its
+/// own block of ids, `detect::detect_all`) is found by asking again with
+/// its `first_id`: one target, one detection, as the page's cards and the
+/// solvers' views take them.
 #[wasm_bindgen]
 pub fn detect_target(
     bytes: &[u8],
