@@ -46,7 +46,7 @@ test-native:
 test-wasm: setup
 	CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner cargo test --lib --target $(WASM_TARGET)
 
-test-node: pkg
+test-node: pkg cli
 	tools/setup.sh node
 	node tests/node/smoke.mjs
 

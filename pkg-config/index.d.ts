@@ -131,7 +131,45 @@ export interface TargetKinds {
   single_circle: { /** Circle diameter, metres. */ diameter_m: number };
   /** `cols x rows` separate dark squares (Zhang's 1998 target), 4 corners each: id = `4 (i + j * cols) + k`; square `(i, j)` spans `(i, j) * pitch_m` to that `+ side_m`, corner k = 0 (x0, y0), 1 (x0 + side, y0), 2 (x0 + side, y0 + side), 3 (x0, y0 + side). */
   square_grid: { cols: number; rows: number; /** Side of one square, metres (< pitch). */ side_m: number; /** Distance between the origins of neighbouring squares, metres. */ pitch_m: number };
+  /**
+   * OpenCV's ChArUco board (4.6+ layout unless `legacy`) of `squares_x x squares_y` squares:
+   * points are the `(squares_x - 1) x (squares_y - 1)` inner chessboard corners,
+   * `id = i + j (squares_x - 1)` (OpenCV's ChArUco corner ids); a detection holds the
+   * corners seen (any subset; docs/detection-json.md).
+   */
+  charuco: {
+    /** Squares along a row (OpenCV's squaresX). */ squares_x: number;
+    /** Squares along a column (OpenCV's squaresY). */ squares_y: number;
+    /** Side of one square, metres. */ square_m: number;
+    /** Side of one marker, its black border included, metres (< square_m). */ marker_m: number;
+    dictionary: ArucoDictionary;
+    /** Id of the first marker, the others following (0 by default; serialised always). */ first_id?: number;
+    /** Explicit marker ids in board order, instead of `first_id`. */ marker_ids?: number[];
+    /** The layout of boards made before OpenCV 4.6 (differs for an even `squares_y`); false by default. */ legacy?: boolean;
+  };
+  /**
+   * Kalibr's AprilGrid of tag36h11 tags: 4 points per tag with Kalibr's point ids
+   * (`r * 2 tag_cols + c`, corner row r from the bottom of the print, column c from the left;
+   * docs/detection-json.md); a detection holds the corners seen (any subset).
+   */
+  aprilgrid: {
+    /** Tags along a row (Kalibr's tagCols). */ tag_cols: number;
+    /** Rows of tags (Kalibr's tagRows). */ tag_rows: number;
+    /** Side of one tag, edge to edge, metres (Kalibr's tagSize). */ tag_m: number;
+    /** Gap between tags over the tag side, in (0, 1] (Kalibr's tagSpacing). */ spacing_ratio: number;
+    /** Id of tag 0 (0 in Kalibr; serialised always). */ first_id?: number;
+  };
 }
+
+/** OpenCV's predefined ArUco dictionaries, by their OpenCV names. */
+export type ArucoDictionary =
+  | 'DICT_4X4_50' | 'DICT_4X4_100' | 'DICT_4X4_250' | 'DICT_4X4_1000'
+  | 'DICT_5X5_50' | 'DICT_5X5_100' | 'DICT_5X5_250' | 'DICT_5X5_1000'
+  | 'DICT_6X6_50' | 'DICT_6X6_100' | 'DICT_6X6_250' | 'DICT_6X6_1000'
+  | 'DICT_7X7_50' | 'DICT_7X7_100' | 'DICT_7X7_250' | 'DICT_7X7_1000'
+  | 'DICT_ARUCO_ORIGINAL'
+  | 'DICT_APRILTAG_16h5' | 'DICT_APRILTAG_25h9' | 'DICT_APRILTAG_36h10' | 'DICT_APRILTAG_36h11'
+  | 'DICT_ARUCO_MIP_36h12';
 
 /** A target kind name. */
 export type TargetKind = keyof TargetKinds;
@@ -144,14 +182,19 @@ export type Target = { [K in TargetKind]: TargetOf<K> }[TargetKind];
  * A CLI target spec, the other form `detect_target` takes: `chessboard:9x6:30mm`,
  * `circles:4x11:20mm[:asymmetric|symmetric][:dark-on-light|light-on-dark]`,
  * `dots:7x7:25mm[:12.5mm]` (dot diameter defaults to half the pitch),
- * `circle:10mm`, `squares:8x8:12.7mm:22.5778mm` (side, then pitch); lengths in mm, cm or m.
+ * `circle:10mm`, `squares:8x8:12.7mm:22.5778mm` (side, then pitch),
+ * `charuco:12x9:20mm:15mm:DICT_5X5_100[:first=N][:ids=A,B,...][:legacy]` (squares, square side,
+ * marker side, dictionary), `aprilgrid:6x6:88mm:0.3[:first=N]` (tags, tag size, spacing ratio);
+ * lengths in mm, cm or m.
  */
 export type TargetSpec =
   | `chessboard:${number}x${number}:${string}`
   | `circles:${number}x${number}:${string}`
   | `dots:${number}x${number}:${string}`
   | `circle:${string}`
-  | `squares:${number}x${number}:${string}:${string}`;
+  | `squares:${number}x${number}:${string}:${string}`
+  | `charuco:${number}x${number}:${string}:${string}:${ArucoDictionary}${string}`
+  | `aprilgrid:${number}x${number}:${string}:${number}${string}`;
 
 /** One detected target point. */
 export interface DetectedPoint {
@@ -1235,6 +1278,8 @@ export interface RobocalJson {
   render_demo: [never, DemoIndex];
   /** `parse_target(spec or JSON.stringify(target))` -> the target, checked by the core. */
   parse_target: [Target, Target];
+  /** `read_kalibr_target(yamlText)` -> the target of a Kalibr target YAML (`target_type: aprilgrid` or `checkerboard`). */
+  read_kalibr_target: [never, Target];
   /** `target_points(spec or target JSON)` -> the board points in id order, metres. */
   target_points: [Target, TargetPoint[]];
   /** `target_svg(spec or target JSON)` returns the printable sheet (SVG text, mm at true scale), not JSON. */

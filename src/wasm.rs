@@ -244,6 +244,16 @@ pub fn parse_target(spec_or_json: &str) -> Result<String, JsError> {
     serde_json::to_string(&target).map_err(|e| JsError::new(&e.to_string()))
 }
 
+/// A Kalibr calibration-target YAML (`target_type: aprilgrid` with
+/// `tagCols`, `tagRows`, `tagSize`, `tagSpacing`, or `target_type:
+/// checkerboard`) as the target JSON ([`parse_target`]'s output), or the
+/// reader's error naming the line or key.
+#[wasm_bindgen]
+pub fn read_kalibr_target(yaml: &str) -> Result<String, JsError> {
+    let target = crate::io::parse_kalibr_target(yaml).map_err(js_error)?;
+    serde_json::to_string(&target).map_err(|e| JsError::new(&e.to_string()))
+}
+
 /// The canonical CLI spec of a target (spec or JSON): what
 /// `robocal detect --target` takes, e.g. `chessboard:9x6:30mm`.
 #[wasm_bindgen]
@@ -283,7 +293,12 @@ pub fn target_svg(spec_or_json: &str) -> Result<String, JsError> {
 
 /// Detect a calibration target in image bytes. `target_spec_or_json` is a
 /// CLI spec (see [`parse_target`]) or a target JSON object. Returns the
-/// Detection JSON (see `docs/detection-json.md`).
+/// Detection JSON (see `docs/detection-json.md`). ChArUco boards and
+/// AprilGrids give the corners seen (any subset) of the board whose
+/// markers carry the target's ids; another board in the same image (its
+/// own block of ids, `detect::detect_all`) is found by asking again with
+/// its `first_id`: one target, one detection, as the page's cards and the
+/// solvers' views take them.
 #[wasm_bindgen]
 pub fn detect_target(
     bytes: &[u8],

@@ -45,6 +45,11 @@ const handlers = {
     const json = JSON.stringify(target);
     return { target, spec: robocal.target_spec(json), points: JSON.parse(robocal.target_points(json)), svg: robocal.target_svg(json) };
   },
+  /** A Kalibr target YAML as the core's target JSON (io::kalibr_target). */
+  async kalibrTarget({ text }) {
+    await ready;
+    return JSON.parse(robocal.read_kalibr_target(text));
+  },
   /** Stereo pairing by file name: the rule of `robocal stereo` (io::pairing). */
   async pair({ left, right }) {
     await ready;

@@ -235,6 +235,9 @@ const targets = [
   { kind: 'dot_plate', cols: 7, rows: 7, pitch_m: 0.025, dot_diameter_m: 0.0125 },
   { kind: 'single_circle', diameter_m: 0.01 },
   { kind: 'square_grid', cols: 8, rows: 8, side_m: 0.0127, pitch_m: 0.0225778 },
+  { kind: 'charuco', squares_x: 8, squares_y: 6, square_m: 0.03, marker_m: 0.022, dictionary: 'DICT_5X5_100', first_id: 4, legacy: true },
+  { kind: 'charuco', squares_x: 3, squares_y: 3, square_m: 0.02, marker_m: 0.015, dictionary: 'DICT_ARUCO_ORIGINAL', marker_ids: [7, 8, 9, 10] },
+  { kind: 'aprilgrid', tag_cols: 6, tag_rows: 6, tag_m: 0.088, spacing_ratio: 0.3, first_id: 36 },
 ];
 for (const t of targets) {
   const parsed = call('parse_target', t, `parse_target ${t.kind}`);
@@ -244,6 +247,12 @@ for (const t of targets) {
   assert.match(robocal.target_svg(JSON.stringify(input('target_svg', t))), /^<\?xml|<svg/);
   assert.equal(robocal.parse_target(robocal.target_spec(JSON.stringify(input('target_spec', t)))), JSON.stringify(parsed), `${t.kind}: the spec reads back`);
 }
+// Kalibr's target YAML: an AprilGrid (its template, comments kept) and a checkerboard.
+const kalibrGrid = output('read_kalibr_target', JSON.parse(robocal.read_kalibr_target("target_type: 'aprilgrid' #gridtype\ntagCols: 6\ntagRows: 6\ntagSize: 0.088 #[m]\ntagSpacing: 0.3\n")), 'read_kalibr_target aprilgrid');
+assert.deepEqual(kalibrGrid, { kind: 'aprilgrid', tag_cols: 6, tag_rows: 6, tag_m: 0.088, spacing_ratio: 0.3, first_id: 0 });
+const kalibrBoard = output('read_kalibr_target', JSON.parse(robocal.read_kalibr_target('target_type: checkerboard\ntargetCols: 9\ntargetRows: 6\nrowSpacingMeters: 0.03\ncolSpacingMeters: 0.03\n')), 'read_kalibr_target checkerboard');
+assert.equal(kalibrBoard.kind, 'chessboard');
+assert.throws(() => robocal.read_kalibr_target("target_type: 'aprilgrid'\ntagCols: 6\ntagRows: 6\ntagSpacing: 0.3\n"), { message: "Kalibr target: missing key 'tagSize'" });
 // Stereo pairing: by number, and by order when no name has one.
 const pairLeft = input('pair_images', ['cam_L_10.png', 'cam_L_2.png']);
 const pairRight = input('pair_images', ['cam_R_2.png', 'cam_R_010.png']);

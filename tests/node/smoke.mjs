@@ -19,6 +19,9 @@ writeFileSync(join(work, 'package.json'), '{ "name": "robocal-smoke", "private":
 npm(['install', '--no-audit', '--no-fund', '--offline', join(work, tarball)], work);
 
 writeFileSync(join(work, 'board.png'), makePng(64, 48, (x, y) => [x * 4, y * 5, 128]));
+// A rendered ChArUco board with its exact corners (the CLI's renderer, `make
+// test-node` builds it): one view, grey-level noise sigma 2.
+execFileSync(join(root, 'target/release/robocal'), ['render', '--out', join(work, 'charuco'), '--target', 'charuco:8x6:30mm:22mm:DICT_5X5_100', '--views', '1', '--seed', '2', '--noise', '2'], { stdio: 'ignore' });
 
 const esm = `
 import assert from 'node:assert/strict';
@@ -62,6 +65,28 @@ assert.deepEqual([points.length, points[10]], [54, { id: 10, x_m: 0.03, y_m: 0.0
 const svg = robocal.target_svg('chessboard:9x6:30mm');
 assert.match(svg, /<rect class="check-bar" x="10" y="[0-9.]+" width="100" height="3"/);
 assert.match(svg, />robocal target chessboard:9x6:30mm</);
+// Marker boards: the ChArUco spec as the core's JSON and back, its sheet, and
+// a rendered board detected against the render's exact corners.
+const charucoSpec = 'charuco:8x6:30mm:22mm:DICT_5X5_100:first=4';
+const charuco = JSON.parse(robocal.parse_target(charucoSpec));
+assert.deepEqual(charuco, { kind: 'charuco', squares_x: 8, squares_y: 6, square_m: 0.03, marker_m: 0.022, dictionary: 'DICT_5X5_100', first_id: 4, legacy: false });
+assert.equal(robocal.target_spec(JSON.stringify(charuco)), charucoSpec);
+assert.equal(JSON.parse(robocal.target_points(charucoSpec)).length, 7 * 5);
+assert.match(robocal.target_svg(charucoSpec), />robocal target charuco:8x6:30mm:22mm:DICT_5X5_100:first=4</);
+assert.deepEqual(JSON.parse(robocal.parse_target('aprilgrid:6x6:88mm:0.3')), { kind: 'aprilgrid', tag_cols: 6, tag_rows: 6, tag_m: 0.088, spacing_ratio: 0.3, first_id: 0 });
+assert.equal(JSON.parse(robocal.target_points('aprilgrid:6x6:88mm:0.3')).length, 4 * 36);
+const truth = JSON.parse(readFileSync(new URL('./charuco/truth.json', import.meta.url)));
+const found = JSON.parse(robocal.detect_target(readFileSync(new URL('./charuco/view_000.png', import.meta.url)), JSON.stringify(truth.target)));
+const exact = new Map(truth.views[0].points.map((p) => [p.id, p]));
+// The whole board is in view: every corner found, each on the truth.
+assert.equal(found.points.length, 35, 'ChArUco corners found');
+const errs = found.points.map((p) => Math.hypot(p.x_px - exact.get(p.id).x_px, p.y_px - exact.get(p.id).y_px));
+const meanErr = errs.reduce((a, b) => a + b, 0) / errs.length;
+// Noise sigma 2 grey levels gives saddle points good to a few hundredths of
+// a pixel (BENCHMARKS.md: ~0.02 px mean); 0.1 px mean and 0.3 px at most
+// leave room for a blurrier view yet catch a wrong id or a corner off by one square.
+assert.ok(meanErr < 0.1 && Math.max(...errs) < 0.3, 'ChArUco corner error px: mean ' + meanErr + ', max ' + Math.max(...errs));
+console.log('charuco detected: 35 corners, mean error ' + meanErr.toFixed(4) + ' px');
 assert.throws(() => robocal.parse_target('chessboard:1x6:30mm'), { message: 'target: a grid needs 2 to 100000 points with at least 2 per side, got 1x6' });
 // Stereo pairing, the rule of robocal stereo.
 assert.deepEqual(JSON.parse(robocal.pair_images('["l10.png","l2.png"]', '["r2.png","r010.png"]')), { paired_by: 'number', pairs: [[0, 1], [1, 0]] });

@@ -21,6 +21,15 @@ const dots: Target = { kind: 'dot_plate', cols: 7, rows: 7, pitch_m: 0.025, dot_
 const circle: Target = { kind: 'single_circle', diameter_m: 0.01 };
 const squares: TargetOf<'square_grid'> = { kind: 'square_grid', cols: 8, rows: 8, side_m: 0.0127, pitch_m: 0.0225778 };
 const squaresSpec: TargetSpec = 'squares:8x8:12.7mm:22.5778mm';
+const charuco: TargetOf<'charuco'> = { kind: 'charuco', squares_x: 12, squares_y: 9, square_m: 0.02, marker_m: 0.015, dictionary: 'DICT_5X5_100', first_id: 0, legacy: false };
+const charucoIds: Target = { kind: 'charuco', squares_x: 3, squares_y: 3, square_m: 0.02, marker_m: 0.015, dictionary: 'DICT_ARUCO_ORIGINAL', marker_ids: [7, 8, 9, 10] };
+const aprilgrid: TargetOf<'aprilgrid'> = { kind: 'aprilgrid', tag_cols: 6, tag_rows: 6, tag_m: 0.088, spacing_ratio: 0.3, first_id: 36 };
+const charucoSpec: TargetSpec = 'charuco:12x9:20mm:15mm:DICT_5X5_100:first=4:legacy';
+const aprilgridSpec: TargetSpec = 'aprilgrid:6x6:88mm:0.3';
+// @ts-expect-error: OpenCV spells the dictionary DICT_5X5_100
+const wrongDictionary: Target = { ...charuco, dictionary: '5X5_100' };
+// @ts-expect-error: an AprilGrid's tag side is tag_m
+const wrongTagKey: Target = { kind: 'aprilgrid', tag_cols: 6, tag_rows: 6, tag_size_m: 0.088, spacing_ratio: 0.3 };
 // @ts-expect-error: a chessboard has no spacing_m
 const wrongKey: Target = { kind: 'chessboard', cols: 9, rows: 6, spacing_m: 0.03 };
 // @ts-expect-error: no such target kind (yet)
@@ -79,7 +88,7 @@ const calibration: CameraCalibration = {
   distortion: { k1: -0.18, k2: 0.05, p1: 0.0005, p2: -0.0003, k3: 0 },
   rms_px: 0.05,
   std: { fx: 0.1, fy: 0.1, cx: 0.2, cy: 0.2, skew: 0 },
-  views: [{ name: 'demo_00.png', rms_px: 0.05, n_points: 54, camera_from_target: pose, outliers: [{ index: 3, id: 3, residual_px: 4.2, reason: 'beyond 3 robust sigmas' }], residuals_px: [{ x: 244.2, y: 94.5, dx: 0.01, dy: -0.02, id: 0 }] }],
+  views: [{ name: 'demo_00.png', rms_px: 0.05, n_points: 54, camera_from_target: pose, outliers: [{ index: 3, id: 3, residual_px: 4.2, x_px: 301.5, y_px: 120.25, reason: 'beyond 3 robust sigmas' }], residuals_px: [{ x: 244.2, y: 94.5, dx: 0.01, dy: -0.02, id: 0 }] }],
   correlation: { names: ['fx', 'fy'], matrix: [[1, 0.99], [0.99, 1]] },
   projection_uncertainty: { reference_depth_m: 0.6, x_px: [0, 1023], y_px: [0, 767], std_px: [[0.1, null], [0.1, 0.2]], max_std_px: 0.2 },
   distortion_field: { vectors: [{ x: 0, y: 0, dx: -30, dy: -22 }] },
@@ -235,7 +244,7 @@ const noJson: JsonInput<'image_info'> = {};
 type NoSuch = JsonOutput<'calibrate_lidar'>;
 
 export {
-  dots, squares, squaresSpec, wrongKey, wrongKind, wrongPolarity, spec, wrongSpec, wrongSize, wrongFormat, preview, none, eucm, wrongCoefficient,
+  dots, squares, squaresSpec, charuco, charucoIds, aprilgrid, charucoSpec, aprilgridSpec, wrongDictionary, wrongTagKey, wrongKey, wrongKind, wrongPolarity, spec, wrongSpec, wrongSize, wrongFormat, preview, none, eucm, wrongCoefficient,
   wrongView, wrongMethod, wrongTermination, stereoInput, fx, wrongPoseFormat, ambiguous, bothImages, wrongSetup,
   wrongKeyForSetup, cameraPose, rank, ranked, formats, format, wrongExport, exportable, urdf, fitRequest, fit, wrongTransform,
   solvedPlanar, xyReport, noHistory, motionReport, spec2, firstPng, targetInput, handeyeAgain, noJson,

@@ -33,6 +33,23 @@ export class ImagesView {
     this.residuals = new Map(); // image name -> [{x, y, dx, dy}]
     this.wire();
     store.onChange((what) => { if (what === 'target') this.targetChanged(); });
+    this.board = null; // { spec, kind, total } of the target the cards count against
+  }
+
+  /**
+   * How many points the session's target has, from the core (a marker
+   * board's card says "41 of 88 corners"); null when the target is not
+   * valid. Asked once per spec.
+   */
+  async boardInfo() {
+    let spec;
+    try { spec = targetSpec(this.store.session.target); } catch { return null; }
+    if (this.board && this.board.spec === spec) return this.board;
+    try {
+      const reply = await this.engine.call('target', { spec });
+      this.board = { spec, kind: reply.target.kind, total: reply.points.length };
+    } catch { this.board = null; }
+    return this.board;
   }
 
   /**
@@ -92,6 +109,7 @@ export class ImagesView {
 
   /** Rebuild cards from the session (after a reload or a demo load). */
   async restore() {
+    await this.boardInfo();
     fill($('cards'));
     this.cards.clear();
     for (const img of this.images) {
@@ -158,6 +176,7 @@ export class ImagesView {
     let spec;
     try { spec = targetSpec(this.store.session.target); } catch (e) { return; }
     this.busy = true;
+    await this.boardInfo();
     this.cancelled = false;
     $('progress-row').hidden = false;
     $('detect-progress').max = todo.length;
@@ -288,7 +307,7 @@ export class ImagesView {
     if (p) drawImage(card.canvas, p, img.detection ? img.detection.points : [], p.scale, 1);
     card.li.className = `card ${img.status === 'error' ? 'warn' : 'ok'}${img.included ? '' : ' excluded'}`;
     const parts = [describe(img.info)];
-    if (img.detection) parts.push(`${img.detection.points.length} points`);
+    if (img.detection) parts.push(pointCount(img.detection.points, this.board));
     if (img.largerGrid) parts.push(img.largerGrid);
     if (img.status === 'error') parts.push(img.error);
     if (img.bytesMissing) parts.push('from a session file: add the image to see it');
@@ -340,14 +359,40 @@ export class ImagesView {
     if (!img || !this.full) return;
     const zoom = Number($('inspector-zoom').value);
     const res = this.residuals.get(img.name) || [];
-    drawImage($('inspector-canvas'), this.full, img.detection ? img.detection.points : [], this.full.scale, zoom, res);
+    drawImage($('inspector-canvas'), this.full, img.detection ? img.detection.points : [], this.full.scale, zoom, res, true);
     const rms = res.length ? Math.sqrt(res.reduce((s, r) => s + r.dx * r.dx + r.dy * r.dy, 0) / res.length) : null;
-    $('inspector-info').textContent = `${describe(img.info)} · ${img.detection ? img.detection.points.length + ' points' : img.error || 'not detected'}` +
+    $('inspector-info').textContent = `${describe(img.info)} · ${img.detection ? pointCount(img.detection.points, this.board) : img.error || 'not detected'}` +
       (rms !== null ? ` · reprojection RMS ${rms.toFixed(3)} px (residual vectors drawn ×${RESIDUAL_GAIN})` : '');
   }
 }
 
 const RESIDUAL_GAIN = 20;
+
+/** Marker boards report the corners they see, any subset of the board's. */
+const MARKER_BOARDS = new Set(['charuco', 'aprilgrid']);
+
+/**
+ * A card's point count. Whole-target kinds: "54 points". Marker boards:
+ * "41 of 88 corners (partial view) · ids 0-5, 9-12, ..." (a partial view
+ * is a valid detection: the solvers use any subset of the points).
+ */
+export function pointCount(points, board) {
+  if (!board || !MARKER_BOARDS.has(board.kind)) return `${points.length} points`;
+  const partial = points.length < board.total ? ' (partial view)' : '';
+  return `${points.length} of ${board.total} corners${partial} · ids ${idRanges(points.map((p) => p.id))}`;
+}
+
+/** Sorted ids as ranges: [0,1,2,5,7,8] -> "0-2, 5, 7-8"; long lists end in "…". */
+export function idRanges(ids, most = 6) {
+  const runs = [];
+  for (const id of [...ids].sort((a, b) => a - b)) {
+    const last = runs[runs.length - 1];
+    if (last && id === last[1] + 1) last[1] = id;
+    else runs.push([id, id]);
+  }
+  const text = runs.slice(0, most).map(([a, b]) => (a === b ? `${a}` : `${a}-${b}`));
+  return text.join(', ') + (runs.length > most ? ', …' : '');
+}
 
 function describe(info) {
   if (!info) return '';
@@ -356,7 +401,7 @@ function describe(info) {
 }
 
 /** Draw a preview with its points (pixel coordinates of the full image) at `zoom`. */
-function drawImage(canvas, p, points, scale, zoom, residuals = []) {
+function drawImage(canvas, p, points, scale, zoom, residuals = [], ids = false) {
   const { width, height } = p.image; // the core's ImageData, put as it came
   canvas.width = Math.round(width * zoom);
   canvas.height = Math.round(height * zoom);
@@ -378,11 +423,24 @@ function drawImage(canvas, p, points, scale, zoom, residuals = []) {
     ctx.stroke();
   });
   if (points.length > 1) {
+    // Consecutive ids only: a partial view's gaps stay gaps.
     ctx.strokeStyle = 'rgba(255,127,14,0.5)';
     ctx.lineWidth = 1;
     ctx.beginPath();
-    points.forEach((pt, i) => (i ? ctx.lineTo(X(pt.x_px), Y(pt.y_px)) : ctx.moveTo(X(pt.x_px), Y(pt.y_px))));
+    points.forEach((pt, i) => (i && pt.id === points[i - 1].id + 1 ? ctx.lineTo(X(pt.x_px), Y(pt.y_px)) : ctx.moveTo(X(pt.x_px), Y(pt.y_px))));
     ctx.stroke();
+  }
+  if (ids) {
+    // Each point's board id beside it (dark outline so it reads on black and white).
+    ctx.font = `${Math.round(Math.max(10, Math.min(16, 6 * zoom)))}px system-ui`;
+    ctx.lineWidth = 3;
+    ctx.strokeStyle = 'rgba(0,0,0,0.8)';
+    ctx.fillStyle = '#ffd54f';
+    for (const pt of points) {
+      const [x, y] = [X(pt.x_px) + r + 1, Y(pt.y_px) - r - 1];
+      ctx.strokeText(String(pt.id), x, y);
+      ctx.fillText(String(pt.id), x, y);
+    }
   }
   ctx.strokeStyle = '#d62728';
   ctx.lineWidth = 1.5;

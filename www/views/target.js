@@ -45,11 +45,19 @@ function legacySpec(t) {
   }
 }
 
-/** The form's controls that belong to `kind` (their `data-for` names it). */
+/** The form's controls that belong to `kind` (their `data-for` names it; hints have none). */
 function fieldsOf(form, kind) {
-  return [...form.querySelectorAll('[data-for]')].filter((label) => label.dataset.for.split(' ').includes(kind))
-    .map((label) => label.querySelector('input, select'));
+  return [...form.querySelectorAll('label[data-for]')].filter((label) => label.dataset.for.split(' ').includes(kind))
+    .map((label) => label.querySelector('input, select')).filter(Boolean);
 }
+
+/** A control's key in the target JSON: `data-key` when two kinds share a
+ * JSON name (the ChArUco square side is `square_m` like the chessboard's),
+ * else its name with `_mm` turned into `_m`. */
+const keyOf = (el) => el.dataset.key || el.name.replace(/_mm$/, '_m');
+
+/** The label's text of a control, for messages ("Squares across"). */
+const labelOf = (el) => el.closest('label').firstChild.textContent.trim();
 
 /**
  * A number field's value, or an error naming the field: an empty field, or
@@ -59,9 +67,26 @@ function fieldsOf(form, kind) {
 function numberField(el, unit) {
   const v = el.value.trim();
   if (v !== '' && Number.isFinite(Number(v))) return v;
-  const label = el.parentElement.firstChild.textContent.trim();
-  throw new Error(`${label}: the field is empty or not a number; enter ${unit}`);
+  throw new Error(`${labelOf(el)}: the field is empty or not a number; enter ${unit}`);
 }
+
+/** A whole-number field (counts and ids), or an error naming the field. */
+function countField(el, what) {
+  const v = Number(numberField(el, what));
+  if (Number.isInteger(v) && v >= 0) return v;
+  throw new Error(`${labelOf(el)}: ${el.value.trim()} is not a whole number; enter ${what}`);
+}
+
+/** What each whole-number field holds, for its message. */
+const COUNTS = {
+  cols: 'a whole number of points, at least 2',
+  rows: 'a whole number of points, at least 2',
+  squares_x: 'a whole number of squares, at least 2 (e.g. 12)',
+  squares_y: 'a whole number of squares, at least 2 (e.g. 9)',
+  tag_cols: 'a whole number of tags, at least 1 (e.g. 6)',
+  tag_rows: 'a whole number of tags, at least 1 (e.g. 6)',
+  first_id: 'the id of the board\'s first marker, 0 or more',
+};
 
 /** The form as target JSON text (names ending in _mm become _m in metres). */
 function readForm(form) {
@@ -69,10 +94,18 @@ function readForm(form) {
   const t = { kind };
   for (const el of fieldsOf(form, kind)) {
     const v = el.value;
-    if (el.name.endsWith('_mm')) t[el.name.replace(/_mm$/, '_m')] = mmToM(numberField(el, 'a size in millimetres, e.g. 30'));
-    else if (el.name === 'cols' || el.name === 'rows') t[el.name] = Number(numberField(el, 'a whole number of points, at least 2'));
+    if (el.name.endsWith('_mm')) t[keyOf(el)] = mmToM(numberField(el, 'a size in millimetres, e.g. 30'));
+    else if (el.name in COUNTS) t[el.name] = countField(el, COUNTS[el.name]);
+    else if (el.name === 'spacing_ratio') t.spacing_ratio = Number(numberField(el, 'the gap between tags over the tag size, e.g. 0.3'));
+    else if (el.type === 'checkbox') t[el.name] = el.checked;
     else if (el.name === 'asymmetric') t.asymmetric = v === 'true';
     else t[el.name] = v;
+  }
+  // An explicit marker id list (from a spec or a loaded session) has no
+  // field: it is kept while the kind stays ChArUco, and replaces first_id.
+  if (kind === 'charuco' && form.dataset.markerIds) {
+    t.marker_ids = JSON.parse(form.dataset.markerIds);
+    delete t.first_id;
   }
   return JSON.stringify(t);
 }
@@ -81,10 +114,13 @@ function readForm(form) {
 function writeForm(form, t) {
   form.elements.kind.value = t.kind;
   for (const el of fieldsOf(form, t.kind)) {
-    const key = el.name.replace(/_mm$/, '_m');
+    const key = keyOf(el);
     if (!(key in t)) continue;
-    el.value = el.name.endsWith('_mm') ? String(mToMm(t[key])) : String(t[key]);
+    if (el.type === 'checkbox') el.checked = !!t[key];
+    else el.value = el.name.endsWith('_mm') ? String(mToMm(t[key])) : String(t[key]);
   }
+  if (t.kind === 'charuco' && Array.isArray(t.marker_ids)) form.dataset.markerIds = JSON.stringify(t.marker_ids);
+  else delete form.dataset.markerIds;
 }
 
 /** What the grid fields count, per kind: a chessboard's are its inner corners, not its squares. */
@@ -97,7 +133,7 @@ const GRID_LABELS = {
 
 function showFields(form) {
   const kind = form.elements.kind.value;
-  for (const label of form.querySelectorAll('[data-for]')) label.hidden = !label.dataset.for.split(' ').includes(kind);
+  for (const el of form.querySelectorAll('[data-for]')) el.hidden = !el.dataset.for.split(' ').includes(kind);
   const [cols, rows] = GRID_LABELS[kind] || ['Columns ', 'Rows '];
   form.elements.cols.parentElement.firstChild.textContent = cols;
   form.elements.rows.parentElement.firstChild.textContent = rows;
@@ -105,8 +141,8 @@ function showFields(form) {
 }
 
 /**
- * Draw the core's sheet scaled into the canvas, with point 0 and the board
- * axes over it. Point 0 sits where the sheet's `<g class="marks"
+ * Draw the core's sheet scaled into the canvas, with the board axes and
+ * point 0 over it. The origin sits where the sheet's `<g class="marks"
  * transform="translate(X Y)">` puts it; `points` are the core's (metres).
  */
 export async function drawSheet(canvas, svg, points) {
@@ -140,8 +176,10 @@ export async function drawSheet(canvas, svg, points) {
   };
   arrow(1, 0, reach(0), '#d62728', 'x');
   arrow(0, 1, reach(1), '#2ca02c', 'y');
+  // Point 0 is at the origin except on marker boards (ChArUco: one square in; AprilGrid: bottom left).
+  const [qx, qy] = mm.length ? at(mm[0]) : [px, py];
   ctx.fillStyle = '#1f77b4';
-  ctx.beginPath(); ctx.arc(px, py, 5, 0, 2 * Math.PI); ctx.fill();
+  ctx.beginPath(); ctx.arc(qx, qy, 5, 0, 2 * Math.PI); ctx.fill();
   return { width_mm: width, height_mm: height, origin_mm: origin };
 }
 
@@ -192,6 +230,25 @@ export function initTarget(store, engine) {
   $('print-target').addEventListener('click', () => {
     if (!sheet) return;
     download(`robocal-target-${sheet.spec.replace(/[:]/g, '_')}.svg`, sheet.svg, 'image/svg+xml');
+  });
+  // Kalibr's target YAML (aprilgrid or checkerboard): read by the core into
+  // the form, then used as if typed.
+  $('kalibr-target').addEventListener('click', () => $('kalibr-input').click());
+  $('kalibr-input').addEventListener('change', async (e) => {
+    const [file] = e.target.files;
+    e.target.value = '';
+    if (!file) return;
+    asked++;
+    let target;
+    try {
+      target = await engine.call('kalibrTarget', { text: await file.text() });
+    } catch (err) {
+      refuse(`${file.name}: ${err.message}`);
+      return;
+    }
+    writeForm(form, target);
+    showFields(form);
+    show(JSON.stringify(target), true);
   });
   const fromSession = () => show(targetSpec(store.session.target), false);
   store.onChange((what) => { if (what === 'all' || what === 'target-loaded') fromSession(); });
