@@ -3,7 +3,9 @@
 //! - aprilgrid-detection-samples: the tag counts its SOURCE.md states
 //!   (EuRoC 36, TUM VI 36, iphone 66, two_boards 72 over two boards);
 //! - moveit-handeye-pose-samples: MoveIt's ChArUco test image (5 x 7
-//!   squares, DICT_5X5_250) detected with every marker's corners.
+//!   squares, DICT_5X5_250) detected with every marker's corners, and the
+//!   board pose by PnP from robocal's corners with the stated camera within
+//!   MoveIt's published tolerance.
 
 use robocal::detect::{detect_all, DetectOptions};
 use robocal::target::{Detection, Target};
@@ -104,4 +106,91 @@ fn moveit_charuco_image_is_detected() {
         "corners {}",
         found[0].points.len()
     );
+}
+
+/// MoveIt's expected board pose (SOURCE.md: t and Eigen's eulerAngles(0, 1,
+/// 2), i.e. R = Rx(a) Ry(b) Rz(c)), compared with the PnP pose of robocal's
+/// corners with the stated camera (K and plumb_bob D).
+#[test]
+fn moveit_charuco_board_pose_within_the_published_tolerance() {
+    use nalgebra::{Point2, Point3, Rotation3, Vector3};
+    use robocal::camera::{Camera, Distortion};
+    use robocal::handeye::pnp::camera_from_target;
+    use robocal::handeye::reprojection_refine::ViewPoints;
+    let Some(dir) = dataset("moveit-handeye-pose-samples") else {
+        return;
+    };
+    let img = gray(&dir.join("test_charuco_board_detection.jpg"));
+    let square = 0.1971 / 7.0;
+    let t = Target::Charuco {
+        squares_x: 5,
+        squares_y: 7,
+        square_m: square,
+        marker_m: square * 50.0 / 80.0,
+        dictionary: robocal::target::Dictionary::DICT_5X5_250,
+        first_id: 0,
+        marker_ids: None,
+        legacy: false,
+    };
+    let det = &detect_all(&img, &t, &DetectOptions::default()).unwrap()[0];
+    let camera = Camera {
+        fx: 590.6972346,
+        fy: 592.84676713,
+        cx: 322.33104773,
+        cy: 247.40030325,
+        skew: 0.0,
+        width: 640,
+        height: 480,
+        distortion: Distortion::Brown {
+            k1: 0.15405498,
+            k2: -0.24916842,
+            k3: 0.0,
+            p1: 0.00350791,
+            p2: -0.00110041,
+        },
+    };
+    let objects: std::collections::HashMap<usize, Point3<f64>> =
+        t.object_points().into_iter().collect();
+    let view = ViewPoints {
+        object_points: det.points.iter().map(|p| objects[&p.id]).collect(),
+        image_points: det
+            .points
+            .iter()
+            .map(|p| Point2::new(p.x_px, p.y_px))
+            .collect(),
+    };
+    let (camera_from_board, rms) = camera_from_target(&camera, &view).unwrap();
+    let expected_t = Vector3::new(0.09752, 0.102848, 0.325596);
+    let expected_r = Rotation3::from_axis_angle(&Vector3::x_axis(), 2.88409)
+        * Rotation3::from_axis_angle(&Vector3::y_axis(), -0.147996)
+        * Rotation3::from_axis_angle(&Vector3::z_axis(), 1.13757);
+    // MoveIt's board frame (OpenCV 3's aruco module): origin at the board's
+    // bottom-left outer corner, y up the board, z out of the print towards
+    // the camera; robocal's (OpenCV >= 4.6): origin top-left, y down, z into
+    // the print. The same board, turned by pi about x at (0, 7 squares).
+    let board_from_moveit = nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(0.0, 7.0 * square, 0.0),
+        nalgebra::UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
+    );
+    let camera_from_moveit = camera_from_board * board_from_moveit;
+    let dt = (camera_from_moveit.translation.vector - expected_t).norm();
+    let dr = (camera_from_moveit.rotation.to_rotation_matrix() * expected_r.inverse()).angle();
+    println!(
+        "moveit board pose: reprojection rms {rms:.3} px, translation {:?} m, {:.2} mm and {:.3} deg from the expectation",
+        camera_from_moveit.translation.vector.as_slice(),
+        dt * 1e3,
+        dr.to_degrees()
+    );
+    // MoveIt's test: Eigen isApprox(0.01), a 1 % relative difference of the
+    // translation vector (|t| = 0.354 m -> 3.5 mm) and of the Euler-angle
+    // vector (|(2.884, -0.148, 1.138)| = 3.104 rad -> 0.031 rad, asserted on
+    // the rotation angle between the two poses, which is free of the Euler
+    // triple's ambiguity).
+    assert!(
+        dt <= 0.01 * expected_t.norm(),
+        "translation off by {:.2} mm",
+        dt * 1e3
+    );
+    let euler_norm = Vector3::new(2.88409, -0.147996, 1.13757).norm();
+    assert!(dr <= 0.01 * euler_norm, "rotation off by {:.4} rad", dr);
 }
