@@ -54,6 +54,10 @@ pub const MIN_DISAGREE_PX: f64 = 1.5;
 const MAX_WINDOW_PX: f64 = 6.0;
 /// Smallest saddle-fit half-window, pixels.
 const MIN_WINDOW_PX: f64 = 2.5;
+/// A corner is refined only when it is this many half-windows (plus one
+/// pixel) inside the image: the fit's reach (1.5 half-windows) and its
+/// smoothing.
+const BORDER_WINDOWS: f64 = 2.0;
 
 /// Decoding tunables.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -300,8 +304,23 @@ fn consistent_markers(layout: &MarkerLayout, mine: &mut Vec<(usize, &Marker)>) {
 /// The saddle fit of a seed with half-window `window`, or `None`.
 fn refine(image: &GrayImage, seed: Point2<f64>, window: f64) -> Option<Point2<f64>> {
     let window = window.clamp(MIN_WINDOW_PX, MAX_WINDOW_PX);
+    // The fit reads 1.5 half-windows around the corner plus its smoothing:
+    // where that reaches past the image edge it sees replicated border
+    // pixels and the corner comes out biased (2.6 px on a partial-view
+    // render, once outside the image). Such a corner is left out, as one
+    // beyond the edge is.
+    let margin = BORDER_WINDOWS * window + 1.0;
+    let inside = |p: Point2<f64>| {
+        p.x >= margin
+            && p.y >= margin
+            && p.x <= image.width as f64 - 1.0 - margin
+            && p.y <= image.height as f64 - 1.0 - margin
+    };
+    if !inside(seed) {
+        return None;
+    }
     let fit = refine_saddle(image, seed, window)?;
-    ((fit.pos - seed).norm() <= 0.5 * window + 1.0).then_some(fit.pos)
+    ((fit.pos - seed).norm() <= 0.5 * window + 1.0 && inside(fit.pos)).then_some(fit.pos)
 }
 
 fn charuco_corners(
