@@ -58,7 +58,10 @@ async function setTarget(page, cols, rows, sizeMm) {
   await page.fill('input[name=cols]', String(cols));
   await page.fill('input[name=rows]', String(rows));
   await page.fill('input[name=square_mm]', String(sizeMm));
-  assert.match(await page.textContent('#target-spec'), new RegExp(`^Target spec: chessboard:${cols}x${rows}:${sizeMm}mm`));
+  // The spec line is written after the core has checked the new fields (a
+  // round trip to the worker): wait for it rather than read it at once.
+  const want = `^Target spec: chessboard:${cols}x${rows}:${sizeMm}mm`;
+  await page.waitForFunction((re) => new RegExp(re).test(document.getElementById('target-spec').textContent), want, { timeout: 20000 });
 }
 
 async function solveCamera(page) {
