@@ -208,10 +208,9 @@ fn candidate_boards(target: &Target, layout: &MarkerLayout, markers: &[Marker]) 
         .collect()
 }
 
-/// One board's detection from the markers, `None` when none of its
-/// markers is consistent.
-fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Detection> {
-    let layout = marker_board::layout(board)?;
+/// The found markers that belong to the board of `layout` (each with its
+/// index in the layout) and that one homography places consistently.
+fn board_markers<'m>(layout: &MarkerLayout, markers: &'m [Marker]) -> Vec<(usize, &'m Marker)> {
     let index: HashMap<usize, usize> = layout
         .markers
         .iter()
@@ -222,7 +221,15 @@ fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Det
         .iter()
         .filter_map(|m| index.get(&m.id).map(|&k| (k, m)))
         .collect();
-    consistent_markers(&layout, &mut mine);
+    consistent_markers(layout, &mut mine);
+    mine
+}
+
+/// One board's detection from the markers, `None` when none of its
+/// markers is consistent.
+fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Detection> {
+    let layout = marker_board::layout(board)?;
+    let mine = board_markers(&layout, markers);
     if mine.is_empty() {
         return None;
     }
@@ -449,17 +456,7 @@ fn inliers(board: &Target, markers: &[Marker]) -> usize {
     let Some(layout) = marker_board::layout(board) else {
         return 0;
     };
-    let index: HashMap<usize, usize> = layout
-        .markers
-        .iter()
-        .enumerate()
-        .map(|(k, m)| (m.id, k))
-        .collect();
-    let mut mine: Vec<(usize, &Marker)> = markers
-        .iter()
-        .filter_map(|m| index.get(&m.id).map(|&k| (k, m)))
-        .collect();
-    consistent_markers(&layout, &mut mine);
+    let mine = board_markers(&layout, markers);
     mine.len()
 }
 
