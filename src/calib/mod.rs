@@ -27,6 +27,7 @@ mod refine;
 mod rejected;
 mod report;
 mod residuals;
+pub mod rig_report;
 pub mod stereo;
 pub mod stereo_json;
 mod stereo_problem;
