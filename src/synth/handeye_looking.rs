@@ -183,3 +183,21 @@ pub fn grid_pixels(
         })
         .collect()
 }
+
+/// Move view `view`'s camera by `offset_m` along its own axes (orientation
+/// kept) and the robot pose with it, so that the chain still closes: a
+/// lateral offset pushes the board towards an image edge, the way a
+/// partial view of a marker board is taken. Out-of-range views are ignored.
+pub fn shift_view(scene: &mut LookingScene, view: usize, offset_m: Vector3<f64>) {
+    let Some(camera_from_target) = scene.camera_from_target.get(view).copied() else {
+        return;
+    };
+    // The camera moves by +offset in its frame: points move by -offset.
+    let shifted = Translation3::from(-offset_m) * camera_from_target;
+    let robot = scene.y_true * shifted.inverse() * scene.x_true.inverse();
+    scene.camera_from_target[view] = shifted;
+    scene.base_from_gripper[view] = match scene.setup {
+        Setup::EyeInHand => robot,
+        Setup::EyeToHand => robot.inverse(),
+    };
+}
