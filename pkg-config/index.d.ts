@@ -1248,6 +1248,13 @@ export interface RobocalJson {
   decode_image_preview: [never, ImageInfo];
   /** `detect_target(bytes, JSON.stringify(target) or a TargetSpec)` -> Detection. */
   detect_target: [Target, Detection];
+  /**
+   * `detect_boards(bytes, JSON.stringify(target) or a TargetSpec)` -> Detection[]: every board
+   * of a marker board's layout in the image, the target's own first (when in view), then boards
+   * printed with other blocks of ids (each one's `target.first_id` says which); other targets
+   * give their one detection.
+   */
+  detect_boards: [Target, Detection[]];
   /** `calibrate_camera(input)` -> `{report, comparison}`. */
   calibrate_camera: [CalibrationInput, CalibrationOutput];
   /** `calibrate_stereo(input)` -> the stereo report. */

@@ -315,6 +315,27 @@ pub fn detect_target(
     serde_json::to_string(&detection).map_err(|e| JsError::new(&e.to_string()))
 }
 
+/// Every board of the target's layout in image bytes (`detect::detect_all`):
+/// a JSON array of Detection JSON, the target's own board first when it is
+/// in view, then boards printed with other blocks of ids (each detection's
+/// `target.first_id` says which). Other targets give their one detection.
+/// Errors as [`detect_target`] when no board is found.
+#[wasm_bindgen]
+pub fn detect_boards(
+    bytes: &[u8],
+    target_spec_or_json: &str,
+    options_json: Option<String>,
+) -> Result<String, JsError> {
+    let target = target_from(target_spec_or_json)?;
+    let image = decode(bytes, &decode_options(options_json)?)
+        .map_err(js_error)?
+        .gray;
+    let detections =
+        crate::detect::detect_all(&image, &target, &crate::detect::DetectOptions::default())
+            .map_err(js_error)?;
+    serde_json::to_string(&detections).map_err(|e| JsError::new(&e.to_string()))
+}
+
 /// Write a report (camera or hand-eye JSON) in an export format: the same
 /// bytes as `robocal export REPORT --format FORMAT [--transform NAME]`.
 /// `transform` may be empty for the default transform.

@@ -10,7 +10,7 @@
 
 /** What a request does, for messages: "detecting the target in board.png". */
 const STEPS = {
-  preview: 'decoding', detect: 'detecting the target in', undistort: 'undistorting', calibrate: 'solving the camera',
+  preview: 'decoding', detect: 'detecting the target in', boards: 'detecting the boards in', undistort: 'undistorting', calibrate: 'solving the camera',
   handeye: 'solving the hand-eye calibration', stereo: 'solving the stereo pair', export: 'exporting', poses: 'reading the robot poses',
   demo: 'rendering the demo', target: 'checking the target', kalibrTarget: 'reading the Kalibr target file', pair: 'pairing the stereo images', conventions: 'ranking the pose conventions',
   workflow: 'solving the workflow', 'workflow-csv': 'reading the workflow file',

@@ -22,6 +22,7 @@ const SHELL = [
   'lib/mat4.js',
   'lib/plot.js',
   'lib/view3d.js',
+  'views/boards.js',
   'views/camera.js',
   'views/export.js',
   'views/handeye.js',

@@ -38,6 +38,21 @@ const handlers = {
     await ready;
     return JSON.parse(robocal.detect_target(new Uint8Array(bytes), spec, imageOptions(maxPixels)));
   },
+  /**
+   * Marker boards: every board of the target's layout in the image
+   * (`detect_boards`), split into `detection` (the target's own board, null
+   * when it is not in view) and `others` (boards printed with other blocks
+   * of ids; each detection's target names its first id). No board at all
+   * is an error, as with `detect`.
+   */
+  async boards({ bytes, spec, maxPixels }) {
+    await ready;
+    const key = (t) => robocal.target_spec(JSON.stringify(t));
+    const want = robocal.target_spec(spec);
+    const all = JSON.parse(robocal.detect_boards(new Uint8Array(bytes), spec, imageOptions(maxPixels)));
+    const own = all.find((d) => key(d.target) === want) || null;
+    return { detection: own, others: all.filter((d) => d !== own) };
+  },
   /** Everything the target step shows, from the core: the target JSON, its CLI spec, its points and its printable sheet. */
   async target({ spec }) {
     await ready;

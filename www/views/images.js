@@ -3,6 +3,7 @@
 // inspector with zoom and residuals, include/exclude, and a coverage map.
 import { $, h, fill, trapFocus } from '../lib/dom.js';
 import { targetSpec } from './target.js';
+import { MARKER_BOARDS, pointCount, otherBoard, notTheTarget, otherBoardsText, fillBoardButtons, drawOtherBoards } from './boards.js';
 
 const THUMB_SIDE = 320;
 const IMAGE_EXT = /\.(png|jpe?g|tiff?|bmp|pgm|ppm|pnm|gif)$/i;
@@ -194,10 +195,19 @@ export class ImagesView {
       try {
         const bytes = this.store.bytes.get(img.id).slice(0);
         img.largerGrid = null;
-        try {
-          img.detection = await this.pool.call('detect', { bytes, spec, name: img.name }, [bytes]);
-        } catch (err) {
-          img.detection = await this.largerGrid(img, err);
+        img.otherBoards = null;
+        if (this.board && MARKER_BOARDS.has(this.board.kind)) {
+          // Every board of the layout: the target's own and other id blocks.
+          const found = await this.pool.call('boards', { bytes, spec, name: img.name }, [bytes]);
+          img.otherBoards = found.others.map(otherBoard);
+          if (!found.detection) throw new Error(notTheTarget(this.store.session.target, img.otherBoards));
+          img.detection = found.detection;
+        } else {
+          try {
+            img.detection = await this.pool.call('detect', { bytes, spec, name: img.name }, [bytes]);
+          } catch (err) {
+            img.detection = await this.largerGrid(img, err);
+          }
         }
         if (img.status === 'error') img.included = true; // found now (e.g. after a target change)
         img.status = 'detected';
@@ -262,10 +272,11 @@ export class ImagesView {
     const tools = h('span', { class: 'card-tools' },
       tool('move earlier:', '◀', () => this.move(img, -1)), tool('move later:', '▶', () => this.move(img, 1)),
       tool('remove', 'Remove', () => this.remove(img)));
+    const boards = h('div', { class: 'card-row boards', hidden: true });
     const li = h('li', { class: 'card pending', dataset: { id: img.id } }, canvas,
-      h('p', { class: 'name' }, img.name), meta, h('div', { class: 'card-row' }, order, h('label', { class: 'include' }, toggle, ' use'), tools));
+      h('p', { class: 'name' }, img.name), meta, boards, h('div', { class: 'card-row' }, order, h('label', { class: 'include' }, toggle, ' use'), tools));
     $('cards').append(li);
-    this.cards.set(img.id, { li, canvas, meta, toggle, order });
+    this.cards.set(img.id, { li, canvas, meta, toggle, order, boards });
   }
 
   /** Move `img` one place earlier (-1) or later (+1) in the session's order. */
@@ -304,14 +315,24 @@ export class ImagesView {
       card.meta.textContent = img.error;
       return;
     }
-    if (p) drawImage(card.canvas, p, img.detection ? img.detection.points : [], p.scale, 1);
+    const others = img.otherBoards || [];
+    if (p) drawImage(card.canvas, p, img.detection ? img.detection.points : [], p.scale, 1, [], false, others);
+    fillBoardButtons(card.boards, others, img.name, (b) => this.useBoard(b));
     card.li.className = `card ${img.status === 'error' ? 'warn' : 'ok'}${img.included ? '' : ' excluded'}`;
     const parts = [describe(img.info)];
     if (img.detection) parts.push(pointCount(img.detection.points, this.board));
     if (img.largerGrid) parts.push(img.largerGrid);
     if (img.status === 'error') parts.push(img.error);
+    if (others.length) parts.push(otherBoardsText(others, (pts) => pointCount(pts, this.board)));
     if (img.bytesMissing) parts.push('from a session file: add the image to see it');
     card.meta.textContent = parts.join(' · ');
+  }
+
+  /** Make another board (one of a card's other id blocks) the target: the target step shows it, every image is detected again. */
+  useBoard(board) {
+    this.store.session.target = board.target;
+    this.store.changed('target-loaded');
+    this.store.changed('target');
   }
 
   refresh() {
@@ -359,7 +380,7 @@ export class ImagesView {
     if (!img || !this.full) return;
     const zoom = Number($('inspector-zoom').value);
     const res = this.residuals.get(img.name) || [];
-    drawImage($('inspector-canvas'), this.full, img.detection ? img.detection.points : [], this.full.scale, zoom, res, true);
+    drawImage($('inspector-canvas'), this.full, img.detection ? img.detection.points : [], this.full.scale, zoom, res, true, img.otherBoards || []);
     const rms = res.length ? Math.sqrt(res.reduce((s, r) => s + r.dx * r.dx + r.dy * r.dy, 0) / res.length) : null;
     $('inspector-info').textContent = `${describe(img.info)} · ${img.detection ? pointCount(img.detection.points, this.board) : img.error || 'not detected'}` +
       (rms !== null ? ` · reprojection RMS ${rms.toFixed(3)} px (residual vectors drawn ×${RESIDUAL_GAIN})` : '');
@@ -368,32 +389,6 @@ export class ImagesView {
 
 const RESIDUAL_GAIN = 20;
 
-/** Marker boards report the corners they see, any subset of the board's. */
-const MARKER_BOARDS = new Set(['charuco', 'aprilgrid']);
-
-/**
- * A card's point count. Whole-target kinds: "54 points". Marker boards:
- * "41 of 88 corners (partial view) · ids 0-5, 9-12, ..." (a partial view
- * is a valid detection: the solvers use any subset of the points).
- */
-export function pointCount(points, board) {
-  if (!board || !MARKER_BOARDS.has(board.kind)) return `${points.length} points`;
-  const partial = points.length < board.total ? ' (partial view)' : '';
-  return `${points.length} of ${board.total} corners${partial} · ids ${idRanges(points.map((p) => p.id))}`;
-}
-
-/** Sorted ids as ranges: [0,1,2,5,7,8] -> "0-2, 5, 7-8"; long lists end in "…". */
-export function idRanges(ids, most = 6) {
-  const runs = [];
-  for (const id of [...ids].sort((a, b) => a - b)) {
-    const last = runs[runs.length - 1];
-    if (last && id === last[1] + 1) last[1] = id;
-    else runs.push([id, id]);
-  }
-  const text = runs.slice(0, most).map(([a, b]) => (a === b ? `${a}` : `${a}-${b}`));
-  return text.join(', ') + (runs.length > most ? ', …' : '');
-}
-
 function describe(info) {
   if (!info) return '';
   const channels = { 1: 'grey', 2: 'grey + alpha', 3: 'RGB', 4: 'RGBA' }[info.channels] || `${info.channels} channels`;
@@ -401,7 +396,7 @@ function describe(info) {
 }
 
 /** Draw a preview with its points (pixel coordinates of the full image) at `zoom`. */
-function drawImage(canvas, p, points, scale, zoom, residuals = [], ids = false) {
+function drawImage(canvas, p, points, scale, zoom, residuals = [], ids = false, others = []) {
   const { width, height } = p.image; // the core's ImageData, put as it came
   canvas.width = Math.round(width * zoom);
   canvas.height = Math.round(height * zoom);
@@ -415,6 +410,7 @@ function drawImage(canvas, p, points, scale, zoom, residuals = [], ids = false) 
   const X = (x) => (x + 0.5) * k;
   const Y = (y) => (y + 0.5) * k;
   const r = Math.max(2, Math.min(6, 3 * zoom));
+  drawOtherBoards(ctx, others, X, Y);
   points.forEach((pt, i) => {
     ctx.strokeStyle = i === 0 ? '#1f77b4' : '#ff7f0e';
     ctx.lineWidth = i === 0 ? 2.5 : 1.5;
