@@ -1312,7 +1312,7 @@ export interface ImagePairing {
 
 /**
  * The optional last argument of `image_info`, `decode_image_preview`,
- * `detect_target` and `undistort_preview`, as JSON text: the largest image
+ * `detect_target`, `detect_boards` and `undistort_preview`, as JSON text: the largest image
  * accepted, pixels (default 64 MP in wasm). Over it the error names the
  * image size and the limit.
  */

@@ -138,6 +138,9 @@ output('decode_image_preview', JSON.parse(robocal.decode_image_preview(png(meta.
 input('detect_target', meta.target);
 const detections = meta.images.map((im) => output('detect_target', JSON.parse(robocal.detect_target(png(im), JSON.stringify(meta.target)))));
 const views = meta.images.map((im, i) => ({ name: im.name, detection: detections[i] }));
+input('detect_boards', meta.target);
+// A chessboard is one board: detect_boards gives detect_target's detection alone.
+assert.deepEqual(output('detect_boards', JSON.parse(robocal.detect_boards(png(meta.images[0]), JSON.stringify(meta.target)))), [detections[0]]);
 
 const all = call('calibrate_camera', { model: 'brown', method: 'all', views }, 'calibrate_camera all');
 // A flat board: the DLT is left out and the note says why.

@@ -87,6 +87,11 @@ const meanErr = errs.reduce((a, b) => a + b, 0) / errs.length;
 // leave room for a blurrier view yet catch a wrong id or a corner off by one square.
 assert.ok(meanErr < 0.1 && Math.max(...errs) < 0.3, 'ChArUco corner error px: mean ' + meanErr + ', max ' + Math.max(...errs));
 console.log('charuco detected: 35 corners, mean error ' + meanErr.toFixed(4) + ' px');
+// detect_boards: one board in view, the same detection as detect_target's; a target with other ids finds it as another board.
+const view0 = readFileSync(new URL('./charuco/view_000.png', import.meta.url));
+assert.deepEqual(JSON.parse(robocal.detect_boards(view0, JSON.stringify(truth.target))), [found]);
+const shifted = { ...truth.target, first_id: truth.target.first_id + 24 };
+assert.deepEqual(JSON.parse(robocal.detect_boards(view0, JSON.stringify(shifted))).map((d) => [d.target.first_id, d.points.length]), [[truth.target.first_id, 35]]);
 assert.throws(() => robocal.parse_target('chessboard:1x6:30mm'), { message: 'target: a grid needs 2 to 100000 points with at least 2 per side, got 1x6' });
 // Stereo pairing, the rule of robocal stereo.
 assert.deepEqual(JSON.parse(robocal.pair_images('["l10.png","l2.png"]', '["r2.png","r010.png"]')), { paired_by: 'number', pairs: [[0, 1], [1, 0]] });
