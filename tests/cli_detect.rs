@@ -122,3 +122,84 @@ fn usage_errors_name_the_problem() {
     assert!(String::from_utf8_lossy(&out.stdout)
         .contains("robocal detect --target chessboard:9x6:30mm"));
 }
+
+/// Two AprilGrids of one layout, printed with tags 0-35 and 36-71, in one
+/// 640x480 image (the left half of a render of one beside the right half of
+/// a render of the other), and the second board alone: `robocal detect`
+/// with the first board's spec reports it as the detection and the second
+/// under `other_boards`; the image of the second board alone fails (the
+/// target's ids are not in view) and still lists it.
+#[test]
+fn other_boards_of_the_layout_are_listed_per_image() {
+    let dir = temp_dir("boards");
+    let cam = Pinhole {
+        fx: 700.0,
+        fy: 700.0,
+        cx: 319.5,
+        cy: 239.5,
+        width: 640,
+        height: 480,
+    };
+    let spec = "aprilgrid:6x6:20mm:0.3";
+    let draw = |spec: &str, x: f64, seed: u64| {
+        let t = Target::parse_spec(spec).unwrap();
+        let pose = robocal::synth::board_pose(&t, (0.1, -0.1, 0.0), (x, 0.0, 0.5));
+        let o = RenderOptions {
+            seed,
+            ..RenderOptions::default()
+        };
+        render(&cam, &t, &pose, &o).unwrap().image
+    };
+    let a = draw(spec, -0.11, 1);
+    let b = draw(&format!("{spec}:first=36"), 0.11, 2);
+    let w = a.width as usize;
+    let both: Vec<u8> = (0..a.pixels.len())
+        .map(|i| {
+            if i % w < w / 2 {
+                a.pixels[i]
+            } else {
+                b.pixels[i]
+            }
+        })
+        .collect();
+    let both = robocal::image::GrayImage::new(a.width, a.height, both).unwrap();
+    for (name, img) in [("both.png", &both), ("second.png", &b)] {
+        std::fs::write(dir.join(name), robocal::image::encode_png(img).unwrap()).unwrap();
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .current_dir(&dir)
+        .args(["detect", "--target", spec, "both.png", "second.png"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let images = doc["images"].as_array().unwrap();
+    // Whole boards in view: all 144 corners but at most 2 (the page's test
+    // and tests/detect_markers.rs see 142-144 on such renders).
+    let count = |d: &serde_json::Value| d["points"].as_array().unwrap().len();
+    let both = &images[0];
+    assert_eq!(both["detection"]["target"]["first_id"], 0);
+    assert!(
+        count(&both["detection"]) >= 142,
+        "{}",
+        count(&both["detection"])
+    );
+    let others = both["other_boards"].as_array().unwrap();
+    assert_eq!(others.len(), 1);
+    assert_eq!(others[0]["target"]["first_id"], 36);
+    assert!(count(&others[0]) >= 142, "{}", count(&others[0]));
+    let second = &images[1];
+    assert!(second["error"].is_object(), "{second}");
+    assert_eq!(second["other_boards"][0]["target"]["first_id"], 36);
+    assert!(
+        stderr.contains(
+            "both.png: other boards in view: aprilgrid:6x6:20mm:0.3:first=36 (other_boards)"
+        ),
+        "{stderr}"
+    );
+}

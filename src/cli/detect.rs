@@ -4,7 +4,7 @@
 use super::{parse_target, read_file, CliError, ImageLimits};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use robocal::detect::{detect, CentreModel, DetectOptions};
+use robocal::detect::{detect, detect_all, CentreModel, DetectOptions};
 use robocal::image::DecodeOptions;
 use robocal::target::{Detection, Target};
 use serde_json::json;
@@ -17,7 +17,10 @@ use std::time::Instant;
     after_help = "Output: {\"robocal_version\", \"target\", \"images\": [{\"file\",
 \"detection\": {image_size_px, target, points: [{id, x_px, y_px}]},
 \"detect_ms\"} or {\"file\", \"error\": {\"kind\", \"message\"}}]} in the order
-the files were given (see docs/detection-json.md). Failures are also
+the files were given (see docs/detection-json.md). Marker boards: an
+image that also shows boards of the same layout printed with other blocks of
+ids gets \"other_boards\": [detection, ...] (each with its target's first_id;
+pass --target ...:first=N to make one of them the target). Failures are also
 printed on standard error; the other images go on. Exits with 1 when no
 image gave a detection.
 
@@ -96,11 +99,12 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
     };
     let files = &args.images;
     let decode = args.limits.decode_options();
-    let outcomes = run_all(files, &target, &options, &decode, args.threads)?;
+    let all_boards = matches!(target, Target::Charuco { .. } | Target::Aprilgrid { .. });
+    let outcomes = run_with(files, &target, &options, &decode, args.threads, all_boards)?;
     let mut images = Vec::with_capacity(files.len());
     let mut found = 0;
-    for (file, outcome) in files.iter().zip(outcomes) {
-        images.push(match outcome {
+    for (file, (outcome, others)) in files.iter().zip(outcomes) {
+        let mut entry = match outcome {
             Outcome::Found(d, seconds) => {
                 found += 1;
                 let ms = (seconds * 1e6).round() / 1e3;
@@ -110,7 +114,16 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
                 eprintln!("robocal detect: {file}: {message}");
                 json!({"file": file, "error": {"kind": kind, "message": message}})
             }
-        });
+        };
+        if !others.is_empty() {
+            let firsts: Vec<String> = others.iter().map(|d| d.target.to_spec()).collect();
+            eprintln!(
+                "robocal detect: {file}: other boards in view: {} (other_boards)",
+                firsts.join(", ")
+            );
+            entry["other_boards"] = json!(others);
+        }
+        images.push(entry);
     }
     let doc = json!({
         "robocal_version": robocal::VERSION,
@@ -159,6 +172,20 @@ pub(super) fn run_all(
     decode: &DecodeOptions,
     threads: Option<usize>,
 ) -> Result<Vec<Outcome>, CliError> {
+    let outcomes = run_with(files, target, options, decode, threads, false)?;
+    Ok(outcomes.into_iter().map(|(o, _)| o).collect())
+}
+
+/// [`run_all`], with `all_boards` also the other boards of a marker
+/// board's layout in each image (`detect::detect_all`).
+fn run_with(
+    files: &[String],
+    target: &Target,
+    options: &DetectOptions,
+    decode: &DecodeOptions,
+    threads: Option<usize>,
+    all_boards: bool,
+) -> Result<Vec<(Outcome, Vec<Detection>)>, CliError> {
     // `--threads 0` has always meant one thread; rayon reads 0 as "default".
     let threads = threads.map_or(0, |n| n.max(1));
     let pool = rayon::ThreadPoolBuilder::new()
@@ -170,7 +197,7 @@ pub(super) fn run_all(
         files
             .par_iter()
             .map(|file| {
-                let outcome = guarded(file, target, options, decode);
+                let outcome = guarded(file, target, options, decode, all_boards);
                 bar.set_message(file.clone());
                 bar.inc(1);
                 outcome
@@ -190,32 +217,56 @@ fn guarded(
     target: &Target,
     options: &DetectOptions,
     decode: &DecodeOptions,
-) -> Outcome {
+    all_boards: bool,
+) -> (Outcome, Vec<Detection>) {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        one(file, target, options, decode)
+        one(file, target, options, decode, all_boards)
     }))
     .unwrap_or_else(|_| {
-        Outcome::Failed(
+        let crashed = Outcome::Failed(
             "internal".into(),
             "the detector crashed on this image".into(),
-        )
+        );
+        (crashed, Vec::new())
     })
 }
 
-fn one(file: &str, target: &Target, options: &DetectOptions, decode: &DecodeOptions) -> Outcome {
+/// One image: the target's detection and, with `all_boards`, the other
+/// boards of its layout (the target's own missing: the failure is
+/// [`detect`]'s, whose message names what was seen).
+fn one(
+    file: &str,
+    target: &Target,
+    options: &DetectOptions,
+    decode: &DecodeOptions,
+    all_boards: bool,
+) -> (Outcome, Vec<Detection>) {
+    let failed = |kind: &str, message: String| (Outcome::Failed(kind.into(), message), Vec::new());
     let bytes = match read_file(file) {
         Ok(b) => b,
-        Err(e) => return Outcome::Failed("io".into(), e.to_string()),
+        Err(e) => return failed("io", e.to_string()),
     };
     let image = match robocal::image::decode(&bytes, decode) {
         Ok(d) => d.gray,
-        Err(e) => return Outcome::Failed(e.kind().into(), e.to_string()),
+        Err(e) => return failed(e.kind(), e.to_string()),
     };
     let start = Instant::now();
-    match detect(&image, target, options) {
+    let mut others = Vec::new();
+    if all_boards {
+        if let Ok(mut boards) = detect_all(&image, target, options) {
+            let own = target.to_spec();
+            if let Some(i) = boards.iter().position(|d| d.target.to_spec() == own) {
+                let d = boards.remove(i);
+                return (Outcome::Found(d, start.elapsed().as_secs_f64()), boards);
+            }
+            others = boards;
+        }
+    }
+    let outcome = match detect(&image, target, options) {
         Ok(d) => Outcome::Found(d, start.elapsed().as_secs_f64()),
         Err(e) => Outcome::Failed(e.kind().into(), e.to_string()),
-    }
+    };
+    (outcome, others)
 }
 
 #[cfg(test)]
