@@ -201,3 +201,48 @@ pub fn shift_view(scene: &mut LookingScene, view: usize, offset_m: Vector3<f64>)
         Setup::EyeToHand => robot.inverse(),
     };
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    /// A shifted view keeps the chain exact (to rounding) and moves the
+    /// camera by the offset along its own axes, orientation unchanged.
+    #[wasm_bindgen_test(unsupported = test)]
+    fn a_shifted_view_moves_the_camera_and_keeps_the_chain_closed() {
+        for setup in [Setup::EyeInHand, Setup::EyeToHand] {
+            let config = LookingConfig {
+                setup,
+                views: 4,
+                distance_m: 0.5,
+                grid: (9, 6, 0.03),
+                max_tilt_deg: 30.0,
+                max_roll_deg: 60.0,
+            };
+            let mut scene = looking_scene(&config, 7);
+            let before = scene.camera_from_target[1];
+            let offset = Vector3::new(0.05, -0.02, 0.01);
+            shift_view(&mut scene, 1, offset);
+            shift_view(&mut scene, 99, offset); // out of range: ignored
+            let after = scene.camera_from_target[1];
+            // The camera centre in the target frame moved by R * offset.
+            let moved = after.inverse().translation.vector - before.inverse().translation.vector;
+            let expected = before.inverse().rotation * offset;
+            assert!((moved - expected).norm() < 1e-12, "moved {moved:?} m");
+            assert!(after.rotation.angle_to(&before.rotation) < 1e-12);
+            for k in 0..4 {
+                let robot = match setup {
+                    Setup::EyeInHand => scene.base_from_gripper[k],
+                    Setup::EyeToHand => scene.base_from_gripper[k].inverse(),
+                };
+                let y = robot * scene.x_true * scene.camera_from_target[k];
+                let d = (y.to_homogeneous() - scene.y_true.to_homogeneous()).amax();
+                assert!(
+                    d < 1e-12,
+                    "{setup:?} view {k}: chain off by {d} (m, unitless)"
+                );
+            }
+        }
+    }
+}
