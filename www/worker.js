@@ -5,6 +5,7 @@
 // unrun (`bounced`, with its buffers) and engine.js moves them to a fresh
 // worker.
 import init, * as robocal from './pkg/robocal.js';
+import { greyFromRgba, pgm } from './lib/frames.js';
 
 const ready = init().then(() => {
   robocal.init();
@@ -112,6 +113,32 @@ handlers.undistort = async ({ bytes, camera, maxSide, maxPixels }) => {
 handlers.stereo = async ({ input }) => {
   await ready;
   return JSON.parse(robocal.calibrate_stereo(input));
+};
+
+/**
+ * Live detection on one video frame (an ImageBitmap, transferred): its grey
+ * pixels go through the same detection call as an uploaded image. A frame
+ * without the target is an answer, not an error: `{ found: false, reason }`.
+ * `ms` is the time spent here (grey conversion and detection).
+ */
+handlers.frame = async ({ bitmap, spec }) => {
+  await ready;
+  const started = performance.now();
+  const { width, height } = bitmap;
+  const canvas = new OffscreenCanvas(width, height);
+  const ctx = canvas.getContext('2d', { willReadFrequently: true });
+  ctx.drawImage(bitmap, 0, 0);
+  bitmap.close();
+  const grey = greyFromRgba(ctx.getImageData(0, 0, width, height).data, width, height);
+  let detection = null;
+  let reason = null;
+  try {
+    detection = JSON.parse(robocal.detect_target(pgm(grey, width, height), spec));
+  } catch (err) {
+    if (err instanceof WebAssembly.RuntimeError) throw err;
+    reason = err && err.message ? err.message : String(err);
+  }
+  return { found: !!detection, detection, reason, width, height, ms: performance.now() - started };
 };
 
 /** The ArrayBuffers in a request's arguments (handed back with a bounced request). */
