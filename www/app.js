@@ -134,7 +134,7 @@ async function main() {
   const images = new ImagesView(store, engine, pool);
   await images.restore();
   // The live camera detects in a worker of its own: solves never hold up the preview.
-  new CaptureView(store, images, () => new Engine());
+  new CaptureView(store, images, engine, () => new Engine(), () => robotView);
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);
   robotView = robot;

@@ -26,6 +26,7 @@ const SHELL = [
   'lib/view3d.js',
   'views/camera.js',
   'views/capture.js',
+  'views/capture-poses.js',
   'views/export.js',
   'views/handeye.js',
   'views/images.js',

@@ -123,4 +123,35 @@ export const tests = [
     await page.waitForFunction(() => document.querySelectorAll('.card').length === 3, null, { timeout: 30000 });
     assert.equal((await cards(page))[2].name, 'capture_003.png');
   }],
+  ['hand-eye capture: a typed pose goes with its frame, a bad line captures nothing, the robot step reads the typed poses', async (page, { url, shot }) => {
+    await open(page, url);
+    await page.click('#camera-start');
+    await live(page);
+    await page.fill('#capture-pose', '0.4 0.1');
+    await page.click('#capture-frame');
+    await page.waitForFunction(() => /^Nothing captured/.test(document.getElementById('capture-pose-note').textContent), null, { timeout: 20000 });
+    const note = await page.textContent('#capture-pose-note');
+    assert.match(note, /^Nothing captured: the robot pose could not be read \(.+\)\. Correct the line, or empty it to capture without a pose\.$/);
+    assert.equal(await page.$$eval('.card', (c) => c.length), 0, 'no frame without its pose');
+    // Two UR poses (metres, rotation vector), the second one by Enter in the field.
+    const poses = ['0.412,-0.105,0.331,2.2,-2.21,0.01', '0.5,0.0,0.4,0.0,3.1,0.2'];
+    await page.fill('#capture-pose', poses[0]);
+    await page.click('#capture-frame');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 1, null, { timeout: 20000 });
+    assert.match(await page.textContent('#capture-pose-note'), /^capture_001\.png is paired with the pose read as /);
+    assert.equal(await page.inputValue('#capture-pose'), '', 'the field is emptied for the next pose');
+    await page.fill('#capture-pose', poses[1]);
+    await page.press('#capture-pose', 'Enter');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 2, null, { timeout: 20000 });
+    await shot('captured-with-poses');
+    await page.click('a[data-step=robot]');
+    await page.locator('#pose-table').waitFor({ timeout: 20000 });
+    assert.match(await page.textContent('#pose-format-used'), /^poses typed at capture: 2 poses read as /);
+    const rows = await page.$$eval('#pose-table tbody tr', (trs) => trs.map((tr) => [...tr.children].map((td) => td.textContent)));
+    // x y z shown in mm: the typed metres times 1000.
+    assert.deepEqual(rows.map((r) => r.slice(3, 6).map(Number)), [[412, -105, 331], [500, 0, 400]]);
+    const pairing = await page.$$eval('#pairing-table tbody tr', (trs) => trs.map((tr) => tr.children[2].textContent));
+    assert.deepEqual(pairing, ['capture_001.png', 'capture_002.png']);
+    await shot('robot-step');
+  }],
 ];

@@ -8,6 +8,7 @@
 import { $, download } from '../lib/dom.js';
 import { cameraErrorText, videoInputs, openCamera, capabilities, resolutionChoices, stopStream, RateMeter } from '../lib/camera.js';
 import { targetSpec } from './target.js';
+import { CapturePoses } from './capture-poses.js';
 
 /** Marker boards report any subset of their corners: fewer than all is "partly found". */
 const MARKER_BOARDS = new Set(['charuco', 'aprilgrid']);
@@ -17,11 +18,16 @@ const CAPTURE_NAME = /^capture_(\d+)\.png$/;
 const MOST_IDS = 120;
 
 export class CaptureView {
-  /** `images` is the ImagesView (captures join its session); `makeEngine()` gives the live detection's own worker. */
-  constructor(store, images, makeEngine) {
+  /**
+   * `images` is the ImagesView (captures join its session); `engine` reads
+   * typed robot poses; `makeEngine()` gives the live detection's own worker;
+   * `robot()` the RobotView once it exists.
+   */
+  constructor(store, images, engine, makeEngine, robot) {
     this.store = store;
     this.images = images;
     this.makeEngine = makeEngine;
+    this.poses = new CapturePoses(store, engine, robot);
     this.live = null; // the Engine that detects live frames
     this.stream = null;
     this.inFlight = false;
@@ -42,6 +48,7 @@ export class CaptureView {
     $('camera-device').addEventListener('change', () => { if (this.stream) this.start(); });
     $('camera-resolution').addEventListener('change', () => { if (this.stream) this.start(); });
     $('capture-frame').addEventListener('click', () => this.capture());
+    $('capture-pose').addEventListener('keydown', (e) => { if (e.key === 'Enter') { e.preventDefault(); this.capture(); } });
     $('download-captures').addEventListener('click', () => this.downloadCaptures());
     document.addEventListener('keydown', (e) => {
       if (e.key !== ' ' || !this.stream || $('step-images').hidden) return;
@@ -53,7 +60,12 @@ export class CaptureView {
     if (navigator.mediaDevices && navigator.mediaDevices.addEventListener) {
       navigator.mediaDevices.addEventListener('devicechange', () => this.listDevices());
     }
-    this.store.onChange((what) => { if (/images|all/.test(what)) this.countCaptures(); });
+    this.store.onChange((what) => {
+      if (!/images|all/.test(what)) return;
+      this.countCaptures();
+      // A removed or moved capture takes its typed pose along.
+      if (what === 'images' && this.images.images.some((i) => i.robotPose)) this.poses.sync();
+    });
     this.countCaptures();
   }
 
@@ -273,9 +285,25 @@ export class CaptureView {
   async capture(extra = {}) {
     if (!this.stream || !$('camera-video').videoWidth) return null;
     const name = this.nextCaptureName();
+    // A typed robot pose must read before the frame is taken: a capture
+    // without its pose would shift the pairing of every later one.
+    const line = this.poses.line;
+    let reading = null;
+    if (line) {
+      try {
+        reading = await this.poses.check(line);
+      } catch (err) {
+        this.poses.note(`Nothing captured: the robot pose could not be read (${err.message}). Correct the line, or empty it to capture without a pose.`);
+        return null;
+      }
+    }
+    this.say('');
     try {
       const bytes = await this.grabPng();
-      await this.images.addBytes([{ name, bytes, source: 'camera', ...extra }]);
+      // The frame's card appears at once; detection of the PNG follows.
+      const done = this.images.addBytes([{ name, bytes, source: 'camera', ...(line ? { robotPose: line } : {}), ...extra }]);
+      if (line) await this.poses.captured(name, line, reading);
+      await done;
     } catch (err) {
       this.say(`The frame could not be captured: ${err.message}`);
       return null;
