@@ -27,6 +27,7 @@ const SHELL = [
   'views/camera.js',
   'views/capture.js',
   'views/capture-poses.js',
+  'views/capture-solve.js',
   'views/export.js',
   'views/handeye.js',
   'views/images.js',

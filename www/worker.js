@@ -5,7 +5,7 @@
 // unrun (`bounced`, with its buffers) and engine.js moves them to a fresh
 // worker.
 import init, * as robocal from './pkg/robocal.js';
-import { greyFromRgba, pgm } from './lib/frames.js';
+import { greyFromRgba, greyFromVideoFrame, pgm } from './lib/frames.js';
 
 const ready = init().then(() => {
   robocal.init();
@@ -116,20 +116,19 @@ handlers.stereo = async ({ input }) => {
 };
 
 /**
- * Live detection on one video frame (an ImageBitmap, transferred): its grey
- * pixels go through the same detection call as an uploaded image. A frame
- * without the target is an answer, not an error: `{ found: false, reason }`.
- * `ms` is the time spent here (grey conversion and detection).
+ * Live detection on one video frame: a WebCodecs VideoFrame (its luma plane
+ * read as it is) or an ImageBitmap (drawn, then grey from RGBA), either
+ * transferred and closed here. Its grey pixels go through the same
+ * detection call as an uploaded image. A frame without the target is an
+ * answer, not an error: `{ found: false, reason }`. `ms` is the time spent
+ * here (grey pixels and detection).
  */
-handlers.frame = async ({ bitmap, spec }) => {
+handlers.frame = async ({ frame, bitmap, spec }) => {
   await ready;
   const started = performance.now();
-  const { width, height } = bitmap;
-  const canvas = new OffscreenCanvas(width, height);
-  const ctx = canvas.getContext('2d', { willReadFrequently: true });
-  ctx.drawImage(bitmap, 0, 0);
-  bitmap.close();
-  const grey = greyFromRgba(ctx.getImageData(0, 0, width, height).data, width, height);
+  let pixels = frame ? await greyFromVideoFrame(frame) : null;
+  if (!pixels) pixels = greyFromBitmap(bitmap);
+  const { grey, width, height } = pixels;
   let detection = null;
   let reason = null;
   try {
@@ -140,6 +139,15 @@ handlers.frame = async ({ bitmap, spec }) => {
   }
   return { found: !!detection, detection, reason, width, height, ms: performance.now() - started };
 };
+
+function greyFromBitmap(bitmap) {
+  const { width, height } = bitmap;
+  const canvas = new OffscreenCanvas(width, height);
+  const ctx = canvas.getContext('2d', { willReadFrequently: true });
+  ctx.drawImage(bitmap, 0, 0);
+  bitmap.close();
+  return { grey: greyFromRgba(ctx.getImageData(0, 0, width, height).data, width, height), width, height };
+}
 
 /** The ArrayBuffers in a request's arguments (handed back with a bounced request). */
 const buffersOf = (args) => Object.values(args || {}).filter((v) => v instanceof ArrayBuffer);

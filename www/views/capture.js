@@ -9,6 +9,7 @@ import { $, download } from '../lib/dom.js';
 import { cameraErrorText, videoInputs, openCamera, capabilities, resolutionChoices, stopStream, RateMeter } from '../lib/camera.js';
 import { targetSpec } from './target.js';
 import { CapturePoses } from './capture-poses.js';
+import { RunningSolve } from './capture-solve.js';
 
 /** Marker boards report any subset of their corners: fewer than all is "partly found". */
 const MARKER_BOARDS = new Set(['charuco', 'aprilgrid']);
@@ -28,6 +29,9 @@ export class CaptureView {
     this.images = images;
     this.makeEngine = makeEngine;
     this.poses = new CapturePoses(store, engine, robot);
+    // Solves run on the page's main worker: the live worker keeps detecting.
+    this.solve = new RunningSolve(store, engine, () => this.captured().filter((i) => i.included && i.detection));
+    this.solvedKey = '';
     this.live = null; // the Engine that detects live frames
     this.stream = null;
     this.inFlight = false;
@@ -61,6 +65,7 @@ export class CaptureView {
       navigator.mediaDevices.addEventListener('devicechange', () => this.listDevices());
     }
     this.store.onChange((what) => {
+      if (/detections|included|images|all/.test(what)) this.solveIfChanged();
       if (!/images|all/.test(what)) return;
       this.countCaptures();
       // A removed or moved capture takes its typed pose along.
@@ -173,14 +178,24 @@ export class CaptureView {
 
   /** Detect on this frame unless a detection is running (then the frame is dropped). */
   async detectNewest(video, stream) {
-    if (this.inFlight) { this.dropped++; return; }
+    // Busy: this frame is dropped, but the one showing when the detection
+    // ends is taken at once (not a frame later).
+    if (this.inFlight) { this.dropped++; this.missed = true; return; }
+    this.missed = false;
     let spec;
     try { spec = targetSpec(this.store.session.target); } catch { return; }
     this.inFlight = true;
     try {
-      const bitmap = await createImageBitmap(video);
-      const reply = await this.live.call('frame', { bitmap, spec }, [bitmap]);
+      const started = performance.now();
+      // A VideoFrame wraps the decoded frame without a copy; browsers
+      // without WebCodecs hand over an ImageBitmap.
+      const args = typeof VideoFrame === 'function' ? { frame: new VideoFrame(video) } : { bitmap: await createImageBitmap(video) };
+      // The frame just detected, still showing: not again.
+      if (args.frame && args.frame.timestamp === this.lastTimestamp) { args.frame.close(); return; }
+      if (args.frame) this.lastTimestamp = args.frame.timestamp;
+      const reply = await this.live.call('frame', { ...args, spec }, [args.frame || args.bitmap]);
       if (this.stream !== stream) return;
+      reply.cycleMs = performance.now() - started;
       this.detectRate.tick(performance.now());
       this.last = reply;
       this.draw(reply);
@@ -190,6 +205,7 @@ export class CaptureView {
     } finally {
       this.inFlight = false;
     }
+    if (this.missed && this.stream === stream && !$('step-images').hidden) this.detectNewest(video, stream);
   }
 
   /** found (every point), partial (a marker board's subset) or none. */
@@ -244,7 +260,9 @@ export class CaptureView {
       none: 'Board not found',
     }[state];
     const now = performance.now();
-    this.showStatus(state, `${words} · ${reply.width} × ${reply.height} · camera ${this.cameraRate.rate(now).toFixed(1)} fps · detection ${this.detectRate.rate(now).toFixed(1)} fps (${reply.ms.toFixed(0)} ms a frame; frames dropped while busy: ${this.dropped})`);
+    // The first point's position, for tests and scripts that wait for a new view.
+    $('camera-status').dataset.first = points.length ? `${points[0].x_px.toFixed(1)},${points[0].y_px.toFixed(1)}` : '';
+    this.showStatus(state, `${words} · ${reply.width} × ${reply.height} · camera ${this.cameraRate.rate(now).toFixed(1)} fps · detection ${this.detectRate.rate(now).toFixed(1)} fps (${reply.ms.toFixed(0)} ms a frame in the worker, ${reply.cycleMs.toFixed(0)} ms in all; frames dropped while busy: ${this.dropped})`);
   }
 
   showStatus(state, text) {
@@ -309,6 +327,22 @@ export class CaptureView {
       return null;
     }
     return name;
+  }
+
+  /** A new solve when the captured views with the board are not the ones solved last. */
+  solveIfChanged() {
+    const key = this.captured().filter((i) => i.included && i.detection).map((i) => i.id).join(',');
+    if (key === this.solvedKey) return;
+    this.solvedKey = key;
+    this.solve.update();
+  }
+
+  /** A new solve when the captured views with the board are not the ones solved last. */
+  solveIfChanged() {
+    const key = this.captured().filter((i) => i.included && i.detection).map((i) => i.id).join(',');
+    if (key === this.solvedKey) return;
+    this.solvedKey = key;
+    this.solve.update();
   }
 
   captured() { return this.images.images.filter((i) => i.source === 'camera' && this.store.bytes.has(i.id)); }
