@@ -50,9 +50,10 @@ export class CapturePoses {
     const st = this.store.session.robot;
     if (st.fileName && st.fileName !== TYPED_POSES) return;
     const lines = this.store.session.images.filter((i) => i.robotPose).map((i) => i.robotPose);
-    if (!lines.length) return;
+    const text = `${lines.join('\n')}\n`;
+    if (!lines.length || (st.fileName === TYPED_POSES && st.text === text)) return;
     st.fileName = TYPED_POSES;
-    st.text = `${lines.join('\n')}\n`;
+    st.text = text;
     const view = this.robot();
     if (view) { view.render(); await view.parse(); } else this.store.changed('robot');
   }
