@@ -161,7 +161,7 @@ export const tests = [
     assert.deepEqual(pairing, ['capture_001.png', 'capture_002.png']);
     await shot('robot-step');
   }],
-  ['board video: found state drawn, captures detected, the running calibration lands on the true camera within its std', async (page, { url }) => {
+  ['board video: found state drawn, captures detected, the running calibration lands on the true camera within its std, step 3 solves them and the OpenCV export carries the camera', async (page, { url }) => {
     // 8 rendered views of the session's default 9x6 chessboard, 0.8 s each, as the camera's picture.
     const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
     const browser = { close: async () => {} };
@@ -188,7 +188,7 @@ export const tests = [
         seen.push(await first.jsonValue());
         await p.click('#capture-frame');
       }
-      await p.waitForFunction((n) => [...document.querySelectorAll('.card .meta')].filter((m) => / · 54 points$/.test(m.textContent)).length === n, CAPTURES, { timeout: 60000 });
+      await p.waitForFunction((n) => [...document.querySelectorAll('.card .meta')].filter((m) => / · 54 points( · the same points as capture_\d+\.png: left out)?$/.test(m.textContent)).length === n, CAPTURES, { timeout: 60000 });
       // Settled: no solve running and every capture's detection in.
       await p.waitForFunction(() => { const s = document.getElementById('capture-solve-summary'); return s.dataset.busy === 'no' && Number(s.dataset.views) >= 5; }, null, { timeout: 60000 })
         .catch(async (e) => { await p.screenshot({ path: join(shotsDir, 'capture-board-failure.png'), fullPage: true }); throw new Error(`${await p.textContent('#capture-solve-summary')} (${e.message})`); });
@@ -209,6 +209,19 @@ export const tests = [
       // Excluding a capture solves again without it (when no other capture has its points).
       await p.locator('.card').first().locator('.include input').uncheck();
       if (views === CAPTURES) await p.waitForFunction((n) => document.getElementById('capture-solve-summary').dataset.views === String(n), views - 1, { timeout: 60000 });
+      // Step 3 solves the same captures; the OpenCV YAML export carries its camera.
+      await p.click('a[data-step=camera]');
+      await p.click('#solve-camera');
+      await p.locator('#camera-params').waitFor({ timeout: 60000 });
+      await p.click('a[data-step=export]');
+      await p.click('#camera-formats button[data-format=opencv-yaml]');
+      await p.waitForFunction(() => /^opencv-yaml: \d+ bytes/.test(document.getElementById('export-status').textContent), null, { timeout: 20000 });
+      const [download] = await Promise.all([p.waitForEvent('download'), p.click('#export-download')]);
+      const yaml = readFileSync(await download.path(), 'utf8');
+      const m = /camera_matrix: !!opencv-matrix\s+rows: 3\s+cols: 3\s+dt: d\s+data: \[\s*([-\d.e+]+),\s*[-\d.e+]+,\s*([-\d.e+]+),/.exec(yaml);
+      assert.ok(m, yaml.slice(0, 400));
+      assert.ok(Math.abs(Number(m[1]) - want.fx) < Math.max(4 * params.fx[1], 0.3) && Math.abs(Number(m[2]) - want.cx) < Math.max(4 * params.cx[1], 0.3), `exported fx ${m[1]}, cx ${m[2]}`);
+      await p.screenshot({ path: join(shotsDir, 'capture-board-3-exported.png'), fullPage: true });
       assert.deepEqual(errors, []);
     } finally {
       await other.close();

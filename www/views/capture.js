@@ -322,11 +322,30 @@ export class CaptureView {
       const done = this.images.addBytes([{ name, bytes, source: 'camera', ...(line ? { robotPose: line } : {}), ...extra }]);
       if (line) await this.poses.captured(name, line, reading);
       await done;
+      this.leaveOutRepeat(name);
     } catch (err) {
       this.say(`The frame could not be captured: ${err.message}`);
       return null;
     }
     return name;
+  }
+
+  /**
+   * A capture whose points are exactly those of an earlier one (camera and
+   * board both still) adds nothing, and the solvers refuse a view given
+   * twice: it is kept but left out, with a note on its card.
+   */
+  leaveOutRepeat(name) {
+    const img = this.images.images.find((i) => i.name === name);
+    if (!img || !img.detection) return;
+    const key = JSON.stringify(img.detection.points);
+    const earlier = this.captured().find((i) => i !== img && i.detection && JSON.stringify(i.detection.points) === key);
+    if (!earlier) return;
+    img.included = false;
+    img.note = `the same points as ${earlier.name}: left out`;
+    this.images.renderCard(img);
+    this.images.refresh();
+    this.store.changed('included');
   }
 
   /** A new solve when the captured views with the board are not the ones solved last. */
@@ -335,6 +354,24 @@ export class CaptureView {
     if (key === this.solvedKey) return;
     this.solvedKey = key;
     this.solve.update();
+  }
+
+  /**
+   * A capture whose points are exactly those of an earlier one (camera and
+   * board both still) adds nothing, and the solvers refuse a view given
+   * twice: it is kept but left out, with a note on its card.
+   */
+  leaveOutRepeat(name) {
+    const img = this.images.images.find((i) => i.name === name);
+    if (!img || !img.detection) return;
+    const key = JSON.stringify(img.detection.points);
+    const earlier = this.captured().find((i) => i !== img && i.detection && JSON.stringify(i.detection.points) === key);
+    if (!earlier) return;
+    img.included = false;
+    img.note = `the same points as ${earlier.name}: left out`;
+    this.images.renderCard(img);
+    this.images.refresh();
+    this.store.changed('included');
   }
 
   /** A new solve when the captured views with the board are not the ones solved last. */

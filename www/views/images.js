@@ -312,6 +312,7 @@ export class ImagesView {
     const parts = [describe(img.info)];
     if (img.detection) parts.push(pointCount(img.detection.points, this.board));
     if (img.largerGrid) parts.push(img.largerGrid);
+    if (img.note) parts.push(img.note); // e.g. a camera capture that repeats an earlier one
     if (img.status === 'error') parts.push(img.error);
     if (img.bytesMissing) parts.push('from a session file: add the image to see it');
     card.meta.textContent = parts.join(' · ');
