@@ -228,4 +228,32 @@ export const tests = [
       rmSync(dir, { recursive: true, force: true });
     }
   }],
+  ['marker board half hidden: partly found, drawn with its ids, a capture is a partial view', async (page, { url }) => {
+    const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
+    let other = { close: async () => {} };
+    try {
+      const { path } = await boardVideo(page, dir, { spec: 'charuco:8x6:30mm:22mm:DICT_5X5_100', camera: cameraJson(640, 480), views: 2, hold: 30, seed: 4, hideRight: 0.45 });
+      other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
+      const p = await (await other.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
+      await open(p, url);
+      await p.click('a[data-step=target]');
+      await p.selectOption('#target-kind', 'charuco');
+      for (const [name, value] of [['squares_x', '8'], ['squares_y', '6'], ['charuco_square_mm', '30'], ['marker_mm', '22']]) await p.fill(`#target-form input[name=${name}]`, value);
+      await p.waitForFunction(() => /^Target spec: charuco:8x6:30mm:22mm:DICT_5X5_100 /.test(document.getElementById('target-spec').textContent), null, { timeout: 20000 });
+      await p.click('a[data-step=images]');
+      await p.click('#camera-start');
+      await p.waitForFunction(() => document.getElementById('camera-status').dataset.state === 'partial', null, { timeout: 30000 });
+      const text = await p.textContent('#camera-status');
+      const m = /^Board partly found: (\d+) of 35 corners · 640 × 480 · /.exec(text);
+      assert.ok(m && Number(m[1]) >= 4 && Number(m[1]) < 35, text);
+      assert.equal(await p.textContent('#camera-found'), 'Board partly found');
+      await p.screenshot({ path: join(shotsDir, 'capture-charuco-partial.png') });
+      await p.click('#capture-frame');
+      await p.waitForFunction(() => /corners \(partial view\)/.test(document.querySelector('.card .meta')?.textContent || ''), null, { timeout: 30000 });
+      assert.match(await p.textContent('.card .meta'), /^PNG · 640×480 px · RGBA, 8-bit · \d+ of 35 corners \(partial view\) · ids /);
+    } finally {
+      await other.close();
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
 ];

@@ -24,11 +24,12 @@ export function cameraJson(w, h, camera = {}) {
 
 /**
  * Render `views` views of `spec` in `dir` through `camera` (a camera JSON)
- * and write `dir/board.y4m`, each view held `hold` frames; `page` is any
+ * and write `dir/board.y4m`, each view held `hold` frames (the right
+ * `hideRight` of each frame painted over); `page` is any
  * Chromium page (it decodes the PNGs). Returns the video's path and the
  * render's truth.json.
  */
-export async function boardVideo(page, dir, { spec, camera, views, hold, seed = 3, noise = 2 }) {
+export async function boardVideo(page, dir, { spec, camera, views, hold, seed = 3, noise = 2, hideRight = 0 }) {
   const [w, h] = camera.image_size_px;
   writeFileSync(join(dir, 'camera.json'), JSON.stringify(camera));
   execFileSync(CLI, ['render', '--out', dir, '--target', spec, '--views', String(views), '--seed', String(seed), '--noise', String(noise), '--camera', join(dir, 'camera.json')], { stdio: 'ignore' });
@@ -49,6 +50,9 @@ export async function boardVideo(page, dir, { spec, camera, views, hold, seed = 
       for (let i = 0; i < d.length; i += 4) s += String.fromCharCode(16 + Math.round((219 * d[i]) / 255));
       return btoa(s);
     }, readFileSync(join(dir, name)).toString('base64')), 'base64');
+    // `hideRight`: that fraction of each frame's right side painted mid-grey (a hand over the board).
+    const from = Math.round(w * (1 - hideRight));
+    if (hideRight > 0) for (let y = 0; y < h; y++) luma.fill(126, y * w + from, (y + 1) * w);
     for (let k = 0; k < hold; k++) {
       writeSync(fd, 'FRAME\n');
       writeSync(fd, luma);

@@ -48,6 +48,8 @@ export class CaptureView {
 
   wire() {
     $('camera-start').addEventListener('click', () => this.start());
+    // Disabled in the page until here: a click before the view exists would do nothing.
+    $('camera-start').disabled = false;
     $('camera-stop').addEventListener('click', () => this.stop());
     $('camera-device').addEventListener('change', () => { if (this.stream) this.start(); });
     $('camera-resolution').addEventListener('change', () => { if (this.stream) this.start(); });
