@@ -10,7 +10,8 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launch, shotsDir } from './harness.mjs';
+import { execFileSync } from 'node:child_process';
+import { launch, root, shotsDir } from './harness.mjs';
 import { boardVideo, cameraJson } from './y4m.mjs';
 
 export const launchArgs = ['--use-fake-device-for-media-stream'];
@@ -18,8 +19,8 @@ export const launchArgs = ['--use-fake-device-for-media-stream'];
 const REFUSED = 'Camera access was refused. Allow the camera for this page (the camera icon in the address bar, or the site settings), then press Start camera again. Image files can still be added above.';
 const NO_CAMERA = 'No camera was found. Connect a camera and press Start camera again, or add image files above.';
 
-/** Captures taken from the board video (of its 8 views). */
-const CAPTURES = 6;
+/** Captures taken from the board video (of its 12 holds). */
+const CAPTURES = 7;
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 
@@ -161,13 +162,15 @@ export const tests = [
     assert.deepEqual(pairing, ['capture_001.png', 'capture_002.png']);
     await shot('robot-step');
   }],
-  ['board video: found state drawn, captures detected, the running calibration lands on the true camera within its std, step 3 solves them and the OpenCV export carries the camera', async (page, { url }) => {
-    // 8 rendered views of the session's default 9x6 chessboard, 0.8 s each, as the camera's picture.
+  ['the renderer\'s video: captures in the holds, the running calibration converges to the video\'s camera within its std, uncertainty shrinks, step 3 and the OpenCV export agree', async (page, { url }) => {
+    // `robocal render --video`: the default 9x6 chessboard through 12 one-second holds, 640x480 at 5 fps.
     const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
-    const browser = { close: async () => {} };
-    let other = browser;
+    let other = { close: async () => {} };
     try {
-      const { path, truth } = await boardVideo(page, dir, { spec: 'chessboard:9x6:30mm', camera: cameraJson(640, 480), views: 8, hold: 24, seed: 11 });
+      const path = join(dir, 'board.y4m');
+      // 5 fps: a hold is 5 frames, the render a third of the default 15 fps's time.
+      execFileSync(join(root, 'target/release/robocal'), ['render', '--video', path, '--seed', '11', '--fps', '5'], { stdio: 'ignore' });
+      const truth = JSON.parse(readFileSync(join(dir, 'board.json'), 'utf8'));
       other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
       const context = await other.newContext({ viewport: { width: 1280, height: 900 } });
       const p = await context.newPage();
@@ -178,24 +181,38 @@ export const tests = [
       await p.waitForFunction(() => document.getElementById('camera-status').dataset.state === 'found', null, { timeout: 30000 });
       assert.match(await p.textContent('#camera-status'), /^Board found: 54 points · 640 × 480 · /);
       await p.screenshot({ path: join(shotsDir, 'capture-board-1-found.png') });
-      // A capture of each new view the live detection finds (the board at a new place).
+      // As a user would: capture when the board has been still for 0.3 s
+      // (its first point within 1 px) at a place not captured yet (5 px away).
       const seen = [];
+      const t0 = Date.now();
       for (let i = 0; i < CAPTURES; i++) {
         const first = await p.waitForFunction((seen) => {
           const s = document.getElementById('camera-status');
-          return s.dataset.state === 'found' && !seen.includes(s.dataset.first) && s.dataset.first;
-        }, seen, { timeout: 30000 });
+          const xy = s.dataset.state === 'found' && s.dataset.first ? s.dataset.first.split(',').map(Number) : null;
+          const w = window.stillFor || (window.stillFor = { xy: null, t: 0 });
+          const near = (a, b, d) => a && b && Math.hypot(a[0] - b[0], a[1] - b[1]) <= d;
+          if (!xy || !near(xy, w.xy, 1)) { w.xy = xy; w.t = performance.now(); return false; }
+          return performance.now() - w.t > 300 && !seen.some((q) => near(q, xy, 5)) ? xy : false;
+        }, seen, { timeout: 30000, polling: 50 });
         seen.push(await first.jsonValue());
+        if (process.env.CAPTURE_DEBUG) console.log(`     capture ${i + 1} at ${Date.now() - t0} ms: first point ${seen[seen.length - 1]}; ${await p.textContent('#camera-status')}`);
         await p.click('#capture-frame');
       }
       await p.waitForFunction((n) => [...document.querySelectorAll('.card .meta')].filter((m) => / · 54 points( · the same points as capture_\d+\.png: left out)?$/.test(m.textContent)).length === n, CAPTURES, { timeout: 60000 });
+      if (process.env.CAPTURE_DEBUG) console.log(`     cards detected at ${Date.now() - t0} ms`);
       // Settled: no solve running and every capture's detection in.
       await p.waitForFunction(() => { const s = document.getElementById('capture-solve-summary'); return s.dataset.busy === 'no' && Number(s.dataset.views) >= 5; }, null, { timeout: 60000 })
         .catch(async (e) => { await p.screenshot({ path: join(shotsDir, 'capture-board-failure.png'), fullPage: true }); throw new Error(`${await p.textContent('#capture-solve-summary')} (${e.message})`); });
+      if (process.env.CAPTURE_DEBUG) console.log(`     settled at ${Date.now() - t0} ms`);
       const summary = await p.textContent('#capture-solve-summary');
       const views = Number(await p.getAttribute('#capture-solve-summary', 'data-views'));
       assert.match(summary, new RegExp(`^Solved from ${views} captured views: RMS \\d\\.\\d+ px; projection uncertainty \\(1 sigma\\) worst \\d\\.\\d+ px, median \\d\\.\\d+ px over the image\\.( ${CAPTURES - views} captures? with the same points as an earlier one left out\\.)?$`));
       const params = Object.fromEntries(await p.$$eval('#capture-params tbody tr', (trs) => trs.map((tr) => [tr.children[0].textContent, [Number(tr.children[1].textContent), Number(tr.children[2].textContent)]])));
+      // The newest solve is the best one: less uncertain than the first (4 captures).
+      const history = (await p.getAttribute('#capture-solve-summary', 'data-history')).split(',').map((e) => e.split(':').map(Number));
+      assert.ok(history[0][0] >= 4 && history[0][0] < CAPTURES, `the first solve has 4 views or so: ${history[0][0]}`);
+      assert.ok(history[history.length - 1][1] < history[0][1], `worst projection uncertainty by views: ${JSON.stringify(history)}`);
+      console.log(`     worst projection uncertainty (px) by captured views: ${history.map(([n, w]) => `${n}: ${w.toFixed(3)}`).join(', ')}`);
       const c = truth.camera;
       const want = { fx: c.fx, fy: c.fy, cx: c.cx, cy: c.cy, k1: c.distortion.k1 };
       for (const [name, value] of Object.entries(want)) {

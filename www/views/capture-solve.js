@@ -76,6 +76,8 @@ export class RunningSolve {
     summary.textContent = `Solved from ${entry.views} captured views: RMS ${num(r.rms_px, 3)} px; projection uncertainty (1 sigma) worst ${num(entry.worst_px, 3)} px, median ${num(entry.median_px, 3)} px over the image.${this.duplicates ? ` ${this.duplicates} capture${this.duplicates === 1 ? '' : 's'} with the same points as an earlier one left out.` : ''}`;
     summary.dataset.views = String(entry.views);
     summary.dataset.worstPx = String(entry.worst_px);
+    // Every solve's view count and worst uncertainty, for scripts: "4:0.31,5:0.27".
+    summary.dataset.history = this.history.map((e) => `${e.views}:${e.worst_px}`).join(',');
     fill($('capture-solve-params'), table(['parameter', 'value', 'std'], Object.keys(value).map((n) => [n, num(value[n], 5), std[n] === undefined ? '—' : num(std[n], 3)]), { id: 'capture-params' }));
     const pu = r.projection_uncertainty;
     const [w, hh] = r.image_size_px;

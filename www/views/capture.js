@@ -67,6 +67,8 @@ export class CaptureView {
       navigator.mediaDevices.addEventListener('devicechange', () => this.listDevices());
     }
     this.store.onChange((what) => {
+      // Another target while the camera runs: "partly found" counts against its points.
+      if (/^target/.test(what) && this.stream) this.images.boardInfo().then((b) => { this.board = b; });
       if (/detections|included|images|all/.test(what)) this.solveIfChanged();
       if (!/images|all/.test(what)) return;
       this.countCaptures();
