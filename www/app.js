@@ -6,6 +6,7 @@ import { Store, defaultSession } from './store.js';
 import { $ } from './lib/dom.js';
 import { initTarget } from './views/target.js';
 import { ImagesView } from './views/images.js';
+import { CaptureView } from './views/capture.js';
 import { CameraView } from './views/camera.js';
 import { RobotView } from './views/robot.js';
 import { HandEyeView } from './views/handeye.js';
@@ -132,6 +133,8 @@ async function main() {
   const pool = new EnginePool(engine, Math.min(4, navigator.hardwareConcurrency || 1));
   const images = new ImagesView(store, engine, pool);
   await images.restore();
+  // The live camera detects in a worker of its own: solves never hold up the preview.
+  new CaptureView(store, images, engine, () => new Engine(), () => robotView);
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);
   robotView = robot;

@@ -5,6 +5,7 @@
 // unrun (`bounced`, with its buffers) and engine.js moves them to a fresh
 // worker.
 import init, * as robocal from './pkg/robocal.js';
+import { greyFromRgba, greyFromVideoFrame, pgm } from './lib/frames.js';
 
 const ready = init().then(() => {
   robocal.init();
@@ -128,6 +129,40 @@ handlers.stereo = async ({ input }) => {
   await ready;
   return JSON.parse(robocal.calibrate_stereo(input));
 };
+
+/**
+ * Live detection on one video frame: a WebCodecs VideoFrame (its luma plane
+ * read as it is) or an ImageBitmap (drawn, then grey from RGBA), either
+ * transferred and closed here. Its grey pixels go through the same
+ * detection call as an uploaded image. A frame without the target is an
+ * answer, not an error: `{ found: false, reason }`. `ms` is the time spent
+ * here (grey pixels and detection).
+ */
+handlers.frame = async ({ frame, bitmap, spec }) => {
+  await ready;
+  const started = performance.now();
+  let pixels = frame ? await greyFromVideoFrame(frame) : null;
+  if (!pixels) pixels = greyFromBitmap(bitmap);
+  const { grey, width, height } = pixels;
+  let detection = null;
+  let reason = null;
+  try {
+    detection = JSON.parse(robocal.detect_target(pgm(grey, width, height), spec));
+  } catch (err) {
+    if (err instanceof WebAssembly.RuntimeError) throw err;
+    reason = err && err.message ? err.message : String(err);
+  }
+  return { found: !!detection, detection, reason, width, height, ms: performance.now() - started };
+};
+
+function greyFromBitmap(bitmap) {
+  const { width, height } = bitmap;
+  const canvas = new OffscreenCanvas(width, height);
+  const ctx = canvas.getContext('2d', { willReadFrequently: true });
+  ctx.drawImage(bitmap, 0, 0);
+  bitmap.close();
+  return { grey: greyFromRgba(ctx.getImageData(0, 0, width, height).data, width, height), width, height };
+}
 
 /** The ArrayBuffers in a request's arguments (handed back with a bounced request). */
 const buffersOf = (args) => Object.values(args || {}).filter((v) => v instanceof ArrayBuffer);

@@ -16,6 +16,7 @@ mod info;
 mod intrinsics;
 mod planar;
 mod render;
+mod render_video;
 mod serve;
 mod stereo;
 mod target;

@@ -17,6 +17,8 @@ use std::path::Path;
   robocal render --out DIR [--target SPEC] [--views N] [--seed N]
                  [--camera camera.json] [--noise GREY] [--blur PX]
   robocal render --out DIR --demo [--seed N]
+  robocal render --video board.y4m [--size WxH] [--fps N] [--target SPEC]
+                 [--seed N] [--truth FILE] [--camera camera.json]
 
 Renders N views of the target (random poses: tilt up to 45 degrees, the
 target spanning 35-60 % of the image width) through the camera, supersampled,
@@ -28,10 +30,23 @@ coordinates).
 
 --demo writes the web app's demo session instead: 12 chessboard images, the
 robot poses that go with them (DIR/poses.csv, Universal Robots format with an
-image column) and truth.json with gripper_from_camera and base_from_target.",
+image column) and truth.json with gripper_from_camera and base_from_target.
+
+--video writes a Y4M video (4:2:0, 8-bit; 640x480 at 15 fps by default,
+about 28 s) of the board sliding into view, then holding still for 1 s at
+each of 12 poses (the nine regions of the image, tilts about both axes,
+near and far) with smooth 1.2 s moves between them: what Chromium's fake
+camera plays (--use-fake-device-for-media-stream
+--use-file-for-fake-video-capture=board.y4m). Grey levels are written as
+video-range luma (16 + 219 g / 255). The truth goes beside it (board.json,
+or --truth FILE): {\"camera\", \"target\", \"options\", \"video\", \"size_px\",
+\"frames\": [{index, time_ms, camera_from_target, hold, points}],
+\"holds\": [{first_frame, last_frame, camera_from_target}]}; hold is the
+frame's hold index or null while the board moves.",
     after_help = "Examples:
   robocal render --out renders --views 20 --seed 7
-  robocal render --out demo --demo",
+  robocal render --out demo --demo
+  robocal render --video board.y4m --size 1280x720 --target charuco:12x9:20mm:15mm:DICT_5X5_100",
     args_override_self = true
 )]
 pub struct RenderArgs {
@@ -70,9 +85,29 @@ pub struct RenderArgs {
     /// Write the web app's demo session instead
     #[arg(long)]
     demo: bool,
+    /// Write a Y4M video of the board moving through poses with holds
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["out", "demo", "views"])]
+    video: Option<String>,
+    /// With --video: frame size WIDTHxHEIGHT (even sides)
+    #[arg(
+        long,
+        value_name = "WxH",
+        default_value = "640x480",
+        requires = "video"
+    )]
+    size: String,
+    /// With --video: frames per second
+    #[arg(long, value_name = "N", default_value_t = 15.0, requires = "video")]
+    fps: f64,
+    /// With --video: the truth file (default: the video's name with .json)
+    #[arg(long, value_name = "FILE", requires = "video")]
+    truth: Option<String>,
 }
 
 pub fn run(args: RenderArgs) -> Result<(), CliError> {
+    if let Some(video) = args.video.as_deref() {
+        return run_video(&args, video);
+    }
     let out = args
         .out
         .as_deref()
@@ -90,6 +125,50 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
             "--views must be between 1 and 1000",
         ));
     }
+    check_sigmas(&args)?;
+    let camera = match args.camera.as_deref() {
+        Some(file) => robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0,
+        None => demo_camera(),
+    };
+    write_set(
+        out,
+        &camera,
+        &target,
+        args.views,
+        args.seed,
+        &render_options(&args),
+    )
+}
+
+fn render_options(args: &RenderArgs) -> RenderOptions {
+    RenderOptions {
+        noise_sigma: args.noise,
+        blur_sigma_px: args.blur,
+        vignetting: 0.2,
+        ..RenderOptions::default()
+    }
+}
+
+fn run_video(args: &RenderArgs, video: &str) -> Result<(), CliError> {
+    check_sigmas(args)?;
+    let target = Target::parse_spec(args.target.as_deref().unwrap_or("chessboard:9x6:30mm"))?;
+    let camera = match args.camera.as_deref() {
+        Some(file) => Some(robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0),
+        None => None,
+    };
+    super::render_video::write_video(super::render_video::VideoArgs {
+        video,
+        truth: args.truth.as_deref(),
+        size: &args.size,
+        fps: args.fps,
+        camera,
+        target,
+        seed: args.seed,
+        render: render_options(args),
+    })
+}
+
+fn check_sigmas(args: &RenderArgs) -> Result<(), CliError> {
     for (flag, value, unit) in [
         ("--noise", args.noise, "grey levels"),
         ("--blur", args.blur, "px"),
@@ -101,17 +180,7 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
             ));
         }
     }
-    let camera = match args.camera.as_deref() {
-        Some(file) => robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0,
-        None => demo_camera(),
-    };
-    let options = RenderOptions {
-        noise_sigma: args.noise,
-        blur_sigma_px: args.blur,
-        vignetting: 0.2,
-        ..RenderOptions::default()
-    };
-    write_set(out, &camera, &target, args.views, args.seed, &options)
+    Ok(())
 }
 
 /// Grid of the target's points, as the scene generator places poses.

@@ -8,11 +8,13 @@ pub mod handeye_looking;
 pub mod render;
 pub mod rng;
 pub mod scene;
+pub mod video;
 
 pub use scene::Scene;
 
 pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
 pub use rng::Rng;
+pub use video::{video_camera, BoardVideo, VideoOptions};
 
 use crate::target::Target;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};

@@ -26,19 +26,20 @@ export async function startServer() {
   return { url, stop: () => child.kill() };
 }
 
-export async function launch() {
+/** Chromium, headless; `extraArgs` are a suite's own flags (the capture suite's fake camera). */
+export async function launch(extraArgs = []) {
   return chromium.launch({
     executablePath: '/usr/bin/chromium',
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
+      '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic', ...extraArgs],
   });
 }
 
-/** Runs `tests` ([name, fn(page, ctx)]) each in a fresh browser context. */
-export async function run(suite, tests) {
+/** Runs `tests` ([name, fn(page, ctx)]) each in a fresh browser context of a Chromium launched with `launchArgs`. */
+export async function run(suite, tests, launchArgs = []) {
   mkdirSync(shotsDir, { recursive: true });
   const server = await startServer();
-  const browser = await launch();
+  const browser = await launch(launchArgs);
   let failed = 0;
   try {
     for (const [name, fn] of tests) {

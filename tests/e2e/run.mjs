@@ -2,14 +2,15 @@
 // `node tests/e2e/run.mjs datasets offline`); exits non-zero on any failure.
 import { run } from './harness.mjs';
 
-const all = ['foundation', 'workflows', 'flow', 'pages', 'datasets', 'offline', 'reliability', 'badinputs', 'newcomer', 'newcomer2', 'markers', 'boards'];
+const all = ['foundation', 'workflows', 'flow', 'pages', 'datasets', 'offline', 'reliability', 'badinputs', 'newcomer', 'newcomer2', 'markers', 'boards', 'capture'];
 const wanted = process.argv.slice(2);
 for (const w of wanted) if (!all.includes(w)) throw new Error(`unknown suite '${w}' (known: ${all.join(', ')})`);
 const suites = wanted.length ? wanted : all;
 let failed = 0;
 for (const suite of suites) {
-  const { tests } = await import(`./${suite}.mjs`);
-  failed += await run(suite, tests);
+  // A suite may export `launchArgs`: Chromium flags of its own (the capture suite's fake camera).
+  const { tests, launchArgs } = await import(`./${suite}.mjs`);
+  failed += await run(suite, tests, launchArgs);
 }
 if (failed) {
   console.error(`e2e: ${failed} test(s) failed; screenshots in tests/e2e/screenshots/`);

@@ -144,8 +144,9 @@ export class ImagesView {
 
   async addBytes(list) {
     const added = [];
-    for (const { name, bytes } of list) {
-      const img = { id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name, size: bytes.byteLength, included: true, status: 'pending', info: null, detection: null, error: null };
+    // Extra fields (a camera capture's `source`) stay on the session image.
+    for (const { name, bytes, ...extra } of list) {
+      const img = { ...extra, id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name, size: bytes.byteLength, included: true, status: 'pending', info: null, detection: null, error: null };
       await this.store.addImage(img, bytes);
       this.makeCard(img);
       added.push(img);
@@ -171,7 +172,8 @@ export class ImagesView {
   }
 
   async detectAll(subset) {
-    if (this.busy) return;
+    // Busy: images added meanwhile (camera captures) are detected next, never skipped.
+    if (this.busy) { if (subset) this.waiting = [...(this.waiting || []), ...subset]; return; }
     const todo = (subset || this.images).filter((i) => (i.status !== 'error' || i.detectError) && !i.bytesMissing);
     if (!todo.length) return;
     let spec;
@@ -232,6 +234,7 @@ export class ImagesView {
     setTimeout(() => { if (!this.busy) $('progress-row').hidden = true; }, 1500);
     this.store.changed('detections');
     if (this.redetectAgain) { this.redetectAgain = false; await this.redetect(); }
+    if (this.waiting) { const next = this.waiting; this.waiting = null; await this.detectAll(next.filter((i) => this.images.includes(i))); }
   }
 
   /**
@@ -322,6 +325,7 @@ export class ImagesView {
     const parts = [describe(img.info)];
     if (img.detection) parts.push(pointCount(img.detection.points, this.board));
     if (img.largerGrid) parts.push(img.largerGrid);
+    if (img.note) parts.push(img.note); // e.g. a camera capture that repeats an earlier one
     if (img.status === 'error') parts.push(img.error);
     if (others.length) parts.push(otherBoardsText(others, (pts) => pointCount(pts, this.board)));
     if (img.bytesMissing) parts.push('from a session file: add the image to see it');

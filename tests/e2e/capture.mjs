@@ -1,0 +1,276 @@
+// Issue 21 on the page: live capture from a camera. Chromium's fake camera
+// (`--use-fake-device-for-media-stream`) stands in for a webcam; the
+// permission is granted per test (a context without it is refused, as a
+// user pressing "Block" would). The camera source on the images step: the
+// refused and no-camera messages, the device and resolution pickers, the
+// live preview with the frame rates and the detection state, manual
+// capture (button and space bar) into cards kept in IndexedDB, exclusion
+// and the PNG download of the captured frames.
+import assert from 'node:assert/strict';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { execFileSync } from 'node:child_process';
+import { launch, root, shotsDir } from './harness.mjs';
+import { boardVideo, cameraJson } from './y4m.mjs';
+
+export const launchArgs = ['--use-fake-device-for-media-stream'];
+
+const REFUSED = 'Camera access was refused. Allow the camera for this page (the camera icon in the address bar, or the site settings), then press Start camera again. Image files can still be added above.';
+const NO_CAMERA = 'No camera was found. Connect a camera and press Start camera again, or add image files above.';
+
+/** Captures taken from the board video (of its 12 holds). */
+const CAPTURES = 7;
+
+const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
+
+/** The images step with the camera permission granted (or not). */
+async function open(page, url, grant = true) {
+  if (grant) await page.context().grantPermissions(['camera'], { origin: url });
+  await page.goto(`${url}#images`);
+  await ready(page);
+}
+
+/** Wait until the live status reports at least `frames` detections a second (the loop runs). */
+const live = (page, detectFps = 1) => page.waitForFunction((min) => {
+  const s = document.getElementById('camera-status');
+  return s && Number(s.dataset.detectFps) >= min;
+}, detectFps, { timeout: 30000 });
+
+const cards = (page) => page.$$eval('.card', (els) => els.map((el) => ({
+  name: el.querySelector('.name').textContent, meta: el.querySelector('.meta').textContent, used: el.querySelector('.include input').checked,
+})));
+
+/** Width and height of PNG bytes (the IHDR chunk). */
+const pngSize = (buf) => [buf.readUInt32BE(16), buf.readUInt32BE(20)];
+
+export const tests = [
+  ['permission refused: the message says what to do, file upload stays', async (page, { url, shot }) => {
+    await open(page, url, false);
+    await page.click('#camera-start');
+    await page.locator('#camera-message:not([hidden])').waitFor({ timeout: 10000 });
+    assert.equal(await page.textContent('#camera-message'), REFUSED);
+    assert.equal(await page.getAttribute('#camera-message', 'role'), 'alert');
+    assert.equal(await page.isVisible('#camera-live'), false, 'no preview without a camera');
+    assert.equal(await page.isEnabled('#camera-start'), true, 'the user can try again');
+    assert.equal(await page.isVisible('#choose-files'), true);
+    await shot('refused');
+  }],
+  ['no camera: says so without asking for permission', async (page, { url, shot }) => {
+    // A machine without any video input: enumerateDevices lists none.
+    await page.addInitScript(() => {
+      const md = navigator.mediaDevices;
+      const all = md.enumerateDevices.bind(md);
+      md.enumerateDevices = async () => (await all()).filter((d) => d.kind !== 'videoinput');
+      md.getUserMedia = async () => { throw new Error('getUserMedia must not be called without a camera'); };
+    });
+    await open(page, url);
+    await page.click('#camera-start');
+    await page.locator('#camera-message:not([hidden])').waitFor({ timeout: 10000 });
+    assert.equal(await page.textContent('#camera-message'), NO_CAMERA);
+    await shot('no-camera');
+  }],
+  ['preview: device list, resolutions up to the maximum, frame rates, not-found state drawn', async (page, { url, shot }) => {
+    await open(page, url);
+    await page.click('#camera-start');
+    await live(page, 2);
+    const devices = await page.$$eval('#camera-device option', (os) => os.map((o) => o.textContent));
+    assert.ok(devices.includes('fake_device_0'), `the fake camera is listed by its label: ${devices}`);
+    const res = await page.$$eval('#camera-resolution option', (os) => os.map((o) => o.value));
+    assert.equal(await page.inputValue('#camera-resolution'), '1280x720');
+    assert.equal(res[res.length - 1], 'max', 'the maximum is offered last');
+    const status = await page.$eval('#camera-status', (s) => ({ ...s.dataset, text: s.textContent }));
+    assert.equal(status.state, 'none', 'the fake camera shows no board');
+    assert.match(status.text, /^Board not found · 1280 × 720 · camera \d+\.\d fps · detection \d+\.\d fps \(\d+ ms a frame in the worker, \d+ ms in all; frames dropped while busy: \d+\)$/);
+    assert.ok(Number(status.fps) >= 5, `camera frame rate ${status.fps}`);
+    // One detection in flight: the detection rate never exceeds the camera's.
+    assert.ok(Number(status.detectFps) <= Number(status.fps) * 1.2 + 1, `detection ${status.detectFps} fps, camera ${status.fps} fps`);
+    const overlay = await page.$eval('#camera-overlay', (c) => [c.width, c.height]);
+    assert.deepEqual(overlay, [1280, 720], 'the overlay has the frame\'s pixels');
+    assert.equal(await page.textContent('#camera-found'), 'Board not found');
+    await shot('preview');
+    // Another resolution: the camera is opened again at it.
+    await page.selectOption('#camera-resolution', '640x480');
+    await page.waitForFunction(() => /· 640 × 480 ·/.test(document.getElementById('camera-status').textContent), null, { timeout: 20000 });
+    assert.deepEqual(await page.$eval('#camera-video', (v) => [v.videoWidth, v.videoHeight]), [640, 480]);
+    await page.click('#camera-stop');
+    assert.equal(await page.isVisible('#camera-live'), false);
+  }],
+  ['manual capture: button and space bar add PNG cards, kept after a reload, downloadable', async (page, { url, shot }) => {
+    await open(page, url);
+    await page.selectOption('#camera-resolution', '1920x1080');
+    await page.click('#camera-start');
+    await live(page);
+    await page.click('#capture-frame');
+    await page.locator('#step-images h2').click(); // focus off the button: space captures
+    await page.keyboard.press('Space');
+    await page.waitForFunction(() => [...document.querySelectorAll('.card .meta')].filter((m) => /board not found/.test(m.textContent)).length === 2, null, { timeout: 30000 });
+    let list = await cards(page);
+    assert.deepEqual(list.map((c) => c.name), ['capture_001.png', 'capture_002.png']);
+    for (const c of list) assert.match(c.meta, /^PNG · 1920×1080 px · RGBA, 8-bit · /, 'full resolution');
+    assert.equal(await page.textContent('#capture-count'), '2 frames captured');
+    await shot('captured');
+    // Without the board both are left out of the calibration, like uploads without it.
+    assert.deepEqual(list.map((c) => c.used), [false, false]);
+    const downloads = [];
+    page.on('download', (d) => downloads.push(d));
+    await page.click('#download-captures');
+    for (let i = 0; i < 50 && downloads.length < 2; i++) await page.waitForTimeout(100);
+    assert.deepEqual(downloads.map((d) => d.suggestedFilename()), ['capture_001.png', 'capture_002.png']);
+    for (const d of downloads) assert.deepEqual(pngSize(readFileSync(await d.path())), [1920, 1080]);
+    // Kept in IndexedDB: a reload shows them again and the numbering goes on.
+    await page.waitForTimeout(500);
+    await page.reload();
+    await ready(page);
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 2, null, { timeout: 30000 });
+    list = await cards(page);
+    assert.deepEqual(list.map((c) => [c.name, c.used]), [['capture_001.png', false], ['capture_002.png', false]]);
+    await page.click('#camera-start');
+    await live(page);
+    await page.click('#capture-frame');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 3, null, { timeout: 30000 });
+    assert.equal((await cards(page))[2].name, 'capture_003.png');
+  }],
+  ['hand-eye capture: a typed pose goes with its frame, a bad line captures nothing, the robot step reads the typed poses', async (page, { url, shot }) => {
+    await open(page, url);
+    await page.click('#camera-start');
+    await live(page);
+    await page.fill('#capture-pose', '0.4 0.1');
+    await page.click('#capture-frame');
+    await page.waitForFunction(() => /^Nothing captured/.test(document.getElementById('capture-pose-note').textContent), null, { timeout: 20000 });
+    const note = await page.textContent('#capture-pose-note');
+    assert.match(note, /^Nothing captured: the robot pose could not be read \(.+\)\. Correct the line, or empty it to capture without a pose\.$/);
+    assert.equal(await page.$$eval('.card', (c) => c.length), 0, 'no frame without its pose');
+    // Two UR poses (metres, rotation vector), the second one by Enter in the field.
+    const poses = ['0.412,-0.105,0.331,2.2,-2.21,0.01', '0.5,0.0,0.4,0.0,3.1,0.2'];
+    await page.fill('#capture-pose', poses[0]);
+    await page.click('#capture-frame');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 1, null, { timeout: 20000 });
+    assert.match(await page.textContent('#capture-pose-note'), /^capture_001\.png is paired with the pose read as /);
+    assert.equal(await page.inputValue('#capture-pose'), '', 'the field is emptied for the next pose');
+    await page.fill('#capture-pose', poses[1]);
+    await page.press('#capture-pose', 'Enter');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 2, null, { timeout: 20000 });
+    await shot('captured-with-poses');
+    await page.click('a[data-step=robot]');
+    await page.locator('#pose-table').waitFor({ timeout: 20000 });
+    assert.match(await page.textContent('#pose-format-used'), /^poses typed at capture: 2 poses read as /);
+    const rows = await page.$$eval('#pose-table tbody tr', (trs) => trs.map((tr) => [...tr.children].map((td) => td.textContent)));
+    // x y z shown in mm: the typed metres times 1000.
+    assert.deepEqual(rows.map((r) => r.slice(3, 6).map(Number)), [[412, -105, 331], [500, 0, 400]]);
+    const pairing = await page.$$eval('#pairing-table tbody tr', (trs) => trs.map((tr) => tr.children[2].textContent));
+    assert.deepEqual(pairing, ['capture_001.png', 'capture_002.png']);
+    await shot('robot-step');
+  }],
+  ['the renderer\'s video: captures in the holds, the running calibration converges to the video\'s camera within its std, uncertainty shrinks, step 3 and the OpenCV export agree', async (page, { url }) => {
+    // `robocal render --video`: the default 9x6 chessboard through 12 one-second holds, 640x480 at 5 fps.
+    const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
+    let other = { close: async () => {} };
+    try {
+      const path = join(dir, 'board.y4m');
+      // 5 fps: a hold is 5 frames, the render a third of the default 15 fps's time.
+      execFileSync(join(root, 'target/release/robocal'), ['render', '--video', path, '--seed', '11', '--fps', '5'], { stdio: 'ignore' });
+      const truth = JSON.parse(readFileSync(join(dir, 'board.json'), 'utf8'));
+      other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
+      const context = await other.newContext({ viewport: { width: 1280, height: 900 } });
+      const p = await context.newPage();
+      const errors = [];
+      p.on('pageerror', (e) => errors.push(e.message));
+      await open(p, url);
+      await p.click('#camera-start');
+      await p.waitForFunction(() => document.getElementById('camera-status').dataset.state === 'found', null, { timeout: 30000 });
+      assert.match(await p.textContent('#camera-status'), /^Board found: 54 points · 640 × 480 · /);
+      await p.screenshot({ path: join(shotsDir, 'capture-board-1-found.png') });
+      // As a user would: capture when the board has been still for 0.3 s
+      // (its first point within 1 px) at a place not captured yet (5 px away).
+      const seen = [];
+      const t0 = Date.now();
+      for (let i = 0; i < CAPTURES; i++) {
+        const first = await p.waitForFunction((seen) => {
+          const s = document.getElementById('camera-status');
+          const xy = s.dataset.state === 'found' && s.dataset.first ? s.dataset.first.split(',').map(Number) : null;
+          const w = window.stillFor || (window.stillFor = { xy: null, t: 0 });
+          const near = (a, b, d) => a && b && Math.hypot(a[0] - b[0], a[1] - b[1]) <= d;
+          if (!xy || !near(xy, w.xy, 1)) { w.xy = xy; w.t = performance.now(); return false; }
+          return performance.now() - w.t > 300 && !seen.some((q) => near(q, xy, 5)) ? xy : false;
+        }, seen, { timeout: 30000, polling: 50 });
+        seen.push(await first.jsonValue());
+        if (process.env.CAPTURE_DEBUG) console.log(`     capture ${i + 1} at ${Date.now() - t0} ms: first point ${seen[seen.length - 1]}; ${await p.textContent('#camera-status')}`);
+        await p.click('#capture-frame');
+      }
+      await p.waitForFunction((n) => [...document.querySelectorAll('.card .meta')].filter((m) => / · 54 points( · the same points as capture_\d+\.png: left out)?$/.test(m.textContent)).length === n, CAPTURES, { timeout: 60000 });
+      if (process.env.CAPTURE_DEBUG) console.log(`     cards detected at ${Date.now() - t0} ms`);
+      // Settled: no solve running and every capture's detection in.
+      await p.waitForFunction(() => { const s = document.getElementById('capture-solve-summary'); return s.dataset.busy === 'no' && Number(s.dataset.views) >= 5; }, null, { timeout: 60000 })
+        .catch(async (e) => { await p.screenshot({ path: join(shotsDir, 'capture-board-failure.png'), fullPage: true }); throw new Error(`${await p.textContent('#capture-solve-summary')} (${e.message})`); });
+      if (process.env.CAPTURE_DEBUG) console.log(`     settled at ${Date.now() - t0} ms`);
+      const summary = await p.textContent('#capture-solve-summary');
+      const views = Number(await p.getAttribute('#capture-solve-summary', 'data-views'));
+      assert.match(summary, new RegExp(`^Solved from ${views} captured views: RMS \\d\\.\\d+ px; projection uncertainty \\(1 sigma\\) worst \\d\\.\\d+ px, median \\d\\.\\d+ px over the image\\.( ${CAPTURES - views} captures? with the same points as an earlier one left out\\.)?$`));
+      const params = Object.fromEntries(await p.$$eval('#capture-params tbody tr', (trs) => trs.map((tr) => [tr.children[0].textContent, [Number(tr.children[1].textContent), Number(tr.children[2].textContent)]])));
+      // The newest solve is the best one: less uncertain than the first (4 captures).
+      const history = (await p.getAttribute('#capture-solve-summary', 'data-history')).split(',').map((e) => e.split(':').map(Number));
+      assert.ok(history[0][0] >= 4 && history[0][0] < CAPTURES, `the first solve has 4 views or so: ${history[0][0]}`);
+      assert.ok(history[history.length - 1][1] < history[0][1], `worst projection uncertainty by views: ${JSON.stringify(history)}`);
+      console.log(`     worst projection uncertainty (px) by captured views: ${history.map(([n, w]) => `${n}: ${w.toFixed(3)}`).join(', ')}`);
+      const c = truth.camera;
+      const want = { fx: c.fx, fy: c.fy, cx: c.cx, cy: c.cy, k1: c.distortion.k1 };
+      for (const [name, value] of Object.entries(want)) {
+        const [got, std] = params[name];
+        // 4 sigma, and never below 0.3 px / 0.003: the video's luma steps (219 levels) and the captured frame's colour round trip are not in the std.
+        const tol = Math.max(4 * std, name === 'k1' ? 0.003 : 0.3);
+        assert.ok(Math.abs(got - value) <= tol, `${name}: ${got} vs true ${value} (std ${std}, tolerance ${tol})`);
+      }
+      console.log(`     running calibration from ${views} captures: ${Object.keys(want).map((n) => `${n} ${params[n][0]} ± ${params[n][1]} (true ${want[n]})`).join(', ')}`);
+      await p.screenshot({ path: join(shotsDir, 'capture-board-2-solved.png'), fullPage: true });
+      // Excluding a capture solves again without it (when no other capture has its points).
+      await p.locator('.card').first().locator('.include input').uncheck();
+      if (views === CAPTURES) await p.waitForFunction((n) => document.getElementById('capture-solve-summary').dataset.views === String(n), views - 1, { timeout: 60000 });
+      // Step 3 solves the same captures; the OpenCV YAML export carries its camera.
+      await p.click('a[data-step=camera]');
+      await p.click('#solve-camera');
+      await p.locator('#camera-params').waitFor({ timeout: 60000 });
+      await p.click('a[data-step=export]');
+      await p.click('#camera-formats button[data-format=opencv-yaml]');
+      await p.waitForFunction(() => /^opencv-yaml: \d+ bytes/.test(document.getElementById('export-status').textContent), null, { timeout: 20000 });
+      const [download] = await Promise.all([p.waitForEvent('download'), p.click('#export-download')]);
+      const yaml = readFileSync(await download.path(), 'utf8');
+      const m = /camera_matrix: !!opencv-matrix\s+rows: 3\s+cols: 3\s+dt: d\s+data: \[\s*([-\d.e+]+),\s*[-\d.e+]+,\s*([-\d.e+]+),/.exec(yaml);
+      assert.ok(m, yaml.slice(0, 400));
+      assert.ok(Math.abs(Number(m[1]) - want.fx) < Math.max(4 * params.fx[1], 0.3) && Math.abs(Number(m[2]) - want.cx) < Math.max(4 * params.cx[1], 0.3), `exported fx ${m[1]}, cx ${m[2]}`);
+      await p.screenshot({ path: join(shotsDir, 'capture-board-3-exported.png'), fullPage: true });
+      assert.deepEqual(errors, []);
+    } finally {
+      await other.close();
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+  ['marker board half hidden: partly found, drawn with its ids, a capture is a partial view', async (page, { url }) => {
+    const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
+    let other = { close: async () => {} };
+    try {
+      const { path } = await boardVideo(page, dir, { spec: 'charuco:8x6:30mm:22mm:DICT_5X5_100', camera: cameraJson(640, 480), views: 2, hold: 30, seed: 4, hideRight: 0.45 });
+      other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
+      const p = await (await other.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
+      await open(p, url);
+      await p.click('a[data-step=target]');
+      await p.selectOption('#target-kind', 'charuco');
+      for (const [name, value] of [['squares_x', '8'], ['squares_y', '6'], ['charuco_square_mm', '30'], ['marker_mm', '22']]) await p.fill(`#target-form input[name=${name}]`, value);
+      await p.waitForFunction(() => /^Target spec: charuco:8x6:30mm:22mm:DICT_5X5_100 /.test(document.getElementById('target-spec').textContent), null, { timeout: 20000 });
+      await p.click('a[data-step=images]');
+      await p.click('#camera-start');
+      await p.waitForFunction(() => document.getElementById('camera-status').dataset.state === 'partial', null, { timeout: 30000 });
+      const text = await p.textContent('#camera-status');
+      const m = /^Board partly found: (\d+) of 35 corners · 640 × 480 · /.exec(text);
+      assert.ok(m && Number(m[1]) >= 4 && Number(m[1]) < 35, text);
+      assert.equal(await p.textContent('#camera-found'), 'Board partly found');
+      await p.screenshot({ path: join(shotsDir, 'capture-charuco-partial.png') });
+      await p.click('#capture-frame');
+      await p.waitForFunction(() => /corners \(partial view\)/.test(document.querySelector('.card .meta')?.textContent || ''), null, { timeout: 30000 });
+      assert.match(await p.textContent('.card .meta'), /^PNG · 640×480 px · RGBA, 8-bit · \d+ of 35 corners \(partial view\) · ids /);
+    } finally {
+      await other.close();
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+];
