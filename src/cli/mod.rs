@@ -16,6 +16,7 @@ mod info;
 mod intrinsics;
 mod planar;
 mod render;
+mod rig;
 mod serve;
 mod stereo;
 mod target;
@@ -101,6 +102,7 @@ enum Command {
     Detect(detect::DetectArgs),
     Intrinsics(intrinsics::IntrinsicsArgs),
     Stereo(stereo::StereoArgs),
+    Rig(rig::RigArgs),
     Info(info::InfoArgs),
     Render(render::RenderArgs),
     Planar(planar::PlanarArgs),
@@ -145,6 +147,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Detect(a) => detect::run(a),
         Command::Intrinsics(a) => intrinsics::run(a),
         Command::Stereo(a) => stereo::run(a),
+        Command::Rig(a) => rig::run(a),
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
         Command::Planar(a) => planar::run(a),

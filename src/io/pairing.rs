@@ -127,6 +127,45 @@ pub fn pair_by_number(left: &[&str], right: &[&str]) -> Result<Pairing> {
     })
 }
 
+/// The frame key of every image of one camera of a rig (`robocal rig`):
+/// with [`PairedBy::Number`] the number in its name (every name must have
+/// one, unique within the camera; keys compare across cameras, so
+/// `front07.png` and `side7.jpg` are one frame), with [`PairedBy::Order`]
+/// its position (`"0"`, `"1"`, ...). `camera` names the camera in errors.
+pub fn frame_keys(names: &[&str], by: PairedBy, camera: &str) -> Result<Vec<String>> {
+    if by == PairedBy::Order {
+        return Ok((0..names.len()).map(|i| i.to_string()).collect());
+    }
+    let numbers: Vec<Option<String>> = names
+        .iter()
+        .map(|n| number_in_name(n).map(str::to_string))
+        .collect();
+    let without: Vec<&str> = names
+        .iter()
+        .zip(&numbers)
+        .filter(|(_, n)| n.is_none())
+        .map(|(name, _)| *name)
+        .collect();
+    if !without.is_empty() {
+        return Err(Error::invalid(
+            "images",
+            format!(
+                "frames are grouped by the last number in the file names, but camera {camera} \
+                 has names without one: {} (number every file, or group by order)",
+                without.join(", ")
+            ),
+        ));
+    }
+    index_by_number(names, &numbers, &format!("camera {camera}")).map_err(|e| match e {
+        Error::Invalid { message, .. } => Error::invalid(
+            "images",
+            message.replace("images are paired", "frames are grouped"),
+        ),
+        other => other,
+    })?;
+    Ok(numbers.into_iter().flatten().collect())
+}
+
 fn by_order(n_left: usize, n_right: usize) -> Result<Pairing> {
     if n_left != n_right {
         return Err(invalid(format!(
