@@ -42,8 +42,8 @@ fn rendered_rig(dir: &Path) -> (Vec<Vec<String>>, RigScene) {
     let scene = rig_scene(&config, 11);
     let target = Target::parse_spec(TARGET).expect("target");
     let mut files = vec![Vec::new(); 4];
-    for k in 0..4 {
-        for (f, view) in &scene.views[k] {
+    for (k, (views, list)) in scene.views.iter().zip(&mut files).enumerate() {
+        for (f, view) in views {
             if !whole_board_inside(&scene.cameras[k], view) {
                 continue;
             }
@@ -55,13 +55,13 @@ fn rendered_rig(dir: &Path) -> (Vec<Vec<String>>, RigScene) {
             let r = render(&scene.cameras[k], &target, &pose, &options).expect("render");
             let path = dir.join(format!("cam{k}_{f:03}.png"));
             std::fs::write(&path, encode_png(&r.image).expect("png")).expect("write");
-            files[k].push(path.to_string_lossy().into_owned());
+            list.push(path.to_string_lossy().into_owned());
         }
     }
     (files, scene)
 }
 
-fn args_of<'a>(files: &'a [Vec<String>], keep: impl Fn(&str) -> bool) -> Vec<&'a str> {
+fn args_of(files: &[Vec<String>], keep: impl Fn(&str) -> bool) -> Vec<&str> {
     let mut args = vec!["rig", "--target", TARGET];
     for (k, list) in files.iter().enumerate() {
         args.extend(["--camera", ["cam0", "cam1", "cam2", "cam3"][k]]);
