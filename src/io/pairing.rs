@@ -227,6 +227,33 @@ mod tests {
     }
 
     #[test]
+    fn rig_frame_keys_are_the_numbers_or_the_positions() {
+        let names = ["f/front07.png", "f/front1.png"];
+        assert_eq!(
+            frame_keys(&names, PairedBy::Number, "front").unwrap(),
+            ["7", "1"]
+        );
+        assert_eq!(
+            frame_keys(&names, PairedBy::Order, "front").unwrap(),
+            ["0", "1"]
+        );
+        assert_eq!(
+            frame_keys(&["a1.png", "b.png"], PairedBy::Number, "top")
+                .unwrap_err()
+                .to_string(),
+            "images: frames are grouped by the last number in the file names, but camera top has \
+             names without one: b.png (number every file, or group by order)"
+        );
+        assert_eq!(
+            frame_keys(&["a1.png", "a01.png"], PairedBy::Number, "top")
+                .unwrap_err()
+                .to_string(),
+            "images: frames are grouped by the last number in their file names, but number 1 is \
+             in two camera top images: a1.png, a01.png"
+        );
+    }
+
+    #[test]
     fn pairs_by_number_whatever_the_order() {
         let left = ["l/left10.png", "l/left2.png", "l/left1.png"];
         let right = ["r/right01.png", "r/right02.png", "r/right10.png"];
