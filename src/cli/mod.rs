@@ -17,6 +17,7 @@ mod intrinsics;
 mod planar;
 mod render;
 mod render_video;
+mod rig;
 mod serve;
 mod stereo;
 mod target;
@@ -102,6 +103,7 @@ enum Command {
     Detect(detect::DetectArgs),
     Intrinsics(intrinsics::IntrinsicsArgs),
     Stereo(stereo::StereoArgs),
+    Rig(rig::RigArgs),
     Info(info::InfoArgs),
     Render(render::RenderArgs),
     Planar(planar::PlanarArgs),
@@ -146,6 +148,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Detect(a) => detect::run(a),
         Command::Intrinsics(a) => intrinsics::run(a),
         Command::Stereo(a) => stereo::run(a),
+        Command::Rig(a) => rig::run(a),
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
         Command::Planar(a) => planar::run(a),

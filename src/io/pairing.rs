@@ -127,6 +127,45 @@ pub fn pair_by_number(left: &[&str], right: &[&str]) -> Result<Pairing> {
     })
 }
 
+/// The frame key of every image of one camera of a rig (`robocal rig`):
+/// with [`PairedBy::Number`] the number in its name (every name must have
+/// one, unique within the camera; keys compare across cameras, so
+/// `front07.png` and `side7.jpg` are one frame), with [`PairedBy::Order`]
+/// its position (`"0"`, `"1"`, ...). `camera` names the camera in errors.
+pub fn frame_keys(names: &[&str], by: PairedBy, camera: &str) -> Result<Vec<String>> {
+    if by == PairedBy::Order {
+        return Ok((0..names.len()).map(|i| i.to_string()).collect());
+    }
+    let numbers: Vec<Option<String>> = names
+        .iter()
+        .map(|n| number_in_name(n).map(str::to_string))
+        .collect();
+    let without: Vec<&str> = names
+        .iter()
+        .zip(&numbers)
+        .filter(|(_, n)| n.is_none())
+        .map(|(name, _)| *name)
+        .collect();
+    if !without.is_empty() {
+        return Err(Error::invalid(
+            "images",
+            format!(
+                "frames are grouped by the last number in the file names, but camera {camera} \
+                 has names without one: {} (number every file, or group by order)",
+                without.join(", ")
+            ),
+        ));
+    }
+    index_by_number(names, &numbers, &format!("camera {camera}")).map_err(|e| match e {
+        Error::Invalid { message, .. } => Error::invalid(
+            "images",
+            message.replace("images are paired", "frames are grouped"),
+        ),
+        other => other,
+    })?;
+    Ok(numbers.into_iter().flatten().collect())
+}
+
 fn by_order(n_left: usize, n_right: usize) -> Result<Pairing> {
     if n_left != n_right {
         return Err(invalid(format!(
@@ -185,6 +224,33 @@ mod tests {
         // start of the run was taken one byte after the character's start).
         assert_eq!(number_in_name("spy_px\u{bf}76acing_m"), Some("76"));
         assert_eq!(number_in_name("Bild_über_12.png"), Some("12"));
+    }
+
+    #[test]
+    fn rig_frame_keys_are_the_numbers_or_the_positions() {
+        let names = ["f/front07.png", "f/front1.png"];
+        assert_eq!(
+            frame_keys(&names, PairedBy::Number, "front").unwrap(),
+            ["7", "1"]
+        );
+        assert_eq!(
+            frame_keys(&names, PairedBy::Order, "front").unwrap(),
+            ["0", "1"]
+        );
+        assert_eq!(
+            frame_keys(&["a1.png", "b.png"], PairedBy::Number, "top")
+                .unwrap_err()
+                .to_string(),
+            "images: frames are grouped by the last number in the file names, but camera top has \
+             names without one: b.png (number every file, or group by order)"
+        );
+        assert_eq!(
+            frame_keys(&["a1.png", "a01.png"], PairedBy::Number, "top")
+                .unwrap_err()
+                .to_string(),
+            "images: frames are grouped by the last number in their file names, but number 1 is \
+             in two camera top images: a1.png, a01.png"
+        );
     }
 
     #[test]

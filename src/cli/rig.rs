@@ -1,0 +1,439 @@
+//! `robocal rig`: calibrate a camera rig (every camera and its
+//! camera_from_rig) from synchronised images of a board.
+
+use super::detect::{run_all, Outcome};
+use super::{read_text, write_output, CliError};
+use robocal::calib::json_api::model_from_name;
+use robocal::calib::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
+use robocal::calib::rig_report::RigCalibration;
+use robocal::calib::{CalibrationOptions, View};
+use robocal::camera::Camera;
+use robocal::detect::DetectOptions;
+use robocal::io::import_camera::import_camera;
+use robocal::io::pairing::{frame_keys, number_in_name, PairedBy};
+use robocal::target::Target;
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(clap::Args)]
+#[command(
+    about = "calibrate a camera rig (N cameras, partial overlap): every camera and its camera_from_rig",
+    long_about = "calibrate a camera rig: N cameras that saw one board in synchronised frames
+
+Each --camera takes a name and that camera's images (every argument up to the
+next option, so shell globs work). Images are grouped into frames by the number
+in their file names (the last run of digits in the name without folders and
+extension: front07.png and side/7.jpg are one frame), or by their position with
+--group-by order. Any camera may miss the board in any frame; a detection may
+hold any subset of the board's points (marker boards partly out of view).
+
+Each camera is calibrated alone (Zhang), or its intrinsics are given and held
+with --camera-file NAME=FILE (a robocal camera JSON or report, OpenCV YAML/XML,
+ROS camera_info). The cameras are chained along a spanning tree of the pairs
+that saw the board together most often (rotations averaged over the shared
+frames), then one bundle adjustment refines every intrinsic, every
+camera_from_rig and every frame's board pose. When no frame links two groups of
+cameras, the error names the groups.
+
+Instead of --camera, --input reads a rig file:
+  {\"target\": \"chessboard:9x6:30mm\", \"group_by\": \"number\", \"rig_frame\": \"front\",
+   \"cameras\": [{\"name\": \"front\", \"images\": [\"front/01.png\", ...]},
+               {\"name\": \"side\", \"images\": [...], \"camera_file\": \"side.json\"}]}
+(paths relative to the rig file's folder; every key but cameras optional; the
+flags override the file).
+
+The report (JSON; the rig frame is the rig camera's, camera 0 unless
+--rig-frame): cameras (name, calibration, intrinsics_held, camera_from_rig
+{matrix_row_major, translation_m, quaternion_xyzw}, camera_from_rig_std,
+rms_px, frames_seen), frames (key, rig_from_target, cameras, rms_px),
+co_observation (cameras, frames: the matrix of frames seen together,
+spanning_tree), rms_px, warnings. A summary goes to standard error.",
+    after_help = "Examples:
+  robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png -o rig.json
+  robocal rig --target charuco:12x9:20mm:15mm:DICT_5X5_100 --camera front f/*.png \\
+      --camera back b/*.png --camera top t/*.png --camera-file top=top.json --rig-frame top -o rig.json
+  robocal rig --input rig-files.json -o rig.json
+  robocal export rig.json --format kalibr"
+)]
+pub struct RigArgs {
+    /// The target, as for 'robocal detect' (chessboard:9x6:30mm, ...)
+    #[arg(long, value_name = "SPEC", overrides_with = "target")]
+    target: Option<String>,
+    #[command(flatten)]
+    camera: CameraFlags,
+    /// A rig file listing the cameras and their images (instead of --camera)
+    #[arg(long, value_name = "FILE", overrides_with = "input")]
+    input: Option<String>,
+    /// Hold a camera's intrinsics at those of FILE: NAME=FILE (repeatable)
+    #[arg(long, value_name = "NAME=FILE", action = clap::ArgAction::Append)]
+    camera_file: Vec<String>,
+    /// The camera whose frame is the rig frame (default: the first)
+    #[arg(long, value_name = "NAME", overrides_with = "rig_frame")]
+    rig_frame: Option<String>,
+    /// How images form frames: number (the number in the file names,
+    /// default) or order (their position in each camera's list)
+    #[arg(long, value_name = "RULE", overrides_with = "group_by")]
+    group_by: Option<String>,
+    /// Lens model of the solved cameras: brown (default), radial_k1_k2_k5,
+    /// rational, division, kannala_brandt, eucm, none
+    #[arg(long, value_name = "NAME", overrides_with = "model")]
+    model: Option<String>,
+    /// Images detected in parallel (default: all cores)
+    #[arg(long, value_name = "N", overrides_with = "threads")]
+    threads: Option<usize>,
+    #[command(flatten)]
+    limits: super::ImageLimits,
+    /// Write the report there (default: standard output)
+    #[arg(short = 'o', long, value_name = "FILE", overrides_with = "output")]
+    output: Option<String>,
+}
+
+/// `--camera NAME IMAGES...`, repeatable, each occurrence kept apart
+/// (clap's derive groups occurrences only under its unstable-v5 feature,
+/// so this one argument reads `ArgMatches::get_occurrences` itself).
+#[derive(Clone, Debug, Default)]
+struct CameraFlags(Vec<Vec<String>>);
+
+impl clap::FromArgMatches for CameraFlags {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let groups = m
+            .get_occurrences::<String>("camera")
+            .map(|o| o.map(|v| v.cloned().collect()).collect())
+            .unwrap_or_default();
+        Ok(CameraFlags(groups))
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+impl clap::Args for CameraFlags {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        cmd.arg(
+            clap::Arg::new("camera")
+                .long("camera")
+                .value_names(["NAME", "IMAGES"])
+                .num_args(2..)
+                .action(clap::ArgAction::Append)
+                .help(
+                    "A camera: its name, then its images (every argument up to the next \
+                     option); give one --camera per camera",
+                ),
+        )
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+/// The rig file of `--input`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RigFile {
+    #[serde(default)]
+    target: Option<String>,
+    #[serde(default)]
+    group_by: Option<String>,
+    #[serde(default)]
+    rig_frame: Option<String>,
+    #[serde(default)]
+    model: Option<String>,
+    cameras: Vec<RigFileCamera>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RigFileCamera {
+    name: String,
+    images: Vec<String>,
+    #[serde(default)]
+    camera_file: Option<String>,
+}
+
+/// One camera of the command line: name, images, held intrinsics file.
+struct CameraArg {
+    name: String,
+    images: Vec<String>,
+    camera_file: Option<String>,
+}
+
+fn usage(message: impl Into<String>) -> CliError {
+    CliError::usage("rig", message)
+}
+
+pub fn run(args: RigArgs) -> Result<(), CliError> {
+    // 1. The cameras, from the flags or the rig file.
+    let (mut cameras, file) = match (&args.input, args.camera.0.is_empty()) {
+        (Some(_), false) => {
+            return Err(usage("give either --camera ... or --input FILE, not both"))
+        }
+        (None, true) => {
+            return Err(usage(
+                "give one --camera NAME IMAGES... per camera (at least 2), or --input FILE",
+            ))
+        }
+        (None, false) => (cameras_of_flags(&args.camera.0), None),
+        (Some(path), true) => {
+            let file: RigFile = serde_json::from_str(&read_text(path)?).map_err(|e| {
+                CliError::Io(format!("'{path}': line {}: not a rig file: {e}", e.line()))
+            })?;
+            let dir = Path::new(path).parent().unwrap_or(Path::new(""));
+            let within = |p: &str| dir.join(p).to_string_lossy().into_owned();
+            let cameras = file
+                .cameras
+                .iter()
+                .map(|c| CameraArg {
+                    name: c.name.clone(),
+                    images: c.images.iter().map(|i| within(i)).collect(),
+                    camera_file: c.camera_file.as_deref().map(within),
+                })
+                .collect();
+            (cameras, Some(file))
+        }
+    };
+    for spec in &args.camera_file {
+        let Some((name, path)) = spec.split_once('=') else {
+            return Err(usage(format!(
+                "--camera-file takes NAME=FILE, got '{spec}'"
+            )));
+        };
+        let Some(c) = cameras.iter_mut().find(|c| c.name == name) else {
+            return Err(usage(format!(
+                "--camera-file {spec}: no --camera is named '{name}'"
+            )));
+        };
+        c.camera_file = Some(path.to_string());
+    }
+    let pick = |flag: &Option<String>, f: fn(&RigFile) -> &Option<String>| {
+        flag.clone()
+            .or_else(|| file.as_ref().and_then(|r| f(r).clone()))
+    };
+    let target_spec = pick(&args.target, |r| &r.target)
+        .ok_or_else(|| usage("--target is required, e.g. --target chessboard:9x6:30mm"))?;
+    let target = Target::parse_spec(&target_spec).map_err(|e| usage(e.to_string()))?;
+    let grouping = grouping(pick(&args.group_by, |r| &r.group_by).as_deref(), &cameras)?;
+    let model = pick(&args.model, |r| &r.model);
+    let held = cameras
+        .iter()
+        .map(|c| c.camera_file.as_deref().map(held_camera).transpose())
+        .collect::<Result<Vec<Option<Camera>>, CliError>>()?;
+    // 2. Frame keys, then detection in every image at once.
+    let mut keys_per_camera = Vec::with_capacity(cameras.len());
+    for c in &cameras {
+        let names: Vec<&str> = c.images.iter().map(String::as_str).collect();
+        keys_per_camera.push(frame_keys(&names, grouping, &c.name).map_err(|e| usage(plain(e)))?);
+    }
+    let mut keys: Vec<String> = keys_per_camera.iter().flatten().cloned().collect();
+    sort_frame_keys(&mut keys);
+    keys.dedup();
+    let all: Vec<String> = cameras.iter().flat_map(|c| c.images.clone()).collect();
+    let decode = args.limits.decode_options();
+    let mut outcomes = run_all(
+        &all,
+        &target,
+        &DetectOptions::default(),
+        &decode,
+        args.threads,
+    )?
+    .into_iter();
+    let mut inputs = Vec::with_capacity(cameras.len());
+    for ((c, camera_keys), held) in cameras.iter().zip(&keys_per_camera).zip(held) {
+        let mut views = Vec::new();
+        let mut size: Option<(u32, u32)> = None;
+        for (file, key) in c.images.iter().zip(camera_keys) {
+            match outcomes.next() {
+                Some(Outcome::Found(d, _)) => {
+                    let s = (d.image_size_px[0], d.image_size_px[1]);
+                    if size.is_some_and(|p| p != s) {
+                        return Err(usage(format!(
+                            "camera {}: '{file}' is {}x{} but its earlier images are not",
+                            c.name, s.0, s.1
+                        )));
+                    }
+                    size = Some(s);
+                    let frame = keys.iter().position(|k| k == key).unwrap_or(0);
+                    views.push((frame, View::from_detection(file, &d)));
+                }
+                Some(Outcome::Failed(_, m)) => {
+                    eprintln!("robocal rig: camera {}: {file} left out: {m}", c.name)
+                }
+                None => {}
+            }
+        }
+        let image_size_px = size
+            .or(held.as_ref().map(|h| (h.width, h.height)))
+            .ok_or_else(|| {
+                CliError::Io(format!(
+                    "rig: the target was found in no image of camera {}",
+                    c.name
+                ))
+            })?;
+        inputs.push(RigCameraViews {
+            name: c.name.clone(),
+            image_size_px,
+            views,
+            camera: held,
+        });
+    }
+    // 3. Solve, summarise, write.
+    let options = RigOptions {
+        calibration: CalibrationOptions {
+            model: model_from_name(model.as_deref().unwrap_or("brown"))?,
+            ..CalibrationOptions::default()
+        },
+        rig_frame: pick(&args.rig_frame, |r| &r.rig_frame),
+        target: target.to_spec(),
+        grouping: match grouping {
+            PairedBy::Number => "number".into(),
+            PairedBy::Order => "order".into(),
+        },
+    };
+    let report = calibrate_rig(&inputs, &keys, &options)?;
+    eprint!("{}", summary(&report));
+    let text = serde_json::to_string_pretty(&report)
+        .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
+    write_output(args.output.as_deref(), &(text + "\n"))
+}
+
+fn cameras_of_flags(flags: &[Vec<String>]) -> Vec<CameraArg> {
+    flags
+        .iter()
+        .map(|v| CameraArg {
+            name: v[0].clone(),
+            images: v[1..].to_vec(),
+            camera_file: None,
+        })
+        .collect()
+}
+
+/// The grouping rule: given, or by number unless no file name has one.
+fn grouping(rule: Option<&str>, cameras: &[CameraArg]) -> Result<PairedBy, CliError> {
+    match rule {
+        Some("number") => Ok(PairedBy::Number),
+        Some("order") => Ok(PairedBy::Order),
+        Some(other) => Err(usage(format!(
+            "--group-by takes number or order, got '{other}'"
+        ))),
+        None => {
+            let any_number = cameras
+                .iter()
+                .flat_map(|c| &c.images)
+                .any(|f| number_in_name(f).is_some());
+            if any_number {
+                Ok(PairedBy::Number)
+            } else {
+                eprintln!("robocal rig: no file name has a number: frames grouped by order");
+                Ok(PairedBy::Order)
+            }
+        }
+    }
+}
+
+fn held_camera(path: &str) -> Result<Camera, CliError> {
+    Ok(import_camera(&read_text(path)?)
+        .map_err(|e| CliError::from(e).in_file(path))?
+        .0)
+}
+
+/// A library error's message without its field (for usage errors).
+fn plain(e: robocal::Error) -> String {
+    match e {
+        robocal::Error::Invalid { message, .. } => message,
+        other => other.to_string(),
+    }
+}
+
+/// The summary on standard error: per camera views, rms, extrinsics with
+/// std; the co-observation table; warnings.
+fn summary(r: &RigCalibration) -> String {
+    let seen = r
+        .frames
+        .iter()
+        .filter(|f| f.rig_from_target.is_some())
+        .count();
+    let mut s = format!(
+        "robocal rig: {} cameras, {seen} frames used, rms {:.4} px, rig frame {}\n",
+        r.cameras.len(),
+        r.rms_px,
+        r.rig_frame
+    );
+    let width = r
+        .cameras
+        .iter()
+        .map(|c| c.name.len())
+        .max()
+        .unwrap_or(4)
+        .max(6);
+    s += &format!(
+        "  {:width$}  views  rms_px  translation_m (std mm)                        rotation_deg (std)\n",
+        "camera"
+    );
+    for c in &r.cameras {
+        if c.name == r.rig_frame {
+            s += &format!(
+                "  {:width$}  {:5}  {:6.4}  identity (the rig frame){}\n",
+                c.name,
+                c.frames_seen.len(),
+                c.rms_px,
+                if c.intrinsics_held {
+                    "  (intrinsics held)"
+                } else {
+                    ""
+                }
+            );
+            continue;
+        }
+        let t = c.camera_from_rig.translation_m;
+        let rv = rotvec_deg(c.camera_from_rig.quaternion_xyzw);
+        let (st, sr) = match &c.camera_from_rig_std {
+            Some(sd) => (
+                sd.translation_m.map(|v| v * 1e3),
+                sd.rotation_rad.map(f64::to_degrees),
+            ),
+            None => ([0.0; 3], [0.0; 3]),
+        };
+        s += &format!(
+            "  {:width$}  {:5}  {:6.4}  [{:8.5} ({:.2}) {:8.5} ({:.2}) {:8.5} ({:.2})]  [{:7.3} ({:.3}) {:7.3} ({:.3}) {:7.3} ({:.3})]{}\n",
+            c.name,
+            c.frames_seen.len(),
+            c.rms_px,
+            t[0], st[0], t[1], st[1], t[2], st[2],
+            rv[0], sr[0], rv[1], sr[1], rv[2], sr[2],
+            if c.intrinsics_held { "  (intrinsics held)" } else { "" }
+        );
+    }
+    s += "  frames seen together:\n";
+    s += &format!("  {:width$}", "");
+    for c in &r.co_observation.cameras {
+        s += &format!(" {:>width$}", c);
+    }
+    s += "\n";
+    for (name, row) in r
+        .co_observation
+        .cameras
+        .iter()
+        .zip(&r.co_observation.frames)
+    {
+        s += &format!("  {name:width$}");
+        for n in row {
+            s += &format!(" {n:>width$}");
+        }
+        s += "\n";
+    }
+    for w in &r.warnings {
+        s += &format!("robocal rig: warning: {w}\n");
+    }
+    s
+}
+
+/// The rotation vector of a quaternion (x, y, z, w), degrees.
+fn rotvec_deg(q: [f64; 4]) -> [f64; 3] {
+    let rotation = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+        q[3], q[0], q[1], q[2],
+    ));
+    let v = robocal::geometry::rotvec_from_rotation(&rotation);
+    [v.x.to_degrees(), v.y.to_degrees(), v.z.to_degrees()]
+}
