@@ -19,15 +19,15 @@ const PROFILE: usize = 21;
 const MAX_CORNER_SHIFT_PX: f64 = 3.0;
 
 /// Sub-pixel corners from lines fitted to each side's gradient maxima.
-/// A candidate from a `scale` times smaller image is first fitted with a
-/// search (and step) `scale` times wider, then as one from the frame.
+/// When that fails on a candidate from a `scale` times smaller image, it
+/// is fitted with a search (and step) `scale` times wider first, then
+/// again as one from the frame.
 pub(super) fn refine_quad(img: &GrayImage, q: Quad, scale: f64) -> Quad {
-    let q = if scale > 1.0 {
-        fit_quad(img, q, scale)
-    } else {
-        q
-    };
-    fit_quad(img, q, 1.0)
+    let fine = fit_quad(img, q.clone(), 1.0);
+    if scale <= 1.0 || fine.corners != q.corners {
+        return fine;
+    }
+    fit_quad(img, fit_quad(img, q, scale), 1.0)
 }
 
 /// One fit with the search and step scaled by `scale`; the quad unchanged
