@@ -24,8 +24,10 @@
 //!    Any subset of points may come out (partial views, occlusion).
 
 mod decode;
+mod edges;
 mod homography;
 mod quads;
+mod runs;
 
 use super::refine::refine_saddle;
 use super::DetectOptions;
@@ -88,9 +90,9 @@ impl MarkerOptions {
 pub(crate) fn find_markers(img: &GrayImage, dictionary: Dictionary, border: usize) -> Vec<Marker> {
     let max_errors = MarkerOptions::default().max_bit_errors(dictionary);
     let mut found: Vec<Marker> = Vec::new();
-    for q in quads::find_quads(img) {
-        let Some(m) = decode::read_marker(img, &q, dictionary, border, max_errors) else {
-            continue;
+    quads::find_quads(img, |q| {
+        let Some(m) = decode::read_marker(img, q, dictionary, border, max_errors) else {
+            return false;
         };
         let c = centre(&m.corners);
         let side = mean_side(&m.corners);
@@ -102,7 +104,8 @@ pub(crate) fn find_markers(img: &GrayImage, dictionary: Dictionary, border: usiz
             Some(_) => {}
             None => found.push(m),
         }
-    }
+        true
+    });
     found
 }
 

@@ -1,42 +1,82 @@
 //! Marker candidates: dark convex quadrilaterals.
 //!
-//! 1. A locally adaptive threshold: a pixel is dark when it is more than
-//!    [`THRESHOLD_OFFSET`] grey levels below the mean of a square window
-//!    around it (means from one integral image; two window sizes, as
-//!    OpenCV's ArUco detector tries several).
-//! 2. 4-connected components of dark pixels. Four-connectivity separates
-//!    regions that touch only at a corner (a ChArUco board's black squares,
-//!    an AprilGrid tag and its corner squares): the X-junction pixel sits
-//!    at the local mean, never below it by the offset.
-//! 3. Per component: its boundary pixels' convex hull and the quadrilateral
-//!    of four hull vertices (farthest-point construction). Rejected: regions
-//!    touching the image border, sides below [`MIN_SIDE_PX`], hulls the quad
-//!    covers less than [`MIN_QUAD_FILL`] of (not a quadrilateral), quads
-//!    larger than the image.
-//! 4. Corners to sub-pixel: each side's line is fitted to gradient maxima
-//!    sampled across it; neighbouring lines meet at the corners.
+//! 1. The search image: the frame itself, or its 2 x 2 mean
+//!    ([`runs::decimate`]) when its long side is at least
+//!    [`DECIMATE_FROM_PX`] (a quarter of the pixels for every step below;
+//!    markers keep at least [`MIN_SIDE_PX`] / 2 pixels a side there).
+//! 2. A locally adaptive threshold ([`runs::threshold`]: dark when more
+//!    than 7 grey levels below the mean of a square window, two window
+//!    sizes as OpenCV's ArUco detector tries several), written as runs of
+//!    dark pixels, and the same runs eroded once (breaks the necks where an
+//!    AprilGrid tag meets its corner squares under blur).
+//! 3. 4-connected regions of runs. Four-connectivity separates regions that
+//!    touch only at a corner (a ChArUco board's black squares, an AprilGrid
+//!    tag and its corner squares): the X-junction pixel sits at the local
+//!    mean, never below it by the offset.
+//! 4. Per region: the convex hull of its runs' end points and the
+//!    quadrilateral of four hull vertices (farthest-point construction).
+//!    Rejected: regions touching the image border, sides below
+//!    [`MIN_SIDE_PX`], hulls the quad covers less than [`MIN_QUAD_FILL`] of
+//!    (not a quadrilateral), quads larger than the image.
+//! 5. A candidate already tried (another window, the eroded runs: the same
+//!    corners within [`SAME_QUAD_PX`]) or inside a marker already read is
+//!    skipped; the others get sub-pixel corners on the full-resolution
+//!    frame ([`edges::refine_quad`]) and go to the reader.
+//! 6. When the decimated search reads no marker at all, the frame is
+//!    searched again at full resolution (markers too small for the
+//!    decimated image, or a frame without a board).
 
+use super::edges::refine_quad;
+use super::runs::{self, Region};
 use crate::image::GrayImage;
 use nalgebra::{Point2, Vector2};
+use std::collections::HashMap;
 
-/// Grey levels below the local mean for a dark pixel (OpenCV's
-/// adaptiveThreshConstant is 7).
-const THRESHOLD_OFFSET: i64 = 7;
-/// Shortest quad side, pixels: a 4 x 4 marker with its border has cells of
-/// at least 1.3 px then.
-pub(crate) const MIN_SIDE_PX: f64 = 8.0;
+/// Shortest quad side in the frame, pixels: a 4 x 4 marker with its border
+/// has cells of at least 1.3 px then.
+const MIN_SIDE_PX: f64 = 8.0;
 /// The quad must cover this much of the region's hull.
 const MIN_QUAD_FILL: f64 = 0.88;
-/// Sample points per side for the edge fit.
-const EDGE_SAMPLES: usize = 12;
-/// Search half-length across a side, pixels.
-const EDGE_SEARCH_PX: f64 = 2.5;
+/// Frames whose long side has at least this many pixels are searched at
+/// half resolution first.
+pub(super) const DECIMATE_FROM_PX: u32 = 1000;
+/// Two candidates whose corners all lie this close (frame pixels) are the
+/// same quad.
+const SAME_QUAD_PX: f64 = 2.0;
 
 /// A candidate marker outline: corners clockwise on screen (y down),
 /// starting anywhere.
 #[derive(Debug, Clone)]
 pub(crate) struct Quad {
     pub corners: [Point2<f64>; 4],
+}
+
+impl Quad {
+    fn centre(&self) -> Point2<f64> {
+        Point2::from(
+            self.corners
+                .iter()
+                .fold(Vector2::zeros(), |s, p| s + p.coords)
+                / 4.0,
+        )
+    }
+
+    fn mean_side(&self) -> f64 {
+        (0..4)
+            .map(|k| (self.corners[(k + 1) % 4] - self.corners[k]).norm())
+            .sum::<f64>()
+            / 4.0
+    }
+
+    /// Every corner of `self` within `tol` of one of `other`'s.
+    fn same_as(&self, other: &Quad, tol: f64) -> bool {
+        self.corners.iter().all(|c| {
+            other
+                .corners
+                .iter()
+                .any(|o| (c - o).norm_squared() <= tol * tol)
+        })
+    }
 }
 
 /// Windows (odd side, pixels) of the adaptive threshold for an image.
@@ -46,132 +86,119 @@ fn windows(w: u32, h: u32) -> [usize; 2] {
     [small, (3 * small).min(91) | 1]
 }
 
-/// Every candidate quad of `img` (duplicates across the threshold windows
-/// included; the decoder's duplicates are merged by the caller).
-pub(crate) fn find_quads(img: &GrayImage) -> Vec<Quad> {
-    let (w, h) = (img.width as usize, img.height as usize);
-    let integral = integral_image(img);
-    let mut out = Vec::new();
-    for win in windows(img.width, img.height) {
-        let mask = threshold(img, &integral, win);
-        let eroded = erode(&mask, w, h);
+/// Candidates tried so far: those `read` accepted (a marker, by centre and
+/// side) and the rest (by the cell of their centre, [`SAME_QUAD_PX`]
+/// pixels a side: the same quad is in a neighbouring cell).
+#[derive(Default)]
+struct Tried {
+    markers: Vec<(Point2<f64>, f64)>,
+    others: HashMap<(i64, i64), Vec<Quad>>,
+}
+
+impl Tried {
+    fn cell(p: Point2<f64>) -> (i64, i64) {
+        (
+            (p.x / SAME_QUAD_PX).floor() as i64,
+            (p.y / SAME_QUAD_PX).floor() as i64,
+        )
+    }
+
+    fn covers(&self, q: &Quad) -> bool {
+        let c = q.centre();
+        if self
+            .markers
+            .iter()
+            .any(|(m, side)| (c - m).norm_squared() < 0.25 * side * side)
+        {
+            return true;
+        }
+        let (i, j) = Tried::cell(c);
+        (i - 1..=i + 1).any(|a| {
+            (j - 1..=j + 1).any(|b| {
+                self.others
+                    .get(&(a, b))
+                    .is_some_and(|v| v.iter().any(|o| q.same_as(o, SAME_QUAD_PX)))
+            })
+        })
+    }
+
+    fn add_other(&mut self, q: Quad) {
+        self.others
+            .entry(Tried::cell(q.centre()))
+            .or_default()
+            .push(q);
+    }
+}
+
+/// Hands every candidate quad of `img` to `read` (corners refined on
+/// `img`), which says whether it read a marker there; see the module docs.
+pub(crate) fn find_quads(img: &GrayImage, mut read: impl FnMut(&Quad) -> bool) {
+    let mut tried = Tried::default();
+    if img.width.max(img.height) >= DECIMATE_FROM_PX {
+        let half = runs::decimate(img);
+        search(img, &half, 2.0, &mut tried, &mut read);
+        if !tried.markers.is_empty() {
+            return;
+        }
+    }
+    search(img, img, 1.0, &mut tried, &mut read);
+}
+
+/// One search on `small` (the frame `img` scaled by 1 / `scale`).
+fn search(
+    img: &GrayImage,
+    small: &GrayImage,
+    scale: f64,
+    tried: &mut Tried,
+    read: &mut impl FnMut(&Quad) -> bool,
+) {
+    let min_side = MIN_SIDE_PX / scale;
+    let integral = runs::integral_image(small);
+    // Pixel (i, j) of `small` is centred on scale * (i, j) + (scale - 1) / 2.
+    let offset = 0.5 * (scale - 1.0);
+    for win in windows(small.width, small.height) {
+        let mask = runs::threshold(small, &integral, win);
+        let eroded = runs::erode(&mask);
         for (m, inset) in [(&mask, 0.5), (&eroded, 1.5)] {
-            for region in components(m, w, h) {
-                if let Some(q) = quad_of(&region, inset) {
-                    out.push(refine_quad(img, q));
+            for region in runs::regions(m, (0.5 * min_side) as u32) {
+                let Some(q) = quad_of(&region, inset, min_side) else {
+                    continue;
+                };
+                let q = Quad {
+                    corners: q
+                        .corners
+                        .map(|p| Point2::new(scale * p.x + offset, scale * p.y + offset)),
+                };
+                if tried.covers(&q) {
+                    continue;
                 }
-            }
-        }
-    }
-    out
-}
-
-/// Dark pixels whose four neighbours are dark too: breaks the one- or
-/// two-pixel necks where dark regions meet at a corner under blur and tilt
-/// (an AprilGrid tag and its corner squares), at the price of a pixel all
-/// round (the quad is pushed back out by it).
-fn erode(mask: &[bool], w: usize, h: usize) -> Vec<bool> {
-    let mut out = vec![false; w * h];
-    for y in 1..h.saturating_sub(1) {
-        for x in 1..w - 1 {
-            let i = y * w + x;
-            out[i] = mask[i] && mask[i - 1] && mask[i + 1] && mask[i - w] && mask[i + w];
-        }
-    }
-    out
-}
-
-fn integral_image(img: &GrayImage) -> Vec<u64> {
-    let (w, h) = (img.width as usize, img.height as usize);
-    let mut s = vec![0u64; (w + 1) * (h + 1)];
-    for y in 0..h {
-        let mut row = 0u64;
-        for x in 0..w {
-            row += u64::from(img.pixels[y * w + x]);
-            s[(y + 1) * (w + 1) + x + 1] = s[y * (w + 1) + x + 1] + row;
-        }
-    }
-    s
-}
-
-fn threshold(img: &GrayImage, s: &[u64], win: usize) -> Vec<bool> {
-    let (w, h) = (img.width as usize, img.height as usize);
-    let r = win / 2;
-    let mut mask = vec![false; w * h];
-    for y in 0..h {
-        let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
-        for x in 0..w {
-            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
-            let sum = s[y1 * (w + 1) + x1] + s[y0 * (w + 1) + x0]
-                - s[y0 * (w + 1) + x1]
-                - s[y1 * (w + 1) + x0];
-            let area = ((x1 - x0) * (y1 - y0)) as i64;
-            let v = i64::from(img.pixels[y * w + x]);
-            mask[y * w + x] = (v + THRESHOLD_OFFSET) * area < sum as i64;
-        }
-    }
-    mask
-}
-
-/// Boundary pixels of one 4-connected dark region not touching the image
-/// border.
-struct Region {
-    boundary: Vec<Point2<f64>>,
-}
-
-fn components(mask: &[bool], w: usize, h: usize) -> Vec<Region> {
-    let mut label = vec![false; w * h];
-    let mut out = Vec::new();
-    let mut stack = Vec::new();
-    let max_pixels = w * h / 2;
-    for start in 0..w * h {
-        if !mask[start] || label[start] {
-            continue;
-        }
-        label[start] = true;
-        stack.push(start);
-        let mut boundary = Vec::new();
-        let mut touches_border = false;
-        let mut count = 0usize;
-        while let Some(i) = stack.pop() {
-            count += 1;
-            let (x, y) = (i % w, i / w);
-            if x == 0 || y == 0 || x + 1 == w || y + 1 == h {
-                touches_border = true;
-                continue;
-            }
-            let mut edge = false;
-            for n in [i - 1, i + 1, i - w, i + w] {
-                if mask[n] {
-                    if !label[n] {
-                        label[n] = true;
-                        stack.push(n);
-                    }
+                let refined = refine_quad(img, q.clone(), scale);
+                if read(&refined) {
+                    tried.markers.push((refined.centre(), refined.mean_side()));
                 } else {
-                    edge = true;
+                    tried.add_other(q);
                 }
             }
-            if edge {
-                boundary.push(Point2::new(x as f64, y as f64));
-            }
-        }
-        let min_boundary = (4.0 * MIN_SIDE_PX) as usize - 4;
-        if !touches_border && boundary.len() >= min_boundary && count <= max_pixels {
-            out.push(Region { boundary });
         }
     }
-    out
 }
 
-/// Convex hull (monotone chain), counter-clockwise in x-right/y-up terms,
-/// i.e. clockwise on screen... orientation fixed by the caller.
-fn hull(points: &mut [Point2<f64>]) -> Vec<Point2<f64>> {
-    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+/// Convex hull of a region's pixel centres (monotone chain over the runs'
+/// end points, which come in (y, x) order already: the hull of a run is
+/// its two ends). Collinear points are dropped.
+fn hull(region: &[(u32, runs::Run)]) -> Vec<Point2<f64>> {
+    let mut points = Vec::with_capacity(2 * region.len());
+    for &(y, r) in region {
+        points.push(Point2::new(f64::from(r.x0), f64::from(y)));
+        if r.x1 > r.x0 + 1 {
+            points.push(Point2::new(f64::from(r.x1 - 1), f64::from(y)));
+        }
+    }
     let cross = |o: &Point2<f64>, a: &Point2<f64>, b: &Point2<f64>| {
         (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
     };
     let mut lower: Vec<Point2<f64>> = Vec::new();
-    for p in points.iter() {
+    for p in &points {
         while lower.len() >= 2 && cross(&lower[lower.len() - 2], &lower[lower.len() - 1], p) <= 0.0
         {
             lower.pop();
@@ -206,9 +233,8 @@ fn polygon_area(p: &[Point2<f64>]) -> f64 {
 /// The region's quadrilateral, corners clockwise on screen, or `None`;
 /// `inset` is how far (pixels, along x and y) the region's boundary pixel
 /// centres lie inside the dark area's edge.
-fn quad_of(region: &Region, inset: f64) -> Option<Quad> {
-    let mut pts = region.boundary.clone();
-    let hull = hull(&mut pts);
+fn quad_of(region: &Region, inset: f64, min_side: f64) -> Option<Quad> {
+    let hull = hull(&region.runs);
     if hull.len() < 4 {
         return None;
     }
@@ -242,7 +268,7 @@ fn quad_of(region: &Region, inset: f64) -> Option<Quad> {
     }
     // Screen-clockwise (y down) means positive shoelace area here.
     for k in 0..4 {
-        if (corners[(k + 1) % 4] - corners[k]).norm() < MIN_SIDE_PX {
+        if (corners[(k + 1) % 4] - corners[k]).norm() < min_side {
             return None;
         }
     }
@@ -254,110 +280,4 @@ fn quad_of(region: &Region, inset: f64) -> Option<Quad> {
         Point2::from(p.coords + d.normalize() * inset * std::f64::consts::SQRT_2)
     });
     Some(Quad { corners })
-}
-
-/// Sub-pixel corners from lines fitted to each side's gradient maxima;
-/// the quad unchanged when a side cannot be fitted.
-fn refine_quad(img: &GrayImage, q: Quad) -> Quad {
-    let mut lines = Vec::with_capacity(4);
-    for k in 0..4 {
-        let (a, b) = (q.corners[k], q.corners[(k + 1) % 4]);
-        match edge_line(img, a, b) {
-            Some(l) => lines.push(l),
-            None => return q,
-        }
-    }
-    let mut corners = q.corners;
-    for k in 0..4 {
-        // Corner k is where side k-1 meets side k.
-        let (l0, l1) = (&lines[(k + 3) % 4], &lines[k]);
-        match intersect(l0, l1) {
-            Some(p) if (p - q.corners[k]).norm() < 3.0 => corners[k] = p,
-            _ => return q,
-        }
-    }
-    Quad { corners }
-}
-
-/// A line through `point` with unit `normal`.
-struct Line {
-    point: Point2<f64>,
-    dir: Vector2<f64>,
-}
-
-fn intersect(a: &Line, b: &Line) -> Option<Point2<f64>> {
-    let den = a.dir.x * b.dir.y - a.dir.y * b.dir.x;
-    if den.abs() < 1e-9 {
-        return None;
-    }
-    let d = b.point - a.point;
-    let t = (d.x * b.dir.y - d.y * b.dir.x) / den;
-    Some(a.point + a.dir * t)
-}
-
-fn bilinear(img: &GrayImage, x: f64, y: f64) -> f64 {
-    let (w, h) = (img.width as usize, img.height as usize);
-    let x = x.clamp(0.0, (w - 1) as f64);
-    let y = y.clamp(0.0, (h - 1) as f64);
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-    let (fx, fy) = (x - x0 as f64, y - y0 as f64);
-    let p = |xx: usize, yy: usize| f64::from(img.pixels[yy * w + xx]);
-    (p(x0, y0) * (1.0 - fx) + p(x1, y0) * fx) * (1.0 - fy)
-        + (p(x0, y1) * (1.0 - fx) + p(x1, y1) * fx) * fy
-}
-
-/// The edge between `a` and `b`: gradient maxima across the side at
-/// [`EDGE_SAMPLES`] points in its middle 70 %, then a total-least-squares
-/// line.
-fn edge_line(img: &GrayImage, a: Point2<f64>, b: Point2<f64>) -> Option<Line> {
-    let along = (b - a).normalize();
-    let normal = Vector2::new(-along.y, along.x);
-    let step = 0.25;
-    let n_steps = (2.0 * EDGE_SEARCH_PX / step) as usize;
-    let mut pts = Vec::with_capacity(EDGE_SAMPLES);
-    for s in 0..EDGE_SAMPLES {
-        let t = 0.15 + 0.7 * (s as f64 + 0.5) / EDGE_SAMPLES as f64;
-        let base = a + (b - a) * t;
-        // Profile across the edge; its derivative's peak magnitude.
-        let profile: Vec<f64> = (0..=n_steps)
-            .map(|i| {
-                let o = -EDGE_SEARCH_PX + i as f64 * step;
-                let p = base + normal * o;
-                bilinear(img, p.x, p.y)
-            })
-            .collect();
-        let grad: Vec<f64> = profile.windows(3).map(|w| (w[2] - w[0]).abs()).collect();
-        let (imax, &gmax) = grad.iter().enumerate().max_by(|x, y| x.1.total_cmp(y.1))?;
-        if gmax < 4.0 || imax == 0 || imax + 1 >= grad.len() {
-            continue;
-        }
-        let (l, c, r) = (grad[imax - 1], gmax, grad[imax + 1]);
-        let den = l - 2.0 * c + r;
-        let off = if den.abs() > 1e-12 {
-            0.5 * (l - r) / den
-        } else {
-            0.0
-        };
-        let o = -EDGE_SEARCH_PX + (imax as f64 + 1.0 + off) * step;
-        pts.push(base + normal * o);
-    }
-    if pts.len() < EDGE_SAMPLES / 2 {
-        return None;
-    }
-    let c = pts.iter().fold(Vector2::zeros(), |s, p| s + p.coords) / pts.len() as f64;
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for p in &pts {
-        let d = p.coords - c;
-        sxx += d.x * d.x;
-        sxy += d.x * d.y;
-        syy += d.y * d.y;
-    }
-    // Principal direction of the scatter.
-    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    let dir = Vector2::new(theta.cos(), theta.sin());
-    (dir.dot(&along).abs() > 0.9).then_some(Line {
-        point: Point2::from(c),
-        dir,
-    })
 }
