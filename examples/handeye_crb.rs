@@ -3,7 +3,7 @@
 //! and (optionally) the image-path refinement, per scenario.
 //!
 //! Usage: cargo run --release --example handeye_crb -- [--trials N] [--views N]
-//!        [--image-path] [--trials-json FILE] [--repeat]
+//!        [--image-path] [--trials-json FILE] [--repeat] [--only TEXT]
 //!
 //! Per trial: a seeded scene whose camera looks at a grid
 //! ([`robocal::synth::handeye_looking`]), pixels with Gaussian noise, camera
@@ -165,6 +165,8 @@ fn main() {
     let image_path = args.iter().any(|a| a == "--image-path");
     let repeat = args.iter().any(|a| a == "--repeat");
     let json_path = value("--trials-json");
+    // Run only the scenarios whose name contains this text (quick checks).
+    let only = value("--only");
     let options = HandEyeOptions {
         bootstrap_samples: 0,
         strict_checks: false,
@@ -185,6 +187,9 @@ fn main() {
     let mut repeat_rows = Vec::new();
     let mut model_rows = Vec::new();
     for (si, sc) in scenarios(views).iter().enumerate() {
+        if only.as_ref().is_some_and(|o| !sc.name.contains(o.as_str())) {
+            continue;
+        }
         let (mut bound, mut diag, mut perview, mut image) = (
             Tally::default(),
             Tally::default(),

@@ -49,6 +49,7 @@ pub mod intrinsics_move;
 pub mod json_api;
 pub mod math;
 pub mod motion;
+pub mod noise_choice;
 pub mod output;
 pub mod pnp;
 pub mod pose_noise;

@@ -179,3 +179,72 @@ fn image_points_without_pixel_refinement_feed_the_pnp_covariance() {
     input["refine_poses"] = serde_json::Value::Bool(false);
     assert!(run(&input)["pose_refinement"].is_null());
 }
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_shape_scale_is_fitted_from_a_start_far_off() {
+    // A 75 mm lens (f = 31 250 px) at 2.3 m with 0.1 px pixel noise: the
+    // shape's scale is (0.1 / 31 250)^2 ~ 1e-11, four orders below the
+    // 0.5 m start (4e-8). The chosen model's likelihood at the truth must be
+    // that of the board's own rectangle (origin to twice the look-at point)
+    // fitted from a start near the answer, within 0.5 (a 20 % change of the
+    // scale costs about 2 over 15 views); from the far start alone it was
+    // about 40 worse, and the choice then fell on a 0.9 m square.
+    use super::noise_choice::choose_noise_model;
+    use super::pose_refine::{estimate_noise, negative_log_likelihood};
+    use super::pose_shape::{predicted_covariances, NominalTarget};
+    use nalgebra::Vector3;
+    let camera = Camera::pinhole(31250.0, 31250.0, 2735.5, 1823.5, 5472, 3648);
+    let config = LookingConfig {
+        setup: Setup::EyeInHand,
+        views: 15,
+        distance_m: 2.3,
+        grid: (13, 9, 0.025),
+        max_tilt_deg: 20.0,
+        max_roll_deg: 60.0,
+    };
+    let (sr, st) = (0.02f64.to_radians(), 0.1e-3);
+    for seed in [3, 4] {
+        let scene = looking_scene(&config, seed);
+        let mut rng = Rng::new(seed ^ 0x5eed);
+        let pixels = grid_pixels(&scene, &camera, 0.1, &mut rng);
+        let cams: Vec<Pose> = pixels
+            .iter()
+            .map(|v| camera_from_target_with_covariance(&camera, v).unwrap().0)
+            .collect();
+        let robots: Vec<Pose> = scene
+            .base_from_gripper
+            .iter()
+            .map(|p| perturbed(&mut rng, p, [sr; 3], [st; 3]))
+            .collect();
+        let views = paired(&robots, &cams);
+        let (x, y) = (scene.x_true, scene.y_true);
+        let chosen = choose_noise_model(
+            Setup::EyeInHand,
+            &views,
+            CameraNoise::Diagonal,
+            &x,
+            &y,
+            None,
+            true,
+        )
+        .unwrap();
+        let board = NominalTarget {
+            centre: Vector3::new(0.15, 0.1, 0.0),
+            half: [0.15, 0.1],
+        };
+        let mut near = NoiseModel::new(CameraNoise::PerView(
+            predicted_covariances(&views, &board).unwrap(),
+        ));
+        near.variances[2] = (0.07f64 / 31250.0).powi(2);
+        estimate_noise(Setup::EyeInHand, &views, &mut near, &x, &y, None).unwrap();
+        let nll =
+            |m: &NoiseModel| negative_log_likelihood(Setup::EyeInHand, &views, m, &x, &y).unwrap();
+        assert_eq!(chosen.name, "predicted_pnp", "seed {seed}");
+        assert!(
+            nll(&chosen.noise) <= nll(&near) + 0.5,
+            "seed {seed}: chosen {} vs the board's rectangle {} (negative log-likelihood)",
+            nll(&chosen.noise),
+            nll(&near)
+        );
+    }
+}

@@ -12,14 +12,12 @@
 //! and only the observable part is refined.
 
 use super::motion::build_motions;
+use super::noise_choice::choose_noise_model;
 use super::pnp::camera_from_target_with_covariance;
-use super::pose_noise::{CameraNoise, NoiseLevels, NoiseModel, MIN_POSES_FOR_NOISE_ESTIMATE};
-use super::pose_refine::{
-    estimate_noise, evaluate, negative_log_likelihood, refine, Covariance12, PoseRefineOptions,
-    HUBER_SCALE,
-};
+use super::pose_noise::{CameraNoise, NoiseLevels, NoiseModel};
+use super::pose_refine::{evaluate, refine, Covariance12, PoseRefineOptions, HUBER_SCALE};
 use super::pose_residual::PoseMeasurement;
-use super::pose_shape::{predicted_covariances, NominalTarget};
+use super::pose_shape::NominalTarget;
 use super::repeat::{repeatability_with, Repeatability};
 use super::report::{errors, motion_residuals, pose_difference, view_residuals};
 use super::reprojection_refine::ViewPoints;
@@ -91,44 +89,6 @@ pub struct NominalTargetReport {
     pub centre: [f64; 2],
     /// Half extents along x and y.
     pub half_extent: [f64; 2],
-}
-
-/// The likeliest per-view predicted shape ([`super::pose_shape`]) over the
-/// nominal target candidates, if it is more likely than `diagonal` (whose
-/// levels were fitted at `(x, y)`); its levels fitted at `(x, y)` too.
-fn choose_predicted_shape(
-    setup: Setup,
-    views: &[PoseMeasurement],
-    diagonal: &NoiseModel,
-    x: &Pose,
-    y: &Pose,
-    axis: Option<Vector3<f64>>,
-    pivot: Option<Vector3<f64>>,
-) -> Option<(NoiseModel, NominalTarget)> {
-    // Akaike: each estimated level costs 1 in negative log-likelihood; the
-    // diagonal has 8 levels, the predicted shape 3.
-    let mut best_nll = negative_log_likelihood(setup, views, diagonal, x, y).ok()?
-        + diagonal.variances.len() as f64;
-    let mut best = None;
-    for target in NominalTarget::candidates(views, pivot) {
-        let Some(covs) = predicted_covariances(views, &target) else {
-            continue;
-        };
-        let mut model = NoiseModel::new(CameraNoise::PerView(covs));
-        // Start near (0.2 px / 1000 px)^2 in normalised coordinates.
-        model.variances[2] = 4e-8;
-        if estimate_noise(setup, views, &mut model, x, y, axis).is_err() {
-            continue;
-        }
-        if let Ok(nll) = negative_log_likelihood(setup, views, &model, x, y) {
-            let nll = nll + model.variances.len() as f64;
-            if nll < best_nll {
-                best_nll = nll;
-                best = Some((model, target));
-            }
-        }
-    }
-    best
 }
 
 fn transform_std(cov: &Covariance12, offset: usize) -> TransformStd {
@@ -246,58 +206,24 @@ pub fn apply_pose_refinement_with(
     let views = measurements(input);
     let setup = input.setup;
     let axis = result.unobservable_translation.first().copied();
-    let model_name = match camera_noise {
-        CameraNoise::Diagonal => "diagonal",
-        CameraNoise::PerView(_) => "per_view",
+    let chosen = match choose_noise_model(
+        setup,
+        &views,
+        camera_noise.clone(),
+        &result.x,
+        &result.y,
+        axis,
+        predict_shape,
+    ) {
+        Ok(c) => c,
+        Err(e) => {
+            result
+                .warnings
+                .push(format!("pose refinement skipped: {e}"));
+            return Ok(());
+        }
     };
-    let diagonal = matches!(camera_noise, CameraNoise::Diagonal);
-    let mut pivot = None;
-    let mut noise = NoiseModel::new(camera_noise);
-    if let Err(e) = estimate_noise(setup, &views, &mut noise, &result.x, &result.y, axis) {
-        result
-            .warnings
-            .push(format!("pose refinement skipped: {e}"));
-        return Ok(());
-    }
-    // The diagonal camera noise about the target origin or about where the
-    // camera looks on the target: the one the data make more likely.
-    if let (true, Some(p)) = (diagonal, board_pivot(&views)) {
-        let mut pivoted = NoiseModel::new(CameraNoise::Diagonal);
-        pivoted.pivot_levers = pivot_levers(&views, &p);
-        let better = estimate_noise(setup, &views, &mut pivoted, &result.x, &result.y, axis)
-            .and_then(|_| {
-                let with = negative_log_likelihood(setup, &views, &pivoted, &result.x, &result.y)?;
-                let without = negative_log_likelihood(setup, &views, &noise, &result.x, &result.y)?;
-                Ok(with < without)
-            });
-        if better.unwrap_or(false) {
-            noise = pivoted;
-            pivot = Some([p.x, p.y, p.z]);
-        }
-    }
-    // Camera poses without their covariances: a per-view shape predicted
-    // from each pose for a nominal target, when the data make it more
-    // likely than the diagonal (Akaike). With too few poses for the levels
-    // to be estimated the documented diagonal defaults stand.
-    let mut model_name = model_name.to_string();
-    let mut nominal = None;
-    if diagonal && predict_shape && views.len() >= MIN_POSES_FOR_NOISE_ESTIMATE {
-        let shaped = choose_predicted_shape(
-            setup,
-            &views,
-            &noise,
-            &result.x,
-            &result.y,
-            axis,
-            board_pivot(&views),
-        );
-        if let Some((model, target)) = shaped {
-            noise = model;
-            pivot = None;
-            nominal = Some(target);
-            model_name = "predicted_pnp".to_string();
-        }
-    }
+    let noise = chosen.noise.clone();
     let options = PoseRefineOptions {
         camera_noise: noise.camera.clone(),
         unobservable_translation: axis,
@@ -324,7 +250,6 @@ pub fn apply_pose_refinement_with(
         }
     }
     let (closed_form_cost, started_from, x0, y0) = start;
-    let model_for_resamples = noise.clone();
     let refined = match refine(setup, &views, &x0, &y0, noise, &options) {
         Ok(r) => r,
         Err(e) => {
@@ -334,6 +259,32 @@ pub fn apply_pose_refinement_with(
             return Ok(());
         }
     };
+    // The model choice again at the refined solution: at a closed form its
+    // error inflates the levels and favours the wrong nominal target (at
+    // 2.3 m the fixed-rule closed form is ~1 mm off, three times the bound).
+    let (mut chosen, mut options, mut refined) = (chosen, options, refined);
+    if matches!(camera_noise, CameraNoise::Diagonal) && predict_shape {
+        let again = choose_noise_model(
+            setup,
+            &views,
+            camera_noise,
+            &refined.x,
+            &refined.y,
+            axis,
+            predict_shape,
+        );
+        if let Some(again) = again.ok().filter(|a| !a.same_model(&chosen)) {
+            let again_options = PoseRefineOptions {
+                camera_noise: again.noise.camera.clone(),
+                unobservable_translation: axis,
+            };
+            let (x1, y1) = (refined.x, refined.y);
+            if let Ok(r) = refine(setup, &views, &x1, &y1, again.noise.clone(), &again_options) {
+                (chosen, options, refined) = (again, again_options, r);
+            }
+        }
+    }
+    let model_for_resamples = chosen.noise.clone();
     let chain = Chain::new(setup, &input.base_from_gripper, &input.camera_from_target)?;
     result.x = refined.x;
     result.y = refined.y;
@@ -359,10 +310,10 @@ pub fn apply_pose_refinement_with(
         started_from: started_from.clone(),
         closed_form_cost,
         cost: refined.cost,
-        camera_noise_model: model_name,
+        camera_noise_model: chosen.name,
         noise: refined.noise.levels(),
-        camera_noise_pivot_m: pivot,
-        camera_noise_nominal_target_m: nominal.map(|t: NominalTarget| NominalTargetReport {
+        camera_noise_pivot_m: chosen.pivot,
+        camera_noise_nominal_target_m: chosen.nominal.map(|t: NominalTarget| NominalTargetReport {
             centre: [t.centre.x, t.centre.y],
             half_extent: t.half,
         }),

@@ -12,17 +12,23 @@
 //! being the world itself: set [`RefineOptions::points_in_world`] and `y` is
 //! held at identity.
 //!
-//! Every pose parameter is 6 numbers `[rotation vector, translation]`,
-//! updated by right perturbation `P <- P * exp(delta)`; Jacobians are
+//! Every pose parameter is 6 numbers `[rotation vector, translation]`; `x`
+//! and `y` are updated by right perturbation `P <- P * exp(delta)`. A robot
+//! correction is a decoupled left perturbation of `base_from_gripper` in the
+//! base frame (`R <- exp(w) R`, `t <- t + v`), the noise model of
+//! [`super::pose_residual`] and of the pose refinement, in both setups (eye-to-hand,
+//! a correction of `gripper_from_base` would tie the translation noise to the
+//! rotation noise through the lever arm from the base origin). Jacobians are
 //! analytic through the chain `pixel = project(x^-1 robot^-1 y p)`.
 
 use super::{Chain, Pose, Setup};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::geometry::{params_from_pose, pose_from_params, rotvec_from_rotation};
+use crate::geometry::{params_from_pose, pose_from_params};
 use crate::handeye::math::skew;
+use crate::handeye::pose_residual::{difference, left_jacobian_inverse, perturb as perturb_left};
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix3, Point2, Point3};
+use nalgebra::{DMatrix, DVector, Matrix3, Point2, Point3, SMatrix, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 
 /// Target points and their detections in one view.
@@ -42,7 +48,8 @@ pub enum RobotNoise {
     /// Robot poses are exact.
     Trusted,
     /// Each robot pose gets a correction with a Gaussian prior (std per
-    /// rotation-vector component in radians, per translation component in metres).
+    /// rotation-vector component in radians, per translation component in
+    /// metres; decoupled, in the base frame: `R <- exp(w) R`, `t <- t + v`).
     Prior {
         /// Rotation std (radians).
         rotation_sigma_rad: f64,
@@ -110,7 +117,9 @@ fn perturb(p: &[f64], d: &[f64]) -> Vec<f64> {
 }
 
 struct Problem<'a> {
-    chain_robot: Vec<Pose>,
+    setup: Setup,
+    /// The robot's `base_from_gripper` as given (the prior's centre).
+    measured: &'a [Pose],
     views: &'a [ViewPoints],
     camera: &'a Camera,
     intrinsics: bool,
@@ -127,12 +136,51 @@ impl Problem<'_> {
         }
     }
 
+    /// `base_from_gripper` of view `i`: the corrected one (its block) with
+    /// a prior, else as measured.
     fn robot_at(&self, params: &BlockParams, i: usize) -> Pose {
         match self.prior {
             Some(_) => pose_from_params(&params.blocks[i]),
-            None => self.chain_robot[i],
+            None => self.measured[i],
         }
     }
+}
+
+/// `robot[i]^-1` of the chain (the map from the target's side of the chain
+/// to `x`'s): `gripper_from_base` eye-in-hand, `base_from_gripper` eye-to-hand.
+pub(super) fn chain_robot_inverse(setup: Setup, base_from_gripper: &Pose) -> Pose {
+    match setup {
+        Setup::EyeInHand => base_from_gripper.inverse(),
+        Setup::EyeToHand => *base_from_gripper,
+    }
+}
+
+/// d u / d (decoupled left correction `[w, v]` of `base_from_gripper` =
+/// `(R, t)`, base frame), for `u = chain_robot_inverse(robot) * q1`.
+pub(super) fn robot_correction_jacobian(
+    setup: Setup,
+    robot: &Pose,
+    q1: &Vector3<f64>,
+) -> SMatrix<f64, 3, 6> {
+    let r = robot.rotation.to_rotation_matrix().into_inner();
+    let t = robot.translation.vector;
+    let mut j = SMatrix::<f64, 3, 6>::zeros();
+    match setup {
+        // u = R^T (q1 - t) <- R^T exp(-w) (q1 - t - v).
+        Setup::EyeInHand => {
+            j.fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(r.transpose() * skew(&(q1 - t))));
+            j.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-r.transpose()));
+        }
+        // u = R q1 + t <- exp(w) R q1 + t + v.
+        Setup::EyeToHand => {
+            j.fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(-skew(&(r * q1))));
+            j.fixed_view_mut::<3, 3>(0, 3)
+                .copy_from(&Matrix3::identity());
+        }
+    }
+    j
 }
 
 impl BlockProblem for Problem<'_> {
@@ -148,14 +196,15 @@ impl BlockProblem for Problem<'_> {
         let mut out = Vec::new();
         for (i, view) in self.views.iter().enumerate() {
             let robot = self.robot_at(params, i);
-            let (rx, ry, rr) = (
+            let robot_inv = chain_robot_inverse(self.setup, &robot);
+            let (rx, ry) = (
                 x.rotation.to_rotation_matrix().into_inner(),
                 y.rotation.to_rotation_matrix().into_inner(),
-                robot.rotation.to_rotation_matrix().into_inner(),
             );
+            let rr_inv = robot_inv.rotation.to_rotation_matrix().into_inner();
             for (p, obs) in view.object_points.iter().zip(&view.image_points) {
                 let q1 = y * p;
-                let u = robot.inverse() * q1;
+                let u = robot_inv * q1;
                 let w = x.inverse() * u;
                 let (pixel, d_pt, d_cam) = camera.project_with_jacobians(&w)?;
                 let r = (pixel - obs) * self.pixel_weight;
@@ -170,7 +219,7 @@ impl BlockProblem for Problem<'_> {
                     let mut jg = DMatrix::zeros(2, n_global);
                     // d w / d x-perturbation: [w]x for rotation, -I for translation.
                     let d_u = d_w * rx.transpose();
-                    let d_q1 = d_u * rr.transpose();
+                    let d_q1 = d_u * rr_inv;
                     let dx_rot = d_w * skew(&w.coords);
                     let dy_rot = d_q1 * (-ry * skew(&p.coords));
                     let dy_t = d_q1 * ry;
@@ -184,30 +233,32 @@ impl BlockProblem for Problem<'_> {
                     }
                     block.jac_global = jg;
                     if self.prior.is_some() {
-                        let mut jb = DMatrix::zeros(2, 6);
-                        jb.view_mut((0, 0), (2, 3))
-                            .copy_from(&(d_u * skew(&u.coords)));
-                        jb.view_mut((0, 3), (2, 3)).copy_from(&(-d_u));
-                        block.jac_block = jb;
+                        let jr = robot_correction_jacobian(self.setup, &robot, &q1.coords);
+                        let jb = d_u * jr;
+                        block.jac_block = DMatrix::from_column_slice(2, 6, jb.as_slice());
                     }
                 }
                 out.push(block);
             }
             if let Some((sr, st)) = self.prior {
-                // Prior: the correction robot0^-1 * robot, weighted by 1/sigma.
-                let d = self.chain_robot[i].inverse() * robot;
-                let rv = rotvec_from_rotation(&d.rotation) / sr;
-                let tv = d.translation.vector / st;
+                // Prior: the decoupled base-frame correction of
+                // base_from_gripper (the noise model of pose_residual),
+                // weighted by 1/sigma.
+                let d = difference(&self.measured[i], &robot);
+                let mut rv = d;
+                rv.fixed_rows_mut::<3>(0).scale_mut(1.0 / sr);
+                rv.fixed_rows_mut::<3>(3).scale_mut(1.0 / st);
                 let mut jb = DMatrix::zeros(6, 6);
                 if jac {
+                    let phi = Vector3::new(d[0], d[1], d[2]);
                     jb.view_mut((0, 0), (3, 3))
-                        .copy_from(&(Matrix3::identity() / sr));
+                        .copy_from(&(left_jacobian_inverse(&phi) / sr));
                     jb.view_mut((3, 3), (3, 3))
-                        .copy_from(&(d.rotation.to_rotation_matrix().into_inner() / st));
+                        .copy_from(&(Matrix3::identity() / st));
                 }
                 out.push(ResidualBlock {
                     block: Some(i),
-                    residuals: DVector::from_vec(vec![rv.x, rv.y, rv.z, tv.x, tv.y, tv.z]),
+                    residuals: DVector::from_column_slice(rv.as_slice()),
                     jac_global: DMatrix::zeros(6, if jac { n_global } else { 0 }),
                     jac_block: if jac { jb } else { DMatrix::zeros(6, 0) },
                 });
@@ -228,7 +279,10 @@ impl BlockProblem for Problem<'_> {
                 .blocks
                 .iter()
                 .zip(&step.blocks)
-                .map(|(p, d)| perturb(p, d))
+                .map(|(p, d)| {
+                    let step = Vector6::from_iterator(d.iter().copied());
+                    params_from_pose(&perturb_left(&pose_from_params(p), &step)).to_vec()
+                })
                 .collect(),
         }
     }
@@ -254,7 +308,8 @@ pub fn refine(
             ),
         ));
     }
-    let chain = Chain::new(setup, base_from_gripper, base_from_gripper)?;
+    // Validates the pose count; the corrections live on base_from_gripper.
+    Chain::new(setup, base_from_gripper, base_from_gripper)?;
     let y_start = if options.points_in_world {
         Pose::identity()
     } else {
@@ -287,8 +342,7 @@ pub fn refine(
     let mut params = BlockParams {
         global,
         blocks: match prior {
-            Some(_) => chain
-                .robot
+            Some(_) => base_from_gripper
                 .iter()
                 .map(|p| params_from_pose(p).to_vec())
                 .collect(),
@@ -298,7 +352,8 @@ pub fn refine(
     let mut result = None;
     for _ in 0..rounds {
         let problem = Problem {
-            chain_robot: chain.robot.clone(),
+            setup,
+            measured: base_from_gripper,
             views,
             camera,
             intrinsics: options.intrinsics,
@@ -315,7 +370,7 @@ pub fn refine(
         )?;
         params = lm.params.clone();
         if let (RobotNoise::Estimate, Some(_)) = (options.robot_noise, prior) {
-            prior = Some(estimate_noise(&chain.robot, &params.blocks));
+            prior = Some(estimate_noise(base_from_gripper, &params.blocks));
         }
         result = Some((lm, problem.camera_at(&params.global)?));
     }
@@ -324,12 +379,12 @@ pub fn refine(
     let y = pose_from_params(&params.global[6..12]);
     let robots: Vec<Pose> = match prior {
         Some(_) => params.blocks.iter().map(|b| pose_from_params(b)).collect(),
-        None => chain.robot.clone(),
+        None => base_from_gripper.to_vec(),
     };
     let mut per_view = Vec::new();
     let (mut sum, mut count) = (0.0, 0usize);
     for (view, robot) in views.iter().zip(&robots) {
-        let camera_from_target = x.inverse() * robot.inverse() * y;
+        let camera_from_target = x.inverse() * chain_robot_inverse(setup, robot) * y;
         let (mut s, mut n) = (0.0, 0usize);
         for (p, obs) in view.object_points.iter().zip(&view.image_points) {
             let px = camera_out.project(&(camera_from_target * p))?;
@@ -340,10 +395,6 @@ pub fn refine(
         sum += s;
         count += n;
     }
-    let base_from_gripper = match setup {
-        Setup::EyeInHand => robots.clone(),
-        Setup::EyeToHand => robots.iter().map(|r| r.inverse()).collect(),
-    };
     let x_std = lm.std_global().map(|s| {
         // Residuals were divided by pixel_sigma: scale back is already in the
         // residual variance; report as is.
@@ -355,20 +406,21 @@ pub fn refine(
         camera: camera_out,
         reprojection_rms_px: (sum / count.max(1) as f64).sqrt(),
         per_view_rms_px: per_view,
-        base_from_gripper,
+        base_from_gripper: robots,
         robot_noise_estimate: prior.filter(|_| options.robot_noise != RobotNoise::Trusted),
         x_std,
     })
 }
 
-/// Robot noise from the corrections: RMS per component of the rotation
-/// vectors (rad) and translations (m), floored to keep the prior finite.
+/// Robot noise from the corrections (decoupled, base frame): RMS per
+/// component of the rotation vectors (rad) and translations (m), floored to
+/// keep the prior finite.
 fn estimate_noise(robot0: &[Pose], blocks: &[Vec<f64>]) -> (f64, f64) {
     let (mut sr, mut st) = (0.0, 0.0);
     for (r0, b) in robot0.iter().zip(blocks) {
-        let d = r0.inverse() * pose_from_params(b);
-        sr += rotvec_from_rotation(&d.rotation).norm_squared();
-        st += d.translation.vector.norm_squared();
+        let d = difference(r0, &pose_from_params(b));
+        sr += d.fixed_rows::<3>(0).norm_squared();
+        st += d.fixed_rows::<3>(3).norm_squared();
     }
     let n = (3 * robot0.len().max(1)) as f64;
     ((sr / n).sqrt().max(1e-7), (st / n).sqrt().max(1e-7))

@@ -182,3 +182,33 @@ fn joint_intrinsics_and_control_points_recover_the_truth() {
     assert!(t < 1e-6 && a < 1e-7, "{t} mm {a} deg");
     assert!((r.camera.fx - 800.0).abs() < 1e-6 && (r.camera.cy - 240.0).abs() < 1e-6);
 }
+
+#[wasm_bindgen_test(unsupported = test)]
+fn robot_correction_jacobian_matches_finite_differences() {
+    // u = robot^-1-of-the-chain * q1 under a decoupled base-frame correction
+    // of base_from_gripper; central differences with step 1e-6 have an error
+    // of order step^2 * |q1| ~ 1e-12, so 1e-8 (m per unit step) is loose.
+    use super::pose_residual::perturb;
+    use super::reprojection_refine::{chain_robot_inverse, robot_correction_jacobian};
+    use nalgebra::Vector6;
+    let robot = Pose::from_parts(
+        Translation3::new(0.9, -0.4, 0.6),
+        UnitQuaternion::from_scaled_axis(Vector3::new(2.0, -0.7, 0.4)),
+    );
+    let q1 = Vector3::new(0.3, 1.2, -0.5);
+    for setup in [Setup::EyeInHand, Setup::EyeToHand] {
+        let analytic = robot_correction_jacobian(setup, &robot, &q1);
+        let h = 1e-6;
+        for k in 0..6 {
+            let mut d = Vector6::zeros();
+            d[k] = h;
+            let plus =
+                chain_robot_inverse(setup, &perturb(&robot, &d)) * nalgebra::Point3::from(q1);
+            let minus =
+                chain_robot_inverse(setup, &perturb(&robot, &(-d))) * nalgebra::Point3::from(q1);
+            let numeric = (plus - minus) / (2.0 * h);
+            let diff = (numeric - analytic.column(k)).norm();
+            assert!(diff < 1e-8, "{} column {k}: {diff} m", setup.name());
+        }
+    }
+}
