@@ -34,6 +34,12 @@ pub(crate) fn blobs_at_level(
     }
 }
 
+/// The pyramid level [`blobs_at_level`] works at (without building it).
+pub(crate) fn blob_working_level(img: &GrayImage, options: &DetectOptions) -> u32 {
+    let max_side = options.max_working_side_px.max(BLOB_WORKING_SIDE_PX);
+    super::working_level(img, max_side)
+}
+
 fn to_full_blob(b: &Blob, level: u32) -> (Point2<f64>, Matrix2<f64>) {
     let s = (1u64 << level) as f64;
     (

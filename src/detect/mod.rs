@@ -232,12 +232,7 @@ pub(crate) fn working_level(img: &GrayImage, max_side: u32) -> u32 {
 /// Pyramid levels to search, coarsest first: the first level whose long
 /// side is at most `max_side`, then the next finer one (if any).
 pub(crate) fn pyramid_levels(img: &GrayImage, max_side: u32) -> Vec<(u32, Plane)> {
-    let long = img.width.max(img.height).max(1);
-    let max_side = max_side.max(64);
-    let mut coarse = 0u32;
-    while (long >> coarse) > max_side && coarse < 8 {
-        coarse += 1;
-    }
+    let coarse = working_level(img, max_side);
     let finest = coarse.saturating_sub(1);
     let mut plane = if finest == 0 {
         Plane::from_gray(img)
