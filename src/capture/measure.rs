@@ -14,8 +14,8 @@ const EDGE_PERCENTILE: f64 = 0.98;
 const CONTRAST_PERCENTILES: (f64, f64) = (0.05, 0.95);
 
 /// The blur of the board in a frame, as the sigma (px) of the Gaussian blur
-/// that would give its strongest edges their slope: `contrast / (sqrt(2 pi)
-/// * g)`, where `contrast` is the spread of the grey levels on the board's
+/// that would give its strongest edges their slope:
+/// `contrast / (sqrt(2 pi) g)`, where `contrast` is the spread of the grey levels on the board's
 /// region (95th minus 5th percentile) and `g` the 98th percentile of the
 /// gradient magnitude there (central differences). Relative to the board's
 /// own contrast, so independent of exposure and lighting. A focused render

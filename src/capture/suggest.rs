@@ -147,7 +147,7 @@ pub fn by_coverage(candidates: &[Candidate], coverage: &Coverage) -> Option<Sugg
     let mut best: Option<(&Candidate, usize)> = None;
     for c in candidates {
         let s = score(c);
-        if best.is_none_or(|(_, b)| s > b) {
+        if best.map_or(true, |(_, b)| s > b) {
             best = Some((c, s));
         }
     }
@@ -229,7 +229,7 @@ pub fn by_uncertainty(
             }
         }
         let worst = crate::calib::projection_uncertainty(camera, &full, depth).max_std_px;
-        if best.is_none_or(|(_, b)| worst < b) {
+        if best.map_or(true, |(_, b)| worst < b) {
             best = Some((c, worst));
         }
     }
