@@ -1320,6 +1320,111 @@ export interface ImageOptions {
   max_pixels?: number;
 }
 
+// ---------------------------------------------------------------------------
+// Live capture (`LiveCapture`, docs/live-capture.md; robocal::capture)
+
+/** What the kept frames cover (capture::Coverage). */
+export interface LiveCoverage {
+  /** `[columns, rows]` of the image cell grid (8 x 6). */
+  grid: [number, number];
+  /** Points of kept frames per cell, row-major. */
+  cells: number[];
+  /** Kept frames per tilt bin, `[bin about x][bin about y]`; bins: 0 below -15 deg, 1 within, 2 above 15 deg. */
+  tilt: [[number, number, number], [number, number, number], [number, number, number]];
+  /** Kept frames per distance bin: far, middle, near. */
+  distance: [number, number, number];
+  /** Frames kept. */
+  kept: number;
+}
+
+/** What a frame covers (capture::Signature). */
+export interface LiveSignature {
+  cells: number[];
+  tilt_x_deg: number;
+  tilt_y_deg: number;
+  tilt_bin: [number, number];
+  /** Board side over image width were it facing the camera at its distance. */
+  span: number;
+  /** 0 far, 1 middle, 2 near. */
+  distance_bin: number;
+}
+
+/** What a frame would add (capture::Novelty). */
+export interface LiveNovelty {
+  new_cells: number;
+  new_tilt: boolean;
+  new_distance: boolean;
+}
+
+/** The next pose to show (capture::Suggestion): the board outline to match. */
+export interface LiveSuggestion {
+  rule: 'coverage' | 'uncertainty';
+  /** The board print's four corners in the image, px. */
+  outline_px: [Vec2, Vec2, Vec2, Vec2];
+  camera_from_target: PoseReport;
+  tilt_x_deg: number;
+  tilt_y_deg: number;
+  span: number;
+  /** With the uncertainty rule: the worst projection uncertainty predicted after adding this view, px. */
+  predicted_max_std_px: number | null;
+  why: string;
+}
+
+/** The robot-motion diversity of the captures with robot poses (capture::HandEyeGuide). */
+export interface LiveHandEyeGuide {
+  poses: number;
+  motions: number;
+  axis_spread_deg: number;
+  dominant_axis: Vec3;
+  enough: boolean;
+  advice: string;
+}
+
+/** Why a frame was kept or not. */
+export type LiveReason = 'not_found' | 'too_few_points' | 'settling' | 'moving' | 'blurred' | 'nothing_new' | 'kept' | 'kept_manually';
+
+/** `LiveCapture.push_frame / push_rgba / push_grey` (capture::FrameReport). */
+export interface LiveFrameReport {
+  status: 'found' | 'partial' | 'not_found';
+  /** Detected pixels in id order. */
+  points: Vec2[];
+  ids: number[];
+  still: boolean;
+  /** Largest point motion over the compared frames, px. */
+  motion_px: number | null;
+  sharp: boolean;
+  /** Blur measure: equivalent Gaussian sigma of the board's edges, px. */
+  blur_px: number | null;
+  novel: boolean;
+  novelty: LiveNovelty | null;
+  signature: LiveSignature | null;
+  keep: boolean;
+  reason: LiveReason;
+  /** The reason as a sentence. */
+  message: string;
+  kept: number;
+  coverage: LiveCoverage;
+  suggestion: LiveSuggestion | null;
+  good_enough: boolean;
+}
+
+/** `LiveCapture.state()`, `remove`, `set_robot_pose`; `capture()` adds `index`. */
+export interface LiveState {
+  kept: number;
+  coverage: LiveCoverage;
+  suggestion: LiveSuggestion | null;
+  good_enough: boolean;
+  handeye: LiveHandEyeGuide;
+  /** Only from `capture()`: the index of the kept frame. */
+  index?: number;
+}
+
+/** `LiveCapture.calibrate()`. */
+export interface LiveCalibrated extends LiveState {
+  calibration: CameraCalibration;
+  max_std_px: number;
+}
+
 /** A function that exchanges JSON. */
 export type JsonFunction = keyof RobocalJson;
 /** The JSON a function reads (serialise it with JSON.stringify). */

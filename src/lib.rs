@@ -34,6 +34,7 @@
 
 pub mod calib;
 pub mod camera;
+pub mod capture;
 pub mod detect;
 pub mod error;
 pub mod geometry;

@@ -12,6 +12,9 @@
 //! a panic hook writes the message to `console.error` and records it so the
 //! JS side can show it ([`last_panic_message`]) instead of a dead worker.
 
+mod live_capture;
+pub use live_capture::LiveCapture;
+
 use crate::image::{decode, DecodeOptions};
 use crate::target::Target;
 use serde::Serialize;

@@ -47,7 +47,10 @@ mod zhang;
 pub use closed_form::{intrinsics_from_homographies, pose_from_homography};
 pub use homography::homography;
 pub use rejected::{RejectedInView, RejectedPoints};
-pub use report::{CameraCalibration, Correlation, Outlier, ProjectionUncertainty, ViewReport};
+pub use report::{
+    projection_uncertainty, CameraCalibration, Correlation, Outlier, ProjectionUncertainty,
+    ViewReport,
+};
 pub use residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
 pub use tsai::calibrate_tsai;
 pub use usable::{homography_problem, usable_views, LeftOut};

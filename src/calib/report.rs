@@ -270,7 +270,15 @@ fn correlation(names: &[String], c: &DMatrix<f64>) -> Correlation {
     }
 }
 
-fn projection_uncertainty(camera: &Camera, c: &DMatrix<f64>, depth: f64) -> ProjectionUncertainty {
+/// The projection uncertainty over the image (the report's grid) of
+/// `camera` with parameter covariance `c` (rows and columns in the order
+/// of [`Camera::param_names`]; empty: not available) for points at `depth`
+/// metres: what live capture predicts for a calibration with a view added.
+pub fn projection_uncertainty(
+    camera: &Camera,
+    c: &DMatrix<f64>,
+    depth: f64,
+) -> ProjectionUncertainty {
     let (cols, rows) = UNCERTAINTY_GRID;
     let at = |i: usize, n: usize, size: u32| i as f64 * (size as f64 - 1.0) / (n - 1) as f64;
     let x_px: Vec<f64> = (0..cols).map(|i| at(i, cols, camera.width)).collect();
