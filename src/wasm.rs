@@ -550,6 +550,15 @@ pub fn calibrate_stereo(input_json: &str) -> Result<String, JsError> {
     crate::calib::stereo_json::calibrate_stereo_json(input_json).map_err(js_error)
 }
 
+/// Calibrate a camera rig: the JSON input and output of
+/// `robocal::calib::rig_json::calibrate_rig_json` (`cameras`, each with
+/// `views` keyed by frame; returns every camera's `camera_from_rig` with
+/// its std, the frames, the co-observation graph, `rms_px`, ...).
+#[wasm_bindgen]
+pub fn calibrate_rig(input_json: &str) -> Result<String, JsError> {
+    crate::calib::rig_json::calibrate_rig_json(input_json).map_err(js_error)
+}
+
 /// An undistorted preview of image bytes taken by `camera_json` (the
 /// `camera` object of a calibration report): resampled through the same
 /// camera without distortion, longer side at most `max_side` px, as grey

@@ -4,7 +4,9 @@
 //! report that carries residuals, uncertainties and warnings.
 //!
 //! Two cameras with shared views: [`stereo`] (right_from_left, seed 000),
-//! with its JSON boundary in [`stereo_json`].
+//! with its JSON boundary in [`stereo_json`]; N cameras in synchronised
+//! frames: [`rig`] (every camera_from_rig), its result in [`rig_report`],
+//! its JSON boundary in [`rig_json`].
 //!
 //! From 3-D/2-D point pairs of a non-planar target (seed 002):
 //! - [`dlt`]: the 12-parameter projection matrix, decomposed into K, R, t;
@@ -27,6 +29,11 @@ mod refine;
 mod rejected;
 mod report;
 mod residuals;
+pub mod rig;
+mod rig_graph;
+mod rig_init;
+pub mod rig_json;
+mod rig_problem;
 pub mod rig_report;
 pub mod stereo;
 pub mod stereo_json;

@@ -251,7 +251,7 @@ fn aspect(camera: &crate::camera::Camera, options: &CalibrationOptions) -> Optio
 }
 
 /// The camera_from_target of every view of a report.
-fn report_poses(report: &CameraCalibration) -> Result<Vec<Pose>> {
+pub(crate) fn report_poses(report: &CameraCalibration) -> Result<Vec<Pose>> {
     report
         .views
         .iter()
@@ -260,7 +260,7 @@ fn report_poses(report: &CameraCalibration) -> Result<Vec<Pose>> {
 }
 
 /// Per view, per point: not rejected by the single-camera calibration.
-fn used_masks(views: &[View], report: &CameraCalibration) -> Vec<Vec<bool>> {
+pub(crate) fn used_masks(views: &[View], report: &CameraCalibration) -> Vec<Vec<bool>> {
     views
         .iter()
         .zip(&report.views)
@@ -287,6 +287,21 @@ fn camera_report(
     options: &CalibrationOptions,
 ) -> Result<CameraCalibration> {
     let lm = lm_options(problem.template, options)?;
+    let outliers = single.views.iter().map(|v| v.outliers.clone()).collect();
+    camera_report_with(problem, params, blocks, outliers, size, options, lm)
+}
+
+/// [`camera_report`] with the solver options given (e.g. every parameter
+/// held) and the outliers of each view.
+pub(crate) fn camera_report_with(
+    problem: &CalibProblem,
+    params: &[f64],
+    blocks: &[Vec<f64>],
+    outliers: Vec<Vec<super::Outlier>>,
+    size: (u32, u32),
+    options: &CalibrationOptions,
+    lm: LmOptions,
+) -> Result<CameraCalibration> {
     let start = BlockParams {
         global: params.to_vec(),
         blocks: blocks.to_vec(),
@@ -299,6 +314,5 @@ fn camera_report(
             ..lm
         },
     )?;
-    let outliers = single.views.iter().map(|v| v.outliers.clone()).collect();
     build_report(problem, &result, outliers, size, options)
 }

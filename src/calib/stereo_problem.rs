@@ -21,12 +21,12 @@ pub(crate) struct StereoProblem<'a> {
     pub n_right: usize,
 }
 
-fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+pub(crate) fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
 /// Left-perturbation retraction of a `[rotvec, t]` 6-vector.
-fn retract_pose(b: &[f64], d: &[f64]) -> Vec<f64> {
+pub(crate) fn retract_pose(b: &[f64], d: &[f64]) -> Vec<f64> {
     let rotation = rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2]))
         * rotation_from_rotvec(&Vector3::new(b[0], b[1], b[2]));
     let r = rotvec_from_rotation(&rotation);
@@ -34,7 +34,7 @@ fn retract_pose(b: &[f64], d: &[f64]) -> Vec<f64> {
 }
 
 /// Fold the fixed-aspect column (fy = aspect * fx) into fx's.
-fn fold_aspect(d_params: &mut DMatrix<f64>, aspect: Option<f64>) {
+pub(crate) fn fold_aspect(d_params: &mut DMatrix<f64>, aspect: Option<f64>) {
     if let Some(a) = aspect {
         for r in 0..2 {
             d_params[(r, 0)] += a * d_params[(r, 1)];

@@ -6,6 +6,7 @@ pub mod demo;
 pub mod handeye;
 pub mod handeye_looking;
 pub mod render;
+pub mod rig;
 pub mod rng;
 pub mod scene;
 

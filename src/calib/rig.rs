@@ -1,0 +1,318 @@
+//! Camera-rig calibration (issue 22): N cameras that saw one board in
+//! synchronised frames, any camera missing the board in any frame.
+//!
+//! 1. Each camera alone: its views that fix a homography ([`super::usable`]),
+//!    then Zhang ([`calibrate`]), or, with intrinsics given, only the board
+//!    poses under the held camera ([`super::rig_init::held_camera`]).
+//! 2. The co-observation graph ([`super::rig_graph`]): an error naming the
+//!    groups when it is not connected, else a maximum spanning tree from the
+//!    rig camera; each edge's child_from_parent is averaged over the shared
+//!    frames (rotations by the quaternion mean, as stereo's
+//!    [`initial_right_from_left`]) and chained into every camera_from_rig.
+//! 3. Each frame's rig_from_target from the camera that saw most of it.
+//! 4. One Levenberg-Marquardt ([`super::rig_problem`]) over every camera's
+//!    intrinsics (unless held), every camera_from_rig but the rig camera's
+//!    and every frame's board pose; the covariance gives each extrinsic's
+//!    standard deviation.
+//! 5. The report ([`RigCalibration`]).
+
+use super::refine::{block_from_pose, pose_from_block};
+use super::rig_graph::{co_observation_counts, spanning_tree};
+use super::rig_init::{camera_alone, Alone};
+use super::rig_problem::{RigProblem, Sighting};
+use super::rig_report::{CoObservation, RigCalibration, RigCamera, RigFrame};
+use super::stereo::{camera_report_with, initial_right_from_left, TransformStd};
+use super::zhang::lm_options;
+use super::{CalibrationOptions, View};
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::geometry::{Pose, PoseJson};
+use crate::optim::{solve, BlockParams, BlockProblem, LmOptions};
+
+/// Fewer shared frames than this on a spanning-tree edge draws a warning.
+const FEW_SHARED_FRAMES: usize = 3;
+
+/// One camera's input to [`calibrate_rig`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigCameraViews {
+    /// Unique name (`--camera NAME ...`).
+    pub name: String,
+    /// Image width and height, px.
+    pub image_size_px: (u32, u32),
+    /// Its views, each with the index of its frame (into the frame keys);
+    /// at most one view per frame, in any order.
+    pub views: Vec<(usize, View)>,
+    /// Intrinsics given and held; `None` solves them from its own views.
+    pub camera: Option<Camera>,
+}
+
+/// What to solve and the provenance the report carries.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigOptions {
+    /// Options of every solved camera (lens model, held parameters, loss).
+    pub calibration: CalibrationOptions,
+    /// Name of the camera whose frame is the rig frame; `None`: the first.
+    pub rig_frame: Option<String>,
+    /// The target spec, carried into the report.
+    pub target: String,
+    /// How the frames were grouped (`"number"` or `"order"`), carried into
+    /// the report.
+    pub grouping: String,
+}
+
+/// Calibrate a rig: `frame_keys` names the synchronised frames (the
+/// report keeps their order), `cameras` hold each camera's views keyed by
+/// frame index. See the module docs for the steps.
+pub fn calibrate_rig(
+    cameras: &[RigCameraViews],
+    frame_keys: &[String],
+    options: &RigOptions,
+) -> Result<RigCalibration> {
+    let rig_camera = validate(cameras, frame_keys, options)?;
+    let names: Vec<String> = cameras.iter().map(|c| c.name.clone()).collect();
+    // 1. Each camera alone.
+    let alone = cameras
+        .iter()
+        .map(|c| camera_alone(c, &options.calibration))
+        .collect::<Result<Vec<Alone>>>()?;
+    let mut warnings: Vec<String> = alone.iter().flat_map(|a| a.warnings.clone()).collect();
+    // 2. The graph and the extrinsics along its spanning tree.
+    let frames_of: Vec<Vec<usize>> = alone.iter().map(|a| a.frames.clone()).collect();
+    let counts = co_observation_counts(&frames_of);
+    let tree = spanning_tree(&counts, rig_camera, &names)?;
+    let mut camera_from_rig = vec![Pose::identity(); cameras.len()];
+    for &[parent, child] in &tree {
+        let shared: Vec<(Pose, Pose)> = alone[parent]
+            .frames
+            .iter()
+            .enumerate()
+            .filter_map(|(i, f)| {
+                let j = alone[child].frames.iter().position(|g| g == f)?;
+                Some((alone[parent].poses[i], alone[child].poses[j]))
+            })
+            .collect();
+        let (p, c): (Vec<Pose>, Vec<Pose>) = shared.into_iter().unzip();
+        let child_from_parent = initial_right_from_left(&p, &c)?;
+        camera_from_rig[child] = child_from_parent * camera_from_rig[parent];
+        if counts[parent][child] < FEW_SHARED_FRAMES {
+            warnings.push(format!(
+                "cameras {} and {} share only {} frame(s): their relative pose rests on few \
+                 board views; add frames where both see the board",
+                names[parent], names[child], counts[parent][child]
+            ));
+        }
+    }
+    // 3. The frames some camera used, each from the camera that saw most of it.
+    let mut frames: Vec<Vec<Sighting>> = vec![Vec::new(); frame_keys.len()];
+    for (k, a) in alone.iter().enumerate() {
+        for (view, &f) in a.frames.iter().enumerate() {
+            frames[f].push(Sighting { camera: k, view });
+        }
+    }
+    let used_frames: Vec<usize> = (0..frame_keys.len())
+        .filter(|&f| !frames[f].is_empty())
+        .collect();
+    let blocks: Vec<Vec<f64>> = used_frames
+        .iter()
+        .map(|&f| {
+            let best = frames[f]
+                .iter()
+                .max_by_key(|s| (alone[s.camera].n_used(s.view), usize::MAX - s.camera))
+                .copied()
+                .unwrap_or(Sighting { camera: 0, view: 0 });
+            let camera_from_target = alone[best.camera].poses[best.view];
+            block_from_pose(&(camera_from_rig[best.camera].inverse() * camera_from_target))
+        })
+        .collect();
+    // 4. The joint bundle adjustment.
+    let problem = RigProblem {
+        cameras: alone.iter().map(Alone::problem).collect(),
+        rig_camera,
+        frames: used_frames.iter().map(|&f| frames[f].clone()).collect(),
+    };
+    let mut global: Vec<f64> = alone.iter().flat_map(|a| a.camera.params()).collect();
+    let mut fixed_global: Vec<bool> = alone.iter().flat_map(|a| a.fixed.clone()).collect();
+    for (k, pose) in camera_from_rig.iter().enumerate() {
+        if k != rig_camera {
+            global.extend(block_from_pose(pose));
+            fixed_global.extend([false; 6]);
+        }
+    }
+    let lm = lm_options(&alone[rig_camera].camera, &options.calibration)?;
+    let result = solve(
+        &problem,
+        &BlockParams { global, blocks },
+        &LmOptions { fixed_global, ..lm },
+    )?;
+    // 5. The report.
+    let residuals = problem.residuals_and_jacobian(&result.params, false)?;
+    let owners = problem.residual_cameras();
+    let (mut cam_sq, mut cam_n) = (vec![0.0; cameras.len()], vec![0usize; cameras.len()]);
+    let (mut frame_sq, mut frame_n) = (
+        vec![0.0; used_frames.len()],
+        vec![0usize; used_frames.len()],
+    );
+    for (r, &k) in residuals.iter().zip(&owners) {
+        let sq = r.residuals.norm_squared();
+        cam_sq[k] += sq;
+        cam_n[k] += 1;
+        if let Some(b) = r.block {
+            frame_sq[b] += sq;
+            frame_n[b] += 1;
+        }
+    }
+    let rms = |sq: f64, n: usize| if n == 0 { 0.0 } else { (sq / n as f64).sqrt() };
+    let std = result.std_global();
+    let g = &result.params.global;
+    let rig_from_target: Vec<Pose> = result
+        .params
+        .blocks
+        .iter()
+        .map(|b| pose_from_block(b))
+        .collect();
+    let mut rig_cameras = Vec::with_capacity(cameras.len());
+    for (k, a) in alone.iter().enumerate() {
+        let pose = problem.camera_from_rig(g, k);
+        let o = problem.params_offset(k);
+        let n = a.camera.params().len();
+        let view_blocks: Vec<Vec<f64>> = a
+            .frames
+            .iter()
+            .map(|f| {
+                let b = used_frames.iter().position(|u| u == f).unwrap_or(0);
+                block_from_pose(&(pose * rig_from_target[b]))
+            })
+            .collect();
+        let lm = LmOptions {
+            fixed_global: a.fixed.clone(),
+            ..lm_options(&a.camera, &options.calibration)?
+        };
+        let calibration = camera_report_with(
+            &problem.cameras[k],
+            &g[o..o + n],
+            &view_blocks,
+            a.outliers.clone(),
+            cameras[k].image_size_px,
+            &options.calibration,
+            lm,
+        )?;
+        let camera_from_rig_std = match (problem.pose_offset(k), &std) {
+            (Some(o), Some(s)) => Some(TransformStd {
+                rotation_rad: [s[o], s[o + 1], s[o + 2]],
+                translation_m: [s[o + 3], s[o + 4], s[o + 5]],
+            }),
+            _ => None,
+        };
+        rig_cameras.push(RigCamera {
+            name: names[k].clone(),
+            calibration,
+            intrinsics_held: a.held,
+            camera_from_rig: PoseJson::from(&pose),
+            camera_from_rig_std,
+            rms_px: rms(cam_sq[k], cam_n[k]),
+            frames_seen: a.frames.clone(),
+        });
+    }
+    let rig_frames = frame_keys
+        .iter()
+        .enumerate()
+        .map(|(f, key)| {
+            let b = used_frames.iter().position(|u| *u == f);
+            RigFrame {
+                key: key.clone(),
+                rig_from_target: b.map(|b| PoseJson::from(&rig_from_target[b])),
+                cameras: frames[f].iter().map(|s| names[s.camera].clone()).collect(),
+                rms_px: b.map_or(0.0, |b| rms(frame_sq[b], frame_n[b])),
+            }
+        })
+        .collect();
+    Ok(RigCalibration {
+        crate_version: env!("CARGO_PKG_VERSION").to_string(),
+        rig_frame: names[rig_camera].clone(),
+        target: options.target.clone(),
+        grouping: options.grouping.clone(),
+        cameras: rig_cameras,
+        frames: rig_frames,
+        co_observation: CoObservation {
+            cameras: names,
+            frames: counts,
+            spanning_tree: tree,
+        },
+        rms_px: rms(cam_sq.iter().sum(), cam_n.iter().sum()),
+        iterations: result.iterations,
+        termination: result.termination,
+        warnings,
+    })
+}
+
+/// Check the input; returns the rig camera's index.
+fn validate(
+    cameras: &[RigCameraViews],
+    frame_keys: &[String],
+    options: &RigOptions,
+) -> Result<usize> {
+    if cameras.len() < 2 {
+        return Err(Error::too_few("cameras in a rig", 2, cameras.len()));
+    }
+    for (k, c) in cameras.iter().enumerate() {
+        if c.name.is_empty() {
+            return Err(Error::invalid(
+                format!("cameras[{k}].name"),
+                "must not be empty",
+            ));
+        }
+        if cameras[..k].iter().any(|o| o.name == c.name) {
+            return Err(Error::invalid(
+                format!("cameras[{k}].name"),
+                format!("'{}' is used twice: camera names must be unique", c.name),
+            ));
+        }
+        let mut seen: Vec<Option<&str>> = vec![None; frame_keys.len()];
+        for (f, v) in &c.views {
+            let Some(slot) = seen.get_mut(*f) else {
+                return Err(Error::invalid(
+                    format!("camera {}", c.name),
+                    format!(
+                        "view {} has frame index {f}, but there are {} frames",
+                        v.name,
+                        frame_keys.len()
+                    ),
+                ));
+            };
+            if let Some(first) = slot {
+                return Err(Error::invalid(
+                    format!("camera {}", c.name),
+                    format!(
+                        "two views of frame {}: {first} and {}; keep one",
+                        frame_keys[*f], v.name
+                    ),
+                ));
+            }
+            *slot = Some(&v.name);
+        }
+    }
+    match &options.rig_frame {
+        None => Ok(0),
+        Some(name) => cameras.iter().position(|c| &c.name == name).ok_or_else(|| {
+            let all: Vec<&str> = cameras.iter().map(|c| c.name.as_str()).collect();
+            Error::invalid(
+                "rig_frame",
+                format!(
+                    "no camera is named '{name}' (the cameras are {})",
+                    all.join(", ")
+                ),
+            )
+        }),
+    }
+}
+
+/// Frame keys in report order: integer keys numerically, then the others
+/// as text.
+pub fn sort_frame_keys(keys: &mut [String]) {
+    keys.sort_by(|a, b| match (a.parse::<u64>(), b.parse::<u64>()) {
+        (Ok(x), Ok(y)) => x.cmp(&y).then_with(|| a.cmp(b)),
+        (Ok(_), Err(_)) => std::cmp::Ordering::Less,
+        (Err(_), Ok(_)) => std::cmp::Ordering::Greater,
+        (Err(_), Err(_)) => a.cmp(b),
+    });
+}
