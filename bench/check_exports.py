@@ -5,6 +5,10 @@ For a few cameras (Brown, rational with thin prism, fisheye) this script
 asks `robocal export` for OpenCV YAML and XML, ROS camera_info and Kalibr
 YAML, then reads them back with cv2.FileStorage (opencv-python-headless
 4.14.0.94, pinned in bench/opencv_venv.py) and PyYAML, and compares every number with the input.
+For the 3-camera rig of fixtures/exports/rig.json (issue 22) it reads the
+rig's OpenCV FileStorage (R_k, T_k, camera_matrix_k per camera) with
+cv2.FileStorage, and its Kalibr camchain and ROS camera_infos with PyYAML,
+chaining Kalibr's T_cn_cnm1 back to every camera_from_rig.
 
 Usage (creates bench/.venv on first run; needs target/release/robocal):
     cargo build --release && python3 bench/check_exports.py
@@ -20,7 +24,8 @@ from opencv_venv import ensure_venv
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-ROBOCAL = os.path.join(ROOT, "target", "release", "robocal")
+# ROBOCAL_BIN overrides the binary (e.g. target/debug/robocal of a test run).
+ROBOCAL = os.environ.get("ROBOCAL_BIN") or os.path.join(ROOT, "target", "release", "robocal")
 
 
 CAMERAS = {
@@ -68,8 +73,69 @@ def main():
             ok = ros["camera_matrix"]["data"] == K and ros["distortion_coefficients"]["data"] == want_d
             failures += not ok
             print(f"{'ok  ' if ok else 'FAIL'} PyYAML reads ros-yaml             {name} ({ros['distortion_model']})")
+    failures += check_rig(cv2, np, yaml)
     print("all exports read back exactly" if not failures else f"{failures} export(s) did not read back")
     return 1 if failures else 0
+
+
+# Rotations pass through a quaternion inside robocal (the report's pose is
+# read back as matrix + quaternion): 1e-12 covers that rounding.
+RIG_TOL = 1e-12
+
+
+def check_rig(cv2, np, yaml):
+    """Read the rig exports of fixtures/exports/rig.json with their tools."""
+    rig_path = os.path.join(ROOT, "fixtures", "exports", "rig.json")
+    with open(rig_path) as f:
+        rig = json.load(f)
+    truth = [np.array(c["camera_from_rig"]["matrix_row_major"]) for c in rig["cameras"]]
+    names = [c["name"] for c in rig["cameras"]]
+    failures = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "rig.opencv.yaml")
+        with open(out, "w") as f:
+            f.write(export(rig_path, "opencv-yaml"))
+        fs = cv2.FileStorage(out, cv2.FILE_STORAGE_READ)
+        n = int(fs.getNode("camera_count").real())
+        worst = 0.0
+        ok = n == len(names)
+        for k in range(n):
+            r = fs.getNode(f"R_{k}").mat()
+            t = fs.getNode(f"T_{k}").mat().reshape(-1)
+            worst = max(worst, np.abs(r - truth[k][:3, :3]).max(), np.abs(t - truth[k][:3, 3]).max())
+            cam = rig["cameras"][k]["calibration"]
+            ok = ok and fs.getNode(f"name_{k}").string() == names[k]
+            ok = ok and fs.getNode(f"camera_matrix_{k}").mat().tolist() == cam["camera_matrix"]
+        ok = ok and worst < RIG_TOL
+        failures += not ok
+        print(f"{'ok  ' if ok else 'FAIL'} cv2.FileStorage reads rig opencv-yaml {n} cameras (R_k, T_k within {worst:.1e} of camera_from_rig)")
+
+        chain = yaml.safe_load(export(rig_path, "kalibr"))
+        cam_from_rig = np.eye(4)
+        worst = 0.0
+        ok = len(chain) == len(names)
+        for k in range(len(chain)):
+            entry = chain[f"cam{k}"]
+            if k > 0:
+                cam_from_rig = np.array(entry["T_cn_cnm1"]) @ cam_from_rig
+            worst = max(worst, np.abs(cam_from_rig - truth[k]).max())
+            ok = ok and entry["rostopic"] == f"/{names[k]}/image_raw"
+        ok = ok and worst < RIG_TOL
+        failures += not ok
+        overlaps = [chain[f"cam{k}"]["cam_overlaps"] for k in range(len(chain))]
+        print(f"{'ok  ' if ok else 'FAIL'} PyYAML reads rig kalibr camchain: T_cn_cnm1 chained within {worst:.1e} of camera_from_rig, cam_overlaps {overlaps}")
+
+        folder = os.path.join(tmp, "ros")
+        subprocess.run([ROBOCAL, "export", rig_path, "--format", "ros", "-o", folder], check=True, capture_output=True)
+        ok = True
+        for k, name in enumerate(names):
+            with open(os.path.join(folder, f"{name}.yaml")) as f:
+                info = yaml.safe_load(f)
+            want = [x for row in rig["cameras"][k]["calibration"]["camera_matrix"] for x in row]
+            ok = ok and info["camera_name"] == name and info["camera_matrix"]["data"] == want
+        failures += not ok
+        print(f"{'ok  ' if ok else 'FAIL'} PyYAML reads rig ros camera_info x{len(names)}")
+    return failures
 
 
 if __name__ == "__main__":

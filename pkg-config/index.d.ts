@@ -523,6 +523,101 @@ export interface StereoCalibration {
 }
 
 // ---------------------------------------------------------------------------
+// Camera rigs (src/calib/rig_json.rs, rig_report.rs)
+
+/** One view of a rig camera: `key` names its frame (views with one key saw one board pose). */
+export interface RigInputView {
+  key: string;
+  name: string;
+  detection?: Detection;
+  /** Target points, metres (with `image_px`, instead of `detection`). */
+  object_m?: Vec3[];
+  image_px?: Vec2[];
+}
+
+/** One camera of `calibrate_rig`'s input. */
+export interface RigInputCamera {
+  /** Unique in the rig. */
+  name: string;
+  views: RigInputView[];
+  /** Optional for detections or a given camera. */
+  image_size_px?: ImageSize;
+  /** Intrinsics given and held (a report's `camera`). */
+  camera?: Camera;
+}
+
+/** The input JSON of `calibrate_rig`. */
+export interface RigInput {
+  /** Lens model of the solved cameras (default `brown`). */
+  model?: LensModel;
+  options?: CalibrationOptions;
+  cameras: RigInputCamera[];
+  /** The target spec, carried into the report. */
+  target?: string;
+  /** The camera whose frame is the rig frame (default: the first). */
+  rig_frame?: string;
+  /** How the caller grouped the images into frames (default `number`). */
+  grouping?: string;
+}
+
+/** One camera of a rig report. */
+export interface RigCamera {
+  name: string;
+  /** Its intrinsics at the joint optimum; `views` are the frames it saw. */
+  calibration: CameraCalibration;
+  intrinsics_held: boolean;
+  /** Rig frame -> this camera (`p_cam = camera_from_rig * p_rig`); the identity for the rig camera. */
+  camera_from_rig: PoseReport;
+  /** Standard deviations (rotation: small-angle vector, radians; translation, metres); null for the rig camera or when singular. */
+  camera_from_rig_std: { rotation_rad: Vec3; translation_m: Vec3 } | null;
+  rms_px: number;
+  /** Indices into `frames`. */
+  frames_seen: number[];
+}
+
+/** One synchronised frame (a board pose) of a rig report. */
+export interface RigFrame {
+  key: string;
+  /** The board in the rig frame; null when no camera used the frame. */
+  rig_from_target: PoseReport | null;
+  /** Cameras whose view of this frame was used. */
+  cameras: string[];
+  rms_px: number;
+}
+
+/** The output JSON of `calibrate_rig` (the report `robocal rig` writes). */
+export interface RigCalibration {
+  crate_version: string;
+  /** Name of the camera whose frame is the rig frame. */
+  rig_frame: string;
+  target: string;
+  grouping: string;
+  cameras: RigCamera[];
+  frames: RigFrame[];
+  co_observation: {
+    cameras: string[];
+    /** `frames[i][j]`: frames seen by both camera i and j (diagonal: by camera i). */
+    frames: number[][];
+    /** The pairs the initialisation chained, parent first. */
+    spanning_tree: [number, number][];
+  };
+  rms_px: number;
+  iterations: number;
+  termination: Termination;
+  warnings: string[];
+}
+
+/** The formats of a rig report (`rig_export_formats`). */
+export type RigExportFormat = 'kalibr' | 'opencv-yaml' | 'ros' | 'urdf' | 'mrcal';
+
+/** One file of `export_report_files`. */
+export interface ExportFile {
+  /** A file name without folder (e.g. `front.yaml`, `rig_tf.launch.py`). */
+  name: string;
+  text: string;
+}
+
+// ---------------------------------------------------------------------------
 // Hand-eye (src/handeye/json_api.rs, output.rs)
 
 /** Camera on the gripper (`eye-in-hand`) or fixed in the robot's world (`eye-to-hand`). */
@@ -934,8 +1029,8 @@ export type SimpleTransformFormat =
 export type TransformExportFormat =
   | SimpleTransformFormat
   | `euler-${EulerKind}-${EulerOrder}-${AngleUnit}`;
-/** The `format` of `export_report`; `report` writes the report itself, pretty-printed. */
-export type ExportFormat = CameraExportFormat | 'report' | TransformExportFormat;
+/** The `format` of `export_report`; `report` writes the report itself, pretty-printed; a rig report takes a `RigExportFormat`. */
+export type ExportFormat = CameraExportFormat | 'report' | TransformExportFormat | RigExportFormat;
 /** What `export_formats` lists: every name, the euler family as one pattern. */
 export type ExportFormatListEntry =
   | CameraExportFormat
@@ -945,7 +1040,7 @@ export type ExportFormatListEntry =
 /** A transform key of a report, `parent_from_child` (the `transform` of `export_report`; `""` = the first present of gripper_from_camera, base_from_camera, right_from_left, base_from_target). */
 export type TransformName = `${string}_from_${string}`;
 /** What `export_report` reads: camera formats need a camera report; transform formats a report with the transform. An optional `frame_names` object (`{"gripper": "tool0", "camera": "camera_optical_frame"}`) names the frames of a transform's key in the output. */
-export type ExportableReport = CameraCalibration | HandEyeReport | StereoCalibration;
+export type ExportableReport = CameraCalibration | HandEyeReport | StereoCalibration | RigCalibration;
 
 // ---------------------------------------------------------------------------
 // Planar workflow (src/workflows/planar*.rs)
@@ -1271,6 +1366,12 @@ export interface RobocalJson {
   export_report: [ExportableReport, never];
   /** `export_formats()` -> the format names. */
   export_formats: [never, ExportFormatListEntry[]];
+  /** `calibrate_rig(input)` -> the rig report. */
+  calibrate_rig: [RigInput, RigCalibration];
+  /** `export_report_files(JSON.stringify(report), format, transform or "", JSON.stringify(frames) or "")` -> the files (several for a rig's `ros` and `mrcal`, as `robocal export -o DIR` writes them); `frames` names frames by role, e.g. `{"rig": "camera_rig"}`. */
+  export_report_files: [ExportableReport, ExportFile[]];
+  /** `rig_export_formats()` -> the rig format names. */
+  rig_export_formats: [never, RigExportFormat[]];
   /** `planar_fit(request)` -> the height model and predictions. */
   planar_fit: [PlanarFitRequest, PlanarFitReport];
   /** `planar_solve(request)` -> the planar workflow report. */

@@ -348,6 +348,45 @@ pub fn export_report(report_json: &str, format: &str, transform: &str) -> Result
     crate::io::export::export(report_json, format, transform).map_err(js_error)
 }
 
+/// [`export_report`] as files, a JSON array of `{"name", "text"}`: several
+/// for a rig report's `ros` and `mrcal` (the files `robocal export -o DIR`
+/// writes), else one. `frames_json` may be empty or an object naming frames
+/// by role, e.g. `{"rig": "camera_rig", "front": "front_optical_frame"}`
+/// (`--frame ROLE=NAME`).
+#[wasm_bindgen]
+pub fn export_report_files(
+    report_json: &str,
+    format: &str,
+    transform: &str,
+    frames_json: &str,
+) -> Result<String, JsError> {
+    let frames: Vec<(String, String)> = if frames_json.trim().is_empty() {
+        Vec::new()
+    } else {
+        serde_json::from_str::<std::collections::BTreeMap<String, String>>(frames_json)
+            .map_err(|e| {
+                JsError::new(&format!(
+                    "frames: expected an object of frame names by role, e.g. {{\"rig\": \"camera_rig\"}}: {e}"
+                ))
+            })?
+            .into_iter()
+            .collect()
+    };
+    let options = crate::io::export::ExportOptions {
+        transform: (!transform.is_empty()).then_some(transform),
+        frames,
+    };
+    let files = crate::io::export::export_files(report_json, format, &options).map_err(js_error)?;
+    serde_json::to_string(&files).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// The rig report's export format names, as a JSON array of strings.
+#[wasm_bindgen]
+pub fn rig_export_formats() -> String {
+    serde_json::to_string(&crate::io::export_rig::rig_format_names())
+        .unwrap_or_else(|_| "[]".into())
+}
+
 /// The export format names, as a JSON array of strings.
 #[wasm_bindgen]
 pub fn export_formats() -> String {

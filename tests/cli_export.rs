@@ -107,3 +107,65 @@ fn export_names_frames_with_the_frame_flag() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_rig_report_exports_to_a_folder_of_files_or_to_stdout() {
+    let rig = format!("{FIXTURES}/rig.json");
+    let dir = std::env::temp_dir().join(format!("robocal-export-rig-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let (code, out, err) = robocal(&[
+        "export",
+        &rig,
+        "--format",
+        "ros",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!((code, out.as_str()), (0, ""), "{err}");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "left.yaml",
+            "middle.yaml",
+            "rig_tf.launch",
+            "rig_tf.launch.py",
+            "right.yaml"
+        ]
+    );
+    assert_eq!(err.lines().count(), 5, "{err}");
+    for name in &names {
+        let golden = std::fs::read_to_string(format!("{FIXTURES}/rig.ros.{name}")).unwrap();
+        let written = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert_eq!(
+            written.replace(robocal::VERSION, "VERSION"),
+            golden,
+            "{name}"
+        );
+    }
+    // Without -o: every file after a '# ==> NAME <==' line.
+    let (code, out, _) = robocal(&["export", &rig, "--format", "ros"]);
+    assert_eq!(code, 0);
+    assert_eq!(out.matches("# ==> ").count(), 5);
+    assert!(
+        out.starts_with("# ==> left.yaml <==\nimage_width: 1280\n"),
+        "{out}"
+    );
+    // One-file formats still write one file.
+    let (code, out, _) = robocal(&["export", &rig, "--format", "kalibr"]);
+    assert_eq!(code, 0);
+    assert_eq!(
+        out.replace(robocal::VERSION, "VERSION"),
+        std::fs::read_to_string(format!("{FIXTURES}/rig.kalibr.camchain.yaml")).unwrap()
+    );
+    let (code, _, err) = robocal(&["export", &rig, "--format", "matrix4"]);
+    assert_eq!(
+        (code, err.as_str()),
+        (1, "robocal: format: format 'matrix4' is not a rig format: a rig report exports as kalibr, opencv-yaml, ros, urdf, mrcal (or report)\n")
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -128,3 +128,37 @@ fn bad_requests_say_what_to_fix() {
         "{err}"
     );
 }
+
+/// The rig of fixtures/exports/rig.json (three cameras: Brown, Kannala-Brandt,
+/// pinhole; written by the library's export_rig_tests) in every rig format;
+/// several files (ros) are golden one by one.
+#[test]
+fn every_rig_format_matches_its_golden_files() {
+    let rig = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/exports/rig.json"),
+    )
+    .unwrap();
+    let options = robocal::io::export::ExportOptions::default();
+    for format in ["kalibr", "opencv-yaml", "ros", "urdf"] {
+        let files = robocal::io::export::export_files(&rig, format, &options).unwrap();
+        for f in files {
+            golden(
+                &format!("rig.{format}.{}", f.name),
+                &f.text.replace(robocal::VERSION, "VERSION"),
+            );
+        }
+    }
+    // mrcal has no Kannala-Brandt model: the rig with a pinhole middle camera.
+    let pinhole = rig.replacen(
+        "\"model\": \"kannala_brandt\",\n            \"k1\": 0.01,\n            \"k2\": -0.002,\n            \"k3\": 0.0003,\n            \"k4\": -0.00004",
+        "\"model\": \"none\"",
+        1,
+    );
+    assert_ne!(pinhole, rig, "the fixture's middle camera changed");
+    for f in robocal::io::export::export_files(&pinhole, "mrcal", &options).unwrap() {
+        golden(
+            &format!("rig.mrcal.{}", f.name),
+            &f.text.replace(robocal::VERSION, "VERSION"),
+        );
+    }
+}

@@ -7,8 +7,9 @@ use super::{read_text, write_output, CliError};
     about = "convert a calibration report into OpenCV, ROS, Kalibr, mrcal, Halcon, MATLAB, URDF, robot-controller and other formats",
     long_about = "convert a calibration report into another format
 
-REPORT.json is the output of 'robocal intrinsics' (a camera) or
-'robocal handeye' (transforms), or any JSON with the same keys.",
+REPORT.json is the output of 'robocal intrinsics' (a camera),
+'robocal handeye' (transforms) or 'robocal rig' (a camera rig), or any JSON
+with the same keys.",
     after_help = "Camera formats:
   json          robocal's camera JSON (schema robocal.camera.v1)
   opencv-yaml   OpenCV FileStorage YAML (cv2.FileStorage, camera_matrix, distortion_coefficients)
@@ -37,13 +38,25 @@ role in the output, e.g. --frame gripper=tool0 --frame camera=camera_optical_fra
 frame (z forward, x right, y down): in ROS that is a *_optical_frame, not
 camera_link (x forward).
 
-Output goes to FILE with -o, else to stdout.
+Rig reports (robocal rig): --format kalibr (camchain, T_cn_cnm1 = camera n
+from camera n-1), opencv-yaml (one FileStorage: camera_matrix_k,
+distortion_coefficients_k, R_k, T_k = camera k from rig), ros (a camera_info
+YAML per camera and rig_tf.launch / rig_tf.launch.py placing each camera in
+the frame 'rig'), urdf (link rig, fixed joints rig -> each camera), mrcal (a
+.cameramodel per camera, extrinsics = rt_cam_ref with the rig as reference).
+Frames: --frame rig=NAME, --frame CAMERA=NAME.
+
+Output goes to FILE with -o, else to stdout. Formats of several files (a
+rig's ros and mrcal) go into the folder DIR with -o DIR, else to stdout
+each after a line '# ==> NAME <=='.
 
 Examples:
   robocal export camera.json --format opencv-yaml -o camera.yaml
   robocal export handeye.json --format urdf --transform gripper_from_camera
   robocal export handeye.json --format euler-extrinsic-xyz-deg
-  robocal export handeye.json --format ros1-launch --frame gripper=tool0 --frame camera=camera_optical_frame",
+  robocal export handeye.json --format ros1-launch --frame gripper=tool0 --frame camera=camera_optical_frame
+  robocal export rig.json --format kalibr -o camchain.yaml
+  robocal export rig.json --format ros -o rig_ros/",
     args_override_self = true
 )]
 pub struct ExportArgs {
@@ -59,8 +72,8 @@ pub struct ExportArgs {
     /// Name a frame in the output: ROLE=NAME, e.g. gripper=tool0 (repeatable)
     #[arg(long = "frame", value_name = "ROLE=NAME")]
     frames: Vec<String>,
-    /// Write the export there (default: standard output)
-    #[arg(short = 'o', long, value_name = "FILE")]
+    /// Write the export there (default: standard output); a folder for formats of several files
+    #[arg(short = 'o', long, value_name = "FILE|DIR")]
     output: Option<String>,
 }
 
@@ -87,6 +100,24 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
         transform: args.transform.as_deref(),
         frames,
     };
-    let out = robocal::io::export::export_with(&text, format, &options)?;
-    write_output(args.output.as_deref(), &out)
+    let files = robocal::io::export::export_files(&text, format, &options)?;
+    match (files.as_slice(), args.output.as_deref()) {
+        ([one], path) => write_output(path, &one.text),
+        (_, None | Some("-")) => write_output(None, &robocal::io::export::join_files(&files)),
+        (_, Some(dir)) => write_files(dir, &files),
+    }
+}
+
+/// Several files (a rig's ros and mrcal) into the folder `dir`, created if
+/// missing; their names are listed on stderr.
+fn write_files(dir: &str, files: &[robocal::io::export::ExportFile]) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::Io(format!("cannot create the folder '{dir}': {e}")))?;
+    for f in files {
+        let path = std::path::Path::new(dir).join(&f.name);
+        std::fs::write(&path, &f.text)
+            .map_err(|e| CliError::Io(format!("cannot write '{}': {e}", path.display())))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
 }

@@ -7,8 +7,11 @@
 //! shape, [`crate::geometry::PoseJson`]), or both.
 
 use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
+use super::export_rig::{export_rig, is_rig_report, RigFormat};
+pub use super::export_rig::{join_files, ExportFile};
 use super::export_transform::{export_transform, FrameNames, TransformFormat};
 use super::import_camera::import_camera;
+use crate::calib::rig_report::RigCalibration;
 use crate::error::{Error, Result};
 use crate::geometry::{Pose, PoseInput};
 use serde::Deserialize;
@@ -61,18 +64,69 @@ pub struct ExportOptions<'a> {
     pub frames: Vec<(String, String)>,
 }
 
-/// [`export`] with frame names.
+/// [`export`] with frame names. Formats of several files (a rig's `ros`
+/// and `mrcal`) come as one text, see [`join_files`].
 pub fn export_with(report_json: &str, format: &str, options: &ExportOptions) -> Result<String> {
-    let transform = options.transform;
-    let report: serde_json::Value = serde_json::from_str(report_json).map_err(|e| {
+    let report = parse_report(report_json)?;
+    if is_rig_report(&report) && format != "report" {
+        return export_rig_report(&report, format, options).map(|files| join_files(&files));
+    }
+    export_value(report_json, &report, format, options)
+}
+
+/// [`export_with`] as files: several for a rig's `ros` and `mrcal`, else
+/// one, named `export.<extension>` unless the format names it.
+pub fn export_files(
+    report_json: &str,
+    format: &str,
+    options: &ExportOptions,
+) -> Result<Vec<ExportFile>> {
+    let report = parse_report(report_json)?;
+    if is_rig_report(&report) && format != "report" {
+        return export_rig_report(&report, format, options);
+    }
+    let text = export_value(report_json, &report, format, options)?;
+    let extension = match CameraFormat::from_name(format) {
+        Ok(f) => f.extension(),
+        Err(_) if format == "report" => "json",
+        Err(_) => "txt",
+    };
+    Ok(vec![ExportFile {
+        name: format!("export.{extension}"),
+        text,
+    }])
+}
+
+fn parse_report(report_json: &str) -> Result<serde_json::Value> {
+    serde_json::from_str(report_json).map_err(|e| {
         Error::parse(
             e.line(),
             e.column(),
             format!("the report is not valid JSON: {e}"),
         )
-    })?;
+    })
+}
+
+fn export_rig_report(
+    report: &serde_json::Value,
+    format: &str,
+    options: &ExportOptions,
+) -> Result<Vec<ExportFile>> {
+    let format = RigFormat::from_name(format)?;
+    let rig = RigCalibration::deserialize(report)
+        .map_err(|e| Error::invalid("report", format!("not a readable rig report: {e}")))?;
+    export_rig(&rig, format, &options.frames)
+}
+
+fn export_value(
+    report_json: &str,
+    report: &serde_json::Value,
+    format: &str,
+    options: &ExportOptions,
+) -> Result<String> {
+    let transform = options.transform;
     if format == "report" {
-        return Ok(super::to_string_pretty(&report) + "\n");
+        return Ok(super::to_string_pretty(report) + "\n");
     }
     if let Ok(camera_format) = CameraFormat::from_name(format) {
         let (camera, _) = import_camera(report_json).map_err(|e| match e {
@@ -116,11 +170,11 @@ pub fn export_with(report_json: &str, format: &str, options: &ExportOptions) -> 
                 )
             })?,
     };
-    let pose = pose_from_report(&report, &name)?;
+    let pose = pose_from_report(report, &name)?;
     let roles = FrameNames::from_transform_name(&name)?;
     let names = FrameNames {
-        parent: frame_name(&report, &options.frames, &roles.parent)?,
-        child: frame_name(&report, &options.frames, &roles.child)?,
+        parent: frame_name(report, &options.frames, &roles.parent)?,
+        child: frame_name(report, &options.frames, &roles.child)?,
         key: name.clone(),
     };
     Ok(export_transform(&pose, &names, transform_format))
@@ -150,20 +204,25 @@ fn frame_name(
     let Some(name) = given else {
         return Ok(role.to_string());
     };
-    let valid = name
-        .chars()
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_' || c == '/')
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '/');
-    if !valid {
+    if !is_ros_frame_name(&name) {
         return Err(Error::invalid(
             "frame_names",
             format!("the {role} frame name '{name}' is not a ROS frame name: use letters, digits, _ and / (starting with a letter, _ or /), e.g. tool0"),
         ));
     }
     Ok(name)
+}
+
+/// Whether `name` is a frame name ROS and URDF accept (letters, digits,
+/// `_` and `/`, starting with a letter, `_` or `/`): names go into XML,
+/// shell and Python text unquoted.
+pub(crate) fn is_ros_frame_name(name: &str) -> bool {
+    name.chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_' || c == '/')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '/')
 }
 
 /// Read the transform `name` from a report: any [`PoseInput`] (the matrix

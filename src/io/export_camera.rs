@@ -241,7 +241,7 @@ fn opencv_yaml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
     Ok(out)
 }
 
-fn yaml_matrix(name: &str, rows: usize, cols: usize, data: &[f64]) -> String {
+pub(super) fn yaml_matrix(name: &str, rows: usize, cols: usize, data: &[f64]) -> String {
     format!(
         "{name}: !!opencv-matrix\n   rows: {rows}\n   cols: {cols}\n   dt: d\n   data: [ {} ]\n",
         list(data)

@@ -55,19 +55,47 @@ pub fn ros2_args(pose: &Pose, names: &FrameNames) -> String {
 
 /// A ROS 1 launch file publishing the transform.
 pub fn ros1_launch(label: &str, args: &str, names: &FrameNames) -> String {
+    ros1_launch_nodes(label, &[(args.to_string(), names.clone())])
+}
+
+/// A ROS 1 launch file with one static_transform_publisher node per
+/// `(arguments, frames)`.
+pub fn ros1_launch_nodes(label: &str, nodes: &[(String, FrameNames)]) -> String {
+    let lines: String = nodes
+        .iter()
+        .map(|(args, names)| {
+            format!(
+                "  <node pkg=\"tf2_ros\" type=\"static_transform_publisher\" name=\"{}\" args=\"{args}\"/>\n",
+                node_name(names)
+            )
+        })
+        .collect();
     format!(
-        "<!-- {label}: x y z (m) qx qy qz qw parent child (ROS 1 tf2_ros) -->\n<launch>\n  <node pkg=\"tf2_ros\" type=\"static_transform_publisher\" name=\"{}\" args=\"{args}\"/>\n</launch>\n",
-        node_name(names)
+        "<!-- {label}: x y z (m) qx qy qz qw parent child (ROS 1 tf2_ros) -->\n<launch>\n{lines}</launch>\n"
     )
 }
 
 /// A ROS 2 Python launch file publishing the transform.
 pub fn ros2_launch(label: &str, args: &str, names: &FrameNames) -> String {
-    let quoted: Vec<String> = args.split(' ').map(|a| format!("'{a}'")).collect();
+    ros2_launch_nodes(label, &[(args.to_string(), names.clone())])
+}
+
+/// A ROS 2 Python launch file with one static_transform_publisher node per
+/// `(arguments, frames)`.
+pub fn ros2_launch_nodes(label: &str, nodes: &[(String, FrameNames)]) -> String {
+    let blocks: String = nodes
+        .iter()
+        .map(|(args, names)| {
+            let quoted: Vec<String> = args.split(' ').map(|a| format!("'{a}'")).collect();
+            format!(
+                "        Node(\n            package='tf2_ros',\n            executable='static_transform_publisher',\n            name='{}',\n            arguments=[{}],\n        ),\n",
+                node_name(names),
+                quoted.join(", ")
+            )
+        })
+        .collect();
     format!(
-        "# {label} (ROS 2): save as e.g. calibration.launch.py\nfrom launch import LaunchDescription\nfrom launch_ros.actions import Node\n\n\ndef generate_launch_description():\n    return LaunchDescription([\n        Node(\n            package='tf2_ros',\n            executable='static_transform_publisher',\n            name='{}',\n            arguments=[{}],\n        ),\n    ])\n",
-        node_name(names),
-        quoted.join(", ")
+        "# {label} (ROS 2): save as e.g. calibration.launch.py\nfrom launch import LaunchDescription\nfrom launch_ros.actions import Node\n\n\ndef generate_launch_description():\n    return LaunchDescription([\n{blocks}    ])\n"
     )
 }
 

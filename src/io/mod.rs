@@ -11,6 +11,7 @@ pub mod csv_table;
 pub mod export;
 pub mod export_camera;
 mod export_camera_tools;
+pub mod export_rig;
 pub mod export_ros;
 pub mod export_transform;
 pub mod import_camera;
@@ -26,6 +27,8 @@ mod poses;
 pub mod poses_api;
 pub mod workflow_csv;
 
+#[cfg(test)]
+mod export_rig_tests;
 #[cfg(test)]
 mod export_tests;
 #[cfg(test)]

@@ -10,6 +10,7 @@ import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { rigInput } from './rig_scene.mjs';
 
 // Node has no ImageData; the previews need one (pkg-config/README.md).
 globalThis.ImageData = class ImageData { constructor(data, width, height) { Object.assign(this, { data, width, height }); } };
@@ -154,6 +155,11 @@ const pixels = (d) => d.points.map((p) => [p.x_px, p.y_px]);
 const pairs = views.slice(0, 4).map((v) => ({ name: v.name, object_m: board(v.detection), image_px: pixels(v.detection) }));
 call('calibrate_camera', { model: 'kannala_brandt', method: 'zhang', views: pairs, image_size_px: [1024, 768] }, 'calibrate_camera points');
 call('calibrate_stereo', { model: 'division', left: views, right: views });
+{
+  const rig = call('calibrate_rig', rigInput());
+  output('rig_export_formats', JSON.parse(robocal.rig_export_formats()));
+  output('export_report_files', JSON.parse(robocal.export_report_files(JSON.stringify(input('export_report_files', rig)), 'ros', '', '')));
+}
 const report = all.report;
 {
   const image = robocal.undistort_preview(png(meta.images[0]), JSON.stringify(input('undistort_preview', report.camera)), 200);

@@ -153,4 +153,5 @@ if (!(Math.abs(fxPrinted - 900) < 1.5 && Math.abs(cxPrinted - 511.5) < 1.5 && rm
 }
 console.log('README TypeScript example ran: ' + printed.split('\n')[0]);
 process.stdout.write(execFileSync('node', [join(here, 'shapes.mjs'), work]).toString());
+process.stdout.write(execFileSync('node', [join(here, 'rig.mjs'), work]).toString());
 console.log(`node smoke test passed (${tarball})`);
