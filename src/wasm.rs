@@ -18,7 +18,7 @@ mod live_capture;
 pub use demo::{render_demo, DemoData};
 pub use live_capture::LiveCapture;
 
-use crate::image::{decode, DecodeOptions};
+use crate::image::{decode, DecodeOptions, GrayImage};
 use crate::target::Target;
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
@@ -171,6 +171,13 @@ fn decode_options(options_json: Option<String>) -> Result<DecodeOptions, JsError
     Ok(decode)
 }
 
+/// The grey image of uploaded bytes, decoded under the caller's options.
+fn decode_gray(bytes: &[u8], options_json: Option<String>) -> Result<GrayImage, JsError> {
+    Ok(decode(bytes, &decode_options(options_json)?)
+        .map_err(js_error)?
+        .gray)
+}
+
 /// Decode image bytes (PNG, JPEG, TIFF, BMP, PNM, GIF, WebP); return its
 /// description and a preview (`ImageData`) whose longer side is at most
 /// `max_side` px. `options_json`: see [`ImageOptions`] (`{"max_pixels"}`).
@@ -312,9 +319,7 @@ pub fn detect_target(
     options_json: Option<String>,
 ) -> Result<String, JsError> {
     let target = target_from(target_spec_or_json)?;
-    let image = decode(bytes, &decode_options(options_json)?)
-        .map_err(js_error)?
-        .gray;
+    let image = decode_gray(bytes, options_json)?;
     let detection =
         crate::detect::detect(&image, &target, &crate::detect::DetectOptions::default())
             .map_err(js_error)?;
@@ -333,9 +338,7 @@ pub fn detect_boards(
     options_json: Option<String>,
 ) -> Result<String, JsError> {
     let target = target_from(target_spec_or_json)?;
-    let image = decode(bytes, &decode_options(options_json)?)
-        .map_err(js_error)?
-        .gray;
+    let image = decode_gray(bytes, options_json)?;
     let detections =
         crate::detect::detect_all(&image, &target, &crate::detect::DetectOptions::default())
             .map_err(js_error)?;
@@ -565,9 +568,7 @@ pub fn undistort_preview(
 ) -> Result<ImageData, JsError> {
     let camera: crate::camera::Camera = serde_json::from_str(camera_json)
         .map_err(|e| JsError::new(&format!("camera JSON: {e}")))?;
-    let image = decode(bytes, &decode_options(options_json)?)
-        .map_err(js_error)?
-        .gray;
+    let image = decode_gray(bytes, options_json)?;
     let preview = camera.pinhole_preview(max_side).map_err(js_error)?;
     let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
     let rgba: Vec<u8> = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();

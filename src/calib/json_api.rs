@@ -436,35 +436,57 @@ fn refuse_duplicates(views: &[View]) -> Result<()> {
 
 /// The image size: given, or the one all detections agree on.
 fn image_size(input: &CalibrationInput) -> Result<(u32, u32)> {
-    let mut from_detections = input
-        .views
-        .iter()
-        .filter_map(|v| v.detection.as_ref().map(|d| (v, d.image_size_px)));
-    if let Some([w, h]) = input.image_size_px {
-        if let Some((v, s)) = from_detections.find(|(_, s)| *s != [w, h]) {
+    agreed_image_size(
+        "image_size_px",
+        input.image_size_px,
+        detection_sizes(
+            input
+                .views
+                .iter()
+                .map(|v| (v.name.as_str(), v.detection.as_ref())),
+        ),
+        "required when the views are not detections",
+    )
+}
+
+/// `(name, image size)` of the views that are detections.
+pub(crate) fn detection_sizes<'a>(
+    views: impl Iterator<Item = (&'a str, Option<&'a Detection>)>,
+) -> impl Iterator<Item = (&'a str, [u32; 2])> {
+    views.filter_map(|(name, d)| d.map(|d| (name, d.image_size_px)))
+}
+
+/// One camera's image size (the camera, stereo and rig inputs): `given`, or
+/// the one all its detections agree on; `missing` says why it is needed
+/// when neither is there. Errors name `field`.
+pub(crate) fn agreed_image_size<'a>(
+    field: &str,
+    given: Option<[u32; 2]>,
+    mut sizes: impl Iterator<Item = (&'a str, [u32; 2])>,
+    missing: &str,
+) -> Result<(u32, u32)> {
+    if let Some([w, h]) = given {
+        if let Some((name, s)) = sizes.find(|(_, s)| *s != [w, h]) {
             return Err(Error::invalid(
-                "image_size_px",
+                field,
                 format!(
-                    "{w}x{h} given but the detection of {} is {}x{}",
-                    v.name, s[0], s[1]
+                    "{w}x{h} given but the detection of {name} is {}x{}",
+                    s[0], s[1]
                 ),
             ));
         }
         return Ok((w, h));
     }
-    let Some((_, first)) = from_detections.next() else {
-        return Err(Error::invalid(
-            "image_size_px",
-            "required when the views are not detections",
-        ));
+    let Some((_, first)) = sizes.next() else {
+        return Err(Error::invalid(field, missing));
     };
-    if let Some((v, s)) = from_detections.find(|(_, s)| *s != first) {
+    if let Some((name, s)) = sizes.find(|(_, s)| *s != first) {
         return Err(Error::invalid(
-            "image_size_px",
+            field,
             format!(
-                "the detections disagree: {}x{} and {}x{} ({}): one calibration takes \
+                "the detections disagree: {}x{} and {}x{} ({name}): one calibration takes \
                  the images of one camera at one resolution",
-                first[0], first[1], s[0], s[1], v.name
+                first[0], first[1], s[0], s[1]
             ),
         ));
     }

@@ -33,7 +33,10 @@
 //! and `camera_from_rig_std`, `frames`, `co_observation`, `rms_px`, ...),
 //! the report `robocal rig` writes.
 
-use super::json_api::{calibration_options, check_size, views_of, JsonOptions, JsonView};
+use super::json_api::{
+    agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
+    JsonView,
+};
 use super::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
 use super::rig_report::RigCalibration;
 use crate::camera::Camera;
@@ -177,34 +180,17 @@ fn within(camera: usize, e: Error) -> Error {
 /// One camera's image size: given, the given camera's, or the one all its
 /// detections agree on.
 fn camera_size(k: usize, c: &RigJsonCamera) -> Result<(u32, u32)> {
-    let field = format!("cameras[{k}].image_size_px");
-    let mut sizes = c
-        .views
-        .iter()
-        .filter_map(|v| v.detection.as_ref().map(|d| (v, d.image_size_px)));
-    let first = match (c.image_size_px, &c.camera) {
-        (Some(size), _) => size,
-        (None, Some(camera)) => [camera.width, camera.height],
-        (None, None) => match sizes.next() {
-            Some((_, size)) => size,
-            None => {
-                return Err(Error::invalid(
-                    field,
-                    "required when the views are not detections and no camera is given",
-                ))
-            }
-        },
-    };
-    if let Some((v, s)) = sizes.find(|(_, s)| *s != first) {
-        return Err(Error::invalid(
-            field,
-            format!(
-                "{}x{} and {}x{} ({}): all images of one camera must have one size",
-                first[0], first[1], s[0], s[1], v.name
-            ),
-        ));
-    }
-    Ok((first[0], first[1]))
+    agreed_image_size(
+        &format!("cameras[{k}].image_size_px"),
+        c.image_size_px
+            .or(c.camera.as_ref().map(|cam| [cam.width, cam.height])),
+        detection_sizes(
+            c.views
+                .iter()
+                .map(|v| (v.name.as_str(), v.detection.as_ref())),
+        ),
+        "required when the views are not detections and no camera is given",
+    )
 }
 
 #[cfg(test)]

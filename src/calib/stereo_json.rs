@@ -24,7 +24,8 @@
 //! `right_from_left_std`, `rms_px`, ...), the report `robocal stereo` writes.
 
 use super::json_api::{
-    calibration_options, check_size, views_of, JsonOptions, JsonView, MIN_VIEWS,
+    agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
+    JsonView, MIN_VIEWS,
 };
 use super::stereo::{calibrate_stereo, StereoCalibration};
 use crate::error::{Error, Result};
@@ -105,32 +106,16 @@ fn within(side: &str, e: Error) -> Error {
 
 /// One camera's image size: given, or the one all its detections agree on.
 fn side_size(side: &str, views: &[JsonView], given: Option<[u32; 2]>) -> Result<(u32, u32)> {
-    let field = format!("{side}_image_size_px");
-    let mut sizes = views
-        .iter()
-        .filter_map(|v| v.detection.as_ref().map(|d| (v, d.image_size_px)));
-    let first = match given {
-        Some(size) => size,
-        None => match sizes.next() {
-            Some((_, size)) => size,
-            None => {
-                return Err(Error::invalid(
-                    field,
-                    "required when the views are not detections",
-                ))
-            }
-        },
-    };
-    if let Some((v, s)) = sizes.find(|(_, s)| *s != first) {
-        return Err(Error::invalid(
-            field,
-            format!(
-                "{}x{} and {}x{} ({}): all images of one camera must have one size",
-                first[0], first[1], s[0], s[1], v.name
-            ),
-        ));
-    }
-    Ok((first[0], first[1]))
+    agreed_image_size(
+        &format!("{side}_image_size_px"),
+        given,
+        detection_sizes(
+            views
+                .iter()
+                .map(|v| (v.name.as_str(), v.detection.as_ref())),
+        ),
+        "required when the views are not detections",
+    )
 }
 
 #[cfg(test)]
