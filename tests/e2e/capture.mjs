@@ -20,7 +20,7 @@ const REFUSED = 'Camera access was refused. Allow the camera for this page (the 
 const NO_CAMERA = 'No camera was found. Connect a camera and press Start camera again, or add image files above.';
 
 /** Auto-captures awaited from the board video (of its 12 holds). */
-const CAPTURES = 8;
+const CAPTURES = 6;
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 

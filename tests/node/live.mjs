@@ -61,8 +61,15 @@ const holdsKept = kept.map(({ truth: f }) => f.hold);
 assert.equal(new Set(holdsKept).size, holdsKept.length, `one capture per hold: ${holdsKept}`);
 for (const { truth: f } of kept) assert.ok(f.index - truth.holds[f.hold].first_frame >= 2, `frame ${f.index} kept before the board settled`);
 assert.ok(kept.length >= 8, `captures from the 12 holds: ${holdsKept}`);
-// The board moves between holds: some frames are refused as moving.
-assert.ok(reasons('moving').length > 0 && reasons('moving').every(({ truth: f }) => f.hold === null || f.index - truth.holds[f.hold].first_frame < 1), 'moving frames are the moves');
+// Each hold is kept on its first frame with 250 ms of still history (its
+// third at 5 fps), or refused from then on only for adding nothing new.
+truth.holds.forEach((h, i) => {
+  const still = reports.slice(h.first_frame + 2, h.last_frame + 1).map(({ r }) => r.reason);
+  const want = holdsKept.includes(i) ? ['kept', ...still.slice(1).map(() => 'nothing_new')] : still.map(() => 'nothing_new');
+  assert.deepEqual(still, want, `hold ${i}`);
+});
+// The board moves between holds: those frames are refused as moving (or settling, as it enters).
+assert.ok(reasons('moving').length > 0 && reasons('moving').every(({ truth: f }) => f.hold === null || f.index - truth.holds[f.hold].first_frame < 2), 'moving frames are the moves');
 assert.ok(reasons('not_found').every(({ truth: f }) => f.hold === null), 'the board is found in every hold');
 const last = reports[reports.length - 1].r;
 assert.equal(last.kept, kept.length);
@@ -124,6 +131,26 @@ assert.equal(cal.good_enough, kept.length >= 8 && cal.max_std_px < 0.2);
 assert.equal(live.good_enough(), cal.good_enough);
 assert.equal(cal.suggestion === null, cal.good_enough);
 if (cal.suggestion) assert.equal(cal.suggestion.rule, 'uncertainty');
+// Manual capture keeps the last frame with the board even when the rule would not (hold 6 adds nothing new).
+const notKept = truth.holds.findIndex((_, i) => !holdsKept.includes(i));
+const manualFrame = JSON.parse(live.push_grey(video.frames[truth.holds[notKept].last_frame], W, H, (t += 200)));
+assert.equal(manualFrame.keep, false);
+const manual = JSON.parse(live.capture());
+assert.deepEqual([manual.index, manual.kept, manual.coverage.kept], [kept.length, kept.length + 1, kept.length + 1]);
+live.remove(kept.length);
+
+// Hand-eye guide: robot rotations about one axis are not diverse; one about another axis makes them so.
+const q = (axis, deg) => { const h = (deg * Math.PI) / 360; return [...axis.map((a) => a * Math.sin(h)), Math.cos(h)]; };
+const robot = (i, axis, deg) => JSON.parse(live.set_robot_pose(i, JSON.stringify({ translation_m: [0.4, 0.1 * i, 0.3], quaternion_xyzw: q(axis, deg) })));
+robot(0, [0, 0, 1], 0);
+robot(1, [0, 0, 1], 20);
+const aboutZ = robot(2, [0, 0, 1], 45).handeye;
+assert.equal(aboutZ.poses, 3);
+assert.ok(aboutZ.axis_spread_deg < 1 && Math.abs(Math.abs(aboutZ.dominant_axis[2]) - 1) < 1e-6 && !aboutZ.enough, JSON.stringify(aboutZ));
+const mixed = robot(3, [1, 0, 0], 30).handeye;
+assert.ok(mixed.axis_spread_deg >= 30 && mixed.enough, JSON.stringify(mixed));
+assert.throws(() => live.set_robot_pose(0, '{"translation_m": [0, 0]}'), { message: /^robot pose JSON: / });
+
 // Removing captures down to 4 keeps the calibration possible but not good enough (fewer than 8 views).
 for (let i = kept.length - 1; i >= 4; i--) live.remove(i);
 const four = JSON.parse(live.calibrate());
