@@ -34,6 +34,7 @@ export class CaptureGuide {
     this.report = null; // the newest frame report
     this.state = null; // the newest guide state (coverage, suggestion, good_enough, handeye)
     this.calibrated = null; // the guide's newest calibration reply
+    this.history = []; // [captures, worst projection uncertainty px] of each guide solve
     this.solving = false;
     this.again = false;
   }
@@ -110,7 +111,7 @@ export class CaptureGuide {
     this.solving = true;
     const out = await this.call('calibrate');
     this.solving = false;
-    if (out && !out.error) this.calibrated = out;
+    if (out && !out.error) { this.calibrated = out; this.history.push([out.kept, out.max_std_px]); }
     this.show();
     if (this.again) { this.again = false; await this.solve(); }
   }
@@ -136,6 +137,7 @@ export class CaptureGuide {
     g.dataset.rule = st.suggestion ? st.suggestion.rule : '';
     g.dataset.suggestion = st.suggestion ? JSON.stringify(st.suggestion.outline_px.map((p) => p.map((v) => Math.round(v)))) : '';
     g.dataset.maxStdPx = this.calibrated ? String(this.calibrated.max_std_px) : '';
+    g.dataset.history = this.history.map(([n, w]) => `${n}:${w}`).join(',');
     g.dataset.cells = String(st.coverage.cells.filter((n) => n > 0).length);
     g.dataset.names = this.names.join(',');
     g.dataset.firsts = JSON.stringify(this.firsts);
@@ -217,7 +219,7 @@ function drawCoverage(canvas, cov) {
   ctx.save();
   ctx.textAlign = 'center';
   ctx.font = '10px system-ui';
-  TILT_Y.forEach((t, by) => ctx.fillText(t.replace(' away', ''), tx + by * 34 + 16, top + 3 * 34 + 8));
+  TILT_Y.forEach((t, by) => ctx.fillText(t.split(' ')[0], tx + by * 34 + 16, top + 3 * 34 + 8));
   ctx.fillText('(edge away)', tx + 51, top + 3 * 34 + 20);
   ctx.restore();
   const dx = tx + 3 * 34 + 40;
