@@ -265,6 +265,32 @@ export const tests = [
       assert.ok(m, yaml.slice(0, 400));
       assert.ok(Math.abs(Number(m[1]) - want.fx) < Math.max(4 * params.fx[1], 0.3) && Math.abs(Number(m[2]) - want.cx) < Math.max(4 * params.cx[1], 0.3), `exported fx ${m[1]}, cx ${m[2]}`);
       await p.screenshot({ path: join(shotsDir, 'capture-board-3-exported.png'), fullPage: true });
+      // Hand-eye: captures with typed robot poses (UR: m, rotation vector). Three
+      // rotations about one axis are not diverse; one about another axis makes them so.
+      await p.click('a[data-step=images]');
+      const axisPoses = ['0,0,0.3', '0,0,0.6', '0,0,0.9', '0.8,0,0'];
+      // Each at a view not captured yet (its first point 5 px from every
+      // capture's): a repeat of a captured view is left out, pose and all.
+      const known = [...firsts];
+      for (const [i, r] of axisPoses.entries()) {
+        await p.waitForFunction((known) => {
+          const s = document.getElementById('camera-status');
+          const xy = s.dataset.state === 'found' && s.dataset.first ? s.dataset.first.split(',').map(Number) : null;
+          return xy && known.every((q) => Math.hypot(q[0] - xy[0], q[1] - xy[1]) > 5);
+        }, known, { timeout: 30000, polling: 20 });
+        await p.fill('#capture-pose', `0.41,-0.1,0.33,${r}`);
+        await p.click('#capture-frame');
+        await p.waitForFunction((i) => document.getElementById('capture-handeye').textContent.startsWith(`Hand-eye: ${i + 1} captures`), i, { timeout: 30000 });
+        known.push(JSON.parse(await p.getAttribute('#capture-guide', 'data-firsts')).pop());
+        if (i === 2) {
+          const he = await p.textContent('#capture-handeye');
+          assert.match(he, /^Hand-eye: 3 captures with robot poses, 3 motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/);
+          assert.equal(await p.getAttribute('#capture-handeye', 'data-enough'), 'no');
+        }
+      }
+      assert.match(await p.textContent('#capture-handeye'), /^Hand-eye: 4 captures with robot poses, \d motions; rotation axes spread \d+\.\d degrees \(enough\)\./);
+      assert.equal(await p.getAttribute('#capture-handeye', 'data-enough'), 'yes');
+      await p.screenshot({ path: join(shotsDir, 'capture-board-4-handeye.png'), fullPage: true });
       assert.deepEqual(errors, []);
     } finally {
       await other.close();

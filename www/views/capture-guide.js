@@ -46,7 +46,8 @@ export class CaptureGuide {
     const r = reply.live;
     if (!r) return;
     this.report = r;
-    this.state = r;
+    // A frame report has no hand-eye guide: the last one stays.
+    this.state = { ...r, handeye: this.state && this.state.handeye };
     if (r.keep) {
       const index = r.kept - 1;
       this.firsts[index] = r.points[0];
@@ -145,7 +146,7 @@ export class CaptureGuide {
     he.hidden = !st.handeye || !st.handeye.poses;
     if (!he.hidden) {
       const h = st.handeye;
-      he.textContent = `Hand-eye: ${h.poses} captures with robot poses, ${h.motions} motions; rotation axes spread ${num(h.axis_spread_deg, 1)} degrees${h.enough ? ' (enough).' : ' (at least 30 degrees and 3 motions wanted).'} ${h.advice}`;
+      he.textContent = `Hand-eye: ${h.poses} captures with robot poses, ${h.motions} motions; rotation axes spread ${h.axis_spread_deg.toFixed(1)} degrees${h.enough ? ' (enough).' : ' (at least 30 degrees and 3 motions wanted).'} ${h.advice.charAt(0).toUpperCase()}${h.advice.slice(1)}`;
       he.dataset.enough = h.enough ? 'yes' : 'no';
     }
     drawCoverage($('capture-coverage'), st.coverage);
