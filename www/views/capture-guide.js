@@ -146,7 +146,7 @@ export class CaptureGuide {
     he.hidden = !st.handeye || !st.handeye.poses;
     if (!he.hidden) {
       const h = st.handeye;
-      he.textContent = `Hand-eye: ${h.poses} captures with robot poses, ${h.motions} motions; rotation axes spread ${h.axis_spread_deg.toFixed(1)} degrees${h.enough ? ' (enough).' : ' (at least 30 degrees and 3 motions wanted).'} ${h.advice.charAt(0).toUpperCase()}${h.advice.slice(1)}`;
+      he.textContent = `Hand-eye: ${h.poses} captures with robot poses, ${h.motions} motions; rotation axes spread ${h.axis_spread_deg.toFixed(1)} degrees${h.enough ? ' (enough).' : ' (at least 30 degrees and 3 motions wanted).'} ${h.advice.charAt(0).toUpperCase()}${h.advice.slice(1)}${/[.!]$/.test(h.advice) ? '' : '.'}`;
       he.dataset.enough = h.enough ? 'yes' : 'no';
     }
     drawCoverage($('capture-coverage'), st.coverage);
