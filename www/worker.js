@@ -188,9 +188,14 @@ function guidedFrame(grey, width, height, spec, { auto }, time, started) {
   return { found, detection, reason: found ? null : report.message, width, height, live: report, ms: performance.now() - started };
 }
 
-/** The guide's session calls: capture (manual), remove, robotPose, calibrate, state. */
+/** The guide's session calls: capture (manual), remove, robotPose, calibrate, state, reset. */
 handlers.guide = async ({ op, index, pose }) => {
   await ready;
+  if (op === 'reset') {
+    if (guideSession) guideSession.live.free();
+    guideSession = null;
+    return null;
+  }
   if (!guideSession) throw new Error('the capture guide has seen no frame yet');
   const { live } = guideSession;
   if (op === 'capture') return JSON.parse(live.capture());

@@ -10,7 +10,7 @@
 // The guide's kept frames mirror the captured cards: `names[i]` is the card
 // of the guide's capture i. Excluding or removing a card removes it from
 // the guide; re-including it does not bring it back (its frame is gone
-// from the live session), and a reload starts the guide afresh.
+// from the live session), and a reload or a camera (re)start starts the guide afresh.
 import { $, num } from '../lib/dom.js';
 
 /** Views the guide's running calibration starts from (the core's MIN_VIEWS_TO_CALIBRATE). */
@@ -40,6 +40,14 @@ export class CaptureGuide {
   }
 
   get auto() { return $('capture-auto').checked; }
+
+  /** A fresh guide (the camera opened again, perhaps at another size): the cards stay, the guide starts from none. */
+  async reset() {
+    Object.assign(this, { names: [], firsts: [], report: null, state: null, calibrated: null, history: [] });
+    await this.call('reset');
+    $('capture-guide').textContent = 'Show the board to the camera.';
+    $('capture-handeye').hidden = true;
+  }
 
   /** After each guided frame: auto-capture, the words, the coverage and the suggestion. */
   async frame(reply) {

@@ -134,6 +134,7 @@ export class CaptureView {
     $('camera-start').disabled = false;
     $('camera-start').textContent = 'Restart camera';
     if (!this.live) this.live = this.makeEngine();
+    await this.guide.reset();
     this.board = await this.images.boardInfo();
     this.cameraRate = new RateMeter();
     this.detectRate = new RateMeter();
