@@ -13,7 +13,7 @@ const STEPS = {
   preview: 'decoding', detect: 'detecting the target in', boards: 'detecting the boards in', undistort: 'undistorting', calibrate: 'solving the camera',
   handeye: 'solving the hand-eye calibration', stereo: 'solving the stereo pair', export: 'exporting', poses: 'reading the robot poses',
   demo: 'rendering the demo', target: 'checking the target', kalibrTarget: 'reading the Kalibr target file', pair: 'pairing the stereo images', conventions: 'ranking the pose conventions',
-  workflow: 'solving the workflow', 'workflow-csv': 'reading the workflow file', frame: 'detecting the target in the live video',
+  workflow: 'solving the workflow', 'workflow-csv': 'reading the workflow file', frame: 'detecting the target in the live video', guide: 'updating the capture guide',
 };
 
 export function stepText(op, args = {}) {

@@ -27,6 +27,7 @@ const SHELL = [
   'views/boards.js',
   'views/camera.js',
   'views/capture.js',
+  'views/capture-guide.js',
   'views/capture-poses.js',
   'views/capture-solve.js',
   'views/export.js',

@@ -138,12 +138,13 @@ handlers.stereo = async ({ input }) => {
  * answer, not an error: `{ found: false, reason }`. `ms` is the time spent
  * here (grey pixels and detection).
  */
-handlers.frame = async ({ frame, bitmap, spec }) => {
+handlers.frame = async ({ frame, bitmap, spec, guide, time }) => {
   await ready;
   const started = performance.now();
   let pixels = frame ? await greyFromVideoFrame(frame) : null;
   if (!pixels) pixels = greyFromBitmap(bitmap);
   const { grey, width, height } = pixels;
+  if (guide) return guidedFrame(grey, width, height, spec, guide, time, started);
   let detection = null;
   let reason = null;
   try {
@@ -153,6 +154,56 @@ handlers.frame = async ({ frame, bitmap, spec }) => {
     reason = err && err.message ? err.message : String(err);
   }
   return { found: !!detection, detection, reason, width, height, ms: performance.now() - started };
+};
+
+// The capture guide (LiveCapture, docs/live-capture.md): one session per
+// target and frame size, living in this worker beside the live detection.
+let guideSession = null; // { key, live, time }
+
+function guideOf(spec, width, height) {
+  const key = `${spec}|${width}x${height}`;
+  if (!guideSession || guideSession.key !== key) {
+    if (guideSession) guideSession.live.free();
+    guideSession = { key, live: new robocal.LiveCapture(spec, width, height), time: -Infinity };
+  }
+  return guideSession;
+}
+
+/**
+ * A frame through the guide: detection, stillness, blur and novelty in one
+ * call; the reply carries the detection as `detection` (the overlay's
+ * shape) and the guide's frame report as `live`. With auto-capture off a
+ * frame the rule would keep is not kept (`reason: "auto_off"`).
+ */
+function guidedFrame(grey, width, height, spec, { auto }, time, started) {
+  const g = guideOf(spec, width, height);
+  // Frame times must increase: two frames read in the same millisecond are a microsecond apart.
+  g.time = Math.max(time, g.time + 1e-3);
+  const report = JSON.parse(g.live.push_grey(grey, width, height, g.time));
+  if (report.keep && !auto) {
+    Object.assign(report, JSON.parse(g.live.remove(report.kept - 1)), { keep: false, reason: 'auto_off', message: 'auto-capture is off: press Capture frame to keep this view' });
+  }
+  const found = report.status !== 'not_found';
+  const detection = found ? { points: report.points.map(([x, y], i) => ({ id: report.ids[i], x_px: x, y_px: y })) } : null;
+  return { found, detection, reason: found ? null : report.message, width, height, live: report, ms: performance.now() - started };
+}
+
+/** The guide's session calls: capture (manual), remove, robotPose, calibrate, state, reset. */
+handlers.guide = async ({ op, index, pose }) => {
+  await ready;
+  if (op === 'reset') {
+    if (guideSession) guideSession.live.free();
+    guideSession = null;
+    return null;
+  }
+  if (!guideSession) throw new Error('the capture guide has seen no frame yet');
+  const { live } = guideSession;
+  if (op === 'capture') return JSON.parse(live.capture());
+  if (op === 'remove') return JSON.parse(live.remove(index));
+  if (op === 'robotPose') return JSON.parse(live.set_robot_pose(index, pose));
+  if (op === 'calibrate') return JSON.parse(live.calibrate());
+  if (op === 'state') return JSON.parse(live.state());
+  throw new Error(`unknown guide request '${op}'`);
 };
 
 function greyFromBitmap(bitmap) {

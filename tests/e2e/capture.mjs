@@ -19,8 +19,8 @@ export const launchArgs = ['--use-fake-device-for-media-stream'];
 const REFUSED = 'Camera access was refused. Allow the camera for this page (the camera icon in the address bar, or the site settings), then press Start camera again. Image files can still be added above.';
 const NO_CAMERA = 'No camera was found. Connect a camera and press Start camera again, or add image files above.';
 
-/** Captures taken from the board video (of its 12 holds). */
-const CAPTURES = 7;
+/** Auto-captures awaited from the board video (of its 12 holds). */
+const CAPTURES = 6;
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 
@@ -162,7 +162,7 @@ export const tests = [
     assert.deepEqual(pairing, ['capture_001.png', 'capture_002.png']);
     await shot('robot-step');
   }],
-  ['the renderer\'s video: captures in the holds, the running calibration converges to the video\'s camera within its std, uncertainty shrinks, step 3 and the OpenCV export agree', async (page, { url }) => {
+  ['the renderer\'s video: auto-capture takes the holds, the suggestion moves on, the running calibration converges to the video\'s camera within its std, uncertainty shrinks, step 3 and the OpenCV export agree', async (page, { url }) => {
     // `robocal render --video`: the default 9x6 chessboard through 12 one-second holds, 640x480 at 5 fps.
     const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
     let other = { close: async () => {} };
@@ -181,36 +181,62 @@ export const tests = [
       await p.waitForFunction(() => document.getElementById('camera-status').dataset.state === 'found', null, { timeout: 30000 });
       assert.match(await p.textContent('#camera-status'), /^Board found: 54 points · 640 × 480 · /);
       await p.screenshot({ path: join(shotsDir, 'capture-board-1-found.png') });
-      // As a user would: capture when the board has been still for 0.3 s
-      // (its first point within 1 px) at a place not captured yet (5 px away).
-      const seen = [];
+      // Auto-capture: the guide keeps a frame in a hold (board still, sharp, new),
+      // and its suggestion moves on as coverage grows.
+      const guide = (p, n) => p.waitForFunction((n) => Number(document.getElementById('capture-guide').dataset.kept) >= n, n, { timeout: 90000 });
       const t0 = Date.now();
-      for (let i = 0; i < CAPTURES; i++) {
-        const first = await p.waitForFunction((seen) => {
-          const s = document.getElementById('camera-status');
-          const xy = s.dataset.state === 'found' && s.dataset.first ? s.dataset.first.split(',').map(Number) : null;
-          const w = window.stillFor || (window.stillFor = { xy: null, t: 0 });
-          const near = (a, b, d) => a && b && Math.hypot(a[0] - b[0], a[1] - b[1]) <= d;
-          if (!xy || !near(xy, w.xy, 1)) { w.xy = xy; w.t = performance.now(); return false; }
-          return performance.now() - w.t > 300 && !seen.some((q) => near(q, xy, 5)) ? xy : false;
-        }, seen, { timeout: 30000, polling: 50 });
-        seen.push(await first.jsonValue());
-        if (process.env.CAPTURE_DEBUG) console.log(`     capture ${i + 1} at ${Date.now() - t0} ms: first point ${seen[seen.length - 1]}; ${await p.textContent('#camera-status')}`);
-        await p.click('#capture-frame');
-      }
-      await p.waitForFunction((n) => [...document.querySelectorAll('.card .meta')].filter((m) => / · 54 points( · the same points as capture_\d+\.png: left out)?$/.test(m.textContent)).length === n, CAPTURES, { timeout: 60000 });
-      if (process.env.CAPTURE_DEBUG) console.log(`     cards detected at ${Date.now() - t0} ms`);
+      await guide(p, 1);
+      const early = await p.getAttribute('#capture-guide', 'data-suggestion');
+      await p.screenshot({ path: join(shotsDir, 'capture-board-1b-first-capture.png'), fullPage: true });
+      // The guide says why the newest frame was (not) kept.
+      assert.match(await p.textContent('#capture-guide'), /^(Captured \(\d+ so far\)\.|Not captured: (no board found|hold the board still|the board moves: hold it still \(moved \d+\.\d\d px, at most 1\.5 px\)|this view adds nothing new: move to the suggested pose)\.) Next: match this outline: /);
+      await guide(p, CAPTURES);
+      const later = await p.getAttribute('#capture-guide', 'data-suggestion');
+      if (process.env.CAPTURE_DEBUG) console.log(`     ${CAPTURES} auto-captures at ${Date.now() - t0} ms; suggestion ${early} -> ${later}`);
+      assert.notEqual(later, early, 'the suggested outline changes as coverage grows');
+      // From 4 captures the guide's own calibration chooses by predicted uncertainty and reports its worst.
+      await p.waitForFunction(() => document.getElementById('capture-guide').dataset.maxStdPx !== '', null, { timeout: 60000 });
+      const g = await p.$eval('#capture-guide', (e) => ({ ...e.dataset, text: e.textContent }));
+      assert.equal(g.rule, g.goodEnough === 'yes' ? '' : 'uncertainty');
+      assert.match(g.text, g.goodEnough === 'yes' ? /^Good enough: the worst projection uncertainty over the image is \d\.\d+ px \(below 0\.2 px\) with \d+ captures\./ : /Guide's calibration from \d+ captures: worst projection uncertainty \d\.\d+ px \(good enough below 0\.2 px with at least 8 captures\)\. Next: /);
+      assert.ok(Number(g.maxStdPx) > 0 && Number(g.maxStdPx) < 1, g.maxStdPx);
+      // Two more holds add tilts (the video's 10th and 11th): 8 captures, the guide solves again.
+      await guide(p, 8);
+      await p.waitForFunction(() => / from 8 captures|with 8 captures/.test(document.getElementById('capture-guide').textContent), null, { timeout: 60000 });
+      const g8 = await p.$eval('#capture-guide', (e) => ({ ...e.dataset, text: e.textContent }));
+      const gh = g8.history.split(',').map((e) => e.split(':').map(Number));
+      console.log(`     guide's worst projection uncertainty (px) by captures: ${gh.map(([n, w]) => `${n}: ${w.toFixed(3)}`).join(', ')}; good enough: ${g8.goodEnough}`);
+      // Not monotone (the residual variance is estimated anew each time), but well below the first solve's.
+      assert.ok(gh[0][0] === 4 && gh[gh.length - 1][0] === 8 && gh[gh.length - 1][1] < 0.9 * gh[0][1], `the guide's uncertainty shrinks: ${g8.history}`);
+      assert.equal(g8.goodEnough, Number(g8.maxStdPx) < 0.2 ? 'yes' : 'no', 'good enough: 8 captures and below 0.2 px');
+      assert.equal(g8.suggestion === '', g8.goodEnough === 'yes', 'no suggestion once good enough');
+      await p.screenshot({ path: join(shotsDir, 'capture-board-1d-eight.png'), fullPage: true });
+      await p.screenshot({ path: join(shotsDir, 'capture-board-1c-guide.png'), fullPage: true });
+      // The frames kept are the video's holds: each capture's first point is
+      // a hold's true first point (within 1.5 px: detection and luma rounding), each hold once.
+      const firsts = JSON.parse(await p.getAttribute('#capture-guide', 'data-firsts'));
+      const holdFirst = truth.holds.map((h) => truth.frames[h.first_frame].points[0]);
+      const holds = firsts.map(([x, y]) => holdFirst.findIndex((q) => Math.hypot(q.x_px - x, q.y_px - y) <= 1.5));
+      assert.ok(holds.every((h) => h >= 0), `captures at the holds: ${JSON.stringify(firsts)} vs ${JSON.stringify(holdFirst.map((q) => [q.x_px, q.y_px]))}`);
+      assert.equal(new Set(holds).size, holds.length, `one capture per hold: ${holds}`);
+      console.log(`     auto-captured holds ${holds.join(' ')} (of ${truth.holds.length})`);
+      // Stop taking more: the manual route stays (auto-capture off).
+      await p.uncheck('#capture-auto');
+      await p.waitForTimeout(1000); // a frame in flight with auto-capture on may still be kept
+      const taken = Number(await p.getAttribute('#capture-guide', 'data-kept'));
+      assert.deepEqual((await cards(p)).slice(0, taken).map((c) => c.name), Array.from({ length: taken }, (_, i) => `capture_${String(i + 1).padStart(3, '0')}.png`));
+      await p.waitForFunction((n) => [...document.querySelectorAll('.card .meta')].filter((m) => / · 54 points( · the same points as capture_\d+\.png: left out)?$/.test(m.textContent)).length === n, taken, { timeout: 60000 });
       // Settled: no solve running and every capture's detection in.
       await p.waitForFunction(() => { const s = document.getElementById('capture-solve-summary'); return s.dataset.busy === 'no' && Number(s.dataset.views) >= 5; }, null, { timeout: 60000 })
         .catch(async (e) => { await p.screenshot({ path: join(shotsDir, 'capture-board-failure.png'), fullPage: true }); throw new Error(`${await p.textContent('#capture-solve-summary')} (${e.message})`); });
       if (process.env.CAPTURE_DEBUG) console.log(`     settled at ${Date.now() - t0} ms`);
       const summary = await p.textContent('#capture-solve-summary');
       const views = Number(await p.getAttribute('#capture-solve-summary', 'data-views'));
-      assert.match(summary, new RegExp(`^Solved from ${views} captured views: RMS \\d\\.\\d+ px; projection uncertainty \\(1 sigma\\) worst \\d\\.\\d+ px, median \\d\\.\\d+ px over the image\\.( ${CAPTURES - views} captures? with the same points as an earlier one left out\\.)?$`));
+      assert.match(summary, new RegExp(`^Solved from ${views} captured views: RMS \\d\\.\\d+ px; projection uncertainty \\(1 sigma\\) worst \\d\\.\\d+ px, median \\d\\.\\d+ px over the image\\.( ${taken - views} captures? with the same points as an earlier one left out\\.)?$`));
       const params = Object.fromEntries(await p.$$eval('#capture-params tbody tr', (trs) => trs.map((tr) => [tr.children[0].textContent, [Number(tr.children[1].textContent), Number(tr.children[2].textContent)]])));
       // The newest solve is the best one: less uncertain than the first (4 captures).
       const history = (await p.getAttribute('#capture-solve-summary', 'data-history')).split(',').map((e) => e.split(':').map(Number));
-      assert.ok(history[0][0] >= 4 && history[0][0] < CAPTURES, `the first solve has 4 views or so: ${history[0][0]}`);
+      assert.ok(history[0][0] >= 4 && history[0][0] < taken, `the first solve has 4 views or so: ${history[0][0]}`);
       assert.ok(history[history.length - 1][1] < history[0][1], `worst projection uncertainty by views: ${JSON.stringify(history)}`);
       console.log(`     worst projection uncertainty (px) by captured views: ${history.map(([n, w]) => `${n}: ${w.toFixed(3)}`).join(', ')}`);
       const c = truth.camera;
@@ -225,7 +251,7 @@ export const tests = [
       await p.screenshot({ path: join(shotsDir, 'capture-board-2-solved.png'), fullPage: true });
       // Excluding a capture solves again without it (when no other capture has its points).
       await p.locator('.card').first().locator('.include input').uncheck();
-      if (views === CAPTURES) await p.waitForFunction((n) => document.getElementById('capture-solve-summary').dataset.views === String(n), views - 1, { timeout: 60000 });
+      if (views === taken) await p.waitForFunction((n) => document.getElementById('capture-solve-summary').dataset.views === String(n), views - 1, { timeout: 60000 });
       // Step 3 solves the same captures; the OpenCV YAML export carries its camera.
       await p.click('a[data-step=camera]');
       await p.click('#solve-camera');
@@ -239,6 +265,32 @@ export const tests = [
       assert.ok(m, yaml.slice(0, 400));
       assert.ok(Math.abs(Number(m[1]) - want.fx) < Math.max(4 * params.fx[1], 0.3) && Math.abs(Number(m[2]) - want.cx) < Math.max(4 * params.cx[1], 0.3), `exported fx ${m[1]}, cx ${m[2]}`);
       await p.screenshot({ path: join(shotsDir, 'capture-board-3-exported.png'), fullPage: true });
+      // Hand-eye: captures with typed robot poses (UR: m, rotation vector). Three
+      // rotations about one axis are not diverse; one about another axis makes them so.
+      await p.click('a[data-step=images]');
+      const axisPoses = ['0,0,0.3', '0,0,0.6', '0,0,0.9', '0.8,0,0'];
+      // Each at a view not captured yet (its first point 5 px from every
+      // capture's): a repeat of a captured view is left out, pose and all.
+      const known = [...firsts];
+      for (const [i, r] of axisPoses.entries()) {
+        await p.waitForFunction((known) => {
+          const s = document.getElementById('camera-status');
+          const xy = s.dataset.state === 'found' && s.dataset.first ? s.dataset.first.split(',').map(Number) : null;
+          return xy && known.every((q) => Math.hypot(q[0] - xy[0], q[1] - xy[1]) > 5);
+        }, known, { timeout: 30000, polling: 20 });
+        await p.fill('#capture-pose', `0.41,-0.1,0.33,${r}`);
+        await p.click('#capture-frame');
+        await p.waitForFunction((i) => document.getElementById('capture-handeye').textContent.startsWith(`Hand-eye: ${i + 1} captures`), i, { timeout: 30000 });
+        known.push(JSON.parse(await p.getAttribute('#capture-guide', 'data-firsts')).pop());
+        if (i === 2) {
+          const he = await p.textContent('#capture-handeye');
+          assert.match(he, /^Hand-eye: 3 captures with robot poses, 3 motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/);
+          assert.equal(await p.getAttribute('#capture-handeye', 'data-enough'), 'no');
+        }
+      }
+      assert.match(await p.textContent('#capture-handeye'), /^Hand-eye: 4 captures with robot poses, \d motions; rotation axes spread \d+\.\d degrees \(enough\)\./);
+      assert.equal(await p.getAttribute('#capture-handeye', 'data-enough'), 'yes');
+      await p.screenshot({ path: join(shotsDir, 'capture-board-4-handeye.png'), fullPage: true });
       assert.deepEqual(errors, []);
     } finally {
       await other.close();
@@ -258,6 +310,8 @@ export const tests = [
       for (const [name, value] of [['squares_x', '8'], ['squares_y', '6'], ['charuco_square_mm', '30'], ['marker_mm', '22']]) await p.fill(`#target-form input[name=${name}]`, value);
       await p.waitForFunction(() => /^Target spec: charuco:8x6:30mm:22mm:DICT_5X5_100 /.test(document.getElementById('target-spec').textContent), null, { timeout: 20000 });
       await p.click('a[data-step=images]');
+      // One manual capture, checked below (the box is in the hidden live panel until the camera starts).
+      await p.$eval('#capture-auto', (c) => { c.checked = false; });
       await p.click('#camera-start');
       await p.waitForFunction(() => document.getElementById('camera-status').dataset.state === 'partial', null, { timeout: 30000 });
       const text = await p.textContent('#camera-status');

@@ -10,6 +10,7 @@ import { cameraErrorText, videoInputs, openCamera, capabilities, resolutionChoic
 import { targetSpec } from './target.js';
 import { CapturePoses } from './capture-poses.js';
 import { RunningSolve } from './capture-solve.js';
+import { CaptureGuide } from './capture-guide.js';
 
 /** Marker boards report any subset of their corners: fewer than all is "partly found". */
 const MARKER_BOARDS = new Set(['charuco', 'aprilgrid']);
@@ -40,6 +41,7 @@ export class CaptureView {
     this.detectRate = new RateMeter();
     this.dropped = 0;
     this.listeners = new Set(); // fn(reply, bitmapless frame info) after each live detection
+    this.guide = new CaptureGuide(this);
     this.wire();
   }
 
@@ -70,6 +72,7 @@ export class CaptureView {
       // Another target while the camera runs: "partly found" counts against its points.
       if (/^target/.test(what) && this.stream) this.images.boardInfo().then((b) => { this.board = b; });
       if (/detections|included|images|all/.test(what)) this.solveIfChanged();
+      if (/included|images|all/.test(what)) this.guide.sync();
       if (!/images|all/.test(what)) return;
       this.countCaptures();
       // A removed or moved capture takes its typed pose along.
@@ -131,6 +134,7 @@ export class CaptureView {
     $('camera-start').disabled = false;
     $('camera-start').textContent = 'Restart camera';
     if (!this.live) this.live = this.makeEngine();
+    await this.guide.reset();
     this.board = await this.images.boardInfo();
     this.cameraRate = new RateMeter();
     this.detectRate = new RateMeter();
@@ -197,13 +201,15 @@ export class CaptureView {
       // The frame just detected, still showing: not again.
       if (args.frame && args.frame.timestamp === this.lastTimestamp) { args.frame.close(); return; }
       if (args.frame) this.lastTimestamp = args.frame.timestamp;
-      const reply = await this.live.call('frame', { ...args, spec }, [args.frame || args.bitmap]);
+      // The guide (auto-capture, coverage, suggestion) decides on the same frame in the worker.
+      const reply = await this.live.call('frame', { ...args, spec, guide: { auto: this.guide.auto }, time: performance.now() }, [args.frame || args.bitmap]);
       if (this.stream !== stream) return;
       reply.cycleMs = performance.now() - started;
       this.detectRate.tick(performance.now());
       this.last = reply;
       this.draw(reply);
       for (const fn of this.listeners) fn(reply);
+      this.guide.frame(reply);
     } catch (err) {
       if (this.stream === stream) this.showStatus('none', `Live detection failed: ${err.message}`);
     } finally {
@@ -254,6 +260,7 @@ export class CaptureView {
         ctx.fillText(String(p.id), p.x_px + r + 2, p.y_px - r);
       }
     }
+    this.guide.drawSuggestion(ctx, reply.width);
     // A frame around the picture in the state's colour, readable at a glance.
     ctx.lineWidth = Math.max(4, reply.width / 160);
     ctx.strokeStyle = colour;
@@ -302,11 +309,14 @@ export class CaptureView {
   /**
    * Capture the current frame into the session (a card, kept in IndexedDB,
    * detected like an upload). `extra` fields go on the session image (the
-   * guide adds why it kept the frame). Returns the image's name.
+   * guide adds why it kept the frame). `guideIndex` is the guide's capture
+   * of an auto-capture; a manual capture asks the guide to keep its last
+   * frame. Returns the image's name.
    */
-  async capture(extra = {}) {
+  async capture(extra = {}, guideIndex = null) {
     if (!this.stream || !$('camera-video').videoWidth) return null;
     const name = this.nextCaptureName();
+    if (guideIndex !== null) this.guide.named(guideIndex, name);
     // A typed robot pose must read before the frame is taken: a capture
     // without its pose would shift the pairing of every later one.
     const line = this.poses.line;
@@ -324,7 +334,11 @@ export class CaptureView {
       const bytes = await this.grabPng();
       // The frame's card appears at once; detection of the PNG follows.
       const done = this.images.addBytes([{ name, bytes, source: 'camera', ...(line ? { robotPose: line } : {}), ...extra }]);
-      if (line) await this.poses.captured(name, line, reading);
+      if (guideIndex === null) await this.guide.manual(name);
+      if (line) {
+        await this.poses.captured(name, line, reading);
+        await this.guide.robotPose(name, reading.poses[0] && reading.poses[0].base_from_gripper);
+      }
       await done;
       this.leaveOutRepeat(name);
     } catch (err) {
@@ -332,32 +346,6 @@ export class CaptureView {
       return null;
     }
     return name;
-  }
-
-  /**
-   * A capture whose points are exactly those of an earlier one (camera and
-   * board both still) adds nothing, and the solvers refuse a view given
-   * twice: it is kept but left out, with a note on its card.
-   */
-  leaveOutRepeat(name) {
-    const img = this.images.images.find((i) => i.name === name);
-    if (!img || !img.detection) return;
-    const key = JSON.stringify(img.detection.points);
-    const earlier = this.captured().find((i) => i !== img && i.detection && JSON.stringify(i.detection.points) === key);
-    if (!earlier) return;
-    img.included = false;
-    img.note = `the same points as ${earlier.name}: left out`;
-    this.images.renderCard(img);
-    this.images.refresh();
-    this.store.changed('included');
-  }
-
-  /** A new solve when the captured views with the board are not the ones solved last. */
-  solveIfChanged() {
-    const key = this.captured().filter((i) => i.included && i.detection).map((i) => i.id).join(',');
-    if (key === this.solvedKey) return;
-    this.solvedKey = key;
-    this.solve.update();
   }
 
   /**
