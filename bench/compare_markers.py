@@ -5,7 +5,8 @@ OpenCV 4.14 on seeded renders of the project's renderer (issue 18).
 `cargo run --release --example marker_compare` renders the sets (1280x960,
 noise sigma 2 grey levels, blur 0.7 px: ChArUco 12x9 DICT_5X5_100 full and
 partial views, the chessboard with the same corners at the same poses,
-AprilGrid 6x6 full and partial, board-free images) and times robocal's
+AprilGrid 6x6 full and partial, board-free images: chessboard
+renders, uniform noise, synth::clutter) and times robocal's
 `detect` in its own process (one thread, decoding excluded, median of
 --repeat calls per image). This script runs OpenCV single-threaded
 (cv2.setNumThreads(1)) on the same PNGs, timing the call alone (decoding
@@ -167,20 +168,24 @@ def main():
             d, _ = by_id_errors(im["robocal"]["points"] or [], im["truth"])
             worst += [(e, name, os.path.basename(im["file"])) for e in d if e > 0.2]
     print("\nrobocal corners off by more than 0.2 px:", sorted(worst, reverse=True) or "none")
-    print(f"\nboard-free images ({len(free['images'])}: chessboard renders and uniform noise):")
-    for spec in free["targets"]:
-        n = sum(1 for im in free["images"] if im["robocal"][spec]["points"])
-        ms = np.median([im["robocal"][spec]["ms"] for im in free["images"]])
-        print(f"  robocal {spec}: {n} images with a detection, median {ms:.2f} ms")
-    for label, fn in [("OpenCV CharucoDetector", charuco), ("OpenCV ArucoDetector 36h11 border 2", tags[2]),
-                      ("OpenCV ArucoDetector 36h11 border 1", tags[1])]:
-        n, ms = 0, []
-        for im in free["images"]:
-            g = cv2.imread(im["file"], cv2.IMREAD_GRAYSCALE)
-            t, pts = timed(fn, g, repeat)
-            ms.append(t)
-            n += len(pts)
-        print(f"  {label}: {n} corners/markers in total, median {np.median(ms):.2f} ms")
+    print(f"\nboard-free images ({len(free['images'])}: chessboard renders, uniform noise, clutter):")
+    kinds = sorted({os.path.basename(os.path.dirname(im["file"])) for im in free["images"]})
+    for kind in kinds:
+        ims = [im for im in free["images"] if os.path.basename(os.path.dirname(im["file"])) == kind]
+        print(f" {kind} ({len(ims)} images):")
+        for spec in free["targets"]:
+            n = sum(1 for im in ims if im["robocal"][spec]["points"])
+            ms = np.median([im["robocal"][spec]["ms"] for im in ims])
+            print(f"  robocal {spec}: {n} images with a detection, median {ms:.2f} ms")
+        for label, fn in [("OpenCV CharucoDetector", charuco), ("OpenCV ArucoDetector 36h11 border 2", tags[2]),
+                          ("OpenCV ArucoDetector 36h11 border 1", tags[1])]:
+            n, ms = 0, []
+            for im in ims:
+                g = cv2.imread(im["file"], cv2.IMREAD_GRAYSCALE)
+                t, pts = timed(fn, g, repeat)
+                ms.append(t)
+                n += len(pts)
+            print(f"  {label}: {n} corners/markers in total, median {np.median(ms):.2f} ms")
     print("\nratio = median over images of robocal time / OpenCV time (same images; lower is faster for robocal)")
 
 

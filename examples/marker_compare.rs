@@ -8,7 +8,8 @@
 //! 0.7 px, seeded): ChArUco 12x9 DICT_5X5_100 full and partial views, the
 //! chessboard with the same corner geometry (chessboard:11x8:20mm) at the
 //! same poses and noise seeds, AprilGrid 6x6 full and partial views, and
-//! board-free images (the chessboard renders and uniform noise) for false
+//! board-free images (the chessboard renders, uniform noise and seeded
+//! clutter of quads, ellipses and strokes: `synth::clutter`) for false
 //! markers. Writes OUT_DIR/<set>/NNN.png and OUT_DIR/markers.json:
 //! `{"<set>": {"target", "images": [{"file", "truth": [[id, x, y]],
 //! "robocal": {"ms", "points": [[id, x, y]] | null, "error"}}]}}`; the
@@ -163,8 +164,8 @@ fn main() {
         }
         sets.insert(name.into(), json!({"target": spec, "images": images}));
     }
-    // Board-free: the chessboard renders and uniform noise, each searched for
-    // both marker boards.
+    // Board-free: the chessboard renders, uniform noise and clutter, each
+    // searched for both marker boards.
     let mut free = Vec::new();
     let mut files: Vec<String> = (0..views)
         .map(|k| format!("{out}/chessboard_same_poses/{k:03}.png"))
@@ -175,6 +176,13 @@ fn main() {
         let px = (0..1280 * 960).map(|_| rng.below(256) as u8).collect();
         let img = GrayImage::new(1280, 960, px).expect("noise image");
         let file = format!("{out}/noise/{k:03}.png");
+        save(&img, &file);
+        files.push(file);
+    }
+    std::fs::create_dir_all(format!("{out}/clutter")).expect("mkdir");
+    for k in 0..views as u64 {
+        let img = robocal::synth::clutter(1280, 960, 500 + k, 2.0);
+        let file = format!("{out}/clutter/{k:03}.png");
         save(&img, &file);
         files.push(file);
     }

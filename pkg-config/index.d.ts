@@ -198,7 +198,10 @@ export type TargetSpec =
 
 /** One detected target point. */
 export interface DetectedPoint {
-  /** Board id (`i + j * cols`; square grids: `4 (i + j * cols) + k`). */
+  /**
+   * Board id (`i + j * cols`; square grids: `4 (i + j * cols) + k`; ChArUco: OpenCV's corner id
+   * `i + j (squares_x - 1)`; AprilGrid: Kalibr's point id, four per tag).
+   */
   id: number;
   /** Column coordinate, px. */
   x_px: number;

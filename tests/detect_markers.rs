@@ -200,6 +200,32 @@ fn no_marker_on_images_without_a_board() {
 }
 
 #[test]
+fn no_marker_on_1280x960_clutter() {
+    // Board-free clutter (dark and light quads painted over each other,
+    // ellipses, strokes; noise sigma 2) at a size that goes through the
+    // half-resolution search and the full-resolution retry: every quad
+    // reaches the decoder, none may decode, for small dictionaries (most
+    // codes per bit) and large ones alike.
+    for seed in [500, 501, 502] {
+        let img = robocal::synth::clutter(1280, 960, seed, 2.0);
+        for spec in [
+            "charuco:5x7:30mm:22mm:DICT_4X4_50",
+            "charuco:12x9:20mm:15mm:DICT_5X5_100",
+            "charuco:5x7:30mm:22mm:DICT_APRILTAG_16h5",
+            "charuco:5x7:30mm:22mm:DICT_ARUCO_ORIGINAL",
+            "aprilgrid:6x6:40mm:0.3",
+        ] {
+            let t = Target::parse_spec(spec).unwrap();
+            let e = detect(&img, &t, &DetectOptions::default()).unwrap_err();
+            assert!(
+                e.to_string().contains("no DICT_") && e.to_string().contains("markers found"),
+                "clutter seed {seed}, {spec}: {e}"
+            );
+        }
+    }
+}
+
+#[test]
 fn a_legacy_board_is_named_when_the_spec_misses_legacy() {
     // 12 x 8 squares: an even row count, where the layouts differ.
     let (_, r) = render_board(

@@ -2,6 +2,7 @@
 //! examples and the web app's demo button. Deterministic for a given seed on
 //! every platform (native and wasm).
 
+pub mod clutter;
 pub mod demo;
 pub mod handeye;
 pub mod handeye_looking;
@@ -14,6 +15,7 @@ pub mod video;
 pub use scene::Scene;
 
 pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
+pub use clutter::clutter;
 pub use rng::Rng;
 pub use video::{video_camera, BoardVideo, VideoOptions};
 
