@@ -21,7 +21,7 @@ const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 
 /** Renders a rig into a fresh folder; returns the folder, its truth and each camera's files. */
 function renderRig(sideFrames) {
   const dir = mkdtempSync(join(tmpdir(), 'robocal-rig-e2e-'));
-  execFileSync(CLI, ['render', '--out', dir, '--rig', '--views', '4', '--side-frames', String(sideFrames), '--seed', '5'], { stdio: ['ignore', 'ignore', 'pipe'] });
+  execFileSync(CLI, ['render', '--out', dir, '--rig', '--views', '6', '--side-frames', String(sideFrames), '--seed', '5'], { stdio: ['ignore', 'ignore', 'pipe'] });
   const truth = JSON.parse(readFileSync(join(dir, 'truth.json'), 'utf8'));
   const files = truth.cameras.map((c) => readdirSync(join(dir, c.name)).sort().map((f) => join(dir, c.name, f)));
   return { dir, truth, files };
@@ -119,13 +119,18 @@ export const tests = [
       assert.ok(inked > 2000, `3-D view: ${inked} dark pixels`);
       await page.locator('#rig-3d').scrollIntoViewIfNeeded();
       await shot('3d');
-      // Kalibr camchain from the page equals `robocal export rig.json --format kalibr`.
-      const [kalibr] = await Promise.all([page.waitForEvent('download'), page.click('#rig-export-kalibr')]);
-      const pageKalibr = readFileSync(await kalibr.path(), 'utf8');
-      assert.match(pageKalibr, /T_cn_cnm1/);
+      // OpenCV FileStorage from the page equals `robocal export rig.json --format opencv-yaml`.
+      const [yaml] = await Promise.all([page.waitForEvent('download'), page.click('#rig-export-opencv-yaml')]);
+      const pageYaml = readFileSync(await yaml.path(), 'utf8');
       writeFileSync(join(dir, 'rig.json'), JSON.stringify(report));
-      const cliKalibr = execFileSync(CLI, ['export', join(dir, 'rig.json'), '--format', 'kalibr']).toString();
-      assert.equal(pageKalibr, cliKalibr);
+      const cliYaml = execFileSync(CLI, ['export', join(dir, 'rig.json'), '--format', 'opencv-yaml']).toString();
+      assert.equal(pageYaml, cliYaml);
+      assert.match(pageYaml, /^%YAML:1\.0/);
+      // Kalibr's radtan has no k3: the page shows the core's refusal, as the CLI gives it.
+      await page.click('#rig-export-kalibr');
+      await page.waitForFunction(() => /^kalibr: /.test(document.getElementById('rig-export-status')?.textContent || ''), null, { timeout: 10000 });
+      assert.equal(await page.textContent('#rig-export-status'), "kalibr: format: camera 'cam0': Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr");
+      await shot('exports');
       console.log(`     rig: ${report.frames.length} frames, rms ${report.rms_px.toFixed(4)} px, worst extrinsic error ${worst.toFixed(2)} std`);
     } finally {
       rmSync(dir, { recursive: true, force: true });

@@ -245,7 +245,7 @@ export class RigView {
     for (const c of r.cameras) {
       const rigFromCamera = invert(c.camera_from_rig.matrix_row_major);
       frames.push({ name: c.name, matrix_row_major: rigFromCamera });
-      shapes.push(...frustum(rigFromCamera, c.calibration.camera, 0.15));
+      shapes.push(...frustum(rigFromCamera, c.calibration.camera, 0.3));
     }
     for (const f of r.frames) {
       if (!f.rig_from_target) continue;
