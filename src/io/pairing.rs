@@ -265,6 +265,19 @@ mod tests {
     }
 
     #[test]
+    fn rigs_group_by_number_unless_no_name_has_one() {
+        assert_eq!(
+            default_grouping(["a.png", "cam/b7.png"].into_iter()),
+            PairedBy::Number
+        );
+        assert_eq!(
+            default_grouping(["a.png", "cam7/b.png"].into_iter()),
+            PairedBy::Order
+        );
+        assert_eq!(default_grouping(std::iter::empty()), PairedBy::Order);
+    }
+
+    #[test]
     fn pairs_by_number_whatever_the_order() {
         let left = ["l/left10.png", "l/left2.png", "l/left1.png"];
         let right = ["r/right01.png", "r/right02.png", "r/right10.png"];
