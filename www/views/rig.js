@@ -196,6 +196,8 @@ export class RigView {
       await this.show(result);
     } catch (err) {
       this.progress.textContent = '';
+      this.state.result = null; // the error replaces an earlier result, in the session too
+      this.store.changed('rig-result');
       fill(this.out, h('p', { id: 'rig-error', class: 'msg msg-error', role: 'alert' }, err.message));
     } finally {
       this.solveButton.disabled = false;
