@@ -1399,6 +1399,21 @@ export interface RobocalJson {
   target_spec: [Target, never];
   /** `pair_images(JSON.stringify(leftNames), JSON.stringify(rightNames))` -> the pairs (robocal::io::pairing). */
   pair_images: [string[], ImagePairing];
+  /** `rig_frame_keys(JSON.stringify(cameras), groupBy)` (groupBy `'number'`, `'order'` or `''`: by number unless no name has one) -> each image's frame key, as `robocal rig` groups them. */
+  rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
+}
+
+/** One camera's image names, the input of `rig_frame_keys`. */
+export interface RigCameraNames {
+  name: string;
+  images: string[];
+}
+
+/** What `rig_frame_keys` returns: the rule used, each image's frame key per camera (input order), and every key sorted. */
+export interface RigFrameGrouping {
+  grouped_by: 'number' | 'order';
+  keys: string[][];
+  frames: string[];
 }
 
 /** One board point of `target_points`: id and position in the board frame (z = 0), metres. */

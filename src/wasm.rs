@@ -15,6 +15,8 @@
 
 mod demo;
 mod live_capture;
+mod rig_frames;
+pub use rig_frames::rig_frame_keys;
 pub use demo::{render_demo, DemoData};
 pub use live_capture::LiveCapture;
 

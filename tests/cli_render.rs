@@ -77,6 +77,25 @@ fn render_arguments_are_checked() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let dir = std::env::temp_dir().join(format!("robocal-render-rig-{}", std::process::id()));
+    let dir_arg = dir.to_string_lossy().into_owned();
+    let out = robocal(&["render", "--out", &dir_arg, "--rig", "--views", "0"]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "robocal: render: with --rig, --views (frames facing each pair) must be 1 to 100 and \
+         --side-frames 0 to 100 (see 'robocal render --help')\n"
+    );
+    let out = robocal(&["render", "--out", &dir_arg, "--side-frames", "2"]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--rig"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = robocal(&["render", "--help"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("robocal render --out demo --demo"));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("robocal render --out rig --rig --views 5"));
 }

@@ -14,6 +14,7 @@ export function defaultSession() {
     handeye: { setup: 'eye-in-hand', method: 'all', result: null },
     workflows: { planar: null, xytable: null },
     stereo: { model: 'brown', result: null, left: [], right: [] }, // left/right: { id, name, detection, error, spec }
+    rig: { model: 'brown', result: null, cameras: [] }, // cameras: { name, files: [{ id, name, detection, error, spec }] }
   };
 }
 
@@ -71,6 +72,14 @@ export class Store {
           if (buf) { this.bytes.set(f.id, buf); kept.push(f); }
         }
         stereo[side] = kept;
+      }
+      for (const camera of this.session.rig.cameras) {
+        const kept = [];
+        for (const f of camera.files) {
+          const buf = await tx(this.db, 'blobs', 'readonly', (s) => s.get(f.id));
+          if (buf) { this.bytes.set(f.id, buf); kept.push(f); }
+        }
+        camera.files = kept;
       }
     } catch (e) {
       this.persistent = false;

@@ -125,6 +125,28 @@ handlers.undistort = async ({ bytes, camera, maxSide, maxPixels }) => {
   return { image: robocal.undistort_preview(new Uint8Array(bytes), camera, maxSide, imageOptions(maxPixels)) };
 };
 
+/** Rig frames by file name: the rule of `robocal rig` (io::pairing). */
+handlers.rigFrames = async ({ cameras, groupBy }) => {
+  await ready;
+  return JSON.parse(robocal.rig_frame_keys(cameras, groupBy || ''));
+};
+
+handlers.rig = async ({ input }) => {
+  await ready;
+  return JSON.parse(robocal.calibrate_rig(input));
+};
+
+handlers.rigFormats = async () => {
+  await ready;
+  return JSON.parse(robocal.rig_export_formats());
+};
+
+/** A report's export as files [{name, text}] (several for a rig's ros and mrcal). */
+handlers.exportFiles = async ({ report, format, transform, frames }) => {
+  await ready;
+  return JSON.parse(robocal.export_report_files(report, format, transform || '', frames || ''));
+};
+
 handlers.stereo = async ({ input }) => {
   await ready;
   return JSON.parse(robocal.calibrate_stereo(input));

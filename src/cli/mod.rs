@@ -16,6 +16,7 @@ mod info;
 mod intrinsics;
 mod planar;
 mod render;
+mod render_rig;
 mod render_video;
 mod rig;
 mod serve;

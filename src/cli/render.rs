@@ -17,6 +17,7 @@ use std::path::Path;
   robocal render --out DIR [--target SPEC] [--views N] [--seed N]
                  [--camera camera.json] [--noise GREY] [--blur PX]
   robocal render --out DIR --demo [--seed N]
+  robocal render --out DIR --rig [--views N] [--side-frames N] [--seed N]
   robocal render --video board.y4m [--size WxH] [--fps N] [--target SPEC]
                  [--seed N] [--truth FILE] [--camera camera.json]
 
@@ -32,6 +33,16 @@ coordinates).
 robot poses that go with them (DIR/poses.csv, Universal Robots format with an
 image column) and truth.json with gripper_from_camera and base_from_target.
 
+--rig writes a four-camera rig (robocal::synth::rig: two pairs of 1280x960
+cameras facing each other across a 1.2 m circle) seeing a 10x7 chessboard
+(60 mm squares): N frames facing each pair, --side-frames frames (default 4)
+facing half-way between cam1 and cam2, the only frames that link the two
+pairs (0: two groups no frame connects). Each camera's images go to
+DIR/camK/camK_FFF.png (FFF: the frame), only where the camera faces the
+board; DIR/truth.json: {\"target\", \"rig_frame\", \"cameras\": [{name,
+camera, camera_from_rig, images: [{image, frame}]}], \"frames\": [{key,
+rig_from_target}]}.
+
 --video writes a Y4M video (4:2:0, 8-bit; 640x480 at 15 fps by default,
 about 28 s) of the board sliding into view, then holding still for 1 s at
 each of 12 poses (the nine regions of the image, tilts about both axes,
@@ -46,6 +57,7 @@ frame's hold index or null while the board moves.",
     after_help = "Examples:
   robocal render --out renders --views 20 --seed 7
   robocal render --out demo --demo
+  robocal render --out rig --rig --views 5 --side-frames 3
   robocal render --video board.y4m --size 1280x720 --target charuco:12x9:20mm:15mm:DICT_5X5_100",
     args_override_self = true
 )]
@@ -85,8 +97,14 @@ pub struct RenderArgs {
     /// Write the web app's demo session instead
     #[arg(long)]
     demo: bool,
+    /// Write a four-camera rig's images instead (--views: frames facing each pair)
+    #[arg(long, conflicts_with = "demo")]
+    rig: bool,
+    /// With --rig: frames seen by cam1 and cam2 that link the two pairs
+    #[arg(long, value_name = "N", default_value_t = 4, requires = "rig")]
+    side_frames: usize,
     /// Write a Y4M video of the board moving through poses with holds
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["out", "demo", "views"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["out", "demo", "views", "rig"])]
     video: Option<String>,
     /// With --video: frame size WIDTHxHEIGHT (even sides)
     #[arg(
@@ -117,6 +135,16 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
     let out = Path::new(out);
     if args.demo {
         return write_demo(out, args.seed);
+    }
+    if args.rig {
+        check_sigmas(&args)?;
+        return super::render_rig::write_rig(super::render_rig::RigArgs {
+            out,
+            pair_frames: args.views,
+            side_frames: args.side_frames,
+            seed: args.seed,
+            render: render_options(&args),
+        });
     }
     let target = Target::parse_spec(args.target.as_deref().unwrap_or("chessboard:9x6:30mm"))?;
     if args.views == 0 || args.views > 1000 {
@@ -289,13 +317,13 @@ fn write_demo(out: &Path, seed: u64) -> Result<(), CliError> {
     Ok(())
 }
 
-fn write_png(path: &Path, image: &robocal::image::GrayImage) -> Result<(), CliError> {
+pub(super) fn write_png(path: &Path, image: &robocal::image::GrayImage) -> Result<(), CliError> {
     let png = robocal::image::encode_png(image)?;
     std::fs::write(path, png)
         .map_err(|e| CliError::Io(format!("cannot write '{}': {e}", path.display())))
 }
 
-fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), CliError> {
+pub(super) fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(value).map_err(|e| CliError::Io(e.to_string()))? + "\n";
     std::fs::write(path, text)
         .map_err(|e| CliError::Io(format!("cannot write '{}': {e}", path.display())))

@@ -10,7 +10,7 @@ use robocal::calib::{CalibrationOptions, View};
 use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
 use robocal::io::import_camera::import_camera;
-use robocal::io::pairing::{frame_keys, number_in_name, PairedBy};
+use robocal::io::pairing::{default_grouping, frame_keys, PairedBy};
 use robocal::target::Target;
 use serde::Deserialize;
 use std::path::Path;
@@ -318,16 +318,11 @@ fn grouping(rule: Option<&str>, cameras: &[CameraArg]) -> Result<PairedBy, CliEr
             "--group-by takes number or order, got '{other}'"
         ))),
         None => {
-            let any_number = cameras
-                .iter()
-                .flat_map(|c| &c.images)
-                .any(|f| number_in_name(f).is_some());
-            if any_number {
-                Ok(PairedBy::Number)
-            } else {
+            let by = default_grouping(cameras.iter().flat_map(|c| &c.images).map(String::as_str));
+            if by == PairedBy::Order {
                 eprintln!("robocal rig: no file name has a number: frames grouped by order");
-                Ok(PairedBy::Order)
             }
+            Ok(by)
         }
     }
 }

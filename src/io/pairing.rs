@@ -127,6 +127,17 @@ pub fn pair_by_number(left: &[&str], right: &[&str]) -> Result<Pairing> {
     })
 }
 
+/// The default grouping of a rig's images (`robocal rig` without
+/// `--group-by`, the web app's rig step): by number unless no file name has
+/// one.
+pub fn default_grouping<'a>(mut names: impl Iterator<Item = &'a str>) -> PairedBy {
+    if names.any(|n| number_in_name(n).is_some()) {
+        PairedBy::Number
+    } else {
+        PairedBy::Order
+    }
+}
+
 /// The frame key of every image of one camera of a rig (`robocal rig`):
 /// with [`PairedBy::Number`] the number in its name (every name must have
 /// one, unique within the camera; keys compare across cameras, so
@@ -251,6 +262,19 @@ mod tests {
             "images: frames are grouped by the last number in their file names, but number 1 is \
              in two camera top images: a1.png, a01.png"
         );
+    }
+
+    #[test]
+    fn rigs_group_by_number_unless_no_name_has_one() {
+        assert_eq!(
+            default_grouping(["a.png", "cam/b7.png"].into_iter()),
+            PairedBy::Number
+        );
+        assert_eq!(
+            default_grouping(["a.png", "cam7/b.png"].into_iter()),
+            PairedBy::Order
+        );
+        assert_eq!(default_grouping(std::iter::empty()), PairedBy::Order);
     }
 
     #[test]

@@ -269,6 +269,12 @@ const byNumber = output('pair_images', JSON.parse(robocal.pair_images(JSON.strin
 assert.deepEqual(byNumber, { paired_by: 'number', pairs: [[0, 1], [1, 0]] });
 const byOrder = output('pair_images', JSON.parse(robocal.pair_images('["left.png","l.png"]', '["right.png","r.png"]')), 'pair_images order');
 assert.deepEqual(byOrder, { paired_by: 'order', pairs: [[0, 0], [1, 1]] });
+// Rig frames: the number in the names across cameras, or by order when no name has one.
+const rigNames = input('rig_frame_keys', [{ name: 'front', images: ['front07.png', 'front2.png'] }, { name: 'side', images: ['side/2.jpg'] }]);
+const rigFrames = output('rig_frame_keys', JSON.parse(robocal.rig_frame_keys(JSON.stringify(rigNames), '')), 'rig_frame_keys number');
+assert.deepEqual(rigFrames, { grouped_by: 'number', keys: [['7', '2'], ['2']], frames: ['2', '7'] });
+assert.deepEqual(JSON.parse(robocal.rig_frame_keys('[{"name":"a","images":["x.png","y.png"]}]', '')), { grouped_by: 'order', keys: [['0', '1']], frames: ['0', '1'] });
+assert.throws(() => robocal.rig_frame_keys('[{"name":"a","images":["a1.png","x.png"]}]', ''), { message: 'images: frames are grouped by the last number in the file names, but camera a has names without one: x.png (number every file, or group by order)' });
 
 // The checker itself: it must reject what the declarations do not allow.
 const rejects = (what, value, type) => {

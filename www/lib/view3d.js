@@ -52,8 +52,14 @@ export class FrameView {
     this.draw();
   }
 
-  /** frames: [{name, matrix_row_major, size?}], links: [[nameA, nameB]] drawn as dashed lines. */
-  set(frames, links = []) {
+  /**
+   * frames: [{name, matrix_row_major, size?}] (an empty name: no label),
+   * links: [[nameA, nameB]] drawn as dashed lines, shapes: [{points:
+   * [[x, y, z], ...], closed?, color?}] drawn as thin polylines (a rig's
+   * camera frustums, board outlines).
+   */
+  set(frames, links = [], shapes = []) {
+    this.shapes = shapes;
     this.frames = frames.map((f) => ({ name: f.name, ...mat(f.matrix_row_major), size: f.size }));
     this.links = links;
     // Look at the middle of the frames' bounding box, scaled to its size,
@@ -89,6 +95,14 @@ export class FrameView {
       ctx.beginPath(); ctx.moveTo(x0, y0); ctx.lineTo(x1, y1); ctx.stroke();
     }
     ctx.setLineDash([]);
+    for (const s of this.shapes || []) {
+      const pts = s.points.map((p) => this.project(p));
+      ctx.strokeStyle = s.color || '#555'; ctx.lineWidth = 1;
+      ctx.beginPath();
+      pts.forEach(([x, y], i) => (i ? ctx.lineTo(x, y) : ctx.moveTo(x, y)));
+      if (s.closed) ctx.closePath();
+      ctx.stroke();
+    }
     const axisLen = this.scale * 0.18;
     const labels = [];
     for (const f of this.frames) {
@@ -99,7 +113,7 @@ export class FrameView {
         ctx.strokeStyle = c; ctx.lineWidth = 2.5;
         ctx.beginPath(); ctx.moveTo(o[0], o[1]); ctx.lineTo(tip[0], tip[1]); ctx.stroke();
       });
-      labels.push({ name: f.name, at: o });
+      if (f.name) labels.push({ name: f.name, at: o });
     }
     this.labels = placeLabels(ctx, labels, this.canvas.width, this.canvas.height - 20);
     for (const l of this.labels) {

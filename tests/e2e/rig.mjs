@@ -1,0 +1,181 @@
+// The rig step (step 7, below the stereo pair): a seeded four-camera rig
+// rendered by the release CLI (`robocal render --rig`: two pairs facing each
+// other, linked only by the side frames) through the page: cameras added,
+// frames grouped by the number in the file names, detection and the joint
+// solve in the worker. Every camera_from_rig is checked against the render's
+// truth within 3 of the standard deviations the page reports, and against
+// `robocal rig` on the same files (same core: equal to 1e-9). Without side
+// frames the page shows the core's error naming the two groups. OpenCV's
+// left/right set as a 2-camera rig gives the stereo result.
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { root } from './harness.mjs';
+import { datasetDir } from './datasets.mjs';
+
+const CLI = join(root, 'target/release/robocal');
+const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
+
+/** Renders a rig into a fresh folder; returns the folder, its truth and each camera's files. */
+function renderRig(sideFrames) {
+  const dir = mkdtempSync(join(tmpdir(), 'robocal-rig-e2e-'));
+  execFileSync(CLI, ['render', '--out', dir, '--rig', '--views', '6', '--side-frames', String(sideFrames), '--seed', '5'], { stdio: ['ignore', 'ignore', 'pipe'] });
+  const truth = JSON.parse(readFileSync(join(dir, 'truth.json'), 'utf8'));
+  const files = truth.cameras.map((c) => readdirSync(join(dir, c.name)).sort().map((f) => join(dir, c.name, f)));
+  return { dir, truth, files };
+}
+
+async function setTarget(page, cols, rows, squareMm) {
+  await page.click('a[data-step=target]');
+  await page.fill('#target-form input[name=cols]', String(cols));
+  await page.fill('#target-form input[name=rows]', String(rows));
+  await page.fill('#target-form input[name=square_mm]', String(squareMm));
+  const want = `Target spec: chessboard:${cols}x${rows}:${squareMm}mm `;
+  await page.waitForFunction((w) => document.getElementById('target-spec').textContent.startsWith(w), want, { timeout: 10000 });
+  await page.click('a[data-step=stereo]');
+}
+
+/** Cameras named as given, each with its files. */
+async function loadCameras(page, names, files) {
+  for (let k = 2; k < names.length; k++) await page.click('#rig-add');
+  for (let k = 0; k < names.length; k++) {
+    await page.fill(`#rig-name-${k}`, names[k]);
+    await page.dispatchEvent(`#rig-name-${k}`, 'change');
+    await page.setInputFiles(`#rig-input-${k}`, files[k]);
+    await page.waitForFunction(([k, n]) => document.getElementById(`rig-count-${k}`)?.textContent === `${n} images`, [k, files[k].length], { timeout: 20000 });
+  }
+}
+
+/** rig.json as the page's export button downloads it. */
+async function downloadedReport(page) {
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#rig-export-json')]);
+  assert.equal(download.suggestedFilename(), 'rig.json');
+  return JSON.parse(readFileSync(await download.path(), 'utf8'));
+}
+
+// Small rotation helpers on row-major 3x3 matrices.
+const R3 = (m) => [0, 1, 2].map((i) => m[i].slice(0, 3));
+const mulT = (a, b) => a.map((row) => [0, 1, 2].map((j) => row[0] * b[j][0] + row[1] * b[j][1] + row[2] * b[j][2])); // a b^T
+/** log of a rotation matrix near the identity, as a rotation vector. */
+function logSmall(r) {
+  const angle = Math.acos(Math.max(-1, Math.min(1, (r[0][0] + r[1][1] + r[2][2] - 1) / 2)));
+  const v = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]];
+  const s = angle < 1e-12 ? 0.5 : angle / (2 * Math.sin(angle));
+  return v.map((x) => x * s);
+}
+
+export const tests = [
+  ['four-camera rig: extrinsics within 3 reported std of the truth, page = robocal rig, co-observation, 3-D view, exports', async (page, { url, shot }) => {
+    const { dir, truth, files } = renderRig(3);
+    try {
+      const names = truth.cameras.map((c) => c.name);
+      await page.goto(`${url}#stereo`);
+      await ready(page);
+      await setTarget(page, 10, 7, 60);
+      await loadCameras(page, names, files);
+      const frames = new Set(truth.cameras.flatMap((c) => c.images.map((i) => i.frame))).size;
+      await page.waitForFunction((t) => (document.getElementById('rig-grouping')?.textContent || '') === t, `${frames} frames over 4 cameras, grouped by the number in the file names.`, { timeout: 20000 });
+      assert.equal(await page.isDisabled('#rig-solve'), false);
+      await shot('loaded');
+      await page.click('#rig-solve');
+      await page.locator('#rig-summary').waitFor({ timeout: 600000 });
+      await shot('solved');
+      const report = await downloadedReport(page);
+      const cli = JSON.parse(execFileSync(CLI, ['rig', ...files.flatMap((f, k) => ['--camera', names[k], ...f]), '--target', 'chessboard:10x7:60mm'], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+      assert.deepEqual(report.cameras.map((c) => c.name), names);
+      assert.deepEqual(report.co_observation.frames, cli.co_observation.frames);
+      // cam0 and cam1 never see a frame together with cam3 / cam2 across the pairs' backs.
+      assert.equal(report.co_observation.frames[0][2], 0);
+      assert.equal(report.co_observation.frames[1][3], 0);
+      assert.ok(report.co_observation.frames[1][2] > 0, 'the side frames link cam1 and cam2');
+      let worst = 0;
+      report.cameras.forEach((c, k) => {
+        const t = truth.cameras[k].camera_from_rig;
+        // Same core on the same detections: the page's numbers are the CLI's.
+        c.camera_from_rig.matrix_row_major.flat().forEach((x, i) => assert.ok(Math.abs(x - cli.cameras[k].camera_from_rig.matrix_row_major.flat()[i]) <= 1e-9, `${c.name} entry ${i}: page ${x}, CLI`));
+        if (k === 0) { assert.equal(c.camera_from_rig_std, null); return; }
+        const s = c.camera_from_rig_std;
+        const dt = c.camera_from_rig.translation_m.map((x, i) => x - t.translation_m[i]);
+        // std convention: R_true = exp(d) R_est.
+        const dr = logSmall(mulT(R3(t.matrix_row_major), R3(c.camera_from_rig.matrix_row_major)));
+        dt.forEach((e, i) => { worst = Math.max(worst, Math.abs(e) / s.translation_m[i]); assert.ok(Math.abs(e) <= 3 * s.translation_m[i], `${c.name} T[${i}] off by ${e} m, std ${s.translation_m[i]}`); });
+        dr.forEach((e, i) => { worst = Math.max(worst, Math.abs(e) / s.rotation_rad[i]); assert.ok(Math.abs(e) <= 3 * s.rotation_rad[i], `${c.name} rotation[${i}] off by ${e} rad, std ${s.rotation_rad[i]}`); });
+        // The table shows what the report holds (T in mm, 3 decimals).
+        assert.ok(s.translation_m.every((v) => v > 0 && v < 0.01), `${c.name} std ${s.translation_m}`);
+      });
+      const rows = await page.$$eval('#rig-extrinsics tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+      report.cameras.forEach((c, k) => {
+        assert.equal(rows[k][0], c.name);
+        c.camera_from_rig.translation_m.forEach((v, i) => assert.equal(rows[k][1 + i], (v * 1000).toFixed(3)));
+        if (k) c.camera_from_rig_std.translation_m.forEach((v, i) => assert.equal(rows[k][4 + i], (v * 1000).toFixed(3)));
+      });
+      const co = await page.$$eval('#rig-coobservation tbody tr', (trs) => trs.map((tr) => [...tr.cells].slice(1).map((c) => parseInt(c.textContent, 10))));
+      assert.deepEqual(co, report.co_observation.frames);
+      assert.equal(await page.locator('#rig-frame-residuals tbody tr').count(), report.frames.length);
+      // The 3-D view drew something on its canvas.
+      const inked = await page.$eval('#rig-3d', (c) => { const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; for (let i = 0; i < d.length; i += 4) if (d[i] < 200) n++; return n; });
+      assert.ok(inked > 2000, `3-D view: ${inked} dark pixels`);
+      await page.locator('#rig-3d').scrollIntoViewIfNeeded();
+      await shot('3d');
+      // OpenCV FileStorage from the page equals `robocal export rig.json --format opencv-yaml`.
+      const [yaml] = await Promise.all([page.waitForEvent('download'), page.click('#rig-export-opencv-yaml')]);
+      const pageYaml = readFileSync(await yaml.path(), 'utf8');
+      writeFileSync(join(dir, 'rig.json'), JSON.stringify(report));
+      const cliYaml = execFileSync(CLI, ['export', join(dir, 'rig.json'), '--format', 'opencv-yaml']).toString();
+      assert.equal(pageYaml, cliYaml);
+      assert.match(pageYaml, /^%YAML:1\.0/);
+      // Kalibr's radtan has no k3: the page shows the core's refusal, as the CLI gives it.
+      await page.click('#rig-export-kalibr');
+      await page.waitForFunction(() => /^kalibr: /.test(document.getElementById('rig-export-status')?.textContent || ''), null, { timeout: 10000 });
+      assert.equal(await page.textContent('#rig-export-status'), "kalibr: format: camera 'cam0': Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr");
+      await shot('exports');
+      console.log(`     rig: ${report.frames.length} frames, rms ${report.rms_px.toFixed(4)} px, worst extrinsic error ${worst.toFixed(2)} std`);
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+  ['four-camera rig without linking frames: the error names the two groups; a file without a number is named', async (page, { url, shot }) => {
+    const { dir, truth, files } = renderRig(0);
+    try {
+      await page.goto(`${url}#stereo`);
+      await ready(page);
+      await setTarget(page, 10, 7, 60);
+      await loadCameras(page, truth.cameras.map((c) => c.name), files);
+      await page.click('#rig-solve');
+      await page.locator('#rig-error').waitFor({ timeout: 600000 });
+      await shot('disconnected');
+      const error = await page.textContent('#rig-error');
+      assert.match(error, /cameras are not connected by shared board views: \{cam0, cam1\} and \{cam2, cam3\}; add frames where a camera of each group sees the board/);
+      // A file without a number cannot be put in a frame: the page names it.
+      await page.setInputFiles('#rig-input-3', [{ name: 'extra.png', mimeType: 'image/png', buffer: readFileSync(files[3][0]) }]);
+      await page.waitForFunction(() => /extra\.png/.test(document.querySelector('#rig-grouping.msg-error')?.textContent || ''), null, { timeout: 10000 });
+      assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam3 has names without one: extra.png (number every file, or group by order)');
+      assert.equal(await page.isDisabled('#rig-solve'), true);
+      await page.click('#rig-remove-3');
+      await page.waitForFunction(() => /over 3 cameras/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+      await shot('removed');
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+  ['OpenCV left/right as a 2-camera rig: the stereo right_from_left', async (page, { url, shot }) => {
+    const dir = datasetDir('opencv-left-right-9x6');
+    if (!dir) { console.log('     skipped: opencv-left-right-9x6 not found in ../shared/datasets or /work/shared/datasets'); return; }
+    const side = (s) => readdirSync(dir).filter((f) => new RegExp(`^${s}\\d+\\.jpg$`).test(f)).sort().map((f) => join(dir, f));
+    const [left, right] = [side('left'), side('right')];
+    const stereo = JSON.parse(execFileSync(CLI, ['stereo', '--target', 'chessboard:9x6:30mm', '--left', ...left, '--right', ...right], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+    await page.goto(`${url}#stereo`);
+    await ready(page);
+    await loadCameras(page, ['left', 'right'], [left, right]);
+    await page.click('#rig-solve');
+    await page.locator('#rig-summary').waitFor({ timeout: 600000 });
+    await shot('stereo-as-rig');
+    const report = await downloadedReport(page);
+    const got = report.cameras[1].camera_from_rig;
+    // docs/rig.md: the 2-camera rig equals calibrate_stereo to 3e-16; 1e-9 covers wasm vs native libm.
+    got.matrix_row_major.flat().forEach((x, i) => assert.ok(Math.abs(x - stereo.right_from_left.matrix_row_major.flat()[i]) <= 1e-9, `entry ${i}: rig ${x}, stereo`));
+    assert.ok(Math.abs(report.rms_px - stereo.rms_px) <= 1e-9, `rms ${report.rms_px} vs ${stereo.rms_px}`);
+  }],
+];

@@ -1,0 +1,284 @@
+// Camera rigs: 2 to N cameras that saw the target of step 1 in synchronised
+// frames, any camera missing the board in any frame. Frames are grouped by
+// the rule of `robocal rig` (the last number in each file name, or by order
+// when no name has one); detection per camera in the worker, then one joint
+// calibration (`calibrate_rig`, the core of `robocal rig`). Shows every
+// camera_from_rig with its standard deviation, per-camera and per-frame
+// residuals, the co-observation graph, a 3-D view of the rig and the rig
+// exports. Images, detections and the result are kept in the session.
+import { $, h, fill, table, num, message, download } from '../lib/dom.js';
+import { FrameView } from '../lib/view3d.js';
+import { targetSpec } from './target.js';
+import { MODELS } from './camera.js';
+import { frustum, invert, rotvecDeg, boardOutline, apply, flat } from '../lib/rig3d.js';
+
+const byName = (a, b) => a.name.localeCompare(b.name, undefined, { numeric: true });
+const freeName = (cams) => { let k = 0; while (cams.some((c) => c.name === `cam${k}`)) k++; return `cam${k}`; };
+
+export class RigView {
+  constructor(store, engine, panel) {
+    this.store = store;
+    this.engine = engine;
+    this.panel = panel;
+    this.grouping = { error: null, frames: [], keys: [] };
+    this.render();
+  }
+
+  get state() {
+    const st = this.store.session.rig || (this.store.session.rig = { model: 'brown', result: null, cameras: [] });
+    while (st.cameras.length < 2) st.cameras.push({ name: freeName(st.cameras), files: [] });
+    return st;
+  }
+
+  render() {
+    const model = h('select', { id: 'rig-model' }, MODELS.map(([v, t]) => h('option', { value: v, selected: v === this.state.model }, t)));
+    model.addEventListener('change', () => { this.state.model = model.value; this.store.changed('rig'); });
+    this.camerasOut = h('div', { id: 'rig-cameras', class: 'form' });
+    this.solveButton = h('button', { type: 'button', class: 'primary', id: 'rig-solve', disabled: true }, 'Detect and solve the rig');
+    this.solveButton.addEventListener('click', () => this.solve());
+    this.framesOut = h('div', { id: 'rig-frames' });
+    this.progress = h('p', { id: 'rig-progress', class: 'hint', 'aria-live': 'polite' });
+    this.out = h('div', { id: 'rig-results', 'aria-live': 'polite' });
+    fill(this.panel,
+      h('h3', {}, 'Camera rig: 2 to N cameras'),
+      h('p', { class: 'hint' }, 'Cameras that saw the target of step 1 at the same moments; any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (front07.png with side7.jpg), or by order (sorted names) when no name has a number. The rig frame is the first camera\'s.'),
+      this.camerasOut,
+      h('div', { class: 'row' }, h('button', { type: 'button', id: 'rig-add', onclick: () => this.addCamera() }, 'Add a camera'), h('label', {}, 'Lens model (every camera) ', model)),
+      h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'rig-clear', onclick: () => this.clear() }, 'Remove the rig images')),
+      this.progress, this.framesOut, this.out);
+    this.showCameras();
+    this.showFrames();
+    if (this.state.result) this.show(this.state.result);
+  }
+
+  showCameras() {
+    const cams = this.state.cameras;
+    fill(this.camerasOut, cams.map((c, k) => {
+      const name = h('input', { type: 'text', id: `rig-name-${k}`, value: c.name, size: 10, 'aria-label': `camera ${k + 1} name` });
+      name.addEventListener('change', () => { c.name = name.value.trim(); this.store.changed('rig'); this.showFrames(); });
+      const files = h('input', { type: 'file', id: `rig-input-${k}`, multiple: true, accept: 'image/*,.pgm,.ppm,.pnm,.tif,.tiff,.bmp' });
+      files.addEventListener('change', () => { this.addFiles(c, [...files.files]); files.value = ''; });
+      const remove = cams.length > 2 ? h('button', { type: 'button', id: `rig-remove-${k}`, onclick: () => this.removeCamera(k) }, 'Remove this camera') : null;
+      return h('div', { class: 'row rig-camera' }, h('label', {}, `Camera ${k + 1} `, name), h('label', {}, 'images ', files), h('span', { class: 'hint', id: `rig-count-${k}` }, `${c.files.length} image${c.files.length === 1 ? '' : 's'}`), remove);
+    }));
+  }
+
+  addCamera() {
+    this.state.cameras.push({ name: freeName(this.state.cameras), files: [] });
+    this.store.changed('rig');
+    this.showCameras();
+    this.showFrames();
+  }
+
+  async removeCamera(k) {
+    const [gone] = this.state.cameras.splice(k, 1);
+    await this.store.deleteBytes(gone.files.map((f) => f.id));
+    this.store.changed('rig');
+    this.showCameras();
+    this.showFrames();
+  }
+
+  async addFiles(camera, files) {
+    for (const f of files) {
+      const id = `rig-${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`;
+      await this.store.putBytes(id, await f.arrayBuffer());
+      camera.files.push({ id, name: f.name, detection: null, error: null, spec: null });
+    }
+    camera.files.sort(byName);
+    this.store.changed('rig');
+    this.showCameras();
+    this.showFrames();
+  }
+
+  async clear() {
+    await this.store.deleteBytes(this.state.cameras.flatMap((c) => c.files.map((f) => f.id)));
+    for (const c of this.state.cameras) c.files = [];
+    this.state.result = null;
+    this.store.changed('rig');
+    fill(this.out);
+    this.showCameras();
+    this.showFrames();
+  }
+
+  /** The cameras' names, or an error naming what to fix. */
+  namesError() {
+    const names = this.state.cameras.map((c) => c.name);
+    if (names.some((n) => !n)) return 'every camera needs a name';
+    const twice = names.find((n, i) => names.indexOf(n) !== i);
+    return twice ? `two cameras are named '${twice}': give each camera its own name` : null;
+  }
+
+  async showFrames() {
+    const asked = (this.asked = (this.asked || 0) + 1);
+    this.solveButton.disabled = true;
+    const cams = this.state.cameras;
+    if (!cams.some((c) => c.files.length)) {
+      this.grouping = { error: null, frames: [], keys: [] };
+      fill(this.framesOut, message('info', 'Load each camera\'s images (add cameras for a rig of more than two).'));
+      return;
+    }
+    let grouping;
+    const named = this.namesError();
+    try {
+      if (named) throw new Error(named);
+      const g = await this.engine.call('rigFrames', { cameras: JSON.stringify(cams.map((c) => ({ name: c.name, images: c.files.map((f) => f.name) }))) });
+      grouping = { ...g, error: null };
+    } catch (err) {
+      grouping = { error: err.message, frames: [], keys: [] };
+    }
+    if (asked !== this.asked) return;
+    this.grouping = grouping;
+    if (grouping.error) {
+      fill(this.framesOut, h('p', { id: 'rig-grouping', class: 'msg msg-error', role: 'alert' }, `The images cannot be grouped into frames: ${grouping.error}`));
+      return;
+    }
+    const { frames, keys } = grouping;
+    const empty = cams.filter((c) => !c.files.length).map((c) => c.name);
+    this.solveButton.disabled = empty.length > 0 || frames.length < 3;
+    const status = (f) => (f.error ? `not found: ${f.error}` : f.detection ? `${f.detection.points.length} points` : 'not detected yet');
+    const rows = frames.map((key) => [key, ...cams.map((c, k) => {
+      const i = keys[k].indexOf(key);
+      return i < 0 ? '—' : `${c.files[i].name}: ${status(c.files[i])}`;
+    })]);
+    fill(this.framesOut,
+      h('p', { id: 'rig-grouping' }, `${frames.length} frame${frames.length === 1 ? '' : 's'} over ${cams.length} cameras, grouped ${grouping.grouped_by === 'number' ? 'by the number in the file names' : 'by order (sorted names)'}.`),
+      empty.length ? h('p', { id: 'rig-missing', class: 'msg msg-info', role: 'status' }, `Add images for camera ${empty.join(', ')} to solve.`) : null,
+      table(['frame', ...cams.map((c) => c.name)], rows, { id: 'rig-frame-table', class: 'scroll' }));
+  }
+
+  async detect(file, spec) {
+    if (file.spec === spec && (file.detection || file.error)) return;
+    file.spec = spec;
+    try {
+      const bytes = this.store.bytes.get(file.id);
+      if (!bytes) throw new Error('the image bytes were not found in this browser\'s storage; add the file again');
+      const copy = bytes.slice(0);
+      file.detection = await this.engine.call('detect', { bytes: copy, spec }, [copy]);
+      file.error = null;
+    } catch (err) {
+      file.detection = null;
+      file.error = err.message;
+    }
+  }
+
+  async solve() {
+    let spec;
+    try { spec = targetSpec(this.store.session.target); } catch (err) { fill(this.out, message('error', err.message)); return; }
+    const cams = this.state.cameras;
+    const { keys, grouped_by: groupedBy } = this.grouping;
+    this.solveButton.disabled = true;
+    try {
+      const total = cams.reduce((s, c) => s + c.files.length, 0);
+      let done = 0;
+      for (const c of cams) {
+        for (const f of c.files) {
+          this.progress.textContent = `detecting ${++done} of ${total}: ${c.name} ${f.name}`;
+          await this.detect(f, spec);
+        }
+      }
+      this.store.changed('rig');
+      await this.showFrames();
+      const input = {
+        model: this.state.model,
+        target: spec,
+        grouping: groupedBy,
+        cameras: cams.map((c, k) => ({
+          name: c.name,
+          views: c.files.map((f, i) => ({ f, key: keys[k][i] })).filter(({ f }) => f.detection).map(({ f, key }) => ({ key, name: f.name, detection: f.detection })),
+        })),
+      };
+      const used = input.cameras.reduce((s, c) => s + c.views.length, 0);
+      this.progress.textContent = `detected ${total} images: the target in ${used}; solving…`;
+      const result = await this.engine.call('rig', { input: JSON.stringify(input) });
+      this.state.result = result;
+      this.store.changed('rig-result');
+      this.progress.textContent = `solved with ${used} views in ${result.frames.length} frames.`;
+      await this.show(result);
+    } catch (err) {
+      this.progress.textContent = '';
+      this.state.result = null; // the error replaces an earlier result, in the session too
+      this.store.changed('rig-result');
+      fill(this.out, h('p', { id: 'rig-error', class: 'msg msg-error', role: 'alert' }, err.message));
+    } finally {
+      this.solveButton.disabled = false;
+    }
+  }
+
+  async show(r) {
+    const mm = (v) => num(v * 1000, 3);
+    const deg = (v) => num((v * 180) / Math.PI, 4);
+    const extrinsics = r.cameras.map((c) => {
+      const s = c.camera_from_rig_std;
+      const rv = rotvecDeg(c.camera_from_rig.quaternion_xyzw);
+      return [c.name, ...c.camera_from_rig.translation_m.map(mm), ...(s ? s.translation_m.map(mm) : ['—', '—', '—']),
+        ...rv.map((v) => num(v, 4)), ...(s ? s.rotation_rad.map(deg) : ['—', '—', '—'])];
+    });
+    const cam = (c) => { const k = c.calibration.camera_matrix; return [c.name, num(k[0][0], 3), num(k[1][1], 3), num(k[0][2], 3), num(k[1][2], 3), c.intrinsics_held ? 'given' : 'solved', String(c.frames_seen.length), num(c.rms_px, 4)]; };
+    const co = r.co_observation;
+    const tree = new Set(co.spanning_tree.map(([a, b]) => `${Math.min(a, b)}-${Math.max(a, b)}`));
+    const coRows = co.frames.map((row, i) => [co.cameras[i], ...row.map((n, j) => (i !== j && tree.has(`${Math.min(i, j)}-${Math.max(i, j)}`) ? `${n} (tree)` : String(n)))]);
+    this.canvas = h('canvas', { id: 'rig-3d', width: 900, height: 560, role: 'img', 'aria-label': 'The rig in 3-D: each camera as a frustum, each frame\'s board as an outline' });
+    this.exportsOut = h('div', { id: 'rig-exports' });
+    fill(this.out,
+      h('h3', { id: 'rig-summary' }, `${r.cameras.length} cameras, rig frame ${r.rig_frame}: RMS ${num(r.rms_px, 4)} px over ${r.frames.length} frames`),
+      h('p', { class: 'hint' }, 'camera_from_rig: p_camera = R p_rig + T; the rotation as a rotation vector (axis times angle). Standard deviations from the joint covariance; the rotation\'s as a small-angle vector.'),
+      table(['camera', 'T x (mm)', 'T y (mm)', 'T z (mm)', 'std x (mm)', 'std y (mm)', 'std z (mm)', 'rot x (deg)', 'rot y (deg)', 'rot z (deg)', 'std rx (deg)', 'std ry (deg)', 'std rz (deg)'], extrinsics, { id: 'rig-extrinsics', class: 'scroll' }),
+      table(['camera', 'fx', 'fy', 'cx', 'cy', 'intrinsics', 'frames seen', 'RMS (px)'], r.cameras.map(cam), { id: 'rig-camera-table' }),
+      h('h3', {}, 'Co-observation graph'),
+      h('p', { class: 'hint' }, 'Frames in which both cameras saw the board (the diagonal: frames each camera saw); (tree): the pairs that chained the initial poses.'),
+      table(['', ...co.cameras], coRows, { id: 'rig-coobservation' }),
+      h('h3', {}, 'Frames'),
+      table(['frame', 'cameras', 'RMS (px)'], r.frames.map((f) => [f.key, f.cameras.join(', '), num(f.rms_px, 4)]), { id: 'rig-frame-residuals', class: 'scroll' }),
+      (r.warnings || []).map((w) => message('warning', w)),
+      h('h3', {}, 'The rig in 3-D'),
+      this.canvas,
+      h('h3', {}, 'Export'),
+      this.exportsOut);
+    await this.draw3d(r);
+    await this.showExports(r);
+  }
+
+  async draw3d(r) {
+    const view = new FrameView(this.canvas);
+    let outline = null;
+    try { outline = boardOutline((await this.engine.call('target', { spec: r.target })).points); } catch (e) { outline = null; }
+    const frames = [];
+    const shapes = [];
+    for (const c of r.cameras) {
+      const rigFromCamera = invert(c.camera_from_rig.matrix_row_major);
+      frames.push({ name: c.name, matrix_row_major: rigFromCamera });
+      shapes.push(...frustum(rigFromCamera, c.calibration.camera, 0.3));
+    }
+    for (const f of r.frames) {
+      if (!f.rig_from_target) continue;
+      frames.push({ name: '', matrix_row_major: flat(f.rig_from_target.matrix_row_major), size: 0.03 });
+      if (outline) shapes.push({ color: '#8c564b', points: outline.map((p) => apply(f.rig_from_target.matrix_row_major, p)), closed: true });
+    }
+    view.set(frames, [], shapes);
+    this.view3d = view;
+  }
+
+  async showExports(r) {
+    const formats = await this.engine.call('rigFormats', {});
+    const report = JSON.stringify(r);
+    this.exportStatus = h('div', { id: 'rig-export-status', 'aria-live': 'polite' });
+    fill(this.exportsOut,
+      h('p', { class: 'hint' }, 'The rig report (the file robocal rig -o rig.json writes), and every rig export of robocal export rig.json --format NAME.'),
+      h('div', { class: 'row' },
+        h('button', { type: 'button', id: 'rig-export-json', onclick: () => download('rig.json', `${JSON.stringify(r, null, 2)}\n`, 'application/json') }, 'rig.json'),
+        formats.map((format) => {
+          const b = h('button', { type: 'button', id: `rig-export-${format}` }, format);
+          b.addEventListener('click', async () => {
+            try {
+              const files = await this.engine.call('exportFiles', { report, format });
+              for (const f of files) download(f.name, f.text);
+              fill(this.exportStatus, `${format}: ${files.map((f) => f.name).join(', ')}`);
+            } catch (err) {
+              fill(this.exportStatus, message('error', `${format}: ${err.message}`));
+            }
+          });
+          return b;
+        })),
+      this.exportStatus);
+  }
+}
