@@ -9,11 +9,12 @@ at about 0.45 m, 1280x960, every fourth view partial, robot pose noise
 
 - robocal: `robocal detect --target SPEC view_*.png -o detections.json`, then
   `robocal handeye --setup S --poses poses.txt --pose-format matrix --camera
-  camera.json --detections detections.json --refine MODE` (the same path as
-  images on the command line: PnP per view, every closed form, then the
-  refinement) for MODE trusted (the default with images: "robocal"),
-  stochastic and none (the maximum likelihood over the poses); the closed
-  forms of the default run as "robocal <method>";
+  camera.json --detections detections.json [--refine MODE]` (the same path
+  as images on the command line: PnP per view, every closed form, then the
+  refinement) without --refine (the default, `none`: the maximum likelihood
+  over the poses with each view's PnP covariance: "robocal") and with MODE
+  trusted and stochastic (over the pixels); the closed forms of the default
+  run as "robocal <method>";
 - OpenCV: `cv2.aruco.CharucoDetector.detectBoard` per image, `cv2.solvePnP`
   (SOLVEPNP_ITERATIVE, the true camera, no distortion) on the board's own
   corner positions, then `cv2.calibrateHandEye` (5 methods; eye-to-hand gets
@@ -50,10 +51,10 @@ ROOT = os.path.dirname(HERE)
 OUT = os.path.join(HERE, "out", "handeye_charuco")
 ROBOCAL = os.path.join(ROOT, "target", "release", "robocal")
 SPEC = "charuco:12x9:20mm:15mm:DICT_5X5_100"
-# trusted: the default with images (refined over pixels, robot poses exact);
-# stochastic: robot pose noise estimated too; none: the ML over the poses
-# with each view's PnP covariance (robot noise estimated).
-REFINE_MODES = ["trusted", "stochastic", "none"]
+# None: the default with images (`none`, the ML over the poses with each
+# view's PnP covariance, robot noise estimated); trusted: refined over the
+# pixels, robot poses exact; stochastic: robot pose noise estimated too.
+REFINE_MODES = [None, "trusted", "stochastic"]
 
 
 def arg(name, default):
@@ -93,26 +94,26 @@ def opencv_trial(setup, images, robot, camera_json):
 
 def robocal_trial(setup, trial_dir, images):
     """robocal on one trial: the images detected once (`robocal detect`),
-    then `robocal handeye --detections` with each --refine mode (the default
-    with images is `trusted`). The closed forms come from the default run."""
+    then `robocal handeye --detections` without --refine (the default) and
+    with each other --refine mode. The closed forms come from the default run."""
     detections = os.path.join(trial_dir, "detections.json")
     subprocess.run([ROBOCAL, "detect", "--target", SPEC, "-o", detections, *images],
                    check=True, stderr=subprocess.DEVNULL)
     key = "gripper_from_camera" if setup == "eye-in-hand" else "base_from_camera"
     ours, used = {}, 0
     for mode in REFINE_MODES:
-        out = os.path.join(trial_dir, f"robocal_{mode}.json")
+        out = os.path.join(trial_dir, f"robocal_{mode or 'default'}.json")
         subprocess.run([ROBOCAL, "handeye", "--setup", setup, "--poses",
                         os.path.join(trial_dir, "poses.txt"), "--pose-format", "matrix",
                         "--camera", os.path.join(trial_dir, "camera.json"),
-                        "--detections", detections, "--refine", mode,
+                        "--detections", detections, *(["--refine", mode] if mode else []),
                         "--bootstrap", "0", "--lenient", "-o", out],
                        check=True, stderr=subprocess.DEVNULL)
         with open(out) as f:
             report = json.load(f)
-        label = "robocal" if mode == "trusted" else f"robocal --refine {mode}"
+        label = "robocal" if mode is None else f"robocal --refine {mode}"
         ours[label] = np.array(report[key]["matrix_row_major"])
-        if mode == "trusted":
+        if mode is None:
             ours.update({"robocal " + m["method"]: np.array(m[key]["matrix_row_major"])
                          for m in report["methods"] if key in m})
             used = sum(1 for p in report.get("pairs", []) if p["used"])

@@ -654,7 +654,7 @@ export interface HandEyeInputBase {
   camera_from_target?: PoseInput[];
   /** The camera of the image points (required with `views` or `detections`). */
   camera?: HandEyeCamera;
-  /** Default `trusted` with image points, else `none`. */
+  /** Default `none`: with image points the maximum likelihood over the poses (each view's PnP covariance, robot noise estimated). */
   refine?: RefineMode;
   /** Expected pixel noise of the refinement, px (default 0.5). */
   pixel_sigma_px?: number;

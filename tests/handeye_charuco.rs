@@ -1,10 +1,10 @@
 //! ChArUco hand-eye from rendered images through `robocal handeye --camera
-//! --target charuco:... --refine none IMAGES` (detection, PnP per view,
-//! closed forms, then the maximum likelihood over the poses with each
-//! view's PnP covariance and the robot noise estimated: the mode that beats
-//! OpenCV's best method in BENCHMARKS.md; the default image refinement,
-//! `trusted`, takes the robot poses as exact and is several times worse
-//! at this robot noise), eye-in-hand and eye-to-hand, one view partial
+//! --target charuco:... IMAGES` with no `--refine` (the default, `none`:
+//! detection, PnP per view, closed forms, then the maximum likelihood over
+//! the poses with each view's PnP covariance and the robot noise estimated:
+//! the mode that beats OpenCV's best method in BENCHMARKS.md; `--refine
+//! trusted`, the default before, takes the robot poses as exact and is
+//! several times worse at this robot noise), eye-in-hand and eye-to-hand, one view partial
 //! (the board pushed towards an image edge so that part of it is cut off).
 //! Seeded scenes from `synth::handeye_looking`, rendered at 640x480 with
 //! grey-level noise 2 and blur 0.7 px; robot poses with Gaussian noise of
@@ -22,7 +22,7 @@
 //! the rotation error, from 0.02 deg per axis (0.035 deg in norm) per view,
 //! is expected around 0.02-0.03 deg, bounded at 0.06 deg. Measured
 //! 0.010 deg / 0.25 mm (eye-in-hand) and 0.025 deg / 0.17 mm (eye-to-hand);
-//! the default `trusted` refinement gives 0.13 deg / 0.95 mm on the same
+//! the `trusted` refinement gives 0.13 deg / 0.95 mm on the same
 //! eye-in-hand images, outside both bounds. BENCHMARKS.md ("ChArUco
 //! hand-eye from rendered images") has 20-trial statistics at 1280x960.
 
@@ -153,8 +153,6 @@ fn charuco_handeye_from_images_within_the_robot_noise_in_both_setups() {
             arg(&dir.join("camera.json")),
             "--target".into(),
             SPEC.into(),
-            "--refine".into(),
-            "none".into(),
             "--bootstrap".into(),
             "0".into(),
             "--threads".into(),
@@ -173,10 +171,15 @@ fn charuco_handeye_from_images_within_the_robot_noise_in_both_setups() {
             pairs.iter().all(|p| p["used"] == Value::Bool(true)),
             "{name}: every view used, the partial one included: {pairs:?}"
         );
-        assert!(
-            report["pose_refinement"].is_object(),
-            "{name}: no pose refinement in the report (method {})",
+        assert_eq!(
+            report["pose_refinement"]["camera_noise_model"], "per_view",
+            "{name}: the default with images is the pose refinement with each view's PnP covariance (method {})",
             report["method"]
+        );
+        assert!(
+            report.get("refinement").is_none_or(Value::is_null),
+            "{name}: no refinement over pixels by default: {}",
+            report["refinement"]
         );
         let est = matrix(&report[key]);
         let truth = x_true.to_homogeneous();

@@ -33,8 +33,9 @@ With --camera-poses the closed forms are refined by maximum likelihood over
 the poses (robot and camera pose noise estimated from the data; --no-refine
 keeps the closed form): pose_refinement {started_from, cost, noise,
 camera_transform_std, target_transform_std, covariance, outlier_views} and a
-pose_cost per method. With images and --refine none the same refinement runs
-on the PnP poses with each view's PnP covariance (camera_noise_model per_view).
+pose_cost per method. With images (default --refine none) the same refinement
+runs on the PnP poses with each view's PnP covariance (camera_noise_model
+per_view); --refine trusted|stochastic|joint_intrinsics refines over the pixels.
 A detection may hold any subset of the board's points (a marker board partly out
 of view): each view's pose is fitted to its own points, and a view whose points
 cannot fix a pose (fewer than 4, or all but one on a line) is dropped with its
@@ -76,8 +77,10 @@ pub struct HandeyeArgs {
     /// subset of the board's points)
     #[arg(long, value_name = "FILE")]
     detections: Option<String>,
-    /// trusted (default with images), stochastic (robot pose noise
-    /// estimated), joint_intrinsics (camera refined too) or none
+    /// none (default: with images the maximum-likelihood pose refinement,
+    /// each view's PnP covariance, robot noise estimated), trusted
+    /// (reprojection error, robot poses exact), stochastic (robot pose noise
+    /// estimated) or joint_intrinsics (camera refined too)
     #[arg(long, value_name = "MODE")]
     refine: Option<String>,
     /// Images detected in parallel (default: all cores)
@@ -103,9 +106,9 @@ pub struct HandeyeArgs {
     /// Seed of the bootstrap resampling
     #[arg(long, value_name = "N", default_value_t = 1)]
     seed: u64,
-    /// Pose input: report the closed form chosen by the fixed rule instead
-    /// of the maximum-likelihood pose refinement (on by default; with images
-    /// use --refine none)
+    /// Report the closed form chosen by the fixed rule instead of the
+    /// maximum-likelihood pose refinement (on by default with pose input and
+    /// with images under --refine none, the default)
     #[arg(long)]
     no_refine: bool,
     /// Report suspected input mistakes (units, inverted or shifted poses) as
@@ -253,10 +256,12 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
             ))
         }
     };
-    let mode = match (args.refine.as_deref(), &images) {
-        (Some(name), _) => name.parse::<RefineMode>()?,
-        (None, Some(_)) => RefineMode::Trusted,
-        (None, None) => RefineMode::None,
+    // Default: no refinement over pixels; with images the pose refinement
+    // below (each view's PnP covariance, robot noise estimated) is the
+    // estimate that measured best (BENCHMARKS.md, ChArUco hand-eye).
+    let mode = match args.refine.as_deref() {
+        Some(name) => name.parse::<RefineMode>()?,
+        None => RefineMode::None,
     };
     let mut result = calibrate(&input, &options).map_err(|e| with_dropped(e, &pairs))?;
     match &images {

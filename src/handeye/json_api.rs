@@ -17,7 +17,8 @@
 //! [`crate::io::import_camera::import_camera`] reads), `"views": [{"object_m":
 //! [[x, y, z]...], "image_px": [[u, v]...]}]` (one per pose, same order),
 //! `"refine": "none" | "trusted" | "stochastic" | "joint_intrinsics"`
-//! (default `trusted` when views are given, see [`RefineMode`]) and
+//! (default `none`: with views the maximum likelihood over the poses, each
+//! view's PnP covariance from its points, see [`RefineMode`]) and
 //! `"pixel_sigma_px"` (default 0.5), and `"camera_std"` (optional, `{"fx": std, ...}` in
 //! pixels; read from `camera` when that is a calibration report): with it, a
 //! joint refinement that moves an intrinsic by many standard deviations is
@@ -322,10 +323,11 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         None => (None, Vec::new()),
     };
     let camera = input.camera.as_ref().map(camera_from_json).transpose()?;
-    let mode = match (&input.refine, &views) {
-        (Some(name), _) => name.parse::<RefineMode>()?,
-        (None, Some(_)) => RefineMode::Trusted,
-        (None, None) => RefineMode::None,
+    // Default `none`: with image points the pose refinement with each
+    // view's PnP covariance runs (below), the best estimate measured.
+    let mode = match &input.refine {
+        Some(name) => name.parse::<RefineMode>()?,
+        None => RefineMode::None,
     };
     let needs_images = mode != RefineMode::None || input.camera_from_target.is_none();
     let images = match (views, camera) {

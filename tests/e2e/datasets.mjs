@@ -285,7 +285,7 @@ export const tests = [
     // with --camera-poses): the page equals the CLI on the same camera poses.
     assertX(await solveShown('none'), cli.gripper_from_camera, 'pose refinement');
     assert.equal((/^Result \((.*)\)$/.exec(await page.textContent('#handeye-results h3')) || [])[1], cli.method);
-    // Refined over the image points (the page's default).
+    // Refined over the image points, robot poses exact.
     const mRefined = await solveShown('trusted');
     await shot('handeye');
     assertX(mRefined, cliRefined.gripper_from_camera, 'refined');

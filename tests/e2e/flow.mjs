@@ -47,8 +47,10 @@ export const tests = [
     assert.ok(m, text.slice(0, 300));
     const t = m.slice(1, 4).map(Number);
     [30, -20, 100].forEach((want, i) => assert.ok(Math.abs(t[i] - want) < 2, `gripper_from_camera ${t} mm`));
-    // The default refines over the image points (robot poses trusted).
-    assert.match(await page.textContent('#handeye-refinement'), /^Refined \(over the image points, robot poses exact\) from \S+: reprojection RMS /);
+    // The default: maximum likelihood over the poses, each camera pose
+    // weighted by its PnP covariance from the detected points.
+    assert.match(await page.textContent('#handeye-pose-refinement'), /^Refined over the poses from \S+ \(maximum likelihood; estimated robot noise /);
+    assert.match(await page.textContent('#handeye-measure'), /^This result: Minimises the residuals of A X = Z B per pose, each camera pose weighted by its uncertainty from its detected points/);
     console.log(`     demo hand-eye (refined): gripper_from_camera ${t.join(', ')} mm (truth 30, -20, 100)`);
     // Every export format comes back from the core without an error.
     await page.click('a[data-step=export]');

@@ -252,7 +252,8 @@ export const tests = [
     const help = async (mode) => { await page.selectOption('#handeye-refine', mode); return page.textContent('#handeye-refine-help'); };
     assert.match(await help('stochastic'), /^Minimises the reprojection error \(px\) plus a small correction per robot pose/);
     assert.match(await help('none'), /^Minimises the residuals of A X = Z B per pose/);
-    assert.match(await help('trusted'), /^Minimises the reprojection error of every detected target point \(px\).*it is the default\.$/);
+    assert.match(await help('ml'), /^Minimises the residuals of A X = Z B per pose, each camera pose weighted by its uncertainty from its detected points.*it is the default\.$/);
+    assert.match(await help('trusted'), /^Minimises the reprojection error of every detected target point \(px\).*robot noise goes straight into the result\.$/);
     assert.equal(await solveHandeye(page), null);
     assert.match(await page.textContent('#handeye-measure'), /^This result: Minimises the reprojection error of every detected target point \(px\)/);
     assert.match(await page.textContent('#handeye-refinement'), /^Refined \(over the image points, robot poses exact\) from /);

@@ -177,7 +177,8 @@ assert.ok(ambiguous.parsed === null && ambiguous.candidates.length > 1, 'a bare 
 const base_from_gripper = poses.parsed.poses.map((p) => p.base_from_gripper);
 const eyeInHand = call('solve_handeye', { setup: 'eye-in-hand', base_from_gripper, detections, camera: all, bootstrap_samples: 5 }, 'solve_handeye detections');
 assert.equal(eyeInHand.setup, 'eye-in-hand');
-assert.ok(eyeInHand.refinement && eyeInHand.repeatability, 'refined, with repeatability');
+// The default with image points: the pose refinement with each view's PnP covariance.
+assert.ok(eyeInHand.pose_refinement?.camera_noise_model === 'per_view' && !eyeInHand.refinement && eyeInHand.repeatability, 'refined over the poses, with repeatability');
 const camera_from_target = report.views.map((v) => v.camera_from_target);
 const viewsIn = detections.map((d) => ({ object_m: board(d), image_px: pixels(d) }));
 const joint = call('solve_handeye', { setup: 'eye-in-hand', base_from_gripper, camera_from_target, views: viewsIn, camera: report.camera, refine: 'joint_intrinsics', method: 'park-martin', bootstrap_samples: 0 }, 'solve_handeye joint');

@@ -6,10 +6,14 @@ import { bars, boxplot } from '../lib/plot.js';
 import { FrameView } from '../lib/view3d.js';
 import { flat, mul, fromPose, IDENTITY } from '../lib/mat4.js';
 
-// Refinement over the image points (the core's RefineMode names); 'none'
-// sends the camera poses only, which the core refines by maximum likelihood
-// over the poses (refine_poses); 'closed' turns that off too.
+// Refinement over the image points (the core's RefineMode names). 'ml' (the
+// default, as the CLI's with images) sends the image points with refine
+// 'none': the core's maximum likelihood over the poses, each camera pose
+// weighted by its PnP covariance; 'none' sends the camera poses only, which
+// the core refines the same way with a fitted noise model (refine_poses);
+// 'closed' turns that off too.
 const REFINE = [
+  ['ml', 'Over the poses, each weighted by its image points (maximum likelihood)'],
   ['trusted', 'Over the image points, robot poses exact'],
   ['stochastic', 'Over the image points, robot pose noise estimated'],
   ['joint_intrinsics', 'Over the image points, camera intrinsics refined too'],
@@ -19,13 +23,14 @@ const REFINE = [
 
 /** What each refinement minimises, in a sentence; the result is shown with it. */
 const REFINE_HELP = {
-  trusted: 'Minimises the reprojection error of every detected target point (px) over the hand-eye and target transforms, taking the robot poses as exact. Use it for an accurate robot (an industrial arm, repeatability 0.1 mm or better): it is the default.',
+  ml: 'Minimises the residuals of A X = Z B per pose, each camera pose weighted by its uncertainty from its detected points and each robot pose by the robot noise estimated from the data (maximum likelihood). Use it whenever the robot poses carry any noise (0.1 mm / 0.02 deg is enough): the most accurate, it is the default.',
+  trusted: 'Minimises the reprojection error of every detected target point (px) over the hand-eye and target transforms, taking the robot poses as exact. Use it only when the robot poses are exact to well below what the camera resolves; robot noise goes straight into the result.',
   stochastic: 'Minimises the reprojection error (px) plus a small correction per robot pose, weighted by the robot pose noise it estimates from the data. Use it when the robot poses are less accurate than the camera (a cobot, a hand-measured or tracked pose).',
-  joint_intrinsics: 'As the default, with the camera intrinsics (fx, fy, cx, cy) free too. Use it only when the camera may have changed since its calibration; with inaccurate robot poses the intrinsics absorb the robot error (a warning says so).',
+  joint_intrinsics: 'As "robot poses exact", with the camera intrinsics (fx, fy, cx, cy) free too. Use it only when the camera may have changed since its calibration; with inaccurate robot poses the intrinsics absorb the robot error (a warning says so).',
   none: 'Minimises the residuals of A X = Z B per pose, weighted by robot and camera pose noise estimated from the data (maximum likelihood over the poses, no pixels). Use it when only the camera poses are known, not the image points.',
   closed: 'No refinement: each closed form (Tsai-Lenz, Park-Martin, ...) solves its own algebraic form of A X = X B, rotation first, then translation. For comparison only.',
 };
-const WHICH = 'Which to use: the default, or "robot pose noise estimated" for a less accurate robot. The closure errors below (how far each pose’s robot, hand-eye and camera transforms land from one common target pose) are not what the refinements minimise, so a closed form can show a smaller closure and still be less accurate; compare the reprojection RMS, which every row shows when image points are used.';
+const WHICH = 'Which to use: the default; "robot poses exact" only for a robot far more accurate than the camera. The closure errors below (how far each pose’s robot, hand-eye and camera transforms land from one common target pose) are not what the refinements minimise, so a closed form can show a smaller closure and still be less accurate; compare the reprojection RMS, which every row shows when image points are used.';
 
 const METHODS = [
   ['all', 'All methods (best one refined)'], ['tsai-lenz', 'Tsai-Lenz'], ['park-martin', 'Park-Martin'], ['horaud', 'Horaud'],
@@ -49,8 +54,8 @@ export class HandEyeView {
     const form = h('form', { class: 'form', id: 'handeye-form' },
       sel('handeye-setup', [['eye-in-hand', 'Eye-in-hand (camera on the gripper)'], ['eye-to-hand', 'Eye-to-hand (camera fixed, target on the gripper)']], st.setup, 'Setup '),
       sel('handeye-method', METHODS, st.method, 'Method '),
-      sel('handeye-refine', REFINE, st.refine || 'trusted', 'Refinement '),
-      h('p', { class: 'hint', id: 'handeye-refine-help' }, REFINE_HELP[st.refine || 'trusted']),
+      sel('handeye-refine', REFINE, st.refine || 'ml', 'Refinement '),
+      h('p', { class: 'hint', id: 'handeye-refine-help' }, REFINE_HELP[st.refine || 'ml']),
       h('p', { class: 'hint' }, WHICH),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-handeye' }, 'Solve hand-eye')));
     form.addEventListener('change', () => {
@@ -79,14 +84,14 @@ export class HandEyeView {
     if (!this.robot.pairs().some((p) => p.image)) throw new Error('load the robot poses first (step 4)');
     const views = new Map((cam.views || []).map((v) => [v.name, v]));
     const used = pairs.filter((p) => views.has(p.image.name));
-    const refine = this.state.refine || 'trusted';
+    const refine = this.state.refine || 'ml';
     return {
       setup: this.state.setup,
       method: this.state.method,
       base_from_gripper: used.map((p) => ({ translation_m: p.pose.base_from_gripper.translation_m, quaternion_xyzw: p.pose.base_from_gripper.quaternion_xyzw })),
       camera_from_target: used.map((p) => ({ matrix_row_major: views.get(p.image.name).camera_from_target.matrix_row_major })),
       // The refinement reads the detected points through the solved camera.
-      ...(refine === 'none' || refine === 'closed' ? {} : { refine, camera: cam.camera, camera_std: intrinsicStd(cam.std), detections: used.map((p) => p.image.detection) }),
+      ...(refine === 'none' || refine === 'closed' ? {} : { refine: refine === 'ml' ? 'none' : refine, camera: cam.camera, camera_std: intrinsicStd(cam.std), detections: used.map((p) => p.image.detection) }),
       ...(refine === 'closed' ? { refine_poses: false } : {}),
       names: used.map((p) => p.image.name),
     };
@@ -132,7 +137,8 @@ export class HandEyeView {
           m.errors && m.errors.reprojection_rms_px != null ? num(m.errors.reprojection_rms_px, 4) : '—',
           `${num(m.disagreement_translation_mm, 3)} / ${num(m.disagreement_rotation_deg, 4)}`];
       }), { id: 'handeye-methods' });
-    const mode = r.refinement ? r.refinement.mode : r.pose_refinement ? 'none' : 'closed';
+    const poseMode = r.pose_refinement && r.pose_refinement.camera_noise_model === 'per_view' ? 'ml' : 'none';
+    const mode = r.refinement ? r.refinement.mode : r.pose_refinement ? poseMode : 'closed';
     const measure = h('p', { class: 'hint', id: 'handeye-measure' }, `This result: ${REFINE_HELP[mode].split('. Use it')[0].replace(/\.$/, '')}.`);
     const ref = r.refinement;
     const refinement = ref ? h('p', { class: 'hint', id: 'handeye-refinement' },

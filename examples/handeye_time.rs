@@ -1,0 +1,92 @@
+//! Wall time of the hand-eye solve on many poses, with and without the
+//! maximum-likelihood pose refinement (the pose path's default).
+//!
+//! Usage: cargo run --release --example handeye_time -- [--poses N] [--runs N]
+//!
+//! Scene: `synth::handeye_looking`, eye-in-hand, the camera 0.5 m from a
+//! 9x6 grid (30 mm), tilts up to 30 deg, rolls up to 60 deg, seed 21;
+//! robot noise 0.02 deg / 0.1 mm per axis, camera pose noise 0.05 deg
+//! (0.01 deg about the optical axis) and 0.05 / 0.3 mm (x, y / depth).
+//! Every closed form on all view pairs, no bootstrap (as `robocal handeye
+//! --camera-poses ... --bootstrap 0`). The two variants alternate, `--runs`
+//! times each; printed: every run and the medians (seconds).
+
+use robocal::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions};
+use robocal::handeye::Setup;
+use robocal::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
+use robocal::synth::Rng;
+use std::time::Instant;
+
+fn arg(name: &str, default: usize) -> usize {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1))
+        .map(|v| v.parse().expect("a whole number"))
+        .unwrap_or(default)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let (poses, runs) = (arg("--poses", 1000), arg("--runs", 3));
+    let scene = looking_scene(
+        &LookingConfig {
+            setup: Setup::EyeInHand,
+            views: poses,
+            distance_m: 0.5,
+            grid: (9, 6, 0.03),
+            max_tilt_deg: 30.0,
+            max_roll_deg: 60.0,
+        },
+        21,
+    );
+    let mut rng = Rng::new(3);
+    let r = 0.02f64.to_radians();
+    let c = 0.05f64.to_radians();
+    let input = HandEyeInput {
+        setup: Setup::EyeInHand,
+        base_from_gripper: scene
+            .base_from_gripper
+            .iter()
+            .map(|p| perturbed(&mut rng, p, [r; 3], [1e-4; 3]))
+            .collect(),
+        camera_from_target: scene
+            .camera_from_target
+            .iter()
+            .map(|p| perturbed(&mut rng, p, [c, c, c / 5.0], [5e-5, 5e-5, 3e-4]))
+            .collect(),
+    };
+    let (mut with, mut without) = (Vec::new(), Vec::new());
+    for run in 0..runs {
+        for refine_poses in [true, false] {
+            let options = HandEyeOptions {
+                bootstrap_samples: 0,
+                refine_poses,
+                ..Default::default()
+            };
+            let start = Instant::now();
+            let result = calibrate(&input, &options).expect("the solve");
+            let s = start.elapsed().as_secs_f64();
+            let t_mm = (result.x.translation.vector - scene.x_true.translation.vector).norm() * 1e3;
+            println!(
+                "run {run}: refine_poses {refine_poses}: {s:.3} s ({}; X off by {t_mm:.4} mm)",
+                result.method
+            );
+            if refine_poses {
+                with.push(s);
+            } else {
+                without.push(s);
+            }
+        }
+    }
+    let (a, b) = (median(with), median(without));
+    println!(
+        "{poses} poses, median of {runs}: {a:.3} s with the pose refinement, {b:.3} s without \
+         (refinement {:.3} s)",
+        a - b
+    );
+}
