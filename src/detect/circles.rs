@@ -112,13 +112,7 @@ pub(crate) fn detect_grid(
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    let centres = circle_centres(
-        &board,
-        asymmetric,
-        &outlines,
-        options.circle_centres,
-        (img.width, img.height),
-    );
+    let centres = circle_centres(&board, asymmetric, &outlines, options.circle_centres);
     Ok(outlines
         .iter()
         .zip(centres)
