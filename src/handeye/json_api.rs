@@ -5,8 +5,8 @@
 //! [pose...], "camera_from_target": [pose...], "method": "all" | NAME,
 //! "bootstrap_samples": 100, "seed": 1, "strict_checks": true, "refine_poses":
 //! true}` (`refine_poses`: the maximum-likelihood pose refinement of
-//! [`super::refine_poses`], on by default for pose input, ignored with image
-//! points) where a pose
+//! [`super::refine_poses`], on by default for pose input and for image
+//! points under `refine` none, the default; unused by the other modes) where a pose
 //! is a [`PoseInput`]: `{"matrix_row_major": [[4 numbers] x 4]}`,
 //! `{"translation_m": [x, y, z], "quaternion_xyzw": [x, y, z, w]}` (metres)
 //! or all three (a report's [`crate::geometry::PoseJson`]). Output: the

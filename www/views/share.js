@@ -52,8 +52,8 @@ export function sharedFragment() {
   return location.hash.startsWith(PREFIX) ? location.hash.slice(PREFIX.length) : null;
 }
 
-/** Keys of a result that grow with the number of views or points: left out of a link. */
-const BULKY = new Set(['residuals_px', 'per_motion', 'distortion_field', 'camera_from_target', 'detections', 'per_view_reprojection_rms_px']);
+/** Keys of a result that grow with the number of views or points, and the pose refinement's 12 x 12 covariance (the per-axis std stay): left out of a link. */
+const BULKY = new Set(['residuals_px', 'per_motion', 'distortion_field', 'camera_from_target', 'detections', 'per_view_reprojection_rms_px', 'covariance']);
 
 /** Keys of a result kept with every digit. */
 const EXACT = new Set(['camera', 'camera_matrix', 'distortion', 'rms_px', 'std']);
