@@ -18,6 +18,7 @@ mod planar;
 mod render;
 mod render_video;
 mod rig;
+mod rig_handeye;
 mod serve;
 mod stereo;
 mod target;
