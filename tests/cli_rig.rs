@@ -248,3 +248,22 @@ fn rig_on_a_robot_gives_gripper_from_rig_and_checks_the_poses() {
         "robocal: rig: --setup needs --poses FILE (see 'robocal rig --help')"
     );
 }
+
+#[test]
+fn a_camera_whose_images_show_no_board_is_named() {
+    let dir = temp_dir("rig", "empty");
+    let a = dir.join("a1.png").to_string_lossy().into_owned();
+    let b = dir.join("b1.png").to_string_lossy().into_owned();
+    std::fs::write(&a, b"").expect("write");
+    std::fs::write(&b, b"").expect("write");
+    let (code, _, err) = robocal(&["rig", "--target", TARGET, "--camera", "a", &a, "--camera", "b", &b]);
+    assert_eq!(code, 1, "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(
+        lines,
+        [
+            format!("robocal rig: camera a: {a} left out: not an image: the file is empty"),
+            "robocal: rig: the target was found in no image of camera a".to_string(),
+        ]
+    );
+}
