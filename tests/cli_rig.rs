@@ -177,7 +177,10 @@ fn rig_on_a_robot_gives_gripper_from_rig_and_checks_the_poses() {
     args.extend(["--setup", "eye-in-hand", "--poses", &robot, "-o", &out]);
     let (code, _, err) = robocal(&args);
     assert_eq!(code, 0, "{err}");
-    assert!(err.contains("robocal rig: gripper_from_rig translation_m"), "{err}");
+    assert!(
+        err.contains("robocal rig: gripper_from_rig translation_m"),
+        "{err}"
+    );
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("json");
     let h = &report["handeye"];
@@ -256,7 +259,9 @@ fn a_camera_whose_images_show_no_board_is_named() {
     let b = dir.join("b1.png").to_string_lossy().into_owned();
     std::fs::write(&a, b"").expect("write");
     std::fs::write(&b, b"").expect("write");
-    let (code, _, err) = robocal(&["rig", "--target", TARGET, "--camera", "a", &a, "--camera", "b", &b]);
+    let (code, _, err) = robocal(&[
+        "rig", "--target", TARGET, "--camera", "a", &a, "--camera", "b", &b,
+    ]);
     assert_eq!(code, 1, "{err}");
     let lines: Vec<&str> = err.lines().collect();
     assert_eq!(

@@ -3,13 +3,13 @@
 //! (`synth::rig::robot_poses`): noise-free exact, noisy within the reported
 //! standard deviations, and the errors for poses that do not pair up.
 
+use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use robocal::geometry::{rotvec_from_rotation, Pose};
 use robocal::handeye::reprojection_refine::ViewPoints;
 use robocal::handeye::rig::{calibrate_rig_handeye, rig_handeye_report, RigHandEyeResult};
 use robocal::handeye::rig_pnp::HeldRig;
 use robocal::handeye::{HandEyeOptions, Setup};
 use robocal::synth::rig::{rig_scene, robot_poses, RigScene, RigSceneConfig};
-use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
 fn truth(setup: Setup) -> (Pose, Pose) {
     let x = Pose::from_parts(
@@ -84,8 +84,14 @@ fn noise_free_rig_on_a_robot_is_exact_in_both_setups() {
         let solved = solve(&scene, setup, &options);
         let (rx, tx) = error(&solved.result.x, &x);
         let (ry, ty) = error(&solved.result.y, &y);
-        assert!(rx.norm() < 1e-9 && tx.norm() < 1e-9, "{setup:?} x: {rx} {tx}");
-        assert!(ry.norm() < 1e-9 && ty.norm() < 1e-9, "{setup:?} y: {ry} {ty}");
+        assert!(
+            rx.norm() < 1e-9 && tx.norm() < 1e-9,
+            "{setup:?} x: {rx} {tx}"
+        );
+        assert!(
+            ry.norm() < 1e-9 && ty.norm() < 1e-9,
+            "{setup:?} y: {ry} {ty}"
+        );
         assert!(solved.frames.iter().all(|f| f.used), "{:?}", solved.frames);
         // Each camera's own transform is the rig's times rig_from_camera.
         let names = &scene.names;
@@ -105,7 +111,10 @@ fn noise_free_rig_on_a_robot_is_exact_in_both_setups() {
         let expected = x * scene.camera_from_rig[2].inverse();
         let (r2, t2) = error(&cam2.to_pose().unwrap(), &expected);
         assert!(r2.norm() < 1e-9 && t2.norm() < 1e-9, "cam2: {r2} {t2}");
-        assert_eq!(report["frames"].as_array().unwrap().len(), scene.frame_keys.len());
+        assert_eq!(
+            report["frames"].as_array().unwrap().len(),
+            scene.frame_keys.len()
+        );
     }
 }
 
@@ -139,8 +148,14 @@ fn noisy_rig_hand_eye_lies_within_its_reported_deviations() {
             for i in 0..3 {
                 let (er, sr) = (r[i].to_degrees().abs(), std.rotation_deg[i]);
                 let (et, st) = (t[i].abs() * 1e3, std.translation_mm[i]);
-                assert!(er < 4.0 * sr, "seed {seed} {setup:?} rot {i}: {er} deg, std {sr}");
-                assert!(et < 4.0 * st, "seed {seed} {setup:?} t {i}: {et} mm, std {st}");
+                assert!(
+                    er < 4.0 * sr,
+                    "seed {seed} {setup:?} rot {i}: {er} deg, std {sr}"
+                );
+                assert!(
+                    et < 4.0 * st,
+                    "seed {seed} {setup:?} t {i}: {et} mm, std {st}"
+                );
             }
             assert!(t.norm() < 2e-3 && r.norm().to_degrees() < 0.1, "{t} {r}");
         }

@@ -181,7 +181,10 @@ pub fn summary(h: &Value) -> String {
         );
     }
     for w in h["warnings"].as_array().map_or(&[][..], Vec::as_slice) {
-        s += &format!("robocal rig: hand-eye warning: {}\n", w.as_str().unwrap_or(""));
+        s += &format!(
+            "robocal rig: hand-eye warning: {}\n",
+            w.as_str().unwrap_or("")
+        );
     }
     s
 }

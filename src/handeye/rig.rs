@@ -161,8 +161,8 @@ pub fn rig_handeye_report(solved: &RigHandEyeResult, rig: &HeldRig, names: &[Str
             }
         }
     };
-    let mut report = serde_json::to_value(HandEyeReport::new(&solved.result))
-        .unwrap_or(Value::Null);
+    let mut report =
+        serde_json::to_value(HandEyeReport::new(&solved.result)).unwrap_or(Value::Null);
     rename(&mut report);
     if let Some(methods) = report.get_mut("methods").and_then(Value::as_array_mut) {
         methods.iter_mut().for_each(rename);
