@@ -8,7 +8,11 @@ YAML, then reads them back with cv2.FileStorage (opencv-python-headless
 For the 3-camera rig of fixtures/exports/rig.json (issue 22) it reads the
 rig's OpenCV FileStorage (R_k, T_k, camera_matrix_k per camera) with
 cv2.FileStorage, and its Kalibr camchain and ROS camera_infos with PyYAML,
-chaining Kalibr's T_cn_cnm1 back to every camera_from_rig.
+chaining Kalibr's T_cn_cnm1 back to every camera_from_rig. The rig's mrcal
+.cameramodel files are read by mrcal's own reader (mrcal.cameramodel, from
+Debian's python3-mrcal, run with the system python3 since mrcal is not on
+the venv): lens model, intrinsics and extrinsics_rt_fromref against the
+report; skipped with a note when `import mrcal` fails.
 
 Usage (creates bench/.venv on first run; needs target/release/robocal):
     cargo build --release && python3 bench/check_exports.py
@@ -135,7 +139,69 @@ def check_rig(cv2, np, yaml):
             ok = ok and info["camera_name"] == name and info["camera_matrix"]["data"] == want
         failures += not ok
         print(f"{'ok  ' if ok else 'FAIL'} PyYAML reads rig ros camera_info x{len(names)}")
+        failures += check_rig_mrcal(rig_path, rig, names, truth, np, tmp)
     return failures
+
+
+# Read by mrcal (system python3): every .cameramodel's lens model,
+# intrinsics and rt_cam_ref, and camera_from_rig rebuilt with mrcal's own
+# Rodrigues (mrcal.R_from_r).
+MRCAL_READER = """
+import json, sys, mrcal
+out = {}
+for path in sys.argv[1:]:
+    m = mrcal.cameramodel(path)
+    lens, intr = m.intrinsics()
+    rt = m.extrinsics_rt_fromref()
+    out[path] = {"lensmodel": lens, "intrinsics": intr.tolist(), "rt": rt.tolist(),
+                 "R": mrcal.R_from_r(rt[:3]).tolist(), "size": [int(v) for v in m.imagersize()],
+                 "version": mrcal.__version__ if hasattr(mrcal, "__version__") else "?"}
+print(json.dumps(out))
+"""
+
+
+def check_rig_mrcal(rig_path, rig, names, truth, np, tmp):
+    # mrcal has no Kannala-Brandt model (robocal refuses to write one): the
+    # check reads the rig without such cameras.
+    keep = [k for k, c in enumerate(rig["cameras"]) if c["calibration"]["model"] != "kannala_brandt"]
+    rig = json.loads(json.dumps(rig))
+    kept = [names[k] for k in keep]
+    rig["cameras"] = [rig["cameras"][k] for k in keep]
+    co = rig["co_observation"]
+    co["frames"] = [[co["frames"][i][j] for j in keep] for i in keep]
+    co["cameras"] = kept
+    co["spanning_tree"] = []
+    for f in rig["frames"]:
+        f["cameras"] = [c for c in f["cameras"] if c in kept]
+    names, truth = kept, [truth[k] for k in keep]
+    rig_path = os.path.join(tmp, "rig_for_mrcal.json")
+    with open(rig_path, "w") as f:
+        json.dump(rig, f)
+    folder = os.path.join(tmp, "mrcal")
+    subprocess.run([ROBOCAL, "export", rig_path, "--format", "mrcal", "-o", folder], check=True, capture_output=True)
+    files = [os.path.join(folder, f"{name}.cameramodel") for name in names]
+    run = subprocess.run(["/usr/bin/python3", "-c", MRCAL_READER, *files], capture_output=True, text=True)
+    if run.returncode != 0:
+        print(f"skip mrcal reader not available (apt-get install python3-mrcal): {run.stderr.strip().splitlines()[-1:]}")
+        return 0
+    read = json.loads(run.stdout)
+    worst = 0.0
+    ok = True
+    for k, path in enumerate(files):
+        m = read[path]
+        cam = rig["cameras"][k]["calibration"]
+        K = cam["camera_matrix"]
+        ok = ok and m["intrinsics"][:4] == [K[0][0], K[1][1], K[0][2], K[1][2]]
+        if m["lensmodel"] == "LENSMODEL_OPENCV5":
+            ok = ok and m["intrinsics"][4:] == [cam["distortion"][c] for c in OPENCV_ORDER["brown"]]
+        ok = ok and m["size"] == cam["image_size_px"]
+        worst = max(worst, np.abs(np.array(m["R"]) - truth[k][:3, :3]).max(),
+                    np.abs(np.array(m["rt"][3:]) - truth[k][:3, 3]).max())
+    ok = ok and worst < RIG_TOL
+    lens = sorted({read[p]["lensmodel"] for p in files})
+    print(f"{'ok  ' if ok else 'FAIL'} mrcal.cameramodel reads rig mrcal x{len(names)} ({', '.join(lens)}; "
+          f"extrinsics within {worst:.1e} of camera_from_rig)")
+    return 0 if ok else 1
 
 
 if __name__ == "__main__":

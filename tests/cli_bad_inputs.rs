@@ -493,6 +493,46 @@ const CASES: &[Case] = &[
         stream: Stream::Stderr,
         message: "error: unexpected argument '--targett' found",
     },
+    Case {
+        name: "rig-no-camera",
+        files: &[],
+        args: &["rig", "--target", "chessboard:9x6:30mm"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "robocal: rig: give one --camera NAME IMAGES... per camera (at least 2), or --input FILE (see 'robocal rig --help')",
+    },
+    Case {
+        name: "rig-group-by-unknown",
+        files: &[],
+        args: &["rig", "--target", "chessboard:9x6:30mm", "--camera", "a", "a1.png", "--camera", "b", "b1.png", "--group-by", "sideways"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "robocal: rig: --group-by takes number or order, got 'sideways' (see 'robocal rig --help')",
+    },
+    Case {
+        name: "rig-name-without-number",
+        files: &[],
+        args: &["rig", "--target", "chessboard:9x6:30mm", "--camera", "a", "a1.png", "a.png", "--camera", "b", "b1.png", "--group-by", "number"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "robocal: rig: frames are grouped by the last number in the file names, but camera a has names without one: a.png (number every file, or group by order) (see 'robocal rig --help')",
+    },
+    Case {
+        name: "rig-camera-file-without-name",
+        files: &[],
+        args: &["rig", "--target", "chessboard:9x6:30mm", "--camera", "a", "a1.png", "--camera", "b", "b1.png", "--camera-file", "top.json"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "robocal: rig: --camera-file takes NAME=FILE, got 'top.json' (see 'robocal rig --help')",
+    },
+    Case {
+        name: "rig-poses-without-setup",
+        files: &[],
+        args: &["rig", "--target", "chessboard:9x6:30mm", "--camera", "a", "a1.png", "--camera", "b", "b1.png", "--poses", "p.csv"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "robocal: rig: --poses needs --setup eye-in-hand|eye-to-hand (see 'robocal rig --help')",
+    },
 ];
 
 #[test]

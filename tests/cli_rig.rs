@@ -130,3 +130,145 @@ fn cameras_that_no_frame_links_are_named_and_flags_are_checked() {
         "robocal: rig: --camera-file top=top.json: no --camera is named 'top' (see 'robocal rig --help')"
     );
 }
+
+/// A pose file with an `image` column: one row per frame of `frames`.
+fn pose_file(poses: &[(usize, Pose)]) -> String {
+    let mut s = String::from("image,x,y,z,qx,qy,qz,qw\n");
+    for (f, p) in poses {
+        let t = p.translation.vector;
+        let q = p.rotation.coords;
+        s += &format!(
+            "cam0_{f:03}.png,{},{},{},{},{},{},{}\n",
+            t.x, t.y, t.z, q.x, q.y, q.z, q.w
+        );
+    }
+    s
+}
+
+#[test]
+fn rig_on_a_robot_gives_gripper_from_rig_and_checks_the_poses() {
+    use robocal::handeye::Setup;
+    use robocal::synth::rig::robot_poses;
+    let dir = temp_dir("rig", "robot");
+    let (files, scene) = rendered_rig(&dir);
+    let x = Pose::from_parts(
+        nalgebra::Translation3::new(0.05, -0.12, 0.2),
+        nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(0.3, -1.1, 0.4)),
+    );
+    let y = Pose::from_parts(
+        nalgebra::Translation3::new(0.8, 0.1, -0.3),
+        nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(2.0, 0.2, -0.5)),
+    );
+    let all = robot_poses(&scene, Setup::EyeInHand, &x, &y);
+    // The frames that have an image, in key order.
+    let mut seen: Vec<usize> = files
+        .iter()
+        .flatten()
+        .map(|f| f[f.len() - 7..f.len() - 4].parse().expect("frame"))
+        .collect();
+    seen.sort();
+    seen.dedup();
+    let poses: Vec<(usize, Pose)> = seen.iter().map(|&f| (f, all[f])).collect();
+    let path = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    std::fs::write(path("robot.csv"), pose_file(&poses)).expect("write");
+    let out = path("rig.json");
+    let mut args = args_of(&files, |_| true);
+    let robot = path("robot.csv");
+    args.extend(["--setup", "eye-in-hand", "--poses", &robot, "-o", &out]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("robocal rig: gripper_from_rig translation_m"),
+        "{err}"
+    );
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("json");
+    let h = &report["handeye"];
+    assert_eq!(h["setup"], "eye-in-hand");
+    assert_eq!(h["frames"].as_array().expect("frames").len(), seen.len());
+    // The rig is calibrated from the same renders (camera_from_rig within
+    // 3 mm, 3 mrad, above); each frame's board pose pools the cameras, so
+    // the rig transform lands within the same 3 mm and 3 mrad.
+    let got = pose(&h["gripper_from_rig"]);
+    let dt = (got.translation.vector - x.translation.vector).norm();
+    let dr = rotvec_from_rotation(&(got.rotation * x.rotation.inverse())).norm();
+    assert!(dt < 3e-3 && dr < 3e-3, "{dt} m, {dr} rad; {err}");
+    let cam3 = pose(&h["cameras"][3]["gripper_from_camera"]);
+    let expected = x * scene.camera_from_rig[3].inverse();
+    let dt3 = (cam3.translation.vector - expected.translation.vector).norm();
+    assert!(dt3 < 6e-3, "cam3 {dt3} m");
+
+    // A frame without a robot pose: named.
+    std::fs::write(path("short.csv"), pose_file(&poses[1..])).expect("write");
+    let short = path("short.csv");
+    let mut args = args_of(&files, |_| true);
+    args.extend(["--setup", "eye-in-hand", "--poses", &short]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(
+        err.lines().last().expect("message"),
+        format!(
+            "robocal: '{short}': no robot pose for frame(s) {}: give a pose for every frame, \
+             or leave those frames' images out",
+            seen[0]
+        )
+    );
+    // Poses by order whose count differs from the frames'.
+    let plain: String = poses[1..]
+        .iter()
+        .map(|(_, p)| {
+            let t = p.translation.vector;
+            let q = p.rotation.coords;
+            format!("{} {} {} {} {} {} {}\n", t.x, t.y, t.z, q.x, q.y, q.z, q.w)
+        })
+        .collect();
+    std::fs::write(path("plain.txt"), plain).expect("write");
+    let plain = path("plain.txt");
+    let mut args = args_of(&files, |_| true);
+    args.extend([
+        "--setup",
+        "eye-in-hand",
+        "--poses",
+        &plain,
+        "--pose-format",
+        "xyz-quaternion-xyzw",
+    ]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(
+        err.lines().last().expect("message"),
+        format!(
+            "robocal: poses: {} robot poses but {} frames: give one robot pose per frame, \
+             in frame order",
+            seen.len() - 1,
+            seen.len()
+        )
+    );
+    let (code, _, err) = robocal(&["rig", "--target", TARGET, "--setup", "eye-in-hand"]);
+    assert_eq!(code, 2);
+    assert_eq!(
+        err.trim_end(),
+        "robocal: rig: --setup needs --poses FILE (see 'robocal rig --help')"
+    );
+}
+
+#[test]
+fn a_camera_whose_images_show_no_board_is_named() {
+    let dir = temp_dir("rig", "empty");
+    let a = dir.join("a1.png").to_string_lossy().into_owned();
+    let b = dir.join("b1.png").to_string_lossy().into_owned();
+    std::fs::write(&a, b"").expect("write");
+    std::fs::write(&b, b"").expect("write");
+    let (code, _, err) = robocal(&[
+        "rig", "--target", TARGET, "--camera", "a", &a, "--camera", "b", &b,
+    ]);
+    assert_eq!(code, 1, "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(
+        lines,
+        [
+            format!("robocal rig: camera a: {a} left out: not an image: the file is empty"),
+            "robocal: rig: the target was found in no image of camera a".to_string(),
+        ]
+    );
+}

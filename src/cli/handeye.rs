@@ -41,6 +41,9 @@ of view): each view's pose is fitted to its own points, and a view whose points
 cannot fix a pose (fewer than 4, or all but one on a line) is dropped with its
 robot pose (pairs says why).
 
+A camera rig on a robot (gripper_from_rig or base_from_rig from all cameras'
+views together): robocal rig ... --setup SETUP --poses FILE (docs/rig.md).
+
 Examples:
   robocal handeye --setup eye-in-hand --poses robot.csv --camera camera.json \\
                   --target chessboard:9x6:30mm view*.png -o handeye.json

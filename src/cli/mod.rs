@@ -19,6 +19,7 @@ mod render;
 mod render_rig;
 mod render_video;
 mod rig;
+mod rig_handeye;
 mod serve;
 mod stereo;
 mod target;

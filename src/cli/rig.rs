@@ -47,12 +47,26 @@ The report (JSON; the rig frame is the rig camera's, camera 0 unless
 {matrix_row_major, translation_m, quaternion_xyzw}, camera_from_rig_std,
 rms_px, frames_seen), frames (key, rig_from_target, cameras, rms_px),
 co_observation (cameras, frames: the matrix of frames seen together,
-spanning_tree), rms_px, warnings. A summary goes to standard error.",
+spanning_tree), rms_px, warnings. A summary goes to standard error.
+
+A rig on a robot: with --setup eye-in-hand|eye-to-hand --poses FILE (one
+robot pose base_from_gripper per frame, in frame order, or paired by the frame
+number of an 'image' column), each frame's board pose in the rig frame is
+fitted to every camera that saw it (the calibrated rig held), then the
+hand-eye closed forms and the maximum-likelihood pose refinement give
+gripper_from_rig (eye-in-hand) or base_from_rig (eye-to-hand). The report
+gets 'handeye': the 'robocal handeye' report with the rig in its keys
+(gripper_from_rig or base_from_rig, base_from_target or gripper_from_target,
+methods, errors, pose_refinement with camera_transform_std), cameras (each
+camera's own gripper_from_camera or base_from_camera) and frames (key,
+pose_index, used, cameras, pose_fit_rms_px, reason).",
     after_help = "Examples:
   robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png -o rig.json
   robocal rig --target charuco:12x9:20mm:15mm:DICT_5X5_100 --camera front f/*.png \\
       --camera back b/*.png --camera top t/*.png --camera-file top=top.json --rig-frame top -o rig.json
   robocal rig --input rig-files.json -o rig.json
+  robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png \\
+      --setup eye-in-hand --poses robot.csv -o rig.json
   robocal export rig.json --format kalibr"
 )]
 pub struct RigArgs {
@@ -83,6 +97,8 @@ pub struct RigArgs {
     threads: Option<usize>,
     #[command(flatten)]
     limits: super::ImageLimits,
+    #[command(flatten)]
+    handeye: super::rig_handeye::RigHandEyeFlags,
     /// Write the report there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE", overrides_with = "output")]
     output: Option<String>,
@@ -165,6 +181,7 @@ fn usage(message: impl Into<String>) -> CliError {
 }
 
 pub fn run(args: RigArgs) -> Result<(), CliError> {
+    let handeye = args.handeye.wanted()?;
     // 1. The cameras, from the flags or the rig file.
     let (mut cameras, file) = match (&args.input, args.camera.0.is_empty()) {
         (Some(_), false) => {
@@ -293,7 +310,16 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
     };
     let report = calibrate_rig(&inputs, &keys, &options)?;
     eprint!("{}", summary(&report));
-    let text = serde_json::to_string_pretty(&report)
+    let mut json = serde_json::to_value(&report)
+        .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
+    if handeye {
+        let h = super::rig_handeye::rig_handeye(&args.handeye, &report, &inputs, &keys, grouping)?;
+        eprint!("{}", super::rig_handeye::summary(&h));
+        if let Some(o) = json.as_object_mut() {
+            o.insert("handeye".into(), h);
+        }
+    }
+    let text = serde_json::to_string_pretty(&json)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
     write_output(args.output.as_deref(), &(text + "\n"))
 }

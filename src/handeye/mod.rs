@@ -39,7 +39,9 @@
 //! [`pose_refine`] is the maximum-likelihood problem over the poses alone
 //! (`A_i X = Z B_i` per view, weighted by robot and camera pose noise
 //! estimated from the data); [`refine_poses`] applies it by default on the
-//! pose path (`HandEyeOptions::refine_poses`).
+//! pose path (`HandEyeOptions::refine_poses`). [`rig`] solves a whole camera
+//! rig's transform (`gripper_from_rig`, `base_from_rig`) from every camera's
+//! views together ([`rig_pnp`]: one board pose per frame over the held rig).
 
 pub mod axxb;
 pub mod axzb;
@@ -61,6 +63,8 @@ pub mod refine_poses;
 pub mod repeat;
 pub mod report;
 pub mod reprojection_refine;
+pub mod rig;
+pub mod rig_pnp;
 pub mod scara;
 pub mod solve;
 

@@ -8,11 +8,13 @@
 //! cut off), as marker boards give.
 //!
 //! The rig frame is cam0's. World frame: origin at the centre, y down.
+//! [`robot_poses`] puts the rig (or the board) on a robot for the rig hand-eye.
 
 use super::Rng;
 use crate::calib::View;
 use crate::camera::Camera;
 use crate::geometry::{rotation_from_rotvec, Pose};
+use crate::handeye::Setup;
 use nalgebra::{Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// Distance of every camera from the centre of the working volume, metres.
@@ -185,4 +187,21 @@ pub fn rig_scene(config: &RigSceneConfig, seed: u64) -> RigScene {
         rig_from_target,
         views,
     }
+}
+
+/// Robot poses `base_from_gripper`, one per frame, that carry the scene on
+/// a robot. Eye-in-hand: the rig on the gripper at `x` = `gripper_from_rig`,
+/// the board fixed at `y` = `base_from_target`, so `base_from_gripper[f] =
+/// y * rig_from_target[f]^-1 * x^-1`. Eye-to-hand: the rig fixed at `x` =
+/// `base_from_rig`, the board on the gripper at `y` = `gripper_from_target`,
+/// so `base_from_gripper[f] = x * rig_from_target[f] * y^-1`.
+pub fn robot_poses(scene: &RigScene, setup: Setup, x: &Pose, y: &Pose) -> Vec<Pose> {
+    scene
+        .rig_from_target
+        .iter()
+        .map(|t| match setup {
+            Setup::EyeInHand => y * t.inverse() * x.inverse(),
+            Setup::EyeToHand => x * t * y.inverse(),
+        })
+        .collect()
 }

@@ -1,0 +1,190 @@
+//! `robocal rig ... --setup SETUP --poses FILE`: the rig on a robot. After
+//! the rig calibration, each frame's board pose in the rig frame from every
+//! camera that saw it (the calibrated rig held), then the hand-eye closed
+//! forms and the pose refinement: `gripper_from_rig` or `base_from_rig`,
+//! written into the rig report under `handeye`.
+
+use super::handeye_images::{read_robot_poses, RobotPoses};
+use super::{read_text, CliError};
+use robocal::calib::rig::RigCameraViews;
+use robocal::calib::rig_report::RigCalibration;
+use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::rig::{calibrate_rig_handeye, rig_handeye_report};
+use robocal::handeye::rig_pnp::HeldRig;
+use robocal::handeye::{HandEyeOptions, Setup};
+use robocal::io::pairing::{number_in_name, PairedBy};
+use robocal::io::RobotPose;
+use serde_json::Value;
+
+/// The hand-eye flags of `robocal rig`.
+#[derive(clap::Args, Default)]
+pub struct RigHandEyeFlags {
+    /// The rig on a robot: eye-in-hand (the rig on the gripper, solves
+    /// gripper_from_rig) or eye-to-hand (the rig fixed, base_from_rig); needs --poses
+    #[arg(long, value_name = "SETUP", overrides_with = "setup")]
+    setup: Option<String>,
+    /// Robot poses base_from_gripper, one per frame in frame order, or with
+    /// an 'image' column naming a file of each frame (any robot pose file, as
+    /// 'robocal handeye --poses')
+    #[arg(long, value_name = "FILE", overrides_with = "poses")]
+    poses: Option<String>,
+    /// The pose file's format, as 'robocal handeye --pose-format'
+    #[arg(long, value_name = "NAME", overrides_with = "pose_format")]
+    pose_format: Option<String>,
+    /// Report suspected pose mistakes (units, inverted or shifted poses) as
+    /// warnings instead of failing
+    #[arg(long)]
+    lenient: bool,
+}
+
+impl RigHandEyeFlags {
+    /// Whether a hand-eye was asked for; both flags or neither.
+    pub fn wanted(&self) -> Result<bool, CliError> {
+        match (&self.setup, &self.poses) {
+            (Some(_), Some(_)) => Ok(true),
+            (None, None) => Ok(false),
+            (Some(_), None) => Err(CliError::usage("rig", "--setup needs --poses FILE")),
+            (None, Some(_)) => Err(CliError::usage(
+                "rig",
+                "--poses needs --setup eye-in-hand|eye-to-hand",
+            )),
+        }
+    }
+}
+
+/// The rig hand-eye report of a calibrated rig.
+pub fn rig_handeye(
+    flags: &RigHandEyeFlags,
+    report: &RigCalibration,
+    inputs: &[RigCameraViews],
+    keys: &[String],
+    grouping: PairedBy,
+) -> Result<Value, CliError> {
+    let setup: Setup = flags.setup.as_deref().unwrap_or_default().parse()?;
+    let path = flags.poses.as_deref().unwrap_or_default();
+    let poses = match read_robot_poses(&read_text(path)?, flags.pose_format.as_deref())
+        .map_err(|e| e.in_file(path))?
+    {
+        RobotPoses::Known(p) => p,
+        RobotPoses::Ambiguous(_) => {
+            return Err(CliError::usage(
+                "rig",
+                "the pose file's format is ambiguous: pass --pose-format NAME",
+            ))
+        }
+    };
+    let base_from_gripper = per_frame(&poses, keys, grouping, path)?;
+    let rig = HeldRig {
+        cameras: report
+            .cameras
+            .iter()
+            .map(|c| c.calibration.camera.clone())
+            .collect(),
+        camera_from_rig: report
+            .cameras
+            .iter()
+            .map(|c| c.camera_from_rig.to_pose())
+            .collect::<robocal::Result<_>>()?,
+    };
+    let mut frames = vec![Vec::new(); keys.len()];
+    for (k, camera) in inputs.iter().enumerate() {
+        for (f, view) in &camera.views {
+            frames[*f].push((
+                k,
+                ViewPoints {
+                    object_points: view.object_m.clone(),
+                    image_points: view.image_px.clone(),
+                },
+            ));
+        }
+    }
+    let names: Vec<String> = inputs.iter().map(|c| c.name.clone()).collect();
+    let options = HandEyeOptions {
+        strict_checks: !flags.lenient,
+        ..HandEyeOptions::default()
+    };
+    let solved = calibrate_rig_handeye(
+        setup,
+        &rig,
+        &names,
+        keys,
+        &frames,
+        &base_from_gripper,
+        &options,
+    )?;
+    Ok(rig_handeye_report(&solved, &rig, &names))
+}
+
+/// One robot pose per frame: by the frame numbers of the pose file's image
+/// names when it has them (grouping by number), else in order.
+fn per_frame(
+    poses: &[RobotPose],
+    keys: &[String],
+    grouping: PairedBy,
+    path: &str,
+) -> Result<Vec<robocal::geometry::Pose>, CliError> {
+    let named = grouping == PairedBy::Number && poses.iter().all(|p| p.name.is_some());
+    if !named || poses.is_empty() {
+        return Ok(poses.iter().map(|p| p.base_from_gripper).collect());
+    }
+    let mut out = vec![None; keys.len()];
+    for p in poses {
+        let name = p.name.as_deref().unwrap_or_default();
+        let frame = number_in_name(name).and_then(|n| keys.iter().position(|k| k == n));
+        let Some(f) = frame else {
+            return Err(CliError::Io(format!(
+                "'{path}': line {}: the image '{name}' is in no frame (the frames are {})",
+                p.line,
+                keys.join(", ")
+            )));
+        };
+        out[f] = Some(p.base_from_gripper);
+    }
+    let missing: Vec<&str> = keys
+        .iter()
+        .zip(&out)
+        .filter(|(_, p)| p.is_none())
+        .map(|(k, _)| k.as_str())
+        .collect();
+    if !missing.is_empty() {
+        return Err(CliError::Io(format!(
+            "'{path}': no robot pose for frame(s) {}: give a pose for every frame, or \
+             leave those frames' images out",
+            missing.join(", ")
+        )));
+    }
+    Ok(out.into_iter().flatten().collect())
+}
+
+/// The summary on standard error: the rig transform with its std, frames used.
+pub fn summary(h: &Value) -> String {
+    let key = if h.get("gripper_from_rig").is_some() {
+        "gripper_from_rig"
+    } else {
+        "base_from_rig"
+    };
+    let t = &h[key]["translation_m"];
+    let frames = h["frames"].as_array().map_or(&[][..], Vec::as_slice);
+    let used = frames.iter().filter(|f| f["used"] == true).count();
+    let mut s = format!(
+        "robocal rig: {key} translation_m [{}, {}, {}] ({} method), {used} of {} frames used\n",
+        t[0],
+        t[1],
+        t[2],
+        h["method"].as_str().unwrap_or(""),
+        frames.len()
+    );
+    if let Some(sd) = h["pose_refinement"].get("camera_transform_std") {
+        s += &format!(
+            "  std: translation_mm {} rotation_deg {}\n",
+            sd["translation_mm"], sd["rotation_deg"]
+        );
+    }
+    for w in h["warnings"].as_array().map_or(&[][..], Vec::as_slice) {
+        s += &format!(
+            "robocal rig: hand-eye warning: {}\n",
+            w.as_str().unwrap_or("")
+        );
+    }
+    s
+}
