@@ -16,9 +16,9 @@
 mod demo;
 mod live_capture;
 mod rig_frames;
-pub use rig_frames::rig_frame_keys;
 pub use demo::{render_demo, DemoData};
 pub use live_capture::LiveCapture;
+pub use rig_frames::rig_frame_keys;
 
 use crate::image::{decode, DecodeOptions, GrayImage};
 use crate::target::Target;

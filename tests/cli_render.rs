@@ -97,5 +97,7 @@ fn render_arguments_are_checked() {
     );
     let out = robocal(&["render", "--help"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("robocal render --out demo --demo"));
-    assert!(String::from_utf8_lossy(&out.stdout).contains("robocal render --out rig --rig --views 5"));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("robocal render --out rig --rig --views 5")
+    );
 }

@@ -152,15 +152,22 @@ impl BlockProblem for PoseProblem<'_> {
     }
 
     fn retract(&self, params: &BlockParams, step: &BlockParams) -> BlockParams {
-        let d = &step.global;
-        let delta = Pose::from_parts(
-            Translation3::new(d[3], d[4], d[5]),
-            rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2])),
-        );
-        BlockParams {
-            global: params_from_pose(&(pose_from_params(&params.global) * delta)).to_vec(),
-            blocks: Vec::new(),
-        }
+        retract_pose(params, step)
+    }
+}
+
+/// One pose as the only global parameters (rotation vector, translation),
+/// stepped on the right: `pose * exp(step)`. The PnP problems (one camera,
+/// or a held rig) share it.
+pub(crate) fn retract_pose(params: &BlockParams, step: &BlockParams) -> BlockParams {
+    let d = &step.global;
+    let delta = Pose::from_parts(
+        Translation3::new(d[3], d[4], d[5]),
+        rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2])),
+    );
+    BlockParams {
+        global: params_from_pose(&(pose_from_params(&params.global) * delta)).to_vec(),
+        blocks: Vec::new(),
     }
 }
 

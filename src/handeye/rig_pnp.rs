@@ -11,9 +11,9 @@ use super::reprojection_refine::ViewPoints;
 use super::Pose;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::geometry::{params_from_pose, pose_from_params, rotation_from_rotvec};
+use crate::geometry::{params_from_pose, pose_from_params};
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix6, SMatrix, Translation3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix6, SMatrix};
 
 /// The rig held fixed: every camera's intrinsics and `camera_from_rig`.
 #[derive(Debug, Clone)]
@@ -150,15 +150,7 @@ impl BlockProblem for RigPoseProblem<'_> {
     }
 
     fn retract(&self, params: &BlockParams, step: &BlockParams) -> BlockParams {
-        let d = &step.global;
-        let delta = Pose::from_parts(
-            Translation3::new(d[3], d[4], d[5]),
-            rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2])),
-        );
-        BlockParams {
-            global: params_from_pose(&(pose_from_params(&params.global) * delta)).to_vec(),
-            blocks: Vec::new(),
-        }
+        super::pnp::retract_pose(params, step)
     }
 }
 

@@ -80,7 +80,10 @@ fn random_shape(rng: &mut Rng, w: f64, h: f64) -> Shape {
                 )
             };
             let mut q = [(0.0, 0.0); 4];
-            for (k, (u, v)) in [(-hx, -hy), (-hx, hy), (hx, hy), (hx, -hy)].iter().enumerate() {
+            for (k, (u, v)) in [(-hx, -hy), (-hx, hy), (hx, hy), (hx, -hy)]
+                .iter()
+                .enumerate()
+            {
                 q[k] = corner(*u, *v);
             }
             // `inside` wants the order with a positive shoelace sum.
@@ -116,7 +119,11 @@ fn random_shape(rng: &mut Rng, w: f64, h: f64) -> Shape {
 pub fn clutter(width: u32, height: u32, seed: u64, noise_sigma: f64) -> GrayImage {
     let mut rng = Rng::new(seed);
     let (w, h) = (width as f64, height as f64);
-    let (g0, gx, gy) = (rng.range(80.0, 180.0), rng.range(-60.0, 60.0), rng.range(-60.0, 60.0));
+    let (g0, gx, gy) = (
+        rng.range(80.0, 180.0),
+        rng.range(-60.0, 60.0),
+        rng.range(-60.0, 60.0),
+    );
     let mut plane: Vec<f64> = (0..height)
         .flat_map(|y| (0..width).map(move |x| g0 + gx * x as f64 / w + gy * y as f64 / h))
         .collect();

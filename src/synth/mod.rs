@@ -14,8 +14,8 @@ pub mod video;
 
 pub use scene::Scene;
 
-pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
 pub use clutter::clutter;
+pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
 pub use rng::Rng;
 pub use video::{video_camera, BoardVideo, VideoOptions};
 
