@@ -163,6 +163,7 @@ export const tests = [
     await page.setViewportSize({ width: 400, height: 800 });
     for (const step of ['target', 'images', 'camera', 'robot', 'handeye', 'export', 'share']) {
       await page.click(`a[data-step=${step}]`);
+      await page.locator(`#step-${step}`).waitFor({ state: 'visible', timeout: 10000 });
       await page.waitForTimeout(200);
       const width = await page.evaluate(() => document.documentElement.scrollWidth);
       await shot(`narrow-${step}`);
@@ -171,6 +172,8 @@ export const tests = [
     // D. The 3-D view: large, zoom by buttons and keys, labels apart.
     await page.setViewportSize({ width: 1280, height: 900 });
     await page.click('a[data-step=handeye]');
+    // The step changes on the hash change, a task after the click.
+    await page.locator('#frames-3d').waitFor({ state: 'visible', timeout: 10000 });
     const size = await page.$eval('#frames-3d', (c) => [c.width, c.getBoundingClientRect().width]);
     assert.ok(size[0] >= 900 && size[1] >= 800, `3-D view ${size}`);
     const pixels = () => page.$eval('#frames-3d', (c) => c.toDataURL());

@@ -86,23 +86,31 @@ export function stopStream(stream) {
 }
 
 /**
- * Frames per second over a sliding window of `windowMs`: `tick(t)` on
- * every event (t in ms), `rate(now)` the events per second in the window.
+ * Frames per second over a sliding window of `windowMs`: `tick(t, n)` when
+ * `n` events (default 1) happened by time t (ms), `rate(now)` the events
+ * after the window's start divided by the window's length. The window starts
+ * at the first tick until `windowMs` has passed, so a burst of close ticks
+ * never reads as a high rate.
  */
 export class RateMeter {
   constructor(windowMs = 2000) {
     this.windowMs = windowMs;
-    this.times = [];
+    this.start = null;
+    this.ticks = [];
   }
 
-  tick(t) {
-    this.times.push(t);
-    while (this.times.length && this.times[0] < t - this.windowMs) this.times.shift();
+  tick(t, n = 1) {
+    if (this.start === null) this.start = t;
+    this.ticks.push([t, n]);
+    while (this.ticks.length && this.ticks[0][0] < t - this.windowMs) this.ticks.shift();
   }
 
   rate(now) {
-    const recent = this.times.filter((t) => t >= now - this.windowMs);
-    if (recent.length < 2) return 0;
-    return ((recent.length - 1) * 1000) / (recent[recent.length - 1] - recent[0]);
+    if (this.start === null) return 0;
+    const from = Math.max(this.start, now - this.windowMs);
+    const span = now - from;
+    if (span <= 0) return 0;
+    const count = this.ticks.reduce((sum, [t, n]) => (t > from && t <= now ? sum + n : sum), 0);
+    return (count * 1000) / span;
   }
 }

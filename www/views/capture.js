@@ -171,11 +171,17 @@ export class CaptureView {
     const video = $('camera-video');
     const next = (fn) => (video.requestVideoFrameCallback ? video.requestVideoFrameCallback(fn) : requestAnimationFrame(fn));
     let lastTime = -1;
-    const turn = () => {
+    let presented = null;
+    const turn = (now, meta) => {
       if (this.stream !== stream) return;
       if (video.currentTime !== lastTime && video.videoWidth) {
         lastTime = video.currentTime;
-        this.cameraRate.tick(performance.now());
+        // The camera's rate counts the frames the video presented: a busy
+        // page runs fewer callbacks than there were frames, and a detection
+        // may take a frame no callback saw.
+        const count = meta && Number.isFinite(meta.presentedFrames) ? meta.presentedFrames : null;
+        this.cameraRate.tick(performance.now(), count === null ? 1 : presented === null ? 0 : Math.max(0, count - presented));
+        if (count !== null) presented = count;
         // The step is out of sight: the camera keeps running, detection rests.
         if (!$('step-images').hidden) this.detectNewest(video, stream);
       }
