@@ -265,10 +265,9 @@ export const tests = [
     await page.click('a[data-step=export]');
     await page.selectOption('#export-transform', 'right_from_left');
     await page.$eval('#export-status', (el) => { el.textContent = ''; });
-    await page.click('#transform-formats button[data-format=xyz-quat-xyzw]');
-    await page.waitForFunction(() => /^xyz-quat-xyzw: /.test(document.getElementById('export-status').textContent), null, { timeout: 10000 });
-    const numbers = (await page.textContent('#export-preview')).match(/-?\d+(\.\d+)?(e[-+]?\d+)?/gi).map(Number);
-    const want = [...stereo.right_from_left.translation_m, ...stereo.right_from_left.quaternion_xyzw];
-    assert.deepEqual(numbers.slice(-7).map((x) => x.toFixed(9)), want.map((x) => x.toFixed(9)));
+    await page.click('#transform-formats button[data-format=matrix4]');
+    await page.waitForFunction(() => /^matrix4: /.test(document.getElementById('export-status').textContent), null, { timeout: 10000 });
+    const numbers = (await page.textContent('#export-preview')).match(/-?\d+(\.\d+)?(e[-+]?\d+)?/gi).map(Number).slice(-16);
+    stereo.right_from_left.matrix_row_major.flat().forEach((x, i) => assert.ok(Math.abs(numbers[i] - x) <= 1e-12, `matrix4 entry ${i}: ${numbers[i]} vs ${x}`));
   }],
 ];

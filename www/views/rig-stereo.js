@@ -54,7 +54,7 @@ export function stereoSection(s, heading) {
   return h('div', { id: 'stereo-results' },
     h('h3', {}, heading),
     h('p', { id: 'stereo-summary', class: 'summary' }, `right_from_left: baseline ${num(s.baseline_m * 1000, 4)} mm, RMS ${num(s.rms_px, 4)} px over ${s.pairs} pairs`),
-    h('p', { class: 'hint' }, `right = ${right.name}, left = ${left.name}: p_right = R p_left + T (the OpenCV stereoCalibrate R, T convention); right_from_left can be exported in every transform format in step 8.`),
+    h('p', { class: 'hint' }, `${left.name === 'left' && right.name === 'right' ? '' : `right = camera ${right.name}, left = camera ${left.name}: `}p_right = R p_left + T (the OpenCV stereoCalibrate R, T convention); right_from_left can be exported in every transform format in step 8.`),
     table(['', 'x', 'y', 'z'], [
       ['T (mm)', ...t.map((v) => num(v, 4))],
       ['std T (mm)', ...(s.std ? s.std.translation_m.map((v) => num(v * 1000, 3)) : ['—', '—', '—'])],
