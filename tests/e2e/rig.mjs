@@ -52,12 +52,16 @@ async function loadCameras(page, names, files) {
   }
 }
 
-/** A screenshot at a phone's width (400 px), then back to the suite's 1280 px. */
+/** The step reloaded at a phone's width (400 px) for a screenshot, then back at the suite's 1280 px. */
 async function narrowShot(page, shot, label) {
-  await page.setViewportSize({ width: 400, height: 900 });
-  await page.waitForTimeout(200); // the 3-D view redraws on resize
-  await shot(label);
-  await page.setViewportSize({ width: 1280, height: 900 });
+  await page.waitForTimeout(500); // the store saves 300 ms after the last change
+  for (const width of [400, 1280]) {
+    await page.setViewportSize({ width, height: 900 });
+    await page.reload();
+    await ready(page);
+    await page.locator('#rig-summary').waitFor({ timeout: 30000 });
+    if (width === 400) await shot(label);
+  }
 }
 
 /** rig.json as the page's export button downloads it. */

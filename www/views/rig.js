@@ -242,7 +242,9 @@ export class RigView {
     const co = r.co_observation;
     const tree = new Set(co.spanning_tree.map(([a, b]) => `${Math.min(a, b)}-${Math.max(a, b)}`));
     const coRows = co.frames.map((row, i) => [co.cameras[i], ...row.map((n, j) => (i !== j && tree.has(`${Math.min(i, j)}-${Math.max(i, j)}`) ? `${n} (tree)` : String(n)))]);
-    this.canvas = h('canvas', { id: 'rig-3d', width: 900, height: 560, role: 'img', 'aria-label': 'The rig in 3-D: each camera as a frustum, each frame\'s board as an outline' });
+    // Drawn at the width it is shown at (a phone's too), at most 900 px.
+    const width = Math.max(300, Math.min(900, this.panel.clientWidth || 900));
+    this.canvas = h('canvas', { id: 'rig-3d', width, height: Math.round(width * 0.62), role: 'img', 'aria-label': 'The rig in 3-D: each camera as a frustum, each frame\'s board as an outline' });
     this.exportsOut = h('div', { id: 'rig-exports' });
     const stereo = stereoOfRig(r);
     fill(this.out,
