@@ -105,6 +105,27 @@ fn rig_on_rendered_images_recovers_every_camera_from_rig() {
         assert!(dt < 3e-3 && dr < 3e-3, "cam{k}: {dt} m, {dr} rad; {err}");
     }
     assert!(report["rms_px"].as_f64().expect("rms") < 0.3);
+    // --fix k3 holds k3 at exactly 0 in every camera, so the rig exports to
+    // Kalibr's radtan (k1 k2 p1 p2), which has no k3.
+    let held = dir.join("rig_k3.json").to_string_lossy().into_owned();
+    let mut args = args_of(&files, |_| true);
+    args.extend(["--fix", "k3", "-o", &held]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&held).expect("read")).expect("json");
+    for k in 0..4 {
+        let d = &report["cameras"][k]["calibration"]["distortion"];
+        assert_eq!(d["k3"], 0.0, "cam{k}: {d}");
+        assert_ne!(d["k1"], 0.0, "cam{k}: {d}");
+    }
+    let (code, yaml, err) = robocal(&["export", &held, "--format", "kalibr"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        yaml.matches("distortion_model: radtan").count(),
+        4,
+        "{yaml}"
+    );
 }
 
 #[test]

@@ -11,7 +11,6 @@ import { CameraView } from './views/camera.js';
 import { RobotView } from './views/robot.js';
 import { HandEyeView } from './views/handeye.js';
 import { WorkflowsView } from './views/workflows.js';
-import { StereoView } from './views/stereo.js';
 import { RigView } from './views/rig.js';
 import { ExportView } from './views/export.js';
 import { ShareView, sharedFragment, decodeShare } from './views/share.js';
@@ -141,7 +140,6 @@ async function main() {
   robotView = robot;
   const handeye = new HandEyeView(store, engine, robot);
   new WorkflowsView(store, engine);
-  const stereo = new StereoView(store, engine);
   const rig = new RigView(store, engine, $('rig-panel'));
   new ExportView(store, engine);
   const version = await versionPromise;
@@ -164,11 +162,10 @@ async function main() {
     await images.restore();
     store.changed('target-loaded');
     camera.render();
-    stereo.render();
     rig.render();
     $('engine-status').textContent = readyText();
   };
-  const hasWork = () => store.session.images.length || store.session.robot.text || store.session.camera.result || store.session.stereo.left.length || store.session.rig.cameras.some((c) => c.files.length);
+  const hasWork = () => store.session.images.length || store.session.robot.text || store.session.camera.result || store.session.rig.cameras.some((c) => c.files.length);
   $('new-session').addEventListener('click', async () => {
     if (store.session.images.length && !confirm('Start a new session? Images, detections and results of this session are removed from this browser.')) return;
     await newSession();

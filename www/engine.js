@@ -11,8 +11,8 @@
 /** What a request does, for messages: "detecting the target in board.png". */
 const STEPS = {
   preview: 'decoding', detect: 'detecting the target in', boards: 'detecting the boards in', undistort: 'undistorting', calibrate: 'solving the camera',
-  handeye: 'solving the hand-eye calibration', stereo: 'solving the stereo pair', export: 'exporting', poses: 'reading the robot poses',
-  demo: 'rendering the demo', target: 'checking the target', kalibrTarget: 'reading the Kalibr target file', pair: 'pairing the stereo images', conventions: 'ranking the pose conventions',
+  handeye: 'solving the hand-eye calibration', rig: 'solving the rig', rigFrames: 'grouping the rig images into frames', export: 'exporting', poses: 'reading the robot poses',
+  demo: 'rendering the demo', target: 'checking the target', kalibrTarget: 'reading the Kalibr target file', conventions: 'ranking the pose conventions',
   workflow: 'solving the workflow', 'workflow-csv': 'reading the workflow file', frame: 'detecting the target in the live video', guide: 'updating the capture guide',
 };
 

@@ -13,9 +13,32 @@ export function defaultSession() {
     robot: { fileName: null, text: null, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper', parsed: null },
     handeye: { setup: 'eye-in-hand', method: 'all', result: null },
     workflows: { planar: null, xytable: null },
-    stereo: { model: 'brown', result: null, left: [], right: [] }, // left/right: { id, name, detection, error, spec }
-    rig: { model: 'brown', result: null, cameras: [] }, // cameras: { name, files: [{ id, name, detection, error, spec }] }
+    // model, radial, tangential, options: the lens choice (views/lens.js); cameras: { name, files: [{ id, name, detection, error, spec }] }
+    rig: { model: 'brown', result: null, cameras: [] },
+    stereo: null, // { result }: `robocal stereo`'s report, from a session saved before the rig step replaced the stereo step
   };
+}
+
+/**
+ * A session saved before the rig step replaced the stereo step: its left
+ * and right images become a rig of two cameras named left and right (when
+ * the rig has no images yet), its stereo result stays for the rig step and
+ * the export step until the rig is solved. Returns the ids of stereo images
+ * no longer referenced (their bytes can go).
+ */
+export function migrateStereo(session) {
+  const st = session.stereo;
+  if (!st || !(st.left || st.right)) return [];
+  const [left, right] = [st.left || [], st.right || []];
+  let dropped = [];
+  if (!(session.rig.cameras || []).some((c) => c.files.length) && (left.length || right.length)) {
+    session.rig.cameras = [{ name: 'left', files: left }, { name: 'right', files: right }];
+    if (st.model) session.rig.model = st.model;
+  } else {
+    dropped = [...left, ...right].map((f) => f.id);
+  }
+  session.stereo = st.result ? { result: st.result } : null;
+  return dropped;
 }
 
 function openDb() {
@@ -64,15 +87,8 @@ export class Store {
         else if (img.detection) img.bytesMissing = true;
         else { img.status = 'error'; img.error = 'the image bytes were not found in this browser\'s storage; add the file again'; }
       }
-      const stereo = this.session.stereo;
-      for (const side of ['left', 'right']) {
-        const kept = [];
-        for (const f of stereo[side] || []) {
-          const buf = await tx(this.db, 'blobs', 'readonly', (s) => s.get(f.id));
-          if (buf) { this.bytes.set(f.id, buf); kept.push(f); }
-        }
-        stereo[side] = kept;
-      }
+      const dropped = migrateStereo(this.session);
+      if (dropped.length) await this.deleteBytes(dropped);
       for (const camera of this.session.rig.cameras) {
         const kept = [];
         for (const f of camera.files) {
@@ -114,7 +130,7 @@ export class Store {
     this.changed('images');
   }
 
-  /** Keep bytes that are not a step-2 image (the stereo page's). */
+  /** Keep bytes that are not a step-2 image (the rig step's). */
   async putBytes(id, bytes) {
     this.bytes.set(id, bytes);
     if (this.db && this.persistent) {

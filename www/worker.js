@@ -66,11 +66,6 @@ const handlers = {
     await ready;
     return JSON.parse(robocal.read_kalibr_target(text));
   },
-  /** Stereo pairing by file name: the rule of `robocal stereo` (io::pairing). */
-  async pair({ left, right }) {
-    await ready;
-    return JSON.parse(robocal.pair_images(JSON.stringify(left), JSON.stringify(right)));
-  },
 };
 
 handlers.export = async ({ report, format, transform }) => {
@@ -145,11 +140,6 @@ handlers.rigFormats = async () => {
 handlers.exportFiles = async ({ report, format, transform, frames }) => {
   await ready;
   return JSON.parse(robocal.export_report_files(report, format, transform || '', frames || ''));
-};
-
-handlers.stereo = async ({ input }) => {
-  await ready;
-  return JSON.parse(robocal.calibrate_stereo(input));
 };
 
 /**

@@ -67,7 +67,8 @@ pose_index, used, cameras, pose_fit_rms_px, reason).",
   robocal rig --input rig-files.json -o rig.json
   robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png \\
       --setup eye-in-hand --poses robot.csv -o rig.json
-  robocal export rig.json --format kalibr"
+  robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png \\
+      --fix k3 -o rig.json && robocal export rig.json --format kalibr"
 )]
 pub struct RigArgs {
     /// The target, as for 'robocal detect' (chessboard:9x6:30mm, ...)
@@ -92,6 +93,10 @@ pub struct RigArgs {
     /// rational, division, kannala_brandt, eucm, none
     #[arg(long, value_name = "NAME", overrides_with = "model")]
     model: Option<String>,
+    /// Hold a distortion coefficient of every solved camera at 0
+    /// (repeatable: --fix k3 gives Kalibr's radtan k1 k2 p1 p2)
+    #[arg(long, value_name = "NAME")]
+    fix: Vec<String>,
     /// Images detected in parallel (default: all cores)
     #[arg(long, value_name = "N", overrides_with = "threads")]
     threads: Option<usize>,
@@ -299,6 +304,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
     let options = RigOptions {
         calibration: CalibrationOptions {
             model: model_from_name(model.as_deref().unwrap_or("brown"))?,
+            fixed_coefficients: args.fix.clone(),
             ..CalibrationOptions::default()
         },
         rig_frame: pick(&args.rig_frame, |r| &r.rig_frame),

@@ -283,13 +283,13 @@ function shareCase(fragment, message) {
 }
 const shareText = (bytes) => deflateRawSync(Buffer.from(bytes)).toString('base64url');
 
-/** Stereo: files added side by side; returns the pairing text once it names `expect`. */
-async function stereoAdd(page, left, right, expect) {
+/** The rig step's two cameras: files added to each; returns the grouping text once it includes `expect`. */
+async function rigAdd(page, left, right, expect) {
   const mk = (names) => names.map((n) => png(n, makePng(40, 30, checker(5))));
-  if (left.length) await page.setInputFiles('#stereo-left-input', mk(left));
-  if (right.length) await page.setInputFiles('#stereo-right-input', mk(right));
-  await page.waitForFunction((e) => (document.getElementById('stereo-pairing')?.textContent || '').includes(e), expect, { timeout: 10000 });
-  return page.textContent('#stereo-pairing');
+  if (left.length) await page.setInputFiles('#rig-input-0', mk(left));
+  if (right.length) await page.setInputFiles('#rig-input-1', mk(right));
+  await page.waitForFunction((e) => (document.getElementById('rig-grouping')?.textContent || '').includes(e), expect, { timeout: 10000 });
+  return page.textContent('#rig-grouping');
 }
 
 const MESSAGES = {
@@ -465,39 +465,42 @@ export const tests = [
   ['share-link-not-json', shareCase(shareText('not json'), 'this link does not hold robocal results (its content is not JSON)')],
   ['share-link-null', shareCase(shareText('null'), 'this link does not hold robocal results')],
 
-  // ---- step 7, stereo: the pairing refuses with the core's message ----
-  ['stereo-too-few-pairs', async (page, { url, shot }) => {
+  // ---- step 7, stereo pairs and rigs: the grouping refuses with the core's message ----
+  ['rig-too-few-frames', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);
     await ready(page);
-    assert.equal(await stereoAdd(page, ['l1.png', 'l2.png'], ['r1.png', 'r2.png'], '2 pairs'), '2 pairs, paired by the number in the file names.');
-    assert.equal(await page.textContent('#stereo-too-few'), 'A stereo calibration needs at least 3 pairs: add 1 more pair (a left and a right image each) to solve.');
-    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    assert.equal(await rigAdd(page, ['l1.png', 'l2.png'], ['r1.png', 'r2.png'], '2 frames over 2 cameras'), '2 frames over 2 cameras, grouped by the number in the file names.');
+    assert.equal(await page.textContent('#rig-too-few'), 'A rig calibration needs at least 3 frames: add 1 more frame (an image of each camera, numbered alike) to solve.');
+    assert.equal(await page.isDisabled('#rig-solve'), true);
     await shot('bad');
-    assert.equal(await stereoAdd(page, ['l3.png'], ['r3.png'], '3 pairs'), '3 pairs, paired by the number in the file names.');
-    assert.equal(await page.$('#stereo-too-few'), null);
-    assert.equal(await page.isDisabled('#stereo-solve'), false);
+    assert.equal(await rigAdd(page, ['l3.png'], ['r3.png'], '3 frames'), '3 frames over 2 cameras, grouped by the number in the file names.');
+    assert.equal(await page.$('#rig-too-few'), null);
+    assert.equal(await page.isDisabled('#rig-solve'), false);
   }],
-  ['stereo-number-twice', async (page, { url, shot }) => {
+  ['rig-number-twice', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);
     await ready(page);
-    await stereoAdd(page, ['l1.png', 'l2.png', 'l3.png'], ['r1.png', 'r2.png', 'r3.png'], '3 pairs');
-    const error = await stereoAdd(page, ['l01.png'], [], 'cannot be paired');
-    assert.equal(error, 'The images cannot be paired: images: images are paired by the last number in their file names, but number 1 is in two left images: l1.png, l01.png');
-    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    await rigAdd(page, ['l1.png', 'l2.png', 'l3.png'], ['r1.png', 'r2.png', 'r3.png'], '3 frames');
+    const error = await rigAdd(page, ['l01.png'], [], 'cannot be grouped');
+    assert.equal(error, 'The images cannot be grouped into frames: images: frames are grouped by the last number in their file names, but number 1 is in two camera cam0 images: l1.png, l01.png');
+    assert.equal(await page.isDisabled('#rig-solve'), true);
     await shot('bad');
-    // The files are kept (the message names them); removing them and loading a clean set pairs.
-    await page.click('#stereo-clear');
-    assert.equal(await stereoAdd(page, ['l1.png', 'l2.png', 'l3.png'], ['r1.png', 'r2.png', 'r3.png'], '3 pairs'), '3 pairs, paired by the number in the file names.');
+    // The files are kept (the message names them); removing them and loading a clean set groups.
+    await page.click('#rig-clear');
+    assert.equal(await rigAdd(page, ['l1.png', 'l2.png', 'l3.png'], ['r1.png', 'r2.png', 'r3.png'], '3 frames'), '3 frames over 2 cameras, grouped by the number in the file names.');
   }],
-  ['stereo-count-by-order', async (page, { url, shot }) => {
+  ['rig-names-without-number', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);
     await ready(page);
-    // (After the left files alone the page already shows '3 left but 0 right'.)
-    const error = await stereoAdd(page, ['a.png', 'b.png', 'c.png'], ['x.png', 'y.png'], '3 left but 2 right');
-    assert.equal(error, 'The images cannot be paired: images: images are paired by order: 3 left but 2 right');
+    // Some names have a number: frames go by the number, and the others are named.
+    const error = await rigAdd(page, ['a.png', 'b.png', 'c3.png'], ['x1.png', 'y2.png', 'z3.png'], 'cannot be grouped');
+    assert.equal(error, 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam0 has names without one: a.png, b.png (number every file, or group by order)');
+    assert.equal(await page.isDisabled('#rig-solve'), true);
     await shot('bad');
-    assert.equal(await stereoAdd(page, [], ['z.png'], '3 pairs'), '3 pairs, paired by order (sorted names).');
-    assert.equal(await page.isDisabled('#stereo-solve'), false);
+    // No name with a number: by order (sorted names); a camera with fewer images misses the last frames.
+    await page.click('#rig-clear');
+    assert.equal(await rigAdd(page, ['a.png', 'b.png', 'c.png'], ['x.png', 'y.png'], '3 frames'), '3 frames over 2 cameras, grouped by order (sorted names).');
+    assert.equal(await page.isDisabled('#rig-solve'), false);
   }],
 
   // ---- step 1, target: the field refused, the target in use kept ----

@@ -166,7 +166,7 @@ export const tests = [
     await shot('square-pixels');
     console.log(`     left set: ${cli.views.length} views, page = CLI: fx ${K[0][0].toFixed(4)} fy ${K[1][1].toFixed(4)} cx ${K[0][2].toFixed(4)} cy ${K[1][2].toFixed(4)} k1 ${cli.distortion.k1.toFixed(6)} rms ${cli.rms_px.toFixed(5)} px; square pixels: fx = fy ${Ks[0][0].toFixed(4)} (OpenCV 535.916, Bouguet 533.0/533.2), cx ${Ks[0][2].toFixed(4)} cy ${Ks[1][2].toFixed(4)}, rms ${square.rms_px.toFixed(5)} px`);
   }],
-  ['OpenCV left/right pairs: stereo page equals CLI', async (page, { url, shot }) => {
+  ['OpenCV left/right pairs: the rig step\'s 2-camera stereo pair equals robocal stereo', async (page, { url, shot }) => {
     const dir = datasetDir('opencv-left-right-9x6');
     if (!dir) { console.log('     skipped: opencv-left-right-9x6 not found in ../shared/datasets or /work/shared/datasets'); return; }
     const side = (s) => readdirSync(dir).filter((f) => new RegExp(`^${s}\\d+\\.jpg$`).test(f)).sort().map((f) => join(dir, f));
@@ -176,11 +176,16 @@ export const tests = [
     const cli = JSON.parse(execFileSync(CLI, ['stereo', '--target', SPEC, '--left', ...left, '--right', ...right], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
     await page.goto(`${url}#stereo`);
     await ready(page);
-    // Right before left: the page pairs by the number in the names, not by upload order.
-    await page.setInputFiles('#stereo-right-input', right);
-    await page.setInputFiles('#stereo-left-input', left);
-    await page.waitForFunction(() => /^13 pairs, paired by the number in the file names/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 30000 });
-    await page.click('#stereo-solve');
+    // The rig step with its two cameras: right before left, the page groups by
+    // the number in the names, not by upload order.
+    for (const [k, name] of [[1, 'right'], [0, 'left']]) {
+      await page.fill(`#rig-name-${k}`, name);
+      await page.dispatchEvent(`#rig-name-${k}`, 'change');
+    }
+    await page.setInputFiles('#rig-input-1', right);
+    await page.setInputFiles('#rig-input-0', left);
+    await page.waitForFunction(() => /^13 frames over 2 cameras, grouped by the number in the file names/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 30000 });
+    await page.click('#rig-solve');
     await page.locator('#stereo-summary').waitFor({ timeout: 300000 });
     await shot('stereo');
     const summary = await page.textContent('#stereo-summary');

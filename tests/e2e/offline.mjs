@@ -59,7 +59,7 @@ export const tests = [
     await poll(page, async (v) => JSON.stringify(await caches.keys()) === JSON.stringify([`robocal-${v}`]) || (await caches.keys()), version);
     const cached = await page.evaluate(async (v) => (await (await caches.open(`robocal-${v}`)).keys()).map((r) => new URL(r.url).pathname), version);
     // Every precached file (the shell, modules, the wasm) is in the new cache.
-    for (const f of ['/', '/index.html', '/app.js', '/worker.js', '/pkg/robocal.js', '/pkg/robocal_bg.wasm', '/views/stereo.js']) assert.ok(cached.includes(f), `${f} not cached: ${cached.join(' ')}`);
+    for (const f of ['/', '/index.html', '/app.js', '/worker.js', '/pkg/robocal.js', '/pkg/robocal_bg.wasm', '/views/rig.js']) assert.ok(cached.includes(f), `${f} not cached: ${cached.join(' ')}`);
   }],
   ['loaded once, the app starts and runs the demo offline', async (page, { shot }) => {
     // A server of its own, stopped below: offline means no server at all.

@@ -67,45 +67,43 @@ function zyxAngles(R) {
 }
 
 export const tests = [
-  ['stereo page: pairs by the number in the names (an unpaired file is the core\'s error), refuses fewer than 3 pairs', async (page, { url, shot }) => {
+  ['stereo & rig page: two cameras grouped into frames by the number in the names, a frame seen by one camera kept, refuses fewer than 3 frames, kept over a reload', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);
     await ready(page);
-    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    assert.equal(await page.isDisabled('#rig-solve'), true);
     const png = (name) => ({ name, mimeType: 'image/png', buffer: makePng(40, 30, checker(5)) });
-    await page.setInputFiles('#stereo-left-input', [png('cam_L_2.png'), png('cam_L_10.png')]);
-    await page.setInputFiles('#stereo-right-input', [png('cam_R_10.png'), png('cam_R_2.png'), png('cam_R_7.png')]);
-    // The core's rule (robocal::io::pairing): a file without a partner is an
-    // error naming it, not a warning; nothing is paired and the solve stays off.
-    // Wait for the right-hand files too: after the left ones alone the page
-    // already shows an error (their partners are missing), which is not the
-    // one under test.
-    await page.waitForFunction(() => /cam_R_7\.png/.test(document.querySelector('#stereo-pairing.msg-error')?.textContent || ''), null, { timeout: 10000 });
-    assert.match(await page.textContent('#stereo-pairing'), /^The images cannot be paired: .*no partner for: cam_R_7\.png \(right, number 7\)$/);
-    assert.equal(await page.$('#stereo-pair-table'), null);
-    assert.equal(await page.isDisabled('#stereo-solve'), true);
-    // The full numbered set pairs left n with right n, in left (numeric) order.
-    await page.setInputFiles('#stereo-left-input', [png('cam_L_7.png')]);
-    await page.waitForFunction(() => /^3 pairs, paired by the number in the file names\.$/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
-    const rows = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [tr.cells[1].textContent, tr.cells[3].textContent]));
-    assert.deepEqual(rows, [['cam_L_2.png', 'cam_R_2.png'], ['cam_L_7.png', 'cam_R_7.png'], ['cam_L_10.png', 'cam_R_10.png']]);
-    assert.equal(await page.$('#stereo-pairs .msg-error'), null);
-    assert.equal(await page.isDisabled('#stereo-solve'), false);
-    // Without a chessboard in the images, the solve says why instead of hanging.
-    await page.click('#stereo-solve');
-    await page.locator('#stereo-results .msg-error').waitFor({ timeout: 30000 });
-    assert.match(await page.textContent('#stereo-results .msg-error'), /^requires at least 3 pairs, got 0$/);
+    await page.setInputFiles('#rig-input-0', [png('cam_L_2.png'), png('cam_L_10.png')]);
+    await page.waitForFunction(() => /^2 frames over 2 cameras/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    assert.equal(await page.textContent('#rig-missing'), 'Add images for camera cam1 to solve.');
+    assert.equal(await page.textContent('#rig-too-few'), 'A rig calibration needs at least 3 frames: add 1 more frame (an image of each camera, numbered alike) to solve.');
+    assert.equal(await page.isDisabled('#rig-solve'), true);
+    // The core's rule (robocal::io::pairing, as robocal rig): left n with right
+    // n, in numeric order; a camera may miss a frame (cam_R_7 has no left image).
+    await page.setInputFiles('#rig-input-1', [png('cam_R_10.png'), png('cam_R_2.png'), png('cam_R_7.png')]);
+    await page.waitForFunction(() => /^3 frames over 2 cameras, grouped by the number in the file names\.$/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    const cells = () => page.$$eval('#rig-frame-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+    assert.deepEqual(await cells(), [['2', 'cam_L_2.png: not detected yet', 'cam_R_2.png: not detected yet'], ['7', '—', 'cam_R_7.png: not detected yet'], ['10', 'cam_L_10.png: not detected yet', 'cam_R_10.png: not detected yet']]);
+    assert.equal(await page.$('#rig-too-few'), null);
+    assert.equal(await page.isDisabled('#rig-solve'), false);
+    await page.setInputFiles('#rig-input-0', [png('cam_L_7.png')]);
+    await page.waitForFunction(() => document.getElementById('rig-count-0')?.textContent === '3 images', null, { timeout: 10000 });
+    await page.waitForFunction(() => document.querySelectorAll('#rig-frame-table tbody tr')[1]?.cells[1].textContent === 'cam_L_7.png: not detected yet', null, { timeout: 10000 });
+    // Without a chessboard in the images, the solve says why instead of hanging (the CLI's words).
+    await page.click('#rig-solve');
+    await page.locator('#rig-error').waitFor({ timeout: 30000 });
+    assert.equal(await page.textContent('#rig-error'), 'the target was found in no image of camera cam0');
     await shot('pairs');
-    // The stereo images and their detection results survive a reload.
-    const before = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
-    assert.match(before[0][2], /chessboard|target|found/i);
+    // The images and their detection results survive a reload.
+    const before = await cells();
+    assert.match(before[0][1], /^cam_L_2\.png: not found: .*(chessboard|target|found)/i);
     await page.waitForTimeout(500); // the store saves 300 ms after the last change
     await page.reload();
     await ready(page);
-    await page.waitForFunction(() => /^3 pairs/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
-    assert.deepEqual(await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent))), before);
-    await page.click('#stereo-clear');
-    await page.waitForFunction(() => !document.getElementById('stereo-pair-table'), null, { timeout: 10000 });
-    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    await page.waitForFunction(() => /^3 frames/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    assert.deepEqual(await cells(), before);
+    await page.click('#rig-clear');
+    await page.waitForFunction(() => !document.getElementById('rig-frame-table'), null, { timeout: 10000 });
+    assert.equal(await page.isDisabled('#rig-solve'), true);
   }],
   ['camera page: distortion field drawn, undistorted preview', async (page, { url, shot }) => {
     await demoSolved(page, url);

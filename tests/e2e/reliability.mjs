@@ -1,5 +1,5 @@
 // Nothing falls over, nothing injects, nothing leaks (issue 17 §4, §5; issue
-// 16 §4): stereo pairing by the core's rule, a corrupt JPEG and a wasm trap
+// 16 §4): stereo pairs grouped by the core's rule on the rig step, a corrupt JPEG and a wasm trap
 // answered with messages while the page keeps working, crafted share links
 // shown inertly in the page and in the report, and no request leaving
 // 127.0.0.1 during a whole session.
@@ -130,29 +130,32 @@ return real_decode_image_preview(bytes, max_side, options);
   }
 
 export const tests = [
-  ['stereo pairs by the core rule: shuffled numbered names pair right, a mismatch shows the core message', async (page, { url, shot }) => {
+  ['stereo pairs on the rig step by the core rule: shuffled numbered names group right, a frame seen by one camera is kept, a number twice shows the core message', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);
     await ready(page);
     const png = (name) => ({ name, mimeType: 'image/png', buffer: makePng(40, 30, checker(5)) });
-    await page.setInputFiles('#stereo-left-input', [png('left_10.png'), png('left_2.png'), png('left_07.png')]);
-    await page.setInputFiles('#stereo-right-input', [png('right7.png'), png('right010.png'), png('right002.png')]);
-    await page.waitForFunction(() => /^3 pairs, paired by the number in the file names\.$/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
-    const rows = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [tr.cells[1].textContent, tr.cells[3].textContent]));
-    assert.deepEqual(rows, [['left_2.png', 'right002.png'], ['left_07.png', 'right7.png'], ['left_10.png', 'right010.png']]);
-    assert.equal(await page.isDisabled('#stereo-solve'), false);
-    // A right image without a partner: the core's error, naming the file.
-    await page.setInputFiles('#stereo-right-input', [png('right11.png')]);
-    await page.waitForFunction(() => /cannot be paired/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
-    assert.equal(await page.textContent('#stereo-pairing'), 'The images cannot be paired: images: images are paired by the last number in their file names; no partner for: right11.png (right, number 11)');
-    assert.equal(await page.isDisabled('#stereo-solve'), true);
+    const names = () => page.$$eval('#rig-frame-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent.replace(/: .*$/, ''))));
+    await page.setInputFiles('#rig-input-0', [png('left_10.png'), png('left_2.png'), png('left_07.png')]);
+    await page.setInputFiles('#rig-input-1', [png('right7.png'), png('right010.png'), png('right002.png')]);
+    await page.waitForFunction(() => /^3 frames over 2 cameras, grouped by the number in the file names\.$/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    assert.deepEqual(await names(), [['2', 'left_2.png', 'right002.png'], ['7', 'left_07.png', 'right7.png'], ['10', 'left_10.png', 'right010.png']]);
+    assert.equal(await page.isDisabled('#rig-solve'), false);
+    // A right image without a left one: a frame only the right camera saw (a rig camera may miss any frame).
+    await page.setInputFiles('#rig-input-1', [png('right11.png')]);
+    await page.waitForFunction(() => /^4 frames/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    assert.deepEqual((await names())[3], ['11', '—', 'right11.png']);
+    // Number 2 twice in the right camera: the core's error, naming both files.
+    await page.setInputFiles('#rig-input-1', [png('right2.png')]);
+    await page.waitForFunction(() => /cannot be grouped/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in their file names, but number 2 is in two camera cam1 images: right002.png, right2.png');
+    assert.equal(await page.isDisabled('#rig-solve'), true);
     await shot('mismatch');
     // No numbers anywhere: by order of the sorted names.
-    await page.click('#stereo-clear');
-    await page.setInputFiles('#stereo-left-input', [png('b.png'), png('a.png'), png('c.png')]);
-    await page.setInputFiles('#stereo-right-input', [png('z.png'), png('x.png'), png('y.png')]);
-    await page.waitForFunction(() => /^3 pairs, paired by order/.test(document.getElementById('stereo-pairing')?.textContent || ''), null, { timeout: 10000 });
-    const ordered = await page.$$eval('#stereo-pair-table tbody tr', (trs) => trs.map((tr) => [tr.cells[1].textContent, tr.cells[3].textContent]));
-    assert.deepEqual(ordered, [['a.png', 'x.png'], ['b.png', 'y.png'], ['c.png', 'z.png']]);
+    await page.click('#rig-clear');
+    await page.setInputFiles('#rig-input-0', [png('b.png'), png('a.png'), png('c.png')]);
+    await page.setInputFiles('#rig-input-1', [png('z.png'), png('x.png'), png('y.png')]);
+    await page.waitForFunction(() => /^3 frames over 2 cameras, grouped by order/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    assert.deepEqual(await names(), [['0', 'a.png', 'x.png'], ['1', 'b.png', 'y.png'], ['2', 'c.png', 'z.png']]);
   }],
   ['the 28-byte JPEG gets an error card naming format and defect; a later good image detects', async (page, { url, shot }) => {
     await page.goto(url);

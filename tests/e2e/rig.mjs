@@ -1,12 +1,16 @@
-// The rig step (step 7, below the stereo pair): a seeded four-camera rig
+// The rig step (step 7, stereo pairs and rigs): a seeded four-camera rig
 // rendered by the release CLI (`robocal render --rig`: two pairs facing each
 // other, linked only by the side frames) through the page: cameras added,
 // frames grouped by the number in the file names, detection and the joint
 // solve in the worker. Every camera_from_rig is checked against the render's
 // truth within 3 of the standard deviations the page reports, and against
-// `robocal rig` on the same files (same core: equal to 1e-9). Without side
-// frames the page shows the core's error naming the two groups. OpenCV's
-// left/right set as a 2-camera rig gives the stereo result.
+// `robocal rig` on the same files (same core: equal to 1e-9); with k3 held
+// (the lens choice of step 3) the page's solve equals `robocal rig --fix k3`
+// and its Kalibr camchain the CLI's export. Without side frames the page
+// shows the core's error naming the two groups. OpenCV's left/right set as a
+// 2-camera rig gives the stereo result (right_from_left, its tables, the
+// export step's transform), kept over a reload; an earlier session's stereo
+// result still opens.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
@@ -45,6 +49,18 @@ async function loadCameras(page, names, files) {
     await page.dispatchEvent(`#rig-name-${k}`, 'change');
     await page.setInputFiles(`#rig-input-${k}`, files[k]);
     await page.waitForFunction(([k, n]) => document.getElementById(`rig-count-${k}`)?.textContent === `${n} images`, [k, files[k].length], { timeout: 20000 });
+  }
+}
+
+/** The step reloaded at a phone's width (400 px) for a screenshot, then back at the suite's 1280 px. */
+async function narrowShot(page, shot, label) {
+  await page.waitForTimeout(500); // the store saves 300 ms after the last change
+  for (const width of [400, 1280]) {
+    await page.setViewportSize({ width, height: 900 });
+    await page.reload();
+    await ready(page);
+    await page.locator('#rig-summary').waitFor({ timeout: 30000 });
+    if (width === 400) await shot(label);
   }
 }
 
@@ -131,6 +147,37 @@ export const tests = [
       await page.waitForFunction(() => /^kalibr: /.test(document.getElementById('rig-export-status')?.textContent || ''), null, { timeout: 10000 });
       assert.equal(await page.textContent('#rig-export-status'), "kalibr: format: camera 'cam0': Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr");
       await shot('exports');
+      // Brown-Conrady with 2 radial terms (k3 held at 0, the control of step 3):
+      // the page's solve is `robocal rig --fix k3`'s and exports to Kalibr's radtan.
+      await page.click('#rig-lens-details summary');
+      await page.selectOption('#rig-radial', '2');
+      await page.$eval('#rig-results', (el) => el.replaceChildren());
+      await page.click('#rig-solve');
+      await page.locator('#rig-summary').waitFor({ timeout: 600000 });
+      const held = await downloadedReport(page);
+      const cliHeld = JSON.parse(execFileSync(CLI, ['rig', ...files.flatMap((f, k) => ['--camera', names[k], ...f]), '--target', 'chessboard:10x7:60mm', '--fix', 'k3'], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+      held.cameras.forEach((c, k) => {
+        assert.equal(c.calibration.distortion.k3, 0, `${c.name} k3`);
+        c.camera_from_rig.matrix_row_major.flat().forEach((x, i) => assert.ok(Math.abs(x - cliHeld.cameras[k].camera_from_rig.matrix_row_major.flat()[i]) <= 1e-9, `k3 held: ${c.name} entry ${i}: page ${x}, CLI`));
+      });
+      const [kalibr] = await Promise.all([page.waitForEvent('download'), page.click('#rig-export-kalibr')]);
+      const pageKalibr = readFileSync(await kalibr.path(), 'utf8');
+      writeFileSync(join(dir, 'rig_k3.json'), JSON.stringify(cliHeld));
+      const cliKalibr = execFileSync(CLI, ['export', join(dir, 'rig_k3.json'), '--format', 'kalibr']).toString();
+      const models = (y) => [...y.matchAll(/distortion_model: (\S+)/g)].map((m) => m[1]);
+      const coeffs = (y) => [...y.matchAll(/distortion_coeffs: \[([^\]]*)\]/g)].map((m) => m[1].split(',').map(Number));
+      assert.deepEqual(models(pageKalibr), ['radtan', 'radtan', 'radtan', 'radtan']);
+      assert.deepEqual(models(cliKalibr), models(pageKalibr));
+      const [pc, cc] = [coeffs(pageKalibr), coeffs(cliKalibr)];
+      held.cameras.forEach((c, k) => {
+        const d = c.calibration.distortion;
+        // radtan is [k1, k2, p1, p2]: the page's file holds its report's numbers; the CLI's solve agrees to 1e-9 (wasm vs native libm).
+        assert.deepEqual(pc[k], [d.k1, d.k2, d.p1, d.p2], `${c.name} radtan coefficients`);
+        pc[k].forEach((x, i) => assert.ok(Math.abs(x - cc[k][i]) <= 1e-9, `${c.name} radtan[${i}]: page ${x}, CLI ${cc[k][i]}`));
+      });
+      assert.equal(await page.textContent('#rig-export-status'), 'kalibr: camchain.yaml');
+      await shot('kalibr');
+      await narrowShot(page, shot, 'narrow');
       console.log(`     rig: ${report.frames.length} frames, rms ${report.rms_px.toFixed(4)} px, worst extrinsic error ${worst.toFixed(2)} std`);
     } finally {
       rmSync(dir, { recursive: true, force: true });
@@ -177,5 +224,54 @@ export const tests = [
     // docs/rig.md: the 2-camera rig equals calibrate_stereo to 3e-16; 1e-9 covers wasm vs native libm.
     got.matrix_row_major.flat().forEach((x, i) => assert.ok(Math.abs(x - stereo.right_from_left.matrix_row_major.flat()[i]) <= 1e-9, `entry ${i}: rig ${x}, stereo`));
     assert.ok(Math.abs(report.rms_px - stereo.rms_px) <= 1e-9, `rms ${report.rms_px} vs ${stereo.rms_px}`);
+    // Two cameras are a stereo pair: the stereo step's tables, kept over a reload.
+    const pairText = `right_from_left: baseline ${(stereo.baseline_m * 1000).toFixed(4)} mm, RMS ${stereo.rms_px.toFixed(4)} px over 13 pairs`;
+    assert.equal(await page.textContent('#stereo-summary'), pairText);
+    const tables = () => page.$$eval('#stereo-translation tbody tr, #stereo-rotation tbody tr, #stereo-cameras tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+    const shown = await tables();
+    assert.deepEqual(shown[0], ['T (mm)', ...stereo.right_from_left.translation_m.map((v) => (v * 1000).toFixed(4))]);
+    await page.waitForTimeout(500); // the store saves 300 ms after the last change
+    await page.reload();
+    await ready(page);
+    await page.locator('#stereo-summary').waitFor({ timeout: 30000 });
+    assert.equal(await page.textContent('#stereo-summary'), pairText);
+    assert.deepEqual(await tables(), shown);
+    await narrowShot(page, shot, 'stereo-narrow');
+    // A session saved by the stereo step of an earlier version (its result is
+    // `robocal stereo`'s report) opens on the rig step with that result, and
+    // the export step still writes its right_from_left.
+    const file0 = (side, i) => ({ id: `stereo-${side}-${i}`, name: `${side}0${i}.jpg`, detection: null, error: null, spec: 'chessboard:9x6:30mm' });
+    const old = {
+      kind: 'robocal-session', schema: 1, robocal_version: '0.1.0',
+      session: {
+        schema: 1, target: { kind: 'chessboard', cols: 9, rows: 6, square_m: 0.03 }, images: [],
+        stereo: { model: 'brown', result: stereo, left: [file0('left', 1), file0('left', 2)], right: [file0('right', 1), file0('right', 2)] },
+      },
+    };
+    const file = join(tmpdir(), `robocal-old-stereo-${process.pid}.json`);
+    writeFileSync(file, JSON.stringify(old));
+    try {
+      page.on('dialog', (d) => d.accept());
+      await page.click('#new-session');
+      await page.waitForFunction(() => location.hash === '#target', null, { timeout: 10000 });
+      await page.click('a[data-step=share]');
+      await Promise.all([page.waitForEvent('load'), page.setInputFiles('#session-input', file)]);
+    } finally {
+      rmSync(file, { force: true });
+    }
+    await ready(page);
+    await page.click('a[data-step=stereo]');
+    await page.locator('#stereo-summary').waitFor({ timeout: 30000 });
+    assert.equal(await page.textContent('#stereo-summary'), pairText);
+    assert.match(await page.textContent('#stereo-results h3'), /earlier version/);
+    assert.deepEqual(await page.$$eval('#rig-cameras input[type=text]', (els) => els.map((e) => e.value)), ['left', 'right']);
+    await shot('old-stereo-session');
+    await page.click('a[data-step=export]');
+    await page.selectOption('#export-transform', 'right_from_left');
+    await page.$eval('#export-status', (el) => { el.textContent = ''; });
+    await page.click('#transform-formats button[data-format=matrix4]');
+    await page.waitForFunction(() => /^matrix4: /.test(document.getElementById('export-status').textContent), null, { timeout: 10000 });
+    const numbers = (await page.textContent('#export-preview')).match(/-?\d+(\.\d+)?(e[-+]?\d+)?/gi).map(Number).slice(-16);
+    stereo.right_from_left.matrix_row_major.flat().forEach((x, i) => assert.ok(Math.abs(numbers[i] - x) <= 1e-12, `matrix4 entry ${i}: ${numbers[i]} vs ${x}`));
   }],
 ];

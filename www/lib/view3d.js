@@ -127,11 +127,19 @@ export class FrameView {
       ctx.fillText(l.name, l.x, l.y);
     }
     ctx.fillStyle = '#666'; ctx.font = '12px system-ui';
-    ctx.fillText('drag or arrow keys: rotate · wheel, + / − keys or buttons: zoom · 0: reset · x red, y green, z blue', 8, this.canvas.height - 8);
+    // On a narrow canvas (a phone) the help goes on as many lines as it needs, bottom up.
+    const lines = [];
+    for (const part of HELP.split(' · ')) {
+      const last = lines.length - 1;
+      if (last >= 0 && ctx.measureText(`${lines[last]} · ${part}`).width <= this.canvas.width - 16) lines[last] += ` · ${part}`;
+      else lines.push(part);
+    }
+    lines.reverse().forEach((line, i) => ctx.fillText(line, 8, this.canvas.height - 8 - 15 * i));
   }
 }
 
 const LABEL_FONT = '13px system-ui';
+const HELP = 'drag or arrow keys: rotate · wheel, + / − keys or buttons: zoom · 0: reset · x red, y green, z blue';
 
 /**
  * Puts each frame's name next to its origin where it overlaps no name

@@ -4,18 +4,8 @@
 // preview and the warnings in plain words.
 import { $, h, fill, table, num, message } from '../lib/dom.js';
 import { bars, scatter, vectors, heatmap } from '../lib/plot.js';
+import { MODELS, lensFields, readLens, jsonOptions } from './lens.js';
 
-export const MODELS = [
-  ['brown', 'Brown-Conrady (radial k1 k2 k3, tangential p1 p2: OpenCV, MATLAB, Bouguet, Kalibr radtan)'],
-  ['radial_k1_k2_k5', 'Brown-Conrady radial only, Bouguet numbering (k1 k2 k5)'],
-  ['rational', 'OpenCV rational (k1..k6, p1 p2, thin prism s1..s4)'],
-  ['division', 'Division (Fitzgibbon, Halcon)'],
-  ['kannala_brandt', 'Kannala-Brandt fisheye (OpenCV fisheye, Kalibr equidistant)'],
-  ['eucm', 'Enhanced unified camera model (EUCM, wide angle)'],
-  ['none', 'Pinhole, no distortion'],
-];
-/** Brown-Conrady as users know it: 2 or 3 radial coefficients, tangential on or off (held at 0 otherwise). */
-const RADIAL = [['3', '3 radial (k1 k2 k3: OpenCV default)'], ['2', '2 radial (k1 k2, k3 held at 0: MATLAB, Bouguet, Kalibr default)']];
 export const METHODS = [
   ['zhang', 'Zhang + bundle adjustment'],
   ['dlt', '12-parameter DLT'],
@@ -23,30 +13,12 @@ export const METHODS = [
   ['ekf', 'Extended Kalman filter'],
   ['all', 'All, side by side'],
 ];
-const OPTIONS = [
-  ['fix_principal_point', 'Fix the principal point at the image centre'],
-  ['fix_aspect_ratio', 'Fix the aspect ratio (fy / fx) at its closed-form value'],
-  ['square_pixels', 'Square pixels: fx = fy (OpenCV CALIB_FIX_ASPECT_RATIO with aspect ratio 1)'],
-  ['zero_skew', 'Zero skew', true],
-  ['robust', 'Robust loss with outlier rejection'],
-];
-
 const UNDISTORT_SIDE = 480;
 
 function putPixels(canvas, p) {
   canvas.width = p.image.width;
   canvas.height = p.image.height;
   canvas.getContext('2d').putImageData(p.image, 0, 0); // the core's ImageData
-}
-
-/** The form's options as the core's JSON options (square pixels = aspect_ratio 1; Brown-Conrady's held coefficients). */
-function jsonOptions(options, st = {}) {
-  const { square_pixels: square, ...rest } = options;
-  const fixed = [];
-  if (st.model === 'brown' && st.radial === '2') fixed.push('k3');
-  if (st.model === 'brown' && st.tangential === false) fixed.push('p1', 'p2');
-  const out = square ? { ...rest, aspect_ratio: 1 } : rest;
-  return fixed.length ? { ...out, fixed_coefficients: fixed } : out;
 }
 
 export class CameraView {
@@ -70,15 +42,11 @@ export class CameraView {
     const st = this.state;
     const select = (name, items, value) => h('select', { name, id: `camera-${name}` },
       items.map(([v, label]) => h('option', { value: v, selected: v === value }, label)));
-    const opts = OPTIONS.map(([key, label, dflt]) => h('label', { class: 'check' },
-      h('input', { type: 'checkbox', name: key, checked: st.options[key] ?? !!dflt }), ' ', label));
-    const brown = h('div', { class: 'row', id: 'camera-brown-terms', hidden: st.model !== 'brown' },
-      h('label', {}, 'Radial terms ', select('radial', RADIAL, st.radial || '3')),
-      h('label', { class: 'check' }, h('input', { type: 'checkbox', name: 'tangential', checked: st.tangential !== false }), ' Tangential p1 p2'));
+    const lens = lensFields(st, 'camera');
     const form = h('form', { class: 'form', id: 'camera-form' },
-      h('label', {}, 'Lens model', select('model', MODELS, st.model)), brown,
+      lens.model, lens.brown,
       h('label', {}, 'Method', select('method', METHODS, st.method)),
-      h('fieldset', {}, h('legend', {}, 'Options'), opts),
+      lens.options,
       h('p', { class: 'hint', id: 'camera-input-summary' }),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-camera' }, 'Solve camera')));
     form.addEventListener('change', () => this.readForm(form));
@@ -92,12 +60,8 @@ export class CameraView {
 
   readForm(form) {
     const st = this.state;
-    st.model = form.elements.model.value;
+    readLens(st, form);
     st.method = form.elements.method.value;
-    st.radial = form.elements.radial.value;
-    st.tangential = form.elements.tangential.checked;
-    $('camera-brown-terms').hidden = st.model !== 'brown';
-    for (const [key] of OPTIONS) st.options[key] = form.elements[key].checked;
     this.store.changed('camera-options');
   }
 
@@ -118,7 +82,7 @@ export class CameraView {
     const input = {
       model: st.model,
       method: st.method,
-      options: jsonOptions(st.options, st),
+      options: jsonOptions(st),
       views: views.map((i) => ({ name: i.name, detection: i.detection })),
     };
     try {

@@ -1,6 +1,7 @@
 // Step 7: export. Every format is written by the Rust core (the same bytes
 // as `robocal export`); this page previews, copies and downloads them.
 import { $, h, fill, download, message } from '../lib/dom.js';
+import { sessionStereo } from './rig-stereo.js';
 
 const CAMERA_FORMATS = [
   ['json', 'robocal JSON', 'camera.json'],
@@ -43,9 +44,10 @@ export function frameNames(session) {
 }
 const EULER_ORDERS = ['xyz', 'xzy', 'yxz', 'yzx', 'zxy', 'zyx', 'xyx', 'xzx', 'yxy', 'yzy', 'zxz', 'zyz'];
 
-/** The report the exports read: camera keys, hand-eye transforms and the stereo right_from_left at the top level. */
+/** The report the exports read: camera keys, hand-eye transforms and the stereo right_from_left (a 2-camera rig's) at the top level. */
 export function combinedReport(session) {
-  const stereo = session.stereo && session.stereo.result ? { right_from_left: session.stereo.result.right_from_left } : {};
+  const pair = sessionStereo(session);
+  const stereo = pair ? { right_from_left: pair.right_from_left } : {};
   const frames = session.handeye.result ? { frame_names: frameNames(session) } : {};
   return { ...(session.camera.result || {}), ...(session.handeye.result || {}), ...stereo, ...frames };
 }

@@ -1,17 +1,23 @@
-// Camera rigs: 2 to N cameras that saw the target of step 1 in synchronised
-// frames, any camera missing the board in any frame. Frames are grouped by
-// the rule of `robocal rig` (the last number in each file name, or by order
-// when no name has one); detection per camera in the worker, then one joint
-// calibration (`calibrate_rig`, the core of `robocal rig`). Shows every
-// camera_from_rig with its standard deviation, per-camera and per-frame
-// residuals, the co-observation graph, a 3-D view of the rig and the rig
-// exports. Images, detections and the result are kept in the session.
-import { $, h, fill, table, num, message, download } from '../lib/dom.js';
+// Step 7, stereo pairs and camera rigs: 2 to N cameras that saw the target
+// of step 1 in synchronised frames, any camera missing the board in any
+// frame. Frames are grouped by the rule of `robocal rig` (the last number in
+// each file name, or by order when no name has one); detection per camera in
+// the worker, then one joint calibration (`calibrate_rig`, the core of
+// `robocal rig`) with the lens model and held parameters of the camera step.
+// Shows every camera_from_rig with its standard deviation, per-camera and
+// per-frame residuals, the co-observation graph, a 3-D view of the rig and
+// the rig exports; two cameras are also shown as the stereo pair
+// (right_from_left, exported in step 8). Images, detections and the result
+// are kept in the session.
+import { h, fill, table, num, message, download } from '../lib/dom.js';
 import { FrameView } from '../lib/view3d.js';
 import { targetSpec } from './target.js';
-import { MODELS } from './camera.js';
+import { lensFields, readLens, jsonOptions } from './lens.js';
+import { stereoOfRig, stereoOfLegacy, stereoSection } from './rig-stereo.js';
 import { frustum, invert, rotvecDeg, boardOutline, apply, flat } from '../lib/rig3d.js';
 
+/** Frames a rig solve needs (each camera's intrinsics need 3 views: calib::json_api::MIN_VIEWS). */
+const MIN_FRAMES = 3;
 const byName = (a, b) => a.name.localeCompare(b.name, undefined, { numeric: true });
 const freeName = (cams) => { let k = 0; while (cams.some((c) => c.name === `cam${k}`)) k++; return `cam${k}`; };
 
@@ -31,8 +37,11 @@ export class RigView {
   }
 
   render() {
-    const model = h('select', { id: 'rig-model' }, MODELS.map(([v, t]) => h('option', { value: v, selected: v === this.state.model }, t)));
-    model.addEventListener('change', () => { this.state.model = model.value; this.store.changed('rig'); });
+    const st = this.state;
+    const lens = lensFields(st, 'rig');
+    const form = h('form', { class: 'form', id: 'rig-lens' }, lens.model, lens.brown, lens.options);
+    form.addEventListener('change', () => { readLens(st, form); this.store.changed('rig'); });
+    form.addEventListener('submit', (e) => e.preventDefault());
     this.camerasOut = h('div', { id: 'rig-cameras', class: 'form' });
     this.solveButton = h('button', { type: 'button', class: 'primary', id: 'rig-solve', disabled: true }, 'Detect and solve the rig');
     this.solveButton.addEventListener('click', () => this.solve());
@@ -40,15 +49,25 @@ export class RigView {
     this.progress = h('p', { id: 'rig-progress', class: 'hint', 'aria-live': 'polite' });
     this.out = h('div', { id: 'rig-results', 'aria-live': 'polite' });
     fill(this.panel,
-      h('h3', {}, 'Camera rig: 2 to N cameras'),
-      h('p', { class: 'hint' }, 'Cameras that saw the target of step 1 at the same moments; any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (front07.png with side7.jpg), or by order (sorted names) when no name has a number. The rig frame is the first camera\'s.'),
+      h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. The rig frame is the first camera\'s.'),
       this.camerasOut,
-      h('div', { class: 'row' }, h('button', { type: 'button', id: 'rig-add', onclick: () => this.addCamera() }, 'Add a camera'), h('label', {}, 'Lens model (every camera) ', model)),
+      h('div', { class: 'row' }, h('button', { type: 'button', id: 'rig-add', onclick: () => this.addCamera() }, 'Add a camera')),
+      h('details', { id: 'rig-lens-details', open: st.model !== 'brown' || st.radial === '2' || st.tangential === false },
+        h('summary', {}, 'Lens model and held parameters (every solved camera)'),
+        h('p', { class: 'hint' }, 'As in step 3. Kalibr\'s radtan model is k1 k2 p1 p2: choose Brown-Conrady with 2 radial terms to export the rig to Kalibr.'),
+        form),
       h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'rig-clear', onclick: () => this.clear() }, 'Remove the rig images')),
       this.progress, this.framesOut, this.out);
     this.showCameras();
     this.showFrames();
-    if (this.state.result) this.show(this.state.result);
+    if (st.result) this.show(st.result);
+    else this.showLegacy();
+  }
+
+  /** An earlier session's stereo result (before the rig step): shown until the rig is solved. */
+  showLegacy() {
+    const s = stereoOfLegacy(this.store.session.stereo && this.store.session.stereo.result);
+    if (s) fill(this.out, stereoSection(s, 'Stereo pair (solved by the stereo step of an earlier version; solve the rig to replace it)'));
   }
 
   showCameras() {
@@ -134,7 +153,8 @@ export class RigView {
     }
     const { frames, keys } = grouping;
     const empty = cams.filter((c) => !c.files.length).map((c) => c.name);
-    this.solveButton.disabled = empty.length > 0 || frames.length < 3;
+    const short = MIN_FRAMES - frames.length;
+    this.solveButton.disabled = empty.length > 0 || short > 0;
     const status = (f) => (f.error ? `not found: ${f.error}` : f.detection ? `${f.detection.points.length} points` : 'not detected yet');
     const rows = frames.map((key) => [key, ...cams.map((c, k) => {
       const i = keys[k].indexOf(key);
@@ -143,6 +163,7 @@ export class RigView {
     fill(this.framesOut,
       h('p', { id: 'rig-grouping' }, `${frames.length} frame${frames.length === 1 ? '' : 's'} over ${cams.length} cameras, grouped ${grouping.grouped_by === 'number' ? 'by the number in the file names' : 'by order (sorted names)'}.`),
       empty.length ? h('p', { id: 'rig-missing', class: 'msg msg-info', role: 'status' }, `Add images for camera ${empty.join(', ')} to solve.`) : null,
+      short > 0 ? h('p', { id: 'rig-too-few', class: 'msg msg-info', role: 'status' }, `A rig calibration needs at least ${MIN_FRAMES} frames: add ${short} more frame${short === 1 ? '' : 's'} (an image of each camera, numbered alike) to solve.`) : null,
       table(['frame', ...cams.map((c) => c.name)], rows, { id: 'rig-frame-table', class: 'scroll' }));
   }
 
@@ -180,6 +201,7 @@ export class RigView {
       await this.showFrames();
       const input = {
         model: this.state.model,
+        options: jsonOptions(this.state),
         target: spec,
         grouping: groupedBy,
         cameras: cams.map((c, k) => ({
@@ -187,10 +209,13 @@ export class RigView {
           views: c.files.map((f, i) => ({ f, key: keys[k][i] })).filter(({ f }) => f.detection).map(({ f, key }) => ({ key, name: f.name, detection: f.detection })),
         })),
       };
+      const blind = input.cameras.find((c) => !c.views.length);
+      if (blind) throw new Error(`the target was found in no image of camera ${blind.name}`); // as robocal rig says it
       const used = input.cameras.reduce((s, c) => s + c.views.length, 0);
       this.progress.textContent = `detected ${total} images: the target in ${used}; solving…`;
       const result = await this.engine.call('rig', { input: JSON.stringify(input) });
       this.state.result = result;
+      this.store.session.stereo = null; // an earlier session's stereo result is replaced by the rig's
       this.store.changed('rig-result');
       this.progress.textContent = `solved with ${used} views in ${result.frames.length} frames.`;
       await this.show(result);
@@ -217,9 +242,13 @@ export class RigView {
     const co = r.co_observation;
     const tree = new Set(co.spanning_tree.map(([a, b]) => `${Math.min(a, b)}-${Math.max(a, b)}`));
     const coRows = co.frames.map((row, i) => [co.cameras[i], ...row.map((n, j) => (i !== j && tree.has(`${Math.min(i, j)}-${Math.max(i, j)}`) ? `${n} (tree)` : String(n)))]);
-    this.canvas = h('canvas', { id: 'rig-3d', width: 900, height: 560, role: 'img', 'aria-label': 'The rig in 3-D: each camera as a frustum, each frame\'s board as an outline' });
+    // Drawn at the width it is shown at (a phone's too), at most 900 px.
+    const width = Math.max(300, Math.min(900, this.panel.clientWidth || 900));
+    this.canvas = h('canvas', { id: 'rig-3d', width, height: Math.round(width * 0.62), role: 'img', 'aria-label': 'The rig in 3-D: each camera as a frustum, each frame\'s board as an outline' });
     this.exportsOut = h('div', { id: 'rig-exports' });
+    const stereo = stereoOfRig(r);
     fill(this.out,
+      stereo ? stereoSection(stereo, `Stereo pair: ${r.cameras[1].name} from ${r.cameras[0].name}`) : null,
       h('h3', { id: 'rig-summary' }, `${r.cameras.length} cameras, rig frame ${r.rig_frame}: RMS ${num(r.rms_px, 4)} px over ${r.frames.length} frames`),
       h('p', { class: 'hint' }, 'camera_from_rig: p_camera = R p_rig + T; the rotation as a rotation vector (axis times angle). Standard deviations from the joint covariance; the rotation\'s as a small-angle vector.'),
       table(['camera', 'T x (mm)', 'T y (mm)', 'T z (mm)', 'std x (mm)', 'std y (mm)', 'std z (mm)', 'rot x (deg)', 'rot y (deg)', 'rot z (deg)', 'std rx (deg)', 'std ry (deg)', 'std rz (deg)'], extrinsics, { id: 'rig-extrinsics', class: 'scroll' }),
