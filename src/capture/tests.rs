@@ -310,3 +310,149 @@ fn robot_rotations_about_one_axis_are_not_diverse_and_about_three_are() {
     assert!(many.enough, "{many:?}");
     assert!(many.axis_spread_deg >= 30.0);
 }
+
+/// Six frames of the board at `pose` from `t0` (66.7 ms apart, 400 ms
+/// still) and a frame without it; returns the reports of the six.
+fn hold_at(
+    s: &mut CaptureSession,
+    v: &BoardVideo,
+    pose: &crate::geometry::Pose,
+    noise_px: f64,
+    rng: &mut Rng,
+    t0: f64,
+) -> Vec<FrameReport> {
+    let reports = (1..=6)
+        .map(|i| {
+            let d = detection(v, pose, noise_px, rng);
+            s.push_detection(Some(d), Some(1.0), t0 + i as f64 * 66.7)
+                .unwrap()
+        })
+        .collect();
+    s.push_detection(None, None, t0 + 7.0 * 66.7).unwrap();
+    reports
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn auto_capture_goes_on_while_views_lower_the_uncertainty_and_stops_once_good_enough() {
+    // Detection noise 0.2 px: the video's holds fill the coverage bins but
+    // leave the worst projection uncertainty above 0.2 px, so only the
+    // uncertainty rule can keep frames after them.
+    let v = video();
+    let mut s = session();
+    let noise = 0.2;
+    let mut rng = Rng::new(21);
+    feed_holds(&mut s, &v, noise);
+    let first = s.calibrate().unwrap().projection_uncertainty.max_std_px;
+    assert!(
+        first > suggest::GOOD_MAX_STD_PX,
+        "{first} px after the holds"
+    );
+    // A kept hold again (the same pixels within 3 px): not a new measurement.
+    let again = hold_at(
+        &mut s,
+        &v,
+        &v.holds[0].camera_from_target,
+        0.05,
+        &mut rng,
+        1e5,
+    );
+    let last = again.last().unwrap();
+    assert_eq!(last.reason, Reason::NothingNew);
+    assert_eq!(last.novelty.as_ref().unwrap().predicted_max_std_px, None);
+    // Follow the suggestions: every hold is kept, by the predicted uncertainty.
+    let mut t = 2e5;
+    let mut worst = vec![first];
+    while !s.good_enough() && worst.len() < 40 {
+        let next = s.suggestion().unwrap().clone();
+        assert_eq!(next.rule, Rule::Uncertainty);
+        let pose = next.camera_from_target.to_pose().unwrap();
+        let reports = hold_at(&mut s, &v, &pose, noise, &mut rng, t);
+        t += 1e4;
+        let kept: Vec<&FrameReport> = reports.iter().filter(|r| r.keep).collect();
+        assert_eq!(kept.len(), 1, "one capture per hold");
+        let n = kept[0].novelty.as_ref().unwrap();
+        let now = worst.last().copied().unwrap();
+        let predicted = n.predicted_max_std_px.unwrap();
+        assert!(
+            n.lowers_uncertainty && predicted <= (1.0 - suggest::LOWERS_UNCERTAINTY_BY) * now,
+            "predicted {predicted} px from {now} px"
+        );
+        worst.push(s.calibrate().unwrap().projection_uncertainty.max_std_px);
+    }
+    println!("worst projection uncertainty by guided view (px): {worst:.3?}");
+    assert!(s.good_enough(), "not good enough after {worst:?}");
+    assert!(s.suggestion().is_none());
+    // Good enough: a still, sharp, new view is no longer kept.
+    let kept = s.kept().len();
+    let pose = s.kept()[kept - 1].detection.clone();
+    let other = crate::capture::coverage::pose_of(&pose, &v.camera).unwrap();
+    let turned = crate::geometry::Pose::from_parts(
+        other.translation,
+        other.rotation * rotation_from_rotvec(&Vector3::new(0.0, 0.0, 0.3)),
+    );
+    let after = hold_at(&mut s, &v, &turned, noise, &mut rng, t);
+    assert_eq!(after.last().unwrap().reason, Reason::GoodEnough);
+    assert!(after.iter().all(|r| !r.keep));
+    assert_eq!(s.kept().len(), kept);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn an_excluded_capture_leaves_the_guide_and_comes_back_when_included() {
+    let v = video();
+    let mut s = session();
+    let captured = feed_holds(&mut s, &v, 0.05);
+    let n = captured.len();
+    let all = s.coverage().clone();
+    let views = s.calibrate().unwrap().views.len();
+    assert_eq!(views, n);
+    s.set_robot_pose(1, crate::geometry::Pose::identity())
+        .unwrap();
+    s.set_robot_pose(2, crate::geometry::Pose::identity())
+        .unwrap();
+    assert_eq!(s.handeye_guide().poses, 2);
+    // Excluded: out of the coverage, the calibration and the hand-eye guide; the indices stay.
+    s.set_included(1, false).unwrap();
+    assert_eq!((s.kept().len(), s.used()), (n, n - 1));
+    let c = s.coverage();
+    assert_eq!(c.kept, n - 1);
+    let removed: usize = s.kept()[1].cells.iter().sum();
+    assert_eq!(
+        c.cells.iter().sum::<usize>(),
+        all.cells.iter().sum::<usize>() - removed
+    );
+    assert_eq!(s.handeye_guide().poses, 1);
+    let names: Vec<String> = s
+        .calibrate()
+        .unwrap()
+        .views
+        .iter()
+        .map(|r| r.name.clone())
+        .collect();
+    assert_eq!(names.len(), n - 1);
+    assert!(!names.contains(&"capture_001".to_string()), "{names:?}");
+    // Included again: as before.
+    s.set_included(1, true).unwrap();
+    assert_eq!(s.used(), n);
+    assert_eq!(s.handeye_guide().poses, 2);
+    s.calibrate().unwrap();
+    let back = s.coverage();
+    assert_eq!((back.kept, &back.cells), (all.kept, &all.cells));
+    assert_eq!(back.tilt.iter().flatten().sum::<usize>(), n);
+    let e = s.set_included(n, false).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!("capture: expected a capture index below {n}, got {n}")
+    );
+    // Too few included to calibrate: the message counts the excluded.
+    for i in 0..n - 3 {
+        s.set_included(i, false).unwrap();
+    }
+    let e = s.calibrate().unwrap_err().to_string();
+    assert!(
+        e.ends_with(&format!(
+            "the running calibration needs at least 4 captures, got 3 ({} excluded): keep capturing",
+            n - 3
+        )),
+        "{e}"
+    );
+}
