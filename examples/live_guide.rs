@@ -5,7 +5,11 @@
 //! `--loops` times (Chromium's fake camera loops the file). Prints each
 //! capture with the worst projection uncertainty after it.
 //!
-//!     cargo run --release --example live_guide -- [--fps 5] [--seed 11] [--loops 2]
+//! `--extra DIR`: the PNGs of DIR (e.g. `robocal render --out DIR --views
+//! N --camera` the video's camera) appended to the video as holds of one
+//! second each, as tests/e2e/capture.mjs appends them.
+//!
+//!     cargo run --release --example live_guide -- [--fps 5] [--seed 11] [--loops 2] [--extra DIR]
 
 use robocal::capture::{CaptureConfig, CaptureSession};
 use robocal::image::GrayImage;
@@ -46,11 +50,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             GrayImage::new(640, 480, px.collect())
         })
         .collect::<Result<_, _>>()?;
+    let mut frames = frames;
+    let mut times: Vec<f64> = video.frames.iter().map(|f| f.time_ms).collect();
+    let mut holds: Vec<Option<usize>> = video.frames.iter().map(|f| f.hold).collect();
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(dir) = args
+        .iter()
+        .position(|a| a == "--extra")
+        .and_then(|i| args.get(i + 1))
+    {
+        let mut pngs: Vec<_> = std::fs::read_dir(dir)?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "png"))
+            .collect();
+        pngs.sort();
+        for (k, png) in pngs.iter().enumerate() {
+            let img = robocal::image::decode_gray(&std::fs::read(png)?)?;
+            for _ in 0..fps as usize {
+                times.push(times.last().unwrap() + 1000.0 / fps);
+                holds.push(Some(video.holds.len() + k));
+                frames.push(img.clone());
+            }
+        }
+    }
     let mut s = CaptureSession::new(target, 640, 480, CaptureConfig::default())?;
-    let period = video.frames.len() as f64 * 1000.0 / fps;
+    let period = frames.len() as f64 * 1000.0 / fps;
     for l in 0..loops {
-        for (f, img) in video.frames.iter().zip(&frames) {
-            let r = s.push_image(img, l as f64 * period + f.time_ms + 1.0)?;
+        for ((time_ms, hold), img) in times.iter().zip(&holds).zip(&frames) {
+            let r = s.push_image(img, l as f64 * period + time_ms + 1.0)?;
             if r.keep {
                 let worst = if s.used() >= 4 {
                     format!("{:.3}", s.calibrate()?.projection_uncertainty.max_std_px)
@@ -60,7 +87,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let n = r.novelty.as_ref().unwrap();
                 println!(
                     "loop {l} hold {:?} capture {}: cells {} tilt {} dist {} predicted {:?} -> worst {worst} px good enough {}",
-                    f.hold, r.kept, n.new_cells, n.new_tilt, n.new_distance, n.predicted_max_std_px, s.good_enough()
+                    hold, r.kept, n.new_cells, n.new_tilt, n.new_distance, n.predicted_max_std_px, s.good_enough()
                 );
             }
         }

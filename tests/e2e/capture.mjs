@@ -7,12 +7,12 @@
 // capture (button and space bar) into cards kept in IndexedDB, exclusion
 // and the PNG download of the captured frames.
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { launch, root, shotsDir } from './harness.mjs';
-import { boardVideo, cameraJson } from './y4m.mjs';
+import { appendViews, boardVideo, cameraJson } from './y4m.mjs';
 
 export const launchArgs = ['--use-fake-device-for-media-stream'];
 
@@ -21,6 +21,8 @@ const NO_CAMERA = 'No camera was found. Connect a camera and press Start camera 
 
 /** Auto-captures awaited from the board video (of its 12 holds). */
 const CAPTURES = 6;
+/** Random views (`robocal render --views`) held after the video's 12 holds, so the guide can reach good enough. */
+const EXTRA_VIEWS = 8;
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 
@@ -163,7 +165,8 @@ export const tests = [
     await shot('robot-step');
   }],
   ['the renderer\'s video: auto-capture takes the holds, the suggestion moves on, the running calibration converges to the video\'s camera within its std, uncertainty shrinks, step 3 and the OpenCV export agree', async (page, { url }) => {
-    // `robocal render --video`: the default 9x6 chessboard through 12 one-second holds, 640x480 at 5 fps.
+    // `robocal render --video`: the default 9x6 chessboard through 12 one-second holds, 640x480 at 5 fps,
+    // then EXTRA_VIEWS random views through the same camera held a second each.
     const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
     let other = { close: async () => {} };
     try {
@@ -171,6 +174,8 @@ export const tests = [
       // 5 fps: a hold is 5 frames, the render a third of the default 15 fps's time.
       execFileSync(join(root, 'target/release/robocal'), ['render', '--video', path, '--seed', '11', '--fps', '5'], { stdio: 'ignore' });
       const truth = JSON.parse(readFileSync(join(dir, 'board.json'), 'utf8'));
+      mkdirSync(join(dir, 'extra'));
+      const extra = await appendViews(page, path, join(dir, 'extra'), truth, { views: EXTRA_VIEWS, hold: 5, seed: 5 });
       other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
       const context = await other.newContext({ viewport: { width: 1280, height: 900 } });
       const p = await context.newPage();
@@ -222,14 +227,15 @@ export const tests = [
       assert.equal(await p.getAttribute('#capture-guide', 'data-suggestion'), '');
       await p.screenshot({ path: join(shotsDir, 'capture-board-1d-good-enough.png'), fullPage: true });
       await p.screenshot({ path: join(shotsDir, 'capture-board-1c-guide.png'), fullPage: true });
-      // The frames kept are the video's holds: each capture's first point is
-      // a hold's true first point (within 1.5 px: detection and luma rounding), each hold once.
+      // The frames kept are the video's holds and the views after them: each
+      // capture's first point is a hold's true first point (within 1.5 px:
+      // detection and luma rounding), each hold once.
       const firsts = JSON.parse(await p.getAttribute('#capture-guide', 'data-firsts'));
-      const holdFirst = truth.holds.map((h) => truth.frames[h.first_frame].points[0]);
+      const holdFirst = [...truth.holds.map((h) => truth.frames[h.first_frame].points[0]), ...extra.views.map((v) => v.points[0])];
       const holds = firsts.map(([x, y]) => holdFirst.findIndex((q) => Math.hypot(q.x_px - x, q.y_px - y) <= 1.5));
       assert.ok(holds.every((h) => h >= 0), `captures at the holds: ${JSON.stringify(firsts)} vs ${JSON.stringify(holdFirst.map((q) => [q.x_px, q.y_px]))}`);
       assert.equal(new Set(holds).size, holds.length, `one capture per hold: ${holds}`);
-      console.log(`     auto-captured holds ${holds.join(' ')} (of ${truth.holds.length})`);
+      console.log(`     auto-captured holds ${holds.join(' ')} (of ${holdFirst.length})`);
       // Stop taking more: the manual route stays (auto-capture off).
       await p.uncheck('#capture-auto');
       await p.waitForTimeout(1000); // a frame in flight with auto-capture on may still be kept
