@@ -22,7 +22,7 @@ const NO_CAMERA = 'No camera was found. Connect a camera and press Start camera 
 /** Auto-captures awaited from the board video (of its 12 holds). */
 const CAPTURES = 6;
 /** Random views (`robocal render --views`) held after the video's 12 holds, so the guide can reach good enough. */
-const EXTRA_VIEWS = 8;
+const EXTRA_VIEWS = 12;
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 

@@ -24,12 +24,7 @@
 //!    frame ([`edges::refine_quad`]) and go to the reader.
 //! 6. When the decimated search reads no marker at all, the frame is
 //!    searched again at full resolution (markers too small for the
-//!    decimated image, or a frame without a board) with the small window
-//!    only: markers too small for the decimated search are within a few
-//!    small windows across, and the large window at full resolution sees
-//!    what the decimated search's large window saw (about the same side in
-//!    frame pixels), so it would find only the quads tried already. This
-//!    halves the retry, which is most of a board-free frame's time.
+//!    decimated image, or a frame without a board).
 
 use super::edges::refine_quad;
 use super::runs::{self, Region};
@@ -141,38 +136,19 @@ pub(crate) fn find_quads(img: &GrayImage, mut read: impl FnMut(&Quad) -> bool) {
     let mut tried = Tried::default();
     if img.width.max(img.height) >= DECIMATE_FROM_PX {
         let half = runs::decimate(img);
-        search(
-            img,
-            &half,
-            2.0,
-            &windows(half.width, half.height),
-            &mut tried,
-            &mut read,
-        );
+        search(img, &half, 2.0, &mut tried, &mut read);
         if !tried.markers.is_empty() {
             return;
         }
-        let small = windows(img.width, img.height)[0];
-        search(img, img, 1.0, &[small], &mut tried, &mut read);
-        return;
     }
-    search(
-        img,
-        img,
-        1.0,
-        &windows(img.width, img.height),
-        &mut tried,
-        &mut read,
-    );
+    search(img, img, 1.0, &mut tried, &mut read);
 }
 
-/// One search on `small` (the frame `img` scaled by 1 / `scale`) with the
-/// threshold windows `wins`.
+/// One search on `small` (the frame `img` scaled by 1 / `scale`).
 fn search(
     img: &GrayImage,
     small: &GrayImage,
     scale: f64,
-    wins: &[usize],
     tried: &mut Tried,
     read: &mut impl FnMut(&Quad) -> bool,
 ) {
@@ -180,7 +156,7 @@ fn search(
     let integral = runs::integral_image(small);
     // Pixel (i, j) of `small` is centred on scale * (i, j) + (scale - 1) / 2.
     let offset = 0.5 * (scale - 1.0);
-    for &win in wins {
+    for win in windows(small.width, small.height) {
         let mask = runs::threshold(small, &integral, win);
         let eroded = runs::erode(&mask);
         for (m, inset) in [(&mask, 0.5), (&eroded, 1.5)] {
