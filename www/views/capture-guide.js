@@ -113,7 +113,8 @@ export class CaptureGuide {
     const images = this.view.images.images;
     let changed = false;
     for (let i = this.names.length - 1; i >= 0; i--) {
-      const img = this.names[i] && images.find((im) => im.name === this.names[i]);
+      if (!this.names[i]) continue; // its card is being stored
+      const img = images.find((im) => im.name === this.names[i]);
       if (!img) {
         const out = await this.call('remove', { index: i });
         if (out && !out.error) { this.names.splice(i, 1); this.used.splice(i, 1); this.firsts.splice(i, 1); changed = true; }
