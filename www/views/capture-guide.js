@@ -63,7 +63,7 @@ export class CaptureGuide {
       this.firsts[index] = r.points[0];
       this.used[index] = true;
       const name = await this.view.capture({ capture: 'auto' }, index);
-      if (!name) await this.call('remove', { index });
+      if (!name && !(await this.call('remove', { index }))?.error) { this.used.splice(index, 1); this.firsts.splice(index, 1); }
       this.solve();
     }
     this.show();
