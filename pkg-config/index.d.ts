@@ -1452,7 +1452,7 @@ export interface LiveCoverage {
   tilt: [[number, number, number], [number, number, number], [number, number, number]];
   /** Kept frames per distance bin: far, middle, near. */
   distance: [number, number, number];
-  /** Frames kept. */
+  /** Frames counted: the kept frames not excluded (`set_included`). */
   kept: number;
 }
 
@@ -1473,6 +1473,10 @@ export interface LiveNovelty {
   new_cells: number;
   new_tilt: boolean;
   new_distance: boolean;
+  /** Under a running calibration not yet good enough: the worst projection uncertainty predicted after adding this frame, px (null otherwise, or for a repeat of a kept view). */
+  predicted_max_std_px: number | null;
+  /** That prediction is at least 5 % below the calibration's worst: the frame adds information. */
+  lowers_uncertainty: boolean;
 }
 
 /** The next pose to show (capture::Suggestion): the board outline to match. */
@@ -1500,7 +1504,7 @@ export interface LiveHandEyeGuide {
 }
 
 /** Why a frame was kept or not. */
-export type LiveReason = 'not_found' | 'too_few_points' | 'settling' | 'moving' | 'blurred' | 'nothing_new' | 'kept' | 'kept_manually';
+export type LiveReason = 'not_found' | 'too_few_points' | 'settling' | 'moving' | 'blurred' | 'good_enough' | 'nothing_new' | 'kept' | 'kept_manually';
 
 /** `LiveCapture.push_frame / push_rgba / push_grey` (capture::FrameReport). */
 export interface LiveFrameReport {
@@ -1521,15 +1525,21 @@ export interface LiveFrameReport {
   reason: LiveReason;
   /** The reason as a sentence. */
   message: string;
+  /** Frames kept (excluded ones too): the next capture's index. */
   kept: number;
+  /** Kept frames not excluded. */
+  used: number;
   coverage: LiveCoverage;
   suggestion: LiveSuggestion | null;
   good_enough: boolean;
 }
 
-/** `LiveCapture.state()`, `remove`, `set_robot_pose`; `capture()` adds `index`. */
+/** `LiveCapture.state()`, `remove`, `set_included`, `set_robot_pose`; `capture()` adds `index`. */
 export interface LiveState {
+  /** Frames kept (excluded ones too). */
   kept: number;
+  /** Kept frames not excluded: what the coverage, the running calibration and the hand-eye guide use. */
+  used: number;
   coverage: LiveCoverage;
   suggestion: LiveSuggestion | null;
   good_enough: boolean;

@@ -200,8 +200,8 @@ function guidedFrame(grey, width, height, spec, { auto }, time, started) {
   return { found, detection, reason: found ? null : report.message, width, height, live: report, ms: performance.now() - started };
 }
 
-/** The guide's session calls: capture (manual), remove, robotPose, calibrate, state, reset. */
-handlers.guide = async ({ op, index, pose }) => {
+/** The guide's session calls: capture (manual), remove, include, robotPose, calibrate, state, reset. */
+handlers.guide = async ({ op, index, pose, included }) => {
   await ready;
   if (op === 'reset') {
     if (guideSession) guideSession.live.free();
@@ -212,6 +212,7 @@ handlers.guide = async ({ op, index, pose }) => {
   const { live } = guideSession;
   if (op === 'capture') return JSON.parse(live.capture());
   if (op === 'remove') return JSON.parse(live.remove(index));
+  if (op === 'include') return JSON.parse(live.set_included(index, included));
   if (op === 'robotPose') return JSON.parse(live.set_robot_pose(index, pose));
   if (op === 'calibrate') return JSON.parse(live.calibrate());
   if (op === 'state') return JSON.parse(live.state());

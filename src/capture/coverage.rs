@@ -68,13 +68,26 @@ pub struct Novelty {
     pub new_tilt: bool,
     /// Its distance bin has no kept frame yet.
     pub new_distance: bool,
+    /// With a running calibration that is not good enough: the predicted
+    /// worst projection uncertainty after adding it, px
+    /// ([`super::suggest::Predictor`]; `None` without one, or for a repeat
+    /// of a kept view).
+    pub predicted_max_std_px: Option<f64>,
+    /// It lowers that prediction by at least
+    /// [`super::suggest::LOWERS_UNCERTAINTY_BY`] of the calibration's.
+    pub lowers_uncertainty: bool,
 }
 
 impl Novelty {
     /// Whether the frame adds information by the rule: at least
-    /// [`NEW_CELLS_MIN`] new cells, or a new tilt bin, or a new distance bin.
+    /// [`NEW_CELLS_MIN`] new cells, or a new tilt bin, or a new distance
+    /// bin, or (under a calibration not good enough) a lower predicted
+    /// uncertainty.
     pub fn adds_information(&self) -> bool {
-        self.new_cells >= NEW_CELLS_MIN || self.new_tilt || self.new_distance
+        self.new_cells >= NEW_CELLS_MIN
+            || self.new_tilt
+            || self.new_distance
+            || self.lowers_uncertainty
     }
 }
 
@@ -96,6 +109,8 @@ impl Coverage {
             new_cells: s.cells.iter().filter(|c| self.cells[**c] == 0).count(),
             new_tilt: self.tilt[s.tilt_bin.0][s.tilt_bin.1] == 0,
             new_distance: self.distance[s.distance_bin] == 0,
+            predicted_max_std_px: None,
+            lowers_uncertainty: false,
         }
     }
 

@@ -21,9 +21,14 @@
 //! 3. **sharp**: the blur measure ([`measure::blur_px`], the equivalent
 //!    Gaussian sigma of the board's strongest edges relative to its own
 //!    contrast) at most [`CaptureConfig::sharp_max_blur_px`];
-//! 4. **novel**: it adds information ([`coverage::Novelty::adds_information`]:
-//!    new image cells, a new tilt bin or a new distance bin);
-//! 5. then it is kept.
+//! 4. **not good enough yet**: once the running calibration is good enough
+//!    ([`suggest`]) no frame is kept automatically;
+//! 5. **novel**: it adds information ([`coverage::Novelty::adds_information`]:
+//!    new image cells, a new tilt bin or a new distance bin, or, under a
+//!    running calibration, a predicted worst projection uncertainty at
+//!    least [`suggest::LOWERS_UNCERTAINTY_BY`] lower, not repeating a kept
+//!    view);
+//! 6. then it is kept.
 
 pub mod coverage;
 pub mod handeye_guide;
@@ -93,6 +98,8 @@ pub enum Reason {
     Moving,
     /// The board is blurred.
     Blurred,
+    /// Still and sharp, but the running calibration is good enough already.
+    GoodEnough,
     /// Still and sharp but adds nothing to the coverage.
     NothingNew,
     /// Kept by the automatic rule.
@@ -110,6 +117,7 @@ impl Reason {
             Reason::Settling => "hold the board still",
             Reason::Moving => "the board moves: hold it still",
             Reason::Blurred => "the board is blurred: focus, light or hold steadier",
+            Reason::GoodEnough => "the calibration is good enough: no more captures are needed",
             Reason::NothingNew => "this view adds nothing new: move to the suggested pose",
             Reason::Kept => "captured",
             Reason::KeptManually => "captured (manual)",

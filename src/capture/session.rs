@@ -17,7 +17,7 @@ use crate::synth::video::board_side_m;
 use crate::target::{DetectedPoint, Detection, Target};
 use nalgebra::Point2;
 use serde::Serialize;
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 
 /// Fewest kept frames the running calibration starts from.
 pub const MIN_VIEWS_TO_CALIBRATE: usize = 4;
@@ -38,6 +38,9 @@ pub struct KeptFrame {
     pub robot: Option<Pose>,
     /// Kept on request rather than by the automatic rule.
     pub manual: bool,
+    /// Used by the coverage, the running calibration and the hand-eye
+    /// guide (false while its card is excluded: [`CaptureSession::set_included`]).
+    pub included: bool,
 }
 
 /// What the session says about one frame (the JSON of `push_frame`).
@@ -69,8 +72,10 @@ pub struct FrameReport {
     pub reason: Reason,
     /// The reason as a sentence.
     pub message: String,
-    /// Frames kept so far.
+    /// Frames kept so far (the next capture's index).
     pub kept: usize,
+    /// Of those, the frames included (not excluded by the user).
+    pub used: usize,
     /// The coverage after this frame.
     pub coverage: Coverage,
     /// The pose to suggest next (`None` once good enough).
@@ -207,16 +212,14 @@ impl CaptureSession {
             >= self.config.keep_min_fraction * self.target.point_count() as f64;
         let camera = self.camera();
         let pose = pose_of(detection, &camera);
-        if let Some(pose) = pose {
+        if let Some(pose) = &pose {
             let pixels: Vec<Point2<f64>> = detection
                 .points
                 .iter()
                 .map(|p| Point2::new(p.x_px, p.y_px))
                 .collect();
-            let sig = signature(&pixels, &pose, &camera, self.side_m);
-            let novelty = self.coverage.novelty(&sig);
-            v.novel = novelty.adds_information();
-            v.novelty = Some(novelty);
+            let sig = signature(&pixels, pose, &camera, self.side_m);
+            v.novelty = Some(self.coverage.novelty(&sig));
             v.cells = Some(cell_counts(&pixels, self.size.0, self.size.1));
             v.signature = Some(sig);
         }
@@ -224,6 +227,12 @@ impl CaptureSession {
         let (settled, motion) = self.stillness(&detection.points, time_ms);
         v.motion_px = motion;
         v.still = settled && motion.is_some_and(|m| m <= self.config.still_max_px);
+        // 3. What a still, sharp frame would do to the running calibration.
+        if let (Some(novelty), Some(pose), true) = (&mut v.novelty, &pose, v.still && v.sharp) {
+            self.predict(novelty, detection, pose);
+        }
+        v.novel = v.novelty.as_ref().is_some_and(|n| n.adds_information());
+        let good_enough = self.good_enough();
         v.reason = if !enough || pose.is_none() {
             Reason::TooFewPoints
         } else if !settled {
@@ -232,12 +241,53 @@ impl CaptureSession {
             Reason::Moving
         } else if !v.sharp {
             Reason::Blurred
+        } else if good_enough {
+            Reason::GoodEnough
         } else if !v.novel {
             Reason::NothingNew
         } else {
             Reason::Kept
         };
         v
+    }
+
+    /// The uncertainty part of `novelty` ([`suggest`] module docs): only
+    /// under a running calibration that is not good enough, and not for a
+    /// repeat of a kept view.
+    fn predict(&self, novelty: &mut Novelty, detection: &Detection, pose: &Pose) {
+        let Some(calibration) = self.calibration.as_ref().filter(|_| !self.good_enough()) else {
+            return;
+        };
+        if self.repeats_a_kept_view(detection) {
+            return;
+        }
+        let Some(predictor) = suggest::Predictor::new(calibration) else {
+            return;
+        };
+        let (object_m, _) = detection.correspondences();
+        novelty.predicted_max_std_px = predictor.with_view(&object_m, pose);
+        let now = calibration.projection_uncertainty.max_std_px;
+        novelty.lowers_uncertainty = novelty
+            .predicted_max_std_px
+            .is_some_and(|p| p <= (1.0 - suggest::LOWERS_UNCERTAINTY_BY) * now);
+    }
+
+    /// Every point of `detection` within [`suggest::SAME_VIEW_PX`] of the
+    /// same point of one included kept frame.
+    fn repeats_a_kept_view(&self, detection: &Detection) -> bool {
+        let near = suggest::SAME_VIEW_PX * suggest::SAME_VIEW_PX;
+        self.kept.iter().filter(|k| k.included).any(|k| {
+            let at: HashMap<usize, (f64, f64)> = k
+                .detection
+                .points
+                .iter()
+                .map(|p| (p.id, (p.x_px, p.y_px)))
+                .collect();
+            detection.points.iter().all(|p| {
+                at.get(&p.id)
+                    .is_some_and(|(x, y)| (p.x_px - x).powi(2) + (p.y_px - y).powi(2) <= near)
+            })
+        })
     }
 
     /// (enough history to judge, the largest motion over the compared frames).
@@ -288,6 +338,7 @@ impl CaptureSession {
             cells,
             robot: None,
             manual,
+            included: true,
         });
         self.update_suggestion();
     }
@@ -338,6 +389,30 @@ impl CaptureSession {
         Ok(())
     }
 
+    /// Include or exclude kept frame `index` (its card's include box): an
+    /// excluded frame keeps its index and its robot pose but leaves the
+    /// coverage, the running calibration and the hand-eye guide until it
+    /// is included again.
+    pub fn set_included(&mut self, index: usize, included: bool) -> Result<()> {
+        let n = self.kept.len();
+        let kept = self.kept.get_mut(index).ok_or_else(|| {
+            Error::invalid(
+                "capture",
+                format!("expected a capture index below {n}, got {index}"),
+            )
+        })?;
+        if kept.included != included {
+            kept.included = included;
+            self.recount();
+        }
+        Ok(())
+    }
+
+    /// The kept frames included (not excluded by the user).
+    pub fn used(&self) -> usize {
+        self.kept.iter().filter(|k| k.included).count()
+    }
+
     /// Pair kept frame `index` with the robot's `base_from_gripper`.
     pub fn set_robot_pose(&mut self, index: usize, base_from_gripper: Pose) -> Result<()> {
         let n = self.kept.len();
@@ -355,12 +430,18 @@ impl CaptureSession {
     /// frames; the coverage is then recounted through the calibrated
     /// camera and the suggestion follows the uncertainty rule.
     pub fn calibrate(&mut self) -> Result<&CameraCalibration> {
-        if self.kept.len() < MIN_VIEWS_TO_CALIBRATE {
+        let used = self.used();
+        if used < MIN_VIEWS_TO_CALIBRATE {
+            let excluded = self.kept.len() - used;
+            let also = if excluded > 0 {
+                format!(" ({excluded} excluded)")
+            } else {
+                String::new()
+            };
             return Err(Error::invalid(
                 "captures",
                 format!(
-                    "the running calibration needs at least {MIN_VIEWS_TO_CALIBRATE} captures, got {}: keep capturing",
-                    self.kept.len()
+                    "the running calibration needs at least {MIN_VIEWS_TO_CALIBRATE} captures, got {used}{also}: keep capturing"
                 ),
             ));
         }
@@ -368,6 +449,7 @@ impl CaptureSession {
             .kept
             .iter()
             .enumerate()
+            .filter(|(_, k)| k.included)
             .map(|(i, k)| {
                 let (object_m, image_px) = k.detection.correspondences();
                 View {
@@ -390,7 +472,7 @@ impl CaptureSession {
     fn recount(&mut self) {
         let camera = self.camera();
         self.coverage = Coverage::new();
-        for k in &mut self.kept {
+        for k in self.kept.iter_mut().filter(|k| k.included) {
             if let Some(pose) = pose_of(&k.detection, &camera) {
                 let pixels: Vec<Point2<f64>> = k
                     .detection
@@ -407,7 +489,7 @@ impl CaptureSession {
 
     fn update_suggestion(&mut self) {
         self.suggestion = match &self.calibration {
-            Some(c) if suggest::good_enough(c, self.kept.len()) => None,
+            Some(c) if suggest::good_enough(c, self.used()) => None,
             Some(c) => suggest::by_uncertainty(&self.candidates, c, &self.target)
                 .or_else(|| suggest::by_coverage(&self.candidates, &self.coverage)),
             None => suggest::by_coverage(&self.candidates, &self.coverage),
@@ -418,7 +500,7 @@ impl CaptureSession {
     pub fn good_enough(&self) -> bool {
         self.calibration
             .as_ref()
-            .is_some_and(|c| suggest::good_enough(c, self.kept.len()))
+            .is_some_and(|c| suggest::good_enough(c, self.used()))
     }
 
     /// The kept frames.
@@ -443,7 +525,12 @@ impl CaptureSession {
     }
     /// The hand-eye guide over the kept frames paired with robot poses.
     pub fn handeye_guide(&self) -> HandEyeGuide {
-        let robot: Vec<Pose> = self.kept.iter().filter_map(|k| k.robot).collect();
+        let robot: Vec<Pose> = self
+            .kept
+            .iter()
+            .filter(|k| k.included)
+            .filter_map(|k| k.robot)
+            .collect();
         handeye_guide(&robot)
     }
 
@@ -464,6 +551,7 @@ impl CaptureSession {
             reason: v.reason,
             message: v.reason.message().to_string(),
             kept: self.kept.len(),
+            used: self.used(),
             coverage: self.coverage.clone(),
             suggestion: self.suggestion.clone(),
             good_enough: self.good_enough(),

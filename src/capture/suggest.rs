@@ -23,6 +23,14 @@
 //! Good enough: a calibration of at least [`GOOD_MIN_VIEWS`] views whose
 //! parameters are all determined and whose worst projection uncertainty is
 //! below [`GOOD_MAX_STD_PX`].
+//!
+//! The same prediction judges a still, sharp frame once a calibration
+//! exists and is not good enough: the frame's own points at its pose
+//! (through the calibrated camera) added to the normal equations; it adds
+//! information when the predicted worst projection uncertainty is at least
+//! [`LOWERS_UNCERTAINTY_BY`] below the calibration's, unless it repeats a
+//! kept view ([`SAME_VIEW_PX`]). So the guide keeps capturing views that
+//! help after the coverage bins are full, and stops once good enough.
 
 use super::coverage::{cell_counts, signature, Coverage, Signature};
 use crate::calib::CameraCalibration;
@@ -30,7 +38,7 @@ use crate::camera::Camera;
 use crate::geometry::{Pose, PoseJson};
 use crate::synth::video::{board_side_m, fitted_pose, print_outline};
 use crate::target::Target;
-use nalgebra::{DMatrix, Matrix3, Point2, SymmetricEigen, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, Matrix3, Point2, Point3, SymmetricEigen, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 /// Aims of the candidates, fractions of the image width and height.
@@ -43,6 +51,14 @@ pub const CANDIDATE_SPANS: [f64; 3] = [0.3, 0.45, 0.65];
 pub const GOOD_MAX_STD_PX: f64 = 0.2;
 /// Good enough: the fewest views.
 pub const GOOD_MIN_VIEWS: usize = 8;
+/// Under a running calibration that is not good enough, a frame adds
+/// information when adding it would lower the predicted worst projection
+/// uncertainty by at least this fraction (module docs).
+pub const LOWERS_UNCERTAINTY_BY: f64 = 0.05;
+/// A frame whose points all lie within this many pixels of the same points
+/// of a kept frame is that view again: it never lowers the uncertainty
+/// (its pixels are the same measurement, not a new one).
+pub const SAME_VIEW_PX: f64 = 3.0;
 
 /// A pose the guide may suggest.
 #[derive(Debug, Clone)]
@@ -191,6 +207,62 @@ pub fn good_enough(calibration: &CameraCalibration, views: usize) -> bool {
         && calibration.projection_uncertainty.max_std_px < GOOD_MAX_STD_PX
 }
 
+/// The calibration's normal equations on its free parameters, ready to
+/// predict the worst projection uncertainty after adding a view.
+pub struct Predictor<'a> {
+    camera: &'a Camera,
+    free: Vec<usize>,
+    info: DMatrix<f64>,
+    variance: f64,
+    depth: f64,
+    params: usize,
+}
+
+impl<'a> Predictor<'a> {
+    /// `None` when the calibration's parameters are not all reported
+    /// (no covariance to start from).
+    pub fn new(calibration: &'a CameraCalibration) -> Option<Predictor<'a>> {
+        let camera = &calibration.camera;
+        let names = camera.param_names();
+        let std: Vec<f64> = names
+            .iter()
+            .map(|n| calibration.std.get(*n).copied().unwrap_or(0.0))
+            .collect();
+        let corr = &calibration.correlation.matrix;
+        if corr.len() != names.len() {
+            return None;
+        }
+        let free: Vec<usize> = (0..names.len()).filter(|i| std[*i] > 0.0).collect();
+        let m = free.len();
+        let cov = DMatrix::from_fn(m, m, |a, b| {
+            corr[free[a]][free[b]] * std[free[a]] * std[free[b]]
+        });
+        Some(Predictor {
+            camera,
+            info: pseudo_inverse(&cov),
+            free,
+            variance: calibration.rms_px.powi(2).max(1e-12),
+            depth: calibration.projection_uncertainty.reference_depth_m,
+            params: names.len(),
+        })
+    }
+
+    /// The worst projection uncertainty over the image (px) after adding a
+    /// view of the board points `object_m` (target frame) at `pose`;
+    /// `None` when they fix no pose.
+    pub fn with_view(&self, object_m: &[Point3<f64>], pose: &Pose) -> Option<f64> {
+        let added = schur_information(self.camera, object_m, pose, &self.free)?;
+        let cov_free = pseudo_inverse(&(&self.info + added / self.variance));
+        let mut full = DMatrix::zeros(self.params, self.params);
+        for (a, i) in self.free.iter().enumerate() {
+            for (b, j) in self.free.iter().enumerate() {
+                full[(*i, *j)] = cov_free[(a, b)];
+            }
+        }
+        Some(crate::calib::projection_uncertainty(self.camera, &full, self.depth).max_std_px)
+    }
+}
+
 /// The uncertainty rule's choice (module docs); `None` when the
 /// calibration's parameters are not all determined.
 pub fn by_uncertainty(
@@ -198,37 +270,13 @@ pub fn by_uncertainty(
     calibration: &CameraCalibration,
     target: &Target,
 ) -> Option<Suggestion> {
-    let camera = &calibration.camera;
-    let names = camera.param_names();
-    let std: Vec<f64> = names
-        .iter()
-        .map(|n| calibration.std.get(*n).copied().unwrap_or(0.0))
-        .collect();
-    let corr = &calibration.correlation.matrix;
-    if corr.len() != names.len() {
-        return None;
-    }
-    let free: Vec<usize> = (0..names.len()).filter(|i| std[*i] > 0.0).collect();
-    let m = free.len();
-    let cov = DMatrix::from_fn(m, m, |a, b| {
-        corr[free[a]][free[b]] * std[free[a]] * std[free[b]]
-    });
-    let info = pseudo_inverse(&cov);
-    let variance = calibration.rms_px.powi(2).max(1e-12);
-    let depth = calibration.projection_uncertainty.reference_depth_m;
+    let predictor = Predictor::new(calibration)?;
+    let object_m: Vec<Point3<f64>> = target.object_points().into_iter().map(|p| p.1).collect();
     let mut best: Option<(&Candidate, f64)> = None;
     for c in candidates {
-        let Some(added) = schur_information(camera, target, &c.camera_from_target, &free) else {
+        let Some(worst) = predictor.with_view(&object_m, &c.camera_from_target) else {
             continue;
         };
-        let cov_free = pseudo_inverse(&(&info + added / variance));
-        let mut full = DMatrix::zeros(names.len(), names.len());
-        for (a, i) in free.iter().enumerate() {
-            for (b, j) in free.iter().enumerate() {
-                full[(*i, *j)] = cov_free[(a, b)];
-            }
-        }
-        let worst = crate::calib::projection_uncertainty(camera, &full, depth).max_std_px;
         if best.map_or(true, |(_, b)| worst < b) {
             best = Some((c, worst));
         }
@@ -242,12 +290,13 @@ pub fn by_uncertainty(
     })
 }
 
-/// The information a view of `target` at `pose` adds on the free camera
-/// parameters (columns `free` of the camera's parameter Jacobian), its own
-/// pose eliminated: `Hcc - Hcp Hpp^-1 Hpc`, unit pixel weights.
+/// The information a view of the board points `object_m` at `pose` adds
+/// on the free camera parameters (columns `free` of the camera's parameter
+/// Jacobian), its own pose eliminated: `Hcc - Hcp Hpp^-1 Hpc`, unit pixel
+/// weights.
 fn schur_information(
     camera: &Camera,
-    target: &Target,
+    object_m: &[Point3<f64>],
     pose: &Pose,
     free: &[usize],
 ) -> Option<DMatrix<f64>> {
@@ -255,7 +304,7 @@ fn schur_information(
     let mut hcc = DMatrix::<f64>::zeros(m, m);
     let mut hcp = DMatrix::<f64>::zeros(m, 6);
     let mut hpp = DMatrix::<f64>::zeros(6, 6);
-    for (_, p) in target.object_points() {
+    for p in object_m {
         let pc = pose * p;
         let (_, d_point, d_params) = camera.project_with_jacobians(&pc).ok()?;
         // d pc / d (rotation perturbation, translation): [-[pc]x | I].

@@ -253,6 +253,20 @@ fn a_well_covered_set_is_good_enough_and_a_frontal_one_is_not() {
         good.suggestion().is_none(),
         "no suggestion once good enough"
     );
+    // Good enough: a still, sharp view the guide has not seen (the last one
+    // turned 0.3 rad in its plane) is no longer kept.
+    let kept = good.kept().len();
+    let last = good.kept()[kept - 1].detection.clone();
+    let pose = crate::capture::coverage::pose_of(&last, &v.camera).unwrap();
+    let turned = crate::geometry::Pose::from_parts(
+        pose.translation,
+        pose.rotation * rotation_from_rotvec(&Vector3::new(0.0, 0.0, 0.3)),
+    );
+    let d = detection(&v, &turned, 0.05, &mut rng);
+    let r = hold_at(&mut good, &d, 300_000.0);
+    assert_eq!(r.last().unwrap().reason, Reason::GoodEnough);
+    assert!(r.iter().all(|r| !r.keep));
+    assert_eq!(good.kept().len(), kept);
     // Eight frontal views in the middle: the focal length is poorly fixed.
     let mut poor = session();
     let mut rng = Rng::new(4);
@@ -309,4 +323,121 @@ fn robot_rotations_about_one_axis_are_not_diverse_and_about_three_are() {
     let many = handeye_guide(&mixed);
     assert!(many.enough, "{many:?}");
     assert!(many.axis_spread_deg >= 30.0);
+}
+
+/// The board held still at `detection` (the same points) for six frames
+/// from `t0` (66.7 ms apart, 400 ms), then a frame without it; returns the
+/// reports of the six.
+fn hold_at(s: &mut CaptureSession, detection: &Detection, t0: f64) -> Vec<FrameReport> {
+    let reports = (1..=6)
+        .map(|i| {
+            s.push_detection(Some(detection.clone()), Some(1.0), t0 + i as f64 * 66.7)
+                .unwrap()
+        })
+        .collect();
+    s.push_detection(None, None, t0 + 7.0 * 66.7).unwrap();
+    reports
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_view_that_lowers_the_uncertainty_is_kept_after_the_bins_are_full_and_a_repeat_is_not() {
+    // Detection noise 0.5 px (one draw per hold: the board is still): the
+    // video's holds fill the coverage bins but leave the worst projection
+    // uncertainty above 0.2 px, so only the uncertainty rule keeps more.
+    let v = video();
+    let mut s = session();
+    let mut rng = Rng::new(21);
+    for (k, hold) in v.holds.iter().enumerate() {
+        let d = detection(&v, &hold.camera_from_target, 0.5, &mut rng);
+        hold_at(&mut s, &d, k as f64 * 1000.0);
+    }
+    let kept = s.kept().len();
+    let now = s.calibrate().unwrap().projection_uncertainty.max_std_px;
+    assert!(now > suggest::GOOD_MAX_STD_PX, "{now} px after the holds");
+    // A kept view again (a video replayed): not a new measurement.
+    let again = s.kept()[0].detection.clone();
+    let r = hold_at(&mut s, &again, 1e5);
+    let last = r.last().unwrap();
+    assert_eq!(last.reason, Reason::NothingNew);
+    assert_eq!(last.novelty.as_ref().unwrap().predicted_max_std_px, None);
+    // The suggested pose: kept, by the predicted uncertainty, once.
+    let next = s.suggestion().unwrap().clone();
+    assert_eq!(next.rule, Rule::Uncertainty);
+    let d = detection(
+        &v,
+        &next.camera_from_target.to_pose().unwrap(),
+        0.5,
+        &mut rng,
+    );
+    let r = hold_at(&mut s, &d, 2e5);
+    let keeps: Vec<&FrameReport> = r.iter().filter(|r| r.keep).collect();
+    assert_eq!(keeps.len(), 1, "one capture per hold");
+    let n = keeps[0].novelty.as_ref().unwrap();
+    let predicted = n.predicted_max_std_px.unwrap();
+    assert!(
+        n.lowers_uncertainty && predicted <= (1.0 - suggest::LOWERS_UNCERTAINTY_BY) * now,
+        "predicted {predicted} px from {now} px"
+    );
+    assert_eq!(s.kept().len(), kept + 1);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn an_excluded_capture_leaves_the_guide_and_comes_back_when_included() {
+    let v = video();
+    let mut s = session();
+    let captured = feed_holds(&mut s, &v, 0.05);
+    let n = captured.len();
+    let all = s.coverage().clone();
+    let views = s.calibrate().unwrap().views.len();
+    assert_eq!(views, n);
+    s.set_robot_pose(1, crate::geometry::Pose::identity())
+        .unwrap();
+    s.set_robot_pose(2, crate::geometry::Pose::identity())
+        .unwrap();
+    assert_eq!(s.handeye_guide().poses, 2);
+    // Excluded: out of the coverage, the calibration and the hand-eye guide; the indices stay.
+    s.set_included(1, false).unwrap();
+    assert_eq!((s.kept().len(), s.used()), (n, n - 1));
+    let c = s.coverage();
+    assert_eq!(c.kept, n - 1);
+    let removed: usize = s.kept()[1].cells.iter().sum();
+    assert_eq!(
+        c.cells.iter().sum::<usize>(),
+        all.cells.iter().sum::<usize>() - removed
+    );
+    assert_eq!(s.handeye_guide().poses, 1);
+    let names: Vec<String> = s
+        .calibrate()
+        .unwrap()
+        .views
+        .iter()
+        .map(|r| r.name.clone())
+        .collect();
+    assert_eq!(names.len(), n - 1);
+    assert!(!names.contains(&"capture_001".to_string()), "{names:?}");
+    // Included again: as before.
+    s.set_included(1, true).unwrap();
+    assert_eq!(s.used(), n);
+    assert_eq!(s.handeye_guide().poses, 2);
+    s.calibrate().unwrap();
+    let back = s.coverage();
+    assert_eq!((back.kept, &back.cells), (all.kept, &all.cells));
+    assert_eq!(back.tilt.iter().flatten().sum::<usize>(), n);
+    let e = s.set_included(n, false).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!("capture: expected a capture index below {n}, got {n}")
+    );
+    // Too few included to calibrate: the message counts the excluded.
+    for i in 0..n - 3 {
+        s.set_included(i, false).unwrap();
+    }
+    let e = s.calibrate().unwrap_err().to_string();
+    assert!(
+        e.ends_with(&format!(
+            "the running calibration needs at least 4 captures, got 3 ({} excluded): keep capturing",
+            n - 3
+        )),
+        "{e}"
+    );
 }

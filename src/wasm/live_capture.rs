@@ -43,6 +43,7 @@ fn grey_from_rgba(rgba: &[u8], width: u32, height: u32) -> Result<GrayImage, JsE
 #[derive(Serialize)]
 struct State<'a> {
     kept: usize,
+    used: usize,
     coverage: &'a crate::capture::Coverage,
     suggestion: Option<&'a crate::capture::Suggestion>,
     good_enough: bool,
@@ -112,9 +113,21 @@ impl LiveCapture {
         Ok(value.to_string())
     }
 
-    /// Exclude kept frame `index` (its card removed); returns the state.
+    /// Drop kept frame `index` (its card removed; later indices move down
+    /// by one); returns the state.
     pub fn remove(&mut self, index: u32) -> Result<String, JsError> {
         self.session.remove(index as usize).map_err(js_error)?;
+        self.state()
+    }
+
+    /// Include (`true`) or exclude kept frame `index` (its card's include
+    /// box): an excluded frame keeps its index but leaves the coverage, the
+    /// running calibration and the hand-eye guide until included again.
+    /// Returns the state.
+    pub fn set_included(&mut self, index: u32, included: bool) -> Result<String, JsError> {
+        self.session
+            .set_included(index as usize, included)
+            .map_err(js_error)?;
         self.state()
     }
 
@@ -152,7 +165,7 @@ impl LiveCapture {
         self.session.good_enough()
     }
 
-    /// `{"kept", "coverage", "suggestion", "good_enough", "handeye"}`.
+    /// `{"kept", "used", "coverage", "suggestion", "good_enough", "handeye"}`.
     pub fn state(&self) -> Result<String, JsError> {
         to_json(&self.state_of())
     }
@@ -170,6 +183,7 @@ impl LiveCapture {
     fn state_of(&self) -> State<'_> {
         State {
             kept: self.session.kept().len(),
+            used: self.session.used(),
             coverage: self.session.coverage(),
             suggestion: self.session.suggestion(),
             good_enough: self.session.good_enough(),

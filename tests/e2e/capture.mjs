@@ -7,12 +7,12 @@
 // capture (button and space bar) into cards kept in IndexedDB, exclusion
 // and the PNG download of the captured frames.
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { launch, root, shotsDir } from './harness.mjs';
-import { boardVideo, cameraJson } from './y4m.mjs';
+import { appendViews, boardVideo, cameraJson } from './y4m.mjs';
 
 export const launchArgs = ['--use-fake-device-for-media-stream'];
 
@@ -21,6 +21,8 @@ const NO_CAMERA = 'No camera was found. Connect a camera and press Start camera 
 
 /** Auto-captures awaited from the board video (of its 12 holds). */
 const CAPTURES = 6;
+/** Random views (`robocal render --views`) held after the video's 12 holds, so the guide can reach good enough. */
+const EXTRA_VIEWS = 12;
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 
@@ -163,7 +165,8 @@ export const tests = [
     await shot('robot-step');
   }],
   ['the renderer\'s video: auto-capture takes the holds, the suggestion moves on, the running calibration converges to the video\'s camera within its std, uncertainty shrinks, step 3 and the OpenCV export agree', async (page, { url }) => {
-    // `robocal render --video`: the default 9x6 chessboard through 12 one-second holds, 640x480 at 5 fps.
+    // `robocal render --video`: the default 9x6 chessboard through 12 one-second holds, 640x480 at 5 fps,
+    // then EXTRA_VIEWS random views through the same camera held a second each.
     const dir = mkdtempSync(join(tmpdir(), 'robocal-capture-'));
     let other = { close: async () => {} };
     try {
@@ -171,6 +174,8 @@ export const tests = [
       // 5 fps: a hold is 5 frames, the render a third of the default 15 fps's time.
       execFileSync(join(root, 'target/release/robocal'), ['render', '--video', path, '--seed', '11', '--fps', '5'], { stdio: 'ignore' });
       const truth = JSON.parse(readFileSync(join(dir, 'board.json'), 'utf8'));
+      mkdirSync(join(dir, 'extra'));
+      const extra = await appendViews(page, path, join(dir, 'extra'), truth, { views: EXTRA_VIEWS, hold: 5, seed: 5 });
       other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
       const context = await other.newContext({ viewport: { width: 1280, height: 900 } });
       const p = await context.newPage();
@@ -200,26 +205,37 @@ export const tests = [
       assert.equal(g.rule, g.goodEnough === 'yes' ? '' : 'uncertainty');
       assert.match(g.text, g.goodEnough === 'yes' ? /^Good enough: the worst projection uncertainty over the image is \d\.\d+ px \(below 0\.2 px\) with \d+ captures\./ : /Guide's calibration from \d+ captures: worst projection uncertainty \d\.\d+ px \(good enough below 0\.2 px with at least 8 captures\)\. Next: /);
       assert.ok(Number(g.maxStdPx) > 0 && Number(g.maxStdPx) < 1, g.maxStdPx);
-      // Two more holds add tilts (the video's 10th and 11th): 8 captures, the guide solves again.
-      await guide(p, 8);
-      await p.waitForFunction(() => / from 8 captures|with 8 captures/.test(document.getElementById('capture-guide').textContent), null, { timeout: 60000 });
-      const g8 = await p.$eval('#capture-guide', (e) => ({ ...e.dataset, text: e.textContent }));
-      const gh = g8.history.split(',').map((e) => e.split(':').map(Number));
-      console.log(`     guide's worst projection uncertainty (px) by captures: ${gh.map(([n, w]) => `${n}: ${w.toFixed(3)}`).join(', ')}; good enough: ${g8.goodEnough}`);
-      // Not monotone (the residual variance is estimated anew each time), but well below the first solve's.
-      assert.ok(gh[0][0] === 4 && gh[gh.length - 1][0] === 8 && gh[gh.length - 1][1] < 0.9 * gh[0][1], `the guide's uncertainty shrinks: ${g8.history}`);
-      assert.equal(g8.goodEnough, Number(g8.maxStdPx) < 0.2 ? 'yes' : 'no', 'good enough: 8 captures and below 0.2 px');
-      assert.equal(g8.suggestion === '', g8.goodEnough === 'yes', 'no suggestion once good enough');
-      await p.screenshot({ path: join(shotsDir, 'capture-board-1d-eight.png'), fullPage: true });
+      // The guide keeps capturing the holds that lower its predicted uncertainty
+      // after the coverage bins are full, until good enough (at least 8
+      // captures, worst projection uncertainty below 0.2 px).
+      await p.waitForFunction(() => document.getElementById('capture-guide').dataset.goodEnough === 'yes', null, { timeout: 120000 })
+        .catch(async (e) => { throw new Error(`never good enough: ${await p.textContent('#capture-guide')} history ${await p.getAttribute('#capture-guide', 'data-history')} (${e.message})`); });
+      const ge = await p.$eval('#capture-guide', (e) => ({ ...e.dataset, text: e.textContent }));
+      const gh = ge.history.split(',').map((e) => e.split(':').map(Number));
+      console.log(`     guide's worst projection uncertainty (px) by captures: ${gh.map(([n, w]) => `${n}: ${w.toFixed(3)}`).join(', ')}; good enough at ${ge.used} captures`);
+      assert.match(ge.text, /^Good enough: the worst projection uncertainty over the image is 0\.1\d+ px \(below 0\.2 px\) with \d+ captures\. No more poses are needed: solve in step 3 or export\.$/);
+      assert.ok(Number(ge.used) >= 8 && Number(ge.maxStdPx) < 0.2, `${ge.used} captures, ${ge.maxStdPx} px`);
+      assert.equal(gh[0][0], 4);
+      assert.ok(gh[gh.length - 1][1] < 0.2 && gh[gh.length - 1][1] < 0.5 * gh[0][1], `the guide's uncertainty shrinks: ${ge.history}`);
+      // No suggestion drawn any more, and auto-capture stops: a still, sharp
+      // frame is refused as good enough and no capture is added.
+      assert.deepEqual([ge.suggestion, ge.rule], ['', '']);
+      await p.waitForFunction(() => document.getElementById('capture-guide').dataset.reason === 'good_enough', null, { timeout: 60000 });
+      const done = Number(await p.getAttribute('#capture-guide', 'data-kept'));
+      await p.waitForTimeout(4000);
+      assert.equal(Number(await p.getAttribute('#capture-guide', 'data-kept')), done, 'no capture once good enough');
+      assert.equal(await p.getAttribute('#capture-guide', 'data-suggestion'), '');
+      await p.screenshot({ path: join(shotsDir, 'capture-board-1d-good-enough.png'), fullPage: true });
       await p.screenshot({ path: join(shotsDir, 'capture-board-1c-guide.png'), fullPage: true });
-      // The frames kept are the video's holds: each capture's first point is
-      // a hold's true first point (within 1.5 px: detection and luma rounding), each hold once.
+      // The frames kept are the video's holds and the views after them: each
+      // capture's first point is a hold's true first point (within 1.5 px:
+      // detection and luma rounding), each hold once.
       const firsts = JSON.parse(await p.getAttribute('#capture-guide', 'data-firsts'));
-      const holdFirst = truth.holds.map((h) => truth.frames[h.first_frame].points[0]);
+      const holdFirst = [...truth.holds.map((h) => truth.frames[h.first_frame].points[0]), ...extra.views.map((v) => v.points[0])];
       const holds = firsts.map(([x, y]) => holdFirst.findIndex((q) => Math.hypot(q.x_px - x, q.y_px - y) <= 1.5));
       assert.ok(holds.every((h) => h >= 0), `captures at the holds: ${JSON.stringify(firsts)} vs ${JSON.stringify(holdFirst.map((q) => [q.x_px, q.y_px]))}`);
       assert.equal(new Set(holds).size, holds.length, `one capture per hold: ${holds}`);
-      console.log(`     auto-captured holds ${holds.join(' ')} (of ${truth.holds.length})`);
+      console.log(`     auto-captured holds ${holds.join(' ')} (of ${holdFirst.length})`);
       // Stop taking more: the manual route stays (auto-capture off).
       await p.uncheck('#capture-auto');
       await p.waitForTimeout(1000); // a frame in flight with auto-capture on may still be kept
@@ -249,9 +265,19 @@ export const tests = [
       }
       console.log(`     running calibration from ${views} captures: ${Object.keys(want).map((n) => `${n} ${params[n][0]} ± ${params[n][1]} (true ${want[n]})`).join(', ')}`);
       await p.screenshot({ path: join(shotsDir, 'capture-board-2-solved.png'), fullPage: true });
-      // Excluding a capture solves again without it (when no other capture has its points).
+      // Excluding a capture solves again without it (when no other capture has
+      // its points), and the guide sets it aside; ticking it again brings it back to both.
+      const solves = (await p.getAttribute('#capture-guide', 'data-history')).split(',').length;
       await p.locator('.card').first().locator('.include input').uncheck();
       if (views === taken) await p.waitForFunction((n) => document.getElementById('capture-solve-summary').dataset.views === String(n), views - 1, { timeout: 60000 });
+      await p.waitForFunction((n) => document.getElementById('capture-guide').dataset.used === String(n), taken - 1, { timeout: 30000 });
+      assert.equal(await p.getAttribute('#capture-guide', 'data-kept'), String(taken), 'the capture keeps its place in the guide');
+      await p.locator('.card').first().locator('.include input').check();
+      await p.waitForFunction((n) => document.getElementById('capture-guide').dataset.used === String(n), taken, { timeout: 30000 });
+      await p.waitForFunction((n) => document.getElementById('capture-solve-summary').dataset.views === String(n), views, { timeout: 60000 });
+      // The guide solved again with it: good enough as before.
+      await p.waitForFunction((n) => document.getElementById('capture-guide').dataset.history.split(',').length >= n, solves + 2, { timeout: 60000 });
+      assert.equal(await p.getAttribute('#capture-guide', 'data-good-enough'), 'yes');
       // Step 3 solves the same captures; the OpenCV YAML export carries its camera.
       await p.click('a[data-step=camera]');
       await p.click('#solve-camera');

@@ -33,10 +33,17 @@ export async function boardVideo(page, dir, { spec, camera, views, hold, seed = 
   const [w, h] = camera.image_size_px;
   writeFileSync(join(dir, 'camera.json'), JSON.stringify(camera));
   execFileSync(CLI, ['render', '--out', dir, '--target', spec, '--views', String(views), '--seed', String(seed), '--noise', String(noise), '--camera', join(dir, 'camera.json')], { stdio: 'ignore' });
-  const pngs = readdirSync(dir).filter((f) => f.endsWith('.png')).sort();
   const path = join(dir, 'board.y4m');
   const fd = openSync(path, 'w');
   writeSync(fd, `YUV4MPEG2 W${w} H${h} F30:1 Ip A1:1 C420jpeg\n`);
+  await writeHolds(page, fd, dir, w, h, hold, hideRight);
+  closeSync(fd);
+  return { path, truth: JSON.parse(readFileSync(join(dir, 'truth.json'), 'utf8')) };
+}
+
+/** Each PNG of `dir` (sorted) as `hold` Y4M frames on `fd` (the right `hideRight` painted over). */
+async function writeHolds(page, fd, dir, w, h, hold, hideRight = 0) {
+  const pngs = readdirSync(dir).filter((f) => f.endsWith('.png')).sort();
   const chroma = Buffer.alloc((w / 2) * (h / 2) * 2, 128);
   for (const name of pngs) {
     const luma = Buffer.from(await page.evaluate(async (b64) => {
@@ -59,6 +66,25 @@ export async function boardVideo(page, dir, { spec, camera, views, hold, seed = 
       writeSync(fd, chroma);
     }
   }
+}
+
+/**
+ * Append `views` views rendered by `robocal render --views` (random poses,
+ * seeded) through the video's own camera (`truth.camera` of `robocal render
+ * --video`) to the video at `path`, each held `hold` frames: more held poses
+ * for the capture guide after the video's own. Returns the views' truth.json.
+ */
+export async function appendViews(page, path, dir, truth, { views, hold, seed }) {
+  const c = truth.camera;
+  const [w, h] = truth.size_px;
+  const camera = cameraJson(w, h, {
+    camera_matrix: [[c.fx, 0, c.cx], [0, c.fy, c.cy], [0, 0, 1]],
+    distortion: { k1: c.distortion.k1, k2: c.distortion.k2, k3: c.distortion.k3, p1: c.distortion.p1, p2: c.distortion.p2 },
+  });
+  writeFileSync(join(dir, 'camera.json'), JSON.stringify(camera));
+  execFileSync(CLI, ['render', '--out', dir, '--views', String(views), '--seed', String(seed), '--camera', join(dir, 'camera.json')], { stdio: 'ignore' });
+  const fd = openSync(path, 'a');
+  await writeHolds(page, fd, dir, w, h, hold);
   closeSync(fd);
-  return { path, truth: JSON.parse(readFileSync(join(dir, 'truth.json'), 'utf8')) };
+  return JSON.parse(readFileSync(join(dir, 'truth.json'), 'utf8'));
 }

@@ -4,6 +4,7 @@
 // video's luma is video-range (16-235) and goes back to 0-255 as the page
 // does (www/lib/frames.js). Asserted against the video's truth: frames are
 // kept only in holds (never while the board moves), at most one per hold;
+// an excluded capture leaves the coverage and calibration and comes back;
 // the coverage counts match the kept frames' true points; the tilt signs
 // match what a viewer sees (top / right edge farther); a hold seen again
 // adds nothing; the running calibration finds the video's camera within 4
@@ -138,6 +139,17 @@ assert.equal(manualFrame.keep, false);
 const manual = JSON.parse(live.capture());
 assert.deepEqual([manual.index, manual.kept, manual.coverage.kept], [kept.length, kept.length + 1, kept.length + 1]);
 live.remove(kept.length);
+
+// Excluding a capture (its card unticked) sets it aside, its index kept; including it brings it back.
+const before = JSON.parse(live.state());
+const out = JSON.parse(live.set_included(1, false));
+assert.deepEqual([out.kept, out.used, out.coverage.kept], [before.kept, before.kept - 1, before.kept - 1]);
+const without = JSON.parse(live.calibrate());
+assert.deepEqual([without.used, without.calibration.views.length], [before.kept - 1, before.kept - 1]);
+assert.ok(!without.calibration.views.some((v) => v.name === 'capture_001'), 'capture 1 is left out');
+const back = JSON.parse(live.set_included(1, true));
+assert.deepEqual([back.kept, back.used, back.coverage.kept, back.coverage.cells], [before.kept, before.kept, before.kept, before.coverage.cells]);
+assert.throws(() => live.set_included(before.kept, false), { message: `capture: expected a capture index below ${before.kept}, got ${before.kept}` });
 
 // Hand-eye guide: robot rotations about one axis are not diverse; one about another axis makes them so.
 const q = (axis, deg) => { const h = (deg * Math.PI) / 360; return [...axis.map((a) => a * Math.sin(h)), Math.cos(h)]; };

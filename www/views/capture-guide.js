@@ -8,9 +8,10 @@
 // rotation-diversity advice.
 //
 // The guide's kept frames mirror the captured cards: `names[i]` is the card
-// of the guide's capture i. Excluding or removing a card removes it from
-// the guide; re-including it does not bring it back (its frame is gone
-// from the live session), and a reload or a camera (re)start starts the guide afresh.
+// of the guide's capture i. Excluding a card excludes its capture from the
+// guide (coverage, running calibration, hand-eye) and re-including it brings
+// it back; removing a card removes its capture. A reload or a camera
+// (re)start starts the guide afresh.
 import { $, num } from '../lib/dom.js';
 
 /** Views the guide's running calibration starts from (the core's MIN_VIEWS_TO_CALIBRATE). */
@@ -30,6 +31,7 @@ export class CaptureGuide {
   constructor(view) {
     this.view = view;
     this.names = [];
+    this.used = []; // whether the guide uses capture i (its card included)
     this.firsts = []; // the first detected point of each guide capture, for scripts
     this.report = null; // the newest frame report
     this.state = null; // the newest guide state (coverage, suggestion, good_enough, handeye)
@@ -43,7 +45,7 @@ export class CaptureGuide {
 
   /** A fresh guide (the camera opened again, perhaps at another size): the cards stay, the guide starts from none. */
   async reset() {
-    Object.assign(this, { names: [], firsts: [], report: null, state: null, calibrated: null, history: [] });
+    Object.assign(this, { names: [], used: [], firsts: [], report: null, state: null, calibrated: null, history: [] });
     await this.call('reset');
     $('capture-guide').textContent = 'Show the board to the camera.';
     $('capture-handeye').hidden = true;
@@ -59,8 +61,9 @@ export class CaptureGuide {
     if (r.keep) {
       const index = r.kept - 1;
       this.firsts[index] = r.points[0];
+      this.used[index] = true;
       const name = await this.view.capture({ capture: 'auto' }, index);
-      if (!name) await this.call('remove', { index });
+      if (!name && !(await this.call('remove', { index }))?.error) { this.used.splice(index, 1); this.firsts.splice(index, 1); }
       this.solve();
     }
     this.show();
@@ -83,6 +86,7 @@ export class CaptureGuide {
     const out = await this.call('capture');
     if (!out || out.error) return null;
     this.names[out.index] = name;
+    this.used[out.index] = true;
     this.firsts[out.index] = this.report && this.report.points[0];
     this.solve();
     this.show();
@@ -100,27 +104,38 @@ export class CaptureGuide {
     this.show();
   }
 
-  /** Cards excluded or removed leave the guide (newest first, so the indices hold). */
+  /**
+   * The guide follows the cards: a removed card's capture leaves it (newest
+   * first, so the indices hold), an excluded one is set aside and comes
+   * back when its card is included again; the guide then solves again.
+   */
   async sync() {
     const images = this.view.images.images;
+    let changed = false;
     for (let i = this.names.length - 1; i >= 0; i--) {
+      if (!this.names[i]) continue; // its card is being stored
       const img = images.find((im) => im.name === this.names[i]);
-      if (!this.names[i] || (img && img.included)) continue;
-      const out = await this.call('remove', { index: i });
-      if (out && !out.error) { this.names.splice(i, 1); this.firsts.splice(i, 1); }
+      if (!img) {
+        const out = await this.call('remove', { index: i });
+        if (out && !out.error) { this.names.splice(i, 1); this.used.splice(i, 1); this.firsts.splice(i, 1); changed = true; }
+      } else if (Boolean(img.included) !== this.used[i]) {
+        const out = await this.call('include', { index: i, included: Boolean(img.included) });
+        if (out && !out.error) { this.used[i] = Boolean(img.included); changed = true; }
+      }
     }
+    if (changed) this.solve();
     this.show();
   }
 
   /** The guide's running calibration (never two at once; one more after the running one if asked). */
   async solve() {
-    const kept = this.state ? this.state.kept : 0;
-    if (kept < GUIDE_FIRST_SOLVE) return;
+    const used = this.state ? this.state.used : 0;
+    if (used < GUIDE_FIRST_SOLVE) return;
     if (this.solving) { this.again = true; return; }
     this.solving = true;
     const out = await this.call('calibrate');
     this.solving = false;
-    if (out && !out.error) { this.calibrated = out; this.history.push([out.kept, out.max_std_px]); }
+    if (out && !out.error) { this.calibrated = out; this.history.push([out.used, out.max_std_px]); }
     this.show();
     if (this.again) { this.again = false; await this.solve(); }
   }
@@ -133,14 +148,15 @@ export class CaptureGuide {
     const r = this.report;
     const words = [];
     if (st.good_enough && this.calibrated) {
-      words.push(`Good enough: the worst projection uncertainty over the image is ${num(this.calibrated.max_std_px, 3)} px (below 0.2 px) with ${st.kept} captures. No more poses are needed: solve in step 3 or export.`);
+      words.push(`Good enough: the worst projection uncertainty over the image is ${num(this.calibrated.max_std_px, 3)} px (below 0.2 px) with ${st.used} captures. No more poses are needed: solve in step 3 or export.`);
     } else {
       if (r) words.push(r.keep ? `Captured (${st.kept} so far).` : `Not captured: ${r.message}${r.reason === 'moving' && r.motion_px !== null ? ` (moved ${num(r.motion_px, 2)} px, at most 1.5 px)` : ''}${r.reason === 'blurred' ? ` (blur ${num(r.blur_px, 2)} px, at most 1.6 px)` : ''}.`);
-      if (this.calibrated) words.push(`Guide's calibration from ${this.calibrated.kept} captures: worst projection uncertainty ${num(this.calibrated.max_std_px, 3)} px (good enough below 0.2 px with at least 8 captures).`);
+      if (this.calibrated) words.push(`Guide's calibration from ${this.calibrated.used} captures: worst projection uncertainty ${num(this.calibrated.max_std_px, 3)} px (good enough below 0.2 px with at least 8 captures).`);
       if (st.suggestion) words.push(`Next: ${st.suggestion.why}`);
     }
     g.textContent = words.join(' ');
     g.dataset.kept = String(st.kept);
+    g.dataset.used = String(st.used);
     g.dataset.reason = r ? r.reason : '';
     g.dataset.goodEnough = st.good_enough ? 'yes' : 'no';
     g.dataset.rule = st.suggestion ? st.suggestion.rule : '';
