@@ -74,8 +74,7 @@ fn noisy_points_reproject_at_the_pixel_noise() {
     // the mean squared 2-D residual is 2 sigma^2 (1 - 12 / (2 n)) over n
     // points (12 parameters). About 800 points: the RMS scatters by about
     // 1.8 %, so 5 % is nearly 3 spreads; the pose ML is not the pixel ML,
-    // which can only raise it (measured 0.2766 / 0.2843 px against 0.2818 /
-    // 0.2818 px expected).
+    // which can only raise it.
     let sigma = 0.2;
     for setup in [Setup::EyeInHand, Setup::EyeToHand] {
         let (out, n) = solve(setup, sigma, 43);
