@@ -100,13 +100,15 @@ fn demo_images_recover_the_truth_and_failed_images_are_dropped_with_their_pose()
     assert_eq!(refinement["outlier_views"].as_array().unwrap().len(), 0);
     // Its reprojection RMS (each view's corners through the refined X, the
     // robot pose and the refined target pose): exact robot poses, so about
-    // the corner noise times sqrt(2) (the estimated pixel sigma).
+    // the corner noise times sqrt(2). The pixel sigma is estimated from 11
+    // views' 6-D pose residuals (54 degrees of freedom: about 10 % spread),
+    // so the ratio is held to 0.6-1.6.
     let rms = report["errors"]["reprojection_rms_px"].as_f64().unwrap();
     let sigma = refinement["noise"]["camera_covariance_sigma"]
         .as_f64()
         .unwrap();
     assert!(
-        (rms / (sigma * 2f64.sqrt()) - 1.0).abs() < 0.15 && rms < 0.2,
+        (0.6..1.6).contains(&(rms / (sigma * 2f64.sqrt()))) && rms < 0.2,
         "{rms} px, pixel sigma {sigma}"
     );
     assert_eq!(refinement["reprojection_rms_px"].as_f64().unwrap(), rms);
