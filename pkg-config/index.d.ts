@@ -699,7 +699,7 @@ export interface HandEyeErrors {
   /** RMS of the per-view rotation residuals, degrees. */
   rotation_rms_deg: number;
   rotation_max_deg: number;
-  /** Reprojection RMS, px, when image points were given. */
+  /** Reprojection RMS, px, when image points were given (of the main transforms, refined or closed form, through x^-1 * robot_i^-1 * y). */
   reprojection_rms_px: number | null;
 }
 
@@ -857,6 +857,12 @@ export interface PoseRefinementSummary {
   whitened_residual_norms: number[];
   /** Views down-weighted as outliers (whitened residual norm above 4.1). */
   outlier_views: number[];
+  /** With image points: reprojection RMS (px) of the refined transforms over every point, each view's points projected through camera_from_target = x^-1 * robot_i^-1 * y (the robot pose and the two refined transforms); also errors.reprojection_rms_px. */
+  reprojection_rms_px?: number;
+  /** With image points: the same per view, px. */
+  per_view_reprojection_rms_px?: number[];
+  /** With image points: reprojection RMS of the closed form it started from, px. */
+  closed_form_reprojection_rms_px?: number;
 }
 
 /** One robot pose and the image paired with it (`robocal handeye` with images only). */

@@ -35,7 +35,11 @@ keeps the closed form): pose_refinement {started_from, cost, noise,
 camera_transform_std, target_transform_std, covariance, outlier_views} and a
 pose_cost per method. With images (default --refine none) the same refinement
 runs on the PnP poses with each view's PnP covariance (camera_noise_model
-per_view); --refine trusted|stochastic|joint_intrinsics refines over the pixels.
+per_view) and errors.reprojection_rms_px is that of the refined transforms
+(each view's points through x^-1 * robot_i^-1 * y; also pose_refinement
+{reprojection_rms_px, per_view_reprojection_rms_px,
+closed_form_reprojection_rms_px}); --refine trusted|stochastic|joint_intrinsics
+refines over the pixels.
 A detection may hold any subset of the board's points (a marker board partly out
 of view): each view's pose is fitted to its own points, and a view whose points
 cannot fix a pose (fewer than 4, or all but one on a line) is dropped with its

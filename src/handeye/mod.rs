@@ -78,6 +78,8 @@ pub const MAX_POSES: usize = 1000;
 #[cfg(test)]
 mod pose_refine_tests;
 #[cfg(test)]
+mod pose_reprojection_tests;
+#[cfg(test)]
 mod pose_shape_tests;
 #[cfg(test)]
 mod reprojection_refine_tests;

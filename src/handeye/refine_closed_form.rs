@@ -112,18 +112,44 @@ pub fn reprojection_rms_px(
     x: &Pose,
     y: &Pose,
 ) -> Result<f64> {
+    reprojection_rms_per_view_px(chain, views, camera, x, y).map(|(all, _)| all)
+}
+
+/// Reprojection RMS (px) of `(x, y)` over every point and per view (0 for a
+/// view without points): view `i`'s target points are projected through
+/// the chain's implied `camera_from_target = x^-1 * robot[i]^-1 * y`
+/// (eye-in-hand `camera_from_gripper * gripper_from_base[i] *
+/// base_from_target`, eye-to-hand `camera_from_base * base_from_gripper[i] *
+/// gripper_from_target`), not through the view's own PnP pose.
+pub fn reprojection_rms_per_view_px(
+    chain: &Chain,
+    views: &[ViewPoints],
+    camera: &Camera,
+    x: &Pose,
+    y: &Pose,
+) -> Result<(f64, Vec<f64>)> {
     let (mut sum, mut count) = (0.0, 0usize);
+    let mut per_view = Vec::with_capacity(views.len());
     for (view, robot) in views.iter().zip(&chain.robot) {
         let camera_from_target = x.inverse() * robot.inverse() * y;
+        let (mut view_sum, mut view_count) = (0.0, 0usize);
         for (p, obs) in view.object_points.iter().zip(&view.image_points) {
-            sum += (camera.project(&(camera_from_target * p))? - obs).norm_squared();
+            let e2 = (camera.project(&(camera_from_target * p))? - obs).norm_squared();
+            sum += e2;
+            view_sum += e2;
             count += 1;
+            view_count += 1;
         }
+        per_view.push(if view_count > 0 {
+            (view_sum / view_count as f64).sqrt()
+        } else {
+            0.0
+        });
     }
     if count == 0 {
         return Err(Error::too_few("image points", 1, 0));
     }
-    Ok((sum / count as f64).sqrt())
+    Ok(((sum / count as f64).sqrt(), per_view))
 }
 
 /// Fill the reprojection RMS of every closed form and, unless `mode` is

@@ -18,6 +18,7 @@ use super::pose_noise::{CameraNoise, NoiseLevels, NoiseModel};
 use super::pose_refine::{evaluate, refine, Covariance12, PoseRefineOptions, HUBER_SCALE};
 use super::pose_residual::PoseMeasurement;
 use super::pose_shape::NominalTarget;
+use super::refine_closed_form::reprojection_rms_per_view_px;
 use super::repeat::{repeatability_with, Repeatability};
 use super::report::{errors, motion_residuals, pose_difference, view_residuals};
 use super::reprojection_refine::ViewPoints;
@@ -79,6 +80,18 @@ pub struct PoseRefinementSummary {
     pub whitened_residual_norms: Vec<f64>,
     /// Views down-weighted as outliers (whitened norm above 4.1).
     pub outlier_views: Vec<usize>,
+    /// With image points: reprojection RMS (px) of the refined transforms
+    /// over every point, each view's points projected through
+    /// `x^-1 * robot[i]^-1 * y` (also `errors.reprojection_rms_px`).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub reprojection_rms_px: Option<f64>,
+    /// With image points: the same per view (px).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub per_view_reprojection_rms_px: Option<Vec<f64>>,
+    /// With image points: reprojection RMS (px) of the closed form it
+    /// started from.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub closed_form_reprojection_rms_px: Option<f64>,
 }
 
 /// The nominal target of the `predicted_pnp` camera noise model (metres,
@@ -179,7 +192,7 @@ pub fn apply_pose_refinement_from_views(
         .collect();
     match covariances {
         Ok(c) if c.len() == input.camera_from_target.len() => {
-            apply_pose_refinement(result, input, CameraNoise::PerView(c), motion_pairs)
+            apply_pose_refinement(result, input, CameraNoise::PerView(c), motion_pairs)?
         }
         other => {
             let why = other
@@ -188,9 +201,53 @@ pub fn apply_pose_refinement_from_views(
             result.warnings.push(format!(
                 "pose refinement: no PnP covariance ({why}); camera noise modelled from the poses"
             ));
-            apply_pose_refinement(result, input, CameraNoise::Diagonal, motion_pairs)
+            apply_pose_refinement(result, input, CameraNoise::Diagonal, motion_pairs)?
         }
     }
+    add_reprojection_rms(result, input, views, camera)
+}
+
+/// With image points and the pose refinement run: the reprojection RMS of
+/// the refined transforms (`errors.reprojection_rms_px` and the summary's
+/// keys, as the refinement over pixels reports them), every view's target
+/// points projected through the chain's implied `camera_from_target`
+/// ([`reprojection_rms_per_view_px`]). Not computable (a point behind the
+/// camera): a warning, the key left out.
+fn add_reprojection_rms(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[ViewPoints],
+    camera: &Camera,
+) -> Result<()> {
+    let Some(summary) = result.pose_refinement.as_mut() else {
+        return Ok(());
+    };
+    let chain = Chain::new(
+        input.setup,
+        &input.base_from_gripper,
+        &input.camera_from_target,
+    )?;
+    let closed_form = result
+        .methods
+        .iter()
+        .find(|m| m.method.name() == summary.started_from)
+        .and_then(|m| m.outcome.as_ref().ok())
+        .and_then(|(_, _, e)| e.reprojection_rms_px);
+    match reprojection_rms_per_view_px(&chain, views, camera, &result.x, &result.y) {
+        Ok((rms, per_view)) => {
+            result.errors.reprojection_rms_px = Some(rms);
+            summary.reprojection_rms_px = Some(rms);
+            summary.per_view_reprojection_rms_px = Some(per_view);
+            summary.closed_form_reprojection_rms_px = closed_form;
+        }
+        Err(e) => {
+            result.errors.reprojection_rms_px = None;
+            result.warnings.push(format!(
+                "pose refinement: no reprojection RMS of the refined transforms ({e})"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// [`apply_pose_refinement`]; with `predict_shape` false, a
@@ -325,6 +382,9 @@ pub fn apply_pose_refinement_with(
             .collect(),
         whitened_residual_norms: refined.whitened_norms,
         outlier_views: refined.outliers,
+        reprojection_rms_px: None,
+        per_view_reprojection_rms_px: None,
+        closed_form_reprojection_rms_px: None,
     });
     if let Some(previous) = &result.repeatability {
         let resampled = ResampleSetup {

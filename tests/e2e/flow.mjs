@@ -50,8 +50,14 @@ export const tests = [
     // The default: maximum likelihood over the poses, each camera pose
     // weighted by its PnP covariance from the detected points.
     assert.match(await page.textContent('#handeye-pose-refinement'), /^Refined over the poses from \S+ \(maximum likelihood; estimated robot noise /);
+    // Its reprojection RMS: every corner through the refined transforms and its
+    // robot pose (the demo's robot poses are exact: about the corner noise x sqrt 2).
+    const rmsText = await page.$eval('#handeye-errors tbody', (tb) => [...tb.rows].find((r) => r.cells[0].textContent === 'reprojection RMS').cells[1].textContent);
+    const rms = Number(rmsText.replace(' px', ''));
+    assert.ok(rms > 0 && rms < 0.2, `reprojection RMS ${rmsText}`);
+    assert.match(await page.textContent('#handeye-pose-refinement'), /Reprojection RMS \S+ px \(closed form \S+ px\) over \d+ views, each view's points projected through the refined transforms and its robot pose\.$/);
     assert.match(await page.textContent('#handeye-measure'), /^This result: Minimises the residuals of A X = Z B per pose, each camera pose weighted by its uncertainty from its detected points/);
-    console.log(`     demo hand-eye (refined): gripper_from_camera ${t.join(', ')} mm (truth 30, -20, 100)`);
+    console.log(`     demo hand-eye (refined): gripper_from_camera ${t.join(', ')} mm (truth 30, -20, 100), reprojection RMS ${rmsText}`);
     // Every export format comes back from the core without an error.
     await page.click('a[data-step=export]');
     for (const sel of ['#camera-formats button', '#transform-formats button']) {

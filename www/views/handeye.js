@@ -149,7 +149,10 @@ export class HandEyeView {
     const poseRefinement = pr ? h('p', { class: 'hint', id: 'handeye-pose-refinement' },
       `Refined over the poses from ${pr.started_from} (maximum likelihood; estimated robot noise ${num(pr.noise.robot_rotation_deg, 4)} deg / ${num(pr.noise.robot_translation_mm, 3)} mm). ` +
       `${camKey} std: translation ${std.translation_mm.map((v) => num(v, 3)).join(', ')} mm, rotation ${std.rotation_deg.map((v) => num(v, 4)).join(', ')} deg` +
-      (pr.outlier_views.length ? `; outlier views (down-weighted): ${pr.outlier_views.map((v) => v + 1).join(', ')}.` : '.')) : null;
+      (pr.outlier_views.length ? `; outlier views (down-weighted): ${pr.outlier_views.map((v) => v + 1).join(', ')}.` : '.') +
+      (pr.reprojection_rms_px != null ? ` Reprojection RMS ${num(pr.reprojection_rms_px, 4)} px` +
+        (pr.closed_form_reprojection_rms_px != null ? ` (closed form ${num(pr.closed_form_reprojection_rms_px, 4)} px)` : '') +
+        ` over ${(pr.per_view_reprojection_rms_px || []).length} views, each view's points projected through the refined transforms and its robot pose.` : '')) : null;
     const motion = r.motion ? h('p', { class: 'hint' }, `${r.motion.motions} motions used (${r.motion.discarded_small_rotation} discarded for too little rotation); rotation angles ${num(r.motion.angle_min_deg, 1)}–${num(r.motion.angle_max_deg, 1)} deg (median ${num(r.motion.angle_median_deg, 1)}), axis spread ${num(r.motion.axis_spread_deg, 1)} deg.`) : null;
     // The table's quantity: closure per pose (its RMS and max are the table's).
     const names = r.pair_names || [];
