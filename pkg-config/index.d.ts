@@ -608,6 +608,78 @@ export interface RigCalibration {
   iterations: number;
   termination: Termination;
   warnings: string[];
+  /** The joint covariance of the solved rig parameters (absent in older files, or when singular). */
+  covariance?: RigCovariance;
+}
+
+/** One solved rig parameter: an intrinsic (`fx`, `fy`, `cx`, `cy`, `skew`, a distortion coefficient) or a `camera_from_rig` component (`rotation_x|y|z`, rad, left perturbation; `translation_x|y|z`, m). */
+export interface RigParameter {
+  camera: string;
+  parameter: string;
+}
+
+/** The covariance of the rig's solved parameters, rows and columns in the order of `parameters`. */
+export interface RigCovariance {
+  parameters: RigParameter[];
+  matrix: number[][];
+}
+
+/** The input JSON of `calibrate_rig_handeye`: a camera rig on a robot. */
+export interface RigHandEyeInput {
+  setup: Setup;
+  /** One robot pose per frame, in frame (key) order. */
+  base_from_gripper: PoseInput[];
+  /** The cameras and their views, as `calibrate_rig`'s input; the rig is calibrated from them unless `rig` is given. */
+  calibration: RigInput;
+  /** A calibrated rig (a rig report) to hold: every `calibration.cameras[i].name` must be one of its cameras. */
+  rig?: RigCalibration;
+  /** Report suspected pose mistakes as warnings instead of failing. */
+  lenient?: boolean;
+}
+
+/** Whether the rig hand-eye's std include the rig calibration's own uncertainty. */
+export interface RigUncertainty {
+  /** `false`: the std are conditional on the rig (no rig covariance). */
+  included: boolean;
+  note: string;
+  /** Hand-eye re-solves at the rig moved by one std along each principal axis. */
+  sigma_points: number;
+  /** The std with the rig held, when the rig's uncertainty was added. */
+  conditional_camera_transform_std?: TransformStd;
+  conditional_target_transform_std?: TransformStd;
+}
+
+/** One frame of the rig hand-eye. */
+export interface RigHandEyeFrame {
+  key: string;
+  pose_index: number;
+  used: boolean;
+  cameras: string[];
+  pose_fit_rms_px?: number;
+  reason?: string;
+}
+
+/** A hand-eye method's result with the rig in its keys. */
+export type RigHandEyeMethodResult = Omit<HandEyeMethodResult, 'gripper_from_camera' | 'base_from_camera'> & {
+  gripper_from_rig?: PoseReport;
+  base_from_rig?: PoseReport;
+};
+
+/** The `handeye` of a rig report: the hand-eye report with the rig in its keys. */
+export type RigHandEyeReport = Omit<HandEyeReportBase, 'methods'> & {
+  methods: RigHandEyeMethodResult[];
+  /** Each camera's own transform (`x * camera_from_rig^-1`). */
+  cameras: { name: string; gripper_from_camera?: PoseReport; base_from_camera?: PoseReport }[];
+  frames: RigHandEyeFrame[];
+  rig_uncertainty: RigUncertainty;
+} & (
+  | { setup: 'eye-in-hand'; gripper_from_rig: PoseReport; base_from_target: PoseReport }
+  | { setup: 'eye-to-hand'; base_from_rig: PoseReport; gripper_from_target: PoseReport }
+);
+
+/** The output of `calibrate_rig_handeye` (and of `robocal rig --setup`): the rig report with `handeye`. */
+export interface RigOnRobotReport extends RigCalibration {
+  handeye: RigHandEyeReport;
 }
 
 /** The formats of a rig report (`rig_export_formats`). */
@@ -1377,6 +1449,8 @@ export interface RobocalJson {
   export_formats: [never, ExportFormatListEntry[]];
   /** `calibrate_rig(input)` -> the rig report. */
   calibrate_rig: [RigInput, RigCalibration];
+  /** `calibrate_rig_handeye(input)` -> the rig report with `handeye` (a camera rig on a robot). */
+  calibrate_rig_handeye: [RigHandEyeInput, RigOnRobotReport];
   /** `export_report_files(JSON.stringify(report), format, transform or "", JSON.stringify(frames) or "")` -> the files (several for a rig's `ros` and `mrcal`, as `robocal export -o DIR` writes them); `frames` names frames by role, e.g. `{"rig": "camera_rig"}`. */
   export_report_files: [ExportableReport, ExportFile[]];
   /** `rig_export_formats()` -> the rig format names. */

@@ -218,6 +218,79 @@ fn rig_on_a_robot_gives_gripper_from_rig_and_checks_the_poses() {
     let expected = x * scene.camera_from_rig[3].inverse();
     let dt3 = (cam3.translation.vector - expected.translation.vector).norm();
     assert!(dt3 < 6e-3, "cam3 {dt3} m");
+    // The rig's own uncertainty is in the std (its covariance in the report).
+    assert_eq!(
+        h["rig_uncertainty"]["included"], true,
+        "{}",
+        h["rig_uncertainty"]
+    );
+    assert!(
+        report["covariance"]["parameters"]
+            .as_array()
+            .expect("covariance")
+            .len()
+            > 18
+    );
+
+    // The calibrated rig given back with --rig: the same hand-eye from the
+    // same images (the JSON round trip is exact), the rig file copied.
+    let again = path("again.json");
+    let mut args = args_of(&files, |_| true);
+    args.extend([
+        "--rig",
+        &out,
+        "--setup",
+        "eye-in-hand",
+        "--poses",
+        &robot,
+        "-o",
+        &again,
+    ]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    let held: Value =
+        serde_json::from_str(&std::fs::read_to_string(&again).expect("read")).expect("json");
+    let h2 = &held["handeye"];
+    let got2 = pose(&h2["gripper_from_rig"]);
+    let d = (got2.translation.vector - got.translation.vector).norm();
+    assert!(d < 1e-12, "--rig moved gripper_from_rig by {d} m");
+    for key in ["translation_mm", "rotation_deg"] {
+        let (a, b) = (
+            &h["pose_refinement"]["camera_transform_std"][key],
+            &h2["pose_refinement"]["camera_transform_std"][key],
+        );
+        for i in 0..3 {
+            let (a, b) = (a[i].as_f64().expect("std"), b[i].as_f64().expect("std"));
+            assert!((a - b).abs() <= 1e-9 * a, "std {key}[{i}]: {a} vs {b}");
+        }
+    }
+    assert_eq!(held["cameras"], report["cameras"]);
+    // Only two of its cameras: fine; a camera the rig does not have: named.
+    let two: Vec<Vec<String>> = vec![files[0].clone(), files[1].clone()];
+    let mut args = args_of(&two, |_| true);
+    args.extend(["--rig", &out, "--setup", "eye-in-hand", "--poses", &robot]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    let mut args = args_of(&files, |_| true);
+    let i = args.iter().position(|a| *a == "cam3").expect("cam3");
+    args[i] = "top";
+    args.extend(["--rig", &out, "--setup", "eye-in-hand", "--poses", &robot]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(
+        err.trim_end(),
+        format!(
+            "robocal: rig: '{out}': camera 'top' is not in the rig (its cameras are cam0, cam1, \
+             cam2, cam3) (see 'robocal rig --help')"
+        )
+    );
+    let (code, _, err) = robocal(&["rig", "--rig", &out, "--camera", "cam0", "x.png"]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(
+        err.trim_end(),
+        "robocal: rig: --rig holds a calibrated rig for the hand-eye: give --setup \
+         eye-in-hand|eye-to-hand and --poses FILE with it (see 'robocal rig --help')"
+    );
 
     // A frame without a robot pose: named.
     std::fs::write(path("short.csv"), pose_file(&poses[1..])).expect("write");

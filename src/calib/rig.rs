@@ -20,7 +20,10 @@ use super::refine::{block_from_pose, pose_from_block};
 use super::rig_graph::{co_observation_counts, spanning_tree};
 use super::rig_init::{camera_alone, Alone};
 use super::rig_problem::{RigProblem, Sighting};
-use super::rig_report::{CoObservation, RigCalibration, RigCamera, RigFrame};
+use super::rig_report::{
+    CoObservation, RigCalibration, RigCamera, RigCovariance, RigFrame, RigParameter,
+    POSE_PARAMETERS,
+};
 use super::stereo::{camera_report_with, initial_right_from_left, TransformStd};
 use super::zhang::lm_options;
 use super::{CalibrationOptions, View};
@@ -226,6 +229,10 @@ pub fn calibrate_rig(
             }
         })
         .collect();
+    let covariance = result
+        .covariance_global
+        .as_ref()
+        .map(|c| rig_covariance(&problem, &alone, &names, c));
     Ok(RigCalibration {
         crate_version: env!("CARGO_PKG_VERSION").to_string(),
         rig_frame: names[rig_camera].clone(),
@@ -242,7 +249,58 @@ pub fn calibrate_rig(
         iterations: result.iterations,
         termination: result.termination,
         warnings,
+        covariance,
     })
+}
+
+/// The report's covariance over the free global parameters, named; a held
+/// aspect ratio's `fy` (not a parameter of the solve) follows `fx`.
+fn rig_covariance(
+    problem: &RigProblem,
+    alone: &[Alone],
+    names: &[String],
+    covariance: &nalgebra::DMatrix<f64>,
+) -> RigCovariance {
+    let n = problem.n_global();
+    // Rows of the full covariance to report, with a row of the solve each
+    // maps to and its scale (fy = aspect * fx).
+    let mut rows: Vec<(RigParameter, usize, f64)> = Vec::new();
+    for (k, a) in alone.iter().enumerate() {
+        let o = problem.params_offset(k);
+        let aspect = problem.cameras[k].aspect;
+        for (i, name) in a.camera.param_names().iter().enumerate() {
+            let parameter = RigParameter {
+                camera: names[k].clone(),
+                parameter: name.to_string(),
+            };
+            match (i, aspect) {
+                (1, Some(r)) if !a.fixed[0] => rows.push((parameter, o, r)),
+                _ if a.fixed[i] => {}
+                _ => rows.push((parameter, o + i, 1.0)),
+            }
+        }
+        if let Some(p) = problem.pose_offset(k) {
+            for (i, name) in POSE_PARAMETERS.iter().enumerate() {
+                let parameter = RigParameter {
+                    camera: names[k].clone(),
+                    parameter: name.to_string(),
+                };
+                rows.push((parameter, p + i, 1.0));
+            }
+        }
+    }
+    debug_assert!(rows.iter().all(|r| r.1 < n));
+    RigCovariance {
+        matrix: rows
+            .iter()
+            .map(|(_, i, a)| {
+                rows.iter()
+                    .map(|(_, j, b)| a * b * covariance[(*i, *j)])
+                    .collect()
+            })
+            .collect(),
+        parameters: rows.into_iter().map(|r| r.0).collect(),
+    }
 }
 
 /// Check the input; returns the rig camera's index.

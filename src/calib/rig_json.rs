@@ -122,6 +122,19 @@ pub fn calibrate_rig_json(input_json: &str) -> Result<String> {
 
 /// [`calibrate_rig_json`] on the parsed input.
 pub fn calibrate_rig_input(input: &RigInput) -> Result<RigCalibration> {
+    let (cameras, keys) = rig_views(input)?;
+    let options = RigOptions {
+        calibration: calibration_options(&input.model, &input.options)?,
+        rig_frame: input.rig_frame.clone(),
+        target: input.target.clone(),
+        grouping: input.grouping.clone(),
+    };
+    calibrate_rig(&cameras, &keys, &options)
+}
+
+/// The input's cameras with their views keyed by frame index, and the
+/// frame keys in report order.
+pub fn rig_views(input: &RigInput) -> Result<(Vec<RigCameraViews>, Vec<String>)> {
     let mut keys: Vec<String> = Vec::new();
     for c in &input.cameras {
         for v in &c.views {
@@ -156,13 +169,7 @@ pub fn calibrate_rig_input(input: &RigInput) -> Result<RigCalibration> {
             camera: c.camera.clone(),
         });
     }
-    let options = RigOptions {
-        calibration: calibration_options(&input.model, &input.options)?,
-        rig_frame: input.rig_frame.clone(),
-        target: input.target.clone(),
-        grouping: input.grouping.clone(),
-    };
-    calibrate_rig(&cameras, &keys, &options)
+    Ok((cameras, keys))
 }
 
 /// Field names of a view error point into its camera (`views[2].image_px`

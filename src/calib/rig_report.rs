@@ -92,4 +92,42 @@ pub struct RigCalibration {
     /// Views left out and why, weak links, and the like.
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// The joint covariance of every solved rig parameter (absent in files
+    /// of older versions, or when the solver's information was singular).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub covariance: Option<RigCovariance>,
 }
+
+/// One solved parameter of the rig: a camera's intrinsic (`fx`, `fy`, `cx`,
+/// `cy`, `skew` or a distortion coefficient, as [`crate::camera::Camera::param_names`])
+/// or a component of its `camera_from_rig`: `rotation_x`, `rotation_y`,
+/// `rotation_z` (rad, the left perturbation `R = exp(d) R_est`),
+/// `translation_x`, `translation_y`, `translation_z` (m).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigParameter {
+    /// The camera's name.
+    pub camera: String,
+    /// The parameter's name.
+    pub parameter: String,
+}
+
+/// The covariance of the rig's solved parameters from the joint bundle
+/// adjustment (scaled by the residual variance): held intrinsics and the
+/// rig camera's identity are not parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigCovariance {
+    /// The parameters, in the order of the matrix rows and columns.
+    pub parameters: Vec<RigParameter>,
+    /// The symmetric covariance matrix, row by row.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+/// The names of the `camera_from_rig` components in [`RigParameter`].
+pub const POSE_PARAMETERS: [&str; 6] = [
+    "rotation_x",
+    "rotation_y",
+    "rotation_z",
+    "translation_x",
+    "translation_y",
+    "translation_z",
+];

@@ -9,6 +9,7 @@ use robocal::calib::rig_report::RigCalibration;
 use robocal::calib::{CalibrationOptions, View};
 use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
+use robocal::handeye::rig_json::rig_cameras_named;
 use robocal::io::import_camera::import_camera;
 use robocal::io::pairing::{default_grouping, frame_keys, PairedBy};
 use robocal::target::Target;
@@ -59,7 +60,18 @@ gets 'handeye': the 'robocal handeye' report with the rig in its keys
 (gripper_from_rig or base_from_rig, base_from_target or gripper_from_target,
 methods, errors, pose_refinement with camera_transform_std), cameras (each
 camera's own gripper_from_camera or base_from_camera) and frames (key,
-pose_index, used, cameras, pose_fit_rms_px, reason).",
+pose_index, used, cameras, pose_fit_rms_px, reason) and rig_uncertainty
+(included, note, sigma_points, conditional_camera_transform_std,
+conditional_target_transform_std): the std include the rig calibration's own
+uncertainty, propagated from its covariance (the report's 'covariance').
+
+An already calibrated rig: --rig rig.json (the report of 'robocal rig -o
+rig.json') with --setup and --poses holds that rig's intrinsics and
+camera_from_rig and solves only the hand-eye from the images given with
+--camera (each NAME one of the rig's cameras, any subset of them; --target
+defaults to the rig's). The output is the given rig report with 'handeye'; its
+std include the rig's uncertainty when the file carries 'covariance', else
+rig_uncertainty.included is false and the std are conditional on the rig.",
     after_help = "Examples:
   robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png -o rig.json
   robocal rig --target charuco:12x9:20mm:15mm:DICT_5X5_100 --camera front f/*.png \\
@@ -68,7 +80,9 @@ pose_index, used, cameras, pose_fit_rms_px, reason).",
   robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png \\
       --setup eye-in-hand --poses robot.csv -o rig.json
   robocal rig --target chessboard:9x6:30mm --camera left left*.png --camera right right*.png \\
-      --fix k3 -o rig.json && robocal export rig.json --format kalibr"
+      --fix k3 -o rig.json && robocal export rig.json --format kalibr
+  robocal rig --rig rig.json --camera left l2/*.png --camera right r2/*.png \\
+      --setup eye-to-hand --poses robot2.csv -o rig_on_robot.json"
 )]
 pub struct RigArgs {
     /// The target, as for 'robocal detect' (chessboard:9x6:30mm, ...)
@@ -104,6 +118,12 @@ pub struct RigArgs {
     limits: super::ImageLimits,
     #[command(flatten)]
     handeye: super::rig_handeye::RigHandEyeFlags,
+    /// A calibrated rig (the report of 'robocal rig -o rig.json'): its
+    /// intrinsics and camera_from_rig are held and only the hand-eye is
+    /// solved; needs --setup and --poses; every --camera NAME must be one of
+    /// its cameras
+    #[arg(long, value_name = "FILE", overrides_with = "rig")]
+    rig: Option<String>,
     /// Write the report there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE", overrides_with = "output")]
     output: Option<String>,
@@ -187,6 +207,11 @@ fn usage(message: impl Into<String>) -> CliError {
 
 pub fn run(args: RigArgs) -> Result<(), CliError> {
     let handeye = args.handeye.wanted()?;
+    let given = args
+        .rig
+        .as_deref()
+        .map(|path| given_rig(path, &args, handeye))
+        .transpose()?;
     // 1. The cameras, from the flags or the rig file.
     let (mut cameras, file) = match (&args.input, args.camera.0.is_empty()) {
         (Some(_), false) => {
@@ -234,14 +259,25 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
             .or_else(|| file.as_ref().and_then(|r| f(r).clone()))
     };
     let target_spec = pick(&args.target, |r| &r.target)
+        .or_else(|| given.as_ref().map(|(r, _)| r.target.clone()))
         .ok_or_else(|| usage("--target is required, e.g. --target chessboard:9x6:30mm"))?;
     let target = Target::parse_spec(&target_spec).map_err(|e| usage(e.to_string()))?;
     let grouping = grouping(pick(&args.group_by, |r| &r.group_by).as_deref(), &cameras)?;
     let model = pick(&args.model, |r| &r.model);
-    let held = cameras
+    let mut held = cameras
         .iter()
         .map(|c| c.camera_file.as_deref().map(held_camera).transpose())
         .collect::<Result<Vec<Option<Camera>>, CliError>>()?;
+    let index = match &given {
+        Some((rig, path)) => {
+            let index = rig_cameras(rig, &cameras, path)?;
+            for (h, &k) in held.iter_mut().zip(&index) {
+                *h = Some(rig.cameras[k].calibration.camera.clone());
+            }
+            index
+        }
+        None => (0..cameras.len()).collect(),
+    };
     // 2. Frame keys, then detection in every image at once.
     let mut keys_per_camera = Vec::with_capacity(cameras.len());
     for c in &cameras {
@@ -275,6 +311,14 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
                             c.name, s.0, s.1
                         )));
                     }
+                    if let (Some(_), Some(h)) = (&given, &held) {
+                        if (h.width, h.height) != s {
+                            return Err(usage(format!(
+                                "camera {}: '{file}' is {}x{} but the rig's camera {} is {}x{}",
+                                c.name, s.0, s.1, c.name, h.width, h.height
+                            )));
+                        }
+                    }
                     size = Some(s);
                     let frame = keys.iter().position(|k| k == key).unwrap_or(0);
                     views.push((frame, View::from_detection(file, &d)));
@@ -300,7 +344,20 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
             camera: held,
         });
     }
-    // 3. Solve, summarise, write.
+    // 3. Solve (or hold the given rig), summarise, write.
+    if let Some((report, path)) = given {
+        eprintln!(
+            "robocal rig: the rig of '{path}' held ({} cameras, images of {})",
+            report.cameras.len(),
+            cameras
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        let source = format!("the covariance in '{path}'");
+        return write_with_handeye(&args, &report, &inputs, &index, &keys, grouping, &source);
+    }
     let options = RigOptions {
         calibration: CalibrationOptions {
             model: model_from_name(model.as_deref().unwrap_or("brown"))?,
@@ -316,18 +373,93 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
     };
     let report = calibrate_rig(&inputs, &keys, &options)?;
     eprint!("{}", summary(&report));
-    let mut json = serde_json::to_value(&report)
+    if !handeye {
+        return write_report(&args, &report, None);
+    }
+    let source = "the rig calibration of this run".to_string();
+    write_with_handeye(&args, &report, &inputs, &index, &keys, grouping, &source)
+}
+
+/// The hand-eye of the rig, then the report with it under `handeye`.
+fn write_with_handeye(
+    args: &RigArgs,
+    report: &RigCalibration,
+    inputs: &[RigCameraViews],
+    index: &[usize],
+    keys: &[String],
+    grouping: PairedBy,
+    source: &str,
+) -> Result<(), CliError> {
+    let h = super::rig_handeye::rig_handeye(
+        &args.handeye,
+        report,
+        inputs,
+        index,
+        keys,
+        grouping,
+        source,
+    )?;
+    eprint!("{}", super::rig_handeye::summary(&h));
+    write_report(args, report, Some(h))
+}
+
+fn write_report(
+    args: &RigArgs,
+    report: &RigCalibration,
+    handeye: Option<serde_json::Value>,
+) -> Result<(), CliError> {
+    let mut json = serde_json::to_value(report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
-    if handeye {
-        let h = super::rig_handeye::rig_handeye(&args.handeye, &report, &inputs, &keys, grouping)?;
-        eprint!("{}", super::rig_handeye::summary(&h));
-        if let Some(o) = json.as_object_mut() {
-            o.insert("handeye".into(), h);
-        }
+    if let (Some(h), Some(o)) = (handeye, json.as_object_mut()) {
+        o.insert("handeye".into(), h);
     }
     let text = serde_json::to_string_pretty(&json)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
     write_output(args.output.as_deref(), &(text + "\n"))
+}
+
+/// The rig of `--rig FILE`, with the flags it cannot go with refused.
+fn given_rig(
+    path: &str,
+    args: &RigArgs,
+    handeye: bool,
+) -> Result<(RigCalibration, String), CliError> {
+    if !handeye {
+        return Err(usage(
+            "--rig holds a calibrated rig for the hand-eye: give --setup eye-in-hand|eye-to-hand \
+             and --poses FILE with it",
+        ));
+    }
+    let conflicts = [
+        (!args.camera_file.is_empty(), "--camera-file"),
+        (args.model.is_some(), "--model"),
+        (!args.fix.is_empty(), "--fix"),
+        (args.rig_frame.is_some(), "--rig-frame"),
+    ];
+    if let Some((_, flag)) = conflicts.iter().find(|(on, _)| *on) {
+        return Err(usage(format!(
+            "{flag} cannot go with --rig: the rig file holds every camera's intrinsics and the \
+             rig frame"
+        )));
+    }
+    let text = read_text(path)?;
+    let rig: RigCalibration = serde_json::from_str(&text).map_err(|e| {
+        CliError::Io(format!(
+            "'{path}': line {}: not a rig report (the output of 'robocal rig -o rig.json'): {e}",
+            e.line()
+        ))
+    })?;
+    Ok((rig, path.to_string()))
+}
+
+/// The rig camera of each `--camera`, by name; every name must be in the rig.
+fn rig_cameras(
+    rig: &RigCalibration,
+    cameras: &[CameraArg],
+    path: &str,
+) -> Result<Vec<usize>, CliError> {
+    let names: Vec<&str> = cameras.iter().map(|c| c.name.as_str()).collect();
+    rig_cameras_named(rig, &names, "--camera").map_err(|e| usage(format!("'{path}': {}", plain(e))))
 }
 
 fn cameras_of_flags(flags: &[Vec<String>]) -> Vec<CameraArg> {

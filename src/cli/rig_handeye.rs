@@ -8,9 +8,7 @@ use super::handeye_images::{read_robot_poses, RobotPoses};
 use super::{read_text, CliError};
 use robocal::calib::rig::RigCameraViews;
 use robocal::calib::rig_report::RigCalibration;
-use robocal::handeye::reprojection_refine::ViewPoints;
-use robocal::handeye::rig::{calibrate_rig_handeye, rig_handeye_report};
-use robocal::handeye::rig_pnp::HeldRig;
+use robocal::handeye::rig_json::solve_rig_on_robot;
 use robocal::handeye::{HandEyeOptions, Setup};
 use robocal::io::pairing::{number_in_name, PairedBy};
 use robocal::io::RobotPose;
@@ -52,13 +50,17 @@ impl RigHandEyeFlags {
     }
 }
 
-/// The rig hand-eye report of a calibrated rig.
+/// The rig hand-eye report of a calibrated rig: `index[k]` is the rig
+/// camera of input camera `k`; `source` names where the rig came from (for
+/// the note on its uncertainty).
 pub fn rig_handeye(
     flags: &RigHandEyeFlags,
     report: &RigCalibration,
     inputs: &[RigCameraViews],
+    index: &[usize],
     keys: &[String],
     grouping: PairedBy,
+    source: &str,
 ) -> Result<Value, CliError> {
     let setup: Setup = flags.setup.as_deref().unwrap_or_default().parse()?;
     let path = flags.poses.as_deref().unwrap_or_default();
@@ -74,45 +76,20 @@ pub fn rig_handeye(
         }
     };
     let base_from_gripper = per_frame(&poses, keys, grouping, path)?;
-    let rig = HeldRig {
-        cameras: report
-            .cameras
-            .iter()
-            .map(|c| c.calibration.camera.clone())
-            .collect(),
-        camera_from_rig: report
-            .cameras
-            .iter()
-            .map(|c| c.camera_from_rig.to_pose())
-            .collect::<robocal::Result<_>>()?,
-    };
-    let mut frames = vec![Vec::new(); keys.len()];
-    for (k, camera) in inputs.iter().enumerate() {
-        for (f, view) in &camera.views {
-            frames[*f].push((
-                k,
-                ViewPoints {
-                    object_points: view.object_m.clone(),
-                    image_points: view.image_px.clone(),
-                },
-            ));
-        }
-    }
-    let names: Vec<String> = inputs.iter().map(|c| c.name.clone()).collect();
     let options = HandEyeOptions {
         strict_checks: !flags.lenient,
         ..HandEyeOptions::default()
     };
-    let solved = calibrate_rig_handeye(
+    Ok(solve_rig_on_robot(
         setup,
-        &rig,
-        &names,
+        report,
+        inputs,
+        index,
         keys,
-        &frames,
         &base_from_gripper,
         &options,
-    )?;
-    Ok(rig_handeye_report(&solved, &rig, &names))
+        source,
+    )?)
 }
 
 /// One robot pose per frame: by the frame numbers of the pose file's image
@@ -178,6 +155,12 @@ pub fn summary(h: &Value) -> String {
         s += &format!(
             "  std: translation_mm {} rotation_deg {}\n",
             sd["translation_mm"], sd["rotation_deg"]
+        );
+    }
+    if h["rig_uncertainty"]["included"] == false {
+        s += &format!(
+            "robocal rig: note: {}\n",
+            h["rig_uncertainty"]["note"].as_str().unwrap_or("")
         );
     }
     for w in h["warnings"].as_array().map_or(&[][..], Vec::as_slice) {

@@ -64,7 +64,9 @@ pub mod repeat;
 pub mod report;
 pub mod reprojection_refine;
 pub mod rig;
+pub mod rig_json;
 pub mod rig_pnp;
+pub mod rig_uncertainty;
 pub mod scara;
 pub mod solve;
 

@@ -104,7 +104,7 @@ pub struct NominalTargetReport {
     pub half_extent: [f64; 2],
 }
 
-fn transform_std(cov: &Covariance12, offset: usize) -> TransformStd {
+pub(crate) fn transform_std(cov: &Covariance12, offset: usize) -> TransformStd {
     let s = |k: usize| cov[(offset + k, offset + k)].max(0.0).sqrt();
     TransformStd {
         rotation_deg: [s(0), s(1), s(2)].map(f64::to_degrees),

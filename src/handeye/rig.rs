@@ -9,15 +9,19 @@
 //! ([`super::calibrate`]) and the maximum-likelihood pose refinement with
 //! each frame's multi-camera PnP covariance ([`CameraNoise::PerView`]).
 //! Every camera's own transform follows as `x * camera_from_rig[k]^-1`.
+//!
+//! The refinement's std hold the rig fixed; [`add_rig_uncertainty`] adds
+//! the rig calibration's own covariance ([`super::rig_uncertainty`]).
 
 use super::output::HandEyeReport;
 use super::pose_noise::CameraNoise;
-use super::refine_poses::apply_pose_refinement;
+use super::pose_refine::Covariance12;
+use super::refine_poses::{apply_pose_refinement, transform_std, TransformStd};
 use super::reprojection_refine::ViewPoints;
 use super::rig_pnp::{rig_from_target, HeldRig};
 use super::{calibrate, HandEyeInput, HandEyeOptions, HandEyeResult, Pose, Setup};
 use crate::error::{Error, Result};
-use crate::geometry::PoseJson;
+use crate::geometry::{rotvec_from_rotation, PoseJson};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -48,7 +52,33 @@ pub struct RigHandEyeResult {
     pub result: HandEyeResult,
     /// Every frame, used or not.
     pub frames: Vec<RigHandEyeFrame>,
+    /// Whether the std include the rig's own uncertainty.
+    pub rig_uncertainty: RigUncertainty,
 }
+
+/// What the reported std of the rig transform rest on (the report's
+/// `rig_uncertainty`).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct RigUncertainty {
+    /// Whether `pose_refinement`'s std and covariance include the rig
+    /// calibration's uncertainty (`false`: conditional on the rig).
+    pub included: bool,
+    /// In words: what the std include, or why not the rig's uncertainty.
+    pub note: String,
+    /// Hand-eye solutions evaluated at the rig moved along its covariance.
+    pub sigma_points: usize,
+    /// The std with the rig held (the pose refinement's own), when the
+    /// rig's uncertainty was added.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub conditional_camera_transform_std: Option<TransformStd>,
+    /// Likewise for the target transform.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub conditional_target_transform_std: Option<TransformStd>,
+}
+
+/// The note when no rig covariance is at hand.
+pub const CONDITIONAL_NOTE: &str = "the std are conditional on the rig: its intrinsics and \
+    camera_from_rig are held as exact (the rig carries no covariance)";
 
 /// Solve the rig's hand-eye. `frames[f]` holds the views of frame `f`
 /// (camera index, points), `keys[f]` its key, `base_from_gripper[f]` its
@@ -141,8 +171,130 @@ pub fn calibrate_rig_handeye(
     Ok(RigHandEyeResult {
         result,
         frames: audit,
+        rig_uncertainty: RigUncertainty {
+            included: false,
+            note: CONDITIONAL_NOTE.into(),
+            sigma_points: 0,
+            conditional_camera_transform_std: None,
+            conditional_target_transform_std: None,
+        },
     })
 }
+
+/// Widen the pose refinement's covariance by the rig's own: re-solve at
+/// every sigma point of the rig ([`super::rig_uncertainty::rig_sigma_points`])
+/// with the frames and poses `solved` came from, and add `sum d d^T`. The
+/// conditional std move to `rig_uncertainty`. Without a pose refinement, or
+/// when a re-solve fails, the std stay conditional and the note says why.
+#[allow(clippy::too_many_arguments)]
+pub fn add_rig_uncertainty(
+    solved: &mut RigHandEyeResult,
+    sigma_points: &[[HeldRig; 2]],
+    source: &str,
+    frames: &[Vec<(usize, ViewPoints)>],
+    base_from_gripper: &[Pose],
+    options: &HandEyeOptions,
+) -> Result<()> {
+    let Some(summary) = solved.result.pose_refinement.clone() else {
+        solved.rig_uncertainty.note =
+            "no pose refinement ran: no std to widen by the rig's uncertainty".into();
+        return Ok(());
+    };
+    let used: Vec<usize> = (0..solved.frames.len())
+        .filter(|&f| solved.frames[f].used)
+        .collect();
+    let base = &solved.result;
+    let mut spread = Covariance12::zeros();
+    for pair in sigma_points {
+        let mut ends = Vec::with_capacity(2);
+        for rig in pair {
+            match resolve(base, rig, &used, frames, base_from_gripper, options) {
+                Ok(end) => ends.push(end),
+                Err(e) => {
+                    solved.rig_uncertainty.note = format!(
+                        "{CONDITIONAL_NOTE}: a re-solve at the rig moved by one std failed ({e})"
+                    );
+                    return Ok(());
+                }
+            }
+        }
+        let d = (ends[0] - ends[1]) * 0.5;
+        spread += d * d.transpose();
+    }
+    let conditional = Covariance12::from_fn(|r, c| summary.covariance[r][c]);
+    let total = conditional + spread;
+    let refinement = solved
+        .result
+        .pose_refinement
+        .as_mut()
+        .ok_or_else(|| Error::degenerate("the pose refinement vanished"))?;
+    refinement.camera_transform_std = transform_std(&total, 0);
+    refinement.target_transform_std = transform_std(&total, 6);
+    refinement.covariance = (0..12)
+        .map(|r| std::array::from_fn(|c| total[(r, c)]))
+        .collect();
+    solved.rig_uncertainty = RigUncertainty {
+        included: true,
+        note: format!(
+            "the std include the rig's own uncertainty ({source}), propagated through {} \
+             re-solves at the rig moved by one std along each principal axis",
+            2 * sigma_points.len()
+        ),
+        sigma_points: 2 * sigma_points.len(),
+        conditional_camera_transform_std: Some(summary.camera_transform_std),
+        conditional_target_transform_std: Some(summary.target_transform_std),
+    };
+    Ok(())
+}
+
+/// The hand-eye at a moved rig, from the solution `base`: each used frame's
+/// pose, then the pose refinement; returns `[x, y]`'s difference from
+/// `base` (rotation in the left frame, rad; translation, m).
+fn resolve(
+    base: &HandEyeResult,
+    rig: &HeldRig,
+    used: &[usize],
+    frames: &[Vec<(usize, ViewPoints)>],
+    base_from_gripper: &[Pose],
+    options: &HandEyeOptions,
+) -> Result<Vector12> {
+    let mut input = HandEyeInput {
+        setup: base.setup,
+        base_from_gripper: Vec::with_capacity(used.len()),
+        camera_from_target: Vec::with_capacity(used.len()),
+    };
+    let mut covariances = Vec::with_capacity(used.len());
+    for &f in used {
+        let p = rig_from_target(rig, &frames[f])?;
+        input.base_from_gripper.push(base_from_gripper[f]);
+        input.camera_from_target.push(p.rig_from_target);
+        covariances.push(p.covariance);
+    }
+    let mut moved = base.clone();
+    moved.repeatability = None;
+    moved.pose_refinement = None;
+    apply_pose_refinement(
+        &mut moved,
+        &input,
+        CameraNoise::PerView(covariances),
+        options.motion_pairs,
+    )?;
+    if moved.pose_refinement.is_none() {
+        return Err(Error::degenerate(
+            moved.warnings.last().cloned().unwrap_or_default(),
+        ));
+    }
+    let mut d = Vector12::zeros();
+    for (o, (got, at)) in [(0, (&moved.x, &base.x)), (6, (&moved.y, &base.y))] {
+        let r = rotvec_from_rotation(&(got.rotation * at.rotation.inverse()));
+        let t = got.translation.vector - at.translation.vector;
+        d.fixed_rows_mut::<3>(o).copy_from(&r);
+        d.fixed_rows_mut::<3>(o + 3).copy_from(&t);
+    }
+    Ok(d)
+}
+
+type Vector12 = nalgebra::SVector<f64, 12>;
 
 /// The report: the single-camera hand-eye report with the rig in its keys
 /// (`gripper_from_rig` or `base_from_rig`, also in `methods`), plus
@@ -180,6 +332,10 @@ pub fn rig_handeye_report(solved: &RigHandEyeResult, rig: &HeldRig, names: &[Str
         o.insert(
             "frames".into(),
             serde_json::to_value(&solved.frames).unwrap_or(Value::Null),
+        );
+        o.insert(
+            "rig_uncertainty".into(),
+            serde_json::to_value(&solved.rig_uncertainty).unwrap_or(Value::Null),
         );
     }
     report

@@ -165,6 +165,7 @@ pub(super) fn example_rig() -> (RigCalibration, Vec<Pose>) {
         iterations: 7,
         termination: Termination::CostTolerance,
         warnings: Vec::new(),
+        covariance: None,
     };
     (rig, truth)
 }
