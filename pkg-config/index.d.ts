@@ -624,19 +624,6 @@ export interface RigCovariance {
   matrix: number[][];
 }
 
-/** The input JSON of `calibrate_rig_handeye`: a camera rig on a robot. */
-export interface RigHandEyeInput {
-  setup: Setup;
-  /** One robot pose per frame, in frame (key) order. */
-  base_from_gripper: PoseInput[];
-  /** The cameras and their views, as `calibrate_rig`'s input; the rig is calibrated from them unless `rig` is given. */
-  calibration: RigInput;
-  /** A calibrated rig (a rig report) to hold: every `calibration.cameras[i].name` must be one of its cameras. */
-  rig?: RigCalibration;
-  /** Report suspected pose mistakes as warnings instead of failing. */
-  lenient?: boolean;
-}
-
 /** Whether the rig hand-eye's std include the rig calibration's own uncertainty. */
 export interface RigUncertainty {
   /** `false`: the std are conditional on the rig (no rig covariance). */
@@ -677,7 +664,7 @@ export type RigHandEyeReport = Omit<HandEyeReportBase, 'methods'> & {
   | { setup: 'eye-to-hand'; base_from_rig: PoseReport; gripper_from_target: PoseReport }
 );
 
-/** The output of `calibrate_rig_handeye` (and of `robocal rig --setup`): the rig report with `handeye`. */
+/** The output of `robocal rig --setup` (a camera rig on a robot): the rig report with `handeye`. */
 export interface RigOnRobotReport extends RigCalibration {
   handeye: RigHandEyeReport;
 }
@@ -1449,8 +1436,6 @@ export interface RobocalJson {
   export_formats: [never, ExportFormatListEntry[]];
   /** `calibrate_rig(input)` -> the rig report. */
   calibrate_rig: [RigInput, RigCalibration];
-  /** `calibrate_rig_handeye(input)` -> the rig report with `handeye` (a camera rig on a robot). */
-  calibrate_rig_handeye: [RigHandEyeInput, RigOnRobotReport];
   /** `export_report_files(JSON.stringify(report), format, transform or "", JSON.stringify(frames) or "")` -> the files (several for a rig's `ros` and `mrcal`, as `robocal export -o DIR` writes them); `frames` names frames by role, e.g. `{"rig": "camera_rig"}`. */
   export_report_files: [ExportableReport, ExportFile[]];
   /** `rig_export_formats()` -> the rig format names. */
