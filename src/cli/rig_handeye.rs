@@ -107,15 +107,18 @@ fn per_frame(
     let mut out = vec![None; keys.len()];
     for p in poses {
         let name = p.name.as_deref().unwrap_or_default();
-        let frame = number_in_name(name).and_then(|n| keys.iter().position(|k| k == n));
-        let Some(f) = frame else {
+        let Some(number) = number_in_name(name) else {
             return Err(CliError::Io(format!(
-                "'{path}': line {}: the image '{name}' is in no frame (the frames are {})",
+                "'{path}': line {}: the image '{name}' has no frame number (the frames are {})",
                 p.line,
                 keys.join(", ")
             )));
         };
-        out[f] = Some(p.base_from_gripper);
+        // A pose of a frame none of the given images is in (a pose file of
+        // the whole rig used with some of its cameras) is not needed.
+        if let Some(f) = keys.iter().position(|k| k == number) {
+            out[f] = Some(p.base_from_gripper);
+        }
     }
     let missing: Vec<&str> = keys
         .iter()
