@@ -130,11 +130,20 @@ pub fn reprojection_rms_per_view_px(
 ) -> Result<(f64, Vec<f64>)> {
     let (mut sum, mut count) = (0.0, 0usize);
     let mut per_view = Vec::with_capacity(views.len());
-    for (view, robot) in views.iter().zip(&chain.robot) {
+    for (i, (view, robot)) in views.iter().zip(&chain.robot).enumerate() {
         let camera_from_target = x.inverse() * robot.inverse() * y;
         let (mut view_sum, mut view_count) = (0.0, 0usize);
         for (p, obs) in view.object_points.iter().zip(&view.image_points) {
-            let e2 = (camera.project(&(camera_from_target * p))? - obs).norm_squared();
+            let q = camera_from_target * p;
+            let projected = camera.project(&q).map_err(|_| {
+                Error::degenerate(format!(
+                    "through the solved transforms and view {} a target point lies \
+                     behind the camera (z = {:.4} m)",
+                    i + 1,
+                    q.z
+                ))
+            })?;
+            let e2 = (projected - obs).norm_squared();
             sum += e2;
             view_sum += e2;
             count += 1;

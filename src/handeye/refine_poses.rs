@@ -243,7 +243,8 @@ fn add_reprojection_rms(
         Err(e) => {
             result.errors.reprojection_rms_px = None;
             result.warnings.push(format!(
-                "pose refinement: no reprojection RMS of the refined transforms ({e})"
+                "pose refinement: no reprojection RMS of the refined transforms: {e}; check the \
+                 robot poses' units and convention"
             ));
         }
     }

@@ -137,7 +137,9 @@ export const tests = [
     const names = () => page.$$eval('#rig-frame-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent.replace(/: .*$/, ''))));
     await page.setInputFiles('#rig-input-0', [png('left_10.png'), png('left_2.png'), png('left_07.png')]);
     await page.setInputFiles('#rig-input-1', [png('right7.png'), png('right010.png'), png('right002.png')]);
-    await page.waitForFunction(() => /^3 frames over 2 cameras, grouped by the number in the file names\.$/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    // The left images alone already make 3 frames over 2 cameras: wait for the right ones in the table too.
+    await page.waitForFunction(() => /^3 frames over 2 cameras, grouped by the number in the file names\.$/.test(document.getElementById('rig-grouping')?.textContent || '')
+      && [...document.querySelectorAll('#rig-frame-table tbody tr')].filter((tr) => /^right/.test(tr.cells[2]?.textContent || '')).length === 3, null, { timeout: 10000 });
     assert.deepEqual(await names(), [['2', 'left_2.png', 'right002.png'], ['7', 'left_07.png', 'right7.png'], ['10', 'left_10.png', 'right010.png']]);
     assert.equal(await page.isDisabled('#rig-solve'), false);
     // A right image without a left one: a frame only the right camera saw (a rig camera may miss any frame).
