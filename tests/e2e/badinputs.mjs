@@ -288,7 +288,15 @@ async function rigAdd(page, left, right, expect) {
   const mk = (names) => names.map((n) => png(n, makePng(40, 30, checker(5))));
   if (left.length) await page.setInputFiles('#rig-input-0', mk(left));
   if (right.length) await page.setInputFiles('#rig-input-1', mk(right));
-  await page.waitForFunction((e) => (document.getElementById('rig-grouping')?.textContent || '').includes(e), expect, { timeout: 10000 });
+  // The page groups after each camera's files: wait until the table (when
+  // the files group) holds every file given here, not only the first camera's.
+  await page.waitForFunction(([e, files]) => {
+    if (!(document.getElementById('rig-grouping')?.textContent || '').includes(e)) return false;
+    const table = document.getElementById('rig-frame-table');
+    if (!table) return true;
+    const shown = [...table.querySelectorAll('tbody td')].map((td) => td.textContent.replace(/: .*$/, ''));
+    return files.every((f) => shown.includes(f));
+  }, [expect, [...left, ...right]], { timeout: 10000 });
   return page.textContent('#rig-grouping');
 }
 
