@@ -389,18 +389,23 @@ impl CaptureSession {
         Ok(())
     }
 
+    /// Kept frame `index`, or the error naming the valid indices.
+    fn kept_mut(&mut self, index: usize) -> Result<&mut KeptFrame> {
+        let n = self.kept.len();
+        self.kept.get_mut(index).ok_or_else(|| {
+            Error::invalid(
+                "capture",
+                format!("expected a capture index below {n}, got {index}"),
+            )
+        })
+    }
+
     /// Include or exclude kept frame `index` (its card's include box): an
     /// excluded frame keeps its index and its robot pose but leaves the
     /// coverage, the running calibration and the hand-eye guide until it
     /// is included again.
     pub fn set_included(&mut self, index: usize, included: bool) -> Result<()> {
-        let n = self.kept.len();
-        let kept = self.kept.get_mut(index).ok_or_else(|| {
-            Error::invalid(
-                "capture",
-                format!("expected a capture index below {n}, got {index}"),
-            )
-        })?;
+        let kept = self.kept_mut(index)?;
         if kept.included != included {
             kept.included = included;
             self.recount();
@@ -415,13 +420,7 @@ impl CaptureSession {
 
     /// Pair kept frame `index` with the robot's `base_from_gripper`.
     pub fn set_robot_pose(&mut self, index: usize, base_from_gripper: Pose) -> Result<()> {
-        let n = self.kept.len();
-        let kept = self.kept.get_mut(index).ok_or_else(|| {
-            Error::invalid(
-                "capture",
-                format!("expected a capture index below {n}, got {index}"),
-            )
-        })?;
+        let kept = self.kept_mut(index)?;
         kept.robot = Some(base_from_gripper);
         Ok(())
     }

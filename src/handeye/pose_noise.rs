@@ -114,6 +114,56 @@ pub struct NoiseModel {
     pub pivot_levers: Vec<Vector3<f64>>,
 }
 
+/// One EM step over the inlier views' (components, spread): each level
+/// scaled by its expected over observed trace (or, with `per_component`
+/// false, all by one common factor); true when no level moved by more than
+/// [`EM_TOLERANCE`] (relative).
+fn em_step<'a>(
+    variances: &mut [f64],
+    views: impl Iterator<Item = (&'a [Matrix6<f64>], &'a Matrix6<f64>)>,
+    per_component: bool,
+) -> bool {
+    let before = variances.to_vec();
+    let k = variances.len();
+    let (mut num, mut den) = (vec![0.0; k], vec![0.0; k]);
+    let (mut num_all, mut den_all) = (0.0, 0.0);
+    for (comps, spread) in views {
+        let c = comps
+            .iter()
+            .zip(variances.iter())
+            .fold(Matrix6::zeros(), |acc, (m, s)| acc + m * *s);
+        let Some(w) = c.try_inverse() else { continue };
+        let wsw = w * spread * w;
+        for (j, m) in comps.iter().enumerate() {
+            num[j] += (wsw * m).trace();
+            den[j] += (w * m).trace();
+        }
+        num_all += (w * spread).trace();
+        den_all += 6.0;
+    }
+    if per_component {
+        for j in 0..k {
+            if den[j] > 0.0 {
+                variances[j] = (variances[j] * num[j] / den[j]).max(VARIANCE_FLOOR);
+            }
+        }
+        let change = before
+            .iter()
+            .zip(variances.iter())
+            .map(|(a, b)| (a / b).ln().abs())
+            .fold(0.0, f64::max);
+        change < EM_TOLERANCE
+    } else {
+        if den_all > 0.0 {
+            let f = num_all / den_all;
+            for v in variances.iter_mut() {
+                *v = (*v * f).max(VARIANCE_FLOOR);
+            }
+        }
+        false
+    }
+}
+
 impl NoiseModel {
     /// Start from [`NoiseLevels::default`] (per-view: scale 0.2 px squared).
     pub fn new(camera: CameraNoise) -> NoiseModel {
@@ -249,44 +299,11 @@ impl NoiseModel {
             })
             .collect();
         for _ in 0..if per_component { EM_MAX_ITERATIONS } else { 1 } {
-            let before = self.variances.clone();
-            let k = self.variances.len();
-            let (mut num, mut den) = (vec![0.0; k], vec![0.0; k]);
-            let (mut num_all, mut den_all) = (0.0, 0.0);
-            for (comps, spread) in &fixed {
-                let c = comps
-                    .iter()
-                    .zip(&self.variances)
-                    .fold(Matrix6::zeros(), |acc, (m, s)| acc + m * *s);
-                let Some(w) = c.try_inverse() else { continue };
-                let wsw = w * spread * w;
-                for (j, m) in comps.iter().enumerate() {
-                    num[j] += (wsw * m).trace();
-                    den[j] += (w * m).trace();
-                }
-                num_all += (w * spread).trace();
-                den_all += 6.0;
-            }
-            if per_component {
-                for j in 0..k {
-                    if den[j] > 0.0 {
-                        self.variances[j] =
-                            (self.variances[j] * num[j] / den[j]).max(VARIANCE_FLOOR);
-                    }
-                }
-                let change = before
-                    .iter()
-                    .zip(&self.variances)
-                    .map(|(a, b)| (a / b).ln().abs())
-                    .fold(0.0, f64::max);
-                if change < EM_TOLERANCE {
-                    break;
-                }
-            } else if den_all > 0.0 {
-                let f = num_all / den_all;
-                for v in &mut self.variances {
-                    *v = (*v * f).max(VARIANCE_FLOOR);
-                }
+            let views = fixed
+                .iter()
+                .map(|(comps, spread)| (comps.as_slice(), spread));
+            if em_step(&mut self.variances, views, per_component) {
+                break;
             }
         }
     }
@@ -313,50 +330,21 @@ mod tests {
         let used = inlier.iter().filter(|u| **u).count();
         let per_component = used >= MIN_POSES_FOR_NOISE_ESTIMATE;
         for _ in 0..if per_component { EM_MAX_ITERATIONS } else { 1 } {
-            let before = model.variances.clone();
-            let k = model.variances.len();
-            let (mut num, mut den) = (vec![0.0; k], vec![0.0; k]);
-            let (mut num_all, mut den_all) = (0.0, 0.0);
-            for (i, lin) in lins.iter().enumerate() {
-                if !inlier[i] {
-                    continue;
-                }
-                let comps = model.components(i, lin);
-                let c = comps
-                    .iter()
-                    .zip(&model.variances)
-                    .fold(Matrix6::zeros(), |acc, (m, s)| acc + m * *s);
-                let Some(w) = c.try_inverse() else { continue };
-                let spread = lin.residual * lin.residual.transpose()
-                    + lin.jac_params * param_cov * lin.jac_params.transpose();
-                let wsw = w * spread * w;
-                for (j, m) in comps.iter().enumerate() {
-                    num[j] += (wsw * m).trace();
-                    den[j] += (w * m).trace();
-                }
-                num_all += (w * spread).trace();
-                den_all += 6.0;
-            }
-            if per_component {
-                for j in 0..k {
-                    if den[j] > 0.0 {
-                        model.variances[j] =
-                            (model.variances[j] * num[j] / den[j]).max(VARIANCE_FLOOR);
-                    }
-                }
-                let change = before
-                    .iter()
-                    .zip(&model.variances)
-                    .map(|(a, b)| (a / b).ln().abs())
-                    .fold(0.0, f64::max);
-                if change < EM_TOLERANCE {
-                    break;
-                }
-            } else if den_all > 0.0 {
-                let f = num_all / den_all;
-                for v in &mut model.variances {
-                    *v = (*v * f).max(VARIANCE_FLOOR);
-                }
+            let per_step: Vec<(Vec<Matrix6<f64>>, Matrix6<f64>)> = lins
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| inlier[*i])
+                .map(|(i, lin)| {
+                    let spread = lin.residual * lin.residual.transpose()
+                        + lin.jac_params * param_cov * lin.jac_params.transpose();
+                    (model.components(i, lin), spread)
+                })
+                .collect();
+            let views = per_step
+                .iter()
+                .map(|(comps, spread)| (comps.as_slice(), spread));
+            if em_step(&mut model.variances, views, per_component) {
+                break;
             }
         }
     }
