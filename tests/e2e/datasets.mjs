@@ -184,7 +184,9 @@ export const tests = [
     }
     await page.setInputFiles('#rig-input-1', right);
     await page.setInputFiles('#rig-input-0', left);
-    await page.waitForFunction(() => /^13 frames over 2 cameras, grouped by the number in the file names/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 30000 });
+    // Either camera's files alone make 13 frames: wait for both cameras' counts too.
+    await page.waitForFunction(() => /^13 frames over 2 cameras, grouped by the number in the file names/.test(document.getElementById('rig-grouping')?.textContent || '')
+      && document.getElementById('rig-count-0')?.textContent === '13 images' && document.getElementById('rig-count-1')?.textContent === '13 images', null, { timeout: 30000 });
     await page.click('#rig-solve');
     await page.locator('#stereo-summary').waitFor({ timeout: 300000 });
     await shot('stereo');

@@ -156,7 +156,9 @@ export const tests = [
     await page.click('#rig-clear');
     await page.setInputFiles('#rig-input-0', [png('b.png'), png('a.png'), png('c.png')]);
     await page.setInputFiles('#rig-input-1', [png('z.png'), png('x.png'), png('y.png')]);
-    await page.waitForFunction(() => /^3 frames over 2 cameras, grouped by order/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+    // Again the left images alone make 3 frames: wait for the right camera's column to fill.
+    await page.waitForFunction(() => /^3 frames over 2 cameras, grouped by order/.test(document.getElementById('rig-grouping')?.textContent || '')
+      && [...document.querySelectorAll('#rig-frame-table tbody tr')].filter((tr) => /^[xyz]\.png/.test(tr.cells[2]?.textContent || '')).length === 3, null, { timeout: 10000 });
     assert.deepEqual(await names(), [['0', 'a.png', 'x.png'], ['1', 'b.png', 'y.png'], ['2', 'c.png', 'z.png']]);
   }],
   ['the 28-byte JPEG gets an error card naming format and defect; a later good image detects', async (page, { url, shot }) => {
