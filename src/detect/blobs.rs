@@ -370,6 +370,7 @@ pub(crate) fn bilinear_line(
     let px = &img.pixels[..];
     let last = (img.width as usize) * (img.height as usize) - 1;
     let mask = (1i64 << FIXED_BITS) - 1;
+    out.reserve(count);
     for _ in 0..count {
         // Never below 0 (the drift can carry an end at 0 just under it).
         let (qx, qy) = (fx_x.max(0), fx_y.max(0));
@@ -379,8 +380,10 @@ pub(crate) fn bilinear_line(
         // The rounding of the step can carry the last sample just past
         // the last column or row: clamp the index instead of panicking.
         let i = (yi * stride + xi).min(last.saturating_sub(stride + 1));
-        let (a, b) = (px[i] as f64, px[i + 1] as f64);
-        let (c, d) = (px[i + stride] as f64, px[i + stride + 1] as f64);
+        // One bounds check per row pair.
+        let (top, bottom) = (&px[i..i + 2], &px[i + stride..i + stride + 2]);
+        let (a, b) = (top[0] as f64, top[1] as f64);
+        let (c, d) = (bottom[0] as f64, bottom[1] as f64);
         out.push((a * (1.0 - fx) + b * fx) * (1.0 - fy) + (c * (1.0 - fx) + d * fx) * fy);
         fx_x += dx;
         fx_y += dy;

@@ -76,7 +76,10 @@ const MIN_FIRST_PASS_PROFILES: f64 = 16.0;
 const COARSE_PROFILE_STEP_PX: f64 = 0.5;
 /// The first passes, coarse: samples every `COARSE_PROFILE_STEP_PX`,
 /// profiles every `FIRST_PASS_SPACING_PX` (the first with a wide search).
-const COARSE_PASSES: usize = 2;
+/// One is enough: a second coarse pass (session 9-12) moved the result of
+/// the fine pass after it by ~0.001 px on the renders and took 15 % of a
+/// VGA detection (BENCHMARKS.md, "Square grids: speed", session 13).
+const COARSE_PASSES: usize = 1;
 /// Most edge measurement passes (coarse and fine).
 const PASSES: usize = 4;
 /// A fine pass that moves no corner by more than this ends the
