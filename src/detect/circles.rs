@@ -112,7 +112,13 @@ pub(crate) fn detect_grid(
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    let centres = circle_centres(&board, asymmetric, &outlines, options.circle_centres);
+    let centres = circle_centres(
+        &board,
+        asymmetric,
+        &outlines,
+        options.circle_centres,
+        (img.width, img.height),
+    );
     Ok(outlines
         .iter()
         .zip(centres)

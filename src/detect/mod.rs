@@ -33,7 +33,11 @@
 //! edge points pulled back onto the board through it, the centre of the
 //! ellipse fitted there mapped forward (the pole of the vanishing line
 //! with respect to the imaged conic), iterated until no centre moves by
-//! 1e-4 px. No camera is needed, so the CLI, the page and the npm package
+//! 1e-4 px; then the grid's radial distortion (a one-parameter division
+//! model about the image centre, fitted so that one homography maps the
+//! board to the undistorted centres of that pass) is taken out of the
+//! centres and edge points, the iteration runs again there and the centres
+//! are distorted back. No camera is needed, so the CLI, the page and the npm package
 //! get the same points, and the detection's points stay the projections of
 //! the board points (`centre_model` in the detection records the model).
 //!
@@ -46,20 +50,25 @@
 //! |---|---|---|
 //! | `ellipse_centre` (uncorrected) | 0.102 / 0.154 px | 0.078 / 0.107 px |
 //! | `perspective_pole`, 5x5 window | 0.0113 / 0.029 px | 0.0161 / 0.041 px |
-//! | `perspective_pole`, 3x3 window (default) | 0.0113 / 0.029 px | 0.0134 / 0.033 px |
+//! | `perspective_pole`, 3x3 window | 0.0113 / 0.029 px | 0.0134 / 0.033 px |
 //! | `local_quadratic`, 3x3 window | 0.0113 / 0.029 px | 0.0134 / 0.032 px |
+//! | `perspective_pole`, radial step + 3x3 window (default) | 0.0113 / 0.029 px | 0.0121 / 0.032 px |
 //!
 //! On larger circles (7x5 grid at 0.25 m, ~44 px across, 46 degrees,
 //! strong distortion) the 5x5 window leaves 0.035 px mean, the 3x3 one
-//! 0.020 px (ellipse centres: 0.20 px): the smaller window follows the
-//! lens better. A quadratic term on top of each local homography changes
-//! the centres by less than 0.001 px, so the default is the plain
-//! homography. No calibration-time correction (re-estimating the centres
-//! through the camera model) was built: the detection-time correction
-//! meets issue 20's goal (mean <= 0.03 px, max <= 0.15 px) on the tests'
-//! renders; on the comparison script's steepest distorted set of large
-//! circles one image of three is at 0.033 px mean (BENCHMARKS.md, Session
-//! 8). [`DetectOptions::circle_centres`] selects another model
+//! 0.020 px, with the radial step 0.008 px (ellipse centres: 0.20 px). On
+//! the comparison script's steepest distorted set of large circles
+//! (vignetting, gradients) one image was at 0.033 px mean, 0.11 px max
+//! without the radial step, the error on the board's edge circles, whose
+//! windows lie on one side of them and extrapolate the lens's bending;
+//! with it 0.008 / 0.021 px (BENCHMARKS.md, Session 10; the test
+//! `large_steep_circles_with_vignetting_through_strong_distortion`). A
+//! quadratic term on top of each local homography changes the centres by
+//! less than 0.001 px, so the default is the plain homography. No
+//! calibration-time correction (re-estimating the centres through the
+//! camera model) was built: the detection-time correction meets issue
+//! 20's goal (mean <= 0.03 px, max <= 0.15 px) on every render tested.
+//! [`DetectOptions::circle_centres`] selects another model
 //! (`EllipseCentre` for comparison). A single circle has no grid
 //! neighbours and keeps its ellipse centre.
 //!
