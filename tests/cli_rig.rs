@@ -119,6 +119,27 @@ fn rig_on_rendered_images_recovers_every_camera_from_rig() {
         assert_eq!(d["k3"], 0.0, "cam{k}: {d}");
         assert_ne!(d["k1"], 0.0, "cam{k}: {d}");
     }
+    // The rig file's `fix` key does what --fix does: the same report.
+    let cameras: Vec<Value> = files
+        .iter()
+        .enumerate()
+        .map(|(k, list)| serde_json::json!({"name": format!("cam{k}"), "images": list}))
+        .collect();
+    let input = dir.join("rig_input.json");
+    let text = serde_json::json!({"target": TARGET, "fix": ["k3"], "cameras": cameras});
+    std::fs::write(&input, text.to_string()).expect("write");
+    let from_file = dir.join("rig_k3_file.json").to_string_lossy().into_owned();
+    let input = input.to_string_lossy().into_owned();
+    let (code, _, err) = robocal(&["rig", "--input", &input, "-o", &from_file]);
+    assert_eq!(code, 0, "{err}");
+    let again: Value =
+        serde_json::from_str(&std::fs::read_to_string(&from_file).expect("read")).expect("json");
+    for k in 0..4 {
+        let (a, b) = (&again["cameras"][k]["calibration"], &report["cameras"][k]["calibration"]);
+        assert_eq!(a["distortion"], b["distortion"], "cam{k}");
+        assert_eq!(a["camera_matrix"], b["camera_matrix"], "cam{k}");
+        assert!(a["camera_matrix"].is_array(), "cam{k}: {a}");
+    }
     let (code, yaml, err) = robocal(&["export", &held, "--format", "kalibr"]);
     assert_eq!(code, 0, "{err}");
     assert_eq!(

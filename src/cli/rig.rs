@@ -182,6 +182,9 @@ struct RigFile {
     rig_frame: Option<String>,
     #[serde(default)]
     model: Option<String>,
+    /// Distortion coefficients held at 0, as `--fix` (which replaces them).
+    #[serde(default)]
+    fix: Vec<String>,
     cameras: Vec<RigFileCamera>,
 }
 
@@ -361,7 +364,11 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
     let options = RigOptions {
         calibration: CalibrationOptions {
             model: model_from_name(model.as_deref().unwrap_or("brown"))?,
-            fixed_coefficients: args.fix.clone(),
+            // The flags replace the file's list (as every flag overrides its key).
+            fixed_coefficients: match &file {
+                Some(f) if args.fix.is_empty() => f.fix.clone(),
+                _ => args.fix.clone(),
+            },
             ..CalibrationOptions::default()
         },
         rig_frame: pick(&args.rig_frame, |r| &r.rig_frame),
