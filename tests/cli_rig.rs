@@ -89,11 +89,19 @@ fn rig_on_rendered_images_recovers_every_camera_from_rig() {
     let (code, _, err) = robocal(&args);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("frames seen together"), "{err}");
+    // Each solved camera's own advice, named (cam0 saw 5 frames).
+    let few = "camera cam0: only 5 views: 10 or more from varied angles are recommended";
+    assert!(err.contains(&format!("robocal rig: warning: {few}\n")), "{err}");
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("json");
     assert_eq!(report["rig_frame"], "cam0");
     assert_eq!(report["grouping"], "number");
     assert_eq!(report["co_observation"]["frames"][0][2], 0);
+    assert!(
+        report["warnings"].as_array().expect("warnings").iter().any(|w| w == few),
+        "{}",
+        report["warnings"]
+    );
     // Rendered corners are found to ~0.05 px (tests/detect_render.rs); with
     // 5-8 views per camera at 1.2 m each camera_from_rig is within 3 mm and
     // 3 mrad (about 10 of the reported std).

@@ -216,6 +216,13 @@ pub fn calibrate_rig(
             frames_seen: a.frames.clone(),
         });
     }
+    // Each solved camera's own advice (few views, uncovered image corners,
+    // no tilt, correlated parameters), named; a held camera's intrinsics
+    // are given, so its coverage advice does not apply.
+    for c in rig_cameras.iter().filter(|c| !c.intrinsics_held) {
+        let name = &c.name;
+        warnings.extend(c.calibration.warnings.iter().map(|w| format!("camera {name}: {w}")));
+    }
     let rig_frames = frame_keys
         .iter()
         .enumerate()

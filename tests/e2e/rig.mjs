@@ -130,6 +130,10 @@ export const tests = [
       const co = await page.$$eval('#rig-coobservation tbody tr', (trs) => trs.map((tr) => [...tr.cells].slice(1).map((c) => parseInt(c.textContent, 10))));
       assert.deepEqual(co, report.co_observation.frames);
       assert.equal(await page.locator('#rig-frame-residuals tbody tr').count(), report.frames.length);
+      // The warnings are the CLI's, each solved camera's own advice among them, all shown.
+      assert.deepEqual(report.warnings, cli.warnings);
+      assert.ok(report.warnings.some((w) => /^camera cam\d: /.test(w) && !/left out/.test(w)), report.warnings.join('\n'));
+      assert.deepEqual(await page.$$eval('#rig-results .msg-warning', (ps) => ps.map((p) => p.textContent)), report.warnings);
       // The 3-D view drew something on its canvas.
       const inked = await page.$eval('#rig-3d', (c) => { const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; for (let i = 0; i < d.length; i += 4) if (d[i] < 200) n++; return n; });
       assert.ok(inked > 2000, `3-D view: ${inked} dark pixels`);
