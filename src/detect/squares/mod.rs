@@ -23,13 +23,13 @@
 //! (the image gradient along the normal) in a window moved onto it, so the
 //! threshold plays no part. A curve is fitted to each side's edge points,
 //! a corner is where the curves of its two sides meet, and the profiles
-//! are measured again across the refined sides: two coarse passes
-//! (samples every 0.5 px, a profile every 2 px, at least 16 per side; the
-//! first with a wide search), then fine passes (samples every 0.25 px, a
+//! are measured again across the refined sides: one coarse pass
+//! (samples every 0.5 px, a profile every 2 px, at least 16 per side, a
+//! wide search), then fine passes (samples every 0.25 px, a
 //! profile per pixel) until one moves no corner by more than 0.05 px
 //! (usually the first: fine passes agree to ~0.005 px), at most four
-//! passes in all. Only the fine passes decide the corners; the coarse ones
-//! bring the sides within the fine search (BENCHMARKS.md, "Square grids").
+//! passes in all. Only the fine passes decide the corners; the coarse one
+//! brings the sides within the fine search (BENCHMARKS.md, "Square grids").
 
 //! The curve is a straight line over the whole side, chosen by numbers
 //! (test `side_models_compared_on_distorted_renders`: four 1280x960 views
