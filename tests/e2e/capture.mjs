@@ -76,6 +76,10 @@ export const tests = [
     await open(page, url);
     await page.click('#camera-start');
     await live(page, 2);
+    // The rates are counts over a 2 s window: compare them once the
+    // detection's window is full (just after its first ticks, a few replies
+    // arriving together read as a high rate over a short span).
+    await page.waitForTimeout(2500);
     const devices = await page.$$eval('#camera-device option', (os) => os.map((o) => o.textContent));
     assert.ok(devices.includes('fake_device_0'), `the fake camera is listed by its label: ${devices}`);
     const res = await page.$$eval('#camera-resolution option', (os) => os.map((o) => o.value));
@@ -148,6 +152,8 @@ export const tests = [
     await page.fill('#capture-pose', poses[0]);
     await page.click('#capture-frame');
     await page.waitForFunction(() => document.querySelectorAll('.card').length === 1, null, { timeout: 20000 });
+    // The note follows the card (it is written once the frame is stored).
+    await page.waitForFunction(() => /^capture_001\.png is paired/.test(document.getElementById('capture-pose-note').textContent), null, { timeout: 20000 }).catch(() => {});
     assert.match(await page.textContent('#capture-pose-note'), /^capture_001\.png is paired with the pose read as /);
     assert.equal(await page.inputValue('#capture-pose'), '', 'the field is emptied for the next pose');
     await page.fill('#capture-pose', poses[1]);
@@ -317,11 +323,16 @@ export const tests = [
         assert.ok(taken, `hand-eye capture ${i + 1}: ${await p.textContent('#capture-handeye')}`);
         known.push(JSON.parse(await p.getAttribute('#capture-guide', 'data-firsts')).pop());
         if (i === 2) {
+          // The summary is redrawn after each capture's solve: wait for the sentence, then check it.
+          const three = /^Hand-eye: 3 captures with robot poses, 3 motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/;
+          await p.waitForFunction((src) => new RegExp(src).test(document.getElementById('capture-handeye').textContent), three.source, { timeout: 15000 }).catch(() => {});
           const he = await p.textContent('#capture-handeye');
           assert.match(he, /^Hand-eye: 3 captures with robot poses, 3 motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/);
           assert.equal(await p.getAttribute('#capture-handeye', 'data-enough'), 'no');
         }
       }
+      const four = /^Hand-eye: 4 captures with robot poses, \d motions; rotation axes spread \d+\.\d degrees \(enough\)\./;
+      await p.waitForFunction((src) => new RegExp(src).test(document.getElementById('capture-handeye').textContent), four.source, { timeout: 15000 }).catch(() => {});
       assert.match(await p.textContent('#capture-handeye'), /^Hand-eye: 4 captures with robot poses, \d motions; rotation axes spread \d+\.\d degrees \(enough\)\./);
       assert.equal(await p.getAttribute('#capture-handeye', 'data-enough'), 'yes');
       await p.screenshot({ path: join(shotsDir, 'capture-board-4-handeye.png'), fullPage: true });
