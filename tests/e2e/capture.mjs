@@ -324,10 +324,11 @@ export const tests = [
         known.push(JSON.parse(await p.getAttribute('#capture-guide', 'data-firsts')).pop());
         if (i === 2) {
           // The summary is redrawn after each capture's solve: wait for the sentence, then check it.
-          const three = /^Hand-eye: 3 captures with robot poses, 3 motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/;
+          // 2 or 3 motions: it depends on which video frames were taken (both seen; not the point here).
+          const three = /^Hand-eye: 3 captures with robot poses, [23] motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/;
           await p.waitForFunction((src) => new RegExp(src).test(document.getElementById('capture-handeye').textContent), three.source, { timeout: 15000 }).catch(() => {});
           const he = await p.textContent('#capture-handeye');
-          assert.match(he, /^Hand-eye: 3 captures with robot poses, 3 motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/);
+          assert.match(he, /^Hand-eye: 3 captures with robot poses, [23] motions; rotation axes spread 0\.0 degrees \(at least 30 degrees and 3 motions wanted\)\. \S/);
           assert.equal(await p.getAttribute('#capture-handeye', 'data-enough'), 'no');
         }
       }
