@@ -85,7 +85,12 @@ fn compare(cam: &Camera, name: &str) {
     let (mut chess, mut pole, mut uncorrected) = (0.0, 0.0, 0.0);
     for seed in SEEDS {
         let board = views(cam, "chessboard:9x6:30mm", &[&default], seed);
-        let circles = views(cam, "circles:4x11:20mm:asymmetric", &[&default, &ellipse], seed);
+        let circles = views(
+            cam,
+            "circles:4x11:20mm:asymmetric",
+            &[&default, &ellipse],
+            seed,
+        );
         let e = [
             intrinsics_error(cam, &board[0]),
             intrinsics_error(cam, &circles[0]),

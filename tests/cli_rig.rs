@@ -91,14 +91,21 @@ fn rig_on_rendered_images_recovers_every_camera_from_rig() {
     assert!(err.contains("frames seen together"), "{err}");
     // Each solved camera's own advice, named (cam0 saw 5 frames).
     let few = "camera cam0: only 5 views: 10 or more from varied angles are recommended";
-    assert!(err.contains(&format!("robocal rig: warning: {few}\n")), "{err}");
+    assert!(
+        err.contains(&format!("robocal rig: warning: {few}\n")),
+        "{err}"
+    );
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("json");
     assert_eq!(report["rig_frame"], "cam0");
     assert_eq!(report["grouping"], "number");
     assert_eq!(report["co_observation"]["frames"][0][2], 0);
     assert!(
-        report["warnings"].as_array().expect("warnings").iter().any(|w| w == few),
+        report["warnings"]
+            .as_array()
+            .expect("warnings")
+            .iter()
+            .any(|w| w == few),
         "{}",
         report["warnings"]
     );
@@ -143,7 +150,10 @@ fn rig_on_rendered_images_recovers_every_camera_from_rig() {
     let again: Value =
         serde_json::from_str(&std::fs::read_to_string(&from_file).expect("read")).expect("json");
     for k in 0..4 {
-        let (a, b) = (&again["cameras"][k]["calibration"], &report["cameras"][k]["calibration"]);
+        let (a, b) = (
+            &again["cameras"][k]["calibration"],
+            &report["cameras"][k]["calibration"],
+        );
         assert_eq!(a["distortion"], b["distortion"], "cam{k}");
         assert_eq!(a["camera_matrix"], b["camera_matrix"], "cam{k}");
         assert!(a["camera_matrix"].is_array(), "cam{k}: {a}");

@@ -221,7 +221,12 @@ pub fn calibrate_rig(
     // are given, so its coverage advice does not apply.
     for c in rig_cameras.iter().filter(|c| !c.intrinsics_held) {
         let name = &c.name;
-        warnings.extend(c.calibration.warnings.iter().map(|w| format!("camera {name}: {w}")));
+        warnings.extend(
+            c.calibration
+                .warnings
+                .iter()
+                .map(|w| format!("camera {name}: {w}")),
+        );
     }
     let rig_frames = frame_keys
         .iter()

@@ -20,6 +20,7 @@ mod render_rig;
 mod render_video;
 mod rig;
 mod rig_handeye;
+mod rig_summary;
 mod serve;
 mod stereo;
 mod target;

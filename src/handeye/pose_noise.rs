@@ -288,16 +288,7 @@ impl NoiseModel {
         // The components and the spread of each inlier view do not depend
         // on the levels: computed once, not once per EM step (at 1,000
         // poses and 500 steps they were most of the refinement's time).
-        let fixed: Vec<(Vec<Matrix6<f64>>, Matrix6<f64>)> = lins
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| inlier[*i])
-            .map(|(i, lin)| {
-                let spread = lin.residual * lin.residual.transpose()
-                    + lin.jac_params * param_cov * lin.jac_params.transpose();
-                (self.components(i, lin), spread)
-            })
-            .collect();
+        let fixed = self.view_terms(lins, inlier, param_cov);
         for _ in 0..if per_component { EM_MAX_ITERATIONS } else { 1 } {
             let views = fixed
                 .iter()
@@ -306,6 +297,25 @@ impl NoiseModel {
                 break;
             }
         }
+    }
+
+    /// Each inlier view's noise components and the spread of its residual
+    /// (the residual's outer product plus the parameters' share).
+    fn view_terms(
+        &self,
+        lins: &[ViewLinearisation],
+        inlier: &[bool],
+        param_cov: &SMatrix<f64, 12, 12>,
+    ) -> Vec<(Vec<Matrix6<f64>>, Matrix6<f64>)> {
+        lins.iter()
+            .enumerate()
+            .filter(|(i, _)| inlier[*i])
+            .map(|(i, lin)| {
+                let spread = lin.residual * lin.residual.transpose()
+                    + lin.jac_params * param_cov * lin.jac_params.transpose();
+                (self.components(i, lin), spread)
+            })
+            .collect()
     }
 }
 
@@ -330,16 +340,7 @@ mod tests {
         let used = inlier.iter().filter(|u| **u).count();
         let per_component = used >= MIN_POSES_FOR_NOISE_ESTIMATE;
         for _ in 0..if per_component { EM_MAX_ITERATIONS } else { 1 } {
-            let per_step: Vec<(Vec<Matrix6<f64>>, Matrix6<f64>)> = lins
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| inlier[*i])
-                .map(|(i, lin)| {
-                    let spread = lin.residual * lin.residual.transpose()
-                        + lin.jac_params * param_cov * lin.jac_params.transpose();
-                    (model.components(i, lin), spread)
-                })
-                .collect();
+            let per_step = model.view_terms(lins, inlier, param_cov);
             let views = per_step
                 .iter()
                 .map(|(comps, spread)| (comps.as_slice(), spread));
