@@ -158,7 +158,16 @@ pub(super) fn refine_square(
                 };
             }
             let span = (-0.5 * len + e0, 0.5 * len - e1);
-            let f = fit_side(m, t, nrm, &edge_pts, span, model)?;
+            // The coarse pass's few profiles only place the sides: a line
+            // (half-side segments would get too few points there).
+            let f = fit_side(
+                m,
+                t,
+                nrm,
+                &edge_pts,
+                span,
+                if fine { model } else { SideModel::Line },
+            )?;
             fitted.push(f);
         }
         // The blur seen on the edges sets the next pass's window.
@@ -300,7 +309,7 @@ pub(super) struct Profile {
 /// the grey level (dark inside to light outside), then the centroid of the
 /// derivative in a window of half-width `half_window` moved onto it.
 /// Returns the offset `s` and the edge's blur (the derivative's sd).
-fn edge_on_profile(
+pub(super) fn edge_on_profile(
     img: &GrayImage,
     base: Point2<f64>,
     n: Vector2<f64>,
@@ -358,16 +367,8 @@ fn edge_on_profile(
     }
     let mut centre = at(kb);
     let mut width = 0.0;
-    for _ in 0..4 {
-        // The samples with |s - centre| <= half_window: indices lo..hi.
-        let lo = ((centre - half_window - s0) / step).ceil().max(0.0) as usize;
-        let hi = (((centre + half_window - s0) / step).floor() + 1.0).max(0.0) as usize;
-        let hi = hi.min(count);
-        if lo >= hi {
-            return None;
-        }
-        let (a, b) = (sums[lo], sums[hi]);
-        let (sw, sws, swss) = (b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+    for _ in 0..CENTROID_ITERATIONS {
+        let [sw, sws, swss] = window_sums(sums, &deriv, (s0, step), centre, half_window)?;
         if !(sw > 0.0) {
             return None;
         }
@@ -380,6 +381,45 @@ fn edge_on_profile(
         }
     }
     (centre.abs() <= search + 0.5).then_some((centre, width))
+}
+
+/// Sums of `d`, `d s` and `d s^2` over the window `|s - c| <= h` of a
+/// profile sampled every `step` from `s0`: each sample stands for the cell
+/// of one step around it and counts by the part of its cell inside the
+/// window. So the sums, and the centroid, move continuously with the
+/// window; counting whole samples made them jump by a sample's weight
+/// whenever the window's end crossed one, which left the fixed point of
+/// the centroid iteration (and the corner) to jitter with the sampling
+/// phase from pass to pass (BENCHMARKS.md, "Square grids: the window's
+/// ends", session 14). `sums[k]` holds the sums over the samples before
+/// `k`; the window is cut to the profile's cells.
+fn window_sums(
+    sums: &[[f64; 3]],
+    deriv: &dyn Fn(usize) -> f64,
+    (s0, step): (f64, f64),
+    c: f64,
+    h: f64,
+) -> Option<[f64; 3]> {
+    let count = sums.len() - 1;
+    let at = |k: usize| s0 + k as f64 * step;
+    let a = (c - h).max(s0 - 0.5 * step);
+    let b = (c + h).min(at(count - 1) + 0.5 * step);
+    // The samples whose cells hold the window's ends.
+    let lo = ((a - s0) / step).round().clamp(0.0, (count - 1) as f64) as usize;
+    let hi = ((b - s0) / step).round().clamp(0.0, (count - 1) as f64) as usize;
+    if hi <= lo {
+        return None;
+    }
+    // Whole cells strictly between, then the two end cells' parts.
+    let (x, y) = (sums[lo + 1], sums[hi]);
+    let mut acc = [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
+    let part_lo = (at(lo) + 0.5 * step - a) / step;
+    let part_hi = (b - (at(hi) - 0.5 * step)) / step;
+    for (k, part) in [(lo, part_lo), (hi, part_hi)] {
+        let (d, s) = (deriv(k) * part.clamp(0.0, 1.0), at(k));
+        acc = [acc[0] + d, acc[1] + d * s, acc[2] + d * s * s];
+    }
+    Some(acc)
 }
 
 /// The four corners form a convex quadrilateral, clockwise on screen.

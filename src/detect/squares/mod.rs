@@ -21,7 +21,11 @@
 //! from the corners, where the other side's edge would enter the
 //! profile): an edge point is the centroid of the profile's derivative
 //! (the image gradient along the normal) in a window moved onto it, so the
-//! threshold plays no part. A curve is fitted to each side's edge points,
+//! threshold plays no part. The samples at the window's two ends count by
+//! the part of their cell inside it, so the centroid moves continuously
+//! with the window instead of jumping by a sample whenever an end crosses
+//! one (that jump left the corners to jitter with the sampling phase from
+//! pass to pass). A curve is fitted to each side's edge points,
 //! a corner is where the curves of its two sides meet, and the profiles
 //! are measured again across the refined sides: one coarse pass
 //! (samples every 0.5 px, a profile every 2 px, at least 16 per side, a
@@ -38,15 +42,18 @@
 //!
 //! | side model | noise-free | noise sigma 2 |
 //! |---|---|---|
-//! | line over the whole side | 0.010 / 0.026 px | **0.017 / 0.054 px** |
-//! | parabola over the whole side | 0.0035 / 0.031 px | 0.026 / 0.094 px |
-//! | line over the half side next to each corner | 0.0043 / 0.023 px | 0.023 / 0.083 px |
+//! | line over the whole side | 0.010 / 0.026 px | **0.017 / 0.051 px** |
+//! | parabola over the whole side | 0.0036 / 0.028 px | 0.026 / 0.097 px |
+//! | line over the half side next to each corner | 0.0049 / 0.022 px | 0.022 / 0.077 px |
+//!
+//! (The model is fitted in the fine passes; the coarse pass always fits a
+//! line, its few profiles only place the sides.)
 //!
 //! The distortion bends a side by up to ~0.1 px, which the line does not
 //! follow (its bias, 0.01 px), but the parabola's extrapolation to the
 //! corner and the half-side segments double the noise, which dominates
 //! at any realistic noise level. On Zhang's photos the line also gives the
-//! lowest calibration RMS (0.364 px against 0.407 and 0.385 px; test
+//! lowest calibration RMS (0.362 px against 0.407 and 0.385 px; test
 //! `zhang1998_square_grid_found_and_calibrated`). Corners come with the
 //! covariance propagated from the residuals of their two line fits.
 
@@ -92,6 +99,10 @@ const CONVERGED_PX: f64 = 0.05;
 /// point by 0.01 px, 3.0 adds 20 % noise). A Gaussian-weighted centroid
 /// was worse: its fixed-point iteration converges too slowly.
 const WINDOW_SDS: f64 = 2.5;
+/// Most iterations of the centroid window moved onto an edge (it stops
+/// once the centroid moves by less than 0.001 px; with the window's ends
+/// counted by part, see `edges::window_sums`, it settles in a few).
+const CENTROID_ITERATIONS: usize = 8;
 /// Blobs are first found one pyramid level above the working level; a
 /// board found there is kept when its squares are at least this many
 /// pixels across at that level (the median blob's square root of area),
@@ -240,3 +251,5 @@ mod edges;
 mod tests;
 
 use edges::refine_square;
+#[cfg(test)]
+use edges::{edge_on_profile, Profile};
