@@ -368,7 +368,7 @@ pub(super) fn edge_on_profile(
     let mut centre = at(kb);
     let mut width = 0.0;
     for _ in 0..CENTROID_ITERATIONS {
-        let [sw, sws, swss] = window_sums(sums, &deriv, (s0, step), centre, half_window)?;
+        let [sw, sws, swss] = window_sums(sums, deriv, (s0, step), centre, half_window)?;
         if !(sw > 0.0) {
             return None;
         }
@@ -395,7 +395,7 @@ pub(super) fn edge_on_profile(
 /// `k`; the window is cut to the profile's cells.
 fn window_sums(
     sums: &[[f64; 3]],
-    deriv: &dyn Fn(usize) -> f64,
+    deriv: impl Fn(usize) -> f64,
     (s0, step): (f64, f64),
     c: f64,
     h: f64,
@@ -404,17 +404,19 @@ fn window_sums(
     let at = |k: usize| s0 + k as f64 * step;
     let a = (c - h).max(s0 - 0.5 * step);
     let b = (c + h).min(at(count - 1) + 0.5 * step);
-    // The samples whose cells hold the window's ends.
-    let lo = ((a - s0) / step).round().clamp(0.0, (count - 1) as f64) as usize;
-    let hi = ((b - s0) / step).round().clamp(0.0, (count - 1) as f64) as usize;
+    // The samples whose cells hold the window's ends (a - s0 >= -step / 2,
+    // so the cast rounds a non-negative number; no call to `round`).
+    let inv = 1.0 / step;
+    let lo = (((a - s0) * inv + 0.5) as usize).min(count - 1);
+    let hi = (((b - s0) * inv + 0.5) as usize).min(count - 1);
     if hi <= lo {
         return None;
     }
     // Whole cells strictly between, then the two end cells' parts.
     let (x, y) = (sums[lo + 1], sums[hi]);
     let mut acc = [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
-    let part_lo = (at(lo) + 0.5 * step - a) / step;
-    let part_hi = (b - (at(hi) - 0.5 * step)) / step;
+    let part_lo = (at(lo) + 0.5 * step - a) * inv;
+    let part_hi = (b - (at(hi) - 0.5 * step)) * inv;
     for (k, part) in [(lo, part_lo), (hi, part_hi)] {
         let (d, s) = (deriv(k) * part.clamp(0.0, 1.0), at(k));
         acc = [acc[0] + d, acc[1] + d * s, acc[2] + d * s * s];
