@@ -13,7 +13,9 @@ use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params, rotation_from_rotvec};
 use crate::handeye::math::skew;
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point2, Translation3, Vector3};
+use nalgebra::{
+    DMatrix, DVector, Matrix2x3, Matrix3, Matrix6, Point2, Point3, SMatrix, Translation3, Vector3,
+};
 
 /// Largest |z| (relative to the target's extent) for the target to count as planar.
 const PLANAR_TOLERANCE: f64 = 1e-9;
@@ -100,20 +102,61 @@ pub fn camera_from_target_with_covariance(
         },
         true,
     )?;
+    let covariance = right_step_covariance(&pose, &blocks, "target")?;
+    Ok((pose, rms, covariance))
+}
+
+/// `(J^T J)^-1` of a pose stepped on the right (`pose * exp(d)`, the
+/// problems here) from its residual blocks, in the convention of
+/// [`super::pose_residual`]: rotation `exp(w) R` and translation `t + v`,
+/// order `[w, v]`. `what` names the pose in the error (its points leave it
+/// free).
+pub(super) fn right_step_covariance(
+    pose: &Pose,
+    blocks: &[ResidualBlock],
+    what: &str,
+) -> Result<Matrix6<f64>> {
     let mut jtj = Matrix6::zeros();
-    for b in &blocks {
-        let j = nalgebra::SMatrix::<f64, 2, 6>::from_column_slice(b.jac_global.as_slice());
+    for b in blocks {
+        let j = SMatrix::<f64, 2, 6>::from_column_slice(b.jac_global.as_slice());
         jtj += j.transpose() * j;
     }
-    let inverse = jtj
-        .try_inverse()
-        .ok_or_else(|| Error::degenerate("the target pose is not constrained by its points"))?;
+    let inverse = jtj.try_inverse().ok_or_else(|| {
+        Error::degenerate(format!("the {what} pose is not constrained by its points"))
+    })?;
     // Right perturbation pose * exp(d) = (exp(R d_r) R, t + R d_t).
     let r = pose.rotation.to_rotation_matrix().into_inner();
     let mut g = Matrix6::zeros();
     g.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
     g.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
-    Ok((pose, rms, g * inverse * g.transpose()))
+    Ok(g * inverse * g.transpose())
+}
+
+/// One point's residual block (pixel minus observation) under a pose
+/// stepped on the right: `d_pt` is the projection's Jacobian with respect
+/// to `pose * p` as the camera sees it (a rig camera's rotation already
+/// applied), `r` the pose's rotation.
+pub(super) fn right_step_block(
+    (pixel, obs): (Point2<f64>, &Point2<f64>),
+    d_pt: &Matrix2x3<f64>,
+    r: &Matrix3<f64>,
+    p: &Point3<f64>,
+    jacobians: bool,
+) -> ResidualBlock {
+    let mut jac_global = DMatrix::zeros(2, 0);
+    if jacobians {
+        // Right perturbation pose * exp(d): dw/drot = -R [p]x, dw/dt = R.
+        jac_global = DMatrix::zeros(2, 6);
+        let d_rot = d_pt * (-r * skew(&p.coords));
+        jac_global.view_mut((0, 0), (2, 3)).copy_from(&d_rot);
+        jac_global.view_mut((0, 3), (2, 3)).copy_from(&(d_pt * r));
+    }
+    ResidualBlock {
+        block: None,
+        residuals: DVector::from_column_slice((pixel - obs).as_slice()),
+        jac_global,
+        jac_block: DMatrix::zeros(2, 0),
+    }
 }
 
 struct PoseProblem<'a> {
@@ -133,20 +176,7 @@ impl BlockProblem for PoseProblem<'_> {
         for (p, obs) in self.view.object_points.iter().zip(&self.view.image_points) {
             let w = pose * p;
             let (pixel, d_pt, _) = self.camera.project_with_jacobians(&w)?;
-            let mut jac_global = DMatrix::zeros(2, 0);
-            if jacobians {
-                // Right perturbation pose * exp(d): dw/drot = -R [p]x, dw/dt = R.
-                jac_global = DMatrix::zeros(2, 6);
-                let d_rot = d_pt * (-r * skew(&p.coords));
-                jac_global.view_mut((0, 0), (2, 3)).copy_from(&d_rot);
-                jac_global.view_mut((0, 3), (2, 3)).copy_from(&(d_pt * r));
-            }
-            out.push(ResidualBlock {
-                block: None,
-                residuals: DVector::from_column_slice((pixel - obs).as_slice()),
-                jac_global,
-                jac_block: DMatrix::zeros(2, 0),
-            });
+            out.push(right_step_block((pixel, obs), &d_pt, &r, p, jacobians));
         }
         Ok(out)
     }

@@ -5,15 +5,14 @@
 //! of the camera with the most points, carried into the rig frame; then
 //! Levenberg-Marquardt over the 6 pose parameters and all cameras' pixels.
 
-use super::math::skew;
-use super::pnp::camera_from_target;
+use super::pnp::{camera_from_target, right_step_block, right_step_covariance};
 use super::reprojection_refine::ViewPoints;
 use super::Pose;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params};
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix6, SMatrix};
+use nalgebra::Matrix6;
 
 /// The rig held fixed: every camera's intrinsics and `camera_from_rig`.
 #[derive(Debug, Clone)]
@@ -86,23 +85,11 @@ pub fn rig_from_target(rig: &HeldRig, views: &[(usize, ViewPoints)]) -> Result<R
     let pose = pose_from_params(&lm.params.global);
     let points: usize = views.iter().map(|(_, v)| v.object_points.len()).sum();
     let blocks = problem.residuals_and_jacobian(&lm.params, true)?;
-    let mut jtj = Matrix6::zeros();
-    for b in &blocks {
-        let j = SMatrix::<f64, 2, 6>::from_column_slice(b.jac_global.as_slice());
-        jtj += j.transpose() * j;
-    }
-    let inverse = jtj
-        .try_inverse()
-        .ok_or_else(|| Error::degenerate("the board pose is not constrained by its points"))?;
-    // Right perturbation pose * exp(d) = (exp(R d_r) R, t + R d_t).
-    let r = pose.rotation.to_rotation_matrix().into_inner();
-    let mut g = Matrix6::zeros();
-    g.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
-    g.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
+    let covariance = right_step_covariance(&pose, &blocks, "board")?;
     Ok(RigPose {
         rig_from_target: pose,
         rms_px: (2.0 * lm.cost / points as f64).sqrt(),
-        covariance: g * inverse * g.transpose(),
+        covariance,
         points,
     })
 }
@@ -127,23 +114,9 @@ impl BlockProblem for RigPoseProblem<'_> {
             for (p, obs) in view.object_points.iter().zip(&view.image_points) {
                 let w = camera_from_rig * (pose * p);
                 let (pixel, d_pt, _) = self.rig.cameras[*k].project_with_jacobians(&w)?;
-                let mut jac_global = DMatrix::zeros(2, 0);
-                if jacobians {
-                    // Right perturbation pose * exp(d): d(rig point)/drot =
-                    // -R [p]x, /dt = R; the camera rotates it by Rc.
-                    jac_global = DMatrix::zeros(2, 6);
-                    let d_rot = d_pt * rc * (-r * skew(&p.coords));
-                    jac_global.view_mut((0, 0), (2, 3)).copy_from(&d_rot);
-                    jac_global
-                        .view_mut((0, 3), (2, 3))
-                        .copy_from(&(d_pt * rc * r));
-                }
-                out.push(ResidualBlock {
-                    block: None,
-                    residuals: DVector::from_column_slice((pixel - obs).as_slice()),
-                    jac_global,
-                    jac_block: DMatrix::zeros(2, 0),
-                });
+                // The rig camera's rotation carries the board point on.
+                let d_pt = d_pt * rc;
+                out.push(right_step_block((pixel, obs), &d_pt, &r, p, jacobians));
             }
         }
         Ok(out)
