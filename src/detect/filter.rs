@@ -165,10 +165,15 @@ pub(crate) fn box_level(img: &GrayImage, level: u32) -> Plane {
     Plane { w, h, data }
 }
 
+/// The half-width of [`gaussian_kernel`]'s taps for `sigma`.
+pub(crate) fn gaussian_radius(sigma: f64) -> usize {
+    (3.0 * sigma.max(0.3)).ceil().max(1.0) as usize
+}
+
 /// Normalised Gaussian taps, radius ceil(3 sigma) (at least 1).
 pub(crate) fn gaussian_kernel(sigma: f64) -> Vec<f32> {
     let sigma = sigma.max(0.3);
-    let r = (3.0 * sigma).ceil().max(1.0) as isize;
+    let r = gaussian_radius(sigma) as isize;
     let mut k: Vec<f32> = (-r..=r)
         .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32)
         .collect();

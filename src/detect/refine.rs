@@ -8,7 +8,15 @@
 //! fit repeated until the step is below 0.002 px. Because the window is
 //! symmetric about the final estimate, the odd terms of a point-symmetric
 //! pattern vanish there: the estimate has no bias from the quadratic
-//! model's misfit.
+//! model's misfit. For that the fit points themselves must lie
+//! symmetrically about the centre: they are the centre plus whole-pixel
+//! offsets, where the smoothed image is the raw pixels weighted by the
+//! Gaussian at their fractional distance (the smoothing interpolates).
+//! Fitting at the pixels themselves, whose offsets from a centre between
+//! pixels are not symmetric, biased the corner with its sub-pixel phase
+//! (+-0.007 px on a frontal board, the mean over a board shifted by
+//! fractions of a pixel; BENCHMARKS.md, "Chessboard corners: the fit
+//! points' phase").
 //!
 //! Cost: the smoothing is never applied to the patch. Weights, basis and
 //! smoothing are all separable, so each right-hand side of the normal
@@ -17,7 +25,7 @@
 //! per iteration and the patch is reduced row by row (three dot products
 //! per row). The normal matrix is a product of 1-D weight moments.
 
-use super::filter::gaussian_kernel;
+use super::filter::gaussian_radius;
 use crate::image::GrayImage;
 use nalgebra::{Matrix2, Matrix6, Point2, Vector2, Vector6};
 
@@ -26,10 +34,8 @@ const MAX_ITERATIONS: usize = 10;
 /// Convergence threshold on the step, pixels.
 const STEP_TOLERANCE_PX: f64 = 0.002;
 /// The weights `exp(-2 t^2 / w^2)` (sigma = half the window) are cut at
-/// this multiple of the window, 3 sigma: where they are ~1%, so that
-/// pixels entering or leaving the square as the centre moves do not make
-/// the window asymmetric (a cut at the window itself biases the fixed
-/// point by ~0.07 px on a sheared corner).
+/// this multiple of the window, 3 sigma, where they are ~1% (a cut at the
+/// window itself biased the fixed point by ~0.07 px on a sheared corner).
 const WINDOW_REACH: f64 = 1.5;
 /// Monomial exponents (a, b) of `u^a v^b` in the basis order above.
 const BASIS: [(usize, usize); 6] = [(2, 0), (1, 1), (0, 2), (1, 0), (0, 1), (0, 0)];
@@ -40,11 +46,13 @@ pub(crate) struct SaddleFit {
     pub pos: Point2<f64>,
 }
 
-/// Raw pixels around a start point, f32, with the smoothing taps.
+/// Raw pixels around a start point, f32, with the smoothing's sigma and
+/// reach (taps at offsets `-rs ..= rs + 1` around a fractional position).
 struct Patch {
     size: usize,
     data: Vec<f32>,
-    taps: Vec<f32>,
+    sigma_s: f64,
+    rs: usize,
 }
 
 /// Refine `start` (full-resolution pixels) with a fit window of half-side
@@ -53,8 +61,7 @@ struct Patch {
 pub(crate) fn refine_saddle(img: &GrayImage, start: Point2<f64>, window: f64) -> Option<SaddleFit> {
     let w = window.max(2.0);
     let sigma_s = (w / 3.5).max(1.0);
-    let taps = gaussian_kernel(sigma_s);
-    let rs = taps.len() / 2;
+    let rs = gaussian_radius(sigma_s);
     let travel = 0.5 * w + 1.0;
     let (iw, ih) = (img.width as isize, img.height as isize);
     if iw == 0 || ih == 0 || !start.x.is_finite() || !start.y.is_finite() {
@@ -76,7 +83,12 @@ pub(crate) fn refine_saddle(img: &GrayImage, start: Point2<f64>, window: f64) ->
             data.extend((x0..=x1).map(|x| pixels[x.clamp(0, iw - 1) as usize] as f32));
         }
     }
-    let patch = Patch { size, data, taps };
+    let patch = Patch {
+        size,
+        data,
+        sigma_s,
+        rs,
+    };
     let origin = Vector2::new((cx - margin) as f64, (cy - margin) as f64);
     let mut c = start.coords - origin;
     let c0 = c;
@@ -105,27 +117,42 @@ pub(crate) fn refine_saddle(img: &GrayImage, start: Point2<f64>, window: f64) ->
     })
 }
 
-/// 1-D pieces of the fit along one axis for window centre `c`: the first
-/// fit pixel, the weight moments `sum g(t) t^k` (k = 0..4) and the kernels
-/// `h_a = (g t^a) * taps` (a = 0..2) over `count + 2 rs` raw pixels
-/// starting `rs` before the first fit pixel.
+/// 1-D pieces of the fit along one axis for window centre `c`: the fit
+/// points are `c + t` for the integers `|t| <= n`, so they lie
+/// symmetrically about `c` wherever `c` falls between pixels. The
+/// smoothed image there is the raw pixels weighted by the Gaussian at
+/// their fractional offsets, `S(c + t) = sum_j raw(floor(c) + t + j)
+/// G(frac(c) - j)`. `first`: the raw pixel of `t = -n, j = 0`; the weight
+/// moments `sum g(t) t^k` (k = 0..4: the odd ones vanish); the kernels
+/// `h_a = (g t^a) * taps` (a = 0..2) over `count + 2 rs + 1` raw pixels
+/// starting `rs` before `first`.
 struct Axis {
     first: isize,
     moments: [f64; 5],
     kernels: [Vec<f32>; 3],
 }
 
-fn axis(c: f64, w: f64, sigma_w2: f64, taps: &[f32]) -> Axis {
-    let first = (c - WINDOW_REACH * w).ceil() as isize;
-    let last = (c + WINDOW_REACH * w).floor() as isize;
-    let count = (last - first + 1).max(0) as usize;
-    let rs = taps.len() / 2;
+fn axis(c: f64, w: f64, sigma_w2: f64, sigma_s: f64, rs: usize) -> Axis {
+    let n = (WINDOW_REACH * w).floor() as isize;
+    let base = c.floor();
+    let frac = c - base;
+    let count = (2 * n + 1) as usize;
+    // Taps G(frac - j), j = -rs ..= rs + 1, normalised to sum 1.
+    let mut taps: Vec<f64> = (0..2 * rs + 2)
+        .map(|i| {
+            let d = frac - (i as f64 - rs as f64);
+            (-d * d / (2.0 * sigma_s * sigma_s)).exp()
+        })
+        .collect();
+    let sum: f64 = taps.iter().sum();
+    taps.iter_mut().for_each(|v| *v /= sum);
     let mut moments = [0.0f64; 5];
-    let len = count + 2 * rs;
+    let len = count + 2 * rs + 1;
     let mut kernels = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
-    // g(t) = exp(-t^2 / s) by recurrence over unit steps of t: the ratio
-    // g(t + 1) / g(t) = exp(-(2 t + 1) / s) itself shrinks by exp(-2 / s).
-    let t0 = first as f64 - c;
+    // g(t) = exp(-t^2 / s) by recurrence over the unit steps of t: the
+    // ratio g(t + 1) / g(t) = exp(-(2 t + 1) / s) itself shrinks by
+    // exp(-2 / s).
+    let t0 = -n as f64;
     let mut g = (-t0 * t0 / sigma_w2).exp();
     let mut ratio = (-(2.0 * t0 + 1.0) / sigma_w2).exp();
     let shrink = (-2.0 / sigma_w2).exp();
@@ -136,18 +163,18 @@ fn axis(c: f64, w: f64, sigma_w2: f64, taps: &[f32]) -> Axis {
             *m += p;
             p *= t;
         }
-        let phi = [g as f32, (g * t) as f32, (g * t * t) as f32];
-        // Smoothed pixel k reads raw pixels k .. k + 2 rs (kernel offsets).
+        let phi = [g, g * t, g * t * t];
+        // Fit point k reads raw pixels k .. k + 2 rs + 1 (kernel offsets).
         for (kernel, &f) in kernels.iter_mut().zip(&phi) {
-            for (dst, &tap) in kernel[k..k + 2 * rs + 1].iter_mut().zip(taps) {
-                *dst += f * tap;
+            for (dst, &tap) in kernel[k..k + 2 * rs + 2].iter_mut().zip(&taps) {
+                *dst += (f * tap) as f32;
             }
         }
         g *= ratio;
         ratio *= shrink;
     }
     Axis {
-        first,
+        first: base as isize - n,
         moments,
         kernels,
     }
@@ -161,9 +188,9 @@ fn fit_quadratic(
     w: f64,
     sigma_w2: f64,
 ) -> Option<(Matrix2<f64>, Vector2<f64>)> {
-    let rs = (patch.taps.len() / 2) as isize;
-    let ax = axis(c.x, w, sigma_w2, &patch.taps);
-    let ay = axis(c.y, w, sigma_w2, &patch.taps);
+    let rs = patch.rs as isize;
+    let ax = axis(c.x, w, sigma_w2, patch.sigma_s, patch.rs);
+    let ay = axis(c.y, w, sigma_w2, patch.sigma_s, patch.rs);
     let (x0, y0) = (ax.first - rs, ay.first - rs);
     let (nx, ny) = (ax.kernels[0].len(), ay.kernels[0].len());
     if x0 < 0 || y0 < 0 || x0 as usize + nx > patch.size || y0 as usize + ny > patch.size {
