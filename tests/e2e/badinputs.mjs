@@ -385,7 +385,7 @@ export const tests = [
 
   // ---- step 5, hand-eye on the demo: the consistency checks name the mistake ----
   ['handeye-metres-read-as-mm', handeyeCase(select('pose-length', 'mm'),
-    'robot poses: the robot translations fit the camera motion only when scaled by 999.8486: the camera poses look like millimetres while the robot poses are metres: convert the camera translations to metres (divide by 1000)',
+    'robot poses: the robot translations fit the camera motion only when scaled by 999.9030: the camera poses look like millimetres while the robot poses are metres: convert the camera translations to metres (divide by 1000)',
     select('pose-length', 'auto'))],
   ['handeye-radians-read-as-degrees', async (page, { url, shot }) => {
     // Not refused: the rotations, 57 times too small, are solved with a
@@ -423,10 +423,10 @@ export const tests = [
     assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
   }],
   ['handeye-poses-inverted', handeyeCase(select('pose-direction', 'gripper_from_base'),
-    'robot poses: these poses fit eye-to-hand (the camera fixed, the target on the gripper), not the eye-in-hand chosen: as eye-to-hand they fit the camera motion with rotation RMS 0.006 deg, against 22.972 deg as eye-in-hand: choose the setup eye-to-hand, which solves base_from_camera. Inverting the poses instead would give the same numbers under the wrong frame names; do that only if the setup really is eye-in-hand and the file holds gripper_from_base',
+    'robot poses: these poses fit eye-to-hand (the camera fixed, the target on the gripper), not the eye-in-hand chosen: as eye-to-hand they fit the camera motion with rotation RMS 0.005 deg, against 22.972 deg as eye-in-hand: choose the setup eye-to-hand, which solves base_from_camera. Inverting the poses instead would give the same numbers under the wrong frame names; do that only if the setup really is eye-in-hand and the file holds gripper_from_base',
     select('pose-direction', 'base_from_gripper'))],
   ['handeye-wrong-setup', handeyeCase(select('handeye-setup', 'eye-to-hand'),
-    'robot poses: these poses fit eye-in-hand (the camera on the gripper), not the eye-to-hand chosen: as eye-in-hand they fit the camera motion with rotation RMS 0.006 deg, against 22.972 deg as eye-to-hand: choose the setup eye-in-hand, which solves gripper_from_camera. Inverting the poses instead would give the same numbers under the wrong frame names; do that only if the setup really is eye-to-hand and the file holds gripper_from_base',
+    'robot poses: these poses fit eye-in-hand (the camera on the gripper), not the eye-to-hand chosen: as eye-in-hand they fit the camera motion with rotation RMS 0.005 deg, against 22.972 deg as eye-to-hand: choose the setup eye-in-hand, which solves gripper_from_camera. Inverting the poses instead would give the same numbers under the wrong frame names; do that only if the setup really is eye-to-hand and the file holds gripper_from_base',
     select('handeye-setup', 'eye-in-hand'))],
   ['handeye-pairing-shifted', handeyeCase(async (page) => {
     const [head, , ...rest] = namelessPoses();
@@ -434,7 +434,7 @@ export const tests = [
     await page.setInputFiles('#pose-input', text('shifted.csv', `${[head, ...rest].join('\n')}\n`));
     await page.waitForFunction(() => /^shifted\.csv: 11 poses read as ur/.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
     assert.equal(await page.textContent('#pose-pairing .msg-warning'), '11 poses but 12 images: pairing by order leaves some unpaired. Check that the pose file matches the images.');
-  }, 'robot poses: the pose file looks shifted by one against the images: pairing robot pose i with image i+1 fits with rotation RMS 0.007 deg, against 46.638 deg as given: remove the extra first image so that the lists pair up',
+  }, 'robot poses: the pose file looks shifted by one against the images: pairing robot pose i with image i+1 fits with rotation RMS 0.005 deg, against 46.638 deg as given: remove the extra first image so that the lists pair up',
   async (page) => {
     // The fix the message names: without the extra first image the lists
     // pair up (removed: an excluded image keeps its place in the pairing).
