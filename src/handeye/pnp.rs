@@ -14,7 +14,8 @@ use crate::geometry::{params_from_pose, pose_from_params, rotation_from_rotvec};
 use crate::handeye::math::skew;
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
 use nalgebra::{
-    DMatrix, DVector, Matrix2x3, Matrix3, Matrix6, Point2, Point3, SMatrix, Translation3, Vector3,
+    DMatrix, DVector, Matrix2x3, Matrix3, Matrix6, Point2, Point3, SMatrix, Translation3, Vector2,
+    Vector3,
 };
 
 /// Largest |z| (relative to the target's extent) for the target to count as planar.
@@ -132,12 +133,12 @@ pub(super) fn right_step_covariance(
     Ok(g * inverse * g.transpose())
 }
 
-/// One point's residual block (pixel minus observation) under a pose
-/// stepped on the right: `d_pt` is the projection's Jacobian with respect
-/// to `pose * p` as the camera sees it (a rig camera's rotation already
-/// applied), `r` the pose's rotation.
+/// One point's residual block under a pose stepped on the right:
+/// `residual` is its pixel minus its observation, `d_pt` the projection's
+/// Jacobian with respect to `pose * p` as the camera sees it (a rig
+/// camera's rotation already applied), `r` the pose's rotation.
 pub(super) fn right_step_block(
-    (pixel, obs): (Point2<f64>, &Point2<f64>),
+    residual: Vector2<f64>,
     d_pt: &Matrix2x3<f64>,
     r: &Matrix3<f64>,
     p: &Point3<f64>,
@@ -153,7 +154,7 @@ pub(super) fn right_step_block(
     }
     ResidualBlock {
         block: None,
-        residuals: DVector::from_column_slice((pixel - obs).as_slice()),
+        residuals: DVector::from_column_slice(residual.as_slice()),
         jac_global,
         jac_block: DMatrix::zeros(2, 0),
     }
@@ -176,7 +177,7 @@ impl BlockProblem for PoseProblem<'_> {
         for (p, obs) in self.view.object_points.iter().zip(&self.view.image_points) {
             let w = pose * p;
             let (pixel, d_pt, _) = self.camera.project_with_jacobians(&w)?;
-            out.push(right_step_block((pixel, obs), &d_pt, &r, p, jacobians));
+            out.push(right_step_block(pixel - obs, &d_pt, &r, p, jacobians));
         }
         Ok(out)
     }

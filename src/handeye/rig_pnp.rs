@@ -116,7 +116,7 @@ impl BlockProblem for RigPoseProblem<'_> {
                 let (pixel, d_pt, _) = self.rig.cameras[*k].project_with_jacobians(&w)?;
                 // The rig camera's rotation carries the board point on.
                 let d_pt = d_pt * rc;
-                out.push(right_step_block((pixel, obs), &d_pt, &r, p, jacobians));
+                out.push(right_step_block(pixel - obs, &d_pt, &r, p, jacobians));
             }
         }
         Ok(out)

@@ -53,7 +53,8 @@
 //! follow (its bias, 0.01 px), but the parabola's extrapolation to the
 //! corner and the half-side segments double the noise, which dominates
 //! at any realistic noise level. On Zhang's photos the line also gives the
-//! lowest calibration RMS (0.362 px against 0.407 and 0.385 px; test
+//! lowest calibration RMS (0.362 px; 0.407 and 0.385 px for the others
+//! when they were measured, session 8; test
 //! `zhang1998_square_grid_found_and_calibrated`). Corners come with the
 //! covariance propagated from the residuals of their two line fits.
 
@@ -251,5 +252,3 @@ mod edges;
 mod tests;
 
 use edges::refine_square;
-#[cfg(test)]
-use edges::{edge_on_profile, Profile};

@@ -1,5 +1,6 @@
 //! Tests of the square-grid detector.
 
+use super::edges::{edge_on_profile, Profile};
 use super::*;
 use crate::camera::Camera;
 use crate::synth::{render, RenderOptions};
