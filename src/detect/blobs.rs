@@ -210,7 +210,8 @@ pub(crate) struct Outline {
 /// Sub-pixel ellipse of a dark blob at full resolution. `centre`/`cov` are
 /// the blob's moments scaled to full resolution; edge points are where each
 /// ray's profile crosses the mid level between the blob's inside and the
-/// background just outside it.
+/// background just outside it, moved to the centroid of the gradient there
+/// ([`gradient_centroid`]).
 pub(crate) fn refine_blob(
     img: &GrayImage,
     centre: Point2<f64>,
@@ -228,14 +229,17 @@ pub(crate) fn refine_blob(
     let cov_inv = cov.try_inverse()?;
     let mut c = centre;
     let mut fit = None;
-    for _ in 0..2 {
+    for pass in 0..2 {
+        // The first pass only re-centres the rays; the gradient centroid
+        // (most of the time spent here) is for the edges that are kept.
+        let centroid = pass == 1;
         let mut edges = Vec::with_capacity(RAYS);
         for k in 0..RAYS {
             let phi = k as f64 / RAYS as f64 * std::f64::consts::TAU;
             let d = Vector2::new(phi.cos(), phi.sin());
             // Moment ellipse boundary: Mahalanobis distance 2.
             let r = 2.0 / (d.transpose() * cov_inv * d)[(0, 0)].sqrt();
-            if let Some(e) = edge_on_ray(&plane_at, c, d, r) {
+            if let Some(e) = edge_on_ray(&plane_at, c, d, r, centroid) {
                 edges.push(e);
             }
         }
@@ -255,11 +259,32 @@ pub(crate) fn refine_blob(
     fit
 }
 
+/// Half-width of the window along a ray over which an edge point is the
+/// centroid of the intensity gradient, px (bounded by 0.3 of the blob's
+/// radius so a small dot's window stays on its own edge). It covers the
+/// edge of the renders' 0.7 px blur and of a lens slightly out of focus;
+/// 1.5-3.5 px gave the same centre errors on the renders of
+/// tests/detect_circles.rs (BENCHMARKS.md, issue 20, session 16).
+const EDGE_HALF_WINDOW_PX: f64 = 2.5;
+/// Sample spacing of that window, px.
+const EDGE_SAMPLE_PX: f64 = 0.25;
+/// Passes of the centroid (each re-centres the window on the last one).
+const EDGE_CENTROID_PASSES: usize = 4;
+/// How far the centroid may move from the mid-level crossing, px: the two
+/// differ by a fraction of the blur on an edge, so a larger move is the
+/// window reaching a neighbouring edge, not this one.
+const EDGE_CENTROID_TRAVEL_PX: f64 = 1.0;
+
+/// Edge point on the ray `c + t d` where the profile rises through the
+/// mid level between the blob's inside and the background just outside,
+/// then, with `centroid`, moved to the centroid of the gradient around it
+/// ([`gradient_centroid`]).
 fn edge_on_ray(
     sample: &dyn Fn(f64, f64) -> f64,
     c: Point2<f64>,
     d: Vector2<f64>,
     r: f64,
+    centroid: bool,
 ) -> Option<Point2<f64>> {
     let at = |t: f64| sample(c.x + d.x * t, c.y + d.y * t);
     let inside = (at(0.35 * r) + at(0.45 * r) + at(0.55 * r)) / 3.0;
@@ -278,12 +303,79 @@ fn edge_on_ray(
         if prev < level && v >= level {
             let f = (level - prev) / (v - prev);
             let te = t + f * step;
+            let te = if centroid {
+                gradient_centroid(&at, te, EDGE_HALF_WINDOW_PX.min(0.3 * r))
+            } else {
+                te
+            };
             return Some(Point2::new(c.x + d.x * te, c.y + d.y * te));
         }
         prev = v;
         t = tn;
     }
     None
+}
+
+/// The centroid of the rising gradient `at(s + 0.5) - at(s - 0.5)` over
+/// the window `[te - hw, te + hw]`, re-centred on itself until it stops
+/// moving (at most [`EDGE_CENTROID_PASSES`] times) and kept within
+/// [`EDGE_CENTROID_TRAVEL_PX`] of the crossing `t0` it starts from; `t0`
+/// when the window has no rising gradient. The profile is sampled once, on
+/// a grid of [`EDGE_SAMPLE_PX`] steps from `t0` (the gradient's half-pixel
+/// offsets are whole grid steps), and the passes sum over it.
+///
+/// Why not the mid-level crossing alone: that crossing moves with any error
+/// of the level, which is estimated from a few samples inside and outside
+/// the blob (pulled by vignetting, a neighbouring circle, the blur of a
+/// curved edge). The gradient's centroid needs no level: it is the edge of
+/// a blurred step whatever the step's two grey levels are. Measured on the
+/// noise-free renders of tests/calib_circles.rs (9x6 grid, 30 mm, one
+/// draw): the crossing left a systematic floor of 0.006-0.009 px mean under
+/// the centres, the centroid 0.0023-0.0038 px, and the intrinsics error
+/// from the twelve views fell from 0.136 to 0.041 px through the strongly
+/// distorted camera, from 0.056 to 0.009 px through the 'std' one
+/// (BENCHMARKS.md, issue 20, session 16).
+fn gradient_centroid(at: &dyn Fn(f64) -> f64, t0: f64, hw: f64) -> f64 {
+    let ds = EDGE_SAMPLE_PX;
+    // Offsets of the gradient's sample points from t0, in grid steps: the
+    // window's reach (travel + half-width) and the half pixel either side.
+    let half_pixel = (0.5 / ds).round() as i64;
+    let reach = ((EDGE_CENTROID_TRAVEL_PX + hw) / ds).ceil() as i64;
+    let profile: Vec<f64> = (-reach - half_pixel..=reach + half_pixel)
+        .map(|j| at(t0 + j as f64 * ds))
+        .collect();
+    // Gradient at grid offset j (|j| <= reach), from the profile above.
+    let gradient = |j: i64| {
+        let k = (j + reach + half_pixel) as usize;
+        profile[k + half_pixel as usize] - profile[k - half_pixel as usize]
+    };
+    let mut te = t0;
+    for _ in 0..EDGE_CENTROID_PASSES {
+        let (mut sum_w, mut sum_ws) = (0.0, 0.0);
+        for j in -reach..=reach {
+            let s = t0 + j as f64 * ds;
+            // Each grid point stands for the step of width ds around it:
+            // the part of that step inside the window weighs (so the sum
+            // moves smoothly with te, not by whole steps).
+            let inside = ((hw - (s - te).abs()) / ds + 0.5).clamp(0.0, 1.0);
+            let g = gradient(j) * inside;
+            if g > 0.0 {
+                sum_w += g;
+                sum_ws += g * s;
+            }
+        }
+        if sum_w <= 0.0 {
+            break;
+        }
+        let next =
+            (sum_ws / sum_w).clamp(t0 - EDGE_CENTROID_TRAVEL_PX, t0 + EDGE_CENTROID_TRAVEL_PX);
+        let moved = (next - te).abs();
+        te = next;
+        if moved < 1e-3 {
+            break;
+        }
+    }
+    te
 }
 
 /// `v.floor()` without the libm call that x86-64's baseline (no SSE4.1)
