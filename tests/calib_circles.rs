@@ -36,8 +36,11 @@ use robocal::detect::{detect, CentreModel, DetectOptions};
 use robocal::synth::{board_pose, render, RenderOptions};
 use robocal::target::Target;
 
+/// Three numbers: a roll-pitch-yaw (rad) or a position (m).
+type Triple = (f64, f64, f64);
+
 /// Board poses: roll-pitch-yaw (rad) and position (m) of the board centre.
-const POSES: [((f64, f64, f64), (f64, f64, f64)); 12] = [
+const POSES: [(Triple, Triple); 12] = [
     ((0.63, -0.63, 0.2), (0.0, 0.0, 0.55)),
     ((-0.35, 0.5, -0.4), (0.06, -0.04, 0.5)),
     ((0.55, 0.25, 0.9), (-0.07, 0.05, 0.55)),
