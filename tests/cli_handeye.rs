@@ -158,11 +158,11 @@ fn demo_images_recover_the_truth_and_failed_images_are_dropped_with_their_pose()
         images[0].to_str().unwrap(),
         images[1].to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(1));
     assert!(
         String::from_utf8_lossy(&out.stderr).contains(
-            "3 robot poses but 2 images: give one image per pose in the same order, \
-             or add an image column to the pose file"
+            "unnamed.csv': pairing: 3 robot poses but 2 images: give one image per pose \
+             (paired in numeric order of the file names), or add an image column to the pose file"
         ),
         "{}",
         String::from_utf8_lossy(&out.stderr)
@@ -338,4 +338,167 @@ fn camera_poses_are_refined_by_default_and_no_refine_keeps_the_closed_form() {
     let help = robocal(&["handeye", "--help"]);
     assert!(String::from_utf8_lossy(&help.stdout).contains("--no-refine"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The demo's poses and images as a user's cell has them: unpadded numbers
+/// (`img_0.png` ... `img_11.png`), listed in the shell's order (0, 1, 10,
+/// 11, 2, ...), the pose file's image column holding the path as typed.
+struct Cell {
+    dir: PathBuf,
+    /// Image paths in the shell's (lexicographic) order.
+    images: Vec<String>,
+    /// The demo's pose rows without the image column, in pose order.
+    rows: Vec<String>,
+}
+
+fn cell(name: &str) -> Cell {
+    let dir = std::env::temp_dir().join(format!("robocal-pairing-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    ok(&robocal(&["render", "--out", d, "--demo"]));
+    std::fs::create_dir_all(dir.join("images")).unwrap();
+    for i in 0..12 {
+        std::fs::rename(
+            dir.join(format!("demo_{i:02}.png")),
+            dir.join(format!("images/img_{i}.png")),
+        )
+        .unwrap();
+    }
+    let mut images: Vec<String> = (0..12)
+        .map(|i| {
+            dir.join(format!("images/img_{i}.png"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    images.sort();
+    let text = std::fs::read_to_string(dir.join("poses.csv")).unwrap();
+    assert!(text.starts_with("name,"), "{text}");
+    let rows = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split_once(',').unwrap().1.to_string())
+        .collect();
+    Cell { dir, images, rows }
+}
+
+impl Cell {
+    /// Run `robocal handeye` on a pose file holding `poses` (with `header`).
+    fn run(&self, header: &str, poses: &[String], extra: &[&str]) -> std::process::Output {
+        let file = self.dir.join("poses_user.csv");
+        std::fs::write(&file, format!("{header}\n{}\n", poses.join("\n"))).unwrap();
+        let mut args: Vec<String> = [
+            "handeye",
+            "--setup",
+            "eye-in-hand",
+            "--poses",
+            file.to_str().unwrap(),
+            "--camera",
+            self.dir.join("truth.json").to_str().unwrap(),
+            "--target",
+            "chessboard:9x6:30mm",
+            "--bootstrap",
+            "0",
+            "--threads",
+            "2",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        args.extend(extra.iter().map(|s| s.to_string()));
+        args.extend(self.images.iter().cloned());
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        robocal(&refs)
+    }
+}
+
+fn solved_right(out: &std::process::Output, cell: &Cell) -> serde_json::Value {
+    ok(out);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let truth = read_json(&cell.dir.join("truth.json"));
+    let (t, r) = distance(
+        &matrix(&report["gripper_from_camera"]),
+        &matrix(&truth["gripper_from_camera"]),
+    );
+    assert!(t < 0.1 && r < 0.01, "{t} mm, {r} deg");
+    report
+}
+
+fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn poses_pair_by_path_suffix_and_numeric_order_and_wrong_pairings_are_named() {
+    let c = cell("rules");
+    let header = "x,y,z,rx,ry,rz";
+    // 1. No image column: pose i with the i-th image in numeric order,
+    // although the shell listed img_10.png before img_2.png.
+    let report = solved_right(&c.run(header, &c.rows, &[]), &c);
+    let pairs = report["pairs"].as_array().unwrap();
+    for (i, p) in pairs.iter().enumerate() {
+        let image = p["image"].as_str().unwrap();
+        assert!(
+            image.ends_with(&format!("/img_{i}.png")),
+            "pose {i}: {image}"
+        );
+    }
+    // 2. The image column as the user typed the paths (relative, with the
+    // folder), absolute, or stems: matched by path suffix, path, stem.
+    let dir = c.dir.to_str().unwrap();
+    let namers: [fn(usize, &str) -> String; 3] = [
+        |i, _| format!("images/img_{i}.png"),
+        |i, d| format!("{d}/images/img_{i}.png"),
+        |i, _| format!("img_{i}"),
+    ];
+    for name in namers {
+        let named: Vec<String> = (0..12)
+            .map(|i| format!("{},{}", name(i, dir), c.rows[i]))
+            .collect();
+        solved_right(&c.run(&format!("image,{header}"), &named, &[]), &c);
+    }
+    // 3. Paired in the shell's order on request: the data say numeric order.
+    let out = c.run(header, &c.rows, &["--pair-by", "lexicographic"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(
+        e.starts_with(
+            "robocal: pairing: the poses fit the images only when paired in numeric order of \
+             the file names: the rotation angles of the robot and camera motions agree to 0.0"
+        ) && e.contains("as paired lexicographic order of the file names: pass --pair-by numeric"),
+        "{e}"
+    );
+    // 4. Two rows naming one image, and a row naming no image: errors naming them.
+    let mut named: Vec<String> = (0..12)
+        .map(|i| format!("images/img_{i}.png,{}", c.rows[i]))
+        .collect();
+    named[5] = format!("images/img_4.png,{}", c.rows[5]);
+    let out = c.run(&format!("image,{header}"), &named, &[]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("pairing: two poses name the same image: rows 6, 7 all name '"),
+        "{}",
+        stderr(&out)
+    );
+    named[5] = format!("images/img_44.png,{}", c.rows[5]);
+    let out = c.run(&format!("image,{header}"), &named, &[]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains(
+            "pairing: 1 of 12 poses name no image that was given: row 7 'images/img_44.png': \
+             give those images, or remove their rows from the pose file"
+        ),
+        "{}",
+        stderr(&out)
+    );
+    // 5. --pair-by with an unknown rule.
+    let out = c.run(header, &c.rows, &["--pair-by", "name"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        stderr(&out).trim_end(),
+        "robocal: handeye: --pair-by: unknown rule 'name' (valid: auto, numeric, \
+         lexicographic, given) (see 'robocal handeye --help')"
+    );
+    let _ = std::fs::remove_dir_all(&c.dir);
 }

@@ -139,7 +139,7 @@ async function main() {
   const robot = new RobotView(store, engine);
   robotView = robot;
   const handeye = new HandEyeView(store, engine, robot);
-  new WorkflowsView(store, engine);
+  const workflows = new WorkflowsView(store, engine);
   const rig = new RigView(store, engine, $('rig-panel'));
   new ExportView(store, engine);
   const version = await versionPromise;
@@ -161,7 +161,13 @@ async function main() {
     location.hash = 'target';
     await images.restore();
     store.changed('target-loaded');
+    // Every view that holds the session's objects in its closures is drawn
+    // anew on the new session (the robot and hand-eye steps kept the old
+    // session's poses and setup otherwise).
     camera.render();
+    robot.render();
+    handeye.render();
+    workflows.render();
     rig.render();
     $('engine-status').textContent = readyText();
   };

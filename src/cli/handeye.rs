@@ -1,7 +1,9 @@
 //! `robocal handeye`: read the pose files, call the library, write the report.
 
 use super::detections_file::read_detections;
-use super::handeye_images::{detect_images, image_pairs, read_robot_poses, RobotPoses};
+use super::handeye_images::{
+    detect_images, image_pairs, pair_images, read_robot_poses, PairBy, PosePairs, RobotPoses,
+};
 use super::{parse_target, read_file, CliError};
 use robocal::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
@@ -122,6 +124,14 @@ pub struct HandeyeArgs {
     /// warnings instead of failing
     #[arg(long)]
     lenient: bool,
+    /// How poses pair with images: auto (default: by the pose file's image
+    /// column when it has one, matched by path, path suffix, file name or
+    /// stem; else pose i with the i-th image in numeric order of the file
+    /// names), numeric, lexicographic or given (the order of IMAGES). The
+    /// pairing is then checked against the camera motion: a pairing that
+    /// another of these rules explains better is an error naming the rule
+    #[arg(long, value_name = "RULE", default_value = "auto")]
+    pair_by: String,
     /// Write the JSON report there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE")]
     output: Option<String>,
@@ -211,14 +221,33 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                 .as_deref()
                 .map(|t| parse_target("handeye", t))
                 .transpose()?;
-            let (images, outcomes) = match (&args.detections, &target) {
+            let pair_by: PairBy = args.pair_by.parse()?;
+            // The pose file is read and paired with the image names before
+            // any image is detected: its mistakes come first.
+            let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())
+                .map_err(|e| e.in_file(poses_path))?;
+            let pair = |images: &[String]| -> Result<PosePairs, CliError> {
+                let (image_of_pose, how, unnamed_images) =
+                    pair_images(robot.first(), images, pair_by)
+                        .map_err(|e| e.in_file(poses_path))?;
+                Ok(PosePairs {
+                    image_of_pose,
+                    how,
+                    unnamed_images,
+                })
+            };
+            let (images, outcomes, pairing) = match (&args.detections, &target) {
                 (Some(_), _) if !args.images.is_empty() => {
                     return Err(CliError::usage(
                         "handeye",
                         "give either IMAGES or --detections FILE, not both",
                     ))
                 }
-                (Some(file), _) => read_detections("handeye", file, target.as_ref())?,
+                (Some(file), _) => {
+                    let (images, outcomes) = read_detections("handeye", file, target.as_ref())?;
+                    let pairing = pair(&images)?;
+                    (images, outcomes, pairing)
+                }
                 (None, None) => {
                     return Err(CliError::usage(
                         "handeye",
@@ -231,14 +260,21 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                         "give the images after the options",
                     ))
                 }
-                (None, Some(t)) => (
-                    args.images.clone(),
-                    detect_images(&args.images, t, &args.limits, args.threads)?,
-                ),
+                (None, Some(t)) => {
+                    let pairing = pair(&args.images)?;
+                    let outcomes = detect_images(&args.images, t, &args.limits, args.threads)?;
+                    (args.images.clone(), outcomes, pairing)
+                }
             };
-            let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())
-                .map_err(|e| e.in_file(poses_path))?;
-            let found = image_pairs(setup, robot, &images, outcomes, &camera)?;
+            let found = image_pairs(
+                setup,
+                robot,
+                &images,
+                outcomes,
+                &camera,
+                &pairing,
+                !args.lenient,
+            )?;
             pairs = found.pairs;
             pre_warnings = found.warnings;
             let input = HandEyeInput {

@@ -10,13 +10,14 @@ use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
 use robocal::handeye::checks::{rank_pose_candidates, recommend_candidate};
 use robocal::handeye::output::PairAudit;
+use robocal::handeye::pairing::better_rule;
 use robocal::handeye::pnp::camera_from_target;
 use robocal::handeye::reprojection_refine::ViewPoints;
 use robocal::handeye::{Pose, Setup};
+use robocal::io::pose_pairing::{alternatives, numeric_order, pair_poses};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 use robocal::io::{parse_pose_candidates, parse_poses, PoseFileOptions, PoseFormat, RobotPose};
 use robocal::target::Target;
-use std::path::Path;
 
 /// Robot poses as read: one reading, or ranked candidates of an ambiguous file.
 pub(super) enum RobotPoses {
@@ -27,7 +28,7 @@ pub(super) enum RobotPoses {
 }
 
 impl RobotPoses {
-    fn first(&self) -> &[RobotPose] {
+    pub(super) fn first(&self) -> &[RobotPose] {
         match self {
             RobotPoses::Known(p) => p,
             RobotPoses::Ambiguous(c) => c.first().map_or(&[], |c| &c.1),
@@ -116,43 +117,88 @@ pub(super) struct ImagePairs {
     pub warnings: Vec<String>,
 }
 
-fn file_name(path: &str) -> String {
-    Path::new(path)
-        .file_name()
-        .map_or(path.to_string(), |n| n.to_string_lossy().into_owned())
+/// How poses pair with images (`--pair-by`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum PairBy {
+    /// By the pose file's image column when it has one, else numeric order.
+    Auto,
+    /// Pose i with the i-th image in numeric order of the file names.
+    Numeric,
+    /// Pose i with the i-th image in byte order of the file names.
+    Lexicographic,
+    /// Pose i with the i-th image as given on the command line.
+    Given,
 }
 
-/// Pair poses with images: by the pose file's image column when every pose
-/// names an image that was given, else by order (equal counts required).
-fn pair_images(poses: &[RobotPose], images: &[String]) -> Result<Vec<Option<usize>>, CliError> {
-    let names: Option<Vec<&str>> = poses.iter().map(|p| p.name.as_deref()).collect();
-    if let Some(names) = names {
-        let lookup = |n: &str| {
-            images.iter().position(|img| {
-                let f = file_name(img);
-                f == n
-                    || Path::new(&f)
-                        .file_stem()
-                        .is_some_and(|s| s.to_string_lossy() == n)
-            })
-        };
-        let found: Vec<Option<usize>> = names.iter().map(|n| lookup(n)).collect();
-        if found.iter().any(Option::is_some) {
-            return Ok(found);
+impl std::str::FromStr for PairBy {
+    type Err = CliError;
+    fn from_str(s: &str) -> Result<Self, CliError> {
+        match s {
+            "auto" => Ok(PairBy::Auto),
+            "numeric" => Ok(PairBy::Numeric),
+            "lexicographic" => Ok(PairBy::Lexicographic),
+            "given" => Ok(PairBy::Given),
+            other => Err(CliError::usage(
+                "handeye",
+                format!(
+                    "--pair-by: unknown rule '{other}' (valid: auto, numeric, lexicographic, given)"
+                ),
+            )),
         }
     }
+}
+
+impl PairBy {
+    fn describe(self) -> &'static str {
+        match self {
+            PairBy::Auto => "as paired",
+            PairBy::Numeric => "in numeric order of the file names",
+            PairBy::Lexicographic => "in lexicographic order of the file names",
+            PairBy::Given => "in the order the images were given",
+        }
+    }
+}
+
+/// Poses paired with images by `rule` (module docs of
+/// `robocal::io::pose_pairing`): for each pose its image, how it was
+/// paired, and the images no pose names.
+pub(super) fn pair_images(
+    poses: &[RobotPose],
+    images: &[String],
+    rule: PairBy,
+) -> Result<(Vec<usize>, &'static str, Vec<usize>), CliError> {
+    let paths: Vec<&str> = images.iter().map(String::as_str).collect();
+    let order: Vec<usize> = match rule {
+        PairBy::Auto => {
+            let names: Vec<Option<&str>> = poses.iter().map(|p| p.name.as_deref()).collect();
+            let rows: Vec<usize> = poses.iter().map(|p| p.line).collect();
+            let p = pair_poses(&names, &rows, &paths)?;
+            return Ok((p.image_of_pose, p.paired_by.describe(), p.unnamed_images));
+        }
+        PairBy::Numeric => numeric_order(&paths),
+        PairBy::Lexicographic => {
+            let mut o: Vec<usize> = (0..paths.len()).collect();
+            o.sort_by(|&a, &b| paths[a].cmp(paths[b]));
+            o
+        }
+        PairBy::Given => (0..paths.len()).collect(),
+    };
     if poses.len() != images.len() {
         return Err(CliError::usage(
             "handeye",
             format!(
-                "{} robot poses but {} images: give one image per pose in the same order, \
-                 or add an image column to the pose file",
+                "{} robot poses but {} images: --pair-by {} pairs one image per pose",
                 poses.len(),
-                images.len()
+                images.len(),
+                match rule {
+                    PairBy::Numeric => "numeric",
+                    PairBy::Lexicographic => "lexicographic",
+                    _ => "given",
+                }
             ),
         ));
     }
-    Ok((0..poses.len()).map(Some).collect())
+    Ok((order, rule.describe(), Vec::new()))
 }
 
 /// Detect the target in every image (on `threads` workers).
@@ -171,18 +217,31 @@ pub(super) fn detect_images(
     )
 }
 
+/// The pairing of poses with images, made before any image is detected.
+pub(super) struct PosePairs {
+    /// For each pose, the index of its image.
+    pub image_of_pose: Vec<usize>,
+    /// How the pairing was made, for messages.
+    pub how: &'static str,
+    /// Images no pose names.
+    pub unnamed_images: Vec<usize>,
+}
+
 /// Fit the target's pose in every detected image (`outcomes`, one per
 /// image; a detection may hold any subset of the board's points) with the
-/// known camera, pair with the robot poses and audit.
+/// known camera, pair with the robot poses, prove the pairing against the
+/// camera motion and audit. `strict`: a pairing that another simple rule
+/// explains better is an error (else a warning).
 pub(super) fn image_pairs(
     setup: Setup,
     robot: RobotPoses,
     images: &[String],
     outcomes: Vec<Outcome>,
     camera: &Camera,
+    pairing: &PosePairs,
+    strict: bool,
 ) -> Result<ImagePairs, CliError> {
     let mut warnings = Vec::new();
-    let pairing = pair_images(robot.first(), images)?;
     let mut fitted: Vec<Result<(ViewPoints, Pose, f64), String>> = Vec::new();
     for outcome in outcomes {
         fitted.push(match outcome {
@@ -200,9 +259,11 @@ pub(super) fn image_pairs(
         });
     }
     let used: Vec<(usize, usize)> = pairing
+        .image_of_pose
         .iter()
         .enumerate()
-        .filter_map(|(p, img)| img.filter(|&i| fitted[i].is_ok()).map(|i| (p, i)))
+        .filter(|&(_, &i)| fitted[i].is_ok())
+        .map(|(p, &i)| (p, i))
         .collect();
     let camera_from_target: Vec<Pose> = used
         .iter()
@@ -234,21 +295,26 @@ pub(super) fn image_pairs(
                 .map_or(Vec::new(), |c| c.1)
         }
     };
+    if let Some(message) = check_pairing(setup, &chosen, images, &fitted, pairing, &used) {
+        if strict {
+            return Err(robocal::Error::invalid("pairing", message).into());
+        }
+        warnings.push(format!("pairing: {message}"));
+    }
     let mut pairs = Vec::new();
     let mut views = Vec::new();
-    for (p, img) in pairing.iter().enumerate() {
+    for (p, &i) in pairing.image_of_pose.iter().enumerate() {
         let mut audit = PairAudit {
             pose_index: p,
-            image: img.map(|i| images[i].clone()),
+            image: Some(images[i].clone()),
             used: false,
             view: None,
             reason: None,
             pose_fit_rms_px: None,
         };
-        match img.map(|i| &fitted[i]) {
-            None => audit.reason = Some("no image names this pose".to_string()),
-            Some(Err(why)) => audit.reason = Some(why.clone()),
-            Some(Ok((view, _, rms))) => {
+        match &fitted[i] {
+            Err(why) => audit.reason = Some(why.clone()),
+            Ok((view, _, rms)) => {
                 audit.used = true;
                 audit.view = Some(views.len());
                 audit.pose_fit_rms_px = Some(*rms);
@@ -264,7 +330,7 @@ pub(super) fn image_pairs(
             pairs.len()
         ));
     }
-    let unpaired = images.len() - pairing.iter().flatten().count();
+    let unpaired = pairing.unnamed_images.len();
     if unpaired > 0 {
         warnings.push(format!(
             "{unpaired} images were not named in the pose file and were ignored"
@@ -280,4 +346,49 @@ pub(super) fn image_pairs(
         pairs,
         warnings,
     })
+}
+
+/// Prove the pairing against the camera motion: when another simple rule
+/// (numeric or lexicographic order, the order given) fits the rotation
+/// angles of the motions and the pairing made does not, say which
+/// (`robocal::handeye::pairing`).
+fn check_pairing(
+    setup: Setup,
+    robot: &[RobotPose],
+    images: &[String],
+    fitted: &[Result<(ViewPoints, Pose, f64), String>],
+    pairing: &PosePairs,
+    used: &[(usize, usize)],
+) -> Option<String> {
+    let paths: Vec<&str> = images.iter().map(String::as_str).collect();
+    let given: Vec<(usize, usize)> = pairing.image_of_pose.iter().copied().enumerate().collect();
+    let fits = |i: usize| fitted[i].is_ok();
+    let rules: Vec<_> = alternatives(robot.len(), &paths, &given)
+        .into_iter()
+        .map(|mut r| {
+            r.pairs.retain(|&(_, i)| fits(i));
+            r
+        })
+        .collect();
+    let base: Vec<Pose> = robot.iter().map(|p| p.base_from_gripper).collect();
+    let cameras: Vec<Pose> = fitted
+        .iter()
+        .map(|f| f.as_ref().map_or(Pose::identity(), |f| f.1))
+        .collect();
+    let fit = better_rule(setup, &base, &cameras, used, &rules)?;
+    Some(format!(
+        "{}: the rotation angles of the robot and camera motions agree to {:.3} deg (median) \
+         when paired {}, against {:.3} deg as paired {}: {}",
+        fit.rule.finding,
+        fit.mismatch_deg,
+        fit.rule
+            .name
+            .trim_start_matches("robot pose i with the i-th image "),
+        fit.given_mismatch_deg,
+        pairing
+            .how
+            .trim_start_matches("in ")
+            .trim_start_matches("by "),
+        fit.rule.fix
+    ))
 }

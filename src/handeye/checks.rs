@@ -303,23 +303,21 @@ pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
             found.push(setup_message(input.setup, other, alt.rotation_rms_deg, off));
         }
     }
-    let n = bfg.len();
-    for (label, robot, camera) in [
-        ("robot pose i+1 with image i", &bfg[1..], &cft[..n - 1]),
-        ("robot pose i with image i+1", &bfg[..n - 1], &cft[1..]),
-    ] {
-        if let Ok(alt) = consistency(input.setup, robot, camera) {
+    // A pose list shifted or reversed against the images: the rotation
+    // angles of the motions tell ([`super::pairing`]); the rule found is
+    // confirmed by the fit of the hand-eye rotation before it is reported.
+    let n = bfg.len().min(cft.len());
+    let given_pairs: Vec<(usize, usize)> = (0..n).map(|i| (i, i)).collect();
+    let rules = super::pairing::position_rules(bfg.len(), cft.len());
+    if let Some(fit) = super::pairing::better_rule(input.setup, bfg, cft, &given_pairs, &rules) {
+        let robot: Vec<Pose> = fit.rule.pairs.iter().map(|&(r, _)| bfg[r]).collect();
+        let camera: Vec<Pose> = fit.rule.pairs.iter().map(|&(_, c)| cft[c]).collect();
+        if let Ok(alt) = consistency(input.setup, &robot, &camera) {
             if better(&alt) && robot.len() >= MIN_POSES {
                 found.push(format!(
-                    "the pose file looks shifted by one against the images: pairing {label} fits \
-                     with rotation RMS {:.3} deg, against {off:.3} deg as given: remove the extra \
-                     first {} so that the lists pair up",
-                    alt.rotation_rms_deg,
-                    if label.starts_with("robot pose i+1") {
-                        "robot pose"
-                    } else {
-                        "image"
-                    }
+                    "{}: pairing {} fits with rotation RMS {:.3} deg, against {off:.3} deg as \
+                     given: {}",
+                    fit.rule.finding, fit.rule.name, alt.rotation_rms_deg, fit.rule.fix
                 ));
             }
         }

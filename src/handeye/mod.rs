@@ -53,6 +53,7 @@ pub mod math;
 pub mod motion;
 pub mod noise_choice;
 pub mod output;
+pub mod pairing;
 pub mod pnp;
 pub mod pose_noise;
 pub mod pose_refine;

@@ -135,12 +135,20 @@ pub fn reprojection_rms_per_view_px(
         let (mut view_sum, mut view_count) = (0.0, 0usize);
         for (p, obs) in view.object_points.iter().zip(&view.image_points) {
             let q = camera_from_target * p;
-            let projected = camera.project(&q).map_err(|_| {
+            let projected = camera.project(&q).map_err(|e| {
+                let what = if q.z <= 0.0 {
+                    format!("lies behind the camera (z = {:.4} m)", q.z)
+                } else {
+                    format!(
+                        "(z = {:.4} m) does not project through the lens model ({e}): \
+                         the robot pose of that view does not fit its image; check the \
+                         pairing of poses with images",
+                        q.z
+                    )
+                };
                 Error::degenerate(format!(
-                    "through the solved transforms and view {} a target point lies \
-                     behind the camera (z = {:.4} m)",
+                    "through the solved transforms and view {} a target point {what}",
                     i + 1,
-                    q.z
                 ))
             })?;
             let e2 = (projected - obs).norm_squared();

@@ -20,6 +20,7 @@ pub mod pairing;
 mod pose_candidates;
 mod pose_formats;
 mod pose_json;
+pub mod pose_pairing;
 mod pose_table;
 pub mod pose_text;
 mod pose_writer;

@@ -81,6 +81,8 @@ export class HandEyeView {
     // A view detected with a larger grid than the target has another origin.
     const pairs = paired.filter((p) => !p.image.largerGrid);
     this.leftOut = paired.filter((p) => p.image.largerGrid).map((p) => p.image.name);
+    const problem = this.robot.pairingProblem();
+    if (problem) throw new Error(problem);
     if (!this.robot.pairs().some((p) => p.image)) throw new Error('load the robot poses first (step 4)');
     const views = new Map((cam.views || []).map((v) => [v.name, v]));
     const used = pairs.filter((p) => views.has(p.image.name));

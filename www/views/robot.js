@@ -168,20 +168,57 @@ export class RobotView {
    * position in step 2's order (pose i with the i-th image). An excluded or
    * failed image keeps its pose (it is not used): excluding a view never
    * shifts the pairing of the others; removing the image does.
+   *
+   * A name matches an image as `robocal handeye` matches it
+   * (robocal::io::pose_pairing), on the file name since the page has no
+   * folders: the same file name (`images/0.png` and `C:\cell\0.png` match
+   * `0.png`), else the same stem (`0` matches `0.png`). A row naming no
+   * image, a name matching two images and two rows naming one image are
+   * problems: `problem` says which, and the hand-eye step refuses to solve.
    */
   pairs() {
     const p = this.state.parsed;
     if (!p) return [];
     const imgs = this.store.session.images;
     const byName = p.poses.some((q) => q.name);
-    if (byName) {
-      const stem = (s) => s.replace(/\.[^.]*$/, '');
-      return p.poses.map((pose, i) => {
-        const img = imgs.find((im) => im.name === pose.name || stem(im.name) === stem(pose.name || ''));
-        return { index: i, pose, image: img || null, how: 'name' };
-      });
+    if (!byName) return p.poses.map((pose, i) => ({ index: i, pose, image: imgs[i] || null, how: 'order', problem: null }));
+    const base = (s) => String(s).trim().replace(/\\/g, '/').split('/').pop();
+    const stem = (s) => base(s).replace(/(.)\.[^.]*$/, '$1');
+    const pairs = p.poses.map((pose, i) => {
+      if (!pose.name) return { index: i, pose, image: null, how: 'name', problem: 'names no image (name an image on every row, or on none to pair by order)' };
+      const name = base(pose.name);
+      let found = imgs.filter((im) => im.name === name);
+      if (!found.length) found = imgs.filter((im) => stem(im.name) === stem(name) || stem(im.name) === name);
+      if (found.length > 1) return { index: i, pose, image: null, how: 'name', problem: `'${pose.name}' matches ${found.map((im) => `'${im.name}'`).join(' and ')}` };
+      return { index: i, pose, image: found[0] || null, how: 'name', problem: found.length ? null : `no image named '${pose.name}'` };
+    });
+    for (const q of pairs) {
+      if (!q.image) continue;
+      const same = pairs.filter((o) => o.image === q.image);
+      if (same.length > 1) q.problem = `rows ${same.map((o) => o.pose.line).join(', ')} all name '${q.image.name}'`;
     }
-    return p.poses.map((pose, i) => ({ index: i, pose, image: imgs[i] || null, how: 'order' }));
+    return pairs;
+  }
+
+  /**
+   * The pairing's problems as one message (null when there are none), in
+   * the words of `robocal handeye`.
+   */
+  pairingProblem() {
+    const pairs = this.pairs();
+    const bad = pairs.filter((q) => q.problem);
+    if (!bad.length) return null;
+    const missing = bad.filter((q) => !q.image && /^no image named/.test(q.problem));
+    const list = (qs, f) => qs.slice(0, 5).map(f).join(', ') + (qs.length > 5 ? ` and ${qs.length - 5} more` : '');
+    if (missing.length) {
+      return `pairing: ${missing.length} of ${pairs.length} poses name no image that was loaded: ${list(missing, (q) => `row ${q.pose.line} '${q.pose.name}'`)}: load those images, or remove their rows from the pose file`;
+    }
+    const twice = bad.filter((q) => q.image);
+    if (twice.length) {
+      const seen = [...new Set(twice.map((q) => q.problem))];
+      return `pairing: two poses name the same image: ${list(seen, (t) => t)}: each image pairs with one robot pose; fix the image column`;
+    }
+    return `pairing: ${list(bad, (q) => `row ${q.pose.line} ${q.problem}`)}`;
   }
 
   renderPairing() {
@@ -191,9 +228,10 @@ export class RobotView {
     const used = pairs.filter((q) => q.image && q.image.included && q.image.detection).length;
     const nImages = this.store.session.images.length;
     const rows = pairs.map((q) => [String(q.index + 1), q.pose.name || '', q.image ? q.image.name : '—',
-      !q.image ? 'no image' : !q.image.info ? 'dropped: the image could not be read' : !q.image.detection ? 'dropped: the target was not found in the image' : q.image.included ? 'used' : 'dropped: the image is excluded in step 2']);
+      q.problem ? `not used: ${q.problem}` : !q.image ? 'no image' : !q.image.info ? 'dropped: the image could not be read' : !q.image.detection ? 'dropped: the target was not found in the image' : q.image.included ? 'used' : 'dropped: the image is excluded in step 2']);
     const warn = pairs.length !== nImages ? message('warning', `${pairs.length} poses but ${nImages} images: pairing ${pairs[0].how === 'name' ? 'by name' : 'by order'} leaves some unpaired. Check that the pose file matches the images.`) : null;
-    fill(this.pairing, h('p', {}, `Paired ${pairs[0].how === 'name' ? 'by the name column' : 'by order (pose i with the i-th image of step 2)'}: ${used} pairs usable.`), warn,
+    const problem = this.pairingProblem();
+    fill(this.pairing, problem ? message('error', problem) : null, h('p', {}, `Paired ${pairs[0].how === 'name' ? 'by the name column' : 'by order (pose i with the i-th image of step 2)'}: ${used} pairs usable.`), warn,
       table(['pose', 'name', 'image', 'status'], rows, { id: 'pairing-table' }));
   }
 }
