@@ -137,3 +137,156 @@ fn the_bootstrap_spread_of_the_refined_x_matches_its_reported_std() {
         }
     }
 }
+
+/// The image path of `robocal handeye` on a scene whose model is not exactly
+/// right: a robot error that depends on the pose (0.3 mm / 0.02 deg, a
+/// smooth function of the pose like a kinematic model error) or a focal
+/// length 1 % off for the PnP. Returns the result and the truth.
+fn misspecified(
+    seed: u64,
+    views: usize,
+    max_tilt_deg: f64,
+    max_roll_deg: f64,
+    kinematic: bool,
+    focal_error: f64,
+) -> (robocal::handeye::HandEyeResult, robocal::handeye::Pose) {
+    use nalgebra::{Translation3, UnitQuaternion, Vector3};
+    use robocal::camera::Camera;
+    use robocal::handeye::pnp::camera_from_target_with_covariance;
+    use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
+    use robocal::handeye::{MotionPairs, Pose};
+    use robocal::synth::handeye_looking::grid_pixels;
+    let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
+    let scene = looking_scene(
+        &LookingConfig {
+            setup: Setup::EyeInHand,
+            views,
+            distance_m: 0.5,
+            grid: (9, 6, 0.03),
+            max_tilt_deg,
+            max_roll_deg,
+        },
+        seed,
+    );
+    let mut rng = Rng::new(seed ^ 0xc0ffee);
+    let pixels = grid_pixels(&scene, &camera, 0.2, &mut rng);
+    let f = 1100.0 * (1.0 + focal_error);
+    let used = Camera::pinhole(f, f, 639.5, 479.5, 1280, 960);
+    let cams: Vec<Pose> = pixels
+        .iter()
+        .map(|v| camera_from_target_with_covariance(&used, v).unwrap().0)
+        .collect();
+    let k = std::f64::consts::TAU / 0.4;
+    let amp = if kinematic {
+        (0.3e-3, 0.02f64.to_radians())
+    } else {
+        (0.0, 0.0)
+    };
+    let robots: Vec<Pose> = scene
+        .base_from_gripper
+        .iter()
+        .map(|p| {
+            let (t, w) = (p.translation.vector, p.rotation.scaled_axis());
+            let dt = Vector3::new(
+                (k * t.x).sin(),
+                (k * t.y + 1.0).sin(),
+                (k * t.z + 2.0).sin(),
+            );
+            let dr = Vector3::new(
+                (3.0 * w.x).sin(),
+                (3.0 * w.y + 1.0).sin(),
+                (3.0 * w.z + 2.0).sin(),
+            );
+            let kin = Pose::from_parts(
+                Translation3::from(dt * amp.0),
+                UnitQuaternion::from_scaled_axis(dr * amp.1),
+            ) * p;
+            perturbed(&mut rng, &kin, [0.02f64.to_radians(); 3], [0.1e-3; 3])
+        })
+        .collect();
+    let input = HandEyeInput {
+        setup: Setup::EyeInHand,
+        base_from_gripper: robots,
+        camera_from_target: cams,
+    };
+    let options = HandEyeOptions {
+        bootstrap_samples: 1,
+        refine_poses: false,
+        strict_checks: false,
+        ..Default::default()
+    };
+    let mut result = calibrate(&input, &options).unwrap();
+    apply_pose_refinement_from_views(&mut result, &input, &pixels, &used, MotionPairs::All)
+        .unwrap();
+    (result, scene.x_true)
+}
+
+/// The truth within 3 reported std on all six components of X.
+fn covered(result: &robocal::handeye::HandEyeResult, truth: &robocal::handeye::Pose) -> bool {
+    let std = &result
+        .pose_refinement
+        .as_ref()
+        .unwrap()
+        .camera_transform_std;
+    let dt = (result.x.translation.vector - truth.translation.vector) * 1e3;
+    let dr = (result.x.rotation * truth.rotation.inverse()).scaled_axis();
+    (0..3).all(|k| {
+        dt[k].abs() <= 3.0 * std.translation_mm[k]
+            && dr[k].to_degrees().abs() <= 3.0 * std.rotation_deg[k]
+    })
+}
+
+/// Issue 35, item 3: small rotations (tilts and rolls to 8 deg) and a robot
+/// error the noise model leaves out. Before the leave-one-out check 90 % of
+/// such trials (tilts to 10 deg) were covered by 3 std
+/// (examples/handeye_coverage.rs, 100 trials); with it 100 %. Here 16 trials: at least 15 covered, and every trial not
+/// covered carries a warning; the weak geometry is named in every trial.
+#[test]
+fn weak_geometry_and_robot_error_are_named_and_the_std_covers_the_truth() {
+    let mut hits = 0;
+    for seed in 0..16 {
+        let (result, truth) = misspecified(500 + seed, 12, 8.0, 8.0, true, 0.0);
+        let ok = covered(&result, &truth);
+        hits += usize::from(ok);
+        assert!(
+            result
+                .warnings
+                .iter()
+                .any(|w| w.starts_with("weak geometry: the largest rotation between two poses is")),
+            "seed {seed}: {:?}",
+            result.warnings
+        );
+        let summary = result.pose_refinement.as_ref().unwrap();
+        assert!(summary.work_point_std_mm.unwrap() > 0.0);
+        assert!((summary.work_distance_m.unwrap() - 0.5).abs() < 0.06);
+    }
+    assert!(hits >= 15, "{hits} of 16 covered");
+}
+
+/// Issue 35, item 3: a focal length 1 % off for the PnP puts every target
+/// 1 % too far. The scale that fits the robot translations to the camera
+/// motion says so (a warning naming about 1 %), and the std includes what a
+/// refit with the translations rescaled moves: before, 0 of 40 trials were
+/// covered by 3 std; with the check 90 of 100 (examples/handeye_coverage.rs).
+/// Here 12 trials: the warning in at least 10 (it names 0.5-1.5 %), at
+/// least 9 covered.
+#[test]
+fn a_focal_length_one_percent_off_is_named_and_in_the_std() {
+    let (mut named, mut hits) = (0, 0);
+    for seed in 0..12 {
+        let (result, truth) = misspecified(700 + seed, 20, 30.0, 60.0, false, 0.01);
+        hits += usize::from(covered(&result, &truth));
+        if let Some(w) = result.warnings.iter().find(|w| w.starts_with("scale: ")) {
+            let pct: f64 = w
+                .split("is about ")
+                .nth(1)
+                .and_then(|s| s.split(" %").next())
+                .and_then(|s| s.parse().ok())
+                .unwrap();
+            assert!((0.5..1.5).contains(&pct), "seed {seed}: {w}");
+            named += 1;
+        }
+    }
+    assert!(named >= 10, "{named} of 12 named the scale");
+    assert!(hits >= 9, "{hits} of 12 covered");
+}

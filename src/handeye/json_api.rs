@@ -451,7 +451,16 @@ mod tests {
             assert!(out["errors"][key].as_f64().unwrap() < 1e-6, "{key}");
         }
         assert!(out["errors"]["reprojection_rms_px"].is_null());
-        assert!(out["warnings"].as_array().unwrap().is_empty());
+        // Six poses: named as too few, nothing else.
+        let warnings = out["warnings"].as_array().unwrap();
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(
+            warnings[0]
+                .as_str()
+                .unwrap()
+                .starts_with("weak geometry: only 6 poses: "),
+            "{warnings:?}"
+        );
         let bad = solve_handeye_json(
             r#"{"setup":"eye-in-hand","base_from_gripper":[],"camera_from_target":[],"method":"tsai"}"#,
         );

@@ -70,6 +70,7 @@ pub mod rig_pnp;
 pub mod rig_uncertainty;
 pub mod scara;
 pub mod solve;
+pub mod trust;
 
 /// Most robot/camera pose pairs one hand-eye calibration takes. Motions are
 /// formed between every two poses and the repeatability check re-solves per

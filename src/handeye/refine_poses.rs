@@ -32,7 +32,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// Per-axis standard deviations of one transform.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, Default)]
 pub struct TransformStd {
     /// Rotation std about the x, y, z axes of the transform's left frame (degrees).
     pub rotation_deg: [f64; 3],
@@ -92,6 +92,47 @@ pub struct PoseRefinementSummary {
     /// started from.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub closed_form_reprojection_rms_px: Option<f64>,
+    /// When the leave-one-out solutions spread wider than the noise model
+    /// predicts: the factor the std (and the covariance's square root) was
+    /// widened by ([`super::trust`]); absent: not widened.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub std_widened_by: Option<f64>,
+    /// The working distance: the median camera-target distance (m).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub work_distance_m: Option<f64>,
+    /// The std of a point at the working distance on the camera's optical
+    /// axis (mm, root-sum-square over the axes): the hand-eye error where
+    /// the camera looks ([`super::trust::work_point_std_mm`]).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub work_point_std_mm: Option<f64>,
+}
+
+#[cfg(test)]
+impl PoseRefinementSummary {
+    /// A summary holding only `covariance` (tests of what reads it).
+    pub(crate) fn for_tests(covariance: Vec<[f64; 12]>) -> Self {
+        PoseRefinementSummary {
+            started_from: String::new(),
+            closed_form_cost: 0.0,
+            cost: 0.0,
+            camera_noise_model: String::new(),
+            noise: NoiseLevels::default(),
+            camera_noise_pivot_m: None,
+            camera_noise_nominal_target_m: None,
+            noise_estimated_per_component: true,
+            camera_transform_std: TransformStd::default(),
+            target_transform_std: TransformStd::default(),
+            covariance,
+            whitened_residual_norms: Vec::new(),
+            outlier_views: Vec::new(),
+            reprojection_rms_px: None,
+            per_view_reprojection_rms_px: None,
+            closed_form_reprojection_rms_px: None,
+            std_widened_by: None,
+            work_distance_m: None,
+            work_point_std_mm: None,
+        }
+    }
 }
 
 /// The nominal target of the `predicted_pnp` camera noise model (metres,
@@ -386,6 +427,9 @@ pub fn apply_pose_refinement_with(
         reprojection_rms_px: None,
         per_view_reprojection_rms_px: None,
         closed_form_reprojection_rms_px: None,
+        std_widened_by: None,
+        work_distance_m: None,
+        work_point_std_mm: None,
     });
     if let Some(previous) = &result.repeatability {
         let resampled = ResampleSetup {
@@ -400,7 +444,103 @@ pub fn apply_pose_refinement_with(
             result.repeatability = Some(r);
         }
     }
+    check_translation_scale(result, input, &views, &model_for_resamples, &options);
+    check_uncertainty(result, input);
     Ok(())
+}
+
+/// The camera translations against the robot's
+/// ([`super::trust::translation_scale`]): when they disagree by more than
+/// three of their jackknife std (and [`super::trust::SCALE_MIN`]), a refit
+/// with the camera translations rescaled shows how far that moves the
+/// transforms; the shift joins the covariance and a warning names the
+/// likely causes.
+fn check_translation_scale(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[PoseMeasurement],
+    noise: &NoiseModel,
+    options: &PoseRefineOptions,
+) {
+    let Some((k, sk)) = super::trust::translation_scale(
+        input.setup,
+        &input.base_from_gripper,
+        &input.camera_from_target,
+    ) else {
+        return;
+    };
+    let off = k - 1.0;
+    if !(off.abs() > 3.0 * sk && off.abs() > super::trust::SCALE_MIN) {
+        return;
+    }
+    let scaled: Vec<PoseMeasurement> = views
+        .iter()
+        .map(|m| PoseMeasurement {
+            base_from_gripper: m.base_from_gripper,
+            camera_from_target: Pose::from_parts(
+                nalgebra::Translation3::from(m.camera_from_target.translation.vector / k),
+                m.camera_from_target.rotation,
+            ),
+        })
+        .collect();
+    let Ok(refit) = refine(
+        input.setup,
+        &scaled,
+        &result.x,
+        &result.y,
+        noise.clone(),
+        options,
+    ) else {
+        return;
+    };
+    let dx = super::trust::pose_shift(&result.x, &refit.x);
+    let dy = super::trust::pose_shift(&result.y, &refit.y);
+    let Some(summary) = result.pose_refinement.as_mut() else {
+        return;
+    };
+    super::trust::add_shift_to_covariance(summary, &dx, &dy);
+    let (moved_mm, moved_deg) = pose_difference(&result.x, &refit.x);
+    result.warnings.push(format!(
+        "scale: the camera translations match the robot's only when scaled by {:.4} (+- {:.4}): \
+         the camera's focal length or the target's square size is about {:.2} % off; a refit \
+         with the camera translations rescaled moves {} by {moved_mm:.2} mm and {moved_deg:.3} \
+         deg, which the std now includes; check the camera calibration and the target spec",
+        1.0 / k,
+        sk / (k * k),
+        100.0 * off.abs(),
+        input.setup.camera_key()
+    ));
+}
+
+/// The uncertainty checked against the data ([`super::trust`]): widened
+/// to the leave-one-out spread when that is larger, and the error at the
+/// working distance.
+fn check_uncertainty(result: &mut HandEyeResult, input: &HandEyeInput) {
+    let n = input.camera_from_target.len();
+    let Some(summary) = result.pose_refinement.as_mut() else {
+        return;
+    };
+    let rotation = result.x.rotation.to_rotation_matrix().into_inner();
+    if let Some(rep) = &result.repeatability {
+        if let Some(w) = super::trust::widen_to_leave_one_out(summary, rep, &rotation, n) {
+            result.warnings.push(w);
+        }
+    }
+    let mut d: Vec<f64> = input
+        .camera_from_target
+        .iter()
+        .map(|p| p.translation.vector.norm())
+        .filter(|v| v.is_finite())
+        .collect();
+    if d.is_empty() {
+        return;
+    }
+    d.sort_by(f64::total_cmp);
+    let distance = d[d.len() / 2];
+    summary.work_distance_m = Some(distance);
+    summary.work_point_std_mm = Some(super::trust::work_point_std_mm(
+        summary, &rotation, distance,
+    ));
 }
 
 /// What re-solving a resample of the views with the pose refinement needs.

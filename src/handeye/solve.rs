@@ -148,6 +148,16 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             super::MIN_MOTION_ROTATION_DEG
         ));
     }
+    let distances: Vec<f64> = input
+        .camera_from_target
+        .iter()
+        .map(|p| p.translation.vector.norm())
+        .collect();
+    warnings.extend(super::trust::geometry_warnings(
+        chain.len(),
+        &motion,
+        &distances,
+    ));
     let lever = lever_arm_m(&chain);
     // 2. Parallel rotation axes (SCARA): only the observable part.
     if motion.axis_spread_deg < scara::PARALLEL_AXES_DEG {
