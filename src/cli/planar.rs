@@ -90,6 +90,18 @@ enum Mode {
 }
 
 pub fn run(args: PlanarArgs) -> Result<(), CliError> {
+    super::check_optional_bounds(
+        "planar",
+        "--reject",
+        args.reject,
+        super::bounds::REJECT_SIGMA,
+    )?;
+    super::check_optional_bounds(
+        "planar",
+        "--predict",
+        args.predict,
+        super::bounds::PREDICT_HEIGHT_MM,
+    )?;
     let (Some(mode), Some(file)) = (args.mode, args.file.as_deref()) else {
         return Err(CliError::usage(
             "planar",

@@ -80,6 +80,12 @@ pub struct XytableArgs {
 }
 
 pub fn run(args: XytableArgs) -> Result<(), CliError> {
+    super::check_optional_bounds(
+        "xytable",
+        "--noise-px",
+        args.noise_px,
+        super::bounds::NOISE_PX,
+    )?;
     let Some(file) = args.file.as_deref() else {
         return Err(CliError::usage("xytable", "give the positions file"));
     };
