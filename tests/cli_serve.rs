@@ -356,3 +356,51 @@ fn info_reports_each_file() {
         "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP"
     );
 }
+
+/// The policy of www/index.html's `<meta http-equiv="Content-Security-Policy">`.
+fn page_policy() -> String {
+    let page = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/www/index.html"))
+        .expect("read www/index.html");
+    let meta = page
+        .lines()
+        .find(|l| l.contains("http-equiv=\"Content-Security-Policy\""))
+        .expect("the page's CSP meta");
+    let content = meta.split("content=\"").nth(1).expect("content=");
+    content
+        .split('"')
+        .next()
+        .expect("closing quote")
+        .to_string()
+}
+
+#[test]
+fn dotfiles_are_404_and_every_response_carries_the_page_policy() {
+    let root = site("dotfiles");
+    std::fs::create_dir_all(root.join(".git")).unwrap();
+    std::fs::write(root.join(".git/config"), "[remote \"origin\"]").unwrap();
+    std::fs::write(root.join(".env"), "TOKEN=1").unwrap();
+    std::fs::write(root.join("sub/.hidden.js"), "x").unwrap();
+    let server = start(&root);
+    for target in [
+        "/.git/config",
+        "/.git/",
+        "/.env",
+        "/%2eenv",
+        "/sub/.hidden.js",
+    ] {
+        let r = request(&server, "GET", target);
+        assert_eq!(
+            (r.status, r.body.as_slice()),
+            (404, &b"not found\n"[..]),
+            "{target}"
+        );
+    }
+    let want = format!("{}; frame-ancestors 'none'", page_policy());
+    for target in ["/", "/m.wasm", "/missing", "/.env"] {
+        let r = request(&server, "GET", target);
+        assert_eq!(r.header("Content-Security-Policy"), want, "{target}");
+        assert_eq!(r.header("X-Content-Type-Options"), "nosniff", "{target}");
+    }
+    let refused = request(&server, "POST", "/");
+    assert_eq!(refused.header("Content-Security-Policy"), want);
+}

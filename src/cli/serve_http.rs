@@ -33,7 +33,10 @@
 //! bench/serve_load.py: BENCHMARKS.md, "robocal serve under load").
 //!
 //! GET and HEAD only (405 otherwise), `Connection: close` on every response,
-//! no directory listing, 404 for anything outside the served folder.
+//! no directory listing, 404 for anything outside the served folder and for
+//! dotfiles. Every response carries [`CONTENT_SECURITY_POLICY`] (the page's
+//! own policy plus `frame-ancestors 'none'`, which a `<meta>` cannot set)
+//! and `X-Content-Type-Options: nosniff`.
 
 use super::files::{mime_type, resolve};
 use std::fs::File;
@@ -44,6 +47,12 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
+
+/// The Content-Security-Policy header: the policy of www/index.html's
+/// `<meta http-equiv="Content-Security-Policy">` (tests/cli_serve.rs checks
+/// they agree) plus `frame-ancestors 'none'`, so no other site can frame
+/// the page.
+pub const CONTENT_SECURITY_POLICY: &str = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; style-src 'self'; img-src 'self' blob: data:; worker-src 'self'; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 
 /// Most headers one request may carry (431 beyond).
 pub const MAX_HEADERS: usize = 64;
@@ -450,7 +459,8 @@ fn head_lines(status: Status, mime: &str, len: u64) -> String {
     let (code, reason) = status.code_and_reason();
     format!(
         "HTTP/1.1 {code} {reason}\r\nContent-Type: {mime}\r\nContent-Length: {len}\r\n{}\
-         Cache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+         Cache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\n\
+         Content-Security-Policy: {CONTENT_SECURITY_POLICY}\r\nConnection: close\r\n\r\n",
         status.extra_headers()
     )
 }
