@@ -607,7 +607,7 @@ const CASES: &[Case] = &[
         args: &["xytable", "p.csv", "--noise-px", "-1"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: xytable: --noise-px must be between 0.001 and 1000 (see 'robocal xytable --help')",
+        message: "robocal: xytable: --noise-px must be between 0 and 1000 (see 'robocal xytable --help')",
     },
     Case {
         name: "max-pixels-huge",
@@ -688,6 +688,14 @@ const CASES: &[Case] = &[
         code: 2,
         stream: Stream::Stderr,
         message: "robocal: detect: target: the square size must be a positive length, got -1e-300 mm (see 'robocal detect --help')",
+    },
+    Case {
+        name: "planar-point-huge",
+        files: &[],
+        args: &["planar", "fit", "m.csv", "--predict", "60", "--point", "1e300,2"],
+        code: 2,
+        stream: Stream::Stderr,
+        message: "robocal: planar: --point must be between -1000000 and 1000000 (see 'robocal planar --help')",
     },
 ];
 

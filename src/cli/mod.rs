@@ -234,7 +234,11 @@ pub mod bounds {
     /// `planar --predict`: the height, mm (a kilometre either way).
     pub const PREDICT_HEIGHT_MM: (f64, f64) = (-1.0e6, 1.0e6);
     /// `xytable --noise-px`: the measurement noise sigma, px.
-    pub const NOISE_PX: (f64, f64) = (0.001, 1000.0);
+    pub const NOISE_PX: (f64, f64) = (0.0, 1000.0);
+    /// `planar --point U,V`: each coordinate, px.
+    pub const POINT_PX: (f64, f64) = (-1.0e6, 1.0e6);
+    /// `xytable --start-mm X,Y,Z`: each coordinate, mm (a kilometre).
+    pub const START_MM: (f64, f64) = (-1.0e6, 1.0e6);
 }
 
 /// A numeric flag outside `(lo, hi)` (NaN included) is a usage error of
