@@ -136,6 +136,37 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// Numbers beyond this magnitude (or below its inverse squared, 1e-12) are
+/// written in scientific notation by [`compact`].
+const COMPACT_LIMIT: f64 = 1e6;
+
+/// A number for a human message: as Rust prints it between 1e-12 and a
+/// million (`0.5`, `-30`), in scientific notation beyond (`1e308`, not 309
+/// digits; `-2.5e-20`).
+pub fn compact(x: f64) -> String {
+    let a = x.abs();
+    if x.is_finite()
+        && a != 0.0
+        && !(1.0 / (COMPACT_LIMIT * COMPACT_LIMIT)..COMPACT_LIMIT).contains(&a)
+    {
+        format!("{x:e}")
+    } else {
+        x.to_string()
+    }
+}
+
+/// `n` as an English ordinal: 1st, 2nd, 3rd, 4th, 11th, 12th, 13th, 21st.
+pub fn ordinal(n: usize) -> String {
+    let suffix = match (n % 10, n % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{n}{suffix}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,5 +187,32 @@ mod tests {
             "requires at least 3 views, got 1"
         );
         assert_eq!(Error::too_few("views", 3, 1).kind(), "too_few");
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn numbers_in_messages_stay_short() {
+        assert_eq!(compact(1e308), "1e308");
+        assert_eq!(compact(-2.5e-20), "-2.5e-20");
+        assert_eq!(compact(1e6), "1e6");
+        assert_eq!(compact(999999.5), "999999.5");
+        assert_eq!(compact(-30.0), "-30");
+        assert_eq!(compact(0.0), "0");
+        assert_eq!(compact(f64::NAN), "NaN");
+        assert_eq!(compact(f64::NEG_INFINITY), "-inf");
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn ordinals_have_their_english_suffix() {
+        let got: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 23, 100, 101, 111, 112]
+            .into_iter()
+            .map(ordinal)
+            .collect();
+        assert_eq!(
+            got,
+            [
+                "1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "23rd",
+                "100th", "101st", "111th", "112th"
+            ]
+        );
     }
 }

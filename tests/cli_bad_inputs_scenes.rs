@@ -130,7 +130,19 @@ fn pose_rows() -> Vec<Row> {
             "eye-in-hand",
             "robocal: the robot only translated: the largest rotation between two poses is 0.00 deg and 0 motion pair(s) rotate at least 2 deg (2 needed); the hand-eye rotation is unobservable: rotate the gripper between poses, ideally by 30 deg or more about at least two different axes",
         ),
+        pose_row(
+            "handeye-1001-poses",
+            pose_lines(&cycled(&robot, 1001), 1.0),
+            pose_lines(&cycled(&camera, 1001), 1.0),
+            "eye-in-hand",
+            "robocal: poses: 1001 poses: at most 1000 are supported (the solvers and the repeatability check use every pair of poses, which grows with the square); keep a subset spread over the workspace, e.g. every 2nd pose",
+        ),
     ]
+}
+
+/// The first `n` poses of `poses` repeated.
+fn cycled(poses: &[Pose], n: usize) -> Vec<Pose> {
+    poses.iter().cycle().take(n).copied().collect()
 }
 
 fn image_rows() -> Vec<Row> {

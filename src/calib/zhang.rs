@@ -236,7 +236,10 @@ fn validate(views: &[View], image_size_px: (u32, u32), options: &CalibrationOpti
         if !(r.is_finite() && r > 0.0) {
             return Err(Error::invalid(
                 "aspect_ratio",
-                format!("fx / fy must be finite and > 0, got {r}"),
+                format!(
+                    "fx / fy must be finite and > 0, got {}",
+                    crate::error::compact(r)
+                ),
             ));
         }
     }

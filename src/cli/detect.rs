@@ -77,6 +77,13 @@ pub(super) enum Outcome {
 }
 
 pub fn run(args: DetectArgs) -> Result<(), CliError> {
+    super::check_optional_bounds("detect", "--threads", args.threads, super::bounds::THREADS)?;
+    super::check_optional_bounds(
+        "detect",
+        "--max-side",
+        args.max_side,
+        super::bounds::MAX_SIDE_PX,
+    )?;
     let Some(text) = args.target.as_deref() else {
         return Err(CliError::usage(
             "detect",
@@ -131,11 +138,7 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
         "images": images,
     });
     let text = serde_json::to_string_pretty(&doc).map_err(|e| CliError::Io(e.to_string()))?;
-    match &args.output {
-        Some(path) => std::fs::write(path, text + "\n")
-            .map_err(|e| CliError::Io(format!("cannot write '{path}': {e}")))?,
-        None => println!("{text}"),
-    }
+    super::write_output(args.output.as_deref(), &(text + "\n"))?;
     eprintln!(
         "robocal detect: target found in {found} of {} images",
         files.len()

@@ -115,8 +115,7 @@ fn write_files(dir: &str, files: &[robocal::io::export::ExportFile]) -> Result<(
         .map_err(|e| CliError::Io(format!("cannot create the folder '{dir}': {e}")))?;
     for f in files {
         let path = std::path::Path::new(dir).join(&f.name);
-        std::fs::write(&path, &f.text)
-            .map_err(|e| CliError::Io(format!("cannot write '{}': {e}", path.display())))?;
+        super::output::write_file(&path, f.text.as_bytes())?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())

@@ -4,7 +4,7 @@ use super::detections_file::read_detections;
 use super::handeye_images::{
     detect_images, image_pairs, pair_images, read_robot_poses, PairBy, PosePairs, RobotPoses,
 };
-use super::{parse_target, read_file, CliError};
+use super::{parse_target, CliError};
 use robocal::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
@@ -148,12 +148,18 @@ fn pose_format(value: Option<&str>) -> Result<Option<PoseTextFormat>, CliError> 
 }
 
 fn read_text(path: &str) -> Result<String, CliError> {
-    String::from_utf8(read_file(path)?)
-        .map_err(|_| CliError::Io(format!("'{path}' is not UTF-8 text")))
+    super::read_pose_text(path)
 }
 
 /// Run `robocal handeye`.
 pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
+    super::check_optional_bounds("handeye", "--threads", args.threads, super::bounds::THREADS)?;
+    super::check_bounds(
+        "handeye",
+        "--bootstrap",
+        args.bootstrap,
+        super::bounds::BOOTSTRAP,
+    )?;
     let setup: Setup = args
         .setup
         .as_deref()
@@ -345,11 +351,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     report.pairs = pairs;
     let json = serde_json::to_string_pretty(&report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
-    match &args.output {
-        Some(path) => std::fs::write(path, json + "\n")
-            .map_err(|e| CliError::Io(format!("cannot write '{path}': {e}")))?,
-        None => println!("{json}"),
-    }
+    super::write_output(args.output.as_deref(), &(json + "\n"))?;
     for w in &result.warnings {
         eprintln!("warning: {w}");
     }

@@ -42,7 +42,7 @@ pub fn run(args: InfoArgs) -> Result<(), CliError> {
                 serde_json::json!({ "file": file, "error": e.to_string() })
             }
         };
-        println!("{line}");
+        super::output::println_stdout(&line.to_string())?;
     }
     if failed > 0 {
         return Err(CliError::Io(format!(

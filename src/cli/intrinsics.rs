@@ -86,6 +86,15 @@ pub struct IntrinsicsArgs {
 }
 
 pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
+    use super::{bounds, check_bounds, check_optional_bounds};
+    check_optional_bounds("intrinsics", "--threads", args.threads, bounds::THREADS)?;
+    check_bounds("intrinsics", "--repeat", args.repeat, bounds::REPEAT)?;
+    check_optional_bounds(
+        "intrinsics",
+        "--aspect-ratio",
+        args.aspect_ratio,
+        bounds::ASPECT_RATIO,
+    )?;
     let target = match args.target.as_deref() {
         Some(t) => {
             Some(Target::parse_spec(t).map_err(|e| CliError::usage("intrinsics", e.to_string()))?)

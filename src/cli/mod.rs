@@ -13,7 +13,9 @@ mod export;
 mod handeye;
 mod handeye_images;
 mod info;
+mod input;
 mod intrinsics;
+pub mod output;
 mod planar;
 mod render;
 mod render_rig;
@@ -25,6 +27,8 @@ mod serve;
 mod stereo;
 mod target;
 mod xytable;
+
+pub use input::{read_file, read_pose_text, read_text};
 
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use robocal::target::Target;
@@ -39,7 +43,14 @@ pub enum CliError {
     Io(String),
     /// The library refused the input.
     Robocal(robocal::Error),
+    /// Standard output was closed by its reader (`| head -1`): the command
+    /// ends quietly with [`BROKEN_PIPE_EXIT`].
+    BrokenPipe,
 }
+
+/// The exit code after the reader of stdout went away: 128 + SIGPIPE (13),
+/// what a shell reports for a process killed by a closed pipe.
+pub const BROKEN_PIPE_EXIT: i32 = 141;
 
 impl CliError {
     /// A usage error of `command`, pointing at its help.
@@ -63,6 +74,7 @@ impl CliError {
         match self {
             CliError::Usage(_) => 2,
             CliError::Io(_) | CliError::Robocal(_) => 1,
+            CliError::BrokenPipe => BROKEN_PIPE_EXIT,
         }
     }
 }
@@ -72,6 +84,7 @@ impl fmt::Display for CliError {
         match self {
             CliError::Usage(m) | CliError::Io(m) => write!(f, "{m}"),
             CliError::Robocal(e) => write!(f, "{e}"),
+            CliError::BrokenPipe => write!(f, "the reader of standard output went away"),
         }
     }
 }
@@ -140,9 +153,7 @@ struct CompletionsArgs {
 pub fn run(cli: Cli) -> Result<(), CliError> {
     let Some(command) = cli.command else {
         // No subcommand: the overview, as `robocal --help` (exit 0).
-        return Cli::command()
-            .print_help()
-            .map_err(|e| CliError::Io(format!("cannot write to stdout: {e}")));
+        return output::write_stdout(&Cli::command().render_help().to_string());
     };
     match command {
         Command::Serve(a) => serve::run(a),
@@ -202,6 +213,62 @@ impl ImageLimits {
     }
 }
 
+/// The bounds of the numeric flags, each far beyond what a real calibration
+/// asks for and low enough that no value allocates or runs away
+/// (docs/bounds.md lists them with the reasons).
+pub mod bounds {
+    /// `--threads` of every command that detects (0 and 1 both mean one).
+    pub const THREADS: (usize, usize) = (0, 256);
+    /// `handeye --bootstrap`: resamples of the pose pairs.
+    pub const BOOTSTRAP: (usize, usize) = (0, 1000);
+    /// `intrinsics --repeat`: timed solves.
+    pub const REPEAT: (usize, usize) = (1, 1000);
+    /// `detect --max-side`: the long side of the coarse search level, px.
+    pub const MAX_SIDE_PX: (u32, u32) = (16, 100_000);
+    /// `--max-pixels`: the decoder's pixel limit (10000 MP).
+    pub const MAX_PIXELS: u64 = 10_000_000_000;
+    /// `intrinsics --aspect-ratio`: the held fx / fy.
+    pub const ASPECT_RATIO: (f64, f64) = (0.01, 100.0);
+    /// `planar --reject`: the rejection threshold in sigmas.
+    pub const REJECT_SIGMA: (f64, f64) = (0.1, 1000.0);
+    /// `planar --predict`: the height, mm (a kilometre either way).
+    pub const PREDICT_HEIGHT_MM: (f64, f64) = (-1.0e6, 1.0e6);
+    /// `xytable --noise-px`: the measurement noise sigma, px.
+    pub const NOISE_PX: (f64, f64) = (0.0, 1000.0);
+    /// `planar --point U,V`: each coordinate, px.
+    pub const POINT_PX: (f64, f64) = (-1.0e6, 1.0e6);
+    /// `xytable --start-mm X,Y,Z`: each coordinate, mm (a kilometre).
+    pub const START_MM: (f64, f64) = (-1.0e6, 1.0e6);
+}
+
+/// A numeric flag outside `(lo, hi)` (NaN included) is a usage error of
+/// `command`: `--bootstrap must be between 0 and 1000`.
+pub fn check_bounds<T: PartialOrd + fmt::Display + Copy>(
+    command: &str,
+    flag: &str,
+    value: T,
+    (lo, hi): (T, T),
+) -> Result<(), CliError> {
+    if lo <= value && value <= hi {
+        Ok(())
+    } else {
+        Err(CliError::usage(
+            command,
+            format!("{flag} must be between {lo} and {hi}"),
+        ))
+    }
+}
+
+/// [`check_bounds`] for a flag that may be absent.
+pub fn check_optional_bounds<T: PartialOrd + fmt::Display + Copy>(
+    command: &str,
+    flag: &str,
+    value: Option<T>,
+    bounds: (T, T),
+) -> Result<(), CliError> {
+    value.map_or(Ok(()), |v| check_bounds(command, flag, v, bounds))
+}
+
 /// A pixel count: digits, or digits with the suffix MP (megapixels).
 fn parse_pixel_count(text: &str) -> Result<u64, String> {
     let t = text.trim();
@@ -209,10 +276,17 @@ fn parse_pixel_count(text: &str) -> Result<u64, String> {
         Some(d) => (d.trim(), 1_000_000),
         None => (t, 1),
     };
+    let too_large = || {
+        format!(
+            "'{text}' is more than {}MP: downscale the image first",
+            bounds::MAX_PIXELS / 1_000_000
+        )
+    };
     match digits.parse::<u64>() {
         Ok(n) if n > 0 => n
             .checked_mul(scale)
-            .ok_or_else(|| format!("'{text}' is too large")),
+            .filter(|n| *n <= bounds::MAX_PIXELS)
+            .ok_or_else(too_large),
         _ => Err(format!(
             "'{text}' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP"
         )),
@@ -230,29 +304,13 @@ pub fn parse_target(command: &str, text: &str) -> Result<Target, CliError> {
     Target::parse_spec(text).map_err(|e| CliError::usage(command, e.to_string()))
 }
 
-/// Read a whole text file, with an error that names it.
-pub fn read_text(path: &str) -> Result<String, CliError> {
-    std::fs::read_to_string(path).map_err(|e| CliError::Io(format!("cannot read '{path}': {e}")))
-}
-
-/// Write `text` to `path`, or to stdout when `path` is `None` or `-`.
+/// Write `text` to `path` (replaced atomically), or to stdout when `path`
+/// is `None` or `-`.
 pub fn write_output(path: Option<&str>, text: &str) -> Result<(), CliError> {
     match path {
-        None | Some("-") => {
-            use std::io::Write;
-            let mut out = std::io::stdout().lock();
-            out.write_all(text.as_bytes())
-                .map_err(|e| CliError::Io(format!("cannot write to stdout: {e}")))
-        }
-        Some(p) => {
-            std::fs::write(p, text).map_err(|e| CliError::Io(format!("cannot write '{p}': {e}")))
-        }
+        None | Some("-") => output::write_stdout(text),
+        Some(p) => output::write_file(std::path::Path::new(p), text.as_bytes()),
     }
-}
-
-/// Read a whole file, with an error that names it.
-pub fn read_file(path: &str) -> Result<Vec<u8>, CliError> {
-    std::fs::read(path).map_err(|e| CliError::Io(format!("cannot read '{path}': {e}")))
 }
 
 #[cfg(test)]
@@ -265,6 +323,23 @@ mod tests {
     }
 
     #[test]
+    fn numbers_outside_their_bounds_are_usage_errors_naming_the_flag() {
+        assert!(check_bounds("handeye", "--bootstrap", 1000, bounds::BOOTSTRAP).is_ok());
+        let e = check_bounds("handeye", "--bootstrap", 1001, bounds::BOOTSTRAP).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        assert_eq!(
+            e.to_string(),
+            "handeye: --bootstrap must be between 0 and 1000 (see 'robocal handeye --help')"
+        );
+        let nan = check_bounds("planar", "--reject", f64::NAN, bounds::REJECT_SIGMA);
+        assert_eq!(
+            nan.unwrap_err().to_string(),
+            "planar: --reject must be between 0.1 and 1000 (see 'robocal planar --help')"
+        );
+        assert!(check_optional_bounds("detect", "--threads", None, bounds::THREADS).is_ok());
+    }
+
+    #[test]
     fn pixel_counts_parse_with_and_without_mp() {
         assert_eq!(parse_pixel_count("150000000"), Ok(150_000_000));
         assert_eq!(parse_pixel_count("250MP"), Ok(250_000_000));
@@ -274,6 +349,11 @@ mod tests {
                 "'0' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP".into()
             )
         );
+        assert_eq!(
+            parse_pixel_count("10001MP"),
+            Err("'10001MP' is more than 10000MP: downscale the image first".into())
+        );
+        assert_eq!(parse_pixel_count("10000MP"), Ok(10_000_000_000));
         let raised = ImageLimits {
             max_pixels: Some(300_000_000),
         }

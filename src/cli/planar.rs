@@ -90,6 +90,18 @@ enum Mode {
 }
 
 pub fn run(args: PlanarArgs) -> Result<(), CliError> {
+    super::check_optional_bounds(
+        "planar",
+        "--reject",
+        args.reject,
+        super::bounds::REJECT_SIGMA,
+    )?;
+    super::check_optional_bounds(
+        "planar",
+        "--predict",
+        args.predict,
+        super::bounds::PREDICT_HEIGHT_MM,
+    )?;
     let (Some(mode), Some(file)) = (args.mode, args.file.as_deref()) else {
         return Err(CliError::usage(
             "planar",
@@ -180,7 +192,12 @@ fn predictions(args: &PlanarArgs) -> Result<Vec<PredictRequest>, CliError> {
 fn pair(text: &str, flag: &str) -> Result<[f64; 2], CliError> {
     let parsed: Vec<Option<f64>> = text.split(',').map(|t| t.trim().parse().ok()).collect();
     match parsed.as_slice() {
-        [Some(a), Some(b)] if a.is_finite() && b.is_finite() => Ok([*a, *b]),
+        [Some(a), Some(b)] if a.is_finite() && b.is_finite() => {
+            for v in [a, b] {
+                super::check_bounds("planar", &format!("--{flag}"), *v, super::bounds::POINT_PX)?;
+            }
+            Ok([*a, *b])
+        }
         _ => Err(CliError::usage(
             "planar",
             format!("--{flag}: expected two numbers 'A,B', got '{text}'"),

@@ -204,7 +204,10 @@ fn check_sigmas(args: &RenderArgs) -> Result<(), CliError> {
         if !(value.is_finite() && value >= 0.0) {
             return Err(CliError::usage(
                 "render",
-                format!("{flag} must be a sigma >= 0 in {unit}, got {value}"),
+                format!(
+                    "{flag} must be a sigma >= 0 in {unit}, got {}",
+                    robocal::error::compact(value)
+                ),
             ));
         }
     }
@@ -300,8 +303,7 @@ fn write_demo(out: &Path, seed: u64) -> Result<(), CliError> {
     for (name, image) in &demo.images {
         write_png(&out.join(name), image)?;
     }
-    std::fs::write(out.join("poses.csv"), &demo.poses_csv)
-        .map_err(|e| CliError::Io(format!("cannot write poses.csv: {e}")))?;
+    super::output::write_file(&out.join("poses.csv"), demo.poses_csv.as_bytes())?;
     let truth = serde_json::json!({
         "camera": demo.camera,
         "target": demo.target,
@@ -319,12 +321,10 @@ fn write_demo(out: &Path, seed: u64) -> Result<(), CliError> {
 
 pub(super) fn write_png(path: &Path, image: &robocal::image::GrayImage) -> Result<(), CliError> {
     let png = robocal::image::encode_png(image)?;
-    std::fs::write(path, png)
-        .map_err(|e| CliError::Io(format!("cannot write '{}': {e}", path.display())))
+    super::output::write_file(path, &png)
 }
 
 pub(super) fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(value).map_err(|e| CliError::Io(e.to_string()))? + "\n";
-    std::fs::write(path, text)
-        .map_err(|e| CliError::Io(format!("cannot write '{}': {e}", path.display())))
+    super::output::write_file(path, text.as_bytes())
 }

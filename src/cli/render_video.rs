@@ -2,11 +2,11 @@
 //! [`robocal::synth::video`] as a Y4M file (4:2:0, 8-bit, written with the
 //! `y4m` crate) that Chromium's fake camera plays, and its truth as JSON.
 
+use super::output::AtomicFile;
 use super::CliError;
 use robocal::camera::Camera;
 use robocal::synth::{BoardVideo, RenderOptions, VideoOptions};
-use robocal::target::Target;
-use std::io::Write;
+use robocal::target::{DetectedPoint, Target};
 use std::path::{Path, PathBuf};
 
 /// What `render --video` needs beyond the shared render options.
@@ -53,7 +53,10 @@ pub fn write_video(a: VideoArgs) -> Result<(), CliError> {
     if !(a.fps.is_finite() && (1.0..=120.0).contains(&a.fps)) {
         return Err(CliError::usage(
             "render",
-            format!("--fps must be between 1 and 120, got {}", a.fps),
+            format!(
+                "--fps must be between 1 and 120, got {}",
+                robocal::error::compact(a.fps)
+            ),
         ));
     }
     let camera = match a.camera {
@@ -75,36 +78,16 @@ pub fn write_video(a: VideoArgs) -> Result<(), CliError> {
         ..VideoOptions::default()
     };
     let video = BoardVideo::new(&camera, &a.target, &options)?;
-    let file = std::fs::File::create(a.video)
-        .map_err(|e| CliError::Io(format!("cannot create '{}': {e}", a.video)))?;
-    let io = |e: y4m::Error| CliError::Io(format!("cannot write '{}': {e:?}", a.video));
-    // Integer frame rates exactly; others as a ratio over 1000.
-    let rate = y4m::Ratio::new((a.fps * 1000.0).round() as usize, 1000);
-    let rate = if a.fps.fract() == 0.0 {
-        y4m::Ratio::new(a.fps as usize, 1)
-    } else {
-        rate
+    let mut file = AtomicFile::create(Path::new(a.video))?;
+    let written = encode(&mut file, &video, &a.render, (w, h), a.fps);
+    let points = match written {
+        Ok(points) => {
+            file.finish(Ok(()))?;
+            points
+        }
+        Err(Encode::Io(e)) => return file.finish(Err(e)),
+        Err(Encode::Robocal(e)) => return Err(e.into()),
     };
-    let mut encoder = y4m::encode(w as usize, h as usize, rate)
-        .with_colorspace(y4m::Colorspace::C420)
-        .write_header(std::io::BufWriter::new(file))
-        .map_err(io)?;
-    let chroma = vec![128u8; w.div_ceil(2) as usize * h.div_ceil(2) as usize];
-    let mut points = Vec::with_capacity(video.frames.len());
-    for i in 0..video.frames.len() {
-        let rendered = video.render_frame(i, &a.render)?;
-        let luma: Vec<u8> = rendered
-            .image
-            .pixels
-            .iter()
-            .map(|g| luma_from_grey(*g))
-            .collect();
-        encoder
-            .write_frame(&y4m::Frame::new([&luma, &chroma, &chroma], None))
-            .map_err(io)?;
-        points.push(rendered.points);
-    }
-    drop(encoder);
     let mut truth = serde_json::to_value(&video).map_err(|e| CliError::Io(e.to_string()))?;
     truth["video"] = Path::new(a.video)
         .file_name()
@@ -121,9 +104,7 @@ pub fn write_video(a: VideoArgs) -> Result<(), CliError> {
     }
     let path = truth_path(a.video, a.truth);
     let text = serde_json::to_string_pretty(&truth).map_err(|e| CliError::Io(e.to_string()))?;
-    std::fs::File::create(&path)
-        .and_then(|mut f| f.write_all((text + "\n").as_bytes()))
-        .map_err(|e| CliError::Io(format!("cannot write '{}': {e}", path.display())))?;
+    super::output::write_file(&path, (text + "\n").as_bytes())?;
     eprintln!(
         "robocal render: wrote {} frames ({w}x{h}, {} fps, {} holds) to {} and the truth to {}",
         video.frames.len(),
@@ -133,4 +114,50 @@ pub fn write_video(a: VideoArgs) -> Result<(), CliError> {
         path.display()
     );
     Ok(())
+}
+
+/// Why encoding the video stopped.
+enum Encode {
+    Io(std::io::Error),
+    Robocal(robocal::Error),
+}
+
+/// Encode every frame of `video` into `out`; the rendered points of each.
+fn encode(
+    out: &mut AtomicFile,
+    video: &BoardVideo,
+    render: &RenderOptions,
+    (w, h): (u32, u32),
+    fps: f64,
+) -> Result<Vec<Vec<DetectedPoint>>, Encode> {
+    let io = |e: y4m::Error| match e {
+        y4m::Error::IoError(e) => Encode::Io(e),
+        other => Encode::Io(std::io::Error::other(format!("{other:?}"))),
+    };
+    // Integer frame rates exactly; others as a ratio over 1000.
+    let rate = if fps.fract() == 0.0 {
+        y4m::Ratio::new(fps as usize, 1)
+    } else {
+        y4m::Ratio::new((fps * 1000.0).round() as usize, 1000)
+    };
+    let mut encoder = y4m::encode(w as usize, h as usize, rate)
+        .with_colorspace(y4m::Colorspace::C420)
+        .write_header(out)
+        .map_err(io)?;
+    let chroma = vec![128u8; w.div_ceil(2) as usize * h.div_ceil(2) as usize];
+    let mut points = Vec::with_capacity(video.frames.len());
+    for i in 0..video.frames.len() {
+        let rendered = video.render_frame(i, render).map_err(Encode::Robocal)?;
+        let luma: Vec<u8> = rendered
+            .image
+            .pixels
+            .iter()
+            .map(|g| luma_from_grey(*g))
+            .collect();
+        encoder
+            .write_frame(&y4m::Frame::new([&luma, &chroma, &chroma], None))
+            .map_err(io)?;
+        points.push(rendered.points);
+    }
+    Ok(points)
 }

@@ -209,6 +209,7 @@ fn usage(message: impl Into<String>) -> CliError {
 }
 
 pub fn run(args: RigArgs) -> Result<(), CliError> {
+    super::check_optional_bounds("rig", "--threads", args.threads, super::bounds::THREADS)?;
     let handeye = args.handeye.wanted()?;
     let given = args
         .rig

@@ -5,7 +5,6 @@
 //! header size and time, is in serve_http.rs.
 
 use super::CliError;
-use std::io::Write;
 use std::net::{IpAddr, SocketAddr, TcpListener};
 
 // Sibling files rather than a `mod` line in cli/mod.rs, so the serving
@@ -83,13 +82,13 @@ pub fn run(args: ServeArgs) -> Result<(), CliError> {
         IpAddr::V6(ip) => format!("[{ip}]"),
         IpAddr::V4(ip) => ip.to_string(),
     };
-    println!(
+    // The banner is a courtesy: serving goes on if nobody reads stdout.
+    let _ = super::output::println_stdout(&format!(
         "robocal {} serving {} at http://{shown}:{}/",
         robocal::VERSION,
         root.display(),
         local.port()
-    );
-    let _ = std::io::stdout().flush();
+    ));
     http::serve(listener, root, http::Limits::default())
         .map_err(|e| CliError::Io(format!("serving on {host}:{}: {e}", local.port())))
 }

@@ -6,8 +6,10 @@ use std::path::{Component, Path, PathBuf};
 
 /// Map a request target to a file inside `root`, or `None` (answered 404).
 /// Rejects `..`, absolute components, NUL bytes, backslashes, malformed
-/// percent escapes, and anything whose real path (after symlinks) leaves
-/// `root`. A folder stands for its index.html.
+/// percent escapes, any path component starting with `.` (`/.git/config`,
+/// `/.env`: dotfiles are never served, also when a symlink leads to one),
+/// and anything whose real path (after symlinks) leaves `root`. A folder
+/// stands for its index.html.
 pub fn resolve(root: &Path, target: &str) -> Option<PathBuf> {
     let path = target.split(['?', '#']).next().unwrap_or("");
     let decoded = percent_decode(path)?;
@@ -17,6 +19,7 @@ pub fn resolve(root: &Path, target: &str) -> Option<PathBuf> {
     let mut candidate = root.to_path_buf();
     for component in Path::new(&decoded[1..]).components() {
         match component {
+            Component::Normal(part) if is_hidden(part) => return None,
             Component::Normal(part) => candidate.push(part),
             Component::CurDir => {}
             Component::ParentDir | Component::RootDir | Component::Prefix(_) => return None,
@@ -26,7 +29,16 @@ pub fn resolve(root: &Path, target: &str) -> Option<PathBuf> {
     if real.is_dir() {
         real = std::fs::canonicalize(real.join("index.html")).ok()?;
     }
-    (real.starts_with(root) && real.is_file()).then_some(real)
+    let inside = real.strip_prefix(root).ok()?;
+    let hidden = inside
+        .components()
+        .any(|c| matches!(c, Component::Normal(part) if is_hidden(part)));
+    (!hidden && real.is_file()).then_some(real)
+}
+
+/// A dotfile or dot-folder name (`.git`, `.env`, `.DS_Store`).
+fn is_hidden(part: &std::ffi::OsStr) -> bool {
+    part.as_encoded_bytes().first() == Some(&b'.')
 }
 
 /// Strict `%XX` decoding of a URL path: a malformed escape or a result that
@@ -89,6 +101,30 @@ mod tests {
         assert_eq!(percent_decode("/%zz"), None);
         assert_eq!(percent_decode("/%2"), None);
         assert_eq!(percent_decode("/%ff"), None, "not UTF-8");
+    }
+
+    #[test]
+    fn dotfiles_are_never_resolved() {
+        let root = std::env::temp_dir().join(format!("robocal-serve-dot-{}", std::process::id()));
+        std::fs::create_dir_all(root.join(".git")).unwrap();
+        std::fs::create_dir_all(root.join("sub")).unwrap();
+        std::fs::write(root.join(".git/config"), "[core]").unwrap();
+        std::fs::write(root.join(".env"), "KEY=1").unwrap();
+        std::fs::write(root.join("sub/a.txt"), "a").unwrap();
+        #[cfg(unix)]
+        std::os::unix::fs::symlink(root.join(".env"), root.join("sub/env.txt")).unwrap();
+        let root = std::fs::canonicalize(&root).unwrap();
+        for target in [
+            "/.git/config",
+            "/.env",
+            "/%2egit/config",
+            "/sub/../.env",
+            "/sub/env.txt",
+        ] {
+            assert_eq!(resolve(&root, target), None, "{target}");
+        }
+        assert_eq!(resolve(&root, "/sub/a.txt"), Some(root.join("sub/a.txt")));
+        std::fs::remove_dir_all(root).unwrap();
     }
 
     #[test]

@@ -24,16 +24,26 @@
 //! - every write within `write_stall`, the whole response within
 //!   `response_deadline`; files are streamed in [`CHUNK`]-sized pieces.
 //!
+//! - a slow-client budget: a connection gets `fast_wait` to send its whole
+//!   head, and every write `fast_wait` to go out; a client slower than that
+//!   needs one of `slow_slots` slots (fewer than the workers) to go on, up to
+//!   the deadlines above, and is cut off (408, no linger) when all are taken.
+//!   So however many slow clients there are, at least `workers - slow_slots`
+//!   workers only ever wait `fast_wait` for a client, and a normal request
+//!   queued behind slow ones is reached within about `queue * fast_wait /
+//!   (workers - slow_slots)` (64 * 20 ms / 8 = 0.16 s with the defaults).
+//!
 //! Threads are `workers + 1`, memory about `workers * (max_head_bytes +
 //! CHUNK)` plus the queued sockets, whatever the load. The price of blocking
-//! workers: a slow client holds a worker for up to `head_deadline` plus
-//! [`LINGER_TIME`], so behind slow clients a normal one waits seconds, and a
-//! flood of more than `workers + queue` slow clients is answered 503 while it
-//! lasts; service is back within one `head_deadline` after it (measured with
-//! bench/serve_load.py: BENCHMARKS.md, "robocal serve under load").
+//! workers: a flood of more than `workers + queue` connections at once is
+//! answered 503 while it lasts (measured with bench/serve_load.py:
+//! BENCHMARKS.md, "robocal serve under load").
 //!
 //! GET and HEAD only (405 otherwise), `Connection: close` on every response,
-//! no directory listing, 404 for anything outside the served folder.
+//! no directory listing, 404 for anything outside the served folder and for
+//! dotfiles. Every response carries [`CONTENT_SECURITY_POLICY`] (the page's
+//! own policy plus `frame-ancestors 'none'`, which a `<meta>` cannot set)
+//! and `X-Content-Type-Options: nosniff`.
 
 use super::files::{mime_type, resolve};
 use std::fs::File;
@@ -41,9 +51,16 @@ use std::io::{self, ErrorKind, Read, Write};
 use std::net::{Shutdown, TcpListener, TcpStream};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{self, Receiver, SyncSender, TrySendError};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
+
+/// The Content-Security-Policy header: the policy of www/index.html's
+/// `<meta http-equiv="Content-Security-Policy">` (tests/cli_serve.rs checks
+/// they agree) plus `frame-ancestors 'none'`, so no other site can frame
+/// the page.
+pub const CONTENT_SECURITY_POLICY: &str = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; style-src 'self'; img-src 'self' blob: data:; worker-src 'self'; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 
 /// Most headers one request may carry (431 beyond).
 pub const MAX_HEADERS: usize = 64;
@@ -82,6 +99,14 @@ pub struct Limits {
     /// Longest one response may take in total (default 60 s: a 2 MB wasm
     /// file at 35 kB/s).
     pub response_deadline: Duration,
+    /// Time a client gets to send its whole head, and each write to go out,
+    /// before it counts as slow (default 20 ms; on loopback both take well
+    /// under a millisecond, and a head sent in one piece has usually
+    /// arrived before a worker takes the connection).
+    pub fast_wait: Duration,
+    /// Connections that may be slow at once (default 8, half the workers);
+    /// a slow client beyond them is cut off with 408.
+    pub slow_slots: usize,
 }
 
 impl Default for Limits {
@@ -93,6 +118,8 @@ impl Default for Limits {
             head_deadline: Duration::from_secs(5),
             write_stall: Duration::from_secs(10),
             response_deadline: Duration::from_secs(60),
+            fast_wait: Duration::from_millis(20),
+            slow_slots: 8,
         }
     }
 }
@@ -100,15 +127,20 @@ impl Default for Limits {
 /// Serves the files under `root` (a canonical folder path) on `listener`
 /// until accepting fails for good. Returns only on an error.
 pub fn serve(listener: TcpListener, root: PathBuf, limits: Limits) -> io::Result<()> {
+    let budget = Arc::new(SlowBudget {
+        in_use: AtomicUsize::new(0),
+        max: limits.slow_slots,
+    });
     let limits = Arc::new(limits);
     let root = Arc::new(root);
     let (queue, jobs) = mpsc::sync_channel::<Accepted>(limits.queue);
     let jobs = Arc::new(Mutex::new(jobs));
     for i in 0..limits.workers {
-        let (jobs, root, limits) = (jobs.clone(), root.clone(), limits.clone());
+        let (jobs, root, limits, budget) =
+            (jobs.clone(), root.clone(), limits.clone(), budget.clone());
         std::thread::Builder::new()
             .name(format!("serve-worker-{i}"))
-            .spawn(move || work(&jobs, &root, &limits))?;
+            .spawn(move || work(&jobs, &root, &limits, &budget))?;
     }
     for stream in listener.incoming() {
         match stream {
@@ -153,8 +185,52 @@ fn admit(queue: &SyncSender<Accepted>, stream: TcpStream) -> io::Result<()> {
     }
 }
 
+/// The slots of the slow-client budget (see [`Limits::slow_slots`]).
+struct SlowBudget {
+    in_use: AtomicUsize,
+    max: usize,
+}
+
+/// One connection's claim on the [`SlowBudget`]: taken at most once, when
+/// the client first turns out slow, and given back when the connection ends.
+struct Slowness<'a> {
+    budget: &'a SlowBudget,
+    held: bool,
+}
+
+impl<'a> Slowness<'a> {
+    fn new(budget: &'a SlowBudget) -> Self {
+        Slowness {
+            budget,
+            held: false,
+        }
+    }
+
+    /// Whether this connection may be slow: it holds a slot, or takes one.
+    fn allow(&mut self) -> bool {
+        if !self.held {
+            self.held = self
+                .budget
+                .in_use
+                .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                    (n < self.budget.max).then_some(n + 1)
+                })
+                .is_ok();
+        }
+        self.held
+    }
+}
+
+impl Drop for Slowness<'_> {
+    fn drop(&mut self) {
+        if self.held {
+            self.budget.in_use.fetch_sub(1, Ordering::SeqCst);
+        }
+    }
+}
+
 /// One worker: takes connections off the queue, one at a time, forever.
-fn work(jobs: &Mutex<Receiver<Accepted>>, root: &Path, limits: &Limits) {
+fn work(jobs: &Mutex<Receiver<Accepted>>, root: &Path, limits: &Limits, budget: &SlowBudget) {
     let mut head = vec![0u8; limits.max_head_bytes];
     let mut chunk = vec![0u8; CHUNK];
     loop {
@@ -165,7 +241,7 @@ fn work(jobs: &Mutex<Receiver<Accepted>>, root: &Path, limits: &Limits) {
         // A panic would lose one connection, never a worker: the pool stays
         // at its size.
         let _ = panic::catch_unwind(AssertUnwindSafe(|| {
-            handle(job, root, limits, &mut head, &mut chunk)
+            handle(job, root, limits, budget, &mut head, &mut chunk)
         }));
     }
 }
@@ -242,35 +318,63 @@ enum NoRequest {
     Gone,
     /// The client is answered with this status, then the connection closed.
     Refused(Status),
+    /// The client is slow and the slow-client budget is spent: 408 at once,
+    /// without a linger.
+    OverBudget,
 }
 
 fn handle(
     job: Accepted,
     root: &Path,
     limits: &Limits,
+    budget: &SlowBudget,
     head: &mut [u8],
     chunk: &mut [u8],
 ) -> io::Result<()> {
     let Accepted { mut stream, at } = job;
-    let request = read_head(&mut stream, at + limits.head_deadline, head);
-    let writer = Deadline::new(limits);
+    let mut slow = Slowness::new(budget);
+    let deadlines = HeadDeadlines {
+        fast: Instant::now() + limits.fast_wait,
+        end: at + limits.head_deadline,
+    };
+    let request = read_head(&mut stream, &deadlines, &mut slow, head);
+    let mut writer = Deadline::new(limits, slow);
     match request {
         Ok(request) => {
-            let answered = answer(&mut stream, &request, root, &writer, chunk);
+            let answered = answer(&mut stream, &request, root, &mut writer, chunk);
             // The head was read to its end; drop anything sent after it
             // that has already arrived, so closing does not reset.
             drain_pending(&mut stream);
             answered
         }
         Err(NoRequest::Gone) => Ok(()),
+        Err(NoRequest::OverBudget) => {
+            let written = writer.write(&mut stream, &status_page(Status::RequestTimeout, false));
+            drain_pending(&mut stream);
+            let _ = stream.shutdown(Shutdown::Both);
+            written
+        }
         Err(NoRequest::Refused(status)) => {
             let written = writer.write(&mut stream, &status_page(status, false));
             // The request was not read to its end (a 408 may not have read
-            // a byte of it): close only once the client stops sending.
-            linger(&mut stream);
+            // a byte of it): close only once the client stops sending; a
+            // client without a slow slot gets `fast_wait` for that.
+            let time = if writer.slow.held {
+                LINGER_TIME
+            } else {
+                limits.fast_wait
+            };
+            linger(&mut stream, time);
             written
         }
     }
+}
+
+/// When a request head must have arrived: `fast` without a slow slot,
+/// `end` with one.
+struct HeadDeadlines {
+    fast: Instant,
+    end: Instant,
 }
 
 /// Reads the request head into `buf` until it is complete, too large, late
@@ -283,15 +387,23 @@ fn handle(
 /// answered, not refused.
 fn read_head(
     stream: &mut TcpStream,
-    deadline: Instant,
+    deadlines: &HeadDeadlines,
+    slow: &mut Slowness,
     buf: &mut [u8],
 ) -> Result<Request, NoRequest> {
     let mut len = 0;
     loop {
-        let remaining = deadline
-            .checked_duration_since(Instant::now())
-            .filter(|d| !d.is_zero());
-        let late = remaining.is_none();
+        let now = Instant::now();
+        if now >= deadlines.fast && now < deadlines.end && !slow.allow() {
+            return Err(NoRequest::OverBudget);
+        }
+        let end = if slow.held {
+            deadlines.end
+        } else {
+            deadlines.fast.min(deadlines.end)
+        };
+        let remaining = end.checked_duration_since(now).filter(|d| !d.is_zero());
+        let late = now >= deadlines.end;
         stream
             .set_read_timeout(Some(remaining.unwrap_or(LATE_READ)))
             .map_err(|_| NoRequest::Gone)?;
@@ -299,6 +411,10 @@ fn read_head(
             Ok(0) => return Err(NoRequest::Gone),
             Ok(n) => n,
             Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+            // Out of fast time: the loop's top takes a slow slot or gives up.
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) && !late => {
+                continue
+            }
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
                 return Err(NoRequest::Refused(Status::RequestTimeout))
             }
@@ -340,7 +456,7 @@ fn answer(
     stream: &mut TcpStream,
     request: &Request,
     root: &Path,
-    writer: &Deadline,
+    writer: &mut Deadline,
     chunk: &mut [u8],
 ) -> io::Result<()> {
     let head_only = request.method == Method::Head;
@@ -369,28 +485,55 @@ fn answer(
     }
 }
 
-/// Writes bounded by the per-write stall and the response's deadline.
-struct Deadline {
+/// Writes bounded by the response's deadline and the per-write stall: a
+/// write that waits more than `fast` makes the client slow, which needs a
+/// slot of the slow-client budget (else the write fails with TimedOut).
+struct Deadline<'a> {
     stall: Duration,
+    fast: Duration,
     end: Instant,
+    slow: Slowness<'a>,
 }
 
-impl Deadline {
-    fn new(limits: &Limits) -> Self {
+impl<'a> Deadline<'a> {
+    fn new(limits: &Limits, slow: Slowness<'a>) -> Self {
         Deadline {
             stall: limits.write_stall,
+            fast: limits.fast_wait,
             end: Instant::now() + limits.response_deadline,
+            slow,
         }
     }
 
-    fn write(&self, stream: &mut TcpStream, bytes: &[u8]) -> io::Result<()> {
-        let remaining = self
-            .end
-            .checked_duration_since(Instant::now())
-            .filter(|d| !d.is_zero())
-            .ok_or_else(|| io::Error::from(ErrorKind::TimedOut))?;
-        stream.set_write_timeout(Some(remaining.min(self.stall)))?;
-        stream.write_all(bytes)
+    fn write(&mut self, stream: &mut TcpStream, mut bytes: &[u8]) -> io::Result<()> {
+        while !bytes.is_empty() {
+            let remaining = self
+                .end
+                .checked_duration_since(Instant::now())
+                .filter(|d| !d.is_zero())
+                .ok_or_else(|| io::Error::from(ErrorKind::TimedOut))?;
+            let patience = if self.slow.held {
+                self.stall
+            } else {
+                self.fast
+            };
+            stream.set_write_timeout(Some(remaining.min(patience)))?;
+            match stream.write(bytes) {
+                Ok(0) => return Err(ErrorKind::WriteZero.into()),
+                Ok(n) => bytes = &bytes[n..],
+                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(e)
+                    if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut)
+                        && !self.slow.held =>
+                {
+                    if !self.slow.allow() {
+                        return Err(ErrorKind::TimedOut.into());
+                    }
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(())
     }
 }
 
@@ -400,9 +543,9 @@ impl Deadline {
 /// makes the kernel answer with a reset, and a reset can destroy a response
 /// the client has not read yet. A client that closes on our FIN ends the
 /// linger at once.
-fn linger(stream: &mut TcpStream) {
+fn linger(stream: &mut TcpStream, time: Duration) {
     let _ = stream.shutdown(Shutdown::Write);
-    let end = Instant::now() + LINGER_TIME;
+    let end = Instant::now() + time;
     let mut sink = [0u8; 4096];
     let mut drained = 0;
     while drained < LINGER_BYTES {
@@ -450,7 +593,8 @@ fn head_lines(status: Status, mime: &str, len: u64) -> String {
     let (code, reason) = status.code_and_reason();
     format!(
         "HTTP/1.1 {code} {reason}\r\nContent-Type: {mime}\r\nContent-Length: {len}\r\n{}\
-         Cache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+         Cache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\n\
+         Content-Security-Policy: {CONTENT_SECURITY_POLICY}\r\nConnection: close\r\n\r\n",
         status.extra_headers()
     )
 }

@@ -109,6 +109,7 @@ fn side(
 }
 
 pub fn run(args: StereoArgs) -> Result<(), CliError> {
+    super::check_optional_bounds("stereo", "--threads", args.threads, super::bounds::THREADS)?;
     let target = args
         .target
         .as_deref()

@@ -80,6 +80,12 @@ pub struct XytableArgs {
 }
 
 pub fn run(args: XytableArgs) -> Result<(), CliError> {
+    super::check_optional_bounds(
+        "xytable",
+        "--noise-px",
+        args.noise_px,
+        super::bounds::NOISE_PX,
+    )?;
     let Some(file) = args.file.as_deref() else {
         return Err(CliError::usage("xytable", "give the positions file"));
     };
@@ -156,6 +162,9 @@ fn triple(text: &str) -> Result<[f64; 3], CliError> {
     let v: Vec<Option<f64>> = text.split(',').map(|t| t.trim().parse().ok()).collect();
     match v.as_slice() {
         [Some(a), Some(b), Some(c)] if a.is_finite() && b.is_finite() && c.is_finite() => {
+            for v in [a, b, c] {
+                super::check_bounds("xytable", "--start-mm", *v, super::bounds::START_MM)?;
+            }
             Ok([*a, *b, *c])
         }
         _ => Err(CliError::usage(

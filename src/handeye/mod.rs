@@ -269,8 +269,8 @@ impl Chain {
                 format!(
                     "{n} poses: at most {MAX_POSES} are supported (the solvers and the \
                      repeatability check use every pair of poses, which grows with the \
-                     square); keep a subset spread over the workspace, e.g. every {}th pose",
-                    n.div_ceil(MAX_POSES)
+                     square); keep a subset spread over the workspace, e.g. every {} pose",
+                    crate::error::ordinal(n.div_ceil(MAX_POSES))
                 ),
             ));
         }

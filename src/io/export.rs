@@ -138,8 +138,10 @@ fn export_value(
             ),
             other => other,
         })?;
+        let name = report["name"].as_str().unwrap_or("camera");
+        check_one_line("name", "camera name", name)?;
         let info = CameraExportInfo {
-            name: report["name"].as_str().unwrap_or("camera").to_string(),
+            name: name.to_string(),
             rms_px: report["rms_px"].as_f64(),
             ..CameraExportInfo::default()
         };
@@ -172,6 +174,20 @@ fn export_value(
     };
     let pose = pose_from_report(report, &name)?;
     let roles = FrameNames::from_transform_name(&name)?;
+    // The key is written as the label of every format (comments, XML) and
+    // its parts are the default frame names.
+    for part in [&roles.parent, &roles.child] {
+        if !is_ros_frame_name(part) {
+            return Err(Error::invalid(
+                "transform",
+                format!(
+                    "'{}' cannot be exported: the frames of a transform name are ROS frame names (letters, digits, _ and /, starting with a letter, _ or /), as in gripper_from_camera; '{}' is not one",
+                    shown(&name),
+                    shown(part)
+                ),
+            ));
+        }
+    }
     let names = FrameNames {
         parent: frame_name(report, &options.frames, &roles.parent)?,
         child: frame_name(report, &options.frames, &roles.child)?,
@@ -207,7 +223,7 @@ fn frame_name(
     if !is_ros_frame_name(&name) {
         return Err(Error::invalid(
             "frame_names",
-            format!("the {role} frame name '{name}' is not a ROS frame name: use letters, digits, _ and / (starting with a letter, _ or /), e.g. tool0"),
+            format!("the {role} frame name '{}' is not a ROS frame name: use letters, digits, _ and / (starting with a letter, _ or /), e.g. tool0", shown(&name)),
         ));
     }
     Ok(name)
@@ -223,6 +239,60 @@ pub(crate) fn is_ros_frame_name(name: &str) -> bool {
         && name
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '/')
+}
+
+/// A name written into an export as text (a camera's, a rig frame's) must
+/// be one line of printable text: a newline would start a new key or
+/// element in the file. `field` and `what` name it in the error.
+pub(crate) fn check_one_line(field: &str, what: &str, name: &str) -> Result<()> {
+    match name.chars().find(|c| c.is_control()) {
+        None => Ok(()),
+        Some(c) => Err(Error::invalid(
+            field,
+            format!(
+                "the {what} '{}' holds a control character ({}): a name is one line of printable text",
+                shown(name),
+                c.escape_default()
+            ),
+        )),
+    }
+}
+
+/// `name` for an error message: as it is, its control characters escaped
+/// (`\n`), so the message stays one line.
+fn shown(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+/// `text` as a YAML scalar that reads back as the same string: as it is
+/// when it is a plain name (letters, digits, `_`, `-`, `.`, `/`, not a
+/// number, boolean or null), else double-quoted with JSON's escapes (a
+/// JSON string is a YAML double-quoted scalar).
+pub(crate) fn yaml_scalar(text: &str) -> String {
+    let plain = text
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_' || c == '/')
+        && text
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '/'))
+        && !matches!(
+            text.to_ascii_lowercase().as_str(),
+            "true" | "false" | "yes" | "no" | "on" | "off" | "y" | "n" | "null" | "nan" | "inf"
+        );
+    if plain {
+        text.to_string()
+    } else {
+        serde_json::Value::String(text.to_string()).to_string()
+    }
 }
 
 /// Read the transform `name` from a report: any [`PoseInput`] (the matrix

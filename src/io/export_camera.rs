@@ -303,7 +303,9 @@ fn ros_yaml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
     };
     let mut out = format!(
         "image_width: {}\nimage_height: {}\ncamera_name: {}\n",
-        c.width, c.height, info.name
+        c.width,
+        c.height,
+        super::export::yaml_scalar(&info.name)
     );
     out += &block("camera_matrix", 3, 3, &k);
     out += &format!("distortion_model: {model}\n");

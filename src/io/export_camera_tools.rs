@@ -58,8 +58,10 @@ pub(super) fn kalibr_camera(c: &Camera, name: &str) -> Result<String> {
         list(&coeffs)
     );
     out += &format!(
-        "  resolution: [{}, {}]\n  rostopic: /{name}/image_raw\n",
-        c.width, c.height
+        "  resolution: [{}, {}]\n  rostopic: {}\n",
+        c.width,
+        c.height,
+        super::export::yaml_scalar(&format!("/{name}/image_raw"))
     );
     Ok(out)
 }

@@ -116,6 +116,10 @@ fn entries(rig: &RigCalibration) -> Result<Vec<RigEntry<'_>>> {
     if rig.cameras.is_empty() {
         return Err(Error::invalid("cameras", "the rig report has no cameras"));
     }
+    super::export::check_one_line("rig_frame", "rig frame name", &rig.rig_frame)?;
+    for (k, c) in rig.cameras.iter().enumerate() {
+        super::export::check_one_line(&format!("cameras[{k}].name"), "camera name", &c.name)?;
+    }
     rig.cameras
         .iter()
         .enumerate()
@@ -245,8 +249,10 @@ fn kalibr(rig: &RigCalibration, cameras: &[RigEntry]) -> Result<String> {
 }
 
 /// A double-quoted YAML string (OpenCV's FileStorage reads these).
+/// A YAML double-quoted scalar (JSON's escapes, so no character of `s`
+/// can end the string or the line).
 fn quoted(s: &str) -> String {
-    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+    serde_json::Value::String(s.to_string()).to_string()
 }
 
 fn opencv_yaml(rig: &RigCalibration, cameras: &[RigEntry]) -> Result<String> {

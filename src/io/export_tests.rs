@@ -280,3 +280,59 @@ fn frame_names_come_from_the_options_then_the_report_then_the_key() {
         "frame_names: 'camera' should name a frame as a string, got 3"
     );
 }
+
+/// The top-level keys of a block YAML text (lines that start a mapping key
+/// at column 0).
+fn top_level_keys(yaml: &str) -> Vec<&str> {
+    yaml.lines()
+        .filter(|l| !l.starts_with([' ', '#', '%', '-']) && !l.is_empty())
+        .filter_map(|l| l.split_once(':').map(|(k, _)| k))
+        .collect()
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn camera_names_are_quoted_for_yaml_or_refused_when_they_break_lines() {
+    use super::export::export;
+    let camera = export_camera(&brown(), &CameraExportInfo::default(), CameraFormat::Json).unwrap();
+    let named = |name: &str| {
+        let mut v: serde_json::Value = serde_json::from_str(&camera).unwrap();
+        v["name"] = name.into();
+        v.to_string()
+    };
+    let ros = export(&named("cam: x # y"), "ros-yaml", None).unwrap();
+    assert!(ros.contains("\ncamera_name: \"cam: x # y\"\n"), "{ros}");
+    assert_eq!(
+        top_level_keys(&ros),
+        [
+            "image_width",
+            "image_height",
+            "camera_name",
+            "camera_matrix",
+            "distortion_model",
+            "distortion_coefficients",
+            "rectification_matrix",
+            "projection_matrix"
+        ]
+    );
+    let plain = export(&named("left_cam"), "ros-yaml", None).unwrap();
+    assert!(plain.contains("\ncamera_name: left_cam\n"), "{plain}");
+    let err = export(&named("cam\ncamera_matrix: {rows: 3}"), "ros-yaml", None).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        r"name: the camera name 'cam\ncamera_matrix: {rows: 3}' holds a control character (\n): a name is one line of printable text"
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn transform_names_that_are_not_frame_names_are_refused() {
+    use super::export::export;
+    let report = r#"{"a_from_b\"/><node name=\"x": {"translation_m": [0, 0, 0], "quaternion_xyzw": [0, 0, 0, 1]}}"#;
+    for format in ["ros1-launch", "urdf", "matrix4"] {
+        let err = export(report, format, Some("a_from_b\"/><node name=\"x")).unwrap_err();
+        assert!(
+            err.to_string()
+                .ends_with("as in gripper_from_camera; 'b\"/><node name=\"x' is not one"),
+            "{format}: {err}"
+        );
+    }
+}

@@ -243,14 +243,20 @@ fn check_options(o: &VideoOptions) -> Result<()> {
     if !ok {
         return Err(Error::invalid(
             "video",
-            format!("expected a frame rate between 1 and 120 fps, got {}", o.fps),
+            format!(
+                "expected a frame rate between 1 and 120 fps, got {}",
+                crate::error::compact(o.fps)
+            ),
         ));
     }
     for (name, s) in times {
         if !(s.is_finite() && (0.0..=60.0).contains(&s)) {
             return Err(Error::invalid(
                 "video",
-                format!("expected a {name} time between 0 and 60 s, got {s}"),
+                format!(
+                    "expected a {name} time between 0 and 60 s, got {}",
+                    crate::error::compact(s)
+                ),
             ));
         }
     }

@@ -144,7 +144,8 @@ pub(super) fn validate(target: &Target) -> Result<()> {
         } => {
             if !(spacing_ratio.is_finite() && *spacing_ratio > 0.0 && *spacing_ratio <= 1.0) {
                 return bad(format!(
-                    "the AprilGrid spacing ratio must be in (0, 1] (Kalibr's tagSpacing), got {spacing_ratio}"
+                    "the AprilGrid spacing ratio must be in (0, 1] (Kalibr's tagSpacing), got {}",
+                    crate::error::compact(*spacing_ratio)
                 ));
             }
             let d = Dictionary::DICT_APRILTAG_36h11;

@@ -284,7 +284,7 @@ impl Target {
         };
         if let Some((name, l)) = lengths.iter().find(|(_, l)| !l.is_finite() || *l <= 0.0) {
             let got = if l.is_finite() {
-                format!("{} mm", l * 1000.0)
+                format!("{} mm", crate::error::compact(l * 1000.0))
             } else {
                 l.to_string()
             };
