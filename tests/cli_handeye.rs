@@ -466,7 +466,8 @@ fn poses_pair_by_path_suffix_and_numeric_order_and_wrong_pairings_are_named() {
         e.starts_with(
             "robocal: pairing: the poses fit the images only when paired in numeric order of \
              the file names: the rotation angles of the robot and camera motions agree to 0.0"
-        ) && e.contains("as paired lexicographic order of the file names: pass --pair-by numeric"),
+        ) && e
+            .contains("as paired in lexicographic order of the file names: pass --pair-by numeric"),
         "{e}"
     );
     // 4. Two rows naming one image, and a row naming no image: errors naming them.

@@ -385,10 +385,7 @@ fn check_pairing(
             .name
             .trim_start_matches("robot pose i with the i-th image "),
         fit.given_mismatch_deg,
-        pairing
-            .how
-            .trim_start_matches("in ")
-            .trim_start_matches("by "),
+        pairing.how,
         fit.rule.fix
     ))
 }

@@ -153,7 +153,7 @@ pub fn position_rules(n_robot: usize, n_camera: usize) -> Vec<PairingRule> {
     rules.push(PairingRule {
         name: "robot pose i with image n-1-i (the reverse order)".to_string(),
         finding: "the poses and the images are listed in opposite orders".to_string(),
-        fix: "the poses and the images are listed in opposite orders: reverse one list".to_string(),
+        fix: "reverse one list so that they pair up".to_string(),
         pairs: (0..n).map(|i| (i, n - 1 - i)).collect(),
     });
     rules
