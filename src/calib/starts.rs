@@ -92,7 +92,8 @@ pub(crate) fn best_start(
         // (points behind the camera) is no candidate.
         let Ok(fitted) = fitted else { continue };
         outcomes.push(outcome(problem, name, &fitted)?);
-        if fitted.cost < best.1.cost {
+        // Equal minima differ by round-off: the earlier start keeps them.
+        if fitted.cost < best.1.cost * (1.0 - SAME_COST) {
             best = (name.to_string(), fitted);
         }
     }
@@ -111,6 +112,8 @@ pub(crate) fn best_start(
 }
 
 const HELD_THEN_FREED: &str = "distortion_held_then_freed";
+/// Relative cost difference below which two starts reached the same minimum.
+const SAME_COST: f64 = 1e-9;
 
 /// The other starts, each conformed to the held parameters of the problem
 /// (principal point, aspect ratio, skew and held coefficients keep the
