@@ -291,7 +291,7 @@ const BETTER_MARGIN: f64 = 1e-9;
 /// if it ends lower: a row of the table below the chosen result is a bug,
 /// not a footnote. A row that stays lower (a method fitting parameters the
 /// options hold, such as the DLT's skew) is named in a warning.
-fn at_least_as_good(
+pub(crate) fn at_least_as_good(
     zhang: CameraCalibration,
     outcomes: &[(Method, Result<CameraCalibration>)],
     views: &[View],
@@ -315,7 +315,7 @@ fn at_least_as_good(
                 refined.warnings.insert(
                     0,
                     format!(
-                        "the bundle adjustment from its own start reached {:.3} px, above {}'s                          {:.3} px: refined from {}'s camera instead, to {:.3} px",
+                        "the bundle adjustment from its own start reached {:.3} px, above {}'s {:.3} px: refined from {}'s camera instead, to {:.3} px",
                         report.rms_px,
                         method.name(),
                         other.rms_px,
@@ -332,7 +332,7 @@ fn at_least_as_good(
     for (method, rms) in notes {
         if rms < report.rms_px * (1.0 - BETTER_MARGIN) {
             report.warnings.push(format!(
-                "{} reaches {rms:.3} px, below the chosen result's {:.3} px, and the bundle                  adjustment refined from it does not: it fits parameters these options hold                  (free skew, no held coefficients); solve with its options to compare",
+                "{} reaches {rms:.3} px, below the chosen result's {:.3} px, and the bundle adjustment refined from it does not: it fits parameters these options hold (free skew, no held coefficients); solve with its options to compare",
                 method.name(),
                 report.rms_px
             ));

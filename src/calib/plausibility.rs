@@ -114,15 +114,15 @@ pub fn distortion_fold(camera: &Camera) -> Option<(f64, f64)> {
         for i in 1..=FOLD_SAMPLES {
             let phi = FOLD_MAX_ANGLE * i as f64 / FOLD_SAMPLES as f64;
             let ray = Point3::new(phi.sin() * theta.cos(), phi.sin() * theta.sin(), phi.cos());
-            let Ok(p) = camera.project(&ray) else { break };
-            let r = (p - centre).norm();
-            if !r.is_finite() {
-                break;
-            }
             if last >= corner_r {
                 break;
             }
-            if r < last {
+            // The polynomial models refuse rays beyond their first fold:
+            // a refusal before the corner is a fold inside the image.
+            let r = camera
+                .project(&ray)
+                .map_or(f64::NAN, |p| (p - centre).norm());
+            if r.is_nan() || r < last {
                 if worst.map_or(true, |(f, _)| last < f) {
                     worst = Some((last, corner_r));
                 }
@@ -199,4 +199,72 @@ pub fn not_converged(iterations: usize, rms_px: f64, starts: &[String]) -> Strin
         },
         starts.join(", ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Distortion;
+
+    fn webcam(k1: f64) -> Camera {
+        Camera {
+            fx: 910.0,
+            fy: 910.0,
+            cx: 639.5,
+            cy: 359.5,
+            skew: 0.0,
+            width: 1280,
+            height: 720,
+            distortion: Distortion::Brown {
+                k1,
+                k2: 0.0,
+                k3: 0.0,
+                p1: 0.0,
+                p2: 0.0,
+            },
+        }
+    }
+
+    /// r_d = r (1 + k1 r^2) peaks at r = 1 / sqrt(-3 k1): for k1 = -0.4 at
+    /// r_d = 0.60858, 553.8 px at fx 910, inside the 734 px of the corner.
+    /// Tolerance 0.5 px: the angle samples are 0.022 deg apart, and r_d is
+    /// flat at its peak.
+    #[test]
+    fn a_fold_inside_the_image_is_found_where_r_d_peaks() {
+        let (fold, corner) = distortion_fold(&webcam(-0.4)).expect("a fold");
+        let r = 1.0 / (1.2f64).sqrt();
+        let want = 910.0 * r * (1.0 - 0.4 * r * r);
+        assert!((fold - want).abs() < 0.5, "fold {fold} px, want {want} px");
+        assert!(
+            (corner - 640.0f64.hypot(360.0)).abs() < 1e-9,
+            "corner {corner} px"
+        );
+        assert_eq!(distortion_fold(&webcam(-0.1)), None);
+        assert_eq!(distortion_fold(&webcam(0.2)), None);
+        let w = warnings(&webcam(-0.4), 0.2, None);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("the lens distortion folds inside the image: the distorted radius stops increasing 554 px"), "{}", w[0]);
+    }
+
+    #[test]
+    fn an_off_centre_principal_point_and_non_square_pixels_are_named() {
+        let c = Camera {
+            fx: 733.0,
+            fy: 967.0,
+            cx: 268.0,
+            ..webcam(0.0)
+        };
+        assert!(implausible(&c));
+        let w = warnings(&c, 0.319, Some(0.156));
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(w[0].starts_with("fx / fy is 0.758 (fx 733.0 px, fy 967.0 px), yet a fit with square pixels reaches 0.156 px against 0.319 px"), "{}", w[0]);
+        assert!(w[1].starts_with("the principal point (268.0, 359.5) px is -372 px, 0 px from the image centre (639.5, 359.5) (29 % of the width, 0 % of the height"), "{}", w[1]);
+        assert!(!implausible(&webcam(-0.1)));
+        assert_eq!(Severity::of(&w), Severity::Warning);
+        assert_eq!(
+            Severity::of(&[not_converged(400, 0.3, &["tsai".into()])]),
+            Severity::Error
+        );
+        assert_eq!(Severity::of(&[]), Severity::Ok);
+    }
 }
