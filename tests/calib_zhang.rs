@@ -447,3 +447,35 @@ fn the_best_start_wins_or_the_report_says_error() {
         );
     }
 }
+
+/// With a budget of 2 iterations no start converges: the report says so at
+/// error level, first, naming every start tried.
+#[test]
+fn a_fit_that_converges_from_no_start_is_an_error_level_report() {
+    let truth = webcam();
+    let scene = Scene::calibration(11, &truth, (9, 6), 0.03, 4, 0.2).expect("scene");
+    let report = calibrate(
+        &scene.views,
+        (truth.width, truth.height),
+        &CalibrationOptions {
+            max_iterations: 2,
+            ..options_for(&truth)
+        },
+    )
+    .expect("a report");
+    assert_eq!(report.severity, Severity::Error);
+    assert_eq!(report.termination, Termination::MaxIterations);
+    assert_eq!(report.starts.len(), 6, "{:?}", report.starts);
+    assert!(
+        report.warnings[0].starts_with(
+            "error: the fit did not converge: from the best of 6 starts (closed_form, tsai, \
+             square_pixels, centred_principal_point, square_pixels_centred, \
+             distortion_held_then_freed) the solver stopped at its iteration limit ("
+        ),
+        "{}",
+        report.warnings[0]
+    );
+    assert!(report.warnings[1..]
+        .iter()
+        .all(|w| !w.starts_with("error: ")));
+}
