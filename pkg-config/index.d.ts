@@ -445,7 +445,7 @@ export interface CameraCalibration {
   };
   /** Distorted minus undistorted pixel positions on a 16 x 12 grid, px. */
   distortion_field: { vectors: PixelVector[] };
-  /** Coverage, tilt and correlation warnings. */
+  /** Coverage, tilt, correlation and plausibility warnings; error-level ones come first and begin with "error: " (see `severity`). */
   warnings: string[];
   /** Solver iterations in the last round. */
   iterations: number;
@@ -456,6 +456,26 @@ export interface CameraCalibration {
   options: CalibrationSolverOptions;
   /** Present with the robust option. */
   rejected?: RejectedPoints;
+  /** The worst level of `warnings`: "error" means the result is not a calibration (the fit did not converge from any start) and the first warning, beginning with "error: ", says why. */
+  severity: "ok" | "warning" | "error";
+  /** Zhang's method: the start the result came from ("closed_form", "given", "tsai", "dlt", "square_pixels", "centred_principal_point", "square_pixels_centred", "distortion_held_then_freed", "comparison:METHOD"). */
+  start?: string;
+  /** Every start tried, when the first did not converge or gave an implausible camera (the lowest cost wins). */
+  starts?: StartOutcome[];
+}
+
+/** One start of Zhang's bundle adjustment and where it ended. */
+export interface StartOutcome {
+  start: string;
+  /** sqrt(2 cost / points), px: the RMS residual norm for the squared loss. */
+  rms_px: number;
+  iterations: number;
+  /** "max_iterations": this start did not converge. */
+  termination: Termination;
+  fx: number;
+  fy: number;
+  cx: number;
+  cy: number;
 }
 
 /** One method's row of the `method: "all"` comparison (values null when it failed). */

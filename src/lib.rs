@@ -37,6 +37,7 @@ pub mod camera;
 pub mod capture;
 pub mod detect;
 pub mod error;
+pub mod finite;
 pub mod geometry;
 pub mod handeye;
 pub mod image;

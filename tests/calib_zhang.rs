@@ -2,7 +2,8 @@
 //! exact; noisy: bounds from the injected sigma; the reported std checked
 //! against the scatter over repetitions) and on Zhang's 1998 data.
 
-use robocal::calib::{calibrate, CalibrationOptions, View};
+use robocal::calib::{calibrate, CalibrationOptions, Severity, View};
+use robocal::optim::Termination;
 use robocal::synth::Scene;
 use robocal::{Camera, Distortion};
 
@@ -325,4 +326,156 @@ fn undetermined_parameters_give_a_warning_not_a_failure() {
         "{:?}",
         report.warnings
     );
+}
+
+/// A 1280x720 webcam with strong barrel distortion (the failure class of
+/// issue 35: a Zhang fit that stopped at its iteration limit far from the
+/// minimum Tsai's start finds).
+fn webcam() -> Camera {
+    Camera {
+        fx: 910.0,
+        fy: 910.0,
+        cx: 645.0,
+        cy: 352.0,
+        skew: 0.0,
+        width: 1280,
+        height: 720,
+        distortion: Distortion::Brown {
+            k1: -0.38,
+            k2: 0.18,
+            k3: -0.04,
+            p1: 0.0005,
+            p2: -0.0003,
+        },
+    }
+}
+
+/// Starts perturbed over a grid (fx and fy 0.5x to 2x, independently;
+/// cx 500 px and cy 300 px off) on four noisy views (0.2 px) of the
+/// webcam, with the default budget of 200 iterations and a short one of
+/// 25: some first starts settle in a wrong minimum (the 1.4x / 0.6x start
+/// stops at 11.8 px) or hit the limit. Whatever the first start does, the
+/// result reaches the cost the best start reaches (the minimum found from
+/// the truth with a long budget), within 1e-6 relative in RMS, and is no
+/// worse than any start it tried; or it carries the error-level warning
+/// first. The tolerance: equal minima agree to the solver's cost tolerance
+/// (1e-12 relative), far below 1e-6.
+#[test]
+fn the_best_start_wins_or_the_report_says_error() {
+    let truth = webcam();
+    let size = (truth.width, truth.height);
+    let scene = Scene::calibration(11, &truth, (9, 6), 0.03, 4, 0.2).expect("scene");
+    let options = options_for(&truth);
+    let reference = calibrate(
+        &scene.views,
+        size,
+        &CalibrationOptions {
+            initial_camera: Some(truth.clone()),
+            max_iterations: 5000,
+            ..options.clone()
+        },
+    )
+    .expect("from the truth");
+    for budget in [200, 25] {
+        let (mut failed_first, mut errors) = (0, 0);
+        for (sx, sy) in [(0.5, 0.5), (0.6, 1.4), (1.4, 0.6), (2.0, 2.0), (0.8, 1.06)] {
+            for (cx_off, cy_off) in [(-500.0, -300.0), (0.0, 300.0), (500.0, 300.0)] {
+                let start = Camera {
+                    fx: truth.fx * sx,
+                    fy: truth.fy * sy,
+                    cx: truth.cx + cx_off,
+                    cy: truth.cy + cy_off,
+                    distortion: zeros(&truth.distortion),
+                    ..truth.clone()
+                };
+                let what = format!(
+                    "budget {budget}, start fx x{sx} fy x{sy}, cx {cx_off:+} cy {cy_off:+} px"
+                );
+                let report = calibrate(
+                    &scene.views,
+                    size,
+                    &CalibrationOptions {
+                        initial_camera: Some(start),
+                        max_iterations: budget,
+                        ..options.clone()
+                    },
+                )
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+                if let Some(first) = report.starts.first() {
+                    let stalled = first.rms_px > 1.01 * reference.rms_px;
+                    if stalled || first.termination == Termination::MaxIterations {
+                        failed_first += 1;
+                    }
+                    let lowest = report
+                        .starts
+                        .iter()
+                        .map(|s| s.rms_px)
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(
+                        report.rms_px <= lowest * (1.0 + 1e-9),
+                        "{what}: rms {} px above the best start's {lowest} px",
+                        report.rms_px
+                    );
+                }
+                if report.severity == Severity::Error {
+                    errors += 1;
+                    assert!(
+                        report.warnings[0].starts_with("error: the fit did not converge"),
+                        "{what}: {:?}",
+                        report.warnings
+                    );
+                    continue;
+                }
+                assert!(
+                    (report.rms_px - reference.rms_px).abs() <= 1e-6 * reference.rms_px,
+                    "{what}: rms {} px, the best start reaches {} px (start {:?}, starts {:?})",
+                    report.rms_px,
+                    reference.rms_px,
+                    report.start,
+                    report.starts
+                );
+            }
+        }
+        eprintln!(
+            "budget {budget}: {failed_first} of 15 first starts stalled or hit the limit, \
+             {errors} reports at error level; minimum {:.4} px",
+            reference.rms_px
+        );
+        assert!(
+            failed_first >= 1,
+            "budget {budget}: no first start failed: the test shows nothing"
+        );
+    }
+}
+
+/// With a budget of 2 iterations no start converges: the report says so at
+/// error level, first, naming every start tried.
+#[test]
+fn a_fit_that_converges_from_no_start_is_an_error_level_report() {
+    let truth = webcam();
+    let scene = Scene::calibration(11, &truth, (9, 6), 0.03, 4, 0.2).expect("scene");
+    let report = calibrate(
+        &scene.views,
+        (truth.width, truth.height),
+        &CalibrationOptions {
+            max_iterations: 2,
+            ..options_for(&truth)
+        },
+    )
+    .expect("a report");
+    assert_eq!(report.severity, Severity::Error);
+    assert_eq!(report.termination, Termination::MaxIterations);
+    assert_eq!(report.starts.len(), 6, "{:?}", report.starts);
+    assert!(
+        report.warnings[0].starts_with(
+            "error: the fit did not converge: from the best of 6 starts (closed_form, tsai, \
+             square_pixels, centred_principal_point, square_pixels_centred, \
+             distortion_held_then_freed) the solver stopped at its iteration limit ("
+        ),
+        "{}",
+        report.warnings[0]
+    );
+    assert!(report.warnings[1..]
+        .iter()
+        .all(|w| !w.starts_with("error: ")));
 }

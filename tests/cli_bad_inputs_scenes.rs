@@ -3,7 +3,9 @@
 //! hand-eye scenes (robocal::synth) written as pose files, then spoiled the
 //! way users spoil them: millimetres read as metres, the wrong setup,
 //! pairing shifted by one, a robot that only translates, images of two
-//! sizes, the same image twice, too few views, stereo names that do not pair.
+//! sizes, the same image twice, too few views, stereo names that do not pair;
+//! and (issue 35) one pose row in mm or at 1e6 m, a camera pose at 1e308 m,
+//! the same images for both stereo or rig cameras.
 
 mod support;
 use robocal::handeye::{Pose, Setup};
@@ -23,6 +25,13 @@ fn pose_lines(poses: &[Pose], scale: f64) -> Vec<u8> {
         ));
     }
     text.into_bytes()
+}
+
+/// `poses` with pose 3 spoiled by `spoil` (issue 35: one bad row).
+fn one_row(poses: &[Pose], spoil: impl Fn(&mut Pose)) -> Vec<Pose> {
+    let mut out = poses.to_vec();
+    spoil(&mut out[3]);
+    out
 }
 
 /// A noise-free 10-view scene of `setup`: (robot poses, camera poses).
@@ -124,6 +133,27 @@ fn pose_rows() -> Vec<Row> {
             "robocal: robot poses: the pose file looks shifted by one against the images: pairing robot pose i with image i+1 fits with rotation RMS 0.000 deg, against 40.844 deg as given: remove the extra first image so that the lists pair up",
         ),
         pose_row(
+            "handeye-one-row-in-mm",
+            pose_lines(&one_row(&robot, |p| p.translation.vector *= 1000.0), 1.0),
+            pose_lines(&camera, 1.0),
+            "eye-in-hand",
+            "robocal: poses: pose pair 3 (robot pose and camera pose 3, counting from 0) is a gross error: with it left out the other 9 fit one hand-eye transform with a median residual of 0.000 mm, and it is off by 1766099.5 mm and 0.00 deg: that row holds a typo or another unit (millimetres in a metre file?): fix or remove it",
+        ),
+        pose_row(
+            "handeye-one-row-at-1e6",
+            pose_lines(&one_row(&robot, |p| p.translation.vector.x = 1e6), 1.0),
+            pose_lines(&camera, 1.0),
+            "eye-in-hand",
+            "robocal: base_from_gripper: pose 3 (counting from 0) has a translation of 1.000e6 m, beyond 10000 m: that row holds a typo or another unit (translations are metres): fix or remove it",
+        ),
+        pose_row(
+            "handeye-camera-pose-at-1e308",
+            pose_lines(&robot, 1.0),
+            pose_lines(&one_row(&camera, |p| p.translation.vector.z = 1e308), 1.0),
+            "eye-in-hand",
+            "robocal: camera_from_target: pose 3 (counting from 0) has a translation of 1.000e308 m, beyond 10000 m: that row holds a typo or another unit (translations are metres): fix or remove it",
+        ),
+        pose_row(
             "handeye-translations-only",
             pose_lines(&still, 1.0),
             pose_lines(&camera, 1.0),
@@ -184,6 +214,24 @@ fn image_rows() -> Vec<Row> {
             &["stereo", "--target", target, "--left", "a/view_000.png", "a/view_001.png", "--right", "a/view_000.png", "a/view_002.png"],
             "robocal: stereo: images are paired by the last number in their file names; no partner for: a/view_001.png (left, number 1), a/view_002.png (right, number 2) (see 'robocal stereo --help')",
         ),
+        Row {
+            code: 1,
+            ..image_row(
+                "stereo-same-images-both-sides",
+                vec![render("a", "3", &[])],
+                &["stereo", "--target", target, "--left", "a/view_000.png", "a/view_001.png", "a/view_002.png", "--right", "a/view_000.png", "a/view_001.png", "a/view_002.png"],
+                "robocal: right: the left and right images have identical detections in all 3 pairs: the same images were given for both cameras, which would solve to a baseline of 0 m; give each camera its own images",
+            )
+        },
+        Row {
+            code: 1,
+            ..image_row(
+                "rig-same-images-two-cameras",
+                vec![render("a", "3", &[])],
+                &["rig", "--target", target, "--camera", "left", "a/view_000.png", "a/view_001.png", "a/view_002.png", "--camera", "right", "a/view_000.png", "a/view_001.png", "a/view_002.png"],
+                "robocal: cameras: cameras left and right have identical detections in all 3 shared frames: the same images were given for both cameras, which would solve to a baseline of 0 m; give each camera its own images",
+            )
+        },
     ]
 }
 

@@ -239,19 +239,24 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     // 3. The method(s).
     if input.method == "all" {
         let outcomes = compare_methods(&views, size, &options);
+        let zhang = outcomes
+            .iter()
+            .find(|(m, _)| *m == Method::Zhang)
+            .map(|(_, outcome)| outcome.clone())
+            .ok_or_else(|| Error::invalid("method", "the comparison has no Zhang row"))??;
+        // 4. The chosen result is at least as good as every row.
+        let mut report = at_least_as_good(zhang, &outcomes, &views, size, &options);
         let comparison = outcomes
             .iter()
-            .map(|(m, outcome)| ComparisonRow::new(*m, outcome))
+            .map(|(m, outcome)| match m {
+                Method::Zhang => ComparisonRow::new(*m, &Ok(report.clone())),
+                _ => ComparisonRow::new(*m, outcome),
+            })
             .collect();
-        let report = outcomes
-            .into_iter()
-            .find(|(m, _)| *m == Method::Zhang)
-            .map(|(_, outcome)| outcome)
-            .ok_or_else(|| Error::invalid("method", "the comparison has no Zhang row"))??;
-        let mut report = report;
         report
             .warnings
             .extend(left_out.iter().map(LeftOut::warning));
+        report.refresh_severity();
         return Ok(CalibrationOutput {
             report,
             comparison: Some(comparison),
@@ -267,6 +272,7 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     report
         .warnings
         .extend(left_out.iter().map(LeftOut::warning));
+    report.refresh_severity();
     Ok(CalibrationOutput {
         report,
         comparison: None,
@@ -274,6 +280,66 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
         centre_model,
         centre_models: models,
     })
+}
+
+/// Relative margin by which another method's RMS must be lower than the
+/// chosen result's to count as better (round-off of equal minima).
+const BETTER_MARGIN: f64 = 1e-9;
+
+/// Zhang's report, or, when another method of the comparison reaches a
+/// lower RMS, Zhang's bundle adjustment refined from that method's camera
+/// if it ends lower: a row of the table below the chosen result is a bug,
+/// not a footnote. A row that stays lower (a method fitting parameters the
+/// options hold, such as the DLT's skew) is named in a warning.
+pub(crate) fn at_least_as_good(
+    zhang: CameraCalibration,
+    outcomes: &[(Method, Result<CameraCalibration>)],
+    views: &[View],
+    size: (u32, u32),
+    options: &CalibrationOptions,
+) -> CameraCalibration {
+    let mut report = zhang;
+    let mut notes = Vec::new();
+    for (method, outcome) in outcomes {
+        let Ok(other) = outcome else { continue };
+        let lower = other.rms_px < report.rms_px * (1.0 - BETTER_MARGIN);
+        if *method == Method::Zhang || !lower {
+            continue;
+        }
+        let from_other = CalibrationOptions {
+            initial_camera: Some(other.camera.clone()),
+            ..options.clone()
+        };
+        match super::calibrate(views, size, &from_other) {
+            Ok(mut refined) if refined.rms_px < report.rms_px => {
+                refined.warnings.insert(
+                    0,
+                    format!(
+                        "the bundle adjustment from its own start reached {:.3} px, above {}'s {:.3} px: refined from {}'s camera instead, to {:.3} px",
+                        report.rms_px,
+                        method.name(),
+                        other.rms_px,
+                        method.name(),
+                        refined.rms_px
+                    ),
+                );
+                refined.start = Some(format!("comparison:{}", method.name()));
+                report = refined;
+            }
+            _ => notes.push((*method, other.rms_px)),
+        }
+    }
+    for (method, rms) in notes {
+        if rms < report.rms_px * (1.0 - BETTER_MARGIN) {
+            report.warnings.push(format!(
+                "{} reaches {rms:.3} px, below the chosen result's {:.3} px, and the bundle adjustment refined from it does not: it fits parameters these options hold (free skew, no held coefficients); solve with its options to compare",
+                method.name(),
+                report.rms_px
+            ));
+        }
+    }
+    report.refresh_severity();
+    report
 }
 
 /// The lens model of a name, with the coefficients the solver starts from

@@ -391,3 +391,43 @@ fn the_output_says_which_circle_centre_model_the_views_used() {
     let out = run(json!({"views": point_views(&s), "image_size_px": [1280, 960]}));
     assert!(out.get("centre_model").is_none(), "{out}");
 }
+
+/// Issue 35: a row of the comparison below the chosen result is a bug.
+/// Given Tsai's report as the "chosen" one (0.1 px noise: its model has
+/// no k2, so it fits worse) and Zhang's as another row, the chosen result
+/// is refined from that row's camera and ends at its RMS (within 1e-9
+/// relative: the same minimum), named `comparison:ekf` with a warning.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_comparison_row_below_the_chosen_result_is_taken() {
+    use super::compare::Method;
+    use super::{calibrate, calibrate_tsai, CalibrationOptions};
+    let s = scene(0.1);
+    let size = (s.camera.width, s.camera.height);
+    let options = CalibrationOptions::default();
+    let zhang = calibrate(&s.views, size, &options).expect("zhang");
+    let tsai = calibrate_tsai(&s.views, size, &options).expect("tsai");
+    assert!(
+        tsai.rms_px > 1.01 * zhang.rms_px,
+        "{} {}",
+        tsai.rms_px,
+        zhang.rms_px
+    );
+    let outcomes = vec![(Method::Ekf, Ok(zhang.clone()))];
+    let chosen =
+        super::json_api::at_least_as_good(tsai.clone(), &outcomes, &s.views, size, &options);
+    assert!(
+        (chosen.rms_px - zhang.rms_px).abs() <= 1e-9 * zhang.rms_px,
+        "{} px vs {} px",
+        chosen.rms_px,
+        zhang.rms_px
+    );
+    assert_eq!(chosen.start.as_deref(), Some("comparison:ekf"));
+    assert_eq!(
+        chosen.warnings[0],
+        format!(
+            "the bundle adjustment from its own start reached {:.3} px, above ekf's {:.3} px: \
+             refined from ekf's camera instead, to {:.3} px",
+            tsai.rms_px, zhang.rms_px, chosen.rms_px
+        )
+    );
+}

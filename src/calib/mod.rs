@@ -25,6 +25,7 @@ pub mod json_api;
 #[cfg(test)]
 mod json_api_tests;
 pub mod model_advice;
+pub mod plausibility;
 mod refine;
 mod rejected;
 mod report;
@@ -35,6 +36,8 @@ mod rig_init;
 pub mod rig_json;
 mod rig_problem;
 pub mod rig_report;
+mod same_images;
+pub mod starts;
 pub mod stereo;
 pub mod stereo_json;
 mod stereo_problem;
@@ -46,6 +49,7 @@ mod zhang;
 
 pub use closed_form::{intrinsics_from_homographies, pose_from_homography};
 pub use homography::homography;
+pub use plausibility::Severity;
 pub use rejected::{RejectedInView, RejectedPoints};
 pub use report::{
     projection_uncertainty, CameraCalibration, Correlation, Outlier, ProjectionUncertainty,

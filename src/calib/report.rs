@@ -1,9 +1,11 @@
 //! The calibration report: parameters, residuals per view, parameter
 //! uncertainty and correlation, a projection-uncertainty grid and warnings.
 
+use super::plausibility::Severity;
 use super::refine::{pose_from_block, CalibProblem};
 use super::rejected::{rejected_points, RejectedPoints};
 use super::residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
+use super::starts::StartOutcome;
 use super::CalibrationOptions;
 use crate::camera::Camera;
 use crate::error::Result;
@@ -135,6 +137,22 @@ pub struct CameraCalibration {
     /// views and where; absent without it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rejected: Option<RejectedPoints>,
+    /// The worst level of `warnings`: `ok` (none), `warning`, or `error`:
+    /// the result is not a calibration (the fit did not converge from any
+    /// start) and the first warning, beginning with `error: `, says why.
+    #[serde(default)]
+    pub severity: Severity,
+    /// Zhang's method: the start its result came from (`closed_form`,
+    /// `given` with an initial camera, `tsai`, `dlt`, `square_pixels`,
+    /// `centred_principal_point`, `square_pixels_centred`,
+    /// `distortion_held_then_freed`, `comparison:METHOD`); absent for the
+    /// other methods.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<String>,
+    /// Every start tried, when the first one did not converge or gave an
+    /// implausible camera (the lowest cost wins); absent otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub starts: Vec<StartOutcome>,
 }
 
 pub(crate) fn build_report(
@@ -212,6 +230,7 @@ pub(crate) fn build_report(
     depths.sort_by(f64::total_cmp);
     let depth = depths.get(depths.len() / 2).copied().unwrap_or(1.0);
     let k = camera.camera_matrix();
+    let warnings = warnings(problem, &poses, &correlation, covariance.is_none());
     Ok(CameraCalibration {
         crate_version: crate::VERSION.to_string(),
         image_size_px: [size.0, size.1],
@@ -222,7 +241,8 @@ pub(crate) fn build_report(
         std,
         projection_uncertainty: projection_uncertainty(&camera, cov, depth),
         distortion_field: distortion_field(&camera),
-        warnings: warnings(problem, &poses, &correlation, covariance.is_none()),
+        severity: Severity::of(&warnings),
+        warnings,
         views,
         correlation,
         iterations: result.iterations,
@@ -231,6 +251,8 @@ pub(crate) fn build_report(
         options: options.clone(),
         camera,
         rejected,
+        start: None,
+        starts: Vec::new(),
     })
 }
 

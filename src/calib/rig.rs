@@ -24,6 +24,7 @@ use super::rig_report::{
     CoObservation, RigCalibration, RigCamera, RigCovariance, RigFrame, RigParameter,
     POSE_PARAMETERS,
 };
+use super::same_images::{refuse_identical_views, refuse_zero_baseline};
 use super::stereo::{camera_report_with, initial_right_from_left, TransformStd};
 use super::zhang::lm_options;
 use super::{CalibrationOptions, View};
@@ -206,6 +207,14 @@ pub fn calibrate_rig(
             }),
             _ => None,
         };
+        if k != rig_camera {
+            refuse_zero_baseline(
+                "camera_from_rig",
+                &format!("cameras {} and {}", names[rig_camera], names[k]),
+                pose.translation.vector.norm(),
+                camera_from_rig_std.as_ref().map(|s| s.translation_m),
+            )?;
+        }
         rig_cameras.push(RigCamera {
             name: names[k].clone(),
             calibration,
@@ -361,6 +370,7 @@ fn validate(
             *slot = Some(&v.name);
         }
     }
+    refuse_identical_cameras(cameras, frame_keys.len())?;
     match &options.rig_frame {
         None => Ok(0),
         Some(name) => cameras.iter().position(|c| &c.name == name).ok_or_else(|| {
@@ -374,6 +384,38 @@ fn validate(
             )
         }),
     }
+}
+
+/// Refuse two cameras with identical detections in every frame they share.
+fn refuse_identical_cameras(cameras: &[RigCameraViews], n_frames: usize) -> Result<()> {
+    let frames: Vec<Vec<Option<&View>>> = cameras
+        .iter()
+        .map(|c| {
+            let mut out: Vec<Option<&View>> = vec![None; n_frames];
+            for (f, v) in &c.views {
+                if let Some(slot) = out.get_mut(*f) {
+                    *slot = Some(v);
+                }
+            }
+            out
+        })
+        .collect();
+    for (j, a) in cameras.iter().enumerate() {
+        for (k, b) in cameras.iter().enumerate().skip(j + 1) {
+            let pairs: Vec<(&View, &View)> = frames[j]
+                .iter()
+                .zip(&frames[k])
+                .filter_map(|(x, y)| Some(((*x)?, (*y)?)))
+                .collect();
+            refuse_identical_views(
+                "cameras",
+                &format!("cameras {} and {}", a.name, b.name),
+                "shared frames",
+                &pairs,
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// Frame keys in report order: integer keys numerically, then the others

@@ -9,6 +9,7 @@
 
 use super::refine::{block_from_pose, CalibProblem};
 use super::report::build_report;
+use super::same_images::{refuse_identical_views, refuse_zero_baseline};
 use super::stereo_problem::StereoProblem;
 use super::usable::{usable_views, LeftOut};
 use super::zhang::lm_options;
@@ -81,6 +82,8 @@ pub fn calibrate_stereo(
             ),
         ));
     }
+    let pairs: Vec<(&View, &View)> = left.iter().zip(right).collect();
+    refuse_identical_views("right", "the left and right images", "pairs", &pairs)?;
     let (left, right, warnings) = usable_pairs(left, right, options)?;
     let (left, right) = (&left[..], &right[..]);
     let single_left = calibrate(left, left_size_px, options)?;
@@ -158,12 +161,19 @@ pub fn calibrate_stereo(
         rotation_rad: [s[o], s[o + 1], s[o + 2]],
         translation_m: [s[o + 3], s[o + 4], s[o + 5]],
     });
+    let baseline_m = rfl.inverse().translation.vector.norm();
+    refuse_zero_baseline(
+        "right_from_left",
+        "the left and right cameras",
+        baseline_m,
+        right_from_left_std.as_ref().map(|s| s.translation_m),
+    )?;
     Ok(StereoCalibration {
         left: left_report,
         right: right_report,
         right_from_left: PoseJson::from(&rfl),
         initial_right_from_left: PoseJson::from(&initial),
-        baseline_m: rfl.inverse().translation.vector.norm(),
+        baseline_m,
         right_from_left_std,
         rms_px: (squared / blocks.len().max(1) as f64).sqrt(),
         iterations: result.iterations,

@@ -152,3 +152,62 @@ fn mismatched_pairs_are_refused() {
     );
     assert!(initial_right_from_left(&[], &[]).is_err());
 }
+
+/// Issue 35, item 6: the same images on both sides are refused before
+/// solving (they would solve to a baseline of 0 m); the same board poses
+/// seen from one place with independent noise (0.1 px) are refused after,
+/// the baseline being zero within its uncertainty.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_same_images_on_both_sides_are_refused() {
+    let p = pair(5, 0.1);
+    let size = (p.left_camera.width, p.left_camera.height);
+    let e = calibrate_stereo(&p.left, &p.left, size, size, &CalibrationOptions::default())
+        .expect_err("identical");
+    assert_eq!(
+        e.to_string(),
+        "right: the left and right images have identical detections in all 8 pairs: the same \
+         images were given for both cameras, which would solve to a baseline of 0 m; give each \
+         camera its own images"
+    );
+    let mut rng = Rng::new(77);
+    let again: Vec<View> = p
+        .left
+        .iter()
+        .map(|v| View {
+            image_px: v
+                .image_px
+                .iter()
+                .map(|q| Point2::new(q.x + rng.gaussian(0.1), q.y + rng.gaussian(0.1)))
+                .collect(),
+            ..v.clone()
+        })
+        .collect();
+    let e = calibrate_stereo(&p.left, &again, size, size, &CalibrationOptions::default())
+        .expect_err("zero baseline")
+        .to_string();
+    assert!(
+        e.starts_with("right_from_left: the baseline between the left and right cameras is 0.000"),
+        "{e}"
+    );
+    assert!(
+        e.ends_with(
+            "the two cameras are at the same place, so the images are of one camera (the same \
+             scene given for both?); give each camera its own images, taken at the same moments"
+        ),
+        "{e}"
+    );
+    // The real pair (6 cm) passes.
+    let ok = calibrate_stereo(
+        &p.left,
+        &p.right,
+        size,
+        size,
+        &CalibrationOptions::default(),
+    )
+    .expect("a real pair");
+    assert!(
+        (ok.baseline_m - 0.06).abs() < 2e-3,
+        "baseline {} m",
+        ok.baseline_m
+    );
+}

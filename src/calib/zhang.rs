@@ -4,13 +4,15 @@
 
 use super::closed_form::{intrinsics_from_homographies, pose_from_homography};
 use super::homography::homography;
+use super::plausibility::{self, aspect_off, not_converged};
 use super::refine::{block_from_pose, CalibProblem};
 use super::report::{build_report, Outlier};
+use super::starts::{best_start, converged, StartOutcome};
 use super::usable::{left_out_clause, usable_views, LeftOut};
 use super::{CameraCalibration, View};
 use crate::camera::{Camera, Distortion, N_PINHOLE_PARAMS};
 use crate::error::{Error, Result};
-use crate::optim::{solve, BlockParams, LmOptions, Loss};
+use crate::optim::{solve, BlockParams, LmOptions, LmResult, Loss};
 use nalgebra::{Matrix3, Point2};
 use serde::{Deserialize, Serialize};
 
@@ -143,15 +145,34 @@ fn calibrate_usable(
         .iter()
         .map(|h| pose_from_homography(&k, h).map(|p| block_from_pose(&p)))
         .collect::<Result<Vec<_>>>()?;
-    // 4. Bundle adjustment, with outlier rounds.
+    // 4. Bundle adjustment from the best start, with outlier rounds.
     let all_used: Vec<Vec<bool>> = views.iter().map(|v| vec![true; v.object_m.len()]).collect();
     let mut used = all_used.clone();
-    let mut params = BlockParams {
+    let params = BlockParams {
         global: initial.params(),
         blocks: poses,
     };
     let lm_options = lm_options(&initial, options)?;
     let aspect = held_aspect(&initial, options);
+    let first_name = if options.initial_camera.is_some() {
+        "given"
+    } else {
+        "closed_form"
+    };
+    let best = best_start(
+        &CalibProblem {
+            template: &initial,
+            views,
+            used: &used,
+            aspect,
+        },
+        &params,
+        first_name,
+        &lm_options,
+        &homographies,
+        options,
+    )?;
+    let mut result = best.result;
     let mut rounds = 0;
     loop {
         let problem = CalibProblem {
@@ -160,14 +181,21 @@ fn calibrate_usable(
             used: &used,
             aspect,
         };
-        let result = solve(&problem, &params, &lm_options)?;
         let Some(k) = options.outlier_sigma else {
-            return build_report(
+            let report = build_report(
                 &problem,
                 &result,
                 vec![vec![]; views.len()],
                 image_size_px,
                 options,
+            )?;
+            return finish(
+                report,
+                &problem,
+                &result,
+                &lm_options,
+                best.start,
+                best.outcomes,
             );
         };
         // Classify every point, dropped ones included, so that inliers
@@ -179,12 +207,86 @@ fn calibrate_usable(
         let (next_used, outliers) = classify(&every, &result.params, &used, k)?;
         if next_used == used || rounds >= options.max_outlier_rounds {
             // 5. The report.
-            return build_report(&problem, &result, outliers, image_size_px, options);
+            let report = build_report(&problem, &result, outliers, image_size_px, options)?;
+            return finish(
+                report,
+                &problem,
+                &result,
+                &lm_options,
+                best.start,
+                best.outcomes,
+            );
         }
-        params = result.params;
         used = next_used;
         rounds += 1;
+        let next = CalibProblem {
+            template: &initial,
+            views,
+            used: &used,
+            aspect,
+        };
+        result = solve(&next, &result.params, &lm_options)?;
     }
+}
+
+/// The report with its start, the plausibility warnings and, for a fit
+/// that did not converge, the error-level warning first.
+fn finish(
+    mut report: CameraCalibration,
+    problem: &CalibProblem,
+    result: &LmResult,
+    lm: &LmOptions,
+    start: String,
+    outcomes: Vec<StartOutcome>,
+) -> Result<CameraCalibration> {
+    let mut checks = Vec::new();
+    if !converged(result) {
+        let names: Vec<String> = if outcomes.is_empty() {
+            vec![start.clone()]
+        } else {
+            outcomes.iter().map(|o| o.start.clone()).collect()
+        };
+        checks.push(not_converged(result.iterations, report.rms_px, &names));
+    }
+    let square = if aspect_off(&report.camera) && problem.aspect.is_none() {
+        square_pixel_rms(problem, result, lm)
+    } else {
+        None
+    };
+    checks.extend(plausibility::warnings(
+        &report.camera,
+        report.rms_px,
+        square,
+    ));
+    checks.append(&mut report.warnings);
+    report.warnings = checks;
+    report.start = Some(start);
+    report.starts = outcomes;
+    report.refresh_severity();
+    Ok(report)
+}
+
+/// The RMS (px) of the fit from `result` with fy held at fx (square
+/// pixels); `None` when it fails.
+fn square_pixel_rms(problem: &CalibProblem, result: &LmResult, lm: &LmOptions) -> Option<f64> {
+    let square = CalibProblem {
+        aspect: Some(1.0),
+        ..*problem
+    };
+    let mut fixed = lm.fixed_global.clone();
+    if let Some(f) = fixed.get_mut(1) {
+        *f = true;
+    }
+    let r = solve(
+        &square,
+        &result.params,
+        &LmOptions {
+            fixed_global: fixed,
+            ..lm.clone()
+        },
+    )
+    .ok()?;
+    Some((2.0 * r.cost / (r.n_residuals / 2).max(1) as f64).sqrt())
 }
 
 fn validate(views: &[View], image_size_px: (u32, u32), options: &CalibrationOptions) -> Result<()> {

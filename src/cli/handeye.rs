@@ -347,7 +347,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     }
     pre_warnings.append(&mut result.warnings);
     result.warnings = pre_warnings;
-    let mut report = HandEyeReport::new(&result);
+    let mut report = HandEyeReport::checked(&result)?;
     report.pairs = pairs;
     let json = serde_json::to_string_pretty(&report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;

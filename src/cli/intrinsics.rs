@@ -21,7 +21,12 @@ use robocal::target::Target;
 
 Images where the target is not found are listed on standard error and skipped.
 The report (JSON) has camera_matrix, distortion, rms_px, std, per-view residuals,
-correlations, projection uncertainty and warnings; 'robocal export' converts it.",
+correlations, projection uncertainty and warnings; 'robocal export' converts it.
+A fit that stops at its iteration limit or looks implausible is solved again
+from every other start (Tsai, DLT, square pixels, centred principal point,
+distortion held then freed) and the lowest cost wins (report keys start,
+starts); severity is ok, warning or error (no start converged: the first
+warning says so, and is printed as 'error:').",
     after_help = "Examples:
   robocal intrinsics --target chessboard:9x6:25mm left*.jpg -o camera.json
   robocal intrinsics --detections detections.json --fix-aspect-ratio --fix k3 -o camera.json
@@ -165,7 +170,10 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
         eprintln!("robocal intrinsics: {}", rejected.summary);
     }
     for w in &r.warnings {
-        eprintln!("robocal intrinsics: warning: {w}");
+        match w.strip_prefix(robocal::calib::plausibility::ERROR_PREFIX) {
+            Some(error) => eprintln!("robocal intrinsics: error: {error}"),
+            None => eprintln!("robocal intrinsics: warning: {w}"),
+        }
     }
     // The report, with the circle-centre model of circle and dot views
     // beside its keys (`centre_model`, and `centre_models` when mixed).

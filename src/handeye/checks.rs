@@ -6,8 +6,8 @@
 
 use super::axxb;
 use super::motion::build_motions;
-use super::report::{motion_residuals, motion_rms};
-use super::solve::{HandEyeInput, HandEyeOptions};
+use super::report::{lever_arm_m, motion_residuals, motion_rms, view_residuals, ViewResidual};
+use super::solve::{solve_method, HandEyeInput, HandEyeOptions};
 use super::{Chain, HandEyeMethod, MotionPairs, Pose, Setup, MIN_MOTION_ROTATION_DEG};
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -27,6 +27,19 @@ const MISTAKE_MIN_ROTATION_DEG: f64 = 0.5;
 const MISTAKE_MIN_TRANSLATION_MM: f64 = 5.0;
 /// Fitted robot-translation scales outside [1/this, this] are a unit mistake.
 const SCALE_TOLERANCE: f64 = 1.5;
+/// Largest translation component (m) a pose may have: no robot cell or
+/// camera range is 10 km; beyond it a row holds a typo or another unit.
+pub const MAX_TRANSLATION_M: f64 = 1e4;
+/// A pose pair is a gross error when, with it left out, its residual (the
+/// displacement at the target, mm) is this many times the median of the
+/// others ...
+pub const GROSS_RATIO: f64 = 100.0;
+/// ... and at least this large (mm): noise-free data has medians of 1e-9 mm,
+/// and a few centimetres are the robust refinement's to down-weight.
+pub const GROSS_MIN_MM: f64 = 100.0;
+/// Pose pairs with the largest residuals under the full solution that are
+/// each tried left out.
+const GROSS_CANDIDATES: usize = 3;
 
 /// How well robot poses fit the camera motion (Park-Martin rotation, least
 /// squares translation, residuals of `A X = X B` over all motion pairs).
@@ -246,6 +259,21 @@ pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec
         }) {
             return Err(Error::invalid(what, format!("pose {i} is not finite")));
         }
+        if let Some((i, t)) = poses
+            .iter()
+            .map(|p| p.translation.vector.amax())
+            .enumerate()
+            .find(|(_, t)| *t > MAX_TRANSLATION_M)
+        {
+            return Err(Error::invalid(
+                what,
+                format!(
+                    "pose {i} (counting from 0) has a translation of {t:.3e} m, beyond \
+                     {MAX_TRANSLATION_M:.0} m: that row holds a typo or another unit \
+                     (translations are metres): fix or remove it"
+                ),
+            ));
+        }
     }
     let chain = Chain::new(
         input.setup,
@@ -272,6 +300,7 @@ pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec
             set.kept.len()
         )));
     }
+    refuse_gross_pose(&chain, options.motion_pairs)?;
     let findings = mistakes(input)?;
     if options.strict_checks {
         if let Some(first) = findings.first() {
@@ -279,6 +308,74 @@ pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec
         }
     }
     Ok(findings)
+}
+
+/// Refuse a pose pair whose residual is orders of magnitude above the
+/// others' (a row typed in mm in a metre file, a digit too many): with the
+/// candidate left out (each of the [`GROSS_CANDIDATES`] largest residuals
+/// under the full Park-Martin solution; the one whose removal fits the
+/// others best), its residual is above [`GROSS_RATIO`] times the median of
+/// the others and above [`GROSS_MIN_MM`]. The error names the pair.
+pub fn refuse_gross_pose(chain: &Chain, pairs: MotionPairs) -> Result<()> {
+    let n = chain.len();
+    if n <= MIN_POSES {
+        return Ok(());
+    }
+    let lever = lever_arm_m(chain);
+    let displacement = |r: &ViewResidual| {
+        let rot_mm = r.rotation_deg.to_radians() * lever * 1e3;
+        r.translation_mm.hypot(rot_mm)
+    };
+    let solve = |c: &Chain| -> Option<(Pose, Pose)> {
+        let (x, y, _) = solve_method(HandEyeMethod::ParkMartin, c, pairs).ok()?;
+        Some((x, y))
+    };
+    let Some((x, y)) = solve(chain) else {
+        return Ok(());
+    };
+    let full: Vec<f64> = view_residuals(chain, &x, &y)
+        .iter()
+        .map(displacement)
+        .collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| full[b].total_cmp(&full[a]));
+    // (median of the others, the candidate, its residual and rotation).
+    let mut best: Option<(f64, usize, ViewResidual, f64)> = None;
+    for &c in order.iter().take(GROSS_CANDIDATES) {
+        let keep: Vec<usize> = (0..n).filter(|&i| i != c).collect();
+        let rest = Chain {
+            robot: keep.iter().map(|&i| chain.robot[i]).collect(),
+            camera: keep.iter().map(|&i| chain.camera[i]).collect(),
+        };
+        let Some((x, y)) = solve(&rest) else { continue };
+        let residuals = view_residuals(chain, &x, &y);
+        let mut others: Vec<f64> = keep.iter().map(|&i| displacement(&residuals[i])).collect();
+        others.sort_by(f64::total_cmp);
+        let median = others[others.len() / 2];
+        if best.as_ref().map_or(true, |b| median < b.0) {
+            let own = residuals[c].clone();
+            let d = displacement(&own);
+            best = Some((median, c, own, d));
+        }
+    }
+    let Some((median, c, own, d)) = best else {
+        return Ok(());
+    };
+    if d > GROSS_RATIO * median && d > GROSS_MIN_MM {
+        return Err(Error::invalid(
+            "poses",
+            format!(
+                "pose pair {c} (robot pose and camera pose {c}, counting from 0) is a gross \
+                 error: with it left out the other {} fit one hand-eye transform with a median \
+                 residual of {median:.3} mm, and it is off by {:.1} mm and {:.2} deg: that row \
+                 holds a typo or another unit (millimetres in a metre file?): fix or remove it",
+                n - 1,
+                own.translation_mm,
+                own.rotation_deg
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Messages for likely input mistakes (empty when the input looks right).
@@ -431,5 +528,95 @@ mod tests {
             };
             assert!(mistakes(&right).unwrap().is_empty());
         }
+    }
+
+    /// The noise-free 10-view eye-in-hand scene, as (robot, camera) poses.
+    fn scene10() -> (Vec<Pose>, Vec<Pose>) {
+        let s = handeye_scene(&HandEyeSceneConfig::noise_free(Setup::EyeInHand, 10), 4);
+        (s.base_from_gripper, s.camera_from_target)
+    }
+
+    fn check(robot: Vec<Pose>, camera: Vec<Pose>) -> Result<Vec<String>> {
+        let input = HandEyeInput {
+            setup: Setup::EyeInHand,
+            base_from_gripper: robot,
+            camera_from_target: camera,
+        };
+        check_input(&input, &HandEyeOptions::default())
+    }
+
+    /// Issue 35, item 4: one robot row typed in millimetres in a metre
+    /// file is refused by name, with its residual against the others'
+    /// median (noise-free: the others fit to rounding); absurd and
+    /// non-finite translations are refused at input.
+    #[wasm_bindgen_test(unsupported = test)]
+    fn one_gross_pose_is_refused_by_name() {
+        let (robot, camera) = scene10();
+        assert!(check(robot.clone(), camera.clone()).unwrap().is_empty());
+        let mut mm = robot.clone();
+        mm[3].translation.vector *= 1000.0;
+        let e = check(mm, camera.clone()).unwrap_err().to_string();
+        let t_mm = (robot[3].translation.vector * 999.0).norm() * 1e3;
+        assert!(
+            e.starts_with(
+                "poses: pose pair 3 (robot pose and camera pose 3, counting from 0) is a gross \
+                 error: with it left out the other 9 fit one hand-eye transform with a median \
+                 residual of 0.000 mm, and it is off by "
+            ),
+            "{e}"
+        );
+        // The residual is the row's error: the translation moved by 999 t.
+        let off: f64 = e
+            .split("off by ")
+            .nth(1)
+            .and_then(|r| r.split(" mm").next())
+            .and_then(|v| v.parse().ok())
+            .expect("residual in the message");
+        assert!((off - t_mm).abs() < 0.1, "{off} mm vs {t_mm} mm");
+        assert!(e.ends_with("0.00 deg: that row holds a typo or another unit (millimetres in a metre file?): fix or remove it"), "{e}");
+        let mut far = robot.clone();
+        far[3].translation.vector.x = 1e6;
+        assert_eq!(
+            check(far, camera.clone()).unwrap_err().to_string(),
+            "base_from_gripper: pose 3 (counting from 0) has a translation of 1.000e6 m, beyond \
+             10000 m: that row holds a typo or another unit (translations are metres): fix or \
+             remove it"
+        );
+        let mut huge = camera.clone();
+        huge[3].translation.vector.z = 1e308;
+        assert_eq!(
+            check(robot.clone(), huge).unwrap_err().to_string(),
+            "camera_from_target: pose 3 (counting from 0) has a translation of 1.000e308 m, \
+             beyond 10000 m: that row holds a typo or another unit (translations are metres): \
+             fix or remove it"
+        );
+        let mut nan = camera;
+        nan[2].translation.vector.y = f64::NAN;
+        assert_eq!(
+            check(robot, nan).unwrap_err().to_string(),
+            "camera_from_target: pose 2 is not finite"
+        );
+    }
+
+    /// A translation RMS of metres is an error, not a warning.
+    #[wasm_bindgen_test(unsupported = test)]
+    fn a_translation_rms_of_metres_is_an_error() {
+        let errors = |mm: f64| super::super::report::Errors {
+            translation_rms_mm: mm,
+            translation_max_mm: mm,
+            rotation_rms_deg: 0.1,
+            rotation_max_deg: 0.1,
+            reprojection_rms_px: None,
+        };
+        assert!(super::super::solve::refuse_metres(&errors(999.0)).is_ok());
+        assert_eq!(
+            super::super::solve::refuse_metres(&errors(189_000.0))
+                .unwrap_err()
+                .to_string(),
+            "the hand-eye solution's translation RMS is 189000.0 mm (189.00 m): the poses do not \
+             fit one hand-eye transform, so no transform is written: check the units of both \
+             pose files, the setup (eye-in-hand or eye-to-hand) and that pose i belongs with \
+             image i"
+        );
     }
 }

@@ -396,7 +396,7 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
             )?;
         }
     }
-    serde_json::to_string(&HandEyeReport::new(&result))
+    serde_json::to_string(&HandEyeReport::checked(&result)?)
         .map_err(|e| Error::invalid("report", e.to_string()))
 }
 

@@ -142,6 +142,14 @@ fn keyed(setup: Setup, x: &Pose, y: &Pose) -> PosePair {
 }
 
 impl HandEyeReport {
+    /// [`HandEyeReport::new`], refused when any number in it is NaN or
+    /// infinite (the error names the field: `report.per_view[3].translation_mm`).
+    pub fn checked(result: &HandEyeResult) -> crate::error::Result<Self> {
+        let report = HandEyeReport::new(result);
+        crate::finite::check_finite("report", &report)?;
+        Ok(report)
+    }
+
     /// Build the serialisable report of a result.
     pub fn new(result: &HandEyeResult) -> Self {
         let methods: Vec<MethodJson> = result

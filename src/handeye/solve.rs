@@ -253,7 +253,8 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
     with_pose_refinement(result, input, options)
 }
 
-/// `result` with the pose refinement applied when `options.refine_poses`.
+/// `result` with the pose refinement applied when `options.refine_poses`;
+/// a translation RMS of metres is refused.
 fn with_pose_refinement(
     mut result: HandEyeResult,
     input: &HandEyeInput,
@@ -267,5 +268,24 @@ fn with_pose_refinement(
             options.motion_pairs,
         )?;
     }
+    refuse_metres(&result.errors)?;
     Ok(result)
+}
+
+/// A translation RMS (mm) from which a solution is no calibration: the
+/// poses do not fit one hand-eye transform.
+pub const MAX_TRANSLATION_RMS_MM: f64 = 1000.0;
+
+/// Refuse a solution whose per-view translation RMS is a metre or more.
+pub(crate) fn refuse_metres(errors: &Errors) -> Result<()> {
+    let rms = errors.translation_rms_mm;
+    if rms < MAX_TRANSLATION_RMS_MM {
+        return Ok(());
+    }
+    Err(Error::degenerate(format!(
+        "the hand-eye solution's translation RMS is {rms:.1} mm ({:.2} m): the poses do not \
+         fit one hand-eye transform, so no transform is written: check the units of both pose \
+         files, the setup (eye-in-hand or eye-to-hand) and that pose i belongs with image i",
+        rms / 1e3
+    )))
 }

@@ -65,6 +65,9 @@ fn calibration_of(camera: Camera, rms_px: f64) -> CameraCalibration {
         n_points: 0,
         options: CalibrationOptions::default(),
         rejected: None,
+        severity: Default::default(),
+        start: None,
+        starts: Vec::new(),
     }
 }
 

@@ -1,0 +1,270 @@
+//! Plausibility checks of a fitted camera, and the error-level warning of a
+//! fit that did not converge (issue 35, item 2).
+//!
+//! A converged fit can still be a wrong minimum. Three signatures are
+//! checked, each a warning that says what is wrong and what to do:
+//!
+//! - fx / fy off 1 by more than [`ASPECT_OFF`] while a fit with square
+//!   pixels reaches the same RMS (within [`SAME_FIT_RATIO`] plus
+//!   [`SAME_FIT_PX`]): the views do not determine the aspect ratio;
+//! - the principal point farther from the image centre than
+//!   [`CENTRE_OFF_FRACTION`] of the width or height;
+//! - radial distortion that folds inside the image: along the ray towards
+//!   an image corner the distorted radius r_d(r) stops increasing before it
+//!   reaches the corner, so points beyond the fold have two projections.
+//!
+//! The report's `severity` is the worst level of its warnings: `error` when
+//! the first warning is error-level (it then begins with `error: `),
+//! `warning` when there are warnings, `ok` otherwise.
+
+use super::report::CameraCalibration;
+use crate::camera::Camera;
+use nalgebra::{Point2, Point3};
+use serde::{Deserialize, Serialize};
+
+/// |fx / fy - 1| above which the aspect ratio is checked against a fit
+/// with square pixels.
+pub const ASPECT_OFF: f64 = 0.05;
+/// Principal point offset from the image centre, as a fraction of the width
+/// (x) or height (y), above which it is implausible (lenses put it within a
+/// few per cent).
+pub const CENTRE_OFF_FRACTION: f64 = 0.15;
+/// A square-pixel fit "fits as well" at this times the RMS, plus [`SAME_FIT_PX`].
+pub const SAME_FIT_RATIO: f64 = 1.05;
+/// See [`SAME_FIT_RATIO`], px.
+pub const SAME_FIT_PX: f64 = 0.005;
+/// Ray angles sampled from the optical axis to 89.5 deg when looking for a fold.
+const FOLD_SAMPLES: usize = 4000;
+/// Largest ray angle sampled, radians (89.5 deg: the perspective models end at 90).
+const FOLD_MAX_ANGLE: f64 = 89.5 * std::f64::consts::PI / 180.0;
+/// Prefix of an error-level warning.
+pub const ERROR_PREFIX: &str = "error: ";
+
+/// How bad the worst warning of a report is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Severity {
+    /// No warnings.
+    #[default]
+    Ok,
+    /// Warnings to read; the result stands.
+    Warning,
+    /// The result is not a calibration (e.g. the fit did not converge);
+    /// the first warning says why.
+    Error,
+}
+
+impl Severity {
+    /// The severity of a list of warnings (error-level ones begin with
+    /// [`ERROR_PREFIX`]).
+    pub fn of(warnings: &[String]) -> Severity {
+        if warnings.iter().any(|w| w.starts_with(ERROR_PREFIX)) {
+            Severity::Error
+        } else if warnings.is_empty() {
+            Severity::Ok
+        } else {
+            Severity::Warning
+        }
+    }
+}
+
+impl CameraCalibration {
+    /// Set `severity` from the warnings, with error-level ones moved first:
+    /// call after adding warnings.
+    pub fn refresh_severity(&mut self) {
+        let (mut errors, rest): (Vec<String>, Vec<String>) = std::mem::take(&mut self.warnings)
+            .into_iter()
+            .partition(|w| w.starts_with(ERROR_PREFIX));
+        errors.extend(rest);
+        self.warnings = errors;
+        self.severity = Severity::of(&self.warnings);
+    }
+}
+
+/// The principal point's offset from the image centre (px), when it is
+/// beyond [`CENTRE_OFF_FRACTION`] of the width or the height.
+pub fn principal_point_off(camera: &Camera) -> Option<(f64, f64)> {
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    let (dx, dy) = (camera.cx - 0.5 * (w - 1.0), camera.cy - 0.5 * (h - 1.0));
+    (dx.abs() > CENTRE_OFF_FRACTION * w || dy.abs() > CENTRE_OFF_FRACTION * h).then_some((dx, dy))
+}
+
+/// Whether fx / fy is off 1 by more than [`ASPECT_OFF`].
+pub fn aspect_off(camera: &Camera) -> bool {
+    (camera.fx / camera.fy - 1.0).abs() > ASPECT_OFF
+}
+
+/// Where the distortion folds inside the image: `(fold radius, corner
+/// radius)` in px from the principal point, along the ray towards the
+/// image corner where the fold is nearest; `None` when r_d(r) increases
+/// all the way to every corner.
+pub fn distortion_fold(camera: &Camera) -> Option<(f64, f64)> {
+    let (w, h) = (camera.width as f64 - 0.5, camera.height as f64 - 0.5);
+    let corners = [(-0.5, -0.5), (w, -0.5), (-0.5, h), (w, h)];
+    let centre = Point2::new(camera.cx, camera.cy);
+    let mut worst: Option<(f64, f64)> = None;
+    for (u, v) in corners {
+        let corner = Point2::new(u, v);
+        let corner_r = (corner - centre).norm();
+        // The ray's direction around the axis, from the pinhole part alone.
+        let ny = (v - camera.cy) / camera.fy;
+        let nx = (u - camera.cx - camera.skew * ny) / camera.fx;
+        let theta = ny.atan2(nx);
+        let mut last = 0.0;
+        for i in 1..=FOLD_SAMPLES {
+            let phi = FOLD_MAX_ANGLE * i as f64 / FOLD_SAMPLES as f64;
+            let ray = Point3::new(phi.sin() * theta.cos(), phi.sin() * theta.sin(), phi.cos());
+            if last >= corner_r {
+                break;
+            }
+            // The polynomial models refuse rays beyond their first fold:
+            // a refusal before the corner is a fold inside the image.
+            let r = camera
+                .project(&ray)
+                .map_or(f64::NAN, |p| (p - centre).norm());
+            if r.is_nan() || r < last {
+                if worst.map_or(true, |(f, _)| last < f) {
+                    worst = Some((last, corner_r));
+                }
+                break;
+            }
+            last = r;
+        }
+    }
+    worst
+}
+
+/// Whether a camera shows a signature of a wrong minimum (principal point
+/// far off, fx / fy far from 1, distortion folding inside the image):
+/// reason enough to try the other starts.
+pub fn implausible(camera: &Camera) -> bool {
+    principal_point_off(camera).is_some() || aspect_off(camera) || distortion_fold(camera).is_some()
+}
+
+/// The warnings of the checks on `camera`; `square_fit` is the RMS (px) of
+/// a fit with square pixels when fx / fy is off ([`aspect_off`]), `rms_px`
+/// the report's.
+pub fn warnings(camera: &Camera, rms_px: f64, square_fit: Option<f64>) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(square) = square_fit {
+        if square <= SAME_FIT_RATIO * rms_px + SAME_FIT_PX {
+            out.push(format!(
+                "fx / fy is {:.3} (fx {:.1} px, fy {:.1} px), yet a fit with square pixels \
+                 reaches {square:.3} px against {rms_px:.3} px: the views do not determine the \
+                 aspect ratio and the fit is likely a wrong minimum: hold square pixels (CLI: \
+                 --aspect-ratio 1) or add views tilted about both axes",
+                camera.fx / camera.fy,
+                camera.fx,
+                camera.fy
+            ));
+        }
+    }
+    if let Some((dx, dy)) = principal_point_off(camera) {
+        out.push(format!(
+            "the principal point ({:.1}, {:.1}) px is {dx:.0} px, {dy:.0} px from the image \
+             centre ({:.1}, {:.1}) ({:.0} % of the width, {:.0} % of the height; lenses put it \
+             within a few per cent): the fit is likely a wrong minimum or the views do not \
+             determine it: add views that fill the image and tilt the board, or hold it at \
+             the centre (CLI: --fix-principal-point)",
+            camera.cx,
+            camera.cy,
+            0.5 * (camera.width as f64 - 1.0),
+            0.5 * (camera.height as f64 - 1.0),
+            100.0 * dx.abs() / camera.width as f64,
+            100.0 * dy.abs() / camera.height as f64,
+        ));
+    }
+    if let Some((fold, corner)) = distortion_fold(camera) {
+        out.push(format!(
+            "the lens distortion folds inside the image: the distorted radius stops increasing \
+             {fold:.0} px from the principal point, while the image corner is {corner:.0} px \
+             away, so points beyond the fold have two projections: the distortion is \
+             extrapolated beyond the target's points or the fit is a wrong minimum: add views \
+             with the target in the image corners, or hold coefficients (CLI: --fix k3)"
+        ));
+    }
+    out
+}
+
+/// The error-level warning of a fit that did not converge from any start.
+pub fn not_converged(iterations: usize, rms_px: f64, starts: &[String]) -> String {
+    format!(
+        "{ERROR_PREFIX}the fit did not converge: from the best of {} ({}) the solver stopped at \
+         its iteration limit ({iterations} iterations) at {rms_px:.3} px; these parameters are \
+         not a calibration: add views that fill the image and tilt the board 20-45 deg, or \
+         hold parameters (--fix-principal-point, --aspect-ratio 1, --fix k3)",
+        match starts.len() {
+            1 => "1 start".to_string(),
+            n => format!("{n} starts"),
+        },
+        starts.join(", ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Distortion;
+
+    fn webcam(k1: f64) -> Camera {
+        Camera {
+            fx: 910.0,
+            fy: 910.0,
+            cx: 639.5,
+            cy: 359.5,
+            skew: 0.0,
+            width: 1280,
+            height: 720,
+            distortion: Distortion::Brown {
+                k1,
+                k2: 0.0,
+                k3: 0.0,
+                p1: 0.0,
+                p2: 0.0,
+            },
+        }
+    }
+
+    /// r_d = r (1 + k1 r^2) peaks at r = 1 / sqrt(-3 k1): for k1 = -0.4 at
+    /// r_d = 0.60858, 553.8 px at fx 910, inside the 734 px of the corner.
+    /// Tolerance 0.5 px: the angle samples are 0.022 deg apart, and r_d is
+    /// flat at its peak.
+    #[test]
+    fn a_fold_inside_the_image_is_found_where_r_d_peaks() {
+        let (fold, corner) = distortion_fold(&webcam(-0.4)).expect("a fold");
+        let r = 1.0 / (1.2f64).sqrt();
+        let want = 910.0 * r * (1.0 - 0.4 * r * r);
+        assert!((fold - want).abs() < 0.5, "fold {fold} px, want {want} px");
+        assert!(
+            (corner - 640.0f64.hypot(360.0)).abs() < 1e-9,
+            "corner {corner} px"
+        );
+        assert_eq!(distortion_fold(&webcam(-0.1)), None);
+        assert_eq!(distortion_fold(&webcam(0.2)), None);
+        let w = warnings(&webcam(-0.4), 0.2, None);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("the lens distortion folds inside the image: the distorted radius stops increasing 554 px"), "{}", w[0]);
+    }
+
+    #[test]
+    fn an_off_centre_principal_point_and_non_square_pixels_are_named() {
+        let c = Camera {
+            fx: 733.0,
+            fy: 967.0,
+            cx: 268.0,
+            ..webcam(0.0)
+        };
+        assert!(implausible(&c));
+        let w = warnings(&c, 0.319, Some(0.156));
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(w[0].starts_with("fx / fy is 0.758 (fx 733.0 px, fy 967.0 px), yet a fit with square pixels reaches 0.156 px against 0.319 px"), "{}", w[0]);
+        assert!(w[1].starts_with("the principal point (268.0, 359.5) px is -372 px, 0 px from the image centre (639.5, 359.5) (29 % of the width, 0 % of the height"), "{}", w[1]);
+        assert!(!implausible(&webcam(-0.1)));
+        assert_eq!(Severity::of(&w), Severity::Warning);
+        assert_eq!(
+            Severity::of(&[not_converged(400, 0.3, &["tsai".into()])]),
+            Severity::Error
+        );
+        assert_eq!(Severity::of(&[]), Severity::Ok);
+    }
+}
