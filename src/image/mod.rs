@@ -6,13 +6,23 @@
 //! (8/16/32-bit, uncompressed, LZW, deflate, PackBits, tiled), BMP, PNM and
 //! WebP. The format is recognised from the content, not a file name.
 //!
-//! Every decode runs under `image`'s [`Limits`](::image::Limits): at most
+//! Every decode runs under `image`'s [`Limits`](::image::Limits) from the
+//! first byte (header and metadata chunks included): at most
 //! [`DecodeOptions::max_pixels`] pixels (checked against the header before
 //! any pixel buffer exists) and [`DecodeOptions::max_alloc_bytes`] bytes of
 //! decoder memory. The defaults are [`DEFAULT_MAX_PIXELS`] and
 //! [`DEFAULT_MAX_ALLOC_BYTES`]: 100 MP and 1 GiB natively; 64 MP and 512 MiB
 //! in wasm, where one worker's memory is at most 4 GiB and a tab runs
-//! several. Over a limit the error names the image size and the limit.
+//! several. Over a limit the error names the image size or the limit, and
+//! what to do. PNG goes through the `png` crate directly (`png_rows`): its
+//! colour profile is never inflated and rows become grey strip by strip, so
+//! a 16-bit RGBA PNG costs the grey image, not eight times it;
+//! [`decode_peak`] gives any file's peak from its header.
+//!
+//! The EXIF Orientation (JPEG, TIFF, WebP, PNG's eXIf) is applied to the
+//! grey image as OpenCV's `imread` and image viewers apply it, and reported
+//! as [`ImageInfo::exif_orientation`]. A file cut short is an error that
+//! says so (`truncation`), never a partly grey image.
 //!
 //! Grey is `image`'s luma conversion: 0.2126 R + 0.7152 G + 0.0722 B
 //! (sRGB / Rec. 709 weights), 16-bit and float samples scaled to 8 bits
