@@ -246,3 +246,23 @@ fn jpeg_and_png_cut_anywhere_are_named_truncated() {
         assert!(decode_gray(&bytes).is_ok(), "{format} whole");
     }
 }
+
+#[test]
+fn a_gif_over_the_memory_limit_gives_the_limit_and_what_to_do() {
+    // A GIF screen of 1000 x 1000 (4 MB as RGBA) under a 100 kB limit.
+    let mut gif = b"GIF89a".to_vec();
+    gif.extend_from_slice(&1000u16.to_le_bytes());
+    gif.extend_from_slice(&1000u16.to_le_bytes());
+    gif.extend_from_slice(&[0, 0, 0]);
+    gif.extend_from_slice(b",\0\0\0\0\xe8\x03\xe8\x03\0\x02\x02\x4c\x01\0;");
+    let options = DecodeOptions {
+        max_alloc_bytes: 100_000,
+        ..Default::default()
+    };
+    assert_eq!(
+        decode(&gif, &options).unwrap_err().to_string(),
+        "GIF image needs more memory to decode than the limit of 100000 bytes: downscale it, \
+         or save it as 8-bit grey (all calibration uses); --max-pixels N in the CLI raises the \
+         limit to 10 bytes a pixel"
+    );
+}
