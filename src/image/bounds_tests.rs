@@ -261,7 +261,8 @@ fn a_gif_over_the_memory_limit_gives_the_limit_and_what_to_do() {
     };
     assert_eq!(
         decode(&gif, &options).unwrap_err().to_string(),
-        "GIF image needs more memory to decode than the limit of 100000 bytes: downscale it, \
+        "GIF image is 1000x1000: decoding it needs 4000000 bytes, more than the memory limit \
+         of 100000 bytes: downscale it, \
          or save it as 8-bit grey (all calibration uses); --max-pixels N in the CLI raises the \
          limit to 10 bytes a pixel"
     );

@@ -377,10 +377,21 @@ fn open<'a>(bytes: &'a [u8], options: &DecodeOptions, whole_file: bool) -> Resul
     // The output buffer counts against the allocation limit too; what is
     // left of it bounds the decoder's own working memory.
     let mut limits = limits(options);
+    let needed = decoder.total_bytes();
     limits
-        .reserve(decoder.total_bytes())
+        .reserve(needed)
         .and_then(|()| decoder.set_limits(limits))
-        .map_err(fail)?;
+        .map_err(|e| match e {
+            ImageError::Limits(_) => Error::Image {
+                message: format!(
+                    "{} image is {width}x{height}: decoding it needs {needed} bytes, more than \
+                     the memory limit of {}: {MEMORY_ADVICE}",
+                    format.name(),
+                    byte_count(options.max_alloc_bytes)
+                ),
+            },
+            other => fail(other),
+        })?;
     let color = decoder.original_color_type();
     let channels = color.channel_count();
     let bits_per_channel = (color.bits_per_pixel() / channels.max(1) as u16) as u8;
@@ -559,6 +570,10 @@ fn pixel_count(n: u64, other: u64) -> String {
     }
 }
 
+/// What to do about an image over the memory limit.
+const MEMORY_ADVICE: &str = "downscale it, or save it as 8-bit grey (all calibration uses); \
+     --max-pixels N in the CLI raises the limit to 10 bytes a pixel";
+
 /// A byte count as people read it: "1.0 GiB (1073741824 bytes)", or
 /// "1000 bytes" under a mebibyte.
 fn byte_count(n: u64) -> String {
@@ -583,9 +598,7 @@ fn decode_error(format: ImageFormat, e: ImageError, len: usize, options: &Decode
     let name = format.name();
     let message = match e {
         ImageError::Limits(_) => format!(
-            "{name} image needs more memory to decode than the limit of {}: \
-             downscale it, or save it as 8-bit grey (all calibration uses); \
-             --max-pixels N in the CLI raises the limit to 10 bytes a pixel",
+            "{name} image needs more memory to decode than the limit of {}: {MEMORY_ADVICE}",
             byte_count(options.max_alloc_bytes)
         ),
         ImageError::Unsupported(e) => format!("{name} variant not supported: {e}"),
