@@ -198,6 +198,22 @@ fn every_exif_orientation_is_applied_as_viewers_do() {
             (d.info.width, d.info.height),
             (expected.width, expected.height)
         );
+        // The page's preview is turned the same way.
+        let with_preview = DecodeOptions {
+            preview_max_side: Some(100),
+            ..Default::default()
+        };
+        let preview = decode(&jpeg(&src, Some(o)), &with_preview)
+            .expect("decode")
+            .preview
+            .expect("preview");
+        assert_eq!(
+            (preview.width, preview.height),
+            (expected.width, expected.height),
+            "preview, orientation {o}"
+        );
+        let preview_grey: Vec<u8> = preview.pixels.chunks(4).map(|p| p[0]).collect();
+        assert_eq!(preview_grey, expected.pixels, "preview, orientation {o}");
         let applied = if o == 1 { None } else { Some(o as u8) };
         assert_eq!(d.info.exif_orientation, applied, "orientation {o}");
     }

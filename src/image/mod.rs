@@ -221,39 +221,49 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     let opened = open(bytes, options, true)?;
     let (format, orientation) = (opened.format, opened.orientation);
     let fail = |e: ImageError| decode_error(format, e, bytes.len(), options);
+    // The grey image, and the decoded image when its pixels are not grey
+    // already (PNG rows are converted as they come).
     let (gray, image) = match opened.source {
         Source::PngRows(reader) => {
             let pixels = reader
                 .read_gray(opened.width, opened.height)
                 .map_err(fail)?;
-            (GrayImage::new(opened.width, opened.height, pixels)?, None)
+            (
+                Some(GrayImage::new(opened.width, opened.height, pixels)?),
+                None,
+            )
         }
         Source::PngWhole(reader) => {
             let image = reader
                 .read_whole(opened.width, opened.height)
                 .map_err(fail)?;
-            (gray_of(&image)?, Some(image))
+            (None, Some(image))
         }
-        Source::Other(decoder) => {
-            let image = DynamicImage::from_decoder(decoder).map_err(fail)?;
-            (gray_of(&image)?, Some(image))
-        }
+        Source::Other(decoder) => (
+            None,
+            Some(DynamicImage::from_decoder(decoder).map_err(fail)?),
+        ),
     };
     let (mut channels, mut bits_per_channel) = (opened.channels, opened.bits_per_channel);
-    if let Some(image) = &image {
-        if indexed(format, bytes) && all_grey(image) {
-            // `image` expands palettes to RGB: an 8-bit BMP or a GIF of a mono
-            // camera (a palette of greys) would be listed as "RGB".
-            (channels, bits_per_channel) = (1, 8);
+    let mut small = None;
+    let gray = match (gray, image) {
+        (Some(gray), _) => gray,
+        (None, Some(image)) => {
+            if indexed(format, bytes) && all_grey(&image) {
+                // `image` expands palettes to RGB: an 8-bit BMP or a GIF of a
+                // mono camera (a palette of greys) would be listed as "RGB".
+                (channels, bits_per_channel) = (1, 8);
+            }
+            small = options.preview_max_side.map(|side| preview(&image, side));
+            // Moves the pixels of a grey image instead of copying them.
+            let luma = image.into_luma8();
+            GrayImage::new(luma.width(), luma.height(), luma.into_raw())?
         }
-    }
-    let preview = match (options.preview_max_side, image) {
-        (Some(side), Some(mut image)) => {
-            image.apply_orientation(orientation);
-            Some(preview(&image, side))
+        (None, None) => {
+            return Err(Error::invalid("pixels", "the decoder produced no image"));
         }
-        _ => None,
     };
+    let preview = small.map(|p| orient_rgba(p, orientation)).transpose()?;
     let gray = orient(gray, orientation)?;
     let info = ImageInfo {
         format,
@@ -408,9 +418,29 @@ fn open<'a>(bytes: &'a [u8], options: &DecodeOptions, whole_file: bool) -> Resul
     })
 }
 
-fn gray_of(image: &DynamicImage) -> Result<GrayImage> {
-    let luma = image.to_luma8();
-    GrayImage::new(luma.width(), luma.height(), luma.into_raw())
+/// [`orient`] for the RGBA preview.
+fn orient_rgba(small: RgbaImage, orientation: Orientation) -> Result<RgbaImage> {
+    if orientation == Orientation::NoTransforms {
+        return Ok(small);
+    }
+    let (w, h) = (small.width, small.height);
+    let buffer = ::image::RgbaImage::from_raw(w, h, small.pixels).ok_or_else(|| {
+        Error::invalid(
+            "preview",
+            format!(
+                "a {w}x{h} preview needs {} bytes",
+                4 * w as usize * h as usize
+            ),
+        )
+    })?;
+    let mut image = DynamicImage::ImageRgba8(buffer);
+    image.apply_orientation(orientation);
+    let rgba = image.into_rgba8();
+    Ok(RgbaImage {
+        width: rgba.width(),
+        height: rgba.height(),
+        pixels: rgba.into_raw(),
+    })
 }
 
 /// Rotate or flip the grey image as the EXIF Orientation tag says, as
