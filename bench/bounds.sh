@@ -5,6 +5,10 @@
 #    MP) for every target kind;
 #  - progressive JPEGs with 5,000 and 50,000 scans (bench/progressive_jpeg.py,
 #    needs bench/.venv: created on first use);
+#  - hostile and awkward image files (issue 37): a 4 MB PNG whose iCCP
+#    profile inflates to 3.9 GiB, a 10000x10000 16-bit RGBA PNG (alone and
+#    four at once on 4 threads), 3 GB of zeros named .png, /dev/zero, a FIFO
+#    with no writer, a JPEG cut at 10 %;
 #  - camera calibrations of 100 to 10,000 views (detections JSON of a 9x6
 #    board, random poses), and the refusal above calib::json_api::MAX_VIEWS.
 # Usage: bench/bounds.sh [CLI] (default target/release/robocal). Prints
@@ -55,6 +59,50 @@ done
   && python3 progressive_jpeg.py "$dir/prog-99mp-5k.jpg" 9900 5000 >&2)
 for img in prog-5k prog-50k prog-99mp-5k; do
   time_row "| $img.jpg | detect --target chessboard:9x6:30mm" "$CLI" detect --target chessboard:9x6:30mm -o /dev/null "$dir/$img.jpg"
+done
+
+
+echo
+echo "## Hostile image files"
+echo
+python3 - "$dir" <<'P'
+import os, struct, sys, zlib
+d = sys.argv[1]
+def chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+def png(path, w, h, depth, colour, row, extra=b""):
+    z = zlib.compressobj(9)
+    idat = b"".join(z.compress(b"\0" + row) for _ in range(h)) + z.flush()
+    ihdr = struct.pack(">IIBBBBB", w, h, depth, colour, 0, 0, 0)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + extra + chunk(b"IDAT", idat) + chunk(b"IEND", b""))
+# The colour profile: 3.9 GiB of zeros, deflated in 64 MiB pieces.
+z, block, parts = zlib.compressobj(9), bytes(64 << 20), []
+for _ in range(62):
+    parts.append(z.compress(block))
+parts.append(z.flush())
+png(f"{d}/iccp-bomb.png", 640, 480, 8, 0, bytes(640), chunk(b"iCCP", b"bomb\0\0" + b"".join(parts)))
+png(f"{d}/rgba16-100mp.png", 10000, 10000, 16, 6, b"\x80\x00" * 40000)
+P
+for i in 1 2 3 4; do cp "$dir/rgba16-100mp.png" "$dir/rgba16-100mp-$i.png"; done
+truncate -s 3G "$dir/junk-3gb.png"
+mkfifo "$dir/fifo.png"
+python3 -c "import sys; b = open(sys.argv[1], 'rb').read(); open(sys.argv[2], 'wb').write(b[:len(b) // 10])" \
+  "$dir/prog-5k.jpg" "$dir/cut10.jpg"
+echo "| file (bytes) | command | median s | peak RSS MB |"
+echo "|---|---|---|---|"
+time_row "| iccp-bomb.png ($(stat -c %s "$dir/iccp-bomb.png")) | info" "$CLI" info "$dir/iccp-bomb.png"
+time_row "| iccp-bomb.png | detect --target chessboard:9x6:30mm" "$CLI" detect --target chessboard:9x6:30mm -o /dev/null "$dir/iccp-bomb.png"
+time_row "| rgba16-100mp.png ($(stat -c %s "$dir/rgba16-100mp.png")) | info" "$CLI" info "$dir/rgba16-100mp.png"
+time_row "| rgba16-100mp.png | detect --target chessboard:9x6:30mm" "$CLI" detect --target chessboard:9x6:30mm -o /dev/null "$dir/rgba16-100mp.png"
+time_row "| 4 x rgba16-100mp.png | detect --threads 4 --target circles:4x11:20mm:asymmetric" "$CLI" detect --threads 4 --target circles:4x11:20mm:asymmetric -o /dev/null "$dir"/rgba16-100mp-?.png
+time_row "| junk-3gb.png (3221225472) | info" "$CLI" info "$dir/junk-3gb.png"
+time_row "| /dev/zero | info" "$CLI" info /dev/zero
+time_row "| fifo.png (no writer) | info" timeout 10 "$CLI" info "$dir/fifo.png"
+time_row "| cut10.jpg | info" "$CLI" info "$dir/cut10.jpg"
+echo
+for f in "$dir/iccp-bomb.png" "$dir/junk-3gb.png" /dev/zero "$dir/fifo.png" "$dir/cut10.jpg"; do
+  echo "- \`robocal info $(basename "$f")\`: \`$(timeout 10 "$CLI" info "$f" 2>/dev/null | sed "s|$dir/||g")\`"
 done
 
 echo

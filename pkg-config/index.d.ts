@@ -93,14 +93,20 @@ export interface ImageInfo {
   format: 'png' | 'jpeg' | 'tiff' | 'bmp' | 'pnm' | 'gif';
   /** Upper-case display name, e.g. "PNG". */
   format_name: 'PNG' | 'JPEG' | 'TIFF' | 'BMP' | 'PNM' | 'GIF';
-  /** Width, px. */
+  /** Width, px (after the EXIF orientation). */
   width: number;
-  /** Height, px. */
+  /** Height, px (after the EXIF orientation). */
   height: number;
   /** Channels in the file: 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA. */
   channels: number;
   /** Bits per channel in the file: 8 or 16, 32 for float TIFF. */
   bits_per_channel: number;
+  /**
+   * The EXIF Orientation (2-8) applied to the pixels, as OpenCV's `imread`
+   * and image viewers apply it; absent when the file has none. `width` and
+   * `height` are the size after it.
+   */
+  exif_orientation?: number;
 }
 
 /** `undistort_preview(...).info_json`: the preview's size, px. */

@@ -105,7 +105,9 @@ pub struct ImagePreview {
 #[wasm_bindgen]
 impl ImagePreview {
     /// JSON: `{format, format_name, width, height, channels,
-    /// bits_per_channel}` of the full image.
+    /// bits_per_channel}` of the full image, plus `exif_orientation` (2-8)
+    /// when the file's EXIF Orientation was applied (width and height are
+    /// then the size after it).
     #[wasm_bindgen(getter)]
     pub fn info_json(&self) -> String {
         self.info_json.clone()
@@ -127,6 +129,9 @@ struct InfoJson {
     channels: u8,
     bits_per_channel: u8,
     format_name: &'static str,
+    /// The EXIF Orientation applied (2-8), absent when none was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    exif_orientation: Option<u8>,
 }
 
 impl InfoJson {
@@ -138,6 +143,7 @@ impl InfoJson {
             channels: info.channels,
             bits_per_channel: info.bits_per_channel,
             format_name: info.format.name(),
+            exif_orientation: info.exif_orientation,
         }
     }
 }

@@ -60,7 +60,11 @@ fn info_names_the_format_and_the_defect() {
     std::fs::write(&tiff, tiff_huge_tiles()).unwrap();
     let (code, out, err) = robocal(&["info", tiff.to_str().unwrap()]);
     assert_eq!(code, 1, "stdout {out} stderr {err}");
-    assert!(out.contains("corrupt or truncated TIFF file"), "{out}");
+    // Its tiles lie beyond the end of the file.
+    assert!(
+        out.contains("the TIFF file is truncated: it ends after 200 bytes"),
+        "{out}"
+    );
 }
 
 #[test]
@@ -116,4 +120,186 @@ fn max_pixels_lowers_and_raises_the_size_limit() {
         err.starts_with("error: invalid value 'lots' for '--max-pixels <N>': 'lots' is not a pixel count: give a whole number > 0, e.g. 150000000 or 150MP"),
         "{err}"
     );
+}
+
+/// A 320 x 240 grey ramp, as JPEG (quality 90) and as PNG.
+fn ramp_files() -> [(&'static str, &'static str, Vec<u8>); 2] {
+    let (w, h) = (320u32, 240u32);
+    let pixels: Vec<u8> = (0..w * h)
+        .map(|i| ((i % w) * 3 + (i / w) * 5) as u8)
+        .collect();
+    let mut jpeg = Vec::new();
+    jpeg_encoder::Encoder::new(&mut jpeg, 90)
+        .encode(&pixels, w as u16, h as u16, jpeg_encoder::ColorType::Luma)
+        .unwrap();
+    let image = robocal::image::GrayImage::new(w, h, pixels).unwrap();
+    let png = robocal::image::encode_png(&image).unwrap();
+    [("JPEG", "jpg", jpeg), ("PNG", "png", png)]
+}
+
+fn truncated(format: &str, n: usize) -> String {
+    format!(
+        "the {format} file is truncated: it ends after {n} bytes, before the end of its image \
+         data (an interrupted copy or download?): copy it again from the camera or its source"
+    )
+}
+
+#[test]
+fn files_cut_at_10_50_and_90_percent_are_named_truncated() {
+    let dir = temp_dir("bad-images", "truncated");
+    for (format, ext, bytes) in ramp_files() {
+        for percent in [10, 50, 90] {
+            let n = bytes.len() * percent / 100;
+            let path = dir.join(format!("cut{percent}.{ext}"));
+            std::fs::write(&path, &bytes[..n]).unwrap();
+            let file = path.to_str().unwrap();
+            let message = truncated(format, n);
+            let (code, out, _) = robocal(&["info", file]);
+            assert_eq!(code, 1, "{format} {percent} %");
+            let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+            assert_eq!(
+                line["error"],
+                message.as_str(),
+                "info, {format} {percent} %"
+            );
+            let (code, _, err) = robocal(&["detect", "--target", "chessboard:9x6:30mm", file]);
+            assert_eq!(code, 1, "{format} {percent} %");
+            assert_eq!(
+                err.lines().next(),
+                Some(format!("robocal detect: {file}: {message}").as_str()),
+                "detect, {format} {percent} %"
+            );
+        }
+    }
+}
+
+#[test]
+fn only_regular_files_are_read() {
+    let (code, out, _) = robocal(&["info", "/dev/zero"]);
+    assert_eq!(code, 1);
+    assert_eq!(
+        out.trim(),
+        r#"{"error":"'/dev/zero' is not a regular file (a character device): give an image file","file":"/dev/zero"}"#
+    );
+    let dir = temp_dir("bad-images", "fifo");
+    let fifo = dir.join("camera.png");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        // No writer: reading would block for ever.
+        let file = fifo.to_str().unwrap();
+        let (code, _, err) = robocal(&["detect", "--target", "chessboard:9x6:30mm", file]);
+        assert_eq!(code, 1);
+        assert_eq!(
+            err.lines().next(),
+            Some(
+                format!(
+                    "robocal detect: {file}: '{file}' is not a regular file (a FIFO): give an image file"
+                )
+                .as_str()
+            )
+        );
+    }
+}
+
+#[test]
+fn large_files_are_judged_before_they_are_read() {
+    let dir = temp_dir("bad-images", "large");
+    // 3 GB of zeros named .png (a sparse file: no disk used): refused from
+    // its first bytes.
+    let junk = dir.join("junk.png");
+    std::fs::File::create(&junk)
+        .unwrap()
+        .set_len(3_000_000_000)
+        .unwrap();
+    let (code, out, _) = robocal(&["info", junk.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(
+        out.contains(r#""error":"not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP""#),
+        "{out}"
+    );
+    // A PNG signature followed by 1 GiB: over the cap, refused unread.
+    let big = dir.join("big.png");
+    {
+        use std::io::Write;
+        let mut f = std::fs::File::create(&big).unwrap();
+        f.write_all(b"\x89PNG\r\n\x1a\n").unwrap();
+        f.set_len((1 << 30) + 1).unwrap();
+    }
+    let file = big.to_str().unwrap();
+    let (code, out, _) = robocal(&["info", file]);
+    assert_eq!(code, 1);
+    let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    assert_eq!(
+        line["error"],
+        format!(
+            "'{file}' is 1073741825 bytes, more than any image the decoder accepts (at most \
+             1073741824 bytes, its memory limit): downscale or compress the image, or raise the \
+             limit with --max-pixels (10 bytes a pixel)"
+        )
+    );
+    let _ = std::fs::remove_file(&junk);
+    let _ = std::fs::remove_file(&big);
+}
+
+#[test]
+fn an_iccp_profile_that_inflates_to_gigabytes_is_not_inflated() {
+    // 1.25 GiB of zeros as the colour profile of a 64 x 48 PNG.
+    let mut data = b"bomb\0\0".to_vec();
+    let mut z = fdeflate::Compressor::new(Vec::new()).unwrap();
+    let block = vec![0u8; 1 << 20];
+    for _ in 0..1280 {
+        z.write_data(&block).unwrap();
+    }
+    data.extend_from_slice(&z.finish().unwrap());
+    let mut chunk = (data.len() as u32).to_be_bytes().to_vec();
+    chunk.extend_from_slice(b"iCCP");
+    chunk.extend_from_slice(&data);
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(b"iCCP");
+    crc.update(&data);
+    chunk.extend_from_slice(&crc.finalize().to_be_bytes());
+    let image = robocal::image::GrayImage::new(64, 48, vec![90; 64 * 48]).unwrap();
+    let png = robocal::image::encode_png(&image).unwrap();
+    let bomb = [&png[..33], &chunk, &png[33..]].concat();
+    let dir = temp_dir("bad-images", "iccp");
+    let path = dir.join("profile.png");
+    std::fs::write(&path, bomb).unwrap();
+    let (code, out, err) = robocal(&["info", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out} {err}");
+    assert!(out.contains(r#""format":"png","height":48"#), "{out}");
+}
+
+#[test]
+fn the_exif_orientation_is_reported_by_info_and_detect() {
+    let (w, h) = (64u16, 48u16);
+    let mut jpeg = Vec::new();
+    let mut enc = jpeg_encoder::Encoder::new(&mut jpeg, 90);
+    // Orientation 6 (rotate 90 degrees clockwise to display).
+    enc.add_exif_metadata(
+        b"II*\x00\x08\x00\x00\x00\x01\x00\x12\x01\x03\x00\x01\x00\x00\x00\x06\x00\x00\x00\x00\x00\x00\x00",
+    )
+    .unwrap();
+    enc.encode(
+        &vec![128u8; w as usize * h as usize],
+        w,
+        h,
+        jpeg_encoder::ColorType::Luma,
+    )
+    .unwrap();
+    let dir = temp_dir("bad-images", "exif");
+    let path = dir.join("portrait.jpg");
+    std::fs::write(&path, jpeg).unwrap();
+    let file = path.to_str().unwrap();
+    let (code, out, _) = robocal(&["info", file]);
+    assert_eq!(code, 0);
+    let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    assert_eq!(
+        (line["width"].as_u64(), line["height"].as_u64()),
+        (Some(48), Some(64))
+    );
+    assert_eq!(line["exif_orientation"], 6);
+    let (_, out, _) = robocal(&["detect", "--target", "chessboard:9x6:30mm", file]);
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(doc["images"][0]["exif_orientation"], 6, "{out}");
 }

@@ -73,7 +73,7 @@ const CASES: &[Case] = &[
         args: &["info", "sig.png"],
         code: 1,
         stream: Stream::Stdout,
-        message: r#"{"error":"corrupt or truncated PNG file: unexpected end of file","file":"sig.png"}"#,
+        message: r#"{"error":"the PNG file is truncated: it ends after 8 bytes, before the end of its image data (an interrupted copy or download?): copy it again from the camera or its source","file":"sig.png"}"#,
     },
     Case {
         name: "image-gif-truncated",
@@ -407,7 +407,7 @@ const CASES: &[Case] = &[
         args: &["info", "t.bmp"],
         code: 1,
         stream: Stream::Stdout,
-        message: r#"{"error":"corrupt or truncated BMP file: failed to fill whole buffer","file":"t.bmp"}"#,
+        message: r#"{"error":"the BMP file is truncated: it ends after 12 bytes, before the end of its image data (an interrupted copy or download?): copy it again from the camera or its source","file":"t.bmp"}"#,
     },
     Case {
         name: "image-tiff-truncated",
@@ -415,7 +415,7 @@ const CASES: &[Case] = &[
         args: &["info", "t.tif"],
         code: 1,
         stream: Stream::Stdout,
-        message: r#"{"error":"corrupt or truncated TIFF file: failed to fill whole buffer","file":"t.tif"}"#,
+        message: r#"{"error":"the TIFF file is truncated: it ends after 10 bytes, before the end of its image data (an interrupted copy or download?): copy it again from the camera or its source","file":"t.tif"}"#,
     },
     Case {
         name: "image-jpeg-28-bytes",

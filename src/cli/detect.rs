@@ -1,7 +1,9 @@
 //! `robocal detect`: find a calibration target in images, in parallel
 //! (rayon), with a progress bar on a terminal (indicatif).
 
-use super::{parse_target, read_file, CliError, ImageLimits};
+use super::image_file::open_image;
+use super::memory_budget::{MemoryBudget, DETECT_BYTES_PER_PIXEL, DETECT_MEMORY_BUDGET};
+use super::{parse_target, CliError, ImageLimits};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use robocal::detect::{detect, detect_all, CentreModel, DetectOptions};
@@ -110,7 +112,15 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
     let outcomes = run_with(files, &target, &options, &decode, args.threads, all_boards)?;
     let mut images = Vec::with_capacity(files.len());
     let mut found = 0;
-    for (file, (outcome, others)) in files.iter().zip(outcomes) {
+    for (
+        file,
+        Processed {
+            outcome,
+            others,
+            exif_orientation,
+        },
+    ) in files.iter().zip(outcomes)
+    {
         let mut entry = match outcome {
             Outcome::Found(d, seconds) => {
                 found += 1;
@@ -122,6 +132,9 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
                 json!({"file": file, "error": {"kind": kind, "message": message}})
             }
         };
+        if let Some(o) = exif_orientation {
+            entry["exif_orientation"] = json!(o);
+        }
         if !others.is_empty() {
             let firsts: Vec<String> = others.iter().map(|d| d.target.to_spec()).collect();
             eprintln!(
@@ -176,7 +189,25 @@ pub(super) fn run_all(
     threads: Option<usize>,
 ) -> Result<Vec<Outcome>, CliError> {
     let outcomes = run_with(files, target, options, decode, threads, false)?;
-    Ok(outcomes.into_iter().map(|(o, _)| o).collect())
+    Ok(outcomes.into_iter().map(|p| p.outcome).collect())
+}
+
+/// One image's outcome, the other boards in view and the EXIF orientation
+/// applied to it.
+struct Processed {
+    outcome: Outcome,
+    others: Vec<Detection>,
+    exif_orientation: Option<u8>,
+}
+
+impl Processed {
+    fn failed(kind: &str, message: String) -> Self {
+        Processed {
+            outcome: Outcome::Failed(kind.into(), message),
+            others: Vec::new(),
+            exif_orientation: None,
+        }
+    }
 }
 
 /// [`run_all`], with `all_boards` also the other boards of a marker
@@ -188,7 +219,7 @@ fn run_with(
     decode: &DecodeOptions,
     threads: Option<usize>,
     all_boards: bool,
-) -> Result<Vec<(Outcome, Vec<Detection>)>, CliError> {
+) -> Result<Vec<Processed>, CliError> {
     // `--threads 0` has always meant one thread; rayon reads 0 as "default".
     let threads = threads.map_or(0, |n| n.max(1));
     let pool = rayon::ThreadPoolBuilder::new()
@@ -196,11 +227,12 @@ fn run_with(
         .build()
         .map_err(|e| CliError::Io(format!("cannot start the detection threads: {e}")))?;
     let bar = progress(files.len());
+    let budget = MemoryBudget::new(DETECT_MEMORY_BUDGET);
     let outcomes = pool.install(|| {
         files
             .par_iter()
             .map(|file| {
-                let outcome = guarded(file, target, options, decode, all_boards);
+                let outcome = guarded(file, target, options, decode, all_boards, &budget);
                 bar.set_message(file.clone());
                 bar.inc(1);
                 outcome
@@ -221,37 +253,54 @@ fn guarded(
     options: &DetectOptions,
     decode: &DecodeOptions,
     all_boards: bool,
-) -> (Outcome, Vec<Detection>) {
+    budget: &MemoryBudget,
+) -> Processed {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        one(file, target, options, decode, all_boards)
+        one(file, target, options, decode, all_boards, budget)
     }))
-    .unwrap_or_else(|_| {
-        let crashed = Outcome::Failed(
-            "internal".into(),
-            "the detector crashed on this image".into(),
-        );
-        (crashed, Vec::new())
-    })
+    .unwrap_or_else(|_| Processed::failed("internal", "the detector crashed on this image".into()))
 }
 
 /// One image: the target's detection and, with `all_boards`, the other
 /// boards of its layout (the target's own missing: the failure is
-/// [`detect`]'s, whose message names what was seen).
+/// [`detect`]'s, whose message names what was seen). The file is read,
+/// decoded and searched under a reservation of `budget` for all of it.
 fn one(
     file: &str,
     target: &Target,
     options: &DetectOptions,
     decode: &DecodeOptions,
     all_boards: bool,
-) -> (Outcome, Vec<Detection>) {
-    let failed = |kind: &str, message: String| (Outcome::Failed(kind.into(), message), Vec::new());
-    let bytes = match read_file(file) {
-        Ok(b) => b,
-        Err(e) => return failed("io", e.to_string()),
+    budget: &MemoryBudget,
+) -> Processed {
+    let cli_failed = |e: CliError| match e {
+        CliError::Robocal(e) => Processed::failed(e.kind(), e.to_string()),
+        other => Processed::failed("io", other.to_string()),
     };
-    let image = match robocal::image::decode(&bytes, decode) {
-        Ok(d) => d.gray,
-        Err(e) => return failed(e.kind(), e.to_string()),
+    let opened = match open_image(file, decode) {
+        Ok(f) => f,
+        Err(e) => return cli_failed(e),
+    };
+    // The header is usually in the first bytes; when it is not, the
+    // decoder's limit is the bound.
+    let peak = robocal::image::decode_peak(&opened.head, decode).map_or(
+        decode.max_alloc_bytes + decode.max_pixels * DETECT_BYTES_PER_PIXEL,
+        |p| p.bytes + p.pixels * DETECT_BYTES_PER_PIXEL,
+    );
+    let _reservation = budget.reserve(opened.len() + peak);
+    let bytes = match opened.read_all() {
+        Ok(b) => b,
+        Err(e) => return cli_failed(e),
+    };
+    let (image, exif_orientation) = match robocal::image::decode(&bytes, decode) {
+        Ok(d) => (d.gray, d.info.exif_orientation),
+        Err(e) => return Processed::failed(e.kind(), e.to_string()),
+    };
+    drop(bytes);
+    let found = |outcome: Outcome, others: Vec<Detection>| Processed {
+        outcome,
+        others,
+        exif_orientation,
     };
     let start = Instant::now();
     let mut others = Vec::new();
@@ -260,7 +309,7 @@ fn one(
             let own = target.to_spec();
             if let Some(i) = boards.iter().position(|d| d.target.to_spec() == own) {
                 let d = boards.remove(i);
-                return (Outcome::Found(d, start.elapsed().as_secs_f64()), boards);
+                return found(Outcome::Found(d, start.elapsed().as_secs_f64()), boards);
             }
             others = boards;
         }
@@ -269,7 +318,7 @@ fn one(
         Ok(d) => Outcome::Found(d, start.elapsed().as_secs_f64()),
         Err(e) => Outcome::Failed(e.kind().into(), e.to_string()),
     };
-    (outcome, others)
+    found(outcome, others)
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! `robocal info`: decode images and print their format and size.
 
-use super::{read_file, CliError};
+use super::image_file::read_image;
+use super::CliError;
 
 #[derive(clap::Args)]
 #[command(
@@ -9,7 +10,11 @@ use super::{read_file, CliError};
 
 Prints one JSON object per line: {\"file\", \"format\", \"width\", \"height\",
 \"channels\", \"bits_per_channel\"} or {\"file\", \"error\"} for files that are not
-supported images. Exits with 1 if any file failed.",
+supported images. A file with an EXIF Orientation tag is rotated as viewers
+and OpenCV's imread do: \"exif_orientation\" (2-8) says which, and width and
+height are the size after it. Only regular files are read, at most as many
+bytes as the decoder's memory limit (1 GiB, raised by --max-pixels); a
+truncated file is an error. Exits with 1 if any file failed.",
     after_help = "Example:
   robocal info left01.jpg board.tiff
   robocal info --max-pixels 250MP wafer_scan.tiff",
@@ -29,9 +34,10 @@ pub fn run(args: InfoArgs) -> Result<(), CliError> {
     }
     let mut failed = 0;
     for file in &args.files {
-        let line = match read_file(file).and_then(|b| {
-            robocal::image::decode(&b, &args.limits.decode_options()).map_err(CliError::from)
-        }) {
+        let options = args.limits.decode_options();
+        let line = match read_image(file, &options)
+            .and_then(|b| robocal::image::decode(&b, &options).map_err(CliError::from))
+        {
             Ok(d) => {
                 let mut v = serde_json::to_value(&d.info).unwrap_or_default();
                 v["file"] = serde_json::Value::String(file.clone());

@@ -6,25 +6,41 @@
 //! (8/16/32-bit, uncompressed, LZW, deflate, PackBits, tiled), BMP, PNM and
 //! WebP. The format is recognised from the content, not a file name.
 //!
-//! Every decode runs under `image`'s [`Limits`](::image::Limits): at most
+//! Every decode runs under `image`'s [`Limits`](::image::Limits) from the
+//! first byte (header and metadata chunks included): at most
 //! [`DecodeOptions::max_pixels`] pixels (checked against the header before
 //! any pixel buffer exists) and [`DecodeOptions::max_alloc_bytes`] bytes of
 //! decoder memory. The defaults are [`DEFAULT_MAX_PIXELS`] and
 //! [`DEFAULT_MAX_ALLOC_BYTES`]: 100 MP and 1 GiB natively; 64 MP and 512 MiB
 //! in wasm, where one worker's memory is at most 4 GiB and a tab runs
-//! several. Over a limit the error names the image size and the limit.
+//! several. Over a limit the error names the image size or the limit, and
+//! what to do. PNG goes through the `png` crate directly (`png_rows`): its
+//! colour profile is never inflated and rows become grey strip by strip, so
+//! a 16-bit RGBA PNG costs the grey image, not eight times it;
+//! [`decode_peak`] gives any file's peak from its header.
+//!
+//! The EXIF Orientation (JPEG, TIFF, WebP, PNG's eXIf) is applied to the
+//! grey image as OpenCV's `imread` and image viewers apply it, and reported
+//! as [`ImageInfo::exif_orientation`]. A file cut short is an error that
+//! says so (`truncation`), never a partly grey image.
 //!
 //! Grey is `image`'s luma conversion: 0.2126 R + 0.7152 G + 0.0722 B
 //! (sRGB / Rec. 709 weights), 16-bit and float samples scaled to 8 bits
 //! with rounding; alpha is ignored.
 
 use crate::error::{Error, Result};
+use ::image::metadata::Orientation;
 use ::image::{DynamicImage, ImageDecoder, ImageError, ImageReader, Limits};
 use serde::Serialize;
 use std::io::Cursor;
+use truncation::JpegEnd;
 
 #[cfg(test)]
+mod bounds_tests;
+#[cfg(test)]
 mod format_tests;
+mod png_rows;
+mod truncation;
 
 /// Largest image accepted by default, in pixels: a 100 MP sensor natively
 /// (twice the 50 MP the detectors are specified for), 64 MP in wasm.
@@ -150,6 +166,12 @@ pub struct ImageInfo {
     pub channels: u8,
     /// Bits per channel in the file (8 or 16, 32 for float TIFF).
     pub bits_per_channel: u8,
+    /// The EXIF Orientation (2-8) that was applied to the pixels, as
+    /// OpenCV's `imread` and image viewers apply it; absent when the file
+    /// has none (or 1, "as stored"). `width` and `height` are the size after
+    /// it: for 5-8 the file stores the image transposed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exif_orientation: Option<u8>,
 }
 
 /// Options for [`decode`].
@@ -191,53 +213,261 @@ pub fn decode_gray(bytes: &[u8]) -> Result<GrayImage> {
     decode(bytes, &DecodeOptions::default()).map(|d| d.gray)
 }
 
-/// Decode image bytes: recognise the format from the content, check the
-/// size against the limits from the header, decode under `image`'s limits,
-/// convert to grey (and a preview when asked).
+/// Decode image bytes: recognise the format from the content, read the
+/// header under the limits, check the size, decode under the limits,
+/// convert to grey, apply the EXIF orientation (and make a preview when
+/// asked). A file cut short is an error that says so ([`truncation`]).
 pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
-    let format = sniff_format(bytes)?;
-    let mut reader = ImageReader::new(Cursor::new(bytes));
-    reader.set_format(format.to_image_crate());
-    // The header is read without limits (nothing it allocates scales with
-    // the claimed size); the pixel limit is checked next, by `check_size`,
-    // so that the message can name the size; the decode runs under `limits`.
-    reader.no_limits();
-    let mut decoder = reader
-        .into_decoder()
-        .map_err(|e| image_error(format, e, options))?;
-    let (width, height) = decoder.dimensions();
-    check_size(width, height, options)?;
-    // The output buffer counts against the allocation limit too; what is
-    // left of it bounds the decoder's own working memory.
-    let mut limits = limits(options);
-    limits
-        .reserve(decoder.total_bytes())
-        .and_then(|()| decoder.set_limits(limits))
-        .map_err(|e| image_error(format, e, options))?;
-    let color = decoder.original_color_type();
-    let mut channels = color.channel_count();
-    let mut bits_per_channel = (color.bits_per_pixel() / channels.max(1) as u16) as u8;
-    let image = DynamicImage::from_decoder(decoder).map_err(|e| image_error(format, e, options))?;
-    if indexed(format, bytes) && all_grey(&image) {
-        // `image` expands palettes to RGB: an 8-bit BMP or a GIF of a mono
-        // camera (a palette of greys) would be listed as "RGB".
-        (channels, bits_per_channel) = (1, 8);
-    }
+    let opened = open(bytes, options, true)?;
+    let (format, orientation) = (opened.format, opened.orientation);
+    let fail = |e: ImageError| decode_error(format, e, bytes.len(), options);
+    // The grey image, and the decoded image when its pixels are not grey
+    // already (PNG rows are converted as they come).
+    let (gray, image) = match opened.source {
+        Source::PngRows(reader) => {
+            let pixels = reader
+                .read_gray(opened.width, opened.height)
+                .map_err(fail)?;
+            (
+                Some(GrayImage::new(opened.width, opened.height, pixels)?),
+                None,
+            )
+        }
+        Source::PngWhole(reader) => {
+            let image = reader
+                .read_whole(opened.width, opened.height)
+                .map_err(fail)?;
+            (None, Some(image))
+        }
+        Source::Other(decoder) => (
+            None,
+            Some(DynamicImage::from_decoder(decoder).map_err(fail)?),
+        ),
+    };
+    let (mut channels, mut bits_per_channel) = (opened.channels, opened.bits_per_channel);
+    let mut small = None;
+    let gray = match (gray, image) {
+        (Some(gray), _) => gray,
+        (None, Some(image)) => {
+            if indexed(format, bytes) && all_grey(&image) {
+                // `image` expands palettes to RGB: an 8-bit BMP or a GIF of a
+                // mono camera (a palette of greys) would be listed as "RGB".
+                (channels, bits_per_channel) = (1, 8);
+            }
+            small = options.preview_max_side.map(|side| preview(&image, side));
+            // Moves the pixels of a grey image instead of copying them.
+            let luma = image.into_luma8();
+            GrayImage::new(luma.width(), luma.height(), luma.into_raw())?
+        }
+        (None, None) => {
+            return Err(Error::invalid("pixels", "the decoder produced no image"));
+        }
+    };
+    let preview = small.map(|p| orient_rgba(p, orientation)).transpose()?;
+    let gray = orient(gray, orientation)?;
     let info = ImageInfo {
         format,
-        width,
-        height,
+        width: gray.width,
+        height: gray.height,
         channels,
         bits_per_channel,
+        exif_orientation: exif_orientation(orientation),
     };
-    let preview = options.preview_max_side.map(|side| preview(&image, side));
-    let luma = image.into_luma8();
-    let gray = GrayImage::new(luma.width(), luma.height(), luma.into_raw())?;
     Ok(Decoded {
         info,
         gray,
         preview,
     })
+}
+
+/// What decoding an image will cost, from its header: see [`decode_peak`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DecodePeak {
+    /// Pixels of the image.
+    pub pixels: u64,
+    /// The most memory [`decode`] holds at once, in bytes (the input bytes
+    /// not counted): the grey image, plus one strip of rows for a
+    /// non-interlaced PNG or the whole image at the file's pixel format for
+    /// every other file, plus a second grey buffer when the EXIF
+    /// orientation rotates.
+    pub bytes: u64,
+}
+
+/// The cost of decoding these bytes with these options, from the header
+/// alone: what a caller running several decodes at once budgets for (the
+/// CLI's `detect`). `bytes` may be the file's first bytes only, as long as
+/// they hold the header (a truncated file is not reported here).
+pub fn decode_peak(bytes: &[u8], options: &DecodeOptions) -> Result<DecodePeak> {
+    let opened = open(bytes, options, false)?;
+    let pixels = opened.width as u64 * opened.height as u64;
+    let rotated = match opened.orientation {
+        Orientation::NoTransforms | Orientation::FlipHorizontal | Orientation::FlipVertical => 0,
+        _ => pixels,
+    };
+    let sample_bytes = opened.bits_per_channel.div_ceil(8) as u64;
+    let decoded = match &opened.source {
+        // One strip of rows at the file's depth, twice (the rows and their
+        // samples widened), beside the grey image.
+        Source::PngRows(_) => {
+            let row = opened.width as u64 * opened.channels as u64 * sample_bytes;
+            2 * row * png_rows::STRIP_ROWS as u64
+        }
+        Source::PngWhole(_) | Source::Other(_) => pixels * opened.channels as u64 * sample_bytes,
+    };
+    Ok(DecodePeak {
+        pixels,
+        bytes: decoded + pixels + rotated,
+    })
+}
+
+/// A file whose header has been read: where its pixels come from.
+struct Opened<'a> {
+    format: ImageFormat,
+    width: u32,
+    height: u32,
+    channels: u8,
+    bits_per_channel: u8,
+    orientation: Orientation,
+    source: Source<'a>,
+}
+
+enum Source<'a> {
+    /// A non-interlaced PNG, converted to grey row by row.
+    PngRows(png_rows::PngReader<'a>),
+    /// An interlaced PNG, or any PNG when a preview is asked for.
+    PngWhole(png_rows::PngReader<'a>),
+    /// Every other format, through `image`'s decoder.
+    Other(Box<dyn ImageDecoder + 'a>),
+}
+
+/// Sniff the format, check a JPEG's framing for truncation (when `bytes`
+/// are the `whole_file`), read the header
+/// under the limits and check the size.
+fn open<'a>(bytes: &'a [u8], options: &DecodeOptions, whole_file: bool) -> Result<Opened<'a>> {
+    let format = sniff_format(bytes)?;
+    let fail = |e: ImageError| decode_error(format, e, bytes.len(), options);
+    if whole_file
+        && format == ImageFormat::Jpeg
+        && truncation::jpeg_end(bytes) == JpegEnd::Truncated
+    {
+        return Err(Error::Image {
+            message: truncation::message(format, bytes.len()),
+        });
+    }
+    if format == ImageFormat::Png {
+        let (reader, header) = png_rows::open(bytes, options)?;
+        let orientation = header
+            .exif
+            .as_deref()
+            .and_then(Orientation::from_exif_chunk)
+            .unwrap_or(Orientation::NoTransforms);
+        let whole = header.interlaced || options.preview_max_side.is_some();
+        return Ok(Opened {
+            format,
+            width: header.width,
+            height: header.height,
+            channels: header.channels,
+            bits_per_channel: header.bits_per_channel,
+            orientation,
+            source: if whole {
+                Source::PngWhole(reader)
+            } else {
+                Source::PngRows(reader)
+            },
+        });
+    }
+    let mut reader = ImageReader::new(Cursor::new(bytes));
+    reader.set_format(format.to_image_crate());
+    // The limits are on from the first byte: a header may hold chunks that
+    // inflate (colour profiles, metadata), and those count too.
+    reader.limits(limits(options));
+    let mut decoder = reader.into_decoder().map_err(fail)?;
+    let (width, height) = decoder.dimensions();
+    check_size(width, height, options)?;
+    // The output buffer counts against the allocation limit too; what is
+    // left of it bounds the decoder's own working memory.
+    let mut limits = limits(options);
+    let needed = decoder.total_bytes();
+    limits
+        .reserve(needed)
+        .and_then(|()| decoder.set_limits(limits))
+        .map_err(|e| match e {
+            ImageError::Limits(_) => Error::Image {
+                message: format!(
+                    "{} image is {width}x{height}: decoding it needs {needed} bytes, more than \
+                     the memory limit of {}: {MEMORY_ADVICE}",
+                    format.name(),
+                    byte_count(options.max_alloc_bytes)
+                ),
+            },
+            other => fail(other),
+        })?;
+    let color = decoder.original_color_type();
+    let channels = color.channel_count();
+    let bits_per_channel = (color.bits_per_pixel() / channels.max(1) as u16) as u8;
+    // A damaged EXIF block is no reason to refuse the pixels: no rotation.
+    let orientation = decoder.orientation().unwrap_or(Orientation::NoTransforms);
+    Ok(Opened {
+        format,
+        width,
+        height,
+        channels,
+        bits_per_channel,
+        orientation,
+        source: Source::Other(Box::new(decoder)),
+    })
+}
+
+/// [`orient`] for the RGBA preview.
+fn orient_rgba(small: RgbaImage, orientation: Orientation) -> Result<RgbaImage> {
+    if orientation == Orientation::NoTransforms {
+        return Ok(small);
+    }
+    let (w, h) = (small.width, small.height);
+    let buffer = ::image::RgbaImage::from_raw(w, h, small.pixels).ok_or_else(|| {
+        Error::invalid(
+            "preview",
+            format!(
+                "a {w}x{h} preview needs {} bytes",
+                4 * w as usize * h as usize
+            ),
+        )
+    })?;
+    let mut image = DynamicImage::ImageRgba8(buffer);
+    image.apply_orientation(orientation);
+    let rgba = image.into_rgba8();
+    Ok(RgbaImage {
+        width: rgba.width(),
+        height: rgba.height(),
+        pixels: rgba.into_raw(),
+    })
+}
+
+/// Rotate or flip the grey image as the EXIF Orientation tag says, as
+/// OpenCV's `imread` and image viewers do (`image`'s `apply_orientation`).
+fn orient(gray: GrayImage, orientation: Orientation) -> Result<GrayImage> {
+    if orientation == Orientation::NoTransforms {
+        return Ok(gray);
+    }
+    let (w, h) = (gray.width, gray.height);
+    let buffer = ::image::GrayImage::from_raw(w, h, gray.pixels).ok_or_else(|| {
+        Error::invalid(
+            "pixels",
+            format!("a {w}x{h} image needs {} bytes", w as usize * h as usize),
+        )
+    })?;
+    let mut image = DynamicImage::ImageLuma8(buffer);
+    image.apply_orientation(orientation);
+    let luma = image.into_luma8();
+    GrayImage::new(luma.width(), luma.height(), luma.into_raw())
+}
+
+/// The EXIF Orientation value (2-8) applied, `None` when nothing was.
+fn exif_orientation(orientation: Orientation) -> Option<u8> {
+    match orientation {
+        Orientation::NoTransforms => None,
+        other => Some(other.to_exif()),
+    }
 }
 
 /// Whether the file stores palette indices: every GIF, and a BMP of at most
@@ -370,13 +600,36 @@ fn pixel_count(n: u64, other: u64) -> String {
     }
 }
 
-/// `image`'s error as ours, naming the format and what to do.
-fn image_error(format: ImageFormat, e: ImageError, options: &DecodeOptions) -> Error {
+/// What to do about an image over the memory limit.
+const MEMORY_ADVICE: &str = "downscale it, or save it as 8-bit grey (all calibration uses); \
+     --max-pixels N in the CLI raises the limit to 10 bytes a pixel";
+
+/// A byte count as people read it: "1.0 GiB (1073741824 bytes)", or
+/// "1000 bytes" under a mebibyte.
+fn byte_count(n: u64) -> String {
+    const MIB: u64 = 1 << 20;
+    if n >= 1 << 30 {
+        format!("{:.1} GiB ({n} bytes)", n as f64 / (1u64 << 30) as f64)
+    } else if n >= MIB {
+        format!("{:.1} MiB ({n} bytes)", n as f64 / MIB as f64)
+    } else {
+        format!("{n} bytes")
+    }
+}
+
+/// `image`'s error as ours, naming the format and what to do; `len` is the
+/// file's length (a truncated file is named as such).
+fn decode_error(format: ImageFormat, e: ImageError, len: usize, options: &DecodeOptions) -> Error {
+    if truncation::is_end_of_file(&e) {
+        return Error::Image {
+            message: truncation::message(format, len),
+        };
+    }
     let name = format.name();
     let message = match e {
         ImageError::Limits(_) => format!(
-            "{name} image too large to decode within the memory limit ({} bytes)",
-            options.max_alloc_bytes
+            "{name} image needs more memory to decode than the limit of {}: {MEMORY_ADVICE}",
+            byte_count(options.max_alloc_bytes)
         ),
         ImageError::Unsupported(e) => format!("{name} variant not supported: {e}"),
         ImageError::Decoding(e) => format!("corrupt or truncated {name} file: {e}"),
@@ -472,12 +725,18 @@ mod tests {
     }
 
     #[wasm_bindgen_test(unsupported = test)]
-    fn truncated_png_is_reported_as_corrupt() {
+    fn truncated_png_is_reported_as_truncated() {
         let bytes = encode_png(&gradient(64, 64)).unwrap();
-        let err = decode_gray(&bytes[..bytes.len() / 2])
-            .unwrap_err()
-            .to_string();
-        assert!(err.starts_with("corrupt or truncated PNG file"), "{err}");
+        let n = bytes.len() / 2;
+        let err = decode_gray(&bytes[..n]).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            format!(
+                "the PNG file is truncated: it ends after {n} bytes, before the end of its \
+                 image data (an interrupted copy or download?): copy it again from the camera \
+                 or its source"
+            )
+        );
     }
 
     #[wasm_bindgen_test(unsupported = test)]
