@@ -691,6 +691,20 @@ export type RigHandEyeReport = Omit<HandEyeReportBase, 'methods'> & {
 );
 
 /** The output of `robocal rig --setup` (a camera rig on a robot): the rig report with `handeye`. */
+/** The input JSON of `calibrate_rig_handeye`: a camera rig on a robot. */
+export interface RigHandEyeInput {
+  /** `eye-in-hand` (the rig on the gripper) or `eye-to-hand` (the rig fixed, the target on the gripper). */
+  setup: 'eye-in-hand' | 'eye-to-hand';
+  /** One robot pose per frame, in the order of the frame keys. */
+  base_from_gripper: PoseInput[];
+  /** The cameras and their views (the input of `calibrate_rig`). */
+  calibration: RigInput;
+  /** A calibrated rig to hold (its intrinsics and `camera_from_rig`); absent: calibrated first. */
+  rig?: RigCalibration;
+  /** Report suspected pose mistakes as warnings instead of errors. */
+  lenient?: boolean;
+}
+
 export interface RigOnRobotReport extends RigCalibration {
   handeye: RigHandEyeReport;
 }
@@ -1462,6 +1476,8 @@ export interface RobocalJson {
   export_formats: [never, ExportFormatListEntry[]];
   /** `calibrate_rig(input)` -> the rig report. */
   calibrate_rig: [RigInput, RigCalibration];
+  /** `calibrate_rig_handeye(input)` -> the rig report with `handeye` (a rig on a robot). */
+  calibrate_rig_handeye: [RigHandEyeInput, RigOnRobotReport];
   /** `export_report_files(JSON.stringify(report), format, transform or "", JSON.stringify(frames) or "")` -> the files (several for a rig's `ros` and `mrcal`, as `robocal export -o DIR` writes them); `frames` names frames by role, e.g. `{"rig": "camera_rig"}`. */
   export_report_files: [ExportableReport, ExportFile[]];
   /** `rig_export_formats()` -> the rig format names. */

@@ -562,6 +562,18 @@ pub fn calibrate_rig(input_json: &str) -> Result<String, JsError> {
     crate::calib::rig_json::calibrate_rig_json(input_json).map_err(js_error)
 }
 
+/// A camera rig on a robot: the JSON input and output of
+/// `robocal::handeye::rig_json::calibrate_rig_handeye_json` (`setup`,
+/// `base_from_gripper` one per frame in key order, `calibration` the input
+/// of `calibrate_rig`, optionally `rig` a calibrated rig report to hold;
+/// returns the rig report with `handeye`: `gripper_from_rig` or
+/// `base_from_rig` with its std), what `robocal rig --setup ... --poses`
+/// writes.
+#[wasm_bindgen]
+pub fn calibrate_rig_handeye(input_json: &str) -> Result<String, JsError> {
+    crate::handeye::rig_json::calibrate_rig_handeye_json(input_json).map_err(js_error)
+}
+
 /// An undistorted preview of image bytes taken by `camera_json` (the
 /// `camera` object of a calibration report): resampled through the same
 /// camera without distortion, longer side at most `max_side` px, as grey

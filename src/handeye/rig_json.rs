@@ -1,6 +1,6 @@
 //! A rig on a robot end to end, shared by `robocal rig --setup` and the
-//! JSON boundary [`calibrate_rig_handeye_json`] (not bound to wasm: it would
-//! take the module past the 1.2 MB gzip guard, +69 KB measured).
+//! JSON boundary [`calibrate_rig_handeye_json`] (wasm and npm:
+//! `calibrate_rig_handeye`).
 //!
 //! JSON input:
 //!

@@ -29,14 +29,18 @@ export const truth = [
 ];
 const seen = { left: [0, 1, 2, 3, 4, 5, 6], middle: [0, 1, 2, 3, 4, 5, 6, 7, 8, 9], right: [3, 4, 5, 6, 7, 8, 9] };
 
-export function rigInput() {
-  const board = [];
-  for (let r = 0; r < 6; r++) for (let c = 0; c < 9; c++) board.push([c * 0.03, r * 0.03, 0]);
-  // rig_from_target: the board about 0.8 m ahead, tilted, drifting to the right.
-  const frames = Array.from({ length: 10 }, (_, k) => ({
+/** rig_from_target per frame: the board about 0.8 m ahead, tilted, drifting to the right. */
+export function rigFromTarget() {
+  return Array.from({ length: 10 }, (_, k) => ({
     R: rotation(0.35 * Math.sin(k), 0.25 * Math.cos(1.3 * k) + 0.05 * k, 0.1 * k),
     t: [-0.2 + 0.06 * k, -0.08, 0.75 + 0.02 * (k % 3)],
   }));
+}
+
+export function rigInput() {
+  const board = [];
+  for (let r = 0; r < 6; r++) for (let c = 0; c < 9; c++) board.push([c * 0.03, r * 0.03, 0]);
+  const frames = rigFromTarget();
   const cameras = truth.map((cam) => ({
     name: cam.name,
     image_size_px: [1280, 960],
