@@ -470,6 +470,69 @@ export const tests = [
     assert.match(await page.textContent('#camera-results h3'), /^Result: RMS \S+ px over 12 views$/);
   }],
 
+  // ---- pairing (issue 35): names with folders pair by file name; two rows for one image are refused ----
+  ['pose-names-with-folders', async (page, { url, shot }) => {
+    await loadDemoImages(page, url);
+    assert.equal(await solveCamera(page), null);
+    await page.click('a[data-step=robot]');
+    // The image column as a user's script writes it: a folder, Windows separators, a stem.
+    const lines = demo().poses.trim().split('\n');
+    const named = [lines[0], ...lines.slice(1).map((l, i) => {
+      const rest = l.slice(l.indexOf(','));
+      const name = i % 3 === 0 ? `images/demo_${String(i).padStart(2, '0')}.png` : i % 3 === 1 ? `C:\\cell\\demo_${String(i).padStart(2, '0')}.png` : `demo_${String(i).padStart(2, '0')}`;
+      return name + rest;
+    })];
+    await page.setInputFiles('#pose-input', text('folders.csv', `${named.join('\n')}\n`));
+    await page.waitForFunction(() => /Paired by the name column: 12 pairs usable/.test(document.getElementById('pose-pairing')?.textContent || ''), null, { timeout: 20000 });
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-errors').waitFor({ timeout: 60000 });
+    assert.equal(await page.$('#handeye-results .msg-error'), null);
+    // Two rows naming one image: refused, the rows named.
+    await page.click('a[data-step=robot]');
+    const twice = [...named];
+    twice[3] = `images/demo_01.png${lines[3].slice(lines[3].indexOf(','))}`;
+    await page.setInputFiles('#pose-input', text('twice.csv', `${twice.join('\n')}\n`));
+    await page.waitForFunction(() => /two poses name the same image/.test(document.getElementById('pose-pairing')?.textContent || ''), null, { timeout: 20000 });
+    await shot('bad');
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-results .msg-error').waitFor({ timeout: 10000 });
+    assert.equal(await page.textContent('#handeye-results'), "pairing: two poses name the same image: rows 3, 4 all name 'demo_01.png': each image pairs with one robot pose; fix the image column");
+  }],
+
+  // ---- New session (issue 34): every step starts anew, the hand-eye setup included ----
+  ['new-session-resets-every-step', async (page, { url }) => {
+    await loadDemoImages(page, url);
+    assert.equal(await solveCamera(page), null);
+    await page.click('a[data-step=robot]');
+    await page.setInputFiles('#pose-input', text('poses.csv', demo().poses));
+    await page.waitForFunction(() => /^poses\.csv: 12 poses read as ur/.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    await page.click('a[data-step=handeye]');
+    await page.selectOption('#handeye-setup', 'eye-to-hand');
+    page.once('dialog', (d) => d.accept());
+    await page.click('#new-session');
+    await page.waitForFunction(() => document.getElementById('handeye-setup')?.value === 'eye-in-hand', null, { timeout: 20000 });
+    assert.equal(await page.textContent('#pose-file-name'), 'no file loaded');
+    // The new session's images and pose file, eye-to-hand chosen anew: the
+    // solve uses them (the demo is eye-in-hand, so eye-to-hand is refused by name).
+    await page.setInputFiles('#file-input', demo().images);
+    await settled(page, demo().images.length);
+    assert.equal(await solveCamera(page), null);
+    await page.click('a[data-step=robot]');
+    await page.setInputFiles('#pose-input', text('new.csv', demo().poses));
+    await page.waitForFunction(() => /^new\.csv: 12 poses read as ur/.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    await page.click('a[data-step=handeye]');
+    await page.selectOption('#handeye-setup', 'eye-to-hand');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-results .msg-error').waitFor({ timeout: 60000 });
+    assert.match(await page.textContent('#handeye-results'), /^robot poses: these poses fit eye-in-hand \(the camera on the gripper\), not the eye-to-hand chosen/);
+    await page.selectOption('#handeye-setup', 'eye-in-hand');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-errors').waitFor({ timeout: 60000 });
+    assert.match(await page.textContent('#handeye-results'), /gripper_from_camera: translation/);
+  }],
+
   // ---- a share link (#share=...): the banner says what is wrong, the own session is kept ----
   ['share-link-damaged', shareCase(shareText(JSON.stringify({ kind: 'robocal-share', schema: 1 })).slice(0, 12),
     'this share link is damaged (it may have been cut off when it was copied)')],
