@@ -962,6 +962,12 @@ export interface PoseRefinementSummary {
   per_view_reprojection_rms_px?: number[];
   /** With image points: reprojection RMS of the closed form it started from, px. */
   closed_form_reprojection_rms_px?: number;
+  /** Present when the leave-one-out solutions spread wider than the noise model predicts: the factor the std (and the covariance's square root) were widened by. */
+  std_widened_by?: number;
+  /** The working distance: the median camera-target distance, m. */
+  work_distance_m?: number;
+  /** The std of a point at the working distance on the camera's optical axis, mm (root-sum-square over the axes): the hand-eye error where the camera looks. */
+  work_point_std_mm?: number;
 }
 
 /** One robot pose and the image paired with it (`robocal handeye` with images only). */
