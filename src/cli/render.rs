@@ -260,7 +260,7 @@ fn effects_of(a: &EffectArgs) -> Result<Effects, CliError> {
         fx.jpeg_quality = Some(q);
     }
     if let Some(t) = a.paper_texture {
-        fx.paper = (t > 0.0).then(|| Paper {
+        fx.paper = (t > 0.0).then_some(Paper {
             rms: t,
             wavelength_m: 0.04,
             seed: 17,
