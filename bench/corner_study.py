@@ -48,6 +48,8 @@ ROWS = [
     ("ideal", []),
     ("gamma 2.2", ["--gamma", "2.2"]),
     ("lens blur", ["--defocus", "0.8", "--field-curvature", "1", "--astigmatism", "1.5", "--coma", "1.5"]),
+    ("coma 1.5", ["--coma", "1.5"]),
+    ("astigmatism 1.5", ["--astigmatism", "1.5"]),
     ("motion 1.5 px", ["--motion", "1.5"]),
     ("bayer", ["--bayer"]),
     ("sensor 6000 e-", ["--full-well", "6000", "--noise", "0"]),
