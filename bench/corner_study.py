@@ -48,6 +48,7 @@ ROWS = [
     ("ideal", []),
     ("gamma 2.2", ["--gamma", "2.2"]),
     ("lens blur", ["--defocus", "0.8", "--field-curvature", "1", "--astigmatism", "1.5", "--coma", "1.5"]),
+    ("defocus + curvature", ["--defocus", "0.8", "--field-curvature", "1"]),
     ("coma 1.5", ["--coma", "1.5"]),
     ("astigmatism 1.5", ["--astigmatism", "1.5"]),
     ("motion 1.5 px", ["--motion", "1.5"]),
