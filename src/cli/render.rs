@@ -5,6 +5,7 @@ use super::CliError;
 use robocal::camera::Camera;
 use robocal::io::export_transform::transform_json;
 use robocal::synth::demo::{demo_camera, demo_session};
+use robocal::synth::effects::{Bayer, Effects, MotionBlur, Optics, Paper, SensorNoise};
 use robocal::synth::{render, RenderOptions, Scene};
 use robocal::target::Target;
 use std::path::Path;
@@ -16,6 +17,7 @@ use std::path::Path;
 
   robocal render --out DIR [--target SPEC] [--views N] [--seed N]
                  [--camera camera.json] [--noise GREY] [--blur PX]
+                 [--effects realistic] [--gamma G] [--defocus PX] ...
   robocal render --out DIR --demo [--seed N]
   robocal render --out DIR --rig [--views N] [--side-frames N] [--seed N]
   robocal render --video board.y4m [--size WxH] [--fps N] [--target SPEC]
@@ -28,6 +30,13 @@ DIR/view_000.png ... plus DIR/truth.json: {\"camera\", \"target\",
 \"views\": [{\"image\", \"camera_from_target\", \"points\": [{id, x_px, y_px}]}]}
 with the exact projection of every target point (pixel centres at integer
 coordinates).
+
+Camera effects (image sets only; default none, and renders without them
+are unchanged): --effects realistic turns on a cheap camera's gamma, lens
+blur growing to the corners, motion blur, Bayer mosaic and demosaic, shot
+and read noise, JPEG and paper texture; each effect flag sets or overrides
+one of them. The truth stays the ideal projection (with --rolling-shutter,
+the sheared position where the point is imaged).
 
 --demo writes the web app's demo session instead: 12 chessboard images, the
 robot poses that go with them (DIR/poses.csv, Universal Robots format with an
@@ -56,6 +65,8 @@ or --truth FILE): {\"camera\", \"target\", \"options\", \"video\", \"size_px\",
 frame's hold index or null while the board moves.",
     after_help = "Examples:
   robocal render --out renders --views 20 --seed 7
+  robocal render --out real --views 20 --effects realistic --noise 0
+  robocal render --out coma --coma 1.5 --astigmatism 1 --gamma 2.2
   robocal render --out demo --demo
   robocal render --out rig --rig --views 5 --side-frames 3
   robocal render --video board.y4m --size 1280x720 --target charuco:12x9:20mm:15mm:DICT_5X5_100",
@@ -120,6 +131,142 @@ pub struct RenderArgs {
     /// With --video: the truth file (default: the video's name with .json)
     #[arg(long, value_name = "FILE", requires = "video")]
     truth: Option<String>,
+    #[command(flatten)]
+    effects: EffectArgs,
+}
+
+/// Camera effects (robocal::synth::effects); each flag overrides the preset.
+#[derive(clap::Args)]
+#[command(next_help_heading = "Camera effects (default: none)")]
+struct EffectArgs {
+    /// Preset: none, or realistic (gamma 2.2, lens blur growing to the
+    /// corners, 0.5 px motion, Bayer + bilinear demosaic, shot + read noise,
+    /// JPEG 90, paper texture; see robocal::synth::Effects::realistic)
+    #[arg(long, value_name = "PRESET", default_value = "none")]
+    effects: String,
+    /// Camera response: encoded = 255 (linear / 255)^(1 / GAMMA)
+    #[arg(long, value_name = "GAMMA")]
+    gamma: Option<f64>,
+    /// Defocus disc radius at the image centre, pixels
+    #[arg(long, value_name = "PX")]
+    defocus: Option<f64>,
+    /// Extra defocus radius at the image corners (field curvature), pixels
+    #[arg(long, value_name = "PX")]
+    field_curvature: Option<f64>,
+    /// Extra radial blur radius at the image corners, pixels
+    #[arg(long, value_name = "PX")]
+    astigmatism: Option<f64>,
+    /// Comatic flare at the image corners, pixels
+    #[arg(long, value_name = "PX")]
+    coma: Option<f64>,
+    /// Motion blur length, pixels
+    #[arg(long, value_name = "PX")]
+    motion: Option<f64>,
+    /// Motion direction, degrees from the image x axis towards y
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 30.0,
+        allow_negative_numbers = true
+    )]
+    motion_angle: f64,
+    /// Rolling shutter: x shift of the scene per image row, pixels per row
+    #[arg(long, value_name = "PX", allow_negative_numbers = true)]
+    rolling_shutter: Option<f64>,
+    /// Bayer mosaic (RGGB) with 5 % white-balance residuals, bilinear demosaic
+    #[arg(long)]
+    bayer: bool,
+    /// Sensor noise: full well in electrons (255 grey levels at the full
+    /// well, 4 e- read noise)
+    #[arg(long, value_name = "ELECTRONS")]
+    full_well: Option<f64>,
+    /// JPEG quality 1-100
+    #[arg(long, value_name = "Q", value_parser = clap::value_parser!(u8).range(1..=100))]
+    jpeg: Option<u8>,
+    /// Paper texture, relative RMS of the albedo
+    #[arg(long, value_name = "RMS")]
+    paper_texture: Option<f64>,
+}
+
+fn effects_of(a: &EffectArgs) -> Result<Effects, CliError> {
+    let mut fx = match a.effects.as_str() {
+        "none" => Effects::default(),
+        "realistic" => Effects::realistic(),
+        other => {
+            return Err(CliError::usage(
+                "render",
+                format!("--effects must be none or realistic, got '{other}'"),
+            ))
+        }
+    };
+    for (flag, value) in [
+        ("--gamma", a.gamma),
+        ("--defocus", a.defocus),
+        ("--field-curvature", a.field_curvature),
+        ("--astigmatism", a.astigmatism),
+        ("--coma", a.coma),
+        ("--motion", a.motion),
+        ("--full-well", a.full_well),
+        ("--paper-texture", a.paper_texture),
+    ] {
+        if value.is_some_and(|v| !(v.is_finite() && v >= 0.0)) {
+            return Err(CliError::usage(
+                "render",
+                format!("{flag} must be a number >= 0, got {}", value.unwrap_or(0.0)),
+            ));
+        }
+    }
+    if let Some(g) = a.gamma {
+        fx.gamma = (g > 0.0).then_some(g);
+    }
+    if a.defocus.is_some()
+        || a.field_curvature.is_some()
+        || a.astigmatism.is_some()
+        || a.coma.is_some()
+    {
+        let o = fx.optics.get_or_insert(Optics {
+            defocus_px: 0.0,
+            field_curvature_px: 0.0,
+            astigmatism_px: 0.0,
+            coma_px: 0.0,
+        });
+        o.defocus_px = a.defocus.unwrap_or(o.defocus_px);
+        o.field_curvature_px = a.field_curvature.unwrap_or(o.field_curvature_px);
+        o.astigmatism_px = a.astigmatism.unwrap_or(o.astigmatism_px);
+        o.coma_px = a.coma.unwrap_or(o.coma_px);
+    }
+    if let Some(m) = a.motion {
+        fx.motion = (m > 0.0).then(|| MotionBlur {
+            length_px: m,
+            angle_rad: a.motion_angle.to_radians(),
+        });
+    }
+    if let Some(r) = a.rolling_shutter {
+        fx.rolling_shutter_px_per_row = r;
+    }
+    if a.bayer {
+        fx.bayer = Some(Bayer {
+            channel_gain: [0.95, 1.0, 1.05],
+        });
+    }
+    if let Some(fw) = a.full_well {
+        fx.sensor = (fw > 0.0).then(|| SensorNoise {
+            full_well_e: fw,
+            gain_dn_per_e: 255.0 / fw,
+            read_noise_e: 4.0,
+        });
+    }
+    if let Some(q) = a.jpeg {
+        fx.jpeg_quality = Some(q);
+    }
+    if let Some(t) = a.paper_texture {
+        fx.paper = (t > 0.0).then_some(Paper {
+            rms: t,
+            wavelength_m: 0.04,
+            seed: 17,
+        });
+    }
+    Ok(fx)
 }
 
 pub fn run(args: RenderArgs) -> Result<(), CliError> {
@@ -158,14 +305,11 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         Some(file) => robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0,
         None => demo_camera(),
     };
-    write_set(
-        out,
-        &camera,
-        &target,
-        args.views,
-        args.seed,
-        &render_options(&args),
-    )
+    let options = RenderOptions {
+        effects: effects_of(&args.effects)?,
+        ..render_options(&args)
+    };
+    write_set(out, &camera, &target, args.views, args.seed, &options)
 }
 
 fn render_options(args: &RenderArgs) -> RenderOptions {

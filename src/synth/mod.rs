@@ -4,6 +4,7 @@
 
 pub mod clutter;
 pub mod demo;
+pub mod effects;
 pub mod handeye;
 pub mod handeye_looking;
 pub mod render;
@@ -15,6 +16,7 @@ pub mod video;
 pub use scene::Scene;
 
 pub use clutter::clutter;
+pub use effects::Effects;
 pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
 pub use rng::Rng;
 pub use video::{video_camera, BoardVideo, VideoOptions};
@@ -34,3 +36,6 @@ pub fn board_pose(target: &Target, rpy: (f64, f64, f64), at: (f64, f64, f64)) ->
     let t = Vector3::new(at.0, at.1, at.2) - r * Vector3::new(mx, my, 0.0);
     Isometry3::from_parts(Translation3::from(t), r)
 }
+
+#[cfg(test)]
+mod effects_tests;

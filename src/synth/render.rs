@@ -21,6 +21,7 @@
 
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
+use crate::synth::effects::{self, Effects};
 use crate::synth::Rng;
 use crate::target::{DetectedPoint, Polarity, Target};
 use nalgebra::{Isometry3, Point2, Point3, Vector3};
@@ -108,6 +109,9 @@ pub struct RenderOptions {
     pub circle_diameter_ratio: f64,
     /// Noise seed.
     pub seed: u64,
+    /// Camera effects (gamma, lens PSF, motion, rolling shutter, Bayer,
+    /// sensor noise, JPEG, paper texture); default: all off.
+    pub effects: Effects,
 }
 
 impl Default for RenderOptions {
@@ -124,6 +128,7 @@ impl Default for RenderOptions {
             supersample: 8,
             circle_diameter_ratio: 0.5,
             seed: 1,
+            effects: Effects::default(),
         }
     }
 }
@@ -156,12 +161,18 @@ pub fn render(
     let target_from_camera = camera_from_target.inverse();
     let normal = camera_from_target.rotation * Vector3::z();
     let origin = camera_from_target.translation.vector;
+    let fx = &options.effects;
+    let (hw, hh) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
+    let skew = fx.rolling_shutter_px_per_row;
     // Board coordinates at the pixel corners (x - 0.5, y - 0.5).
     let (cw, ch) = (w as usize + 1, h as usize + 1);
     let mut corners: Vec<Option<(f64, f64)>> = Vec::with_capacity(cw * ch);
     for y in 0..ch {
         for x in 0..cw {
-            let px = Point2::new(x as f64 - 0.5, y as f64 - 0.5);
+            let mut px = Point2::new(x as f64 - 0.5, y as f64 - 0.5);
+            if skew != 0.0 {
+                px.x -= skew * (px.y - hh);
+            }
             corners.push(camera.unproject_pixel(&px).and_then(|ray| {
                 let den = normal.dot(&ray);
                 let lambda = normal.dot(&origin) / den;
@@ -191,34 +202,59 @@ pub fn render(
             };
         }
     }
+    if let Some(paper) = &fx.paper {
+        apply_paper(&mut img, &corners, w as usize, paper);
+    }
+    let mut plane = crate::detect::filter::Plane {
+        w: w as usize,
+        h: h as usize,
+        data: img,
+    };
+    if let Some(optics) = &fx.optics {
+        plane = effects::apply_optics(&plane, optics);
+    }
+    if let Some(motion) = &fx.motion {
+        plane = effects::apply_motion(&plane, motion);
+    }
     let blurred = if options.blur_sigma_px > 0.0 {
-        let plane = crate::detect::filter::Plane {
-            w: w as usize,
-            h: h as usize,
-            data: img,
-        };
         plane.gaussian(options.blur_sigma_px).data
     } else {
-        img
+        plane.data
     };
     let mut rng = Rng::new(options.seed);
-    let (hw, hh) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
     let rmax2 = hw * hw + hh * hh;
-    let mut pixels = Vec::with_capacity(blurred.len());
-    for (i, v) in blurred.iter().enumerate() {
-        let (x, y) = ((i % w as usize) as f64, (i / w as usize) as f64);
-        let r2 = ((x - hw).powi(2) + (y - hh).powi(2)) / rmax2.max(1e-9);
-        let light = options.gain
-            * (1.0 - options.vignetting * r2)
-            * (1.0 + options.gradient * (x / (w as f64).max(1.0) - 0.5));
-        let g = *v as f64 * light + rng.gaussian(options.noise_sigma);
-        pixels.push(g.round().clamp(0.0, 255.0) as u8);
-    }
+    let mut signal: Vec<f64> = blurred
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let (x, y) = ((i % w as usize) as f64, (i / w as usize) as f64);
+            let r2 = ((x - hw).powi(2) + (y - hh).powi(2)) / rmax2.max(1e-9);
+            let light = options.gain
+                * (1.0 - options.vignetting * r2)
+                * (1.0 + options.gradient * (x / (w as f64).max(1.0) - 0.5));
+            *v as f64 * light
+        })
+        .collect();
+    let pixels = if fx.is_off() {
+        signal
+            .iter()
+            .map(|v| {
+                (v + rng.gaussian(options.noise_sigma))
+                    .round()
+                    .clamp(0.0, 255.0) as u8
+            })
+            .collect()
+    } else {
+        camera_pipeline(&mut signal, w, h, options, &mut rng)?
+    };
     let points = target
         .object_points()
         .into_iter()
         .filter_map(|(id, p)| {
-            let q = camera.project_point(&(camera_from_target * p))?;
+            let mut q = camera.project_point(&(camera_from_target * p))?;
+            if skew != 0.0 {
+                q.x += skew * (q.y - hh);
+            }
             let inside = q.x >= 0.0 && q.y >= 0.0 && q.x <= w as f64 - 1.0 && q.y <= h as f64 - 1.0;
             inside.then_some(DetectedPoint {
                 id,
@@ -232,6 +268,70 @@ pub fn render(
         image: GrayImage::new(w, h, pixels)?,
         points,
     })
+}
+
+/// Steps 5-9 of [`effects`]: mosaic, sensor and additive noise, demosaic,
+/// response, 8 bits, JPEG.
+fn camera_pipeline(
+    signal: &mut [f64],
+    w: u32,
+    h: u32,
+    options: &RenderOptions,
+    rng: &mut Rng,
+) -> Result<Vec<u8>> {
+    let fx = &options.effects;
+    if let Some(bayer) = &fx.bayer {
+        effects::mosaic(signal, w as usize, bayer);
+    }
+    if let Some(sensor) = &fx.sensor {
+        // Its own stream: the additive noise keeps its draws.
+        let mut shot = Rng::new(options.seed ^ SENSOR_SEED);
+        effects::sensor_noise(signal, sensor, &mut shot);
+    }
+    for v in signal.iter_mut() {
+        *v += rng.gaussian(options.noise_sigma);
+    }
+    let grey = match &fx.bayer {
+        Some(_) => effects::demosaic_to_grey(signal, w as usize, h as usize),
+        None => signal.to_vec(),
+    };
+    let pixels: Vec<u8> = grey
+        .iter()
+        .map(|&v| {
+            let g = fx.gamma.map_or(v, |gamma| effects::response(v, gamma));
+            g.round().clamp(0.0, 255.0) as u8
+        })
+        .collect();
+    match fx.jpeg_quality {
+        Some(q) => effects::jpeg_round_trip(&pixels, w, h, q),
+        None => Ok(pixels),
+    }
+}
+
+/// Seed offset of the sensor-noise stream.
+const SENSOR_SEED: u64 = 0x5E45_0A11_D0C5_0001;
+
+/// Paper texture at each pixel's centre (the mean of its corners' board
+/// coordinates): the texture is smooth over a pixel.
+fn apply_paper(img: &mut [f32], corners: &[Option<(f64, f64)>], w: usize, paper: &effects::Paper) {
+    let texture = effects::Texture::new(paper);
+    let cw = w + 1;
+    for (i, v) in img.iter_mut().enumerate() {
+        let (x, y) = (i % w, i / w);
+        let c = [
+            corners[y * cw + x],
+            corners[y * cw + x + 1],
+            corners[(y + 1) * cw + x],
+            corners[(y + 1) * cw + x + 1],
+        ];
+        if let [Some(a), Some(b), Some(d), Some(e)] = c {
+            let (bx, by) = (
+                0.25 * (a.0 + b.0 + d.0 + e.0),
+                0.25 * (a.1 + b.1 + d.1 + e.1),
+            );
+            *v = (*v as f64 * (1.0 + texture.at(bx, by))) as f32;
+        }
+    }
 }
 
 fn supersample(albedo: &Albedo, c: &[Option<(f64, f64)>; 4], n: usize) -> f64 {
