@@ -222,7 +222,7 @@ fn aspect_ratio_holds_fx_equal_fy_and_repeat_times_the_solve() {
     for (value, message) in [
         (
             "0",
-            "robocal: aspect_ratio: fx / fy must be finite and > 0, got 0\n",
+            "robocal: intrinsics: --aspect-ratio must be between 0.01 and 100 (see 'robocal intrinsics --help')\n",
         ),
         (
             "x",
