@@ -225,6 +225,20 @@ pub fn calibrate_rig(
             frames_seen: a.frames.clone(),
         });
     }
+    // A joint fit that drags a camera's intrinsics far from what its own
+    // views say (issue 35): the rig's frames disagree with that camera
+    // (timing between free-running cameras, a camera moved between frames),
+    // and the intrinsics absorb it. Named, with the fix.
+    for (k, a) in alone.iter().enumerate() {
+        if let Some(w) = intrinsics_drift(
+            &names[k],
+            &a.camera,
+            &rig_cameras[k].calibration.camera,
+            &a.solo_std,
+        ) {
+            warnings.push(w);
+        }
+    }
     // Each solved camera's own advice (few views, uncovered image corners,
     // no tilt, correlated parameters), named; a held camera's intrinsics
     // are given, so its coverage advice does not apply.
@@ -427,4 +441,79 @@ pub fn sort_frame_keys(keys: &mut [String]) {
         (Err(_), Ok(_)) => std::cmp::Ordering::Greater,
         (Err(_), Err(_)) => a.cmp(b),
     });
+}
+
+/// A joint intrinsic further than this many of the camera's own std from
+/// its own calibration is named.
+pub const DRIFT_STD: f64 = 5.0;
+
+/// The warning for a camera whose intrinsics the joint fit moved by more
+/// than [`DRIFT_STD`] of their own std (`solo_std`, from the camera alone),
+/// naming the parameters that moved most (at most three).
+pub(crate) fn intrinsics_drift(
+    name: &str,
+    solo: &Camera,
+    joint: &Camera,
+    solo_std: &std::collections::BTreeMap<String, f64>,
+) -> Option<String> {
+    let names = solo.param_names();
+    let (a, b) = (solo.params(), joint.params());
+    let mut moved: Vec<(f64, String)> = names
+        .iter()
+        .zip(a.iter().zip(&b))
+        .filter_map(|(n, (x, y))| {
+            let s = *solo_std.get(*n)?;
+            let d = (y - x).abs();
+            (s > 0.0 && s.is_finite() && d > DRIFT_STD * s)
+                .then(|| (d / s, format!("{n} {x:.4} -> {y:.4} ({:.0} std)", d / s)))
+        })
+        .collect();
+    if moved.is_empty() {
+        return None;
+    }
+    moved.sort_by(|p, q| q.0.total_cmp(&p.0));
+    let list: Vec<String> = moved.into_iter().take(3).map(|m| m.1).collect();
+    Some(format!(
+        "camera {name}: the joint rig fit moved its intrinsics beyond their own uncertainty \
+         ({}): the rig's frames disagree with this camera (frames not taken at the same \
+         moment by free-running cameras, a camera moved, a board that bends); hold its \
+         intrinsics from its own calibration (CLI: --camera-file {name}=camera.json) or check \
+         the synchronisation",
+        list.join(", ")
+    ))
+}
+
+#[cfg(test)]
+mod drift_tests {
+    use super::*;
+    use std::collections::BTreeMap;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn intrinsics_moved_beyond_their_own_std_are_named() {
+        let solo = Camera::pinhole(907.0, 912.0, 622.0, 360.0, 1280, 720);
+        let std: BTreeMap<String, f64> = [("fx", 1.5), ("fy", 1.5), ("cx", 2.0), ("cy", 2.0)]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        // Within 5 std: nothing to say.
+        let near = Camera::pinhole(910.0, 915.0, 630.0, 362.0, 1280, 720);
+        assert_eq!(intrinsics_drift("cam2", &solo, &near, &std), None);
+        // cx dragged 108 px (54 std), fx 15 px (10 std): named, largest first.
+        let far = Camera::pinhole(922.0, 913.0, 514.0, 361.0, 1280, 720);
+        assert_eq!(
+            intrinsics_drift("cam2", &solo, &far, &std).unwrap(),
+            "camera cam2: the joint rig fit moved its intrinsics beyond their own uncertainty \
+             (cx 622.0000 -> 514.0000 (54 std), fx 907.0000 -> 922.0000 (10 std)): the rig's \
+             frames disagree with this camera (frames not taken at the same moment by \
+             free-running cameras, a camera moved, a board that bends); hold its intrinsics from \
+             its own calibration (CLI: --camera-file cam2=camera.json) or check the \
+             synchronisation"
+        );
+        // A held camera (no std of its own) is never named.
+        assert_eq!(
+            intrinsics_drift("cam2", &solo, &far, &BTreeMap::new()),
+            None
+        );
+    }
 }

@@ -40,6 +40,9 @@ pub(crate) struct Alone {
     pub outliers: Vec<Vec<Outlier>>,
     /// Views left out and why.
     pub warnings: Vec<String>,
+    /// The std of each intrinsic parameter from this camera's own
+    /// calibration (names of [`Camera::param_names`]); empty when held.
+    pub solo_std: std::collections::BTreeMap<String, f64>,
 }
 
 impl Alone {
@@ -89,6 +92,7 @@ pub(crate) fn camera_alone(input: &RigCameraViews, options: &CalibrationOptions)
                 poses: report_poses(&report)?,
                 used: used_masks(&usable, &report),
                 outliers: report.views.iter().map(|v| v.outliers.clone()).collect(),
+                solo_std: report.std.clone(),
                 camera,
                 held: false,
                 views: usable,
@@ -108,6 +112,7 @@ pub(crate) fn camera_alone(input: &RigCameraViews, options: &CalibrationOptions)
                     .map(|v| vec![true; v.object_m.len()])
                     .collect(),
                 outliers: vec![Vec::new(); usable.len()],
+                solo_std: Default::default(),
                 camera: given.clone(),
                 held: true,
                 views: usable,
