@@ -3,7 +3,7 @@
 // A URL whose fragment is #share=... opens a read-only results page.
 import { Engine, EnginePool } from './engine.js';
 import { Store, defaultSession } from './store.js';
-import { $ } from './lib/dom.js';
+import { $, h, fill, download } from './lib/dom.js';
 import { initTarget } from './views/target.js';
 import { ImagesView } from './views/images.js';
 import { CaptureView } from './views/capture.js';
@@ -13,7 +13,7 @@ import { HandEyeView } from './views/handeye.js';
 import { WorkflowsView } from './views/workflows.js';
 import { RigView } from './views/rig.js';
 import { ExportView } from './views/export.js';
-import { ShareView, sharedFragment, decodeShare } from './views/share.js';
+import { ShareView, sharedFragment, decodeShare, sessionFile } from './views/share.js';
 
 const engine = new Engine();
 let robotView = null;
@@ -113,12 +113,53 @@ async function openShared(fragment) {
   onHashChange(true, fragment);
 }
 
+/**
+ * What the page says about this browser's storage: a saved session that
+ * could not be restored (kept downloadable), or saving that failed (the
+ * session file offered). Empty and hidden when all is well.
+ */
+function showStorage(store) {
+  const box = $('storage-status');
+  const parts = [];
+  if (store.damaged) {
+    parts.push(h('p', {}, `The session saved in this browser could not be restored (${store.damaged.message}); a new session was started.`),
+      h('button', { type: 'button', id: 'download-damaged-session', onclick: () => download('robocal-damaged-session.json', sessionFile(store.damaged.session, 'unknown'), 'application/json') }, 'Download the damaged session'));
+  }
+  if (store.saveError) {
+    parts.push(h('p', {}, `Your work is no longer being saved in this browser (${store.saveError}): download the session file to keep it.`),
+      h('button', { type: 'button', id: 'download-unsaved-session', onclick: () => download('robocal-session.json', sessionFile(store.session, 'unknown'), 'application/json') }, 'Download session file'));
+  }
+  fill(box, ...parts);
+  box.hidden = !parts.length;
+}
+
 async function main() {
   const fragment = sharedFragment();
   if (fragment) return openShared(fragment);
   const versionPromise = engineVersion();
   stepKeys();
   await store.load();
+  showStorage(store);
+  store.onChange((what) => { if (what === 'storage') showStorage(store); });
+  // Whatever fails while the steps are built, New session still starts anew.
+  let started = false;
+  $('new-session').addEventListener('click', async () => {
+    if (started) return;
+    await store.reset();
+    location.hash = '';
+    location.reload();
+  });
+  try {
+    await startSteps(versionPromise);
+    started = true;
+  } catch (err) {
+    $('restoring').hidden = true;
+    $('engine-status').textContent = `The page could not restore this session: ${err.message}. Press New session to start anew.`;
+    console.error(err);
+  }
+}
+
+async function startSteps(versionPromise) {
   // Decoding the thumbnails of a saved session takes seconds: say so on the
   // step that will open instead of showing a blank panel.
   showStep(false);

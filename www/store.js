@@ -1,6 +1,7 @@
 // The session: everything the user loaded and computed, kept in IndexedDB so
 // that a reload or a crashed tab loses nothing. Image bytes live in their own
 // object store; the rest is one JSON document.
+import { checkSession } from './lib/validate.js';
 const DB_NAME = 'robocal';
 const DB_VERSION = 1;
 
@@ -79,7 +80,16 @@ export class Store {
     try {
       this.db = await openDb();
       const saved = await tx(this.db, 'session', 'readonly', (s) => s.get('current'));
-      if (saved && saved.schema === 1) this.session = { ...defaultSession(), ...saved };
+      if (saved && saved.schema === 1) {
+        try {
+          this.session = checkSession(saved);
+        } catch (e) {
+          // A damaged saved session never bricks the page: a new one starts,
+          // and the damaged one stays downloadable (app.js says so).
+          this.damaged = { session: saved, message: e.message };
+          this.session = defaultSession();
+        }
+      }
       for (const img of this.session.images) {
         const buf = await tx(this.db, 'blobs', 'readonly', (s) => s.get(img.id));
         if (buf) { this.bytes.set(img.id, buf); delete img.bytesMissing; }
@@ -116,8 +126,14 @@ export class Store {
     if (!this.db || !this.persistent) return;
     try {
       await tx(this.db, 'session', 'readwrite', (s) => s.put(this.session, 'current'));
+      if (this.saveError) {
+        this.saveError = null;
+        for (const fn of this.listeners) fn('storage');
+      }
     } catch (e) {
-      console.warn('could not save the session:', e);
+      // Saving never stops silently: the page says so and offers the session file.
+      this.saveError = e && e.message ? e.message : String(e);
+      for (const fn of this.listeners) fn('storage');
     }
   }
 

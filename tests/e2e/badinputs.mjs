@@ -540,6 +540,55 @@ export const tests = [
   ['share-link-not-json', shareCase(shareText('not json'), 'this link does not hold robocal results (its content is not JSON)')],
   ['share-link-null', shareCase(shareText('null'), 'this link does not hold robocal results')],
 
+  // Wrong types in a link (issue 37): refused by field, never an uncaught TypeError or a stack overflow.
+  ['share-link-wrong-types', shareCase(shareText(JSON.stringify({ kind: 'robocal-share', schema: 1, camera: { result: { camera_matrix: 'abc' } } })),
+    "this link's results are damaged: camera.result.camera_matrix must be a list, got the text 'abc'")],
+  ['share-link-views-not-a-list', shareCase(shareText(JSON.stringify({ kind: 'robocal-share', schema: 1, camera: { result: { camera_matrix: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], views: {} } } })),
+    "this link's results are damaged: camera.result.views must be a list, got an object")],
+  ['share-link-200000-views', shareCase(shareText(JSON.stringify({ kind: 'robocal-share', schema: 1, camera: { result: { camera_matrix: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], views: new Array(200000).fill(0) } } })),
+    "this link's results are damaged: camera.result.views holds 200000 entries, more than the 10000 the page takes")],
+
+  // ---- a damaged session (issue 37): refused by field, the current session kept, the page never bricked ----
+  ['session-file-null-camera', async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.click('a[data-step=share]');
+    const doc = { kind: 'robocal-session', schema: 1, robocal_version: 'x', session: { schema: 1, images: [], camera: null } };
+    await page.setInputFiles('#session-input', text('damaged.json', JSON.stringify(doc)));
+    await page.waitForFunction(() => /damaged/.test(document.getElementById('session-status')?.textContent || ''), null, { timeout: 10000 });
+    assert.equal(await page.textContent('#session-status'), 'damaged.json: this session file is damaged: session.camera must be an object, got null; nothing was loaded, the current session is kept');
+    await shot('bad');
+    await page.click('a[data-step=images]');
+    assert.deepEqual((await cards(page)).map((c) => c.name), ['board.png']);
+  }],
+  ['saved-session-damaged', async (page, { url, shot }) => {
+    await loadBoard(page, url);
+    await page.waitForTimeout(500); // saved 300 ms after the last change
+    // The saved session damaged in storage (as a bad session file of an older page left it).
+    await page.evaluate(() => new Promise((resolve, reject) => {
+      const req = indexedDB.open('robocal', 1);
+      req.onsuccess = () => {
+        const t = req.result.transaction('session', 'readwrite');
+        const s = t.objectStore('session');
+        const get = s.get('current');
+        get.onsuccess = () => { s.put({ ...get.result, robot: null }, 'current'); };
+        t.oncomplete = () => resolve();
+        t.onerror = () => reject(t.error);
+      };
+      req.onerror = () => reject(req.error);
+    }));
+    await page.reload();
+    await ready(page);
+    await page.locator('#storage-status:not([hidden])').waitFor({ timeout: 20000 });
+    assert.match(await page.textContent('#storage-status'), /^The session saved in this browser could not be restored \(session\.robot must be an object, got null\); a new session was started\.Download the damaged session$/);
+    assert.equal(await page.isVisible('#restoring'), false);
+    await shot('bad');
+    // The page works: the demo loads and the damaged session stays downloadable.
+    await page.click('#demo-button');
+    await page.waitForFunction(() => /12 with the target/.test(document.getElementById('image-summary').textContent), null, { timeout: 120000 });
+    const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#download-damaged-session')]);
+    assert.equal(dl.suggestedFilename(), 'robocal-damaged-session.json');
+  }],
+
   // ---- step 7, stereo pairs and rigs: the grouping refuses with the core's message ----
   ['rig-too-few-frames', async (page, { url, shot }) => {
     await page.goto(`${url}#stereo`);

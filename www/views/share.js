@@ -4,6 +4,7 @@
 // load. And a self-contained HTML report (views/report.js).
 import { $, h, fill, download, message } from '../lib/dom.js';
 import { reportHtml } from './report.js';
+import { checkSession, checkSharePayload } from '../lib/validate.js';
 
 const PREFIX = '#share=';
 
@@ -45,7 +46,11 @@ export async function decodeShare(text) {
     throw new Error('this link does not hold robocal results (its content is not JSON)');
   }
   if (!payload || payload.kind !== 'robocal-share' || payload.schema !== 1) throw new Error('this link does not hold robocal results');
-  return payload;
+  try {
+    return checkSharePayload(payload);
+  } catch (e) {
+    throw new Error(`this link's results are damaged: ${e.message}`);
+  }
 }
 
 export function sharedFragment() {
@@ -109,7 +114,11 @@ export function readSessionFile(text) {
     throw new Error('this file is not a robocal session file (save one with "Download session file")');
   }
   if (!Array.isArray(doc.session.images)) throw new Error('this session file has no image list');
-  return doc.session;
+  try {
+    return checkSession(doc.session, 'session');
+  } catch (e) {
+    throw new Error(`this session file is damaged: ${e.message}; nothing was loaded, the current session is kept`);
+  }
 }
 
 export class ShareView {

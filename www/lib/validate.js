@@ -1,0 +1,176 @@
+// Sessions and share links checked field by field before the page uses them
+// (issue 37): a damaged or crafted one is refused with a message naming the
+// field, never half-used (a null step used to leave "Restoring your
+// session..." forever, an image without an id silently stopped saving).
+import { defaultSession } from '../store.js';
+
+/** Most images, rig files, views or poses a session or link may hold. */
+export const MAX_ITEMS = 10000;
+
+const isObject = (v) => v !== null && typeof v === 'object' && !Array.isArray(v);
+
+function describe(v) {
+  if (v === null) return 'null';
+  if (Array.isArray(v)) return 'a list';
+  if (v === undefined) return 'nothing';
+  if (typeof v === 'string') return `the text '${v.length > 20 ? `${v.slice(0, 20)}…` : v}'`;
+  return typeof v === 'object' ? 'an object' : `a ${typeof v}`;
+}
+
+function fail(path, want, got) {
+  throw new Error(`${path} must be ${want}, got ${describe(got)}`);
+}
+
+const check = {
+  object(v, path) { if (!isObject(v)) fail(path, 'an object', v); return v; },
+  objectOrNull(v, path) { if (v !== null && v !== undefined && !isObject(v)) fail(path, 'an object or null', v); return v ?? null; },
+  string(v, path) { if (typeof v !== 'string') fail(path, 'a text', v); return v; },
+  stringOrNull(v, path) { if (v !== null && v !== undefined && typeof v !== 'string') fail(path, 'a text or null', v); return v ?? null; },
+  number(v, path) { if (typeof v !== 'number' || !Number.isFinite(v)) fail(path, 'a finite number', v); return v; },
+  list(v, path) {
+    if (!Array.isArray(v)) fail(path, 'a list', v);
+    if (v.length > MAX_ITEMS) throw new Error(`${path} holds ${v.length} entries, more than the ${MAX_ITEMS} the page takes`);
+    return v;
+  },
+  oneOf(v, path, values) {
+    if (!values.includes(v)) throw new Error(`${path} must be one of ${values.join(', ')}, got ${describe(v)}`);
+    return v;
+  },
+};
+
+/** A 3 x 3 matrix of finite numbers. */
+function matrix3(v, path) {
+  check.list(v, path);
+  if (v.length !== 3) throw new Error(`${path} must have 3 rows, got ${v.length}`);
+  v.forEach((row, i) => {
+    check.list(row, `${path}[${i}]`);
+    if (row.length !== 3) throw new Error(`${path}[${i}] must have 3 numbers, got ${row.length}`);
+    row.forEach((x, j) => check.number(x, `${path}[${i}][${j}]`));
+  });
+}
+
+/** The camera step's result as the views read it: a camera report. */
+export function checkCameraResult(r, path) {
+  if (r === null || r === undefined) return null;
+  check.object(r, path);
+  matrix3(r.camera_matrix, `${path}.camera_matrix`);
+  if (r.distortion !== undefined) check.object(r.distortion, `${path}.distortion`);
+  if (r.rms_px !== undefined) check.number(r.rms_px, `${path}.rms_px`);
+  if (r.std !== undefined) check.object(r.std, `${path}.std`);
+  if (r.views !== undefined) {
+    check.list(r.views, `${path}.views`).forEach((view, i) => {
+      check.object(view, `${path}.views[${i}]`);
+      if (view.name !== undefined) check.string(view.name, `${path}.views[${i}].name`);
+    });
+  }
+  if (r.warnings !== undefined) check.list(r.warnings, `${path}.warnings`);
+  return r;
+}
+
+/** The hand-eye step's result: a hand-eye report. */
+export function checkHandeyeResult(r, path) {
+  if (r === null || r === undefined) return null;
+  check.object(r, path);
+  if (r.setup !== undefined) check.oneOf(r.setup, `${path}.setup`, ['eye-in-hand', 'eye-to-hand']);
+  for (const key of ['gripper_from_camera', 'base_from_camera', 'base_from_target', 'gripper_from_target']) {
+    if (r[key] !== undefined && r[key] !== null) {
+      check.object(r[key], `${path}.${key}`);
+      const m = r[key].matrix_row_major;
+      if (m !== undefined) {
+        check.list(m, `${path}.${key}.matrix_row_major`);
+        m.forEach((row, i) => check.list(row, `${path}.${key}.matrix_row_major[${i}]`).forEach((x, j) => check.number(x, `${path}.${key}.matrix_row_major[${i}][${j}]`)));
+      }
+    }
+  }
+  for (const key of ['errors', 'motion', 'pose_refinement', 'repeatability']) check.objectOrNull(r[key], `${path}.${key}`);
+  for (const key of ['warnings', 'methods', 'per_view', 'per_motion', 'pairs', 'pair_names']) if (r[key] !== undefined) check.list(r[key], `${path}.${key}`);
+  return r;
+}
+
+/** One image of the session's list. */
+function checkImage(img, path) {
+  check.object(img, path);
+  if (!(typeof img.id === 'string' && img.id) && !Number.isFinite(img.id)) fail(`${path}.id`, 'a text or number', img.id);
+  check.string(img.name, `${path}.name`);
+  if (img.included === undefined) img.included = true;
+  else if (typeof img.included !== 'boolean') fail(`${path}.included`, 'true or false', img.included);
+  for (const key of ['detection', 'info']) check.objectOrNull(img[key], `${path}.${key}`);
+  for (const key of ['status', 'error']) check.stringOrNull(img[key], `${path}.${key}`);
+  return img;
+}
+
+/**
+ * A session (IndexedDB or a session file) made whole and checked: missing
+ * steps and fields take their defaults, a field of the wrong type is an
+ * Error naming it (`session.camera must be an object, got null`).
+ */
+export function checkSession(raw, path = 'session') {
+  check.object(raw, path);
+  const d = defaultSession();
+  const step = (key) => {
+    if (raw[key] === undefined) return d[key];
+    check.object(raw[key], `${path}.${key}`);
+    return { ...d[key], ...raw[key] };
+  };
+  const s = { ...d, ...raw, schema: 1 };
+  s.target = raw.target === undefined ? d.target : check.object(raw.target, `${path}.target`);
+  s.images = raw.images === undefined ? [] : check.list(raw.images, `${path}.images`);
+  s.images.forEach((img, i) => checkImage(img, `${path}.images[${i}]`));
+  const ids = new Set();
+  s.images.forEach((img, i) => {
+    if (ids.has(img.id)) throw new Error(`${path}.images[${i}].id '${img.id}' is used twice`);
+    ids.add(img.id);
+  });
+
+  s.camera = step('camera');
+  check.string(s.camera.model, `${path}.camera.model`);
+  check.string(s.camera.method, `${path}.camera.method`);
+  check.object(s.camera.options, `${path}.camera.options`);
+  s.camera.result = checkCameraResult(s.camera.result, `${path}.camera.result`);
+  if (s.camera.comparison !== null && s.camera.comparison !== undefined && typeof s.camera.comparison !== 'object') fail(`${path}.camera.comparison`, 'an object, a list or null', s.camera.comparison);
+
+  s.robot = step('robot');
+  for (const key of ['fileName', 'text']) s.robot[key] = check.stringOrNull(s.robot[key], `${path}.robot.${key}`);
+  for (const key of ['format', 'lengthUnit', 'angleUnit', 'direction']) check.string(s.robot[key], `${path}.robot.${key}`);
+  s.robot.parsed = check.objectOrNull(s.robot.parsed, `${path}.robot.parsed`);
+  if (s.robot.parsed && s.robot.parsed.poses !== undefined) check.list(s.robot.parsed.poses, `${path}.robot.parsed.poses`);
+
+  s.handeye = step('handeye');
+  check.oneOf(s.handeye.setup, `${path}.handeye.setup`, ['eye-in-hand', 'eye-to-hand']);
+  check.string(s.handeye.method, `${path}.handeye.method`);
+  s.handeye.result = checkHandeyeResult(s.handeye.result, `${path}.handeye.result`);
+
+  s.workflows = step('workflows');
+  for (const key of ['planar', 'xytable']) s.workflows[key] = check.objectOrNull(s.workflows[key], `${path}.workflows.${key}`);
+
+  s.rig = step('rig');
+  check.string(s.rig.model, `${path}.rig.model`);
+  s.rig.result = check.objectOrNull(s.rig.result, `${path}.rig.result`);
+  check.list(s.rig.cameras, `${path}.rig.cameras`).forEach((cam, i) => {
+    const p = `${path}.rig.cameras[${i}]`;
+    check.object(cam, p);
+    check.string(cam.name, `${p}.name`);
+    check.list(cam.files, `${p}.files`).forEach((f, j) => {
+      check.object(f, `${p}.files[${j}]`);
+      if (!(typeof f.id === 'string' && f.id) && !Number.isFinite(f.id)) fail(`${p}.files[${j}].id`, 'a text or number', f.id);
+      check.string(f.name, `${p}.files[${j}].name`);
+    });
+  });
+  s.stereo = check.objectOrNull(raw.stereo, `${path}.stereo`);
+  return s;
+}
+
+/** A share link's payload (`{kind, schema, target, camera, handeye, ...}`) checked as the read-only page reads it. */
+export function checkSharePayload(p) {
+  if (p.target !== undefined && p.target !== null) check.object(p.target, 'target');
+  if (p.camera !== undefined && p.camera !== null) {
+    check.object(p.camera, 'camera');
+    checkCameraResult(p.camera.result, 'camera.result');
+  }
+  if (p.handeye !== undefined && p.handeye !== null) {
+    check.object(p.handeye, 'handeye');
+    if (p.handeye.setup !== undefined) check.oneOf(p.handeye.setup, 'handeye.setup', ['eye-in-hand', 'eye-to-hand']);
+    checkHandeyeResult(p.handeye.result, 'handeye.result');
+  }
+  return p;
+}
