@@ -463,7 +463,7 @@ export interface CameraCalibration {
   /** Present with the robust option. */
   rejected?: RejectedPoints;
   /** The worst level of `warnings`: "error" means the result is not a calibration (the fit did not converge from any start) and the first warning, beginning with "error: ", says why. */
-  severity: "ok" | "warning" | "error";
+  severity?: "ok" | "warning" | "error";
   /** Zhang's method: the start the result came from ("closed_form", "given", "tsai", "dlt", "square_pixels", "centred_principal_point", "square_pixels_centred", "distortion_held_then_freed", "comparison:METHOD"). */
   start?: string;
   /** Every start tried, when the first did not converge or gave an implausible camera (the lowest cost wins). */

@@ -30,7 +30,7 @@ mod stereo;
 mod target;
 mod xytable;
 
-pub use input::{read_file, read_pose_text, read_text};
+pub use input::{read_pose_text, read_text};
 
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use robocal::target::Target;

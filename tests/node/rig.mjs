@@ -6,7 +6,7 @@
 import assert from 'node:assert/strict';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { rigInput, rigFromTarget, rotation, truth } from './rig_scene.mjs';
+import { rigInput, rigOnRobot, truth } from './rig_scene.mjs';
 
 const work = process.argv[2];
 if (!work) throw new Error('usage: node rig.mjs WORK_DIR (with robocal installed)');
@@ -48,25 +48,12 @@ console.log(`rig ok: 3 cameras, worst camera_from_rig error ${worstT.toExponenti
 // The rig on a robot (`calibrate_rig_handeye`): the same frames as robot
 // poses of an eye-in-hand cell with a known gripper_from_rig and
 // base_from_target; noise-free, so gripper_from_rig must come back to 1e-6 m.
-const mul = (A, B) => A.map((row) => B[0].map((_, j) => row.reduce((s, v, k) => s + v * B[k][j], 0)));
-const hom = (R, t) => [[...R[0], t[0]], [...R[1], t[1]], [...R[2], t[2]], [0, 0, 0, 1]];
-const inv = (M) => {
-  const Rt = [0, 1, 2].map((i) => [0, 1, 2].map((j) => M[j][i]));
-  const t = [0, 1, 2].map((i) => -(Rt[i][0] * M[0][3] + Rt[i][1] * M[1][3] + Rt[i][2] * M[2][3]));
-  return hom(Rt, t);
-};
-const gripperFromRig = hom(rotation(0.1, -0.05, 0.3), [0.03, -0.02, 0.11]);
-const baseFromTarget = hom(rotation(3.0, 0.1, -0.2), [0.7, 0.1, -0.1]);
-const robot = rigFromTarget().map((f) => mul(mul(baseFromTarget, inv(hom(f.R, f.t))), inv(gripperFromRig)));
-const onRobot = JSON.parse(robocal.calibrate_rig_handeye(JSON.stringify({
-  setup: 'eye-in-hand',
-  base_from_gripper: robot.map((m) => ({ matrix_row_major: m })),
-  calibration: rigInput(),
-})));
+const { gripperFromRig, input: onRobotInput } = rigOnRobot();
+const onRobot = JSON.parse(robocal.calibrate_rig_handeye(JSON.stringify(onRobotInput)));
 const solved = onRobot.handeye.gripper_from_rig.matrix_row_major;
 let handeyeErr = 0;
 for (let i = 0; i < 3; i++) for (let j = 0; j < 4; j++) handeyeErr = Math.max(handeyeErr, Math.abs(solved[i][j] - gripperFromRig[i][j]));
 assert.ok(handeyeErr < 1e-6, 'gripper_from_rig error ' + handeyeErr);
 assert.deepEqual(onRobot.cameras.map((c) => c.name), ['left', 'middle', 'right']);
-assert.throws(() => robocal.calibrate_rig_handeye(JSON.stringify({ setup: 'eye-in-hand', base_from_gripper: [], calibration: rigInput(), extra: 1 })), { message: /unknown field `extra`/ });
+assert.throws(() => robocal.calibrate_rig_handeye(JSON.stringify({ ...onRobotInput, extra: 1 })), { message: /unknown field `extra`/ });
 console.log(`rig on a robot ok: gripper_from_rig within ${handeyeErr.toExponential(1)} (m and rotation entries)`);

@@ -55,3 +55,26 @@ export function rigInput() {
   // k3 held at 0: Kalibr's radtan has no k3 (the kalibr export needs it).
   return { model: 'brown', options: { fixed_coefficients: ['k3'] }, target: 'chessboard:9x6:30mm', cameras };
 }
+
+const mul = (A, B) => A.map((row) => B[0].map((_, j) => row.reduce((acc, v, k) => acc + v * B[k][j], 0)));
+const hom = (R, t) => [[...R[0], t[0]], [...R[1], t[1]], [...R[2], t[2]], [0, 0, 0, 1]];
+const inv = (M) => {
+  const Rt = [0, 1, 2].map((i) => [0, 1, 2].map((j) => M[j][i]));
+  const t = [0, 1, 2].map((i) => -(Rt[i][0] * M[0][3] + Rt[i][1] * M[1][3] + Rt[i][2] * M[2][3]));
+  return hom(Rt, t);
+};
+
+/**
+ * The rig on a robot, eye-in-hand: a known gripper_from_rig and
+ * base_from_target, and the robot pose of every frame that closes the chain
+ * (base_from_gripper = base_from_target * target_from_rig * rig_from_gripper).
+ */
+export function rigOnRobot() {
+  const gripperFromRig = hom(rotation(0.1, -0.05, 0.3), [0.03, -0.02, 0.11]);
+  const baseFromTarget = hom(rotation(3.0, 0.1, -0.2), [0.7, 0.1, -0.1]);
+  const robot = rigFromTarget().map((f) => mul(mul(baseFromTarget, inv(hom(f.R, f.t))), inv(gripperFromRig)));
+  return {
+    gripperFromRig,
+    input: { setup: 'eye-in-hand', base_from_gripper: robot.map((m) => ({ matrix_row_major: m })), calibration: rigInput() },
+  };
+}

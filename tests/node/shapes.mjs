@@ -10,7 +10,7 @@ import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { rigInput } from './rig_scene.mjs';
+import { rigInput, rigOnRobot } from './rig_scene.mjs';
 
 // Node has no ImageData; the previews need one (pkg-config/README.md).
 globalThis.ImageData = class ImageData { constructor(data, width, height) { Object.assign(this, { data, width, height }); } };
@@ -154,9 +154,16 @@ const board = (d) => d.points.map((p) => [(p.id % 9) * 0.03, Math.floor(p.id / 9
 const pixels = (d) => d.points.map((p) => [p.x_px, p.y_px]);
 const pairs = views.slice(0, 4).map((v) => ({ name: v.name, object_m: board(v.detection), image_px: pixels(v.detection) }));
 call('calibrate_camera', { model: 'kannala_brandt', method: 'zhang', views: pairs, image_size_px: [1024, 768] }, 'calibrate_camera points');
-call('calibrate_stereo', { model: 'division', left: views, right: views });
+{
+  // A real pair (the same images on both sides are refused): the rig scene's
+  // left and middle cameras over the frames both see (1-7).
+  const [left, middle] = rigInput().cameras;
+  const strip = (v) => ({ name: v.name, object_m: v.object_m, image_px: v.image_px });
+  call('calibrate_stereo', { model: 'division', left: left.views.map(strip), right: middle.views.slice(0, 7).map(strip), left_image_size_px: [1280, 960], right_image_size_px: [1280, 960] });
+}
 {
   const rig = call('calibrate_rig', rigInput());
+  call('calibrate_rig_handeye', rigOnRobot().input);
   output('rig_export_formats', JSON.parse(robocal.rig_export_formats()));
   output('export_report_files', JSON.parse(robocal.export_report_files(JSON.stringify(input('export_report_files', rig)), 'ros', '', '')));
 }
