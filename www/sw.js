@@ -24,6 +24,7 @@ const SHELL = [
   'lib/mat4.js',
   'lib/plot.js',
   'lib/rig3d.js',
+  'lib/validate.js',
   'lib/view3d.js',
   'views/boards.js',
   'views/camera.js',

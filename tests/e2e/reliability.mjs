@@ -48,15 +48,16 @@ function craftedPayload() {
     camera: {
       model: 'brown', method: 'zhang', comparison: null,
       result: {
-        model: EVIL.img, image_size_px: [640, 480], rms_px: EVIL.js,
+        model: EVIL.img, image_size_px: [640, 480], rms_px: 0.5, method: EVIL.js,
         camera_matrix: [[500, 0, 320], [0, 500, 240], [0, 0, 1]],
         distortion: { k1: 0.1, [EVIL.script]: EVIL.img }, std: {}, views: [],
         warnings: [EVIL.img, { message: EVIL.js }],
       },
     },
     handeye: {
-      setup: EVIL.img,
+      setup: 'eye-in-hand',
       result: {
+        method: EVIL.img,
         gripper_from_camera: { matrix_row_major: [[1, 0, 0, 0.1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], translation_m: [0.1, 0, 0], quaternion_xyzw: [0, 0, 0, 1] },
         errors: { [EVIL.img]: EVIL.js }, warnings: [EVIL.script],
       },
