@@ -14,13 +14,14 @@
 //!
 //! `cargo run --release --example handeye_coverage -- [TRIALS]` (default 100).
 
-use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use robocal::camera::Camera;
 use robocal::handeye::pnp::camera_from_target_with_covariance;
 use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
 use robocal::handeye::reprojection_refine::ViewPoints;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
-use robocal::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
+use robocal::synth::handeye_looking::{
+    grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,
+};
 use robocal::synth::Rng;
 
 struct Cell {
@@ -33,26 +34,6 @@ struct Cell {
     kinematic: (f64, f64),
     /// Relative focal-length error of the camera used for PnP.
     focal_error: f64,
-}
-
-/// A robot error that depends on the pose smoothly, like a kinematic model
-/// error: the same pose always gets the same error.
-fn kinematic_error(pose: &Pose, amp_mm: f64, amp_deg: f64) -> Pose {
-    let p = pose.translation.vector;
-    let w = pose.rotation.scaled_axis();
-    let k = std::f64::consts::TAU / 0.4;
-    let dt = Vector3::new(
-        (k * p.x).sin(),
-        (k * p.y + 1.0).sin(),
-        (k * p.z + 2.0).sin(),
-    ) * amp_mm
-        * 1e-3;
-    let dr = Vector3::new(
-        (3.0 * w.x).sin(),
-        (3.0 * w.y + 1.0).sin(),
-        (3.0 * w.z + 2.0).sin(),
-    ) * amp_deg.to_radians();
-    Pose::from_parts(Translation3::from(dt), UnitQuaternion::from_scaled_axis(dr)) * pose
 }
 
 /// One trial: `(covered, covered by the model's std before widening,

@@ -150,12 +150,11 @@ fn misspecified(
     kinematic: bool,
     focal_error: f64,
 ) -> (robocal::handeye::HandEyeResult, robocal::handeye::Pose) {
-    use nalgebra::{Translation3, UnitQuaternion, Vector3};
     use robocal::camera::Camera;
     use robocal::handeye::pnp::camera_from_target_with_covariance;
     use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
     use robocal::handeye::{MotionPairs, Pose};
-    use robocal::synth::handeye_looking::grid_pixels;
+    use robocal::synth::handeye_looking::{grid_pixels, kinematic_error};
     let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
     let scene = looking_scene(
         &LookingConfig {
@@ -176,31 +175,12 @@ fn misspecified(
         .iter()
         .map(|v| camera_from_target_with_covariance(&used, v).unwrap().0)
         .collect();
-    let k = std::f64::consts::TAU / 0.4;
-    let amp = if kinematic {
-        (0.3e-3, 0.02f64.to_radians())
-    } else {
-        (0.0, 0.0)
-    };
+    let amp = if kinematic { (0.3, 0.02) } else { (0.0, 0.0) };
     let robots: Vec<Pose> = scene
         .base_from_gripper
         .iter()
         .map(|p| {
-            let (t, w) = (p.translation.vector, p.rotation.scaled_axis());
-            let dt = Vector3::new(
-                (k * t.x).sin(),
-                (k * t.y + 1.0).sin(),
-                (k * t.z + 2.0).sin(),
-            );
-            let dr = Vector3::new(
-                (3.0 * w.x).sin(),
-                (3.0 * w.y + 1.0).sin(),
-                (3.0 * w.z + 2.0).sin(),
-            );
-            let kin = Pose::from_parts(
-                Translation3::from(dt * amp.0),
-                UnitQuaternion::from_scaled_axis(dr * amp.1),
-            ) * p;
+            let kin = kinematic_error(p, amp.0, amp.1);
             perturbed(&mut rng, &kin, [0.02f64.to_radians(); 3], [0.1e-3; 3])
         })
         .collect();

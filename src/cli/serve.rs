@@ -13,6 +13,8 @@ use std::net::{IpAddr, SocketAddr, TcpListener};
 mod files;
 #[path = "serve_http.rs"]
 mod http;
+#[path = "serve_slow.rs"]
+mod slow;
 
 #[derive(clap::Args)]
 #[command(

@@ -6,8 +6,8 @@
 
 use super::axxb;
 use super::motion::build_motions;
-use super::report::{lever_arm_m, motion_residuals, motion_rms, view_residuals, ViewResidual};
-use super::solve::{solve_method, HandEyeInput, HandEyeOptions};
+use super::report::{motion_residuals, motion_rms};
+use super::solve::{HandEyeInput, HandEyeOptions};
 use super::{Chain, HandEyeMethod, MotionPairs, Pose, Setup, MIN_MOTION_ROTATION_DEG};
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -30,17 +30,6 @@ const SCALE_TOLERANCE: f64 = 1.5;
 /// Largest translation component (m) a pose may have: no robot cell or
 /// camera range is 10 km; beyond it a row holds a typo or another unit.
 pub const MAX_TRANSLATION_M: f64 = 1e4;
-/// A pose pair is a gross error when, with it left out, its residual (the
-/// displacement at the target, mm) is this many times the median of the
-/// others ...
-pub const GROSS_RATIO: f64 = 100.0;
-/// ... and at least this large (mm): noise-free data has medians of 1e-9 mm,
-/// and a few centimetres are the robust refinement's to down-weight.
-pub const GROSS_MIN_MM: f64 = 100.0;
-/// Pose pairs with the largest residuals under the full solution that are
-/// each tried left out.
-const GROSS_CANDIDATES: usize = 3;
-
 /// How well robot poses fit the camera motion (Park-Martin rotation, least
 /// squares translation, residuals of `A X = X B` over all motion pairs).
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -300,7 +289,7 @@ pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec
             set.kept.len()
         )));
     }
-    refuse_gross_pose(&chain, options.motion_pairs)?;
+    super::gross::refuse_gross_pose(&chain, options.motion_pairs)?;
     let findings = mistakes(input)?;
     if options.strict_checks {
         if let Some(first) = findings.first() {
@@ -308,74 +297,6 @@ pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec
         }
     }
     Ok(findings)
-}
-
-/// Refuse a pose pair whose residual is orders of magnitude above the
-/// others' (a row typed in mm in a metre file, a digit too many): with the
-/// candidate left out (each of the [`GROSS_CANDIDATES`] largest residuals
-/// under the full Park-Martin solution; the one whose removal fits the
-/// others best), its residual is above [`GROSS_RATIO`] times the median of
-/// the others and above [`GROSS_MIN_MM`]. The error names the pair.
-pub fn refuse_gross_pose(chain: &Chain, pairs: MotionPairs) -> Result<()> {
-    let n = chain.len();
-    if n <= MIN_POSES {
-        return Ok(());
-    }
-    let lever = lever_arm_m(chain);
-    let displacement = |r: &ViewResidual| {
-        let rot_mm = r.rotation_deg.to_radians() * lever * 1e3;
-        r.translation_mm.hypot(rot_mm)
-    };
-    let solve = |c: &Chain| -> Option<(Pose, Pose)> {
-        let (x, y, _) = solve_method(HandEyeMethod::ParkMartin, c, pairs).ok()?;
-        Some((x, y))
-    };
-    let Some((x, y)) = solve(chain) else {
-        return Ok(());
-    };
-    let full: Vec<f64> = view_residuals(chain, &x, &y)
-        .iter()
-        .map(displacement)
-        .collect();
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| full[b].total_cmp(&full[a]));
-    // (median of the others, the candidate, its residual and rotation).
-    let mut best: Option<(f64, usize, ViewResidual, f64)> = None;
-    for &c in order.iter().take(GROSS_CANDIDATES) {
-        let keep: Vec<usize> = (0..n).filter(|&i| i != c).collect();
-        let rest = Chain {
-            robot: keep.iter().map(|&i| chain.robot[i]).collect(),
-            camera: keep.iter().map(|&i| chain.camera[i]).collect(),
-        };
-        let Some((x, y)) = solve(&rest) else { continue };
-        let residuals = view_residuals(chain, &x, &y);
-        let mut others: Vec<f64> = keep.iter().map(|&i| displacement(&residuals[i])).collect();
-        others.sort_by(f64::total_cmp);
-        let median = others[others.len() / 2];
-        if best.as_ref().map_or(true, |b| median < b.0) {
-            let own = residuals[c].clone();
-            let d = displacement(&own);
-            best = Some((median, c, own, d));
-        }
-    }
-    let Some((median, c, own, d)) = best else {
-        return Ok(());
-    };
-    if d > GROSS_RATIO * median && d > GROSS_MIN_MM {
-        return Err(Error::invalid(
-            "poses",
-            format!(
-                "pose pair {c} (robot pose and camera pose {c}, counting from 0) is a gross \
-                 error: with it left out the other {} fit one hand-eye transform with a median \
-                 residual of {median:.3} mm, and it is off by {:.1} mm and {:.2} deg: that row \
-                 holds a typo or another unit (millimetres in a metre file?): fix or remove it",
-                n - 1,
-                own.translation_mm,
-                own.rotation_deg
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// Messages for likely input mistakes (empty when the input looks right).

@@ -47,6 +47,7 @@ pub mod axxb;
 pub mod axzb;
 pub mod checks;
 pub mod daniilidis;
+pub mod gross;
 pub mod intrinsics_move;
 pub mod json_api;
 pub mod math;

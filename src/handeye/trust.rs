@@ -26,8 +26,13 @@
 
 use super::checks::consistency;
 use super::motion::MotionStats;
+use super::pose_noise::NoiseModel;
+use super::pose_refine::{refine, PoseRefineOptions};
+use super::pose_residual::PoseMeasurement;
 use super::refine_poses::{transform_std, PoseRefinementSummary};
 use super::repeat::Repeatability;
+use super::report::pose_difference;
+use super::solve::{HandEyeInput, HandEyeResult};
 use super::{Pose, Setup};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
@@ -263,6 +268,98 @@ pub fn pose_shift(a: &Pose, b: &Pose) -> [f64; 6] {
     [w.x, w.y, w.z, t.x, t.y, t.z]
 }
 
+/// The camera translations against the robot's
+/// ([`translation_scale`]): when they disagree by more than
+/// three of their jackknife std (and [`SCALE_MIN`]), a refit
+/// with the camera translations rescaled shows how far that moves the
+/// transforms; the shift joins the covariance and a warning names the
+/// likely causes.
+pub(crate) fn check_translation_scale(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[PoseMeasurement],
+    noise: &NoiseModel,
+    options: &PoseRefineOptions,
+) {
+    let Some((k, sk)) = translation_scale(
+        input.setup,
+        &input.base_from_gripper,
+        &input.camera_from_target,
+    ) else {
+        return;
+    };
+    let off = k - 1.0;
+    if !(off.abs() > 3.0 * sk && off.abs() > SCALE_MIN) {
+        return;
+    }
+    let scaled: Vec<PoseMeasurement> = views
+        .iter()
+        .map(|m| PoseMeasurement {
+            base_from_gripper: m.base_from_gripper,
+            camera_from_target: Pose::from_parts(
+                nalgebra::Translation3::from(m.camera_from_target.translation.vector / k),
+                m.camera_from_target.rotation,
+            ),
+        })
+        .collect();
+    let Ok(refit) = refine(
+        input.setup,
+        &scaled,
+        &result.x,
+        &result.y,
+        noise.clone(),
+        options,
+    ) else {
+        return;
+    };
+    let dx = pose_shift(&result.x, &refit.x);
+    let dy = pose_shift(&result.y, &refit.y);
+    let Some(summary) = result.pose_refinement.as_mut() else {
+        return;
+    };
+    add_shift_to_covariance(summary, &dx, &dy);
+    let (moved_mm, moved_deg) = pose_difference(&result.x, &refit.x);
+    result.warnings.push(format!(
+        "scale: the camera translations match the robot's only when scaled by {:.4} (+- {:.4}): \
+         the camera's focal length or the target's square size is about {:.2} % off; a refit \
+         with the camera translations rescaled moves {} by {moved_mm:.2} mm and {moved_deg:.3} \
+         deg, which the std now includes; check the camera calibration and the target spec",
+        1.0 / k,
+        sk / (k * k),
+        100.0 * off.abs(),
+        input.setup.camera_key()
+    ));
+}
+
+/// The uncertainty checked against the data ([`super::trust`]): widened
+/// to the leave-one-out spread when that is larger, and the error at the
+/// working distance.
+pub(crate) fn check_uncertainty(result: &mut HandEyeResult, input: &HandEyeInput) {
+    let n = input.camera_from_target.len();
+    let Some(summary) = result.pose_refinement.as_mut() else {
+        return;
+    };
+    let rotation = result.x.rotation.to_rotation_matrix().into_inner();
+    if let Some(rep) = &result.repeatability {
+        if let Some(w) = widen_to_leave_one_out(summary, rep, &rotation, n) {
+            result.warnings.push(w);
+        }
+    }
+    let mut d: Vec<f64> = input
+        .camera_from_target
+        .iter()
+        .map(|p| p.translation.vector.norm())
+        .filter(|v| v.is_finite())
+        .collect();
+    if d.is_empty() {
+        return;
+    }
+    d.sort_by(f64::total_cmp);
+    let distance = d[d.len() / 2];
+    summary.work_distance_m = Some(distance);
+    summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, distance));
+}
+
 /// The frame name of the camera transform, for messages.
 pub fn camera_transform_name(setup: Setup) -> &'static str {
     setup.camera_key()
@@ -323,7 +420,7 @@ mod tests {
         // y: sqrt(3 * 1 + 2 * 0.25) mm.
         let mut cov = vec![[0.0; 12]; 12];
         for (k, row) in cov.iter_mut().enumerate().take(6) {
-            row[k] = if k < 3 { 1e-6 } else { 1e-6 };
+            row[k] = 1e-6; // (1 mrad)^2 for rotations, (1 mm)^2 for translations
         }
         let summary = PoseRefinementSummary::for_tests(cov);
         let s = work_point_std_mm(&summary, &Matrix3::identity(), 0.5);

@@ -39,7 +39,11 @@ use truncation::JpegEnd;
 mod bounds_tests;
 #[cfg(test)]
 mod format_tests;
+mod messages;
+mod orientation;
 mod png_rows;
+use messages::{byte_count, check_size, decode_error, MEMORY_ADVICE};
+use orientation::{exif_orientation, orient, orient_rgba};
 mod truncation;
 
 /// Largest image accepted by default, in pixels: a 100 MP sensor natively
@@ -418,58 +422,6 @@ fn open<'a>(bytes: &'a [u8], options: &DecodeOptions, whole_file: bool) -> Resul
     })
 }
 
-/// [`orient`] for the RGBA preview.
-fn orient_rgba(small: RgbaImage, orientation: Orientation) -> Result<RgbaImage> {
-    if orientation == Orientation::NoTransforms {
-        return Ok(small);
-    }
-    let (w, h) = (small.width, small.height);
-    let buffer = ::image::RgbaImage::from_raw(w, h, small.pixels).ok_or_else(|| {
-        Error::invalid(
-            "preview",
-            format!(
-                "a {w}x{h} preview needs {} bytes",
-                4 * w as usize * h as usize
-            ),
-        )
-    })?;
-    let mut image = DynamicImage::ImageRgba8(buffer);
-    image.apply_orientation(orientation);
-    let rgba = image.into_rgba8();
-    Ok(RgbaImage {
-        width: rgba.width(),
-        height: rgba.height(),
-        pixels: rgba.into_raw(),
-    })
-}
-
-/// Rotate or flip the grey image as the EXIF Orientation tag says, as
-/// OpenCV's `imread` and image viewers do (`image`'s `apply_orientation`).
-fn orient(gray: GrayImage, orientation: Orientation) -> Result<GrayImage> {
-    if orientation == Orientation::NoTransforms {
-        return Ok(gray);
-    }
-    let (w, h) = (gray.width, gray.height);
-    let buffer = ::image::GrayImage::from_raw(w, h, gray.pixels).ok_or_else(|| {
-        Error::invalid(
-            "pixels",
-            format!("a {w}x{h} image needs {} bytes", w as usize * h as usize),
-        )
-    })?;
-    let mut image = DynamicImage::ImageLuma8(buffer);
-    image.apply_orientation(orientation);
-    let luma = image.into_luma8();
-    GrayImage::new(luma.width(), luma.height(), luma.into_raw())
-}
-
-/// The EXIF Orientation value (2-8) applied, `None` when nothing was.
-fn exif_orientation(orientation: Orientation) -> Option<u8> {
-    match orientation {
-        Orientation::NoTransforms => None,
-        other => Some(other.to_exif()),
-    }
-}
-
 /// Whether the file stores palette indices: every GIF, and a BMP of at most
 /// 8 bits per pixel (the `biBitCount` field at byte 28 of the file; `image`
 /// does not report it).
@@ -566,82 +518,6 @@ pub fn sniff_format(bytes: &[u8]) -> Result<ImageFormat> {
     }
 }
 
-/// Refuse empty images and images over [`DecodeOptions::max_pixels`], from
-/// the header's dimensions, before any pixel buffer.
-fn check_size(width: u32, height: u32, options: &DecodeOptions) -> Result<()> {
-    if width == 0 || height == 0 {
-        return Err(Error::Image {
-            message: format!("image is {width}x{height} pixels: it has no pixels"),
-        });
-    }
-    let pixels = width as u64 * height as u64;
-    if pixels > options.max_pixels {
-        return Err(Error::Image {
-            message: format!(
-                "image is {width}x{height} = {}, more than the limit of {}: downscale it first, \
-                 or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)",
-                pixel_count(pixels, options.max_pixels),
-                pixel_count(options.max_pixels, pixels)
-            ),
-        });
-    }
-    Ok(())
-}
-
-/// A pixel count as people say it: "12.3 MP", or "3015 pixels" when small
-/// or when "MP" would print it the same as `other` (the count it is set
-/// against in the message).
-fn pixel_count(n: u64, other: u64) -> String {
-    let mp = |n: u64| format!("{:.1} MP", n as f64 / 1e6);
-    if n >= 100_000 && mp(n) != mp(other) {
-        mp(n)
-    } else {
-        format!("{n} pixels")
-    }
-}
-
-/// What to do about an image over the memory limit.
-const MEMORY_ADVICE: &str = "downscale it, or save it as 8-bit grey (all calibration uses); \
-     --max-pixels N in the CLI raises the limit to 10 bytes a pixel";
-
-/// A byte count as people read it: "1.0 GiB (1073741824 bytes)", or
-/// "1000 bytes" under a mebibyte.
-fn byte_count(n: u64) -> String {
-    const MIB: u64 = 1 << 20;
-    if n >= 1 << 30 {
-        format!("{:.1} GiB ({n} bytes)", n as f64 / (1u64 << 30) as f64)
-    } else if n >= MIB {
-        format!("{:.1} MiB ({n} bytes)", n as f64 / MIB as f64)
-    } else {
-        format!("{n} bytes")
-    }
-}
-
-/// `image`'s error as ours, naming the format and what to do; `len` is the
-/// file's length (a truncated file is named as such).
-fn decode_error(format: ImageFormat, e: ImageError, len: usize, options: &DecodeOptions) -> Error {
-    if truncation::is_end_of_file(&e) {
-        return Error::Image {
-            message: truncation::message(format, len),
-        };
-    }
-    let name = format.name();
-    let message = match e {
-        ImageError::Limits(_) => format!(
-            "{name} image needs more memory to decode than the limit of {}: {MEMORY_ADVICE}",
-            byte_count(options.max_alloc_bytes)
-        ),
-        ImageError::Unsupported(e) => format!("{name} variant not supported: {e}"),
-        ImageError::Decoding(e) => format!("corrupt or truncated {name} file: {e}"),
-        ImageError::IoError(e) => format!("corrupt or truncated {name} file: {e}"),
-        ImageError::Parameter(e) => format!("corrupt or truncated {name} file: {e}"),
-        ImageError::Encoding(e) => format!("corrupt {name} file: {e}"),
-    };
-    // Some decoders end their text with a newline (JPEG's I/O errors).
-    let message = message.trim_end().to_string();
-    Error::Image { message }
-}
-
 /// Encode a grey image as a binary PGM (P5); used by the renderer and tests.
 pub fn encode_pgm(img: &GrayImage) -> Vec<u8> {
     let mut out = format!("P5\n{} {}\n255\n", img.width, img.height).into_bytes();
@@ -667,135 +543,4 @@ pub fn encode_png(img: &GrayImage) -> Result<Vec<u8>> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use wasm_bindgen_test::wasm_bindgen_test;
-
-    fn gradient(w: u32, h: u32) -> GrayImage {
-        let pixels = (0..w * h)
-            .map(|i| ((i % w) * 255 / w.max(1)) as u8)
-            .collect();
-        GrayImage::new(w, h, pixels).unwrap()
-    }
-
-    #[wasm_bindgen_test(unsupported = test)]
-    fn png_round_trip_keeps_every_pixel() {
-        let img = gradient(37, 21);
-        let bytes = encode_png(&img).unwrap();
-        let decoded = decode(
-            &bytes,
-            &DecodeOptions {
-                preview_max_side: Some(10),
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        assert_eq!(decoded.gray, img);
-        assert_eq!(decoded.info.format, ImageFormat::Png);
-        assert_eq!(
-            (
-                decoded.info.width,
-                decoded.info.height,
-                decoded.info.channels
-            ),
-            (37, 21, 1)
-        );
-        let preview = decoded.preview.unwrap();
-        assert_eq!((preview.width, preview.height), (10, 6));
-        assert_eq!(preview.pixels.len(), 10 * 6 * 4);
-    }
-
-    #[wasm_bindgen_test(unsupported = test)]
-    fn pgm_round_trip_keeps_every_pixel() {
-        let img = gradient(5, 3);
-        assert_eq!(decode_gray(&encode_pgm(&img)).unwrap(), img);
-    }
-
-    #[wasm_bindgen_test(unsupported = test)]
-    fn garbage_is_not_an_image() {
-        let err = decode_gray(b"hello, this is text").unwrap_err();
-        assert_eq!(
-            err.to_string(),
-            "not an image: the bytes match none of PNG, JPEG, TIFF, BMP, PGM/PPM, GIF, WebP"
-        );
-        assert_eq!(
-            decode_gray(&[]).unwrap_err().to_string(),
-            "not an image: the file is empty"
-        );
-    }
-
-    #[wasm_bindgen_test(unsupported = test)]
-    fn truncated_png_is_reported_as_truncated() {
-        let bytes = encode_png(&gradient(64, 64)).unwrap();
-        let n = bytes.len() / 2;
-        let err = decode_gray(&bytes[..n]).unwrap_err().to_string();
-        assert_eq!(
-            err,
-            format!(
-                "the PNG file is truncated: it ends after {n} bytes, before the end of its \
-                 image data (an interrupted copy or download?): copy it again from the camera \
-                 or its source"
-            )
-        );
-    }
-
-    #[wasm_bindgen_test(unsupported = test)]
-    fn oversized_header_is_refused_before_allocating() {
-        // A PGM header announcing 20000 x 20000 pixels with no data behind it.
-        let bytes = b"P5\n20000 20000\n255\n".to_vec();
-        let err = decode_gray(&bytes).unwrap_err().to_string();
-        // 100 MP natively, 64 MP in wasm.
-        let limit = if cfg!(target_arch = "wasm32") {
-            "64.0 MP"
-        } else {
-            "100.0 MP"
-        };
-        assert_eq!(
-            err,
-            format!("image is 20000x20000 = 400.0 MP, more than the limit of {limit}: downscale it first, or raise the limit (--max-pixels in the CLI, \"max_pixels\" in the JSON options)")
-        );
-        // Counts that print alike in megapixels are given exactly.
-        assert_eq!(pixel_count(120_000, 100_000), "120000 pixels");
-        assert_eq!(pixel_count(12_300_000, 100_000_000), "12.3 MP");
-    }
-
-    #[wasm_bindgen_test(unsupported = test)]
-    fn random_bytes_never_panic() {
-        // Seeded xorshift: random prefixes of real headers and pure noise.
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
-        let png = encode_png(&gradient(16, 16)).unwrap();
-        // Real headers of every format, cut anywhere and followed by noise.
-        let headers: [&[u8]; 8] = [
-            &png,
-            b"BM\x46\x00\x00\x00\x00\x00\x00\x00\x36\x00\x00\x00\x28\x00\x00\x00",
-            b"P6 4 4 255\n",
-            b"P1 4 4\n",
-            b"P7\nWIDTH 2\nHEIGHT 2\nDEPTH 4\nMAXVAL 65535\nENDHDR\n",
-            b"GIF89a\x04\x00\x04\x00\xf0\x00\x00",
-            b"II*\x00\x08\x00\x00\x00",
-            b"\xff\xd8\xff\xe0\x00\x10JFIF\x00",
-        ];
-        for i in 0..800 {
-            let len = (next() % 200) as usize;
-            let mut bytes: Vec<u8> = (0..len).map(|_| next() as u8).collect();
-            if i % 4 != 3 {
-                let header = headers[(next() % headers.len() as u64) as usize];
-                let keep = (next() as usize) % (header.len() + 1);
-                bytes = [&header[..keep], &bytes[..]].concat();
-            }
-            let _ = decode(
-                &bytes,
-                &DecodeOptions {
-                    preview_max_side: Some(8),
-                    ..Default::default()
-                },
-            );
-        }
-    }
-}
+mod tests;

@@ -136,6 +136,30 @@ pub fn looking_scene(config: &LookingConfig, seed: u64) -> LookingScene {
     scene
 }
 
+/// A robot pose error that is a smooth function of the pose, like a
+/// kinematic model error: the same pose always gets the same error, of
+/// amplitude `amp_mm` (translation) and `amp_deg` (rotation) per axis,
+/// applied on the left (base frame).
+pub fn kinematic_error(pose: &Pose, amp_mm: f64, amp_deg: f64) -> Pose {
+    let p = pose.translation.vector;
+    let w = pose.rotation.scaled_axis();
+    let k = std::f64::consts::TAU / 0.4;
+    let dt = Vector3::new(
+        (k * p.x).sin(),
+        (k * p.y + 1.0).sin(),
+        (k * p.z + 2.0).sin(),
+    );
+    let dr = Vector3::new(
+        (3.0 * w.x).sin(),
+        (3.0 * w.y + 1.0).sin(),
+        (3.0 * w.z + 2.0).sin(),
+    );
+    Pose::from_parts(
+        Translation3::from(dt * amp_mm * 1e-3),
+        UnitQuaternion::from_scaled_axis(dr * amp_deg.to_radians()),
+    ) * pose
+}
+
 /// A Gaussian decoupled left perturbation: rotation std `sigma_rot` (rad)
 /// and translation std `sigma_t` (m) per axis, each of 3 values.
 pub fn perturbed(rng: &mut Rng, pose: &Pose, sigma_rot: [f64; 3], sigma_t: [f64; 3]) -> Pose {
