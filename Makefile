@@ -66,7 +66,7 @@ bench:
 # the crate has no unsafe code, and panics, hangs (-timeout) and memory
 # blow-ups (-rss_limit_mb) are what is looked for. A failing input lands in
 # fuzz/artifacts/<target>/; it then belongs in fixtures/fuzz/<target>/
-# (replayed by tests/fuzz_regressions.rs). RELIABILITY.md has the record.
+# (replayed by tests/detect/fuzz_regressions.rs). RELIABILITY.md has the record.
 FUZZ_S ?= 60
 FUZZ_TARGETS := image_decode detect robot_poses camera_files targets_detections calib_json handeye_json workflows
 FUZZ_FLAGS := -timeout=10 -rss_limit_mb=2048 -print_final_stats=1

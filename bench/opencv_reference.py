@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write tests/fixtures/opencv-left-right-9x6.json: OpenCV's refined chessboard
 corners for the public OpenCV left/right 9x6 images, the reference that
-tests/detect_datasets.rs compares robocal's detector with.
+tests/detect/detect_datasets.rs compares robocal's detector with.
 
 Usage (from the crate root; runs in bench/.venv, see bench/opencv_venv.py):
   python3 bench/opencv_reference.py [DATASET_DIR]

@@ -4,6 +4,10 @@
 //! sends nothing while others are still served, 503 beyond the worker pool
 //! and its queue. Correctness only: the load test is bench/serve_load.py.
 //!
+//! A test binary of its own (the others are one per capability): its tests
+//! time a server's answers, so they do not share the process with the
+//! CPU-heavy calibration tests.
+//!
 //! Times: the server gives a request head 5 s from accept (its default
 //! `head_deadline`); every client read here times out after `HANG_GUARD`, so a
 //! server that stops answering fails the test instead of hanging it.

@@ -1,7 +1,7 @@
 //! The body of every fuzz target, one public function per target, each
 //! taking the fuzzer's bytes. Shared by the fuzz targets
 //! (`fuzz/fuzz_targets/<target>.rs`), the seed generator (`fuzz/seeds/`, for
-//! the input layouts) and the regression suite (`tests/fuzz_regressions.rs`,
+//! the input layouts) and the regression suite (`tests/detect/fuzz_regressions.rs`,
 //! which replays `fixtures/fuzz/<target>/*` through the same function), all
 //! through `#[path]`, so a crash input replays exactly as it was fuzzed.
 //!

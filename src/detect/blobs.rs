@@ -264,7 +264,7 @@ pub(crate) fn refine_blob(
 /// radius so a small dot's window stays on its own edge). It covers the
 /// edge of the renders' 0.7 px blur and of a lens slightly out of focus;
 /// 1.5-3.5 px gave the same centre errors on the renders of
-/// tests/detect_circles.rs (BENCHMARKS.md, issue 20, session 16).
+/// tests/detect/detect_circles.rs (BENCHMARKS.md, issue 20, session 16).
 const EDGE_HALF_WINDOW_PX: f64 = 2.5;
 /// Sample spacing of that window, px.
 const EDGE_SAMPLE_PX: f64 = 0.25;
@@ -329,7 +329,7 @@ fn edge_on_ray(
 /// the blob (pulled by vignetting, a neighbouring circle, the blur of a
 /// curved edge). The gradient's centroid needs no level: it is the edge of
 /// a blurred step whatever the step's two grey levels are. Measured on the
-/// noise-free renders of tests/calib_circles.rs (9x6 grid, 30 mm, one
+/// noise-free renders of tests/calib/calib_circles.rs (9x6 grid, 30 mm, one
 /// draw): the crossing left a systematic floor of 0.006-0.009 px mean under
 /// the centres, the centroid 0.0023-0.0038 px, and the intrinsics error
 /// from the twelve views fell from 0.136 to 0.041 px through the strongly

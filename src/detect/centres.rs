@@ -42,7 +42,7 @@
 //!
 //! [`CentreModel`] names the variants; which one is the default and why is
 //! measured in the test `centre_models_compared_on_renders`
-//! (tests/detect_circles.rs) and recorded in `crate::detect`'s docs.
+//! (tests/detect/detect_circles.rs) and recorded in `crate::detect`'s docs.
 
 use super::blobs::Outline;
 use super::ellipse::fit_ellipse;

@@ -41,7 +41,7 @@
 //! get the same points, and the detection's points stay the projections of
 //! the board points (`centre_model` in the detection records the model).
 //!
-//! Chosen by numbers (tests/detect_circles.rs: 1280x960, noise sigma 2,
+//! Chosen by numbers (tests/detect/detect_circles.rs: 1280x960, noise sigma 2,
 //! tilts 30-49 degrees, 4x11 asymmetric and 7x5 symmetric grids in both
 //! polarities and a 7x7 dot plate, three views each; worst per-image mean /
 //! max error over all cases):
@@ -64,7 +64,7 @@
 //! chessboards of the same views: a 9x6 circle grid and a 9x6 chessboard in
 //! the same twelve poses now give intrinsics errors of 0.068 / 0.103 px
 //! ('std' camera) and 0.058 / 0.097 px (strong distortion), eight noise
-//! draws (tests/calib_circles.rs). The centroid costs about 2-2.7 ms per
+//! draws (tests/calib/calib_circles.rs). The centroid costs about 2-2.7 ms per
 //! 1.2 MP image of 44-49 circles (it runs on the second of the two ray
 //! passes only).
 //!

@@ -448,7 +448,7 @@ fn files_text(json: &str, format: &str) -> String {
         .clone()
 }
 
-/// The example rig as JSON, for the golden files of tests/exports.rs and
+/// The example rig as JSON, for the golden files of tests/calib/exports.rs and
 /// the CLI tests (regenerate with UPDATE_FIXTURES=1).
 #[cfg(not(target_arch = "wasm32"))]
 #[test]

@@ -1,5 +1,5 @@
 //! Round trips of the camera and transform exports (golden files live in
-//! tests/exports.rs, natively, with the UPDATE_FIXTURES switch).
+//! tests/calib/exports.rs, natively, with the UPDATE_FIXTURES switch).
 
 use super::export_camera::{export_camera, float, CameraExportInfo, CameraFormat};
 use super::export_transform::{export_transform, FrameNames, TransformFormat};

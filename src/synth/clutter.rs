@@ -158,7 +158,7 @@ mod tests {
 
     #[test]
     fn clutter_is_seeded_and_full_of_contrast() {
-        // The size and seed of tests/detect_markers.rs and the comparison.
+        // The size and seed of tests/detect/detect_markers.rs and the comparison.
         let a = clutter(1280, 960, 500, 2.0);
         assert_eq!(a.pixels, clutter(1280, 960, 500, 2.0).pixels);
         assert_ne!(a.pixels, clutter(1280, 960, 501, 2.0).pixels);

@@ -91,7 +91,7 @@ pub struct EkfOptions {
     /// noise R of the filter pass; re-linearisation replaces it by the
     /// residual sigma). The default 1 px over-states typical noise on
     /// purpose: it damps the early updates made at a poor linearisation
-    /// point (with 0.5 px, 1 of 20 seeded scenes of tests/calib_ekf.rs
+    /// point (with 0.5 px, 1 of 20 seeded scenes of tests/calib/calib_ekf.rs
     /// drove a point past the lens fold; with 1 px none).
     pub pixel_sigma_px: f64,
     /// Standard deviation of the quaternion-norm pseudo-measurement.
@@ -407,7 +407,7 @@ impl EkfCalibrator {
 /// residuals at it, and the standard deviations, correlations and
 /// projection uncertainty from the filter's covariance of
 /// `[fu fv u0 v0 k1 k2 k5]` (skew held at 0). With re-linearisation that
-/// covariance is consistent (tests/calib_ekf.rs: over 20 seeded scenes the
+/// covariance is consistent (tests/calib/calib_ekf.rs: over 20 seeded scenes the
 /// truth within 3 std in 139 of 140 checks, 99.3 %); with `relinearize_passes = 0`
 /// it is the plain filter's, optimistic, and the report warns.
 pub fn calibrate_ekf(

@@ -3,7 +3,7 @@
 //!
 //! Tolerances: noise sigma 2 grey levels on a 190-level contrast, the
 //! chessboard detector's saddle fit (its renders give ~0.016 px mean,
-//! tests/detect_render.rs); bounds stated per test from what the fit's
+//! tests/detect/detect_render.rs); bounds stated per test from what the fit's
 //! window averages.
 
 use robocal::detect::{detect, detect_all, DetectOptions};

@@ -3,7 +3,7 @@
 //! arguments, and the public OpenCV/Bouguet 9x6 pairs against Bouguet's
 //! published stereo result.
 
-mod support;
+use crate::support;
 use support::{dataset, robocal, temp_dir};
 
 use nalgebra::{Translation3, Vector3};
@@ -135,7 +135,7 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
         report["left"]["views"].as_array().map(Vec::len),
         Some(lf.len() - 1)
     );
-    // Rendered corners are found to ~0.05 px (tests/detect_render.rs): the
+    // Rendered corners are found to ~0.05 px (tests/detect/detect_render.rs): the
     // reprojection rms stays well under 0.3 px and, with ~7 pairs at
     // 0.5-1 m, right_from_left is within 2 mm and 2 mrad.
     let rms = report["rms_px"].as_f64().expect("rms");

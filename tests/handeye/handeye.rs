@@ -6,7 +6,7 @@
 //! - RWHE-Calib CS_synthetic_1: its robot pose file parses into 15 rigid
 //!   base_from_gripper poses (solving needs the board detections).
 
-mod support;
+use crate::support;
 
 use nalgebra::Matrix4;
 use robocal::geometry::pose_from_matrix4;

@@ -1,7 +1,7 @@
 //! The EKF calibration's uncertainty: the report's standard deviations are
 //! the filter's own covariance (after re-linearisation), and over seeded
 //! repetitions that covariance is measured against the truth (Zhang's is
-//! checked in tests/calib_zhang.rs).
+//! checked in tests/calib/calib_zhang.rs).
 
 use robocal::calib::ekf::{calibrate_ekf, EkfCalibrator, EkfOptions};
 use robocal::calib::CalibrationOptions;

@@ -26,7 +26,7 @@
 //! eye-in-hand images, outside both bounds. BENCHMARKS.md ("ChArUco
 //! hand-eye from rendered images") has 20-trial statistics at 1280x960.
 
-mod support;
+use crate::support;
 use support::{robocal, temp_dir};
 
 use nalgebra::{Matrix4, Vector3};

@@ -10,7 +10,7 @@
 //! The data sit in ../shared/datasets (beside the crate root; see
 //! tests/support); each test is skipped with a message when absent.
 
-mod support;
+use crate::support;
 use support::dataset;
 
 use nalgebra::{Point2, Point3, Vector3};

@@ -36,11 +36,11 @@ use robocal::workflows::linear_fit::LinearFit;
 use robocal::workflows::planar::{fit_transform, PlanarMatrix, PointPair, TransformKind};
 use robocal::workflows::planar_height::{pixel_density, HeightModel};
 
-const TABLE3: &str = include_str!("../fixtures/seed001/table3_four_points.csv");
-const TABLE4: &str = include_str!("../fixtures/seed001/table4_matrices.csv");
-const TABLE5: &str = include_str!("../fixtures/seed001/table5_linear_fit.csv");
-const TABLE6: &str = include_str!("../fixtures/seed001/table6_pixel_ratio.csv");
-const TABLE7: &str = include_str!("../fixtures/seed001/table7_verification.csv");
+const TABLE3: &str = include_str!("../../fixtures/seed001/table3_four_points.csv");
+const TABLE4: &str = include_str!("../../fixtures/seed001/table4_matrices.csv");
+const TABLE5: &str = include_str!("../../fixtures/seed001/table5_linear_fit.csv");
+const TABLE6: &str = include_str!("../../fixtures/seed001/table6_pixel_ratio.csv");
+const TABLE7: &str = include_str!("../../fixtures/seed001/table7_verification.csv");
 
 fn table4() -> (Vec<f64>, Vec<PlanarMatrix>) {
     let t = CsvTable::parse(TABLE4).unwrap();

@@ -5,7 +5,7 @@
 //! results match the truth to rounding (1e-9 relative / 1e-9 m); views
 //! whose points lie on one line are left out with the documented message.
 
-mod support;
+use crate::support;
 use support::{robocal, temp_dir};
 
 use nalgebra::{Point3, Translation3, Vector3};

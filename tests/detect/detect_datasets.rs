@@ -29,7 +29,7 @@
 //! cleanly instead of inventing a board, and the square-grid detector
 //! (`squares:8x8:12.7mm:22.5778mm`) must find all five boards.
 
-mod support;
+use crate::support;
 use support::dataset;
 
 use robocal::detect::{detect, DetectOptions};

@@ -10,7 +10,7 @@
 //! with probability 0.9973 when the covariance is right, so over many
 //! (trial, component) samples at least 99 % must hold.
 
-mod support;
+use crate::support;
 use support::dataset;
 
 use nalgebra::{Point2, Point3};
@@ -170,7 +170,7 @@ fn noisy_extrinsics_are_within_three_reported_std() {
 }
 
 #[test]
-#[ignore = "200 seeded trials (about a minute in release): cargo test --release --test calib_rig -- --ignored"]
+#[ignore = "200 seeded trials (about a minute in release): cargo test --release --test calib calib_rig:: -- --ignored"]
 fn noisy_extrinsics_are_within_three_reported_std_in_200_trials() {
     let (inside, total) = coverage(200, 0.3);
     eprintln!("within 3 std: {inside} of {total}");

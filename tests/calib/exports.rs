@@ -1,6 +1,6 @@
 //! Golden files for every export format: the exact bytes robocal writes for
 //! a fixed camera and a fixed transform. A change in any writer shows up
-//! here; regenerate on purpose with `UPDATE_FIXTURES=1 cargo test --test exports`.
+//! here; regenerate on purpose with `UPDATE_FIXTURES=1 cargo test --test calib exports::`.
 //! The same `export()` runs in the CLI, node and the browser, so these files
 //! are also what those hosts produce (checked by their own tests).
 

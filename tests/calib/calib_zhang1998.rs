@@ -3,7 +3,7 @@
 //! The data lives outside the crate (../shared/datasets/zhang1998); the test
 //! is skipped with a message when it is absent.
 
-mod support;
+use crate::support;
 use support::dataset;
 
 use nalgebra::{Point2, Point3};

@@ -5,7 +5,7 @@
 //! and within [`TIME_LIMIT`] (the fuzzers' -timeout is 10 s on an
 //! instrumented build; fixed hangs return in milliseconds).
 
-#[path = "../fuzz/src/cases.rs"]
+#[path = "../../fuzz/src/cases.rs"]
 mod cases;
 
 use std::path::Path;

@@ -180,7 +180,7 @@ fn other_boards_of_the_layout_are_listed_per_image() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     let images = doc["images"].as_array().unwrap();
     // Whole boards in view: all 144 corners but at most 2 (the page's test
-    // and tests/detect_markers.rs see 142-144 on such renders).
+    // and tests/detect/detect_markers.rs see 142-144 on such renders).
     let count = |d: &serde_json::Value| d["points"].as_array().unwrap().len();
     let both = &images[0];
     assert_eq!(both["detection"]["target"]["first_id"], 0);

@@ -7,7 +7,7 @@
 //! and (issue 35) one pose row in mm or at 1e6 m, a camera pose at 1e308 m,
 //! the same images for both stereo or rig cameras.
 
-mod support;
+use crate::support;
 use robocal::handeye::{Pose, Setup};
 use robocal::synth::handeye::{handeye_scene, HandEyeSceneConfig};
 use support::catalogue::{check_all, strings, Row, Stream};

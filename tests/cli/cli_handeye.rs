@@ -2,7 +2,7 @@
 //! render --demo` (exact truth, grey noise sigma 2: corners within ~0.05 px)
 //! and RWHE-Calib's CS_synthetic_1 (ground truth X = diag(1, -1, -1), t = 0).
 
-mod support;
+use crate::support;
 use support::dataset;
 
 use std::path::{Path, PathBuf};

@@ -2,7 +2,7 @@
 //! like `robocal detect`'s from seeded synthetic scenes (exact answers),
 //! the OpenCV sample images when present, and bad arguments.
 
-mod support;
+use crate::support;
 use support::{dataset, robocal, temp_dir};
 
 use robocal::synth::Scene;

@@ -4,7 +4,7 @@
 //! rig file input, held intrinsics, and the exact errors for cameras no
 //! frame connects and for bad flags.
 
-mod support;
+use crate::support;
 use support::{robocal, temp_dir};
 
 use robocal::calib::View;
@@ -109,7 +109,7 @@ fn rig_on_rendered_images_recovers_every_camera_from_rig() {
         "{}",
         report["warnings"]
     );
-    // Rendered corners are found to ~0.05 px (tests/detect_render.rs); with
+    // Rendered corners are found to ~0.05 px (tests/detect/detect_render.rs); with
     // 5-8 views per camera at 1.2 m each camera_from_rig is within 3 mm and
     // 3 mrad (about 10 of the reported std).
     for k in 1..4 {

@@ -127,7 +127,7 @@ fn circle_grids_and_dot_plate() {
         let (mean, max) = run(spec, 1280, 960, (0.25, -0.2, 0.1), 0.6, &o);
         // Centres from 64 edge points, noise 2: sd ~0.01 px; the
         // perspective bias of imaged circle centres is corrected (issue 20's
-        // bounds, tests/detect_circles.rs has the steeper views).
+        // bounds, tests/detect/detect_circles.rs has the steeper views).
         assert!(
             mean <= 0.03 && max <= 0.15,
             "{spec}: mean {mean} px, max {max} px"

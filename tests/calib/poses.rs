@@ -1,7 +1,7 @@
 //! Robot pose files from public datasets, parsed with the `io` presets.
 //! Skipped (with a message) when ../shared/datasets is not present.
 
-mod support;
+use crate::support;
 use std::path::PathBuf;
 
 use robocal::geometry::{pose_from_matrix4, rotation_angle_between};

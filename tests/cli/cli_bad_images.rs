@@ -2,7 +2,7 @@
 //! code 1 and a message naming the format and the defect, never a crash
 //! (exit 101) or an abort.
 
-mod support;
+use crate::support;
 use support::{robocal, temp_dir};
 
 /// The 28-byte JPEG that crashed the old hand-written decoder (a DHT

@@ -3,7 +3,7 @@
 //! reader that closes stdout early ends the command quietly (exit 141, as a
 //! shell reports SIGPIPE), and a full stdout is a one-line error (exit 1).
 
-mod support;
+use crate::support;
 use std::io::Read;
 use std::path::Path;
 use std::process::{Command, Stdio};

@@ -2,7 +2,7 @@
 //! (header, 4:2:0 planes, frame count) whose frames show the board where the
 //! truth file says. Tolerances: the frames are renders with grey noise
 //! sigma 2, blur 0.7 px and vignetting, like `robocal render`'s images,
-//! whose corners the detector finds within 0.2 px (tests/cli_render.rs);
+//! whose corners the detector finds within 0.2 px (tests/cli/cli_render.rs);
 //! the luma mapping (16 + 219 g / 255) only scales the contrast.
 
 use robocal::image::GrayImage;

@@ -10,7 +10,7 @@ use nalgebra::Point3;
 use robocal::{Camera, Distortion};
 use serde_json::Value;
 
-const FIXTURE: &str = include_str!("../fixtures/opencv_project_points.json");
+const FIXTURE: &str = include_str!("../../fixtures/opencv_project_points.json");
 
 fn numbers(v: &Value) -> Vec<f64> {
     v.as_array()

@@ -3,7 +3,7 @@
 //! message. A row fails when the message changes: update docs/bad-inputs.md
 //! with it.
 
-mod support;
+use crate::support;
 use support::catalogue::{check_all, strings, Row, Stream};
 
 /// One catalogue row: a name (also the scratch folder), the files written
@@ -11,7 +11,6 @@ use support::catalogue::{check_all, strings, Row, Stream};
 /// the exact first line of the message.
 // Rows 73-90 and 93 (issue 37's second round: flags, outputs, exports,
 // messages) are in a file of their own.
-#[path = "cli_bad_inputs/round2.rs"]
 mod round2;
 
 pub(crate) struct Case {

@@ -1,7 +1,7 @@
 //! `robocal export` through the real binary: same bytes as the library's
 //! golden files, errors on stderr with the exit code of their kind.
 
-mod support;
+use crate::support;
 use support::robocal;
 
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/exports");
