@@ -292,6 +292,51 @@ impl Distortion {
         }
     }
 
+    /// [`Distortion::project_ray`]'s point alone (the same value, the same
+    /// refusals), without the Jacobians and their allocation: for every
+    /// projection that needs no derivatives.
+    pub(crate) fn project_point(&self, p: &Vector3<f64>) -> Result<Vector2<f64>> {
+        match self.family() {
+            Family::KannalaBrandt(k) => Ok(kannala_brandt::project(&k, p)?.0),
+            Family::Eucm(alpha, beta) => Ok(eucm::project(alpha, beta, p)?.0),
+            Family::Pinhole | Family::Poly(..) | Family::Division(_) => {
+                if !(p.z > 0.0) || !p.iter().all(|v| v.is_finite()) {
+                    return Err(not_in_front(p));
+                }
+                self.distort_point(&Vector2::new(p.x / p.z, p.y / p.z))
+            }
+        }
+    }
+
+    /// [`Distortion::distort_with_jacobians`]'s point alone.
+    pub(crate) fn distort_point(&self, n: &Vector2<f64>) -> Result<Vector2<f64>> {
+        match self.family() {
+            Family::Pinhole => Ok(*n),
+            Family::Poly(poly, _) => {
+                if !poly.in_domain(n.norm_squared()) {
+                    return Err(self.beyond_fold(n));
+                }
+                Ok(poly.distort_value(n))
+            }
+            Family::Division(kappa) => Ok(division::distort(kappa, n)?.0),
+            Family::KannalaBrandt(_) | Family::Eucm(..) => {
+                self.project_point(&Vector3::new(n.x, n.y, 1.0))
+            }
+        }
+    }
+
+    fn beyond_fold(&self, n: &Vector2<f64>) -> Error {
+        Error::invalid(
+            "point",
+            format!(
+                "normalised point ({:.4}, {:.4}) lies beyond the fold of the {} distortion model",
+                n.x,
+                n.y,
+                self.model_name()
+            ),
+        )
+    }
+
     /// Project a camera-frame point to the distorted normalised plane.
     pub(crate) fn project_ray(&self, p: &Vector3<f64>) -> Result<RayProjection> {
         match self.family() {
@@ -313,13 +358,7 @@ impl Distortion {
             }
             Family::Pinhole | Family::Poly(..) | Family::Division(_) => {
                 if !(p.z > 0.0) || !p.iter().all(|v| v.is_finite()) {
-                    return Err(Error::invalid(
-                        "point",
-                        format!(
-                            "point ({:.4}, {:.4}, {:.4}) is not in front of the camera (needs z > 0)",
-                            p.x, p.y, p.z
-                        ),
-                    ));
+                    return Err(not_in_front(p));
                 }
                 let n = Vector2::new(p.x / p.z, p.y / p.z);
                 let d_n_d_p =
@@ -344,15 +383,7 @@ impl Distortion {
             Family::Pinhole => Ok((*n, Matrix2::identity(), vec![])),
             Family::Poly(poly, cols) => {
                 if !poly.in_domain(n.norm_squared()) {
-                    return Err(Error::invalid(
-                        "point",
-                        format!(
-                            "normalised point ({:.4}, {:.4}) lies beyond the fold of the {} distortion model",
-                            n.x,
-                            n.y,
-                            self.model_name()
-                        ),
-                    ));
+                    return Err(self.beyond_fold(n));
                 }
                 let (m, d_n, d_all) = poly.distort(n);
                 Ok((m, d_n, cols.iter().map(|&c| d_all[c]).collect()))
@@ -405,4 +436,15 @@ enum Family {
     Division(f64),
     KannalaBrandt([f64; 4]),
     Eucm(f64, f64),
+}
+
+/// The refusal of a point at or behind the camera (or not finite).
+fn not_in_front(p: &Vector3<f64>) -> Error {
+    Error::invalid(
+        "point",
+        format!(
+            "point ({:.4}, {:.4}, {:.4}) is not in front of the camera (needs z > 0)",
+            p.x, p.y, p.z
+        ),
+    )
 }

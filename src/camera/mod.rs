@@ -150,8 +150,8 @@ impl Camera {
     /// field of view of the wide-angle ones, outside the division model's
     /// domain).
     pub fn project(&self, p_camera: &Point3<f64>) -> Result<Point2<f64>> {
-        let ray = self.distortion.project_ray(&p_camera.coords)?;
-        Ok(self.pixel_from_normalized(&ray.m))
+        let m = self.distortion.project_point(&p_camera.coords)?;
+        Ok(self.pixel_from_normalized(&m))
     }
 
     /// [`Camera::project`] with the analytic Jacobians: d pixel / d point
@@ -192,10 +192,9 @@ impl Camera {
 
     /// Apply the lens model to an ideal normalised point `(X/Z, Y/Z)`.
     pub fn distort_normalized(&self, undistorted: &Point2<f64>) -> Result<Point2<f64>> {
-        let (m, _, _) = self
-            .distortion
-            .distort_with_jacobians(&undistorted.coords)?;
-        Ok(Point2::from(m))
+        Ok(Point2::from(
+            self.distortion.distort_point(&undistorted.coords)?,
+        ))
     }
 
     /// Remove the lens model from a distorted normalised point: the ideal

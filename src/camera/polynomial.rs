@@ -83,6 +83,25 @@ impl Poly {
         })
     }
 
+    /// The distorted normalised point alone: the value of [`Poly::distort`]
+    /// (the same expressions, so the same bits) without its Jacobians, for
+    /// projections that need no derivatives.
+    pub fn distort_value(&self, n: &Vector2<f64>) -> Vector2<f64> {
+        let (x, y) = (n.x, n.y);
+        let [k1, k2, k3, k4, k5, k6] = self.k;
+        let [p1, p2] = self.p;
+        let [s1, s2, s3, s4] = self.s;
+        let r2 = x * x + y * y;
+        let r4 = r2 * r2;
+        let r6 = r4 * r2;
+        let a = 1.0 + k1 * r2 + k2 * r4 + k3 * r6;
+        let b = 1.0 + k4 * r2 + k5 * r4 + k6 * r6;
+        let radial = a / b;
+        let xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) + s1 * r2 + s2 * r4;
+        let yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y + s3 * r2 + s4 * r4;
+        Vector2::new(xd, yd)
+    }
+
     /// Distorted normalised point, its 2x2 Jacobian with respect to (x, y),
     /// and the 2x12 Jacobian with respect to the coefficients (columns in
     /// the order of [`col`]).
