@@ -596,4 +596,90 @@ mod tests {
             "{alarm}"
         );
     }
+
+    /// The advice of `n` views of `truth` (0.1 px noise) fitted with `model`.
+    fn advice_of(truth: &Camera, model: &str, n: usize) -> ModelAdvice {
+        let scene = Scene::calibration(7, truth, (9, 6), 0.03, n, 0.1).expect("scene");
+        let views: Vec<View> = scene
+            .views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| View {
+                name: format!("v{i}"),
+                ..v.clone()
+            })
+            .collect();
+        let options = CalibrationOptions {
+            model: model_from_name(model).unwrap(),
+            ..CalibrationOptions::default()
+        };
+        let size = (truth.width, truth.height);
+        let report = calibrate_with(Method::Zhang, &views, size, &options).expect("solve");
+        advise(&views, size, &options, &report)
+    }
+
+    #[test]
+    fn a_fisheye_lens_is_advised_a_fisheye_model_with_its_export_formats() {
+        // The 190-degree Kannala-Brandt example, calibrated with its own model:
+        // the comparison has EUCM and the simpler models, and the advice keeps
+        // kannala_brandt (division may fit about as well, but only JSON and
+        // Halcon hold it, and it is not simpler than what OpenCV reads).
+        let a = advice_of(&Camera::example_kannala_brandt(), "kannala_brandt", 10);
+        assert!(a.half_diagonal_fov_deg > 80.0, "{}", a.half_diagonal_fov_deg);
+        let compared: Vec<&str> = a.compared.iter().map(|f| f.model.as_str()).collect();
+        assert_eq!(compared[0], "kannala_brandt");
+        assert!(compared.contains(&"eucm"), "{compared:?}");
+        assert_eq!(a.recommended, "kannala_brandt", "{}", a.summary);
+        assert!(a.warnings.is_empty(), "{:?}", a.warnings);
+        assert_eq!(
+            a.export_formats,
+            ["json", "opencv-yaml (cv2.fisheye)", "opencv-xml (cv2.fisheye)", "ros-yaml (equidistant)", "kalibr (equidistant)"]
+        );
+        assert!(
+            a.summary.starts_with("lens model: kannala_brandt (kannala_brandt fits at ")
+                && a.summary.ends_with("; kannala_brandt exports to json, opencv-yaml (cv2.fisheye), opencv-xml (cv2.fisheye), ros-yaml (equidistant), kalibr (equidistant)"),
+            "{}",
+            a.summary
+        );
+        // Through Brown-Conrady the lens does not fit: the model named is a
+        // fisheye one that was fitted, with its formats.
+        let a = advice_of(&Camera::example_kannala_brandt(), "brown", 10);
+        assert!(["kannala_brandt", "eucm"].contains(&a.recommended.as_str()), "{}", a.summary);
+        assert!(a.compared.iter().any(|f| f.model == a.recommended));
+        let w = a.warnings.first().unwrap_or_else(|| panic!("{}", a.summary));
+        assert!(
+            w.contains(&format!("switch the model to {m} (CLI: --model {m}); {m} exports to json, ", m = a.recommended)),
+            "{w}"
+        );
+    }
+
+    #[test]
+    fn a_normal_lens_keeps_brown_conrady_which_opencv_holds() {
+        let a = advice_of(&Camera::example_brown(), "brown", 10);
+        assert!(a.half_diagonal_fov_deg < WIDE_ANGLE_HALF_DIAGONAL_DEG, "{}", a.half_diagonal_fov_deg);
+        assert_eq!(a.recommended, "brown", "{}", a.summary);
+        assert!(a.export_formats.iter().any(|f| f == "opencv-yaml"), "{:?}", a.export_formats);
+        assert!(a.summary.ends_with("; brown exports to json, opencv-yaml, opencv-xml, ros-yaml, kalibr (with k3 held at 0), mrcal, halcon, matlab"), "{}", a.summary);
+        // No fisheye model was fitted for a normal lens unless it has fewer
+        // coefficients than Brown-Conrady's five (all the others do).
+        assert!(a.compared.iter().all(|f| f.model == "brown" || f.coefficients < 5));
+    }
+
+    #[test]
+    fn of_models_that_fit_alike_the_one_more_formats_hold_is_picked() {
+        let fit = |model: &str, rms_px: f64, coefficients: usize| ModelFit {
+            model: model.into(),
+            rms_px,
+            coefficients,
+        };
+        let (division, eucm, kb) = (fit("division", 0.100, 1), fit("eucm", 0.1005, 2), fit("kannala_brandt", 0.101, 4));
+        // Within 2 % of the best: Kannala-Brandt (OpenCV, ROS, Kalibr) over
+        // EUCM (Kalibr) and division (Halcon).
+        assert_eq!(pick(&[&division, &eucm, &kb]).unwrap().model, "kannala_brandt");
+        // A clearly worse fit is not picked for its formats; between two that
+        // two formats each hold, the fewer coefficients.
+        let kb_worse = fit("kannala_brandt", 0.2, 4);
+        assert_eq!(pick(&[&division, &eucm, &kb_worse]).unwrap().model, "division");
+        assert_eq!(pick(&[]), None);
+    }
 }

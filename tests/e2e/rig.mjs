@@ -202,8 +202,18 @@ export const tests = [
       // A file without a number cannot be put in a frame: the page names it.
       await page.setInputFiles('#rig-input-3', [{ name: 'extra.png', mimeType: 'image/png', buffer: readFileSync(files[3][0]) }]);
       await page.waitForFunction(() => /extra\.png/.test(document.querySelector('#rig-grouping.msg-error')?.textContent || ''), null, { timeout: 10000 });
-      assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam3 has names without one: extra.png (number every file, or group by order)');
+      assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam3 has names without one: extra.png (group by number or last (the last number in the name, the default), first (the first number), order (the position in each camera\'s list), or a pattern with one (\\d+) such as sync(\\d+))');
       assert.equal(await page.isDisabled('#rig-solve'), true);
+      // The other rules of robocal rig --group-by: by order every image has a
+      // frame; a pattern no name has is named in the error.
+      await page.selectOption('#rig-group-by', 'order');
+      await page.waitForFunction(() => /grouped by order \(sorted names\)\.$/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+      await page.selectOption('#rig-group-by', 'pattern');
+      await page.fill('#rig-group-pattern', 'nothing(\\d+)');
+      await page.dispatchEvent('#rig-group-pattern', 'change');
+      await page.waitForFunction(() => /grouped by the number of the pattern nothing\(\\d\+\) in the file names, but camera cam0 has names without one/.test(document.querySelector('#rig-grouping.msg-error')?.textContent || ''), null, { timeout: 10000 });
+      await page.selectOption('#rig-group-by', '');
+      await page.waitForFunction(() => /extra\.png/.test(document.querySelector('#rig-grouping.msg-error')?.textContent || ''), null, { timeout: 10000 });
       await page.click('#rig-remove-3');
       await page.waitForFunction(() => /over 3 cameras/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
       await shot('removed');

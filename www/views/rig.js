@@ -340,6 +340,29 @@ export class RigView {
           });
           return b;
         })),
+      this.stereoExports(r),
       this.exportStatus);
+  }
+
+  /** A rig of two as a stereo pair (robocal stereo's report: left, right, right_from_left) in the stereo formats of robocal export. */
+  stereoExports(r) {
+    if (!stereoOfRig(r)) return null;
+    const [left, right] = r.cameras;
+    const report = JSON.stringify({ left: left.calibration, right: right.calibration, right_from_left: right.camera_from_rig, rms_px: r.rms_px });
+    return h('div', { class: 'row', id: 'rig-stereo-exports' },
+      h('span', { class: 'hint' }, `As a stereo pair (left ${left.name}, right ${right.name}; x_right = R x_left + T):`),
+      [['opencv-yaml', 'OpenCV stereo YAML (K1 D1 K2 D2 R T E F, R1 R2 P1 P2 Q)'], ['ros', 'ROS left.yaml + right.yaml (rectified)'], ['kalibr', 'Kalibr camchain (cam0, cam1)']].map(([format, label]) => {
+        const b = h('button', { type: 'button', id: `rig-export-stereo-${format}` }, label);
+        b.addEventListener('click', async () => {
+          try {
+            const files = await this.engine.call('exportFiles', { report, format });
+            for (const f of files) download(f.name.startsWith('stereo') ? f.name : `stereo_${f.name}`, f.text);
+            fill(this.exportStatus, `stereo ${format}: ${files.map((f) => f.name).join(', ')}`);
+          } catch (err) {
+            fill(this.exportStatus, message('error', `stereo ${format}: ${err.message}`));
+          }
+        });
+        return b;
+      }));
   }
 }
