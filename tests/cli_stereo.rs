@@ -135,6 +135,7 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
         err.contains("pair dropped") && err.contains("right99_blank.png"),
         "{err}"
     );
+    let stereo_err = err.clone();
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("json");
     for key in [
@@ -195,8 +196,10 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
             "{formats:?}"
         );
         assert!(
-            err.contains(&format!("robocal stereo: {side} camera: lens model: {recommended}")),
-            "{err}"
+            stereo_err.contains(&format!(
+                "robocal stereo: {side} camera: lens model: {recommended}"
+            )),
+            "{stereo_err}"
         );
         assert!(advice["half_diagonal_fov_deg"].as_f64().unwrap() < 50.0, "{advice}");
     }

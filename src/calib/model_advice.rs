@@ -188,6 +188,11 @@ fn format_names(model: &str) -> Vec<&'static str> {
         .collect()
 }
 
+/// Kannala-Brandt and EUCM: the models for lenses past 90 degrees.
+fn is_fisheye(model: &str) -> bool {
+    matches!(model, "kannala_brandt" | "eucm")
+}
+
 fn can_go_to_opencv(model: &str) -> bool {
     format_names(model).contains(&"opencv-yaml")
 }
@@ -306,7 +311,7 @@ pub fn advise(
     let mut fits: Vec<ModelFit> = Vec::new();
     for (name, _) in MODELS {
         let n = coefficient_count(name);
-        let fisheye = matches!(name, "kannala_brandt" | "eucm");
+        let fisheye = is_fisheye(name);
         if name == chosen || !(far_off || n < n_chosen || (wide && fisheye)) {
             continue;
         }
@@ -381,13 +386,18 @@ pub fn advise(
         }
     } else {
         let as_well = |f: &&ModelFit| f.rms_px <= SAME_FIT_RATIO * report.rms_px + SAME_FIT_PX;
-        // A simpler model is named only if it exports wherever the chosen one does.
+        // A simpler model is named only if it exports wherever the chosen one
+        // does, and, for a wide-angle lens fitted with a fisheye model, only
+        // another fisheye model: a polynomial's fit inside the views says
+        // nothing of the rays beyond them, where a wide lens sees most.
         let mine = format_names(chosen);
+        let keeps_fisheye = |m: &str| !(wide && is_fisheye(chosen)) || is_fisheye(m);
         let simplest = fits
             .iter()
             .filter(as_well)
             .filter(|f| f.coefficients < n_chosen)
             .filter(|f| mine.iter().all(|m| format_names(&f.model).contains(m)))
+            .filter(|f| keeps_fisheye(&f.model))
             .min_by(|a, b| {
                 a.coefficients
                     .cmp(&b.coefficients)
