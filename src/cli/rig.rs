@@ -104,7 +104,7 @@ pub struct RigArgs {
     rig_frame: Option<String>,
     /// How images form frames: number or last (the last number in the file
     /// names, default), first (the first number), order (the position in
-    /// each camera's list), or a pattern with one (\\d+) such as 'sync(\\d+)'
+    /// each camera's list), or a pattern with one (\d+) such as 'sync(\d+)'
     #[arg(long, value_name = "RULE", overrides_with = "group_by")]
     group_by: Option<String>,
     /// Lens model of the solved cameras: brown (default), radial_k1_k2_k5,
