@@ -184,7 +184,10 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
     for side in ["left", "right"] {
         let advice = &report["model_advice"][side];
         let recommended = advice["recommended"].as_str().unwrap();
-        assert!(["brown", "radial_k1_k2_k5"].contains(&recommended), "{advice}");
+        assert!(
+            ["brown", "radial_k1_k2_k5"].contains(&recommended),
+            "{advice}"
+        );
         let formats: Vec<&str> = advice["export_formats"]
             .as_array()
             .unwrap()
@@ -201,7 +204,10 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
             )),
             "{stereo_err}"
         );
-        assert!(advice["half_diagonal_fov_deg"].as_f64().unwrap() < 50.0, "{advice}");
+        assert!(
+            advice["half_diagonal_fov_deg"].as_f64().unwrap() < 50.0,
+            "{advice}"
+        );
     }
 }
 

@@ -635,7 +635,11 @@ mod tests {
         // kannala_brandt (division may fit about as well, but only JSON and
         // Halcon hold it, and it is not simpler than what OpenCV reads).
         let a = advice_of(&Camera::example_kannala_brandt(), "kannala_brandt", 10);
-        assert!(a.half_diagonal_fov_deg > 80.0, "{}", a.half_diagonal_fov_deg);
+        assert!(
+            a.half_diagonal_fov_deg > 80.0,
+            "{}",
+            a.half_diagonal_fov_deg
+        );
         let compared: Vec<&str> = a.compared.iter().map(|f| f.model.as_str()).collect();
         assert_eq!(compared[0], "kannala_brandt");
         assert!(compared.contains(&"eucm"), "{compared:?}");
@@ -643,7 +647,13 @@ mod tests {
         assert!(a.warnings.is_empty(), "{:?}", a.warnings);
         assert_eq!(
             a.export_formats,
-            ["json", "opencv-yaml (cv2.fisheye)", "opencv-xml (cv2.fisheye)", "ros-yaml (equidistant)", "kalibr (equidistant)"]
+            [
+                "json",
+                "opencv-yaml (cv2.fisheye)",
+                "opencv-xml (cv2.fisheye)",
+                "ros-yaml (equidistant)",
+                "kalibr (equidistant)"
+            ]
         );
         assert!(
             a.summary.starts_with("lens model: kannala_brandt (kannala_brandt fits at ")
@@ -654,11 +664,21 @@ mod tests {
         // Through Brown-Conrady the lens does not fit: the model named is a
         // fisheye one that was fitted, with its formats.
         let a = advice_of(&Camera::example_kannala_brandt(), "brown", 10);
-        assert!(["kannala_brandt", "eucm"].contains(&a.recommended.as_str()), "{}", a.summary);
-        assert!(a.compared.iter().any(|f| f.model == a.recommended));
-        let w = a.warnings.first().unwrap_or_else(|| panic!("{}", a.summary));
         assert!(
-            w.contains(&format!("switch the model to {m} (CLI: --model {m}); {m} exports to json, ", m = a.recommended)),
+            ["kannala_brandt", "eucm"].contains(&a.recommended.as_str()),
+            "{}",
+            a.summary
+        );
+        assert!(a.compared.iter().any(|f| f.model == a.recommended));
+        let w = a
+            .warnings
+            .first()
+            .unwrap_or_else(|| panic!("{}", a.summary));
+        assert!(
+            w.contains(&format!(
+                "switch the model to {m} (CLI: --model {m}); {m} exports to json, ",
+                m = a.recommended
+            )),
             "{w}"
         );
     }
@@ -666,13 +686,24 @@ mod tests {
     #[test]
     fn a_normal_lens_keeps_brown_conrady_which_opencv_holds() {
         let a = advice_of(&Camera::example_brown(), "brown", 10);
-        assert!(a.half_diagonal_fov_deg < WIDE_ANGLE_HALF_DIAGONAL_DEG, "{}", a.half_diagonal_fov_deg);
+        assert!(
+            a.half_diagonal_fov_deg < WIDE_ANGLE_HALF_DIAGONAL_DEG,
+            "{}",
+            a.half_diagonal_fov_deg
+        );
         assert_eq!(a.recommended, "brown", "{}", a.summary);
-        assert!(a.export_formats.iter().any(|f| f == "opencv-yaml"), "{:?}", a.export_formats);
+        assert!(
+            a.export_formats.iter().any(|f| f == "opencv-yaml"),
+            "{:?}",
+            a.export_formats
+        );
         assert!(a.summary.ends_with("; brown exports to json, opencv-yaml, opencv-xml, ros-yaml, kalibr (with k3 held at 0), mrcal, halcon, matlab"), "{}", a.summary);
         // No fisheye model was fitted for a normal lens unless it has fewer
         // coefficients than Brown-Conrady's five (all the others do).
-        assert!(a.compared.iter().all(|f| f.model == "brown" || f.coefficients < 5));
+        assert!(a
+            .compared
+            .iter()
+            .all(|f| f.model == "brown" || f.coefficients < 5));
     }
 
     #[test]
@@ -682,14 +713,24 @@ mod tests {
             rms_px,
             coefficients,
         };
-        let (division, eucm, kb) = (fit("division", 0.100, 1), fit("eucm", 0.1005, 2), fit("kannala_brandt", 0.101, 4));
+        let (division, eucm, kb) = (
+            fit("division", 0.100, 1),
+            fit("eucm", 0.1005, 2),
+            fit("kannala_brandt", 0.101, 4),
+        );
         // Within 2 % of the best: Kannala-Brandt (OpenCV, ROS, Kalibr) over
         // EUCM (Kalibr) and division (Halcon).
-        assert_eq!(pick(&[&division, &eucm, &kb]).unwrap().model, "kannala_brandt");
+        assert_eq!(
+            pick(&[&division, &eucm, &kb]).unwrap().model,
+            "kannala_brandt"
+        );
         // A clearly worse fit is not picked for its formats; between two that
         // two formats each hold, the fewer coefficients.
         let kb_worse = fit("kannala_brandt", 0.2, 4);
-        assert_eq!(pick(&[&division, &eucm, &kb_worse]).unwrap().model, "division");
+        assert_eq!(
+            pick(&[&division, &eucm, &kb_worse]).unwrap().model,
+            "division"
+        );
         assert_eq!(pick(&[]), None);
     }
 }

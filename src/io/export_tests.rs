@@ -370,7 +370,12 @@ fn the_model_advice_names_the_formats_the_writers_accept() {
                 camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
             }
             let written = export_camera(&camera, &CameraExportInfo::default(), format).is_ok();
-            assert_eq!(written, entry.is_some(), "{model} to {}: listed {entry:?}", format.name());
+            assert_eq!(
+                written,
+                entry.is_some(),
+                "{model} to {}: listed {entry:?}",
+                format.name()
+            );
         }
     }
 }
