@@ -547,7 +547,24 @@ export interface StereoCalibration {
   rms_px: number;
   iterations: number;
   termination: Termination;
-  /** Pairs left out (`pair N left out: left|right NAME: REASON`: a side whose points cannot fix a homography). */
+  /** Pairs left out (`pair N left out: left|right NAME: REASON`: a side whose points cannot fix a homography), and each camera's lens-model advice (`left camera: ...`). */
+  warnings: string[];
+  /** The lens-model advice of each camera (absent in older reports). */
+  model_advice?: { left: ModelAdvice; right: ModelAdvice };
+}
+
+/** The advice on a camera's lens model (src/calib/model_advice.rs). */
+export interface ModelAdvice {
+  /** The model to use: the calibrated one unless another fitted model is named. */
+  recommended: string;
+  /** Every model fitted to the same views, the calibrated one first. */
+  compared: { model: string; rms_px: number; coefficients: number }[];
+  /** The camera export formats that hold the recommended model, with conditions, e.g. `kalibr (with k3 held at 0)`. */
+  export_formats: string[];
+  /** Half the diagonal field of view, degrees (above 50: kannala_brandt and eucm are compared). */
+  half_diagonal_fov_deg: number;
+  /** One line: recommendation, comparison, formats. */
+  summary: string;
   warnings: string[];
 }
 
@@ -1484,7 +1501,7 @@ export interface RobocalJson {
   calibrate_rig: [RigInput, RigCalibration];
   /** `calibrate_rig_handeye(input)` -> the rig report with `handeye` (a rig on a robot). */
   calibrate_rig_handeye: [RigHandEyeInput, RigOnRobotReport];
-  /** `export_report_files(JSON.stringify(report), format, transform or "", JSON.stringify(frames) or "")` -> the files (several for a rig's `ros` and `mrcal`, as `robocal export -o DIR` writes them); `frames` names frames by role, e.g. `{"rig": "camera_rig"}`. */
+  /** `export_report_files(JSON.stringify(report), format, transform or "", JSON.stringify(frames) or "")` -> the files (several for a rig's `ros` and `mrcal` and a stereo pair's `ros`, as `robocal export -o DIR` writes them); `frames` names frames by role, e.g. `{"rig": "camera_rig"}`. */
   export_report_files: [ExportableReport, ExportFile[]];
   /** `rig_export_formats()` -> the rig format names. */
   rig_export_formats: [never, RigExportFormat[]];
@@ -1512,7 +1529,7 @@ export interface RobocalJson {
   target_spec: [Target, never];
   /** `pair_images(JSON.stringify(leftNames), JSON.stringify(rightNames))` -> the pairs (robocal::io::pairing). */
   pair_images: [string[], ImagePairing];
-  /** `rig_frame_keys(JSON.stringify(cameras), groupBy)` (groupBy `'number'`, `'order'` or `''`: by number unless no name has one) -> each image's frame key, as `robocal rig` groups them. */
+  /** `rig_frame_keys(JSON.stringify(cameras), groupBy)` (groupBy `'number'` or `'last'` (the last number in the name), `'first'`, `'order'`, a pattern with one `(\\d+)` such as `'sync(\\d+)'`, or `''`: by number unless no name has one) -> each image's frame key, as `robocal rig --group-by` groups them. */
   rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
 }
 
@@ -1524,7 +1541,8 @@ export interface RigCameraNames {
 
 /** What `rig_frame_keys` returns: the rule used, each image's frame key per camera (input order), and every key sorted. */
 export interface RigFrameGrouping {
-  grouped_by: 'number' | 'order';
+  /** The rule: `number`, `last`, `first`, `order` or the pattern. */
+  grouped_by: string;
   keys: string[][];
   frames: string[];
 }

@@ -41,6 +41,7 @@ pub mod starts;
 pub mod stereo;
 pub mod stereo_json;
 mod stereo_problem;
+pub mod stereo_rectify;
 #[cfg(test)]
 mod stereo_tests;
 mod tsai;

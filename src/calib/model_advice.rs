@@ -18,6 +18,20 @@
 //!   [`SAME_FIT_PX`]), the extra coefficients fit noise; the model with the
 //!   fewest coefficients among those is suggested.
 //!
+//! - **A model no export holds** (division or EUCM where OpenCV and ROS
+//!   are wanted): when a model OpenCV can read fits the same views as well,
+//!   it is named.
+//!
+//! Only a model fitted to the same views is ever recommended; among those
+//! that fit about equally (within [`SAME_FIT_RATIO`]), the one more export
+//! formats hold ([`EXPORT_FORMATS`]), so a fisheye gets kannala_brandt
+//! (OpenCV's fisheye, ROS equidistant, Kalibr) before division (JSON and
+//! Halcon only). A wide-angle lens (half the diagonal field of view above
+//! [`WIDE_ANGLE_HALF_DIAGONAL_DEG`]) always has kannala_brandt and EUCM in
+//! the comparison. Every piece of advice names the formats that hold the
+//! recommended model; [`advise`] also gives the comparison and a summary
+//! line (shown per camera by `robocal stereo`).
+//!
 //! The alternatives are fitted with the user's options except held
 //! coefficients (whose names belong to the chosen model); a model that fails
 //! to solve is left out.
@@ -27,6 +41,9 @@ use super::json_api::model_from_name;
 use super::report::CameraCalibration;
 use super::zhang::CalibrationOptions;
 use super::View;
+use crate::camera::Camera;
+use nalgebra::Point2;
+use serde::{Deserialize, Serialize};
 
 /// RMS residual (px) above which the other models are tried.
 pub const RESIDUAL_ALERT_PX: f64 = 0.5;
@@ -93,6 +110,143 @@ fn coefficient_count(model: &str) -> usize {
     model_from_name(model).map_or(0, |d| d.coefficients().len())
 }
 
+/// What `robocal export` can write a camera of each model to (camera
+/// formats; `text` holds no lens model and is left out). A condition in
+/// parentheses says what the coefficients must be. Mirrors
+/// `io::export_camera` (the io tests check every entry against it).
+pub const EXPORT_FORMATS: [(&str, &[&str]); 7] = [
+    (
+        "none",
+        &[
+            "json",
+            "opencv-yaml",
+            "opencv-xml",
+            "ros-yaml",
+            "kalibr",
+            "mrcal",
+            "halcon",
+            "matlab",
+        ],
+    ),
+    (
+        "brown",
+        &[
+            "json",
+            "opencv-yaml",
+            "opencv-xml",
+            "ros-yaml",
+            "kalibr (with k3 held at 0)",
+            "mrcal",
+            "halcon",
+            "matlab",
+        ],
+    ),
+    (
+        "radial_k1_k2_k5",
+        &[
+            "json",
+            "opencv-yaml",
+            "opencv-xml",
+            "ros-yaml",
+            "kalibr (with k5 held at 0)",
+            "mrcal",
+            "halcon",
+            "matlab",
+        ],
+    ),
+    (
+        "rational",
+        &["json", "opencv-yaml", "opencv-xml", "ros-yaml", "mrcal"],
+    ),
+    ("division", &["json", "halcon"]),
+    (
+        "kannala_brandt",
+        &[
+            "json",
+            "opencv-yaml (cv2.fisheye)",
+            "opencv-xml (cv2.fisheye)",
+            "ros-yaml (equidistant)",
+            "kalibr (equidistant)",
+        ],
+    ),
+    ("eucm", &["json", "kalibr (eucm)"]),
+];
+
+/// The export formats of `model` (see [`EXPORT_FORMATS`]).
+pub fn export_formats(model: &str) -> &'static [&'static str] {
+    EXPORT_FORMATS
+        .iter()
+        .find(|(m, _)| *m == model)
+        .map_or(&[], |(_, f)| f)
+}
+
+/// The format names of `model`, without conditions.
+fn format_names(model: &str) -> Vec<&'static str> {
+    export_formats(model)
+        .iter()
+        .map(|f| f.split(" (").next().unwrap_or(f))
+        .collect()
+}
+
+/// Kannala-Brandt and EUCM: the models for lenses past 90 degrees.
+fn is_fisheye(model: &str) -> bool {
+    matches!(model, "kannala_brandt" | "eucm")
+}
+
+fn can_go_to_opencv(model: &str) -> bool {
+    format_names(model).contains(&"opencv-yaml")
+}
+
+/// Half the diagonal field of view (degrees) above which a lens counts as
+/// wide-angle: kannala_brandt and eucm are then always in the comparison.
+pub const WIDE_ANGLE_HALF_DIAGONAL_DEG: f64 = 50.0;
+
+/// The largest angle (degrees) between the optical axis and the ray of an
+/// image corner, by the camera's own model (the pinhole's when the model
+/// cannot unproject a corner).
+pub fn half_diagonal_fov_deg(camera: &Camera) -> f64 {
+    let (w, h) = (camera.width as f64 - 1.0, camera.height as f64 - 1.0);
+    [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+        .iter()
+        .map(|&(u, v)| match camera.unproject(&Point2::new(u, v)) {
+            Ok(ray) => ray.x.hypot(ray.y).atan2(ray.z),
+            Err(_) => ((u - camera.cx) / camera.fx)
+                .hypot((v - camera.cy) / camera.fy)
+                .atan(),
+        })
+        .fold(0.0, f64::max)
+        .to_degrees()
+}
+
+/// One model fitted to the views.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelFit {
+    /// The model's name.
+    pub model: String,
+    /// Its RMS residual on the same views, px.
+    pub rms_px: f64,
+    /// Its free distortion coefficients.
+    pub coefficients: usize,
+}
+
+/// The advice on a camera's lens model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelAdvice {
+    /// The model to use: the calibrated one, unless another model fitted to
+    /// the same views (one of `compared`) is named instead.
+    pub recommended: String,
+    /// Every model fitted, the calibrated one first.
+    pub compared: Vec<ModelFit>,
+    /// The camera export formats that hold the recommended model.
+    pub export_formats: Vec<String>,
+    /// Half the diagonal field of view of the calibrated camera, degrees.
+    pub half_diagonal_fov_deg: f64,
+    /// One line: the recommendation, the comparison and the formats.
+    pub summary: String,
+    /// The warnings of [`advise_model`] (empty when the model is fine).
+    pub warnings: Vec<String>,
+}
+
 /// Warnings about the lens model of `report`, fitted from `views` with
 /// `options`; empty when the model fits and is not over-parameterised.
 pub fn advise_model(
@@ -101,6 +255,41 @@ pub fn advise_model(
     options: &CalibrationOptions,
     report: &CameraCalibration,
 ) -> Vec<String> {
+    advise(views, image_size_px, options, report).warnings
+}
+
+/// Of the fits within [`SAME_FIT_RATIO`] of the lowest RMS among `fits`,
+/// the one more export formats hold, then the one with fewer coefficients.
+fn pick<'a>(fits: &[&'a ModelFit]) -> Option<&'a ModelFit> {
+    let best = fits.iter().map(|f| f.rms_px).fold(f64::INFINITY, f64::min);
+    fits.iter()
+        .filter(|f| f.rms_px <= SAME_FIT_RATIO * best + SAME_FIT_PX)
+        .min_by(|a, b| {
+            format_names(&b.model)
+                .len()
+                .cmp(&format_names(&a.model).len())
+                .then(a.coefficients.cmp(&b.coefficients))
+                .then(a.rms_px.total_cmp(&b.rms_px))
+        })
+        .copied()
+}
+
+/// "; kannala_brandt exports to json, ..." for a message.
+fn formats_clause(model: &str) -> String {
+    format!("; {model} exports to {}", export_formats(model).join(", "))
+}
+
+/// The advice on the lens model of `report`, fitted from `views` with
+/// `options`: the models compared, the one recommended (never one that was
+/// not fitted), the formats that hold it, and warnings when the model does
+/// not fit the lens, has coefficients to spare, or cannot be exported to
+/// OpenCV while a model that can fits as well.
+pub fn advise(
+    views: &[View],
+    image_size_px: (u32, u32),
+    options: &CalibrationOptions,
+    report: &CameraCalibration,
+) -> ModelAdvice {
     let chosen = report.model.as_str();
     // Coefficients held at 0 are not fitted: they count for nothing.
     let held = model_from_name(chosen).map_or(0, |d| {
@@ -115,14 +304,15 @@ pub fn advise_model(
     let free = if held > 0 { " free" } else { "" };
     let radial = residuals_grow_with_radius(report);
     let far_off = report.rms_px > RESIDUAL_ALERT_PX || radial.is_some();
-    let simpler_exists = MODELS.iter().any(|(m, _)| coefficient_count(m) < n_chosen);
-    if !far_off && !simpler_exists {
-        return Vec::new();
-    }
-    let mut fits: Vec<(&str, f64, usize)> = Vec::new();
+    let fov = half_diagonal_fov_deg(&report.camera);
+    let wide = fov > WIDE_ANGLE_HALF_DIAGONAL_DEG;
+    // 1. The models to fit: all when the model does not fit; else those with
+    // fewer coefficients, and the fisheye models for a wide-angle lens.
+    let mut fits: Vec<ModelFit> = Vec::new();
     for (name, _) in MODELS {
         let n = coefficient_count(name);
-        if name == chosen || (!far_off && n >= n_chosen) {
+        let fisheye = is_fisheye(name);
+        if name == chosen || !(far_off || n < n_chosen || (wide && fisheye)) {
             continue;
         }
         let Ok(model) = model_from_name(name) else {
@@ -135,71 +325,157 @@ pub fn advise_model(
         };
         if let Ok(r) = calibrate_with(Method::Zhang, views, image_size_px, &alternative) {
             if r.rms_px.is_finite() {
-                fits.push((name, r.rms_px, n));
+                fits.push(ModelFit {
+                    model: name.to_string(),
+                    rms_px: r.rms_px,
+                    coefficients: n,
+                });
             }
         }
     }
-    let mut advice = Vec::new();
+    // 2. The recommendation and its warning.
+    let mut warnings = Vec::new();
+    let mut recommended = chosen.to_string();
     if let (Some((inner, outer)), false) = (radial, report.rms_px > RESIDUAL_ALERT_PX) {
-        let best = fits
+        let better: Vec<&ModelFit> = fits
             .iter()
-            .filter(|f| f.1 <= 0.7 * report.rms_px)
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some(&(name, rms, _)) = best {
-            advice.push(format!(
+            .filter(|f| f.rms_px <= 0.7 * report.rms_px)
+            .collect();
+        if let Some(f) = pick(&better) {
+            warnings.push(format!(
                 "the residuals grow with the distance from the image centre (rms {outer:.3} px \
                  in the outer third against {inner:.3} px in the centre): the {} model does \
-                 not follow this lens; {} fits the same views at {rms:.3} px against {:.3} px: \
-                 switch the model to {name} (CLI: --model {name})",
+                 not follow this lens; {} fits the same views at {:.3} px against {:.3} px: \
+                 switch the model to {name} (CLI: --model {name}){}",
                 label(chosen),
-                label(name),
-                report.rms_px
-            ));
-        }
-        return advice;
-    }
-    if far_off {
-        let best = fits
-            .iter()
-            .filter(|f| f.1 <= 0.5 * report.rms_px)
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        match best {
-            Some(&(name, rms, _)) => advice.push(format!(
-                "the residuals (rms {:.3} px) are far above detection noise: the {} model \
-                 does not fit this lens; {} fits the same views at {:.3} px ({:.0}x lower): \
-                 switch the model to {name} (CLI: --model {name})",
+                label(&f.model),
+                f.rms_px,
                 report.rms_px,
-                label(chosen),
-                label(name),
-                rms,
-                report.rms_px / rms
-            )),
-            None => advice.push(format!(
+                formats_clause(&f.model),
+                name = f.model,
+            ));
+            recommended = f.model.clone();
+        }
+    } else if far_off {
+        let better: Vec<&ModelFit> = fits
+            .iter()
+            .filter(|f| f.rms_px <= 0.5 * report.rms_px)
+            .collect();
+        match pick(&better) {
+            Some(f) => {
+                warnings.push(format!(
+                    "the residuals (rms {:.3} px) are far above detection noise: the {} model \
+                     does not fit this lens; {} fits the same views at {:.3} px ({:.0}x lower): \
+                     switch the model to {name} (CLI: --model {name}){}",
+                    report.rms_px,
+                    label(chosen),
+                    label(&f.model),
+                    f.rms_px,
+                    report.rms_px / f.rms_px,
+                    formats_clause(&f.model),
+                    name = f.model,
+                ));
+                recommended = f.model.clone();
+            }
+            None => warnings.push(format!(
                 "the residuals (rms {:.3} px) are far above detection noise (below {} px \
                  expected) and no other lens model fits much better: check the target spec \
                  and its printed size, and exclude views with wrong detections",
                 report.rms_px, RESIDUAL_ALERT_PX
             )),
         }
-        return advice;
+    } else {
+        let as_well = |f: &&ModelFit| f.rms_px <= SAME_FIT_RATIO * report.rms_px + SAME_FIT_PX;
+        // A simpler model is named only if it exports wherever the chosen one
+        // does, and, for a wide-angle lens fitted with a fisheye model, only
+        // another fisheye model: a polynomial's fit inside the views says
+        // nothing of the rays beyond them, where a wide lens sees most.
+        let mine = format_names(chosen);
+        let keeps_fisheye = |m: &str| !(wide && is_fisheye(chosen)) || is_fisheye(m);
+        let simplest = fits
+            .iter()
+            .filter(as_well)
+            .filter(|f| f.coefficients < n_chosen)
+            .filter(|f| mine.iter().all(|m| format_names(&f.model).contains(m)))
+            .filter(|f| keeps_fisheye(&f.model))
+            .min_by(|a, b| {
+                a.coefficients
+                    .cmp(&b.coefficients)
+                    .then(a.rms_px.total_cmp(&b.rms_px))
+            });
+        let exportable = fits
+            .iter()
+            .filter(as_well)
+            .filter(|f| can_go_to_opencv(&f.model))
+            .min_by(|a, b| {
+                a.coefficients
+                    .cmp(&b.coefficients)
+                    .then(a.rms_px.total_cmp(&b.rms_px))
+            });
+        if let Some(f) = simplest {
+            warnings.push(format!(
+                "too many parameters for these views: the {} model's {n_chosen}{free} coefficients \
+                 fit at {:.3} px, and {} with {} fits as well ({:.3} px), so the extra ones fit \
+                 noise and their values mean nothing: use {name} (CLI: --model {name}), or add \
+                 views that fill the image corners{}",
+                label(chosen),
+                report.rms_px,
+                label(&f.model),
+                f.coefficients,
+                f.rms_px,
+                formats_clause(&f.model),
+                name = f.model,
+            ));
+            recommended = f.model.clone();
+        } else if let (false, Some(f)) = (can_go_to_opencv(chosen), exportable) {
+            warnings.push(format!(
+                "the {} model cannot be exported to OpenCV or ROS, and {} fits the same views as \
+                 well ({:.3} px against {:.3} px): use {name} (CLI: --model {name}) to export \
+                 there{}",
+                label(chosen),
+                label(&f.model),
+                f.rms_px,
+                report.rms_px,
+                formats_clause(&f.model),
+                name = f.model,
+            ));
+            recommended = f.model.clone();
+        }
     }
-    let simplest = fits
+    // 3. The summary.
+    let mut compared = vec![ModelFit {
+        model: chosen.to_string(),
+        rms_px: report.rms_px,
+        coefficients: n_chosen,
+    }];
+    compared.extend(fits);
+    let others: Vec<String> = compared[1..]
         .iter()
-        .filter(|f| f.2 < n_chosen && f.1 <= SAME_FIT_RATIO * report.rms_px + SAME_FIT_PX)
-        .min_by(|a, b| a.2.cmp(&b.2).then(a.1.total_cmp(&b.1)));
-    if let Some(&(name, rms, n)) = simplest {
-        advice.push(format!(
-            "too many parameters for these views: the {} model's {n_chosen}{free} coefficients \
-             fit at {:.3} px, and {} with {n} fits as well ({:.3} px), so the extra ones fit \
-             noise and their values mean nothing: use {name} (CLI: --model {name}), or add \
-             views that fill the image corners",
-            label(chosen),
-            report.rms_px,
-            label(name),
-            rms
-        ));
+        .map(|f| format!("{} {:.3} px", f.model, f.rms_px))
+        .collect();
+    let summary = format!(
+        "lens model: {recommended}{} ({} fits at {:.3} px{}; half diagonal field of view {fov:.0} deg){}",
+        if recommended == chosen { "" } else { " recommended" },
+        chosen,
+        report.rms_px,
+        if others.is_empty() {
+            String::new()
+        } else {
+            format!(", compared with {}", others.join(", "))
+        },
+        formats_clause(&recommended),
+    );
+    ModelAdvice {
+        export_formats: export_formats(&recommended)
+            .iter()
+            .map(|f| f.to_string())
+            .collect(),
+        recommended,
+        compared,
+        half_diagonal_fov_deg: fov,
+        summary,
+        warnings,
     }
-    advice
 }
 
 #[cfg(test)]
@@ -329,5 +605,132 @@ mod tests {
             alarm.contains("the division model does not fit this lens"),
             "{alarm}"
         );
+    }
+
+    /// The advice of `n` views of `truth` (0.1 px noise) fitted with `model`.
+    fn advice_of(truth: &Camera, model: &str, n: usize) -> ModelAdvice {
+        let scene = Scene::calibration(7, truth, (9, 6), 0.03, n, 0.1).expect("scene");
+        let views: Vec<View> = scene
+            .views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| View {
+                name: format!("v{i}"),
+                ..v.clone()
+            })
+            .collect();
+        let options = CalibrationOptions {
+            model: model_from_name(model).unwrap(),
+            ..CalibrationOptions::default()
+        };
+        let size = (truth.width, truth.height);
+        let report = calibrate_with(Method::Zhang, &views, size, &options).expect("solve");
+        advise(&views, size, &options, &report)
+    }
+
+    #[test]
+    fn a_fisheye_lens_is_advised_a_fisheye_model_with_its_export_formats() {
+        // The 190-degree Kannala-Brandt example, calibrated with its own model:
+        // the comparison has EUCM and the simpler models, and the advice keeps
+        // kannala_brandt (division may fit about as well, but only JSON and
+        // Halcon hold it, and it is not simpler than what OpenCV reads).
+        let a = advice_of(&Camera::example_kannala_brandt(), "kannala_brandt", 10);
+        assert!(
+            a.half_diagonal_fov_deg > 80.0,
+            "{}",
+            a.half_diagonal_fov_deg
+        );
+        let compared: Vec<&str> = a.compared.iter().map(|f| f.model.as_str()).collect();
+        assert_eq!(compared[0], "kannala_brandt");
+        assert!(compared.contains(&"eucm"), "{compared:?}");
+        assert_eq!(a.recommended, "kannala_brandt", "{}", a.summary);
+        assert!(a.warnings.is_empty(), "{:?}", a.warnings);
+        assert_eq!(
+            a.export_formats,
+            [
+                "json",
+                "opencv-yaml (cv2.fisheye)",
+                "opencv-xml (cv2.fisheye)",
+                "ros-yaml (equidistant)",
+                "kalibr (equidistant)"
+            ]
+        );
+        assert!(
+            a.summary.starts_with("lens model: kannala_brandt (kannala_brandt fits at ")
+                && a.summary.ends_with("; kannala_brandt exports to json, opencv-yaml (cv2.fisheye), opencv-xml (cv2.fisheye), ros-yaml (equidistant), kalibr (equidistant)"),
+            "{}",
+            a.summary
+        );
+        // Through Brown-Conrady the lens does not fit: the model named is a
+        // fisheye one that was fitted, with its formats.
+        let a = advice_of(&Camera::example_kannala_brandt(), "brown", 10);
+        assert!(
+            ["kannala_brandt", "eucm"].contains(&a.recommended.as_str()),
+            "{}",
+            a.summary
+        );
+        assert!(a.compared.iter().any(|f| f.model == a.recommended));
+        let w = a
+            .warnings
+            .first()
+            .unwrap_or_else(|| panic!("{}", a.summary));
+        assert!(
+            w.contains(&format!(
+                "switch the model to {m} (CLI: --model {m}); {m} exports to json, ",
+                m = a.recommended
+            )),
+            "{w}"
+        );
+    }
+
+    #[test]
+    fn a_normal_lens_keeps_brown_conrady_which_opencv_holds() {
+        let a = advice_of(&Camera::example_brown(), "brown", 10);
+        assert!(
+            a.half_diagonal_fov_deg < WIDE_ANGLE_HALF_DIAGONAL_DEG,
+            "{}",
+            a.half_diagonal_fov_deg
+        );
+        assert_eq!(a.recommended, "brown", "{}", a.summary);
+        assert!(
+            a.export_formats.iter().any(|f| f == "opencv-yaml"),
+            "{:?}",
+            a.export_formats
+        );
+        assert!(a.summary.ends_with("; brown exports to json, opencv-yaml, opencv-xml, ros-yaml, kalibr (with k3 held at 0), mrcal, halcon, matlab"), "{}", a.summary);
+        // No fisheye model was fitted for a normal lens unless it has fewer
+        // coefficients than Brown-Conrady's five (all the others do).
+        assert!(a
+            .compared
+            .iter()
+            .all(|f| f.model == "brown" || f.coefficients < 5));
+    }
+
+    #[test]
+    fn of_models_that_fit_alike_the_one_more_formats_hold_is_picked() {
+        let fit = |model: &str, rms_px: f64, coefficients: usize| ModelFit {
+            model: model.into(),
+            rms_px,
+            coefficients,
+        };
+        let (division, eucm, kb) = (
+            fit("division", 0.100, 1),
+            fit("eucm", 0.1005, 2),
+            fit("kannala_brandt", 0.101, 4),
+        );
+        // Within 2 % of the best: Kannala-Brandt (OpenCV, ROS, Kalibr) over
+        // EUCM (Kalibr) and division (Halcon).
+        assert_eq!(
+            pick(&[&division, &eucm, &kb]).unwrap().model,
+            "kannala_brandt"
+        );
+        // A clearly worse fit is not picked for its formats; between two that
+        // two formats each hold, the fewer coefficients.
+        let kb_worse = fit("kannala_brandt", 0.2, 4);
+        assert_eq!(
+            pick(&[&division, &eucm, &kb_worse]).unwrap().model,
+            "division"
+        );
+        assert_eq!(pick(&[]), None);
     }
 }

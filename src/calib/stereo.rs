@@ -7,6 +7,7 @@
 //! right_from_left jointly (the right camera sees the board at
 //! `right_from_left * left_from_target`).
 
+use super::model_advice::{advise, ModelAdvice};
 use super::refine::{block_from_pose, CalibProblem};
 use super::report::build_report;
 use super::same_images::{refuse_identical_views, refuse_zero_baseline};
@@ -53,9 +54,23 @@ pub struct StereoCalibration {
     /// Why the joint solver stopped.
     pub termination: Termination,
     /// Pairs left out (a side whose points cannot fix a homography), with
-    /// the reason; empty when every pair was used.
+    /// the reason, and the lens-model advice of each camera; empty when
+    /// every pair was used and both models fit.
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// The lens-model advice of each camera ([`super::model_advice::advise`]);
+    /// absent in reports written before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_advice: Option<PairModelAdvice>,
+}
+
+/// The lens-model advice of both cameras of a pair.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairModelAdvice {
+    /// The left camera's.
+    pub left: ModelAdvice,
+    /// The right camera's.
+    pub right: ModelAdvice,
 }
 
 /// Calibrate a stereo pair from views paired by index (`left[i]` and
@@ -168,7 +183,17 @@ pub fn calibrate_stereo(
         baseline_m,
         right_from_left_std.as_ref().map(|s| s.translation_m),
     )?;
+    // Each camera's lens model, judged on its views at the joint optimum.
+    let advice = PairModelAdvice {
+        left: advise(left, left_size_px, options, &left_report),
+        right: advise(right, right_size_px, options, &right_report),
+    };
+    let mut warnings = warnings;
+    for (side, a) in [("left", &advice.left), ("right", &advice.right)] {
+        warnings.extend(a.warnings.iter().map(|w| format!("{side} camera: {w}")));
+    }
     Ok(StereoCalibration {
+        model_advice: Some(advice),
         left: left_report,
         right: right_report,
         right_from_left: PoseJson::from(&rfl),

@@ -8,8 +8,8 @@ use super::{read_text, write_output, CliError};
     long_about = "convert a calibration report into another format
 
 REPORT.json is the output of 'robocal intrinsics' (a camera),
-'robocal handeye' (transforms) or 'robocal rig' (a camera rig), or any JSON
-with the same keys.",
+'robocal handeye' (transforms), 'robocal stereo' (a stereo pair) or
+'robocal rig' (a camera rig), or any JSON with the same keys.",
     after_help = "Camera formats:
   json          robocal's camera JSON (schema robocal.camera.v1)
   opencv-yaml   OpenCV FileStorage YAML (cv2.FileStorage, camera_matrix, distortion_coefficients)
@@ -46,8 +46,18 @@ the frame 'rig'), urdf (link rig, fixed joints rig -> each camera), mrcal (a
 .cameramodel per camera, extrinsics = rt_cam_ref with the rig as reference).
 Frames: --frame rig=NAME, --frame CAMERA=NAME.
 
+Stereo reports (robocal stereo; right_from_left is OpenCV's R, T:
+x_right = R x_left + T): --format opencv-yaml (one FileStorage as OpenCV's
+stereo samples keep it: image_width, image_height, K1 D1 K2 D2 R T, E = [T]x R,
+F = K2^-T E K1^-1, and R1 R2 P1 P2 Q of cv2.stereoRectify with
+CALIB_ZERO_DISPARITY and alpha -1), ros (left.yaml and right.yaml, the
+camera_info files of ROS camera_calibration's stereo: rectification_matrix
+R1/R2, projection_matrix P1/P2), kalibr (cam0 = left, cam1 = right with
+T_cn_cnm1 = right_from_left), or a transform format (right_from_left).
+Frames: --frame left=NAME, --frame right=NAME (ROS camera_name, Kalibr topic).
+
 Output goes to FILE with -o, else to stdout. Formats of several files (a
-rig's ros and mrcal) go into the folder DIR with -o DIR, else to stdout
+rig's ros and mrcal, a stereo pair's ros) go into the folder DIR with -o DIR, else to stdout
 each after a line '# ==> NAME <=='.
 
 Examples:
@@ -56,7 +66,8 @@ Examples:
   robocal export handeye.json --format euler-extrinsic-xyz-deg
   robocal export handeye.json --format ros1-launch --frame gripper=tool0 --frame camera=camera_optical_frame
   robocal export rig.json --format kalibr -o camchain.yaml
-  robocal export rig.json --format ros -o rig_ros/",
+  robocal export rig.json --format ros -o rig_ros/
+  robocal export stereo.json --format opencv-yaml -o stereo.yaml",
     args_override_self = true
 )]
 pub struct ExportArgs {

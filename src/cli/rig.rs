@@ -11,7 +11,7 @@ use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
 use robocal::handeye::rig_json::rig_cameras_named;
 use robocal::io::import_camera::import_camera;
-use robocal::io::pairing::{default_grouping, frame_keys, PairedBy};
+use robocal::io::pairing::{default_grouping, frame_keys, FrameGrouping};
 use robocal::target::Target;
 use serde::Deserialize;
 use std::path::Path;
@@ -24,8 +24,11 @@ use std::path::Path;
 Each --camera takes a name and that camera's images (every argument up to the
 next option, so shell globs work). Images are grouped into frames by the number
 in their file names (the last run of digits in the name without folders and
-extension: front07.png and side/7.jpg are one frame), or by their position with
---group-by order. Any camera may miss the board in any frame; a detection may
+extension: front07.png and side/7.jpg are one frame), or as --group-by says:
+first (the first number: sync036_cam0.jpg is frame 36), last (as number),
+order (the position in each camera's list), or a pattern: literal text with
+one (\\d+), matched in the name without folders, such as 'sync(\\d+)'
+(sync036_cam0.jpg and cam1_sync36.png are frame 36). Any camera may miss the board in any frame; a detection may
 hold any subset of the board's points (marker boards partly out of view).
 
 Each camera is calibrated alone (Zhang), or its intrinsics are given and held
@@ -99,8 +102,9 @@ pub struct RigArgs {
     /// The camera whose frame is the rig frame (default: the first)
     #[arg(long, value_name = "NAME", overrides_with = "rig_frame")]
     rig_frame: Option<String>,
-    /// How images form frames: number (the number in the file names,
-    /// default) or order (their position in each camera's list)
+    /// How images form frames: number or last (the last number in the file
+    /// names, default), first (the first number), order (the position in
+    /// each camera's list), or a pattern with one (\d+) such as 'sync(\d+)'
     #[arg(long, value_name = "RULE", overrides_with = "group_by")]
     group_by: Option<String>,
     /// Lens model of the solved cameras: brown (default), radial_k1_k2_k5,
@@ -286,7 +290,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
     let mut keys_per_camera = Vec::with_capacity(cameras.len());
     for c in &cameras {
         let names: Vec<&str> = c.images.iter().map(String::as_str).collect();
-        keys_per_camera.push(frame_keys(&names, grouping, &c.name).map_err(|e| usage(plain(e)))?);
+        keys_per_camera.push(frame_keys(&names, &grouping, &c.name).map_err(|e| usage(plain(e)))?);
     }
     let mut keys: Vec<String> = keys_per_camera.iter().flatten().cloned().collect();
     sort_frame_keys(&mut keys);
@@ -360,7 +364,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
                 .join(", ")
         );
         let source = format!("the covariance in '{path}'");
-        return write_with_handeye(&args, &report, &inputs, &index, &keys, grouping, &source);
+        return write_with_handeye(&args, &report, &inputs, &index, &keys, &grouping, &source);
     }
     let options = RigOptions {
         calibration: CalibrationOptions {
@@ -374,10 +378,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
         },
         rig_frame: pick(&args.rig_frame, |r| &r.rig_frame),
         target: target.to_spec(),
-        grouping: match grouping {
-            PairedBy::Number => "number".into(),
-            PairedBy::Order => "order".into(),
-        },
+        grouping: grouping.rule(),
     };
     let report = calibrate_rig(&inputs, &keys, &options)?;
     eprint!("{}", super::rig_summary::summary(&report));
@@ -385,7 +386,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
         return write_report(&args, &report, None);
     }
     let source = "the rig calibration of this run".to_string();
-    write_with_handeye(&args, &report, &inputs, &index, &keys, grouping, &source)
+    write_with_handeye(&args, &report, &inputs, &index, &keys, &grouping, &source)
 }
 
 /// The hand-eye of the rig, then the report with it under `handeye`.
@@ -395,7 +396,7 @@ fn write_with_handeye(
     inputs: &[RigCameraViews],
     index: &[usize],
     keys: &[String],
-    grouping: PairedBy,
+    grouping: &FrameGrouping,
     source: &str,
 ) -> Result<(), CliError> {
     let h = super::rig_handeye::rig_handeye(
@@ -482,16 +483,14 @@ fn cameras_of_flags(flags: &[Vec<String>]) -> Vec<CameraArg> {
 }
 
 /// The grouping rule: given, or by number unless no file name has one.
-fn grouping(rule: Option<&str>, cameras: &[CameraArg]) -> Result<PairedBy, CliError> {
+fn grouping(rule: Option<&str>, cameras: &[CameraArg]) -> Result<FrameGrouping, CliError> {
     match rule {
-        Some("number") => Ok(PairedBy::Number),
-        Some("order") => Ok(PairedBy::Order),
-        Some(other) => Err(usage(format!(
-            "--group-by takes number or order, got '{other}'"
-        ))),
+        Some(rule) => {
+            FrameGrouping::from_rule(rule).map_err(|e| usage(format!("--group-by {}", plain(e))))
+        }
         None => {
             let by = default_grouping(cameras.iter().flat_map(|c| &c.images).map(String::as_str));
-            if by == PairedBy::Order {
+            if by == FrameGrouping::Order {
                 eprintln!("robocal rig: no file name has a number: frames grouped by order");
             }
             Ok(by)

@@ -10,7 +10,7 @@ use robocal::calib::rig::RigCameraViews;
 use robocal::calib::rig_report::RigCalibration;
 use robocal::handeye::rig_json::solve_rig_on_robot;
 use robocal::handeye::{HandEyeOptions, Setup};
-use robocal::io::pairing::{number_in_name, PairedBy};
+use robocal::io::pairing::FrameGrouping;
 use robocal::io::RobotPose;
 use serde_json::Value;
 
@@ -59,7 +59,7 @@ pub fn rig_handeye(
     inputs: &[RigCameraViews],
     index: &[usize],
     keys: &[String],
-    grouping: PairedBy,
+    grouping: &FrameGrouping,
     source: &str,
 ) -> Result<Value, CliError> {
     let setup: Setup = flags.setup.as_deref().unwrap_or_default().parse()?;
@@ -93,21 +93,22 @@ pub fn rig_handeye(
 }
 
 /// One robot pose per frame: by the frame numbers of the pose file's image
-/// names when it has them (grouping by number), else in order.
+/// names when it has them (keyed by the same rule as the images), else in
+/// order (grouping by order).
 fn per_frame(
     poses: &[RobotPose],
     keys: &[String],
-    grouping: PairedBy,
+    grouping: &FrameGrouping,
     path: &str,
 ) -> Result<Vec<robocal::geometry::Pose>, CliError> {
-    let named = grouping == PairedBy::Number && poses.iter().all(|p| p.name.is_some());
+    let named = *grouping != FrameGrouping::Order && poses.iter().all(|p| p.name.is_some());
     if !named || poses.is_empty() {
         return Ok(poses.iter().map(|p| p.base_from_gripper).collect());
     }
     let mut out = vec![None; keys.len()];
     for p in poses {
         let name = p.name.as_deref().unwrap_or_default();
-        let Some(number) = number_in_name(name) else {
+        let Some(number) = grouping.key(name) else {
             return Err(CliError::Io(format!(
                 "'{path}': line {}: the image '{name}' has no frame number (the frames are {})",
                 p.line,
@@ -116,7 +117,7 @@ fn per_frame(
         };
         // A pose of a frame none of the given images is in (a pose file of
         // the whole rig used with some of its cameras) is not needed.
-        if let Some(f) = keys.iter().position(|k| k == number) {
+        if let Some(f) = keys.iter().position(|k| *k == number) {
             out[f] = Some(p.base_from_gripper);
         }
     }

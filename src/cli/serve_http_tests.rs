@@ -122,6 +122,7 @@ fn clients_beyond_the_pool_and_queue_get_503() {
     // Once the idle clients are gone, service is back.
     let mut s = TcpStream::connect(addr).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
-    s.write_all(b"GET /index.html HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
+    s.write_all(b"GET /index.html HTTP/1.1\r\nHost: x\r\n\r\n")
+        .unwrap();
     assert_eq!(status_of(s), 200);
 }

@@ -33,13 +33,22 @@ listed on standard error. A detection may hold any subset of the board's points
 a pair where a side's points cannot fix a homography (fewer than 4, or all but
 one on a line) is left out with a warning (the report's warnings). Instead of
 images, --left-detections and --right-detections read 'robocal detect' outputs.
-The report (JSON) has left, right (camera reports),
+Each camera's lens model is compared with the others fitted to the same views
+(kannala_brandt and eucm always for a wide-angle lens): the advice names the
+model to use and the export formats that hold it (model_advice, and a line per
+camera on standard error). The report (JSON) has left, right (camera reports),
 right_from_left and initial_right_from_left ({matrix_row_major, translation_m,
-quaternion_xyzw}), baseline_m, right_from_left_std, rms_px and warnings.",
+quaternion_xyzw}, x_right = R x_left + T as OpenCV's R, T), baseline_m,
+right_from_left_std, rms_px, warnings and model_advice. 'robocal export' writes
+it as opencv-yaml (K1 D1 K2 D2 R T E F and the rectification R1 R2 P1 P2 Q),
+ros (left.yaml and right.yaml, rectified), kalibr (cam0, cam1) or any
+transform format (right_from_left).",
     after_help = "Examples:
   robocal stereo --target chessboard:9x6:25mm --left left*.jpg --right right*.jpg -o stereo.json
   robocal stereo --target chessboard:9x6:25mm --model radial_k1_k2_k5 --left l/*.png --right r/*.png
   robocal stereo --left-detections left.json --right-detections right.json -o stereo.json
+  robocal export stereo.json --format opencv-yaml -o stereo.yaml
+  robocal export stereo.json --format ros -o stereo_ros/
   robocal export stereo.json --format xyz-quat-xyzw"
 )]
 pub struct StereoArgs {
@@ -220,6 +229,11 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
     let report = calibrate_stereo(&left, &right, ls, rs, &options)?;
     for w in &report.warnings {
         eprintln!("robocal stereo: warning: {w}");
+    }
+    if let Some(advice) = &report.model_advice {
+        for (side, a) in [("left", &advice.left), ("right", &advice.right)] {
+            eprintln!("robocal stereo: {side} camera: {}", a.summary);
+        }
     }
     let t = report.right_from_left.translation_m;
     eprintln!(

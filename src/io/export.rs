@@ -9,6 +9,7 @@
 use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
 use super::export_rig::{export_rig, is_rig_report, RigFormat};
 pub use super::export_rig::{join_files, ExportFile};
+use super::export_stereo::{export_stereo, is_stereo_report, not_a_stereo_format, StereoFormat};
 use super::export_transform::{export_transform, FrameNames, TransformFormat};
 use super::import_camera::import_camera;
 use crate::calib::rig_report::RigCalibration;
@@ -71,6 +72,9 @@ pub fn export_with(report_json: &str, format: &str, options: &ExportOptions) -> 
     if is_rig_report(&report) && format != "report" {
         return export_rig_report(&report, format, options).map(|files| join_files(&files));
     }
+    if let Some(files) = export_stereo_report(&report, format, options)? {
+        return Ok(join_files(&files));
+    }
     export_value(report_json, &report, format, options)
 }
 
@@ -84,6 +88,9 @@ pub fn export_files(
     let report = parse_report(report_json)?;
     if is_rig_report(&report) && format != "report" {
         return export_rig_report(&report, format, options);
+    }
+    if let Some(files) = export_stereo_report(&report, format, options)? {
+        return Ok(files);
     }
     let text = export_value(report_json, &report, format, options)?;
     let extension = match CameraFormat::from_name(format) {
@@ -116,6 +123,25 @@ fn export_rig_report(
     let rig = RigCalibration::deserialize(report)
         .map_err(|e| Error::invalid("report", format!("not a readable rig report: {e}")))?;
     export_rig(&rig, format, &options.frames)
+}
+
+/// A stereo report in a stereo format; `None` when `report` is not a
+/// stereo report or `format` is a transform format (or `report`), which
+/// write `right_from_left` as for any report. Camera formats that hold one
+/// camera are refused: they would drop the other camera.
+fn export_stereo_report(
+    report: &serde_json::Value,
+    format: &str,
+    options: &ExportOptions,
+) -> Result<Option<Vec<ExportFile>>> {
+    if !is_stereo_report(report) || format == "report" {
+        return Ok(None);
+    }
+    match StereoFormat::from_name(format) {
+        Some(f) => export_stereo(report, f, &options.frames).map(Some),
+        None if CameraFormat::from_name(format).is_ok() => Err(not_a_stereo_format(format)),
+        None => Ok(None),
+    }
 }
 
 fn export_value(

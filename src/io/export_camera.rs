@@ -129,7 +129,7 @@ pub fn export_camera(
         CameraFormat::Json => json(camera, info),
         CameraFormat::OpencvYaml => opencv_yaml(camera, info),
         CameraFormat::OpencvXml => opencv_xml(camera, info),
-        CameraFormat::RosYaml => ros_yaml(camera, info),
+        CameraFormat::RosYaml => ros_camera_info(camera, info, None),
         CameraFormat::Kalibr => kalibr(camera, info),
         CameraFormat::Mrcal => mrcal(camera),
         CameraFormat::Halcon => halcon(camera, info),
@@ -284,7 +284,14 @@ fn opencv_xml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
     Ok(out)
 }
 
-fn ros_yaml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
+/// A ROS camera_info YAML; `rectified` gives its `rectification_matrix`
+/// (3x3) and `projection_matrix` (3x4), row-major, for a camera of a
+/// stereo pair (else the identity and `[K | 0]`).
+pub(super) fn ros_camera_info(
+    c: &Camera,
+    info: &CameraExportInfo,
+    rectified: Option<(&[f64], &[f64])>,
+) -> Result<String> {
     let (dist, fisheye) = opencv_distortion(c)?;
     let model = match (&c.distortion, fisheye) {
         (_, true) => "equidistant",
@@ -310,12 +317,9 @@ fn ros_yaml(c: &Camera, info: &CameraExportInfo) -> Result<String> {
     out += &block("camera_matrix", 3, 3, &k);
     out += &format!("distortion_model: {model}\n");
     out += &block("distortion_coefficients", 1, dist.len(), &dist);
-    out += &block(
-        "rectification_matrix",
-        3,
-        3,
-        &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-    );
-    out += &block("projection_matrix", 3, 4, &p);
+    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+    let (r, p) = rectified.unwrap_or((&identity[..], &p[..]));
+    out += &block("rectification_matrix", 3, 3, r);
+    out += &block("projection_matrix", 3, 4, p);
     Ok(out)
 }

@@ -336,3 +336,46 @@ fn transform_names_that_are_not_frame_names_are_refused() {
         );
     }
 }
+
+/// The model advice's table of formats per model
+/// ([`crate::calib::model_advice::EXPORT_FORMATS`]) is what the writers do:
+/// every camera format but `text` (no lens model) is listed for a model
+/// exactly when it writes the example camera of that model (zero skew, and
+/// the coefficient a condition names held at 0).
+#[test]
+#[wasm_bindgen_test]
+fn the_model_advice_names_the_formats_the_writers_accept() {
+    use crate::calib::model_advice::export_formats;
+    for example in Camera::examples() {
+        let mut camera = Camera {
+            skew: 0.0,
+            ..example
+        };
+        let model = camera.distortion.model_name();
+        let listed = export_formats(model);
+        assert!(!listed.is_empty(), "{model} is not in the table");
+        for format in CameraFormat::ALL {
+            if format == CameraFormat::Text {
+                continue;
+            }
+            let entry = listed
+                .iter()
+                .find(|f| f.split(" (").next() == Some(format.name()));
+            if let Some(condition) = entry.and_then(|e| e.strip_suffix(" held at 0)")) {
+                let coefficient = condition.rsplit(' ').next().unwrap_or_default();
+                let names = camera.distortion.coefficient_names();
+                let mut values = camera.distortion.coefficients();
+                let k = names.iter().position(|n| *n == coefficient).unwrap();
+                values[k] = 0.0;
+                camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
+            }
+            let written = export_camera(&camera, &CameraExportInfo::default(), format).is_ok();
+            assert_eq!(
+                written,
+                entry.is_some(),
+                "{model} to {}: listed {entry:?}",
+                format.name()
+            );
+        }
+    }
+}

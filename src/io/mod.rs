@@ -13,6 +13,7 @@ pub mod export_camera;
 mod export_camera_tools;
 pub mod export_rig;
 pub mod export_ros;
+pub mod export_stereo;
 pub mod export_transform;
 pub mod import_camera;
 pub mod kalibr_target;

@@ -1,4 +1,5 @@
-//! Pairing the images of two cameras (stereo left and right) by file name.
+//! Pairing the images of two cameras (stereo left and right) by file name,
+//! and grouping a rig's images into frames ([`FrameGrouping`]).
 //!
 //! # The rule
 //!
@@ -127,54 +128,220 @@ pub fn pair_by_number(left: &[&str], right: &[&str]) -> Result<Pairing> {
     })
 }
 
-/// The default grouping of a rig's images (`robocal rig` without
-/// `--group-by`, the web app's rig step): by number unless no file name has
-/// one.
-pub fn default_grouping<'a>(mut names: impl Iterator<Item = &'a str>) -> PairedBy {
-    if names.any(|n| number_in_name(n).is_some()) {
-        PairedBy::Number
-    } else {
-        PairedBy::Order
+/// How a rig's images form frames (`robocal rig --group-by`, the page's
+/// rig step): each image gets a frame key from its file name (without
+/// folders), and images of different cameras with the same key are one
+/// frame. Keys are numbers without leading zeros (`sync036` and `sync36`
+/// are one frame).
+///
+/// | rule       | key                                                       |
+/// |------------|-----------------------------------------------------------|
+/// | `number`   | the last run of digits in the stem (the default)          |
+/// | `last`     | the same                                                  |
+/// | `first`    | the first run of digits in the stem                       |
+/// | `order`    | the position in the camera's list (`0`, `1`, ...)         |
+/// | a pattern  | the digits of its one `(\d+)`, e.g. `sync(\d+)`           |
+///
+/// A pattern is literal text with one `(\d+)` (no other regular-expression
+/// syntax): it matches the file name without folders, extension included,
+/// at the first place where the text before `(\d+)` is followed by one or
+/// more digits (all of them are taken) and then by the text after it.
+/// `sync(\d+)` takes `036` from `sync036_cam0.jpg` and from
+/// `cam1_sync036.png`; `left_(\d+).png` takes `12` from `0001_left_12.png`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FrameGrouping {
+    /// `number`: the last run of digits in the stem.
+    Number,
+    /// `last`: the last run of digits in the stem (as `number`).
+    Last,
+    /// `first`: the first run of digits in the stem.
+    First,
+    /// `order`: the position in each camera's list.
+    Order,
+    /// A pattern: the digits between `before` and `after`.
+    Pattern {
+        /// Literal text before the digits.
+        before: String,
+        /// Literal text after the digits.
+        after: String,
+    },
+}
+
+/// The rules, for errors that name them.
+pub const GROUPING_RULES: &str = "number or last (the last number in the name, the default), first (the first number), order (the position in each camera's list), or a pattern with one (\\d+) such as sync(\\d+)";
+
+const CAPTURE: &str = "(\\d+)";
+
+impl FrameGrouping {
+    /// The grouping of a rule name or pattern (see the type's docs).
+    pub fn from_rule(rule: &str) -> Result<FrameGrouping> {
+        match rule {
+            "number" => return Ok(FrameGrouping::Number),
+            "last" => return Ok(FrameGrouping::Last),
+            "first" => return Ok(FrameGrouping::First),
+            "order" => return Ok(FrameGrouping::Order),
+            _ => {}
+        }
+        let refuse = |why: String| {
+            Error::invalid(
+                "group_by",
+                format!("takes {GROUPING_RULES}; got '{}': {why}", shown(rule)),
+            )
+        };
+        let Some((before, after)) = rule.split_once(CAPTURE) else {
+            return Err(refuse("not a rule name, and no (\\d+) in it".into()));
+        };
+        if after.contains(CAPTURE) {
+            return Err(refuse("a pattern has one (\\d+)".into()));
+        }
+        let special = |c: char| "\\()[]{}*+?|^$".contains(c) || c == '/' || c.is_control();
+        if let Some(c) = before.chars().chain(after.chars()).find(|&c| special(c)) {
+            return Err(refuse(format!(
+                "'{}' is not literal text: besides its (\\d+), a pattern is plain text (no other regular-expression syntax, no folders)",
+                shown(&c.to_string())
+            )));
+        }
+        Ok(FrameGrouping::Pattern {
+            before: before.to_string(),
+            after: after.to_string(),
+        })
+    }
+
+    /// The rule as written (`number`, ..., or the pattern).
+    pub fn rule(&self) -> String {
+        match self {
+            FrameGrouping::Number => "number".into(),
+            FrameGrouping::Last => "last".into(),
+            FrameGrouping::First => "first".into(),
+            FrameGrouping::Order => "order".into(),
+            FrameGrouping::Pattern { before, after } => format!("{before}{CAPTURE}{after}"),
+        }
+    }
+
+    /// What the keys are, for messages.
+    fn describe(&self) -> String {
+        match self {
+            FrameGrouping::Number | FrameGrouping::Last => {
+                "the last number in the file names".into()
+            }
+            FrameGrouping::First => "the first number in the file names".into(),
+            FrameGrouping::Order => "order".into(),
+            FrameGrouping::Pattern { .. } => {
+                format!(
+                    "the number of the pattern {} in the file names",
+                    self.rule()
+                )
+            }
+        }
+    }
+
+    /// The frame key of one file name (`None`: the name has none); not
+    /// for [`FrameGrouping::Order`], whose keys are positions.
+    pub fn key(&self, name: &str) -> Option<String> {
+        let digits = match self {
+            FrameGrouping::Number | FrameGrouping::Last => {
+                return number_in_name(name).map(str::to_string)
+            }
+            FrameGrouping::Order => return None,
+            FrameGrouping::First => first_digits(stem(name)),
+            FrameGrouping::Pattern { before, after } => pattern_digits(base(name), before, after),
+        }?;
+        let trimmed = digits.trim_start_matches('0');
+        Some(if trimmed.is_empty() { "0" } else { trimmed }.to_string())
     }
 }
 
-/// The frame key of every image of one camera of a rig (`robocal rig`):
-/// with [`PairedBy::Number`] the number in its name (every name must have
-/// one, unique within the camera; keys compare across cameras, so
-/// `front07.png` and `side7.jpg` are one frame), with [`PairedBy::Order`]
-/// its position (`"0"`, `"1"`, ...). `camera` names the camera in errors.
-pub fn frame_keys(names: &[&str], by: PairedBy, camera: &str) -> Result<Vec<String>> {
-    if by == PairedBy::Order {
+/// `text` with its control characters escaped, so a message stays one line.
+fn shown(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+/// The file name without folders.
+fn base(name: &str) -> &str {
+    name.rsplit(['/', '\\']).next().unwrap_or(name)
+}
+
+fn first_digits(text: &str) -> Option<&str> {
+    let start = text.find(|c: char| c.is_ascii_digit())?;
+    let rest = &text[start..];
+    let end = rest
+        .find(|c: char| !c.is_ascii_digit())
+        .unwrap_or(rest.len());
+    Some(&rest[..end])
+}
+
+fn pattern_digits<'a>(text: &'a str, before: &str, after: &str) -> Option<&'a str> {
+    text.match_indices(before).find_map(|(i, _)| {
+        let rest = &text[i + before.len()..];
+        let end = rest
+            .find(|c: char| !c.is_ascii_digit())
+            .unwrap_or(rest.len());
+        (end > 0 && rest[end..].starts_with(after)).then(|| &rest[..end])
+    })
+}
+
+/// The default grouping of a rig's images (`robocal rig` without
+/// `--group-by`, the web app's rig step): by number unless no file name has
+/// one.
+pub fn default_grouping<'a>(mut names: impl Iterator<Item = &'a str>) -> FrameGrouping {
+    if names.any(|n| number_in_name(n).is_some()) {
+        FrameGrouping::Number
+    } else {
+        FrameGrouping::Order
+    }
+}
+
+/// The frame key of every image of one camera of a rig (`robocal rig`),
+/// by `by` (see [`FrameGrouping`]): every name must have a key, unique
+/// within the camera; keys compare across cameras, so `front07.png` and
+/// `side7.jpg` are one frame. `camera` names the camera in errors, which
+/// list the rules.
+pub fn frame_keys(names: &[&str], by: &FrameGrouping, camera: &str) -> Result<Vec<String>> {
+    if *by == FrameGrouping::Order {
         return Ok((0..names.len()).map(|i| i.to_string()).collect());
     }
-    let numbers: Vec<Option<String>> = names
-        .iter()
-        .map(|n| number_in_name(n).map(str::to_string))
-        .collect();
+    let keys: Vec<Option<String>> = names.iter().map(|n| by.key(n)).collect();
     let without: Vec<&str> = names
         .iter()
-        .zip(&numbers)
-        .filter(|(_, n)| n.is_none())
+        .zip(&keys)
+        .filter(|(_, k)| k.is_none())
         .map(|(name, _)| *name)
         .collect();
     if !without.is_empty() {
         return Err(Error::invalid(
             "images",
             format!(
-                "frames are grouped by the last number in the file names, but camera {camera} \
-                 has names without one: {} (number every file, or group by order)",
+                "frames are grouped by {}, but camera {camera} has names without one: {} (group by {GROUPING_RULES})",
+                by.describe(),
                 without.join(", ")
             ),
         ));
     }
-    index_by_number(names, &numbers, &format!("camera {camera}")).map_err(|e| match e {
-        Error::Invalid { message, .. } => Error::invalid(
-            "images",
-            message.replace("images are paired", "frames are grouped"),
-        ),
-        other => other,
-    })?;
-    Ok(numbers.into_iter().flatten().collect())
+    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    for (i, k) in keys.iter().enumerate() {
+        let Some(k) = k else { continue };
+        if let Some(&first) = seen.get(k.as_str()) {
+            return Err(Error::invalid(
+                "images",
+                format!(
+                    "frames are grouped by {}, but number {k} is in two camera {camera} images: {}, {} (group by {GROUPING_RULES})",
+                    by.describe(),
+                    names[first],
+                    names[i]
+                ),
+            ));
+        }
+        seen.insert(k, i);
+    }
+    Ok(keys.into_iter().flatten().collect())
 }
 
 fn by_order(n_left: usize, n_right: usize) -> Result<Pairing> {
@@ -241,40 +408,119 @@ mod tests {
     fn rig_frame_keys_are_the_numbers_or_the_positions() {
         let names = ["f/front07.png", "f/front1.png"];
         assert_eq!(
-            frame_keys(&names, PairedBy::Number, "front").unwrap(),
+            frame_keys(&names, &FrameGrouping::Number, "front").unwrap(),
             ["7", "1"]
         );
         assert_eq!(
-            frame_keys(&names, PairedBy::Order, "front").unwrap(),
+            frame_keys(&names, &FrameGrouping::Order, "front").unwrap(),
             ["0", "1"]
         );
         assert_eq!(
-            frame_keys(&["a1.png", "b.png"], PairedBy::Number, "top")
+            frame_keys(&["a1.png", "b.png"], &FrameGrouping::Number, "top")
                 .unwrap_err()
                 .to_string(),
             "images: frames are grouped by the last number in the file names, but camera top has \
-             names without one: b.png (number every file, or group by order)"
+             names without one: b.png (group by number or last (the last number in the name, the \
+             default), first (the first number), order (the position in each camera's list), or a \
+             pattern with one (\\d+) such as sync(\\d+))"
         );
         assert_eq!(
-            frame_keys(&["a1.png", "a01.png"], PairedBy::Number, "top")
+            frame_keys(&["a1.png", "a01.png"], &FrameGrouping::Number, "top")
                 .unwrap_err()
                 .to_string(),
-            "images: frames are grouped by the last number in their file names, but number 1 is \
-             in two camera top images: a1.png, a01.png"
+            "images: frames are grouped by the last number in the file names, but number 1 is \
+             in two camera top images: a1.png, a01.png (group by number or last (the last number \
+             in the name, the default), first (the first number), order (the position in each \
+             camera's list), or a pattern with one (\\d+) such as sync(\\d+))"
         );
     }
 
     #[test]
-    fn rigs_group_by_number_unless_no_name_has_one() {
+    fn rig_frames_group_by_the_first_the_last_or_a_pattern() {
+        let rule = |r: &str| FrameGrouping::from_rule(r).unwrap();
+        let cam0 = [
+            "rig/sync036_cam0.jpg",
+            "rig/sync037_cam0.jpg",
+            "rig/sync100_cam0.jpg",
+        ];
+        let cam1 = ["cam1_sync036.png", "cam1_sync37.png", "cam1_sync0100.png"];
+        let left = ["0001_left_12.png", "0002_left_13.png"];
+        // The last number of cam0's names is the camera's: two images have it.
         assert_eq!(
-            default_grouping(["a.png", "cam/b7.png"].into_iter()),
-            PairedBy::Number
+            frame_keys(&cam0, &rule("number"), "cam0")
+                .unwrap_err()
+                .to_string(),
+            "images: frames are grouped by the last number in the file names, but number 0 is \
+             in two camera cam0 images: rig/sync036_cam0.jpg, rig/sync037_cam0.jpg (group by \
+             number or last (the last number in the name, the default), first (the first \
+             number), order (the position in each camera's list), or a pattern with one (\\d+) \
+             such as sync(\\d+))"
         );
         assert_eq!(
-            default_grouping(["a.png", "cam7/b.png"].into_iter()),
-            PairedBy::Order
+            frame_keys(&cam0, &rule("first"), "cam0").unwrap(),
+            ["36", "37", "100"]
         );
-        assert_eq!(default_grouping(std::iter::empty()), PairedBy::Order);
+        assert_eq!(
+            frame_keys(&cam1, &rule("last"), "cam1").unwrap(),
+            ["36", "37", "100"]
+        );
+        let sync = rule("sync(\\d+)");
+        assert_eq!(
+            frame_keys(&cam0, &sync, "cam0").unwrap(),
+            ["36", "37", "100"]
+        );
+        assert_eq!(
+            frame_keys(&cam1, &sync, "cam1").unwrap(),
+            ["36", "37", "100"]
+        );
+        assert_eq!(
+            frame_keys(&left, &rule("first"), "left").unwrap(),
+            ["1", "2"]
+        );
+        assert_eq!(
+            frame_keys(&left, &rule("last"), "left").unwrap(),
+            ["12", "13"]
+        );
+        assert_eq!(
+            frame_keys(&left, &rule("left_(\\d+).png"), "left").unwrap(),
+            ["12", "13"]
+        );
+        // Text after the digits must follow them; the first place that fits counts.
+        assert_eq!(
+            rule("_(\\d+)_").key("0001_left_12_x_7_.png"),
+            Some("12".into())
+        );
+        assert_eq!(rule("(\\d+)").key("a/b0042c9.png"), Some("42".into()));
+        assert_eq!(
+            frame_keys(&["sync1_a.png", "b2.png"], &sync, "top")
+                .unwrap_err()
+                .to_string(),
+            "images: frames are grouped by the number of the pattern sync(\\d+) in the file \
+             names, but camera top has names without one: b2.png (group by number or last (the \
+             last number in the name, the default), first (the first number), order (the \
+             position in each camera's list), or a pattern with one (\\d+) such as sync(\\d+))"
+        );
+        assert_eq!(rule("sync(\\d+)").rule(), "sync(\\d+)");
+    }
+
+    #[test]
+    fn a_rule_that_is_neither_a_name_nor_a_pattern_lists_the_rules() {
+        let err = |r: &str| FrameGrouping::from_rule(r).unwrap_err().to_string();
+        let rules = "group_by: takes number or last (the last number in the name, the default), \
+                     first (the first number), order (the position in each camera's list), or a \
+                     pattern with one (\\d+) such as sync(\\d+)";
+        assert_eq!(
+            err("numbers"),
+            format!("{rules}; got 'numbers': not a rule name, and no (\\d+) in it")
+        );
+        assert_eq!(
+            err("a(\\d+)b(\\d+)"),
+            format!("{rules}; got 'a(\\d+)b(\\d+)': a pattern has one (\\d+)")
+        );
+        assert_eq!(
+            err("sync_(\\d+).*"),
+            format!("{rules}; got 'sync_(\\d+).*': '*' is not literal text: besides its (\\d+), a pattern is plain text (no other regular-expression syntax, no folders)")
+        );
     }
 
     #[test]

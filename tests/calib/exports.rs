@@ -162,3 +162,154 @@ fn every_rig_format_matches_its_golden_files() {
         );
     }
 }
+
+fn stereo_fixture() -> String {
+    std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/exports/stereo.json"),
+    )
+    .unwrap()
+}
+
+/// The pair of fixtures/exports/stereo.json (two Brown-Conrady cameras with
+/// k3 = 0, right_from_left of rotation vector [0.01, -0.04, 0.015] rad and
+/// T [-0.06, 0.002, -0.001] m: the pair of src/calib/stereo_rectify_tests.rs,
+/// whose rectification matches cv2.stereoRectify) in every stereo format.
+#[test]
+fn every_stereo_format_matches_its_golden_files() {
+    let stereo = stereo_fixture();
+    let options = robocal::io::export::ExportOptions::default();
+    let mut names = Vec::new();
+    for format in ["opencv-yaml", "ros", "kalibr"] {
+        for f in robocal::io::export::export_files(&stereo, format, &options).unwrap() {
+            names.push(f.name.clone());
+            golden(
+                &format!("stereo.{format}.{}", f.name),
+                &f.text.replace(robocal::VERSION, "VERSION"),
+            );
+        }
+    }
+    assert_eq!(
+        names,
+        [
+            "stereo.opencv.yaml",
+            "left.yaml",
+            "right.yaml",
+            "camchain.yaml"
+        ]
+    );
+    // A transform format writes right_from_left, as before.
+    let text = export(&stereo, "xyz-quat-xyzw", None).unwrap();
+    assert!(text.contains("-0.06 0.002 -0.001"), "{text}");
+}
+
+/// The numbers of the OpenCV file, read back as cv::FileStorage would:
+/// E = [T]x R, F = K2^-T E K1^-1, and the epipolar constraint of projected
+/// points to 1e-9 (noise-free, so only rounding remains).
+#[test]
+fn the_stereo_opencv_file_holds_e_f_and_a_rectification_that_aligns_rows() {
+    use nalgebra::{Matrix3, Matrix3x4, Point3, Vector3};
+    let text = export(&stereo_fixture(), "opencv-yaml", None).unwrap();
+    let matrix = |key: &str| -> Vec<f64> {
+        let start = text
+            .find(&format!("\n{key}: !!opencv-matrix"))
+            .unwrap_or_else(|| panic!("no {key} in {text}"));
+        let data = &text[start..];
+        let open = data.find("data: [").unwrap() + 7;
+        let close = open + data[open..].find(']').unwrap();
+        data[open..close]
+            .split(',')
+            .map(|v| v.trim().parse().unwrap())
+            .collect()
+    };
+    let m3 = |key: &str| Matrix3::from_row_slice(&matrix(key));
+    let (k1, k2, r, e, f) = (m3("K1"), m3("K2"), m3("R"), m3("E"), m3("F"));
+    let t = Vector3::from_row_slice(&matrix("T"));
+    assert_eq!(matrix("T"), [-0.06, 0.002, -0.001]);
+    assert_eq!(matrix("D1"), [-0.12, 0.01, 0.0005, -0.0003, 0.0]);
+    assert!(
+        text.contains("\nimage_width: 640\nimage_height: 480\n"),
+        "{text}"
+    );
+    assert!((e - t.cross_matrix() * r).norm() < 1e-15, "E = [T]x R");
+    let f_expected = k2.try_inverse().unwrap().transpose() * e * k1.try_inverse().unwrap();
+    assert!((f - f_expected).norm() < 1e-15, "F = K2^-T E K1^-1");
+    assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-15);
+    let (r1, r2) = (m3("R1"), m3("R2"));
+    let p1 = Matrix3x4::from_row_slice(&matrix("P1"));
+    let p2 = Matrix3x4::from_row_slice(&matrix("P2"));
+    for i in 0..30 {
+        let i = i as f64;
+        let x_left = Point3::new(-0.3 + 0.02 * i, 0.2 - 0.013 * i, 0.8 + 0.05 * (i % 7.0));
+        let x_right = r * x_left.coords + t;
+        // Undistorted pixels of both cameras satisfy the epipolar constraint.
+        let (pl, pr) = (k1 * (x_left.coords / x_left.z), k2 * (x_right / x_right.z));
+        let c = pr.dot(&(f * pl));
+        assert!(c.abs() < 1e-9, "p_r^T F p_l = {c}");
+        // Rectified: the same row in both images.
+        let rl = p1 * (r1 * x_left.coords).push(1.0);
+        let rr = p1 * (r2 * x_right).push(1.0);
+        let rr2 = p2 * (r1 * x_left.coords).push(1.0);
+        assert!(
+            (rl.y / rl.z - rr.y / rr.z).abs() < 1e-9,
+            "rows differ by {} px",
+            rl.y / rl.z - rr.y / rr.z
+        );
+        assert!((rr.x / rr.z - rr2.x / rr2.z).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn what_a_stereo_report_cannot_be_exported_as_is_named() {
+    let stereo = stereo_fixture();
+    let err = |report: &str, format: &str| export(report, format, None).unwrap_err().to_string();
+    assert_eq!(
+        err(&stereo, "mrcal"),
+        "format: format 'mrcal' cannot hold a stereo pair: a stereo report exports as opencv-yaml, ros, kalibr (both cameras), as a transform format (right_from_left, e.g. matrix4) or as report"
+    );
+    assert_eq!(
+        err(&stereo, "ros-yaml"),
+        "format: format 'ros-yaml' cannot hold a stereo pair: a stereo report exports as opencv-yaml, ros, kalibr (both cameras), as a transform format (right_from_left, e.g. matrix4) or as report"
+    );
+    let two_sizes = stereo.replacen(
+        "\"image_size_px\": [640, 480]",
+        "\"image_size_px\": [1280, 960]",
+        1,
+    );
+    assert_eq!(
+        err(&two_sizes, "opencv-yaml"),
+        "format: format 'opencv-yaml' holds one image size for both cameras (as cv2.stereoRectify takes one), but the left camera is 1280x960 and the right 640x480: export as kalibr, or each camera alone"
+    );
+    assert!(export(&two_sizes, "kalibr", None)
+        .unwrap()
+        .contains("resolution: [1280, 960]"));
+    let division = stereo
+        .replacen(
+            "\"model\": \"brown\",\n    \"camera_matrix\": [[640.0",
+            "\"model\": \"division\",\n    \"camera_matrix\": [[640.0",
+            1,
+        )
+        .replacen("\"k1\": -0.05, \"k2\"", "\"kappa\": -0.05, \"k2\"", 1);
+    assert_eq!(
+        err(&division, "ros"),
+        "format: right camera: the division lens model cannot be written for OpenCV (use robocal JSON, Halcon for division, Kalibr for EUCM)"
+    );
+    let with_k3 = stereo.replacen("\"k3\": 0.0", "\"k3\": 0.001", 1);
+    assert_eq!(
+        err(&with_k3, "kalibr"),
+        "format: left camera: Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr"
+    );
+    let no_left = stereo.replacen("\"image_size_px\": [640, 480],", "", 1);
+    assert!(
+        err(&no_left, "opencv-yaml").starts_with("left.image_size_px: "),
+        "{}",
+        err(&no_left, "opencv-yaml")
+    );
+    let options = robocal::io::export::ExportOptions {
+        frames: vec![("left".into(), "cam 0".into())],
+        ..Default::default()
+    };
+    assert_eq!(
+        robocal::io::export::export_with(&stereo, "ros", &options).unwrap_err().to_string(),
+        "frame_names: the left camera name 'cam 0' is not a ROS name: use letters, digits, _ and / (starting with a letter, _ or /), e.g. --frame left=cam0"
+    );
+}

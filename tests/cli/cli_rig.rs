@@ -405,3 +405,96 @@ fn a_camera_whose_images_show_no_board_is_named() {
         ]
     );
 }
+
+/// Frame numbers that are not the last number of the name: `sync036_cam0`
+/// (last number: the camera), `cam1_sync036` and `0001_cam2_36` (a capture
+/// counter first). The default rule's error names the other rules; a
+/// pattern, `first` and `last` group them.
+#[test]
+fn frames_group_by_the_first_number_the_last_or_a_pattern() {
+    let dir = temp_dir("rig", "grouping");
+    let (files, _) = rendered_rig(&dir);
+    // The rendered files are camK_FFF.png; rename them as capture tools do.
+    let renamed: Vec<Vec<String>> = files
+        .iter()
+        .enumerate()
+        .map(|(k, list)| {
+            list.iter()
+                .enumerate()
+                .map(|(i, f)| {
+                    let frame = &f[f.len() - 7..f.len() - 4];
+                    let name = match k {
+                        0 => format!("sync{frame}_cam0.png"),
+                        1 => format!("cam1_sync{frame}.png"),
+                        2 => format!("{:04}_cam2_sync{frame}.png", i + 1),
+                        _ => format!("sync{frame}_cam3.png"),
+                    };
+                    let path = dir.join(name);
+                    std::fs::copy(f, &path).expect("copy");
+                    path.to_string_lossy().into_owned()
+                })
+                .collect()
+        })
+        .collect();
+    let rules = "(group by number or last (the last number in the name, the default), first \
+                 (the first number), order (the position in each camera's list), or a pattern \
+                 with one (\\d+) such as sync(\\d+)) (see 'robocal rig --help')";
+    // 1. By the last number, cam0's frames all are frame 0.
+    let (code, _, err) = robocal(&args_of(&renamed, |_| true));
+    assert_eq!(code, 2, "{err}");
+    let first_two: Vec<&str> = renamed[0][..2].iter().map(String::as_str).collect();
+    assert_eq!(
+        err.trim_end(),
+        format!(
+            "robocal: rig: frames are grouped by the last number in the file names, but number 0 \
+             is in two camera cam0 images: {}, {} {rules}",
+            first_two[0], first_two[1]
+        )
+    );
+    // 2. first: cam1's first number is its camera number.
+    let mut args = args_of(&renamed, |_| true);
+    args.extend(["--group-by", "first"]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("frames are grouped by the first number in the file names, but number 1 is in two camera cam1 images"), "{err}");
+    // 3. A rule that is neither.
+    let mut args = args_of(&renamed, |_| true);
+    args.extend(["--group-by", "sync"]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(
+        err.trim_end(),
+        "robocal: rig: --group-by takes number or last (the last number in the name, the \
+         default), first (the first number), order (the position in each camera's list), or a \
+         pattern with one (\\d+) such as sync(\\d+); got 'sync': not a rule name, and no (\\d+) \
+         in it (see 'robocal rig --help')"
+    );
+    // 4. The pattern groups all four cameras as the original names did.
+    let out = dir.join("rig.json").to_string_lossy().into_owned();
+    let mut args = args_of(&renamed, |_| true);
+    args.extend(["--group-by", "sync(\\d+)", "-o", &out]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(report["grouping"], "sync(\\d+)");
+    let keys: Vec<&str> = report["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["key"].as_str().unwrap())
+        .collect();
+    let mut expected: Vec<String> = files
+        .iter()
+        .flatten()
+        .map(|f| {
+            f[f.len() - 7..f.len() - 4]
+                .trim_start_matches('0')
+                .to_string()
+        })
+        .map(|k| if k.is_empty() { "0".into() } else { k })
+        .collect();
+    expected.sort_by_key(|k| k.parse::<u32>().unwrap());
+    expected.dedup();
+    let keys: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
+    assert_eq!(keys, expected);
+}

@@ -14,6 +14,7 @@ use robocal::image::{encode_png, GrayImage};
 use robocal::synth::{render, RenderOptions, Scene};
 use robocal::target::Target;
 use robocal::Camera;
+use serde::Deserialize;
 use serde_json::Value;
 use std::path::Path;
 
@@ -53,6 +54,29 @@ fn rendered_pairs(dir: &Path) -> (Vec<String>, Vec<String>, Pose) {
         Translation3::new(-0.05, 0.001, 0.002),
         rotation_from_rotvec(&Vector3::new(0.005, -0.03, 0.01)),
     );
+    let (mut lf, mut rf) = render_pairs(dir, &left, &right, &right_from_left, 7);
+    let blank = GrayImage::new(640, 480, vec![120; 640 * 480]).expect("image");
+    // Pair 99: a good left image with a blank right one (pairing is by the
+    // number in the file names, as in the page).
+    let path = dir.join("right99_blank.png");
+    std::fs::write(&path, encode_png(&blank).expect("png")).expect("write");
+    let left99 = dir.join("left99.png");
+    std::fs::copy(&lf[0], &left99).expect("copy");
+    lf.push(left99.to_string_lossy().into_owned());
+    rf.push(path.to_string_lossy().into_owned());
+    (lf, rf, right_from_left)
+}
+
+/// Up to `max_pairs` pairs of a 9x6 board seen whole by both cameras,
+/// written as leftNN.png and rightNN.png.
+fn render_pairs(
+    dir: &Path,
+    left: &Camera,
+    right: &Camera,
+    right_from_left: &Pose,
+    max_pairs: usize,
+) -> (Vec<String>, Vec<String>) {
+    let (left, right, right_from_left) = (left.clone(), right.clone(), *right_from_left);
     let target = Target::parse_spec("chessboard:9x6:30mm").expect("target");
     // The scene's points are the inner corners of the board.
     let scene = Scene::calibration(5, &left, (9, 6), 0.03, 24, 0.0).expect("scene");
@@ -68,7 +92,7 @@ fn rendered_pairs(dir: &Path) -> (Vec<String>, Vec<String>, Pose) {
         .enumerate()
     {
         let right_pose = right_from_left * pose;
-        if !inside(&left, v, pose) || !inside(&right, v, &right_pose) || lf.len() == 7 {
+        if !inside(&left, v, pose) || !inside(&right, v, &right_pose) || lf.len() == max_pairs {
             continue;
         }
         for (cam, p, list, side) in [
@@ -91,16 +115,7 @@ fn rendered_pairs(dir: &Path) -> (Vec<String>, Vec<String>, Pose) {
         }
     }
     assert!(lf.len() >= 6, "only {} usable pairs", lf.len());
-    let blank = GrayImage::new(640, 480, vec![120; 640 * 480]).expect("image");
-    // Pair 99: a good left image with a blank right one (pairing is by the
-    // number in the file names, as in the page).
-    let path = dir.join("right99_blank.png");
-    std::fs::write(&path, encode_png(&blank).expect("png")).expect("write");
-    let left99 = dir.join("left99.png");
-    std::fs::copy(&lf[0], &left99).expect("copy");
-    lf.push(left99.to_string_lossy().into_owned());
-    rf.push(path.to_string_lossy().into_owned());
-    (lf, rf, right_from_left)
+    (lf, rf)
 }
 
 #[test]
@@ -120,6 +135,7 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
         err.contains("pair dropped") && err.contains("right99_blank.png"),
         "{err}"
     );
+    let stereo_err = err.clone();
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(&out).expect("read")).expect("json");
     for key in [
@@ -161,6 +177,281 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
         .collect();
     assert_eq!(numbers.len(), 7, "{text}");
     assert!((numbers[0] - got.x).abs() < 1e-9, "{text}");
+    check_stereo_exports(&dir, &out_s, &report);
+    // A normal lens: the advice keeps an OpenCV model (Brown-Conrady, or
+    // k1 k2 k5 when k3 and the tangential terms fit noise: the truth has k1
+    // only), and says OpenCV and ROS hold it.
+    for side in ["left", "right"] {
+        let advice = &report["model_advice"][side];
+        let recommended = advice["recommended"].as_str().unwrap();
+        assert!(
+            ["brown", "radial_k1_k2_k5"].contains(&recommended),
+            "{advice}"
+        );
+        let formats: Vec<&str> = advice["export_formats"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        assert!(
+            formats.contains(&"opencv-yaml") && formats.contains(&"ros-yaml"),
+            "{formats:?}"
+        );
+        assert!(
+            stereo_err.contains(&format!(
+                "robocal stereo: {side} camera: lens model: {recommended}"
+            )),
+            "{stereo_err}"
+        );
+        assert!(
+            advice["half_diagonal_fov_deg"].as_f64().unwrap() < 50.0,
+            "{advice}"
+        );
+    }
+}
+
+/// The stereo exports of a `robocal stereo` report: OpenCV's numbers
+/// (E = [T]x R, F = K2^-T E K1^-1, the epipolar constraint to 1e-9 on the
+/// board corners projected by the calibrated cameras, rectified rows
+/// aligned to 1e-9 px for those and within 0.5 px for the detected corners,
+/// whose noise is ~0.05 px), ROS's two files, and what Kalibr refuses.
+fn check_stereo_exports(dir: &Path, report_path: &str, report: &Value) {
+    use nalgebra::{Matrix3, Matrix3x4, Point2, Point3};
+    let (code, text, err) = robocal(&["export", report_path, "--format", "opencv-yaml"]);
+    assert_eq!(code, 0, "{err}");
+    let matrix = |key: &str| -> Vec<f64> {
+        let start = text
+            .find(&format!("\n{key}: !!opencv-matrix"))
+            .unwrap_or_else(|| panic!("{key}: {text}"));
+        let data = &text[start..];
+        let open = data.find("data: [").unwrap() + 7;
+        let close = open + data[open..].find(']').unwrap();
+        data[open..close]
+            .split(',')
+            .map(|v| v.trim().parse().unwrap())
+            .collect()
+    };
+    let m3 = |key: &str| Matrix3::from_row_slice(&matrix(key));
+    let (k1, k2, r, e, f, r1, r2) = (
+        m3("K1"),
+        m3("K2"),
+        m3("R"),
+        m3("E"),
+        m3("F"),
+        m3("R1"),
+        m3("R2"),
+    );
+    let t = Vector3::from_row_slice(&matrix("T"));
+    let p1 = Matrix3x4::from_row_slice(&matrix("P1"));
+    assert!((e - t.cross_matrix() * r).norm() < 1e-12, "E = [T]x R");
+    let f_expected = k2.try_inverse().unwrap().transpose() * e * k1.try_inverse().unwrap();
+    assert!(
+        (f - f_expected).norm() < 1e-12 * f.norm(),
+        "F = K2^-T E K1^-1"
+    );
+    // The report's right_from_left is R, T.
+    let q = &report["right_from_left"]["translation_m"];
+    assert_eq!(t.x, q[0].as_f64().unwrap());
+    let read = |side: &str| -> Camera {
+        let (c, _) = robocal::io::import_camera::import_camera(&report[side].to_string()).unwrap();
+        c
+    };
+    let (left, right) = (read("left"), read("right"));
+    let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+    let board: Vec<Point3<f64>> = (0..6)
+        .flat_map(|row| {
+            (0..9).map(move |col| Point3::new(0.03 * col as f64, 0.03 * row as f64, 0.0))
+        })
+        .collect();
+    let _ = target;
+    let mut worst_detected: f64 = 0.0;
+    for (vl, vr) in report["left"]["views"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(report["right"]["views"].as_array().unwrap())
+    {
+        let pose = robocal::geometry::PoseInput::deserialize(&vl["camera_from_target"])
+            .unwrap()
+            .to_pose()
+            .unwrap();
+        for p in &board {
+            let x_left = pose * p;
+            let x_right = r * x_left.coords + t;
+            let (pl, pr) = (k1 * (x_left.coords / x_left.z), k2 * (x_right / x_right.z));
+            let c = pr.dot(&(f * pl)) / (pr.norm() * pl.norm());
+            assert!(c.abs() < 1e-9, "epipolar {c}");
+            let (yl, yr) = (
+                p1 * (r1 * x_left.coords).push(1.0),
+                p1 * (r2 * x_right).push(1.0),
+            );
+            assert!((yl.y / yl.z - yr.y / yr.z).abs() < 1e-9);
+        }
+        // Detected corners (the report's residual rows: x, y of each point),
+        // undistorted and rectified: rows agree point by point.
+        let corners = |v: &Value| -> Vec<Point2<f64>> {
+            v["residuals_px"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| Point2::new(r["x"].as_f64().unwrap(), r["y"].as_f64().unwrap()))
+                .collect()
+        };
+        let (cl, cr) = (corners(vl), corners(vr));
+        assert_eq!(cl.len(), 54);
+        for (a, b) in cl.iter().zip(&cr) {
+            let (ra, rb) = (
+                r1 * left.unproject(a).unwrap(),
+                r2 * right.unproject(b).unwrap(),
+            );
+            let (ya, yb) = (p1 * ra.push(1.0), p1 * rb.push(1.0));
+            worst_detected = worst_detected.max((ya.y / ya.z - yb.y / yb.z).abs());
+        }
+    }
+    assert!(
+        worst_detected < 0.5,
+        "detected rows differ by up to {worst_detected} px"
+    );
+    // ROS: two camera_info files, P2's Tx = -fx' * baseline.
+    let ros = dir.join("ros");
+    let (code, _, err) = robocal(&[
+        "export",
+        report_path,
+        "--format",
+        "ros",
+        "-o",
+        ros.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let right_yaml = std::fs::read_to_string(ros.join("right.yaml")).unwrap();
+    assert!(right_yaml.contains("camera_name: right\n"), "{right_yaml}");
+    let p2 = Matrix3x4::from_row_slice(&matrix("P2"));
+    let tx = p2[(0, 3)] / p2[(0, 0)];
+    assert!(
+        (tx + report["baseline_m"].as_f64().unwrap()).abs() < 1e-12,
+        "Tx {tx}"
+    );
+    assert!(std::fs::read_to_string(ros.join("left.yaml"))
+        .unwrap()
+        .contains("rectification_matrix:"));
+    // Kalibr's radtan has no k3, and this calibration fitted one.
+    let (code, _, err) = robocal(&["export", report_path, "--format", "kalibr"]);
+    assert_eq!(
+        (code, err.as_str()),
+        (1, "robocal: format: left camera: Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr\n")
+    );
+    let (code, _, err) = robocal(&["export", report_path, "--format", "mrcal"]);
+    assert_eq!(
+        (code, err.as_str()),
+        (1, "robocal: format: format 'mrcal' cannot hold a stereo pair: a stereo report exports as opencv-yaml, ros, kalibr (both cameras), as a transform format (right_from_left, e.g. matrix4) or as report\n")
+    );
+}
+
+/// A wide-angle fisheye pair (Kannala-Brandt, about 70 degrees from the
+/// axis to the image corners): the advice of each camera compares
+/// kannala_brandt and EUCM and names one of them with its export formats.
+#[test]
+fn a_fisheye_pair_gets_fisheye_model_advice_with_its_export_formats() {
+    let dir = temp_dir("stereo", "fisheye");
+    let fisheye = |fx: f64, cx: f64| Camera {
+        fx,
+        fy: fx,
+        cx,
+        cy: 239.5,
+        skew: 0.0,
+        width: 640,
+        height: 480,
+        distortion: Distortion::KannalaBrandt {
+            k1: 0.02,
+            k2: -0.005,
+            k3: 0.001,
+            k4: -0.0002,
+        },
+    };
+    let right_from_left = Pose::from_parts(
+        Translation3::new(-0.06, 0.001, 0.0),
+        rotation_from_rotvec(&Vector3::new(0.0, -0.02, 0.005)),
+    );
+    let (lf, rf) = render_pairs(
+        &dir,
+        &fisheye(330.0, 319.5),
+        &fisheye(335.0, 322.0),
+        &right_from_left,
+        8,
+    );
+    let out = dir.join("stereo.json");
+    let out_s = out.to_string_lossy().into_owned();
+    let mut args = vec![
+        "stereo",
+        "--target",
+        "chessboard:9x6:30mm",
+        "--model",
+        "kannala_brandt",
+        "--left",
+    ];
+    args.extend(lf.iter().map(String::as_str));
+    args.push("--right");
+    args.extend(rf.iter().map(String::as_str));
+    args.extend(["-o", &out_s]);
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    for side in ["left", "right"] {
+        let advice = &report["model_advice"][side];
+        let recommended = advice["recommended"].as_str().unwrap();
+        assert!(
+            ["kannala_brandt", "eucm"].contains(&recommended),
+            "{advice}"
+        );
+        let compared: Vec<&str> = advice["compared"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["model"].as_str().unwrap())
+            .collect();
+        assert!(
+            compared.contains(&"kannala_brandt") && compared.contains(&"eucm"),
+            "{compared:?}"
+        );
+        assert!(
+            advice["half_diagonal_fov_deg"].as_f64().unwrap() > 50.0,
+            "{advice}"
+        );
+        let formats: Vec<&str> = advice["export_formats"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        assert!(
+            formats.iter().any(|f| f.starts_with("kalibr")),
+            "{formats:?}"
+        );
+        let line = err
+            .lines()
+            .find(|l| {
+                l.starts_with(&format!(
+                    "robocal stereo: {side} camera: lens model: {recommended}"
+                ))
+            })
+            .unwrap_or_else(|| panic!("{err}"));
+        assert!(
+            line.contains(&format!("; {recommended} exports to json, ")),
+            "{line}"
+        );
+    }
+    // The pair exports to OpenCV (fisheye) and Kalibr (equidistant).
+    let (code, text, err) = robocal(&["export", &out_s, "--format", "kalibr"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        text.matches("distortion_model: equidistant").count(),
+        2,
+        "{text}"
+    );
+    let (code, text, err) = robocal(&["export", &out_s, "--format", "opencv-yaml"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(text.contains("(read D1, D2 with cv2.fisheye)"), "{text}");
 }
 
 #[test]

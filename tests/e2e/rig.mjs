@@ -202,8 +202,18 @@ export const tests = [
       // A file without a number cannot be put in a frame: the page names it.
       await page.setInputFiles('#rig-input-3', [{ name: 'extra.png', mimeType: 'image/png', buffer: readFileSync(files[3][0]) }]);
       await page.waitForFunction(() => /extra\.png/.test(document.querySelector('#rig-grouping.msg-error')?.textContent || ''), null, { timeout: 10000 });
-      assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam3 has names without one: extra.png (number every file, or group by order)');
+      assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam3 has names without one: extra.png (group by number or last (the last number in the name, the default), first (the first number), order (the position in each camera\'s list), or a pattern with one (\\d+) such as sync(\\d+))');
       assert.equal(await page.isDisabled('#rig-solve'), true);
+      // The other rules of robocal rig --group-by: by order every image has a
+      // frame; a pattern no name has is named in the error.
+      await page.selectOption('#rig-group-by', 'order');
+      await page.waitForFunction(() => /grouped by order \(sorted names\)\.$/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
+      await page.selectOption('#rig-group-by', 'pattern');
+      await page.fill('#rig-group-pattern', 'nothing(\\d+)');
+      await page.dispatchEvent('#rig-group-pattern', 'change');
+      await page.waitForFunction(() => /grouped by the number of the pattern nothing\(\\d\+\) in the file names, but camera cam0 has names without one/.test(document.querySelector('#rig-grouping.msg-error')?.textContent || ''), null, { timeout: 10000 });
+      await page.selectOption('#rig-group-by', '');
+      await page.waitForFunction(() => /extra\.png/.test(document.querySelector('#rig-grouping.msg-error')?.textContent || ''), null, { timeout: 10000 });
       await page.click('#rig-remove-3');
       await page.waitForFunction(() => /over 3 cameras/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
       await shot('removed');
@@ -231,6 +241,26 @@ export const tests = [
     // Two cameras are a stereo pair: the stereo step's tables, kept over a reload.
     const pairText = `right_from_left: baseline ${(stereo.baseline_m * 1000).toFixed(4)} mm, RMS ${stereo.rms_px.toFixed(4)} px over 13 pairs`;
     assert.equal(await page.textContent('#stereo-summary'), pairText);
+    // The pair in OpenCV's stereo file (K1 D1 K2 D2 R T E F, R1 R2 P1 P2 Q)
+    // from the page = `robocal export` of robocal stereo's report, number by
+    // number (1e-6 relative: the rig of two equals the stereo solve to 1e-9).
+    const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#rig-export-stereo-opencv-yaml')]);
+    assert.equal(dl.suggestedFilename(), 'stereo.opencv.yaml');
+    const tmp = mkdtempSync(join(tmpdir(), 'robocal-stereo-e2e-'));
+    try {
+      writeFileSync(join(tmp, 'stereo.json'), JSON.stringify(stereo));
+      const cliYaml = execFileSync(CLI, ['export', join(tmp, 'stereo.json'), '--format', 'opencv-yaml']).toString();
+      const matrices = (text) => [...text.matchAll(/^(\w+): !!opencv-matrix[\s\S]*?data: \[ ([^\]]*) \]/gm)].map((m) => [m[1], m[2].split(',').map(Number)]);
+      const [ours, theirs] = [matrices(readFileSync(await dl.path(), 'utf8')), matrices(cliYaml)];
+      assert.deepEqual(ours.map(([k]) => k), ['K1', 'D1', 'K2', 'D2', 'R', 'T', 'E', 'F', 'R1', 'R2', 'P1', 'P2', 'Q']);
+      assert.deepEqual(theirs.map(([k]) => k), ours.map(([k]) => k));
+      ours.forEach(([k, a], m) => a.forEach((x, i) => {
+        const y = theirs[m][1][i];
+        assert.ok(Math.abs(x - y) <= 1e-6 * Math.max(1, Math.abs(y)), `${k}[${i}]: page ${x}, CLI ${y}`);
+      }));
+    } finally {
+      rmSync(tmp, { recursive: true, force: true });
+    }
     const tables = () => page.$$eval('#stereo-translation tbody tr, #stereo-rotation tbody tr, #stereo-cameras tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
     const shown = await tables();
     assert.deepEqual(shown[0], ['T (mm)', ...stereo.right_from_left.translation_m.map((v) => (v * 1000).toFixed(4))]);

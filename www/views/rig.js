@@ -1,7 +1,9 @@
 // Step 7, stereo pairs and camera rigs: 2 to N cameras that saw the target
 // of step 1 in synchronised frames, any camera missing the board in any
-// frame. Frames are grouped by the rule of `robocal rig` (the last number in
-// each file name, or by order when no name has one); detection per camera in
+// frame. Frames are grouped by the rules of `robocal rig --group-by` (the
+// last number in each file name, or by order when no name has one; or the
+// first number, the last, the order, or a pattern such as sync(\d+), chosen
+// in the "Frames from file names" field); detection per camera in
 // the worker, then one joint calibration (`calibrate_rig`, the core of
 // `robocal rig`) with the lens model and held parameters of the camera step.
 // Shows every camera_from_rig with its standard deviation, per-camera and
@@ -19,6 +21,20 @@ import { frustum, invert, rotvecDeg, boardOutline, apply, flat } from '../lib/ri
 /** Frames a rig solve needs (each camera's intrinsics need 3 views: calib::json_api::MIN_VIEWS). */
 const MIN_FRAMES = 3;
 const byName = (a, b) => a.name.localeCompare(b.name, undefined, { numeric: true });
+/** The rules of `robocal rig --group-by` ('' = by number unless no name has one). */
+const GROUP_RULES = [
+  ['', 'automatic: the last number, or order'],
+  ['number', 'the last number (number)'],
+  ['first', 'the first number (first)'],
+  ['order', 'order (sorted names)'],
+  ['pattern', 'a pattern with one (\\d+)'],
+];
+const groupedText = (rule) => ({
+  number: 'by the number in the file names',
+  last: 'by the last number in the file names',
+  first: 'by the first number in the file names',
+  order: 'by order (sorted names)',
+})[rule] || `by the pattern ${rule} in the file names`;
 const freeName = (cams) => { let k = 0; while (cams.some((c) => c.name === `cam${k}`)) k++; return `cam${k}`; };
 
 export class RigView {
@@ -46,12 +62,28 @@ export class RigView {
     this.solveButton = h('button', { type: 'button', class: 'primary', id: 'rig-solve', disabled: true }, 'Detect and solve the rig');
     this.solveButton.addEventListener('click', () => this.solve());
     this.framesOut = h('div', { id: 'rig-frames' });
+    const rule = GROUP_RULES.some(([v]) => v === (st.groupBy || '')) ? (st.groupBy || '') : 'pattern';
+    const groupSelect = h('select', { id: 'rig-group-by', 'aria-label': 'Frames from file names' },
+      ...GROUP_RULES.map(([v, label]) => h('option', { value: v, selected: v === rule }, label)));
+    const pattern = h('input', { type: 'text', id: 'rig-group-pattern', value: rule === 'pattern' ? st.groupBy : 'sync(\\d+)', spellcheck: 'false', 'aria-label': 'Pattern with one (\\d+)', hidden: rule !== 'pattern' });
+    const regroup = () => {
+      const v = groupSelect.value;
+      pattern.hidden = v !== 'pattern';
+      st.groupBy = v === 'pattern' ? pattern.value : v;
+      this.store.changed('rig');
+      this.showFrames();
+    };
+    groupSelect.addEventListener('change', regroup);
+    pattern.addEventListener('change', regroup);
+    const grouping = h('div', { class: 'row', id: 'rig-grouping-rule' },
+      h('label', { for: 'rig-group-by' }, 'Frames from file names'), groupSelect, pattern);
     this.progress = h('p', { id: 'rig-progress', class: 'hint', 'aria-live': 'polite' });
     this.out = h('div', { id: 'rig-results', 'aria-live': 'polite' });
     fill(this.panel,
-      h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. The rig frame is the first camera\'s.'),
+      h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. Choose another rule when the last number is not the frame\'s: the first number (sync036_cam0.jpg), order, or a pattern: plain text with one (\\d+), such as sync(\\d+) for sync036_cam0.jpg with cam1_sync36.png. The rig frame is the first camera\'s.'),
       this.camerasOut,
       h('div', { class: 'row' }, h('button', { type: 'button', id: 'rig-add', onclick: () => this.addCamera() }, 'Add a camera')),
+      grouping,
       h('details', { id: 'rig-lens-details', open: st.model !== 'brown' || st.radial === '2' || st.tangential === false },
         h('summary', {}, 'Lens model and held parameters (every solved camera)'),
         h('p', { class: 'hint' }, 'As in step 3. Kalibr\'s radtan model is k1 k2 p1 p2: choose Brown-Conrady with 2 radial terms to export the rig to Kalibr.'),
@@ -140,7 +172,7 @@ export class RigView {
     const named = this.namesError();
     try {
       if (named) throw new Error(named);
-      const g = await this.engine.call('rigFrames', { cameras: JSON.stringify(cams.map((c) => ({ name: c.name, images: c.files.map((f) => f.name) }))) });
+      const g = await this.engine.call('rigFrames', { cameras: JSON.stringify(cams.map((c) => ({ name: c.name, images: c.files.map((f) => f.name) }))), groupBy: this.state.groupBy || '' });
       grouping = { ...g, error: null };
     } catch (err) {
       grouping = { error: err.message, frames: [], keys: [] };
@@ -161,7 +193,7 @@ export class RigView {
       return i < 0 ? '—' : `${c.files[i].name}: ${status(c.files[i])}`;
     })]);
     fill(this.framesOut,
-      h('p', { id: 'rig-grouping' }, `${frames.length} frame${frames.length === 1 ? '' : 's'} over ${cams.length} cameras, grouped ${grouping.grouped_by === 'number' ? 'by the number in the file names' : 'by order (sorted names)'}.`),
+      h('p', { id: 'rig-grouping' }, `${frames.length} frame${frames.length === 1 ? '' : 's'} over ${cams.length} cameras, grouped ${groupedText(grouping.grouped_by)}.`),
       empty.length ? h('p', { id: 'rig-missing', class: 'msg msg-info', role: 'status' }, `Add images for camera ${empty.join(', ')} to solve.`) : null,
       short > 0 ? h('p', { id: 'rig-too-few', class: 'msg msg-info', role: 'status' }, `A rig calibration needs at least ${MIN_FRAMES} frames: add ${short} more frame${short === 1 ? '' : 's'} (an image of each camera, numbered alike) to solve.`) : null,
       table(['frame', ...cams.map((c) => c.name)], rows, { id: 'rig-frame-table', class: 'scroll' }));
@@ -308,6 +340,29 @@ export class RigView {
           });
           return b;
         })),
+      this.stereoExports(r),
       this.exportStatus);
+  }
+
+  /** A rig of two as a stereo pair (robocal stereo's report: left, right, right_from_left) in the stereo formats of robocal export. */
+  stereoExports(r) {
+    if (!stereoOfRig(r)) return null;
+    const [left, right] = r.cameras;
+    const report = JSON.stringify({ left: left.calibration, right: right.calibration, right_from_left: right.camera_from_rig, rms_px: r.rms_px });
+    return h('div', { class: 'row', id: 'rig-stereo-exports' },
+      h('span', { class: 'hint' }, `As a stereo pair (left ${left.name}, right ${right.name}; x_right = R x_left + T):`),
+      [['opencv-yaml', 'OpenCV stereo YAML (K1 D1 K2 D2 R T E F, R1 R2 P1 P2 Q)'], ['ros', 'ROS left.yaml + right.yaml (rectified)'], ['kalibr', 'Kalibr camchain (cam0, cam1)']].map(([format, label]) => {
+        const b = h('button', { type: 'button', id: `rig-export-stereo-${format}` }, label);
+        b.addEventListener('click', async () => {
+          try {
+            const files = await this.engine.call('exportFiles', { report, format });
+            for (const f of files) download(f.name.startsWith('stereo') ? f.name : `stereo_${f.name}`, f.text);
+            fill(this.exportStatus, `stereo ${format}: ${files.map((f) => f.name).join(', ')}`);
+          } catch (err) {
+            fill(this.exportStatus, message('error', `stereo ${format}: ${err.message}`));
+          }
+        });
+        return b;
+      }));
   }
 }
