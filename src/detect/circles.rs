@@ -19,6 +19,10 @@ const MAX_SEEDS: usize = 60;
 const BLOB_WORKING_SIDE_PX: u32 = 2048;
 /// Neighbouring grid blobs differ in area by at most this factor.
 const AREA_RATIO: f64 = 3.0;
+/// An origin-dot grid's big dot has at least this many times the area of
+/// each of the grid's three other corner dots (4 on the print; the corners'
+/// foreshortening differs by far less than a factor 2 in any usable view).
+const ORIGIN_DOT_MIN_AREA_RATIO: f64 = 2.0;
 
 /// Working-level blobs and the level they were found at.
 pub(crate) fn blobs_at_level(
@@ -60,6 +64,62 @@ pub(crate) fn detect_grid(
 ) -> Result<Vec<DetectedPoint>> {
     let invert = polarity == Polarity::LightOnDark;
     let (level, blobs) = blobs_at_level(img, invert, options);
+    let found = find_grid(&blobs, target, asymmetric, diameter_ratio, None)?;
+    measure_grid(img, target, asymmetric, invert, level, &blobs, &found, options)
+}
+
+/// Detect ROS-Industrial's modified circle grid ([`crate::target::origin_dot`]):
+/// dark dots grown into a lattice that accepts the origin dot (four times
+/// the others' area), ordered so that the origin dot is point
+/// `(rows - 1) cols` (right-handed, as every grid; any turn of the print,
+/// 180 degrees included, reads the same).
+pub(crate) fn detect_origin_dot_grid(
+    img: &GrayImage,
+    target: &Target,
+    options: &DetectOptions,
+) -> Result<Vec<DetectedPoint>> {
+    let Target::OriginDotGrid { cols, rows, .. } = target else {
+        return Err(Error::invalid(
+            "target",
+            format!("{} is not an origin-dot grid", target.to_spec()),
+        ));
+    };
+    let (level, blobs) = blobs_at_level(img, false, options);
+    let origin = crate::target::origin_dot::origin_id(*cols, *rows);
+    let found = find_grid(
+        &blobs,
+        target,
+        false,
+        Some(crate::target::origin_dot::DOT_DIAMETER_RATIO),
+        Some(origin),
+    )?;
+    measure_grid(img, target, false, false, level, &blobs, &found, options)
+}
+
+/// Whether the blob at board position `origin` of `order` is the origin
+/// dot: [`ORIGIN_DOT_MIN_AREA_RATIO`] times larger than each other corner.
+fn origin_dot_at(blobs: &[Blob], order: &[usize], origin: usize, cols: usize) -> bool {
+    let n = order.len();
+    if n == 0 || origin >= n || cols == 0 {
+        return false;
+    }
+    let corners = [0, cols - 1, n - cols, n - 1];
+    let big = blobs[order[origin]].area;
+    corners
+        .iter()
+        .filter(|&&c| c != origin)
+        .all(|&c| big >= ORIGIN_DOT_MIN_AREA_RATIO * blobs[order[c]].area)
+}
+
+/// The blob indices of the one complete grid in board order (see
+/// [`detect_grid`]); `origin`: an origin-dot grid's big-dot id.
+fn find_grid(
+    blobs: &[Blob],
+    target: &Target,
+    asymmetric: bool,
+    diameter_ratio: Option<f64>,
+    origin: Option<usize>,
+) -> Result<Vec<usize>> {
     let board = target.grid_coords();
     let n = board.len();
     let cols = board.iter().filter(|c| c.1 == 0).count();
@@ -85,7 +145,18 @@ pub(crate) fn detect_grid(
             describe(target)
         )
     };
-    let order = match search_grid(&blobs, &search, &two_boards)? {
+    let is_origin = |o: &[usize]| origin.is_some_and(|k| origin_dot_at(blobs, o, k, cols));
+    // The origin dot has four times the others' area: the lattice takes
+    // blobs up to that much larger than the seed (a seed is an ordinary dot:
+    // the big one has no neighbour of its size to seed from).
+    let big = match origin {
+        Some(_) => {
+            let s = crate::target::origin_dot::ORIGIN_DOT_SCALE;
+            AREA_RATIO * s * s
+        }
+        None => AREA_RATIO,
+    };
+    let order = match search_grid_with(blobs, &search, &two_boards, big, &is_origin)? {
         Ok(order) => order,
         Err(best_partial) => {
             let message = if best_partial > 1 {
@@ -99,6 +170,31 @@ pub(crate) fn detect_grid(
             return Err(Error::NotFound { message });
         }
     };
+    if origin.is_some() && !is_origin(&order) {
+        return Err(Error::NotFound {
+            message: format!(
+                "found the {} but no corner dot is twice the size of the others: is the origin dot printed and in view?",
+                describe(target)
+            ),
+        });
+    }
+    Ok(order)
+}
+
+/// Centres of the grid's circles in board order: each blob's outline at
+/// full resolution, then the centre model.
+#[allow(clippy::too_many_arguments)]
+fn measure_grid(
+    img: &GrayImage,
+    target: &Target,
+    asymmetric: bool,
+    invert: bool,
+    level: u32,
+    blobs: &[Blob],
+    order: &[usize],
+    options: &DetectOptions,
+) -> Result<Vec<DetectedPoint>> {
+    let board = target.grid_coords();
     let outlines = order
         .iter()
         .enumerate()
@@ -143,6 +239,7 @@ fn describe(target: &Target) -> String {
             }
         ),
         Target::DotPlate { cols, rows, .. } => format!("{cols}x{rows} dot plate"),
+        Target::OriginDotGrid { cols, rows, .. } => format!("{cols}x{rows} origin-dot grid"),
         Target::Chessboard { cols, rows, .. } => format!("{cols}x{rows} chessboard"),
         Target::SingleCircle { .. } => "circle".to_string(),
         Target::SquareGrid { cols, rows, .. } => format!("{cols}x{rows} square grid"),
@@ -154,6 +251,11 @@ fn describe(target: &Target) -> String {
         Target::Aprilgrid {
             tag_cols, tag_rows, ..
         } => format!("{tag_cols}x{tag_rows} AprilGrid"),
+        Target::ArucoGrid {
+            markers_x,
+            markers_y,
+            ..
+        } => format!("{markers_x}x{markers_y} ArUco grid"),
     }
 }
 
@@ -201,6 +303,20 @@ pub(crate) fn search_grid(
     search: &GridSearch,
     two_boards: &dyn Fn() -> String,
 ) -> Result<std::result::Result<Vec<usize>, usize>> {
+    search_grid_with(blobs, search, two_boards, AREA_RATIO, &|_| false)
+}
+
+/// [`search_grid`] with the largest accepted area over the seed's
+/// (`max_area_ratio`, [`AREA_RATIO`] there) and the orders preferred among
+/// a lattice's right-handed ones (`prefer`; none there: id 0 nearest the
+/// image's top-left decides).
+fn search_grid_with(
+    blobs: &[Blob],
+    search: &GridSearch,
+    two_boards: &dyn Fn() -> String,
+    max_area_ratio: f64,
+    prefer: &dyn Fn(&[usize]) -> bool,
+) -> Result<std::result::Result<Vec<usize>, usize>> {
     let n = search.board.len();
     let pts: Vec<Point2<f64>> = blobs.iter().map(|b| b.centre).collect();
     let index = PointIndex::new(&pts, 16.0);
@@ -219,7 +335,7 @@ pub(crate) fn search_grid(
         }
         let accept = |i: usize, _: (i32, i32), _: &lattice::Prediction| {
             let r = blobs[i].area / blobs[seed].area;
-            (1.0 / AREA_RATIO..=AREA_RATIO).contains(&r)
+            (1.0 / AREA_RATIO..=max_area_ratio).contains(&r)
         };
         let mut cells = lattice::grow(&index, seed, step_a, step_b, 2 * n + 8, &accept);
         if search.trim {
@@ -228,7 +344,7 @@ pub(crate) fn search_grid(
             }
         }
         let maps = lattice::complete_maps(&cells, search.board, search.diagonal);
-        match lattice::choose_order(&pts, &cells, &maps, search.board, search.cols, &|_| false) {
+        match lattice::choose_order(&pts, &cells, &maps, search.board, search.cols, prefer) {
             Some(order) => {
                 cells.values().for_each(|&i| in_board[i] = true);
                 found.push(order);

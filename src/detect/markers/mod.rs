@@ -1,4 +1,5 @@
-//! Marker boards: ChArUco (OpenCV) and AprilGrid (Kalibr).
+//! Marker boards: ChArUco and the ArUco GridBoard (OpenCV), AprilGrid
+//! (Kalibr).
 //!
 //! 1. Candidate quads ([`quads`]: adaptive threshold, 4-connected regions,
 //!    convex quadrilaterals, sub-pixel sides) read as markers ([`decode`]:
@@ -20,6 +21,11 @@
 //!      than [`DISAGREE_FRACTION`] of the marker margin apart is dropped.
 //!    - AprilGrid: the four corners of every tag (each is an X-junction with
 //!      Kalibr's corner squares), seeded at the tag's quad corners.
+//!    - ArUco grid: the four corners of every marker, as the quad finder
+//!      measured them (each the meeting point of two straight sub-pixel
+//!      edges fitted along the marker's sides, [`edges`]); a marker's
+//!      corners are plain L-corners of a dark square on white, with no
+//!      saddle to refine on.
 //!
 //!    Any subset of points may come out (partial views, occlusion).
 
@@ -186,7 +192,8 @@ fn candidate_boards(target: &Target, layout: &MarkerLayout, markers: &[Marker]) 
             marker_ids: None,
             ..
         }
-        | Target::Aprilgrid { first_id, .. } => *first_id as i64,
+        | Target::Aprilgrid { first_id, .. }
+        | Target::ArucoGrid { first_id, .. } => *first_id as i64,
         _ => return vec![target.clone()],
     };
     let mut blocks: Vec<i64> = markers
@@ -201,7 +208,9 @@ fn candidate_boards(target: &Target, layout: &MarkerLayout, markers: &[Marker]) 
             let f = first + b * count;
             let mut t = target.clone();
             match &mut t {
-                Target::Charuco { first_id, .. } | Target::Aprilgrid { first_id, .. } => {
+                Target::Charuco { first_id, .. }
+                | Target::Aprilgrid { first_id, .. }
+                | Target::ArucoGrid { first_id, .. } => {
                     *first_id = usize::try_from(f).ok()?;
                 }
                 _ => {}
@@ -239,6 +248,7 @@ fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Det
     let points = match board {
         Target::Charuco { .. } => charuco_corners(image, board, &layout, &mine),
         Target::Aprilgrid { .. } => aprilgrid_corners(image, board, &layout, &mine),
+        Target::ArucoGrid { .. } => aruco_grid_corners(image, &mine),
         _ => Vec::new(),
     };
     if points.is_empty() {
@@ -450,6 +460,37 @@ fn aprilgrid_corners(
             }
         }
     }
+    out.sort_by_key(|p| p.id);
+    out
+}
+
+/// An ArUco grid's points: every consistent marker's four corners, point
+/// `4 k + c` for corner `c` of the board's marker `k` ([`marker_board`]),
+/// in id order. Corners within [`MIN_WINDOW_PX`] of the image border are
+/// left out (their edge fits reach past it).
+fn aruco_grid_corners(image: &GrayImage, mine: &[(usize, &Marker)]) -> Vec<DetectedPoint> {
+    let margin = MIN_WINDOW_PX;
+    let inside = |p: &Point2<f64>| {
+        p.x >= margin
+            && p.y >= margin
+            && p.x <= image.width as f64 - 1.0 - margin
+            && p.y <= image.height as f64 - 1.0 - margin
+    };
+    let mut out: Vec<DetectedPoint> = mine
+        .iter()
+        .flat_map(|&(k, m)| {
+            m.corners
+                .into_iter()
+                .enumerate()
+                .filter(|(_, p)| inside(p))
+                .map(move |(c, p)| DetectedPoint {
+                    id: 4 * k + c,
+                    x_px: p.x,
+                    y_px: p.y,
+                    covariance_px2: None,
+                })
+        })
+        .collect();
     out.sort_by_key(|p| p.id);
     out
 }
