@@ -21,16 +21,16 @@
 //!      than [`DISAGREE_FRACTION`] of the marker margin apart is dropped.
 //!    - AprilGrid: the four corners of every tag (each is an X-junction with
 //!      Kalibr's corner squares), seeded at the tag's quad corners.
-//!    - ArUco grid: the four corners of every marker, as the quad finder
-//!      measured them (each the meeting point of two straight sub-pixel
-//!      edges fitted along the marker's sides, [`edges`]); a marker's
-//!      corners are plain L-corners of a dark square on white, with no
-//!      saddle to refine on.
+//!    - ArUco grid: the four corners of every marker, plain L-corners of a
+//!      dark square on white with no saddle to refine on: each the meeting
+//!      point of two straight edges fitted densely along the marker's sides
+//!      ([`grid_corners`]).
 //!
 //!    Any subset of points may come out (partial views, occlusion).
 
 mod decode;
 mod edges;
+mod grid_corners;
 mod homography;
 mod quads;
 mod runs;
@@ -248,7 +248,7 @@ fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Det
     let points = match board {
         Target::Charuco { .. } => charuco_corners(image, board, &layout, &mine),
         Target::Aprilgrid { .. } => aprilgrid_corners(image, board, &layout, &mine),
-        Target::ArucoGrid { .. } => aruco_grid_corners(image, &mine),
+        Target::ArucoGrid { .. } => aruco_grid_corners(image, &layout, &mine),
         _ => Vec::new(),
     };
     if points.is_empty() {
@@ -464,11 +464,16 @@ fn aprilgrid_corners(
     out
 }
 
-/// An ArUco grid's points: every consistent marker's four corners, point
-/// `4 k + c` for corner `c` of the board's marker `k` ([`marker_board`]),
-/// in id order. Corners within [`MIN_WINDOW_PX`] of the image border are
-/// left out (their edge fits reach past it).
-fn aruco_grid_corners(image: &GrayImage, mine: &[(usize, &Marker)]) -> Vec<DetectedPoint> {
+/// An ArUco grid's points: every consistent marker's four corners
+/// ([`grid_corners`]), point `4 k + c` for corner `c` of the board's marker
+/// `k` ([`marker_board`]), in id order. Corners within [`MIN_WINDOW_PX`] of
+/// the image border are left out (their edge fits reach past it).
+fn aruco_grid_corners(
+    image: &GrayImage,
+    layout: &MarkerLayout,
+    mine: &[(usize, &Marker)],
+) -> Vec<DetectedPoint> {
+    let cells = layout.dictionary.marker_bits() + 2 * layout.border_bits;
     let margin = MIN_WINDOW_PX;
     let inside = |p: &Point2<f64>| {
         p.x >= margin
@@ -479,7 +484,7 @@ fn aruco_grid_corners(image: &GrayImage, mine: &[(usize, &Marker)]) -> Vec<Detec
     let mut out: Vec<DetectedPoint> = mine
         .iter()
         .flat_map(|&(k, m)| {
-            m.corners
+            grid_corners::refine_corners(image, m.corners, cells)
                 .into_iter()
                 .enumerate()
                 .filter(|(_, p)| inside(p))
