@@ -159,8 +159,9 @@ fn origin_dot_ids_are_ros_industrials_and_the_frame_maps_by_a_half_turn() {
             ros.1
         );
     }
-    assert_eq!(origin_dot::dot_radius_m(8, 4, 3, s), 0.01, "origin dot 20 mm across");
-    assert_eq!(origin_dot::dot_radius_m(0, 4, 3, s), 0.005, "dots 10 mm across");
+    let r = |id| origin_dot::dot_radius_m(id, 4, 3, s);
+    assert!((r(8) - 0.01).abs() < 1e-12, "origin dot 20 mm across: {} m radius", r(8));
+    assert!((r(0) - 0.005).abs() < 1e-12, "dots 10 mm across: {} m radius", r(0));
 }
 
 #[wasm_bindgen_test(unsupported = test)]
