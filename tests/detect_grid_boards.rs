@@ -99,7 +99,11 @@ fn aruco_grid_1280x960_noise_2_every_corner_by_id() {
         }
     }
     let m = mean(&all);
-    println!("arucogrid all views: mean {m:.4} px, max {:.4} px over {} corners", max(&all), all.len());
+    println!(
+        "arucogrid all views: mean {m:.4} px, max {:.4} px over {} corners",
+        max(&all),
+        all.len()
+    );
     // Measured 0.0566 / 0.4429 px (eight renders, four poses); the worst
     // views are those with the sides near the pixel axes.
     assert!(m <= 0.1, "mean corner error {m} px");
@@ -134,7 +138,11 @@ fn origin_dot_grid_1280x960_noise_2_upright_and_upside_down() {
         }
     }
     let m = mean(&all);
-    println!("origin-dot all views: mean {m:.4} px, max {:.4} px over {} dots", max(&all), all.len());
+    println!(
+        "origin-dot all views: mean {m:.4} px, max {:.4} px over {} dots",
+        max(&all),
+        all.len()
+    );
     // Measured 0.0075 / 0.0227 px (ten renders, five poses).
     assert!(m <= 0.02, "mean centre error {m} px");
     assert!(max(&all) <= 0.06, "max centre error {} px", max(&all));
@@ -178,8 +186,12 @@ fn calibrate_on_renders(spec: &str, seed: u64) -> (usize, f64, f64) {
             .unwrap_or_else(|e| panic!("{spec} view {k}: {e}"));
         views.push(View::from_detection(format!("view{k}"), &det));
     }
-    let report = calibrate(&views, (cam.width, cam.height), &CalibrationOptions::default())
-        .expect("calibration");
+    let report = calibrate(
+        &views,
+        (cam.width, cam.height),
+        &CalibrationOptions::default(),
+    )
+    .expect("calibration");
     let c = &report.camera;
     println!(
         "{spec}: fx {:.3} (true {:.3}), fy {:.3} (true {:.3}), cx {:.3} ({:.3}), cy {:.3} ({:.3})",
@@ -192,12 +204,18 @@ fn calibrate_on_renders(spec: &str, seed: u64) -> (usize, f64, f64) {
 fn aruco_grid_calibrates_fx_fy_within_half_a_pixel() {
     let (n, dfx, dfy) = calibrate_on_renders("arucogrid:5x7:30mm:8mm:DICT_6X6_250", 300);
     assert_eq!(n, 10);
-    assert!(dfx <= 0.5 && dfy <= 0.5, "fx off by {dfx} px, fy by {dfy} px");
+    assert!(
+        dfx <= 0.5 && dfy <= 0.5,
+        "fx off by {dfx} px, fy by {dfy} px"
+    );
 }
 
 #[test]
 fn origin_dot_grid_calibrates_fx_fy_within_half_a_pixel() {
     let (n, dfx, dfy) = calibrate_on_renders("circles:10x10:20mm:origin-dot", 400);
     assert_eq!(n, 10);
-    assert!(dfx <= 0.5 && dfy <= 0.5, "fx off by {dfx} px, fy by {dfy} px");
+    assert!(
+        dfx <= 0.5 && dfy <= 0.5,
+        "fx off by {dfx} px, fy by {dfy} px"
+    );
 }

@@ -145,9 +145,15 @@ fn aruco_grid_and_origin_dot_handeye_from_images_within_the_robot_noise() {
         let truth = x_true.to_homogeneous();
         let t_mm = (est.fixed_view::<3, 1>(0, 3) - truth.fixed_view::<3, 1>(0, 3)).norm() * 1e3;
         let r = est.fixed_view::<3, 3>(0, 0).transpose() * truth.fixed_view::<3, 3>(0, 0);
-        let rot_deg = ((r.trace() - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees();
+        let rot_deg = ((r.trace() - 1.0) / 2.0)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees();
         println!("{spec} {name}: X off by {rot_deg:.4} deg, {t_mm:.3} mm");
-        assert!(rot_deg < MAX_ROT_DEG, "{spec}: X rotation off by {rot_deg} deg");
+        assert!(
+            rot_deg < MAX_ROT_DEG,
+            "{spec}: X rotation off by {rot_deg} deg"
+        );
         assert!(t_mm < MAX_T_MM, "{spec}: X translation off by {t_mm} mm");
     }
 }

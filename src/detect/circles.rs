@@ -66,7 +66,9 @@ pub(crate) fn detect_grid(
     let invert = polarity == Polarity::LightOnDark;
     let (level, blobs) = blobs_at_level(img, invert, options);
     let found = find_grid(&blobs, target, asymmetric, diameter_ratio, AREA_RATIO)?;
-    measure_grid(img, target, asymmetric, invert, level, &blobs, &found, options)
+    measure_grid(
+        img, target, asymmetric, invert, level, &blobs, &found, options,
+    )
 }
 
 /// Detect ROS-Industrial's modified circle grid ([`crate::target::origin_dot`]):

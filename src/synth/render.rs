@@ -470,7 +470,9 @@ impl Albedo {
                     self.white
                 }
             }
-            Target::DotPlate { .. } | Target::SingleCircle { .. } | Target::OriginDotGrid { .. } => {
+            Target::DotPlate { .. }
+            | Target::SingleCircle { .. }
+            | Target::OriginDotGrid { .. } => {
                 if self.in_dot(x, y) {
                     self.black
                 } else {
@@ -508,7 +510,10 @@ impl Albedo {
         if let Target::SingleCircle { .. } = self.target {
             return x * x + y * y < r2;
         }
-        if let Target::OriginDotGrid { rows, spacing_m, .. } = self.target {
+        if let Target::OriginDotGrid {
+            rows, spacing_m, ..
+        } = self.target
+        {
             // The origin dot, twice as large, first (it reaches past the
             // 3x3 neighbourhood's own dots).
             let (ox, oy) = (0.0, (rows as f64 - 1.0) * spacing_m);

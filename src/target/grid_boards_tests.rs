@@ -85,9 +85,8 @@ fn bad_aruco_grid_and_origin_dot_specs_say_what_is_wrong() {
         err("arucogrid:0x7:40mm:10mm:DICT_6X6_250"),
         "target: a grid needs 2 to 100000 points with at least 2 per side, got 0x7"
     );
-    assert!(err("arucogrid:5x7:40mm:10mm:DICT_9X9_1").starts_with(
-        "target: unknown marker dictionary 'DICT_9X9_1'; known: DICT_4X4_50, "
-    ));
+    assert!(err("arucogrid:5x7:40mm:10mm:DICT_9X9_1")
+        .starts_with("target: unknown marker dictionary 'DICT_9X9_1'; known: DICT_4X4_50, "));
     let origin_dot_only = "is not an origin-dot grid spec; expected circles:COLSxROWS:PITCH:origin-dot with no other option (ROS-Industrial's grid is symmetric, dark dots on light; e.g. circles:10x10:25mm:origin-dot)";
     assert_eq!(
         err("circles:10x10:25mm:origin-dot:asymmetric"),
@@ -160,8 +159,16 @@ fn origin_dot_ids_are_ros_industrials_and_the_frame_maps_by_a_half_turn() {
         );
     }
     let r = |id| origin_dot::dot_radius_m(id, 4, 3, s);
-    assert!((r(8) - 0.01).abs() < 1e-12, "origin dot 20 mm across: {} m radius", r(8));
-    assert!((r(0) - 0.005).abs() < 1e-12, "dots 10 mm across: {} m radius", r(0));
+    assert!(
+        (r(8) - 0.01).abs() < 1e-12,
+        "origin dot 20 mm across: {} m radius",
+        r(8)
+    );
+    assert!(
+        (r(0) - 0.005).abs() < 1e-12,
+        "dots 10 mm across: {} m radius",
+        r(0)
+    );
 }
 
 #[wasm_bindgen_test(unsupported = test)]
@@ -170,7 +177,11 @@ fn the_sheets_draw_every_marker_and_the_big_dot() {
     assert_eq!(svg.matches("class=\"circle\"").count(), 100);
     assert_eq!(svg.matches(r#"r="5"/>"#).count(), 99, "dots 10 mm across");
     // The origin dot: point 90 at (0, 9 * 25) mm, 20 mm across.
-    assert_eq!(svg.matches(r#"<circle class="circle" cx="0" cy="225" r="10"/>"#).count(), 1);
+    assert_eq!(
+        svg.matches(r#"<circle class="circle" cx="0" cy="225" r="10"/>"#)
+            .count(),
+        1
+    );
     assert!(svg.contains("robocal target circles:10x10:25mm:origin-dot"));
     assert!(svg.contains("big dot: ROS-I origin"));
 

@@ -531,6 +531,6 @@ pub use centre_model::CentreModel;
 pub use dictionary::Dictionary;
 
 #[cfg(test)]
-mod tests;
-#[cfg(test)]
 mod grid_boards_tests;
+#[cfg(test)]
+mod tests;

@@ -160,7 +160,10 @@ impl Target {
                 cols,
                 rows,
                 spacing_m,
-            } => format!("circles:{cols}x{rows}:{}:origin-dot", spec_length(*spacing_m)),
+            } => format!(
+                "circles:{cols}x{rows}:{}:origin-dot",
+                spec_length(*spacing_m)
+            ),
             Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
                 marker_board_spec(self).unwrap_or_default()
             }

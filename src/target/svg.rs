@@ -286,7 +286,9 @@ fn description(target: &Target) -> String {
             "{cols} x {rows} dots, pitch {}, dots {}, origin dot {}",
             mm(*spacing_m),
             mm(super::origin_dot::DOT_DIAMETER_RATIO * spacing_m),
-            mm(super::origin_dot::ORIGIN_DOT_SCALE * super::origin_dot::DOT_DIAMETER_RATIO * spacing_m)
+            mm(super::origin_dot::ORIGIN_DOT_SCALE
+                * super::origin_dot::DOT_DIAMETER_RATIO
+                * spacing_m)
         ),
     }
 }
@@ -299,9 +301,7 @@ fn origin_note(target: &Target) -> &'static str {
         Target::ArucoGrid { .. } => {
             "Origin at marker 0's top-left corner, x right, y down (OpenCV)."
         }
-        Target::OriginDotGrid { .. } => {
-            "Point 0 top left, x right, y down; big dot: ROS-I origin."
-        }
+        Target::OriginDotGrid { .. } => "Point 0 top left, x right, y down; big dot: ROS-I origin.",
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
         | Target::DotPlate { .. }
