@@ -18,6 +18,10 @@
 //! renderer leave it out, and the detector fits the dots' outer edges, so
 //! prints with or without it read the same.)
 //!
+//! ROS-Industrial's target configuration `{rows: R, cols: C, spacing: S}`
+//! (metres; `ModifiedCircleGridTargetFinderFactory`) is the spec
+//! `circles:CxR:S:origin-dot` here (columns first, as every robocal grid).
+//!
 //! # Numbering and frame
 //!
 //! ROS-Industrial numbers the dots row by row starting with the row
