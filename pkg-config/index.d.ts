@@ -165,6 +165,27 @@ export interface TargetKinds {
     /** Gap between tags over the tag side, in (0, 1] (Kalibr's tagSpacing). */ spacing_ratio: number;
     /** Id of tag 0 (0 in Kalibr; serialised always). */ first_id?: number;
   };
+  /**
+   * OpenCV's ArUco GridBoard (markers only): 4 points per marker, id `4 k + c` for corner c
+   * (0 top-left, 1 top-right, 2 bottom-right, 3 bottom-left) of marker k (row by row from the
+   * top left, dictionary id `first_id + k`); OpenCV 4.6+'s board frame (origin at marker 0's
+   * top-left corner, y down). A detection holds the corners seen (any subset).
+   */
+  aruco_grid: {
+    /** Markers along a row (OpenCV's markersX). */ markers_x: number;
+    /** Rows of markers (OpenCV's markersY). */ markers_y: number;
+    /** Side of one marker, its black border included, metres. */ marker_m: number;
+    /** Gap between neighbouring markers, metres (OpenCV's markerSeparation). */ separation_m: number;
+    dictionary: ArucoDictionary;
+    /** Id of the top-left marker (0 by default; serialised always). */ first_id?: number;
+  };
+  /**
+   * ROS-Industrial's modified circle grid: dark dots 0.4 spacing across, the origin dot twice
+   * that; ids ROS-Industrial's (`i + j * cols`, row 0 farthest from the big dot, which is id
+   * `(rows - 1) * cols`), points at `(i, j) * spacing_m` (ROS-Industrial's frame:
+   * `(x, (rows - 1) spacing_m - y, -z)`).
+   */
+  origin_dot_grid: { cols: number; rows: number; /** Centre distance, metres. */ spacing_m: number };
 }
 
 /** OpenCV's predefined ArUco dictionaries, by their OpenCV names. */

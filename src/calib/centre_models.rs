@@ -26,14 +26,15 @@ pub const MIXED: &str = "mixed";
 fn model_of(view: &JsonView) -> Option<CentreModel> {
     let d = view.detection.as_ref()?;
     match d.target {
-        Target::CircleGrid { .. } | Target::DotPlate { .. } => {
+        Target::CircleGrid { .. } | Target::DotPlate { .. } | Target::OriginDotGrid { .. } => {
             Some(d.centre_model.unwrap_or(CentreModel::EllipseCentre))
         }
         Target::Chessboard { .. }
         | Target::SingleCircle { .. }
         | Target::SquareGrid { .. }
         | Target::Charuco { .. }
-        | Target::Aprilgrid { .. } => None,
+        | Target::Aprilgrid { .. }
+        | Target::ArucoGrid { .. } => None,
     }
 }
 

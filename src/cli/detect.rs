@@ -44,7 +44,11 @@ pub struct DetectArgs {
     /// e.g. Zhang's squares:8x8:12.7mm:22.5778mm),
     /// charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICT[:first=N][:ids=A,B,...][:legacy]
     /// (OpenCV's ChArUco board; legacy: made before OpenCV 4.6),
-    /// aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO[:first=N] (Kalibr's)
+    /// aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO[:first=N] (Kalibr's),
+    /// arucogrid:COLSxROWS:MARKER:SEPARATION:DICT[:first=N] (OpenCV's ArUco
+    /// GridBoard: 4 corners per marker),
+    /// circles:COLSxROWS:PITCH:origin-dot (ROS-Industrial's modified circle
+    /// grid, the big origin dot fixes the orientation)
     /// (lengths with mm, cm or m), or a target JSON object
     #[arg(long, value_name = "SPEC")]
     target: Option<String>,
@@ -108,7 +112,10 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
     };
     let files = &args.images;
     let decode = args.limits.decode_options();
-    let all_boards = matches!(target, Target::Charuco { .. } | Target::Aprilgrid { .. });
+    let all_boards = matches!(
+        target,
+        Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. }
+    );
     let outcomes = run_with(files, &target, &options, &decode, args.threads, all_boards)?;
     let mut images = Vec::with_capacity(files.len());
     let mut found = 0;

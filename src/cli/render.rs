@@ -405,6 +405,19 @@ fn grid_of(target: &Target) -> ((usize, usize), f64) {
             spacing_ratio,
             ..
         } => ((*tag_cols, *tag_rows), (1.0 + spacing_ratio) * tag_m),
+        // Markers at the marker pitch.
+        Target::ArucoGrid {
+            markers_x,
+            markers_y,
+            marker_m,
+            separation_m,
+            ..
+        } => ((*markers_x, *markers_y), marker_m + separation_m),
+        Target::OriginDotGrid {
+            cols,
+            rows,
+            spacing_m,
+        } => ((*cols, *rows), *spacing_m),
     }
 }
 

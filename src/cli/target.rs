@@ -18,14 +18,18 @@ back in. Print it at 100 % (actual size, no fit to page).",
   robocal target chessboard:9x6:30mm --svg board.svg
   robocal target circles:4x11:20mm:asymmetric --svg acircles.svg
   robocal target charuco:12x9:20mm:15mm:DICT_5X5_100 --svg charuco.svg
-  robocal target aprilgrid:6x6:88mm:0.3 --svg aprilgrid.svg",
+  robocal target aprilgrid:6x6:88mm:0.3 --svg aprilgrid.svg
+  robocal target arucogrid:5x7:40mm:10mm:DICT_6X6_250 --svg arucogrid.svg
+  robocal target circles:10x10:25mm:origin-dot --svg ros_industrial.svg",
     args_override_self = true
 )]
 pub struct TargetArgs {
     /// The target, as for 'robocal detect' (chessboard:9x6:30mm,
     /// circles:4x11:20mm:asymmetric, dots:7x7:25mm, circle:10mm,
     /// squares:8x8:12.7mm:22.5778mm, charuco:12x9:20mm:15mm:DICT_5X5_100,
-    /// aprilgrid:6x6:88mm:0.3) or a target JSON object
+    /// aprilgrid:6x6:88mm:0.3, arucogrid:5x7:40mm:10mm:DICT_6X6_250[:first=N]
+    /// (OpenCV's GridBoard), circles:10x10:25mm:origin-dot (ROS-Industrial's
+    /// modified circle grid)) or a target JSON object
     #[arg(value_name = "SPEC")]
     spec: Option<String>,
     /// Write the printable sheet there (SVG; '-' for standard output)

@@ -19,6 +19,11 @@ const MAX_SEEDS: usize = 60;
 const BLOB_WORKING_SIDE_PX: u32 = 2048;
 /// Neighbouring grid blobs differ in area by at most this factor.
 const AREA_RATIO: f64 = 3.0;
+/// An origin-dot grid's big dot has at least this many times the area of
+/// its two grid neighbours (4 on the print; measured on the sub-pixel
+/// ellipses), and this many times the ratio of any other corner dot to its
+/// neighbours (about 1).
+const ORIGIN_DOT_MIN_AREA_RATIO: f64 = 2.0;
 
 /// Working-level blobs and the level they were found at.
 pub(crate) fn blobs_at_level(
@@ -60,6 +65,130 @@ pub(crate) fn detect_grid(
 ) -> Result<Vec<DetectedPoint>> {
     let invert = polarity == Polarity::LightOnDark;
     let (level, blobs) = blobs_at_level(img, invert, options);
+    let found = find_grid(&blobs, target, asymmetric, diameter_ratio, AREA_RATIO)?;
+    measure_grid(
+        img, target, asymmetric, invert, level, &blobs, &found, options,
+    )
+}
+
+/// Detect ROS-Industrial's modified circle grid ([`crate::target::origin_dot`]):
+/// dark dots grown into a lattice that accepts the origin dot (four times
+/// the others' area), ordered as every grid (right-handed), then turned so
+/// that the largest corner dot is point `(rows - 1) cols`: any turn of the
+/// print, 180 degrees included (and 90 on a square grid), reads the same.
+/// Corner sizes are compared with their neighbours' by their sub-pixel
+/// ellipses.
+pub(crate) fn detect_origin_dot_grid(
+    img: &GrayImage,
+    target: &Target,
+    options: &DetectOptions,
+) -> Result<Vec<DetectedPoint>> {
+    let Target::OriginDotGrid { cols, rows, .. } = target else {
+        return Err(Error::invalid(
+            "target",
+            format!("{} is not an origin-dot grid", target.to_spec()),
+        ));
+    };
+    let (cols, rows) = (*cols, *rows);
+    let (level, blobs) = blobs_at_level(img, false, options);
+    let s = crate::target::origin_dot::ORIGIN_DOT_SCALE;
+    let found = find_grid(
+        &blobs,
+        target,
+        false,
+        Some(crate::target::origin_dot::DOT_DIAMETER_RATIO),
+        AREA_RATIO * s * s,
+    )?;
+    // Corners (0, 0), (cols - 1, 0), (0, rows - 1) (the origin's place),
+    // (cols - 1, rows - 1) of the found order, each with its neighbours in
+    // its row and its column: a corner's size relative to theirs, as
+    // ROS-Industrial's finder compares them (the dots' own sizes differ by
+    // more than 1.6x between the near and far corners of a tilted board).
+    let n = found.len();
+    let corners = [
+        (0, [1, cols]),
+        (cols - 1, [cols - 2, 2 * cols - 1]),
+        (n - cols, [n - cols + 1, n - 2 * cols]),
+        (n - 1, [n - 2, n - 1 - cols]),
+    ];
+    let area = |id: usize| {
+        let (centre, cov) = to_full_blob(&blobs[found[id]], level);
+        refine_blob(img, centre, &cov, false).map_or(0.0, |o| {
+            std::f64::consts::PI * o.ellipse.semi_axes.0 * o.ellipse.semi_axes.1
+        })
+    };
+    let relative: Vec<f64> = corners
+        .iter()
+        .map(|&(c, [a, b])| {
+            let around = 0.5 * (area(a) + area(b));
+            if around > 0.0 {
+                area(c) / around
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let big = (0..4)
+        .max_by(|&a, &b| relative[a].total_cmp(&relative[b]))
+        .unwrap_or(2);
+    let clear = (0..4)
+        .filter(|&k| k != big)
+        .all(|k| relative[big] >= ORIGIN_DOT_MIN_AREA_RATIO * relative[k].max(1.0));
+    if !clear {
+        return Err(Error::NotFound {
+            message: format!(
+                "found the {} but no corner dot is twice the size of its neighbours: is the origin dot printed and in view?",
+                describe(target)
+            ),
+        });
+    }
+    let order = turn_to_origin(&found, cols, rows, big).ok_or_else(|| Error::NotFound {
+        message: format!(
+            "the origin dot of the {} is at the end of a column, not of a row: are the columns and rows swapped (ROS-Industrial's origin dot starts the last row)?",
+            describe(target)
+        ),
+    })?;
+    measure_grid(img, target, false, false, level, &blobs, &order, options)
+}
+
+/// `order` (right-handed, `cols x rows`) turned in the board's plane so that
+/// its corner `big` (0: first of row 0, 1: last of row 0, 2: first of the
+/// last row, 3: last of the last row) becomes the first of the last row.
+/// A quarter turn swaps columns and rows: only a square grid has one
+/// (`None` otherwise).
+fn turn_to_origin(order: &[usize], cols: usize, rows: usize, big: usize) -> Option<Vec<usize>> {
+    let n = order.len();
+    let m = cols;
+    match big {
+        2 => Some(order.to_vec()),
+        // Half a turn: (i, j) -> (cols - 1 - i, rows - 1 - j).
+        1 => Some((0..n).map(|id| order[n - 1 - id]).collect()),
+        // A quarter turn either way: new (i, j) is old (m - 1 - j, i) or
+        // old (j, m - 1 - i); both keep the order right-handed.
+        0 if cols == rows => Some(
+            (0..n)
+                .map(|id| order[(m - 1 - id / m) + (id % m) * m])
+                .collect(),
+        ),
+        3 if cols == rows => Some(
+            (0..n)
+                .map(|id| order[id / m + (m - 1 - id % m) * m])
+                .collect(),
+        ),
+        _ => None,
+    }
+}
+
+/// The blob indices of the one complete grid in board order (see
+/// [`detect_grid`]); `max_area_ratio`: the largest area over the seed's a
+/// grid blob may have ([`AREA_RATIO`], more for the origin-dot grid).
+fn find_grid(
+    blobs: &[Blob],
+    target: &Target,
+    asymmetric: bool,
+    diameter_ratio: Option<f64>,
+    max_area_ratio: f64,
+) -> Result<Vec<usize>> {
     let board = target.grid_coords();
     let n = board.len();
     let cols = board.iter().filter(|c| c.1 == 0).count();
@@ -85,7 +214,10 @@ pub(crate) fn detect_grid(
             describe(target)
         )
     };
-    let order = match search_grid(&blobs, &search, &two_boards)? {
+    // An origin-dot grid's big dot has four times the others' area: the
+    // lattice takes blobs up to that much larger than the seed (a seed is an
+    // ordinary dot: the big one has no neighbour of its size to seed from).
+    let order = match search_grid_with(blobs, &search, &two_boards, max_area_ratio)? {
         Ok(order) => order,
         Err(best_partial) => {
             let message = if best_partial > 1 {
@@ -99,6 +231,23 @@ pub(crate) fn detect_grid(
             return Err(Error::NotFound { message });
         }
     };
+    Ok(order)
+}
+
+/// Centres of the grid's circles in board order: each blob's outline at
+/// full resolution, then the centre model.
+#[allow(clippy::too_many_arguments)]
+fn measure_grid(
+    img: &GrayImage,
+    target: &Target,
+    asymmetric: bool,
+    invert: bool,
+    level: u32,
+    blobs: &[Blob],
+    order: &[usize],
+    options: &DetectOptions,
+) -> Result<Vec<DetectedPoint>> {
+    let board = target.grid_coords();
     let outlines = order
         .iter()
         .enumerate()
@@ -143,6 +292,7 @@ fn describe(target: &Target) -> String {
             }
         ),
         Target::DotPlate { cols, rows, .. } => format!("{cols}x{rows} dot plate"),
+        Target::OriginDotGrid { cols, rows, .. } => format!("{cols}x{rows} origin-dot grid"),
         Target::Chessboard { cols, rows, .. } => format!("{cols}x{rows} chessboard"),
         Target::SingleCircle { .. } => "circle".to_string(),
         Target::SquareGrid { cols, rows, .. } => format!("{cols}x{rows} square grid"),
@@ -154,6 +304,11 @@ fn describe(target: &Target) -> String {
         Target::Aprilgrid {
             tag_cols, tag_rows, ..
         } => format!("{tag_cols}x{tag_rows} AprilGrid"),
+        Target::ArucoGrid {
+            markers_x,
+            markers_y,
+            ..
+        } => format!("{markers_x}x{markers_y} ArUco grid"),
     }
 }
 
@@ -201,6 +356,17 @@ pub(crate) fn search_grid(
     search: &GridSearch,
     two_boards: &dyn Fn() -> String,
 ) -> Result<std::result::Result<Vec<usize>, usize>> {
+    search_grid_with(blobs, search, two_boards, AREA_RATIO)
+}
+
+/// [`search_grid`] with the largest accepted area over the seed's
+/// (`max_area_ratio`, [`AREA_RATIO`] there).
+fn search_grid_with(
+    blobs: &[Blob],
+    search: &GridSearch,
+    two_boards: &dyn Fn() -> String,
+    max_area_ratio: f64,
+) -> Result<std::result::Result<Vec<usize>, usize>> {
     let n = search.board.len();
     let pts: Vec<Point2<f64>> = blobs.iter().map(|b| b.centre).collect();
     let index = PointIndex::new(&pts, 16.0);
@@ -219,7 +385,7 @@ pub(crate) fn search_grid(
         }
         let accept = |i: usize, _: (i32, i32), _: &lattice::Prediction| {
             let r = blobs[i].area / blobs[seed].area;
-            (1.0 / AREA_RATIO..=AREA_RATIO).contains(&r)
+            (1.0 / AREA_RATIO..=max_area_ratio).contains(&r)
         };
         let mut cells = lattice::grow(&index, seed, step_a, step_b, 2 * n + 8, &accept);
         if search.trim {

@@ -148,12 +148,15 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
     let (w, h) = (image.width, image.height);
     let target = target.clone().validated()?;
     let centre_model = match &target {
-        Target::CircleGrid { .. } | Target::DotPlate { .. } => Some(options.circle_centres),
+        Target::CircleGrid { .. } | Target::DotPlate { .. } | Target::OriginDotGrid { .. } => {
+            Some(options.circle_centres)
+        }
         Target::Chessboard { .. }
         | Target::SingleCircle { .. }
         | Target::SquareGrid { .. }
         | Target::Charuco { .. }
-        | Target::Aprilgrid { .. } => None,
+        | Target::Aprilgrid { .. }
+        | Target::ArucoGrid { .. } => None,
     };
     let points = match &target {
         Target::Chessboard { cols, rows, .. } => {
@@ -176,6 +179,7 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
             Some(dot_diameter_m / pitch_m),
             options,
         )?,
+        Target::OriginDotGrid { .. } => circles::detect_origin_dot_grid(image, &target, options)?,
         Target::SingleCircle { .. } => vec![circles::detect_single(image, options)?],
         Target::SquareGrid {
             cols,
@@ -183,7 +187,7 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
             side_m,
             pitch_m,
         } => squares::detect_square_grid(image, *cols, *rows, side_m / pitch_m, options)?,
-        Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+        Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
             return markers::detect_one(image, &target, options)
         }
     };
@@ -195,7 +199,8 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
     })
 }
 
-/// Every board of `target` in `image`: for ChArUco boards and AprilGrids,
+/// Every board of `target` in `image`: for ChArUco boards, AprilGrids and
+/// ArUco grids,
 /// one detection per board of the same layout (the target's own ids
 /// first, then boards printed with other blocks of consecutive ids, e.g.
 /// Kalibr's `two_boards` frame with tags 0-35 and 36-71; each detection's
@@ -208,14 +213,15 @@ pub fn detect_all(
 ) -> Result<Vec<Detection>> {
     check_image(image)?;
     match target {
-        Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+        Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
             markers::detect_boards(image, target, options)
         }
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
         | Target::DotPlate { .. }
         | Target::SingleCircle { .. }
-        | Target::SquareGrid { .. } => Ok(vec![detect(image, target, options)?]),
+        | Target::SquareGrid { .. }
+        | Target::OriginDotGrid { .. } => Ok(vec![detect(image, target, options)?]),
     }
 }
 

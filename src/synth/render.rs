@@ -413,7 +413,11 @@ impl Albedo {
                     maxy + side_m + pitch_m,
                 ),
             ),
-            Target::Charuco { .. } | Target::Aprilgrid { .. } => (
+            Target::OriginDotGrid { spacing_m, .. } => (
+                0.5 * crate::target::origin_dot::DOT_DIAMETER_RATIO * spacing_m,
+                (-spacing_m, -spacing_m, maxx + spacing_m, maxy + spacing_m),
+            ),
+            Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => (
                 0.0,
                 crate::target::marker_board::layout(target)
                     .map_or((0.0, 0.0, 0.0, 0.0), |l| l.extent),
@@ -466,7 +470,9 @@ impl Albedo {
                     self.white
                 }
             }
-            Target::DotPlate { .. } | Target::SingleCircle { .. } => {
+            Target::DotPlate { .. }
+            | Target::SingleCircle { .. }
+            | Target::OriginDotGrid { .. } => {
                 if self.in_dot(x, y) {
                     self.black
                 } else {
@@ -488,7 +494,7 @@ impl Albedo {
                     self.white
                 }
             }
-            Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+            Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
                 if self.print.as_ref().is_some_and(|p| p.dark_at(x, y)) {
                     self.black
                 } else {
@@ -503,6 +509,18 @@ impl Albedo {
         let r2 = self.radius_m * self.radius_m;
         if let Target::SingleCircle { .. } = self.target {
             return x * x + y * y < r2;
+        }
+        if let Target::OriginDotGrid {
+            rows, spacing_m, ..
+        } = self.target
+        {
+            // The origin dot, twice as large, first (it reaches past the
+            // 3x3 neighbourhood's own dots).
+            let (ox, oy) = (0.0, (rows as f64 - 1.0) * spacing_m);
+            let big = crate::target::origin_dot::ORIGIN_DOT_SCALE * self.radius_m;
+            if (x - ox).powi(2) + (y - oy).powi(2) < big * big {
+                return true;
+            }
         }
         // Nearest grid points: check the 3x3 integer neighbourhood.
         let (gx, gy) = ((x / unit).round() as i64, (y / unit).round() as i64);

@@ -361,7 +361,9 @@ pub fn print_outline(target: &Target) -> [Point3<f64>; 4] {
         | Target::DotPlate { .. }
         | Target::SquareGrid { .. }
         | Target::Charuco { .. }
-        | Target::Aprilgrid { .. } => target.unit_m(),
+        | Target::Aprilgrid { .. }
+        | Target::ArucoGrid { .. }
+        | Target::OriginDotGrid { .. } => target.unit_m(),
     };
     let (a, b) = (
         Point3::new(min.x - m, min.y - m, 0.0),

@@ -1,5 +1,5 @@
-//! Marker boards: ChArUco as OpenCV 4.6+ defines it and AprilGrid as Kalibr
-//! defines it. Specs, checks, board points and the printed layout that the
+//! Marker boards: ChArUco and the ArUco GridBoard as OpenCV 4.6+ defines
+//! them and AprilGrid as Kalibr defines it. Specs, checks, board points and the printed layout that the
 //! SVG sheet, the renderer and the detector share.
 //!
 //! # ChArUco (`cv::aruco::CharucoBoard`)
@@ -38,6 +38,27 @@
 //! 1) pitch + tag_m`. Kalibr's frame (origin at tag 0's bottom-left corner,
 //! y up, z out of the print) is this one turned half a turn about x and
 //! shifted by `H`: `kalibr (x, y, z) = (x, H - y, -z)`.
+//!
+//! # ArUco grid (`cv::aruco::GridBoard`)
+//!
+//! `markers_x x markers_y` markers of side `marker_m` (black border
+//! included), `separation_m` apart, nothing else printed. OpenCV's
+//! constructor (`modules/objdetect/src/aruco/aruco_board.cpp`, 4.6+) puts
+//! marker `k = x + y markers_x` (row by row from the top left) at top-left
+//! corner `(x, y) (marker_m + separation_m)`, its corners 0..3 at that
+//! `+ (0, 0)`, `(marker_m, 0)`, `(marker_m, marker_m)`, `(0, marker_m)`
+//! (top-left, top-right, bottom-right, bottom-left on the print: the
+//! marker's own corner order at rotation 0), with id `first_id + k` (OpenCV's
+//! default ids are `0..`, a board made with explicit consecutive ids
+//! `N, N+1, ...` is `first=N`). So the board frame is OpenCV's and this
+//! crate's: origin at the top-left marker's top-left corner, x right, y
+//! down the print, z into it; poses compare with OpenCV's
+//! `estimatePoseBoard`/`solvePnP` on `matchImagePoints` directly. (OpenCV's
+//! aruco module before 4.6 had y up from the bottom row instead.) Points
+//! are the markers' corners, point id `4 k + c` for corner `c` of marker
+//! `k` (the square grid's scheme: marker id `first_id + k` corner `c` is
+//! point `4 (id - first_id) + c`). Markers are printed with OpenCV's
+//! one-bit border (`generateImage`'s default `borderBits`).
 
 use super::dictionary::Dictionary;
 use super::Target;
@@ -48,6 +69,8 @@ use nalgebra::{Point2, Point3};
 pub const APRILGRID_BORDER_BITS: usize = 2;
 /// OpenCV's black border around a ChArUco marker's bits, in bits.
 pub const CHARUCO_BORDER_BITS: usize = 1;
+/// OpenCV's black border around a GridBoard marker's bits, in bits.
+pub const ARUCO_GRID_BORDER_BITS: usize = 1;
 
 /// One marker as printed: its dictionary id and its corners in board metres
 /// in the marker's own order (top-left, top-right, bottom-right,
@@ -158,11 +181,29 @@ pub(super) fn validate(target: &Target) -> Result<()> {
             }
             Ok(())
         }
+        Target::ArucoGrid {
+            markers_x,
+            markers_y,
+            dictionary,
+            first_id,
+            ..
+        } => {
+            let needed = markers_x * markers_y;
+            if first_id.saturating_add(needed) > dictionary.len() {
+                return bad(format!(
+                    "too many markers: a {markers_x}x{markers_y} ArUco grid needs {needed} markers from id {first_id}, but {} has {} (use a larger dictionary or fewer markers)",
+                    dictionary.name(),
+                    dictionary.len()
+                ));
+            }
+            Ok(())
+        }
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
         | Target::DotPlate { .. }
         | Target::SingleCircle { .. }
-        | Target::SquareGrid { .. } => Ok(()),
+        | Target::SquareGrid { .. }
+        | Target::OriginDotGrid { .. } => Ok(()),
     }
 }
 
@@ -273,11 +314,42 @@ pub fn layout(target: &Target) -> Option<MarkerLayout> {
                 extent: (-quiet, -quiet, w + quiet, h + quiet),
             })
         }
+        Target::ArucoGrid {
+            markers_x,
+            markers_y,
+            marker_m,
+            separation_m,
+            dictionary,
+            first_id,
+        } => {
+            let pitch = marker_m + separation_m;
+            let markers = (0..markers_x * markers_y)
+                .map(|k| {
+                    let (x, y) = ((k % markers_x) as f64, (k / markers_x) as f64);
+                    PlacedMarker {
+                        id: first_id + k,
+                        corners: square_corners(x * pitch, y * pitch, *marker_m),
+                    }
+                })
+                .collect();
+            let (w, h) = (
+                *markers_x as f64 * pitch - separation_m,
+                *markers_y as f64 * pitch - separation_m,
+            );
+            let quiet = separation_m + 0.5 * marker_m;
+            Some(MarkerLayout {
+                dictionary: *dictionary,
+                border_bits: ARUCO_GRID_BORDER_BITS,
+                markers,
+                extent: (-quiet, -quiet, w + quiet, h + quiet),
+            })
+        }
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
         | Target::DotPlate { .. }
         | Target::SingleCircle { .. }
-        | Target::SquareGrid { .. } => None,
+        | Target::SquareGrid { .. }
+        | Target::OriginDotGrid { .. } => None,
     }
 }
 
@@ -331,11 +403,13 @@ pub fn dark_squares(target: &Target) -> Vec<(f64, f64, f64)> {
             }
             out
         }
-        Target::Chessboard { .. }
+        Target::ArucoGrid { .. }
+        | Target::Chessboard { .. }
         | Target::CircleGrid { .. }
         | Target::DotPlate { .. }
         | Target::SingleCircle { .. }
-        | Target::SquareGrid { .. } => Vec::new(),
+        | Target::SquareGrid { .. }
+        | Target::OriginDotGrid { .. } => Vec::new(),
     }
 }
 
@@ -384,11 +458,13 @@ impl Print {
                 ..
             } => (-spacing_ratio * tag_m, -spacing_ratio * tag_m),
             Target::Charuco { .. }
+            | Target::ArucoGrid { .. }
             | Target::Chessboard { .. }
             | Target::CircleGrid { .. }
             | Target::DotPlate { .. }
             | Target::SingleCircle { .. }
-            | Target::SquareGrid { .. } => (0.0, 0.0),
+            | Target::SquareGrid { .. }
+            | Target::OriginDotGrid { .. } => (0.0, 0.0),
         };
         let (_, _, x1, y1) = layout.extent;
         let gx = ((x1 - origin.0) / cell_m).ceil() as usize + 1;

@@ -18,6 +18,8 @@
 //! | `square_grid` | `cols x rows` separate squares, 4 corners each: id = `4 (i + j * cols) + k` | square `(i, j)` spans `(i, j) * pitch_m` to that `+ side_m`; corner `k` = 0 `(x0, y0)`, 1 `(x0 + side, y0)`, 2 `(x0 + side, y0 + side)`, 3 `(x0, y0 + side)` |
 //! | `charuco` | `(squares_x - 1) x (squares_y - 1)` inner chessboard corners, id = `i + j (squares_x - 1)` (OpenCV's) | `(i + 1, j + 1) * square_m` |
 //! | `aprilgrid` | 4 corners per tag, Kalibr's ids (row of corners from the bottom) | see [`marker_board`] |
+//! | `aruco_grid` | 4 corners per marker, id = `4 k + c` for the `k`-th marker (row by row from the top left, dictionary id `first_id + k`) and OpenCV's corner `c` | marker `(i, j)` spans `(i, j) * (marker_m + separation_m)` to that `+ marker_m`; corners as a square grid's (OpenCV's `GridBoard`, see [`marker_board`]) |
+//! | `origin_dot_grid` | `cols x rows` dots, id = `i + j * cols` (ROS-Industrial's numbering: row 0 is the row farthest from the big origin dot, which is id `(rows - 1) cols`) | `(i, j) * spacing_m`; ROS-Industrial's frame (origin at the big dot, y up, z out of the print) is `(x, (rows - 1) spacing_m - y, -z)`, see [`origin_dot`] |
 //!
 //! A square grid's corners run square by square (row by row of squares) and,
 //! within a square, clockwise on screen from the corner nearest the board
@@ -55,8 +57,12 @@
 //! "legacy": false}` (optional `"marker_ids": [...]` instead of
 //! `first_id`; `first_id` and `legacy` default to 0 and false),
 //! `{"kind": "aprilgrid", "tag_cols": 6, "tag_rows": 6, "tag_m": 0.088,
-//! "spacing_ratio": 0.3, "first_id": 0}` (`first_id` optional, 0 by default). Marker-board detections may hold any subset of
-//! the points (partial views).
+//! "spacing_ratio": 0.3, "first_id": 0}` (`first_id` optional, 0 by default),
+//! `{"kind": "aruco_grid", "markers_x": 5, "markers_y": 7, "marker_m": 0.04,
+//! "separation_m": 0.01, "dictionary": "DICT_6X6_250", "first_id": 0}`
+//! (`first_id` optional, 0 by default), `{"kind": "origin_dot_grid",
+//! "cols": 10, "rows": 10, "spacing_m": 0.025}`. Marker-board detections may
+//! hold any subset of the points (partial views).
 
 use crate::error::{Error, Result};
 use nalgebra::{Point2, Point3};
@@ -174,6 +180,34 @@ pub enum Target {
         #[serde(default)]
         first_id: usize,
     },
+    /// OpenCV's ArUco `GridBoard`: a grid of markers and nothing else
+    /// ([`marker_board`] docs).
+    ArucoGrid {
+        /// Markers along a row (OpenCV's size.width, markersX).
+        markers_x: usize,
+        /// Rows of markers (OpenCV's size.height, markersY).
+        markers_y: usize,
+        /// Side of one marker (its black border included), metres.
+        marker_m: f64,
+        /// Gap between neighbouring markers, metres (markerSeparation).
+        separation_m: f64,
+        /// The markers' dictionary.
+        dictionary: Dictionary,
+        /// Id of the top-left marker (the others follow row by row); 0 by
+        /// default.
+        #[serde(default)]
+        first_id: usize,
+    },
+    /// ROS-Industrial's modified circle grid: a symmetric grid of dark dots
+    /// whose origin dot is twice as large ([`origin_dot`] docs).
+    OriginDotGrid {
+        /// Dots per row.
+        cols: usize,
+        /// Rows of dots.
+        rows: usize,
+        /// Centre distance, metres.
+        spacing_m: f64,
+    },
 }
 
 /// One detected target point in pixels.
@@ -246,11 +280,17 @@ impl Target {
             Target::Aprilgrid {
                 tag_cols, tag_rows, ..
             } => (*tag_cols, *tag_rows, 1),
+            Target::ArucoGrid {
+                markers_x,
+                markers_y,
+                ..
+            } => (*markers_x, *markers_y, 1),
+            Target::OriginDotGrid { cols, rows, .. } => (*cols, *rows, 2),
         };
         // Square grids and AprilGrids have four points per square or tag.
         let per_cell = match &self {
-            Target::SquareGrid { .. } | Target::Aprilgrid { .. } => 4,
-            Target::Charuco { .. } => 1,
+            Target::SquareGrid { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => 4,
+            Target::Charuco { .. } | Target::OriginDotGrid { .. } => 1,
             Target::Chessboard { .. }
             | Target::CircleGrid { .. }
             | Target::DotPlate { .. }
@@ -281,6 +321,15 @@ impl Target {
                 square_m, marker_m, ..
             } => vec![("square side", *square_m), ("marker side", *marker_m)],
             Target::Aprilgrid { tag_m, .. } => vec![("tag size", *tag_m)],
+            Target::ArucoGrid {
+                marker_m,
+                separation_m,
+                ..
+            } => vec![
+                ("marker side", *marker_m),
+                ("marker separation", *separation_m),
+            ],
+            Target::OriginDotGrid { spacing_m, .. } => vec![("dot spacing", *spacing_m)],
         };
         if let Some((name, l)) = lengths.iter().find(|(_, l)| !l.is_finite() || *l <= 0.0) {
             let got = if l.is_finite() {
@@ -337,14 +386,20 @@ impl Target {
             Target::Aprilgrid {
                 tag_cols, tag_rows, ..
             } => 4 * tag_cols * tag_rows,
+            Target::ArucoGrid {
+                markers_x,
+                markers_y,
+                ..
+            } => 4 * markers_x * markers_y,
+            Target::OriginDotGrid { cols, rows, .. } => cols * rows,
         }
     }
 
     /// Integer board coordinates of every point in id order (metres are these
     /// times [`Target::unit_m`]); for square grids, of every square's origin
     /// in square order (the corners are in [`Target::object_points`]); for
-    /// AprilGrids, of every tag's top-left corner in units of the tag pitch,
-    /// row by row from the top.
+    /// AprilGrids and ArUco grids, of every tag's or marker's top-left corner
+    /// in units of the marker pitch, row by row from the top.
     pub(crate) fn grid_coords(&self) -> Vec<(i32, i32)> {
         if let Target::Charuco {
             squares_x,
@@ -361,10 +416,16 @@ impl Target {
             Target::Chessboard { cols, rows, .. }
             | Target::CircleGrid { cols, rows, .. }
             | Target::DotPlate { cols, rows, .. }
-            | Target::SquareGrid { cols, rows, .. } => (*cols as i32, *rows as i32),
+            | Target::SquareGrid { cols, rows, .. }
+            | Target::OriginDotGrid { cols, rows, .. } => (*cols as i32, *rows as i32),
             Target::Aprilgrid {
                 tag_cols, tag_rows, ..
             } => (*tag_cols as i32, *tag_rows as i32),
+            Target::ArucoGrid {
+                markers_x,
+                markers_y,
+                ..
+            } => (*markers_x as i32, *markers_y as i32),
             Target::SingleCircle { .. } | Target::Charuco { .. } => (1, 1),
         };
         let asymmetric = matches!(
@@ -400,6 +461,12 @@ impl Target {
                 spacing_ratio,
                 ..
             } => (1.0 + spacing_ratio) * tag_m,
+            Target::ArucoGrid {
+                marker_m,
+                separation_m,
+                ..
+            } => marker_m + separation_m,
+            Target::OriginDotGrid { spacing_m, .. } => *spacing_m,
         }
     }
 
@@ -408,7 +475,10 @@ impl Target {
         let unit = self.unit_m();
         let cells = self.grid_coords().into_iter();
         match self {
-            Target::SquareGrid { side_m, .. } => cells
+            Target::SquareGrid { side_m, .. }
+            | Target::ArucoGrid {
+                marker_m: side_m, ..
+            } => cells
                 .flat_map(|(i, j)| {
                     let (x0, y0) = (i as f64 * unit, j as f64 * unit);
                     SQUARE_CORNERS.map(|(u, v)| Point3::new(x0 + u * side_m, y0 + v * side_m, 0.0))
@@ -434,6 +504,7 @@ impl Target {
                 })
                 .collect(),
             Target::Chessboard { .. }
+            | Target::OriginDotGrid { .. }
             | Target::Charuco { .. }
             | Target::CircleGrid { .. }
             | Target::DotPlate { .. }
@@ -452,11 +523,14 @@ pub(crate) const SQUARE_CORNERS: [(f64, f64); 4] = [(0.0, 0.0), (1.0, 0.0), (1.0
 mod centre_model;
 pub mod dictionary;
 pub mod marker_board;
+pub mod origin_dot;
 mod spec;
 pub mod svg;
 
 pub use centre_model::CentreModel;
 pub use dictionary::Dictionary;
 
+#[cfg(test)]
+mod grid_boards_tests;
 #[cfg(test)]
 mod tests;

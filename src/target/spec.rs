@@ -11,7 +11,11 @@ impl Target {
     /// `charuco:12x9:20mm:15mm:DICT_5X5_100[:first=N][:ids=A,B,...][:legacy]`
     /// (squares, square side, marker side, OpenCV dictionary name; first
     /// marker id, explicit marker ids, the pre-4.6 layout),
-    /// `aprilgrid:6x6:88mm:0.3` (tags, tag size, spacing ratio, as Kalibr).
+    /// `aprilgrid:6x6:88mm:0.3` (tags, tag size, spacing ratio, as Kalibr),
+    /// `arucogrid:5x7:40mm:10mm:DICT_6X6_250[:first=N]` (OpenCV's GridBoard:
+    /// markers, marker side, separation, dictionary; first marker id),
+    /// `circles:10x10:25mm:origin-dot` (ROS-Industrial's modified circle
+    /// grid: dots, pitch; the origin dot is twice as large).
     /// Lengths take a unit: `mm`, `cm` or `m`.
     pub fn parse_spec(spec: &str) -> Result<Target> {
         let parts: Vec<&str> = spec.trim().split(':').collect();
@@ -26,6 +30,9 @@ impl Target {
                 }
                 .validated()
             }
+            ["circles", grid, size, flags @ ..] if flags.contains(&"origin-dot") => {
+                parse_origin_dot(spec, grid, size, flags)
+            }
             ["circles", grid, size, flags @ ..] => {
                 let (cols, rows) = parse_grid(grid)?;
                 let mut asymmetric = false;
@@ -38,7 +45,7 @@ impl Target {
                         "light-on-dark" => polarity = Polarity::LightOnDark,
                         other => {
                             return Err(bad(format!(
-                                "unknown circle-grid option '{other}' (expected asymmetric, symmetric, dark-on-light or light-on-dark)"
+                                "unknown circle-grid option '{other}' (expected asymmetric, symmetric, dark-on-light, light-on-dark or origin-dot)"
                             )))
                         }
                     }
@@ -83,11 +90,12 @@ impl Target {
             }
             ["charuco", rest @ ..] => parse_charuco(spec, rest),
             ["aprilgrid", rest @ ..] => parse_aprilgrid(spec, rest),
+            ["arucogrid", rest @ ..] => parse_aruco_grid(spec, rest),
             ["squares", ..] => Err(bad(format!(
                 "'{spec}' is not a square-grid spec; expected squares:COLSxROWS:SIDE:PITCH (e.g. squares:8x8:12.7mm:22.5778mm)"
             ))),
             _ => Err(bad(format!(
-                "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
+                "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO, arucogrid:COLSxROWS:MARKER:SEPARATION:DICTIONARY, circles:COLSxROWS:PITCH:origin-dot or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
             ))),
         }
     }
@@ -148,7 +156,15 @@ impl Target {
                 spec_length(*side_m),
                 spec_length(*pitch_m)
             ),
-            Target::Charuco { .. } | Target::Aprilgrid { .. } => {
+            Target::OriginDotGrid {
+                cols,
+                rows,
+                spacing_m,
+            } => format!(
+                "circles:{cols}x{rows}:{}:origin-dot",
+                spec_length(*spacing_m)
+            ),
+            Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
                 marker_board_spec(self).unwrap_or_default()
             }
         }
@@ -353,10 +369,87 @@ fn marker_board_spec(target: &Target) -> Option<String> {
                 spec_length(*tag_m)
             ))
         }
+        Target::ArucoGrid {
+            markers_x,
+            markers_y,
+            marker_m,
+            separation_m,
+            dictionary,
+            first_id,
+        } => {
+            let first = if *first_id == 0 {
+                String::new()
+            } else {
+                format!(":first={first_id}")
+            };
+            Some(format!(
+                "arucogrid:{markers_x}x{markers_y}:{}:{}:{}{first}",
+                spec_length(*marker_m),
+                spec_length(*separation_m),
+                dictionary.name()
+            ))
+        }
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
         | Target::DotPlate { .. }
         | Target::SingleCircle { .. }
-        | Target::SquareGrid { .. } => None,
+        | Target::SquareGrid { .. }
+        | Target::OriginDotGrid { .. } => None,
     }
+}
+
+/// Parse `arucogrid:COLSxROWS:MARKER:SEPARATION:DICT[:first=N]`.
+fn parse_aruco_grid(spec: &str, rest: &[&str]) -> Result<Target> {
+    let bad = |m: String| Error::invalid("target", m);
+    let (grid, marker, separation, dict, first) = match rest {
+        [grid, marker, separation, dict] => (grid, marker, separation, dict, None),
+        [grid, marker, separation, dict, option] => (grid, marker, separation, dict, Some(option)),
+        _ => {
+            return Err(bad(format!(
+                "'{spec}' is not an ArUco grid spec; expected arucogrid:COLSxROWS:MARKER:SEPARATION:DICTIONARY[:first=N] (e.g. arucogrid:5x7:40mm:10mm:DICT_6X6_250)"
+            )))
+        }
+    };
+    let first_id = match first {
+        None => 0,
+        Some(option) => {
+            let n = option.strip_prefix("first=").ok_or_else(|| {
+                bad(format!(
+                    "unknown ArUco grid option '{option}' (expected first=N, the id of the top-left marker)"
+                ))
+            })?;
+            n.parse()
+                .map_err(|_| bad(format!("'{n}' is not a marker id (first=N)")))?
+        }
+    };
+    let (markers_x, markers_y) = parse_grid(grid)?;
+    Target::ArucoGrid {
+        markers_x,
+        markers_y,
+        marker_m: parse_length(marker)?,
+        separation_m: parse_length(separation)?,
+        dictionary: Dictionary::from_name(dict)?,
+        first_id,
+    }
+    .validated()
+}
+
+/// Parse `circles:COLSxROWS:PITCH:origin-dot` (ROS-Industrial's modified
+/// circle grid: symmetric, dark dots on light, no other option).
+fn parse_origin_dot(spec: &str, grid: &str, pitch: &str, flags: &[&str]) -> Result<Target> {
+    if flags != ["origin-dot"] {
+        return Err(Error::invalid(
+            "target",
+            format!(
+                "'{spec}' is not an origin-dot grid spec; expected circles:COLSxROWS:PITCH:origin-dot with no other option (ROS-Industrial's grid is symmetric, dark dots on light; e.g. circles:10x10:25mm:origin-dot)"
+            ),
+        ));
+    }
+    let (cols, rows) = parse_grid(grid)?;
+    Target::OriginDotGrid {
+        cols,
+        rows,
+        spacing_m: parse_length(pitch)?,
+    }
+    .validated()
 }

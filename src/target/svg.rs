@@ -115,11 +115,30 @@ fn board(target: &Target) -> Board {
                 circles: Vec::new(),
             }
         }
-        Target::Charuco { .. } | Target::Aprilgrid { .. } => marker_board_marks(target),
+        Target::OriginDotGrid {
+            cols,
+            rows,
+            spacing_m,
+        } => Board {
+            extent: (-unit, -unit, max_x + unit, max_y + unit),
+            light_on_dark: false,
+            squares: Vec::new(),
+            circles: points
+                .iter()
+                .enumerate()
+                .map(|(id, &(x, y))| {
+                    let r = super::origin_dot::dot_radius_m(id, *cols, *rows, *spacing_m);
+                    (x, y, mm(r))
+                })
+                .collect(),
+        },
+        Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
+            marker_board_marks(target)
+        }
     }
 }
 
-/// A ChArUco board or an AprilGrid: its dark squares and every dark cell
+/// A ChArUco board, an AprilGrid or an ArUco grid: its dark squares and every dark cell
 /// of every marker, in millimetres (the layout of
 /// [`super::marker_board`], OpenCV's and Kalibr's prints).
 fn marker_board_marks(target: &Target) -> Board {
@@ -246,6 +265,31 @@ fn description(target: &Target) -> String {
             "AprilGrid {tag_cols} x {tag_rows} tag36h11, tags {}, spacing {spacing_ratio}",
             mm(*tag_m)
         ),
+        Target::ArucoGrid {
+            markers_x,
+            markers_y,
+            marker_m,
+            separation_m,
+            dictionary,
+            first_id,
+        } => format!(
+            "ArUco grid {markers_x} x {markers_y}, markers {} {} from id {first_id}, gap {}",
+            mm(*marker_m),
+            dictionary.name(),
+            mm(*separation_m)
+        ),
+        Target::OriginDotGrid {
+            cols,
+            rows,
+            spacing_m,
+        } => format!(
+            "{cols} x {rows} dots, pitch {}, dots {}, origin dot {}",
+            mm(*spacing_m),
+            mm(super::origin_dot::DOT_DIAMETER_RATIO * spacing_m),
+            mm(super::origin_dot::ORIGIN_DOT_SCALE
+                * super::origin_dot::DOT_DIAMETER_RATIO
+                * spacing_m)
+        ),
     }
 }
 
@@ -254,6 +298,10 @@ fn origin_note(target: &Target) -> &'static str {
     match target {
         Target::Aprilgrid { .. } => "Tag 0 and point 0 at the bottom left (Kalibr).",
         Target::Charuco { .. } => "Origin at the top-left corner, x to the right, y down.",
+        Target::ArucoGrid { .. } => {
+            "Origin at marker 0's top-left corner, x right, y down (OpenCV)."
+        }
+        Target::OriginDotGrid { .. } => "Point 0 top left, x right, y down; big dot: ROS-I origin.",
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
         | Target::DotPlate { .. }

@@ -141,7 +141,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "foo:9x6:30mm", "a.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: 'foo:9x6:30mm' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
+        message: "robocal: detect: target: 'foo:9x6:30mm' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO, arucogrid:COLSxROWS:MARKER:SEPARATION:DICTIONARY, circles:COLSxROWS:PITCH:origin-dot or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
     },
     Case {
         name: "spec-missing-size",
@@ -149,7 +149,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "chessboard:9x6", "a.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: 'chessboard:9x6' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
+        message: "robocal: detect: target: 'chessboard:9x6' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO, arucogrid:COLSxROWS:MARKER:SEPARATION:DICTIONARY, circles:COLSxROWS:PITCH:origin-dot or circle:DIAMETER (e.g. chessboard:9x6:30mm) (see 'robocal detect --help')",
     },
     Case {
         name: "spec-unknown-option",
@@ -157,7 +157,7 @@ const CASES: &[Case] = &[
         args: &["detect", "--target", "circles:4x11:20mm:sideways", "a.png"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: detect: target: unknown circle-grid option 'sideways' (expected asymmetric, symmetric, dark-on-light or light-on-dark) (see 'robocal detect --help')",
+        message: "robocal: detect: target: unknown circle-grid option 'sideways' (expected asymmetric, symmetric, dark-on-light, light-on-dark or origin-dot) (see 'robocal detect --help')",
     },
     Case {
         name: "render-zero-views",

@@ -129,6 +129,30 @@ export const tests = [
     assert.match(readFileSync(await grid.path(), 'utf8'), /robocal target aprilgrid:6x6:88mm:0.3:first=36/);
     await shot('aprilgrid-target');
 
+    // Issue 36: OpenCV's ArUco GridBoard and ROS-Industrial's modified
+    // circle grid are in the list, with their fields and specs.
+    await page.selectOption('#target-kind', 'aruco_grid');
+    await page.fill('#target-form input[name=first_id]', '0');
+    await page.fill('#target-form input[name=marker_mm]', '40');
+    await page.selectOption('#target-form select[name=dictionary]', 'DICT_6X6_250');
+    await specShown(/^Target spec: arucogrid:5x7:40mm:10mm:DICT_6X6_250 /);
+    await page.fill('#target-form input[name=markers_x]', '20');
+    await page.fill('#target-form input[name=markers_y]', '20');
+    await page.waitForFunction(() => /too many markers/.test(document.getElementById('target-error').textContent));
+    assert.equal(await page.textContent('#target-error'), 'target: too many markers: a 20x20 ArUco grid needs 400 markers from id 0, but DICT_6X6_250 has 250 (use a larger dictionary or fewer markers)');
+    await page.fill('#target-form input[name=markers_x]', '5');
+    await page.fill('#target-form input[name=markers_y]', '7');
+    await specShown(/^Target spec: arucogrid:5x7:40mm:10mm:DICT_6X6_250 /);
+    const [arucoSheet] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
+    assert.match(readFileSync(await arucoSheet.path(), 'utf8'), /robocal target arucogrid:5x7:40mm:10mm:DICT_6X6_250/);
+    await page.selectOption('#target-kind', 'origin_dot_grid');
+    await page.fill('#target-form input[name=cols]', '10');
+    await page.fill('#target-form input[name=rows]', '10');
+    await page.fill('#target-form input[name=spacing_mm]', '25');
+    await specShown(/^Target spec: circles:10x10:25mm:origin-dot /);
+    const [dotSheet] = await Promise.all([page.waitForEvent('download'), page.click('#print-target')]);
+    assert.match(readFileSync(await dotSheet.path(), 'utf8'), /robocal target circles:10x10:25mm:origin-dot/);
+
     // Kalibr's own target file (its april_6x6.yaml template) fills the form.
     const yaml = (name, text) => ({ name, mimeType: 'text/yaml', buffer: Buffer.from(text) });
     await page.setInputFiles('#kalibr-input', yaml('april_6x6.yaml', "target_type: 'aprilgrid' #gridtype\ntagCols: 6               #number of apriltags\ntagRows: 5\ntagSize: 0.088           #size of apriltag, edge to edge [m]\ntagSpacing: 0.3          #ratio of space between tags to tagSize\n"));

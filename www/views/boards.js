@@ -8,7 +8,7 @@
 import { h, fill } from '../lib/dom.js';
 
 /** Marker boards report the corners they see, any subset of the board's. */
-export const MARKER_BOARDS = new Set(['charuco', 'aprilgrid']);
+export const MARKER_BOARDS = new Set(['charuco', 'aprilgrid', 'aruco_grid']);
 
 /**
  * A card's point count. Whole-target kinds: "54 points". Marker boards:

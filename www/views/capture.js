@@ -13,7 +13,7 @@ import { RunningSolve } from './capture-solve.js';
 import { CaptureGuide } from './capture-guide.js';
 
 /** Marker boards report any subset of their corners: fewer than all is "partly found". */
-const MARKER_BOARDS = new Set(['charuco', 'aprilgrid']);
+const MARKER_BOARDS = new Set(['charuco', 'aprilgrid', 'aruco_grid']);
 /** Captured frames are named capture_001.png, capture_002.png, ... (natural order = capture order). */
 const CAPTURE_NAME = /^capture_(\d+)\.png$/;
 /** Point ids are written on the overlay up to this many points (more would cover the board). */

@@ -85,6 +85,8 @@ const COUNTS = {
   squares_y: 'a whole number of squares, at least 2 (e.g. 9)',
   tag_cols: 'a whole number of tags, at least 1 (e.g. 6)',
   tag_rows: 'a whole number of tags, at least 1 (e.g. 6)',
+  markers_x: 'a whole number of markers, at least 1 (e.g. 5)',
+  markers_y: 'a whole number of markers, at least 1 (e.g. 7)',
   first_id: 'the id of the board\'s first marker, 0 or more',
 };
 
@@ -129,6 +131,7 @@ const GRID_LABELS = {
   square_grid: ['Squares across ', 'Squares down '],
   circle_grid: ['Circles across ', 'Circles down '],
   dot_plate: ['Dots across ', 'Dots down '],
+  origin_dot_grid: ['Dots across ', 'Dots down '],
 };
 
 function showFields(form) {

@@ -1,4 +1,5 @@
-//! Marker boards: ChArUco (OpenCV) and AprilGrid (Kalibr).
+//! Marker boards: ChArUco and the ArUco GridBoard (OpenCV), AprilGrid
+//! (Kalibr).
 //!
 //! 1. Candidate quads ([`quads`]: adaptive threshold, 4-connected regions,
 //!    convex quadrilaterals, sub-pixel sides) read as markers ([`decode`]:
@@ -20,11 +21,16 @@
 //!      than [`DISAGREE_FRACTION`] of the marker margin apart is dropped.
 //!    - AprilGrid: the four corners of every tag (each is an X-junction with
 //!      Kalibr's corner squares), seeded at the tag's quad corners.
+//!    - ArUco grid: the four corners of every marker, plain L-corners of a
+//!      dark square on white with no saddle to refine on: each the meeting
+//!      point of two straight edges fitted densely along the marker's sides
+//!      ([`grid_corners`]).
 //!
 //!    Any subset of points may come out (partial views, occlusion).
 
 mod decode;
 mod edges;
+mod grid_corners;
 mod homography;
 mod quads;
 mod runs;
@@ -186,7 +192,8 @@ fn candidate_boards(target: &Target, layout: &MarkerLayout, markers: &[Marker]) 
             marker_ids: None,
             ..
         }
-        | Target::Aprilgrid { first_id, .. } => *first_id as i64,
+        | Target::Aprilgrid { first_id, .. }
+        | Target::ArucoGrid { first_id, .. } => *first_id as i64,
         _ => return vec![target.clone()],
     };
     let mut blocks: Vec<i64> = markers
@@ -201,7 +208,9 @@ fn candidate_boards(target: &Target, layout: &MarkerLayout, markers: &[Marker]) 
             let f = first + b * count;
             let mut t = target.clone();
             match &mut t {
-                Target::Charuco { first_id, .. } | Target::Aprilgrid { first_id, .. } => {
+                Target::Charuco { first_id, .. }
+                | Target::Aprilgrid { first_id, .. }
+                | Target::ArucoGrid { first_id, .. } => {
                     *first_id = usize::try_from(f).ok()?;
                 }
                 _ => {}
@@ -239,6 +248,7 @@ fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Det
     let points = match board {
         Target::Charuco { .. } => charuco_corners(image, board, &layout, &mine),
         Target::Aprilgrid { .. } => aprilgrid_corners(image, board, &layout, &mine),
+        Target::ArucoGrid { .. } => aruco_grid_corners(image, &layout, &mine),
         _ => Vec::new(),
     };
     if points.is_empty() {
@@ -450,6 +460,42 @@ fn aprilgrid_corners(
             }
         }
     }
+    out.sort_by_key(|p| p.id);
+    out
+}
+
+/// An ArUco grid's points: every consistent marker's four corners
+/// ([`grid_corners`]), point `4 k + c` for corner `c` of the board's marker
+/// `k` ([`marker_board`]), in id order. Corners within [`MIN_WINDOW_PX`] of
+/// the image border are left out (their edge fits reach past it).
+fn aruco_grid_corners(
+    image: &GrayImage,
+    layout: &MarkerLayout,
+    mine: &[(usize, &Marker)],
+) -> Vec<DetectedPoint> {
+    let cells = layout.dictionary.marker_bits() + 2 * layout.border_bits;
+    let margin = MIN_WINDOW_PX;
+    let inside = |p: &Point2<f64>| {
+        p.x >= margin
+            && p.y >= margin
+            && p.x <= image.width as f64 - 1.0 - margin
+            && p.y <= image.height as f64 - 1.0 - margin
+    };
+    let mut out: Vec<DetectedPoint> = mine
+        .iter()
+        .flat_map(|&(k, m)| {
+            grid_corners::refine_corners(image, m.corners, cells)
+                .into_iter()
+                .enumerate()
+                .filter(|(_, p)| inside(p))
+                .map(move |(c, p)| DetectedPoint {
+                    id: 4 * k + c,
+                    x_px: p.x,
+                    y_px: p.y,
+                    covariance_px2: None,
+                })
+        })
+        .collect();
     out.sort_by_key(|p| p.id);
     out
 }
