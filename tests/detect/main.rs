@@ -12,3 +12,4 @@ mod detect_markers;
 mod detect_markers_datasets;
 mod detect_render;
 mod fuzz_regressions;
+mod detect_grid_boards;

@@ -11,7 +11,7 @@
 //! [`MIN_CELL_PX`] per cell keep the finder's corners.
 //!
 //! The centroid's window must hold the whole blurred edge: on renders
-//! (tests/detect_grid_boards.rs, eight views) half-windows of 1.25, 1.75
+//! (tests/detect/detect_grid_boards.rs, eight views) half-windows of 1.25, 1.75
 //! and 2.25 px (searches 2, 2.5, 3 px) gave 0.057 / 0.44, 0.031 / 0.23 and
 //! 0.019 / 0.135 px mean / max (a narrow window is pulled towards the pixel
 //! grid where the sides run near the pixel axes).

@@ -8,7 +8,7 @@
 //! straight edges fitted along the markers' sides (no saddle to refine on
 //! an L-corner): their error is bounded from the measured spread with a
 //! margin of about 2x. Origin-dot centres go through the same centre model as the
-//! other circle grids (tests/detect_circles.rs: <= 0.03 px mean).
+//! other circle grids (tests/detect/detect_circles.rs: <= 0.03 px mean).
 
 use robocal::detect::{detect, DetectOptions};
 use robocal::synth::{board_pose, render, Pinhole, RenderOptions, Rendered};

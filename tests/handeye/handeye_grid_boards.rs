@@ -3,13 +3,13 @@
 //! pose refinement): an ArUco GridBoard eye-in-hand, ROS-Industrial's
 //! origin-dot grid eye-to-hand (with views turned up to 60 degrees about
 //! the optical axis). The scenes, noise levels and bounds are those of
-//! tests/handeye_charuco.rs: 640x480, grey-level noise 2, robot noise 0.02
+//! tests/handeye/handeye_charuco.rs: 640x480, grey-level noise 2, robot noise 0.02
 //! deg per rotation axis and 0.1 mm per translation axis, which dominates
 //! (X expected within about 0.2-0.4 mm and 0.02-0.03 deg; bounded at 0.6 mm
 //! and 0.06 deg). Measured: ArUco grid eye-in-hand 0.0110 deg / 0.110 mm,
 //! origin-dot grid eye-to-hand 0.0230 deg / 0.158 mm.
 
-mod support;
+use crate::support;
 use support::{robocal, temp_dir};
 
 use nalgebra::Matrix4;
