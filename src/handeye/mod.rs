@@ -58,6 +58,7 @@ pub mod pairing;
 pub mod pnp;
 pub mod pose_noise;
 pub mod pose_refine;
+pub mod pose_resample;
 pub mod pose_residual;
 pub mod pose_shape;
 pub mod refine_closed_form;

@@ -4,7 +4,7 @@
 use super::checks;
 use super::motion::{build_motions, motion_stats, MotionStats};
 use super::pose_noise::CameraNoise;
-use super::refine_poses::apply_pose_refinement;
+use super::refine_poses::apply_pose_refinement_resampled;
 use super::repeat::{repeatability, Repeatability};
 use super::report::{
     combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
@@ -227,9 +227,11 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         }
     }
     let primary = methods[best_index].method;
-    // 4. Residuals and repeatability of the primary solution.
+    // 4. Residuals and repeatability of the primary solution; with the
+    // pose refinement on, that of the refined estimate instead (below), and
+    // the closed form's only when the refinement does not run.
     let per_view = view_residuals(&chain, &x, &y);
-    let repeat = if options.bootstrap_samples > 0 {
+    let repeat = if options.bootstrap_samples > 0 && !options.refine_poses {
         Some(repeatability(&chain, primary, options, &x, &y))
     } else {
         None
@@ -261,12 +263,28 @@ fn with_pose_refinement(
     options: &HandEyeOptions,
 ) -> Result<HandEyeResult> {
     if options.refine_poses {
-        apply_pose_refinement(
+        let resampling = (options.bootstrap_samples > 0 && result.method != "scara")
+            .then_some((options.bootstrap_samples, options.seed));
+        apply_pose_refinement_resampled(
             &mut result,
             input,
             CameraNoise::Diagonal,
             options.motion_pairs,
+            true,
+            resampling,
         )?;
+        // The refinement did not run: the closed form's repeatability.
+        if result.pose_refinement.is_none() && resampling.is_some() {
+            if let Ok(method) = result.method.parse::<HandEyeMethod>() {
+                let chain = Chain::new(
+                    input.setup,
+                    &input.base_from_gripper,
+                    &input.camera_from_target,
+                )?;
+                result.repeatability =
+                    Some(repeatability(&chain, method, options, &result.x, &result.y));
+            }
+        }
     }
     refuse_metres(&result.errors)?;
     Ok(result)
