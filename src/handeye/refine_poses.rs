@@ -25,7 +25,7 @@ use super::report::{errors, motion_residuals, pose_difference, view_residuals};
 use super::reprojection_refine::ViewPoints;
 use super::solve::{solve_method, HandEyeInput, HandEyeOptions, HandEyeResult};
 use super::HandEyeMethod;
-use super::{Chain, MotionPairs, Pose};
+use super::{Chain, Motion, MotionPairs, Pose};
 use crate::camera::Camera;
 use crate::error::Result;
 use nalgebra::Vector3;
@@ -310,7 +310,7 @@ pub fn apply_pose_refinement_with(
         result,
         input,
         camera_noise,
-        motion_pairs,
+        (motion_pairs, None),
         predict_shape,
         resampling,
     )
@@ -319,12 +319,12 @@ pub fn apply_pose_refinement_with(
 /// [`apply_pose_refinement_with`] whose repeatability, with `resampling`
 /// `(bootstrap samples, seed)`, is that of the refined estimate
 /// ([`super::pose_resample`]), whether or not `result` holds the closed
-/// form's.
+/// form's; the motions of `motion_pairs` when the caller has them built.
 pub(crate) fn apply_pose_refinement_resampled(
     result: &mut HandEyeResult,
     input: &HandEyeInput,
     camera_noise: CameraNoise,
-    motion_pairs: MotionPairs,
+    (motion_pairs, motions): (MotionPairs, Option<&[Motion]>),
     predict_shape: bool,
     resampling: Option<(usize, u64)>,
 ) -> Result<()> {
@@ -417,7 +417,10 @@ pub(crate) fn apply_pose_refinement_resampled(
     result.method = format!("refined from {started_from}");
     result.per_view = view_residuals(&chain, &result.x, &result.y);
     result.errors = errors(&result.per_view);
-    result.per_motion = motion_residuals(&build_motions(&chain, motion_pairs).kept, &result.x);
+    result.per_motion = match motions {
+        Some(kept) => motion_residuals(kept, &result.x),
+        None => motion_residuals(&build_motions(&chain, motion_pairs).kept, &result.x),
+    };
     for m in &mut result.methods {
         if let Ok((mx, _, _)) = &m.outcome {
             m.disagreement = Some(pose_difference(&result.x, mx));

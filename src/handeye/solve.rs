@@ -10,7 +10,7 @@ use super::report::{
     combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
     view_residuals, Errors, MotionResidual, ViewResidual,
 };
-use super::{axxb, axzb, scara, Chain, HandEyeMethod, MotionPairs, Pose, Setup};
+use super::{axxb, axzb, scara, Chain, HandEyeMethod, Motion, MotionPairs, Pose, Setup};
 use crate::error::{Error, Result};
 use nalgebra::Vector3;
 
@@ -119,11 +119,24 @@ pub fn solve_method(
     pairs: MotionPairs,
 ) -> Result<(Pose, Pose, Vec<Vector3<f64>>)> {
     if method.is_axzb() {
+        return solve_with_motions(method, chain, &[]);
+    }
+    solve_with_motions(method, chain, &build_motions(chain, pairs).kept)
+}
+
+/// [`solve_method`] with the chain's motions built once by the caller
+/// (unused by the AX = ZB methods): at 1,000 poses each build is half a
+/// million motions.
+fn solve_with_motions(
+    method: HandEyeMethod,
+    chain: &Chain,
+    motions: &[Motion],
+) -> Result<(Pose, Pose, Vec<Vector3<f64>>)> {
+    if method.is_axzb() {
         let (x, y) = axzb::solve(method, chain)?;
         return Ok((x, y, Vec::new()));
     }
-    let set = build_motions(chain, pairs);
-    let (x, unobservable) = axxb::solve(method, &set.kept)?;
+    let (x, unobservable) = axxb::solve(method, motions)?;
     let y = estimate_target(chain, &x)?;
     Ok((x, y, unobservable))
 }
@@ -185,13 +198,13 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             refinement: None,
             pose_refinement: None,
         };
-        return with_pose_refinement(result, input, options);
+        return with_pose_refinement(result, input, options, &set.kept);
     }
     // 3. Every requested method; a failing one is reported, not fatal.
     let mut methods = Vec::new();
     let mut best: Option<(f64, usize, Pose, Pose, Vec<Vector3<f64>>)> = None;
     for (i, &method) in options.methods.iter().enumerate() {
-        let outcome = solve_method(method, &chain, options.motion_pairs).map(|(x, y, u)| {
+        let outcome = solve_with_motions(method, &chain, &set.kept).map(|(x, y, u)| {
             let e = errors(&view_residuals(&chain, &x, &y));
             let score = combined_score_mm(&e, lever);
             if best.as_ref().map_or(true, |b| score < b.0) {
@@ -252,7 +265,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         refinement: None,
         pose_refinement: None,
     };
-    with_pose_refinement(result, input, options)
+    with_pose_refinement(result, input, options, &set.kept)
 }
 
 /// `result` with the pose refinement applied when `options.refine_poses`;
@@ -261,6 +274,7 @@ fn with_pose_refinement(
     mut result: HandEyeResult,
     input: &HandEyeInput,
     options: &HandEyeOptions,
+    motions: &[Motion],
 ) -> Result<HandEyeResult> {
     if options.refine_poses {
         let resampling = (options.bootstrap_samples > 0 && result.method != "scara")
@@ -269,7 +283,7 @@ fn with_pose_refinement(
             &mut result,
             input,
             CameraNoise::Diagonal,
-            options.motion_pairs,
+            (options.motion_pairs, Some(motions)),
             true,
             resampling,
         )?;
