@@ -9,8 +9,10 @@
 //! per axis, plus the misspecification named by the row. Columns: trials
 //! whose true `gripper_from_camera` lies within 3 reported std on every one
 //! of its six components (rotation about x, y, z in the left frame and the
-//! translation x, y, z), and trials that are not covered and carry no
-//! warning (silent wrong answers).
+//! translation x, y, z), trials that are not covered and carry no
+//! warning (silent wrong answers), trials whose std was widened to the
+//! leave-one-out spread, and trials warned that this spread is over 2x the
+//! model's.
 //!
 //! `cargo run --release --example handeye_coverage -- [TRIALS]` (default 100).
 
