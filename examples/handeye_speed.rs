@@ -134,7 +134,10 @@ fn main() {
             );
         }
         if let Some(r) = &result.repeatability {
-            for (name, stats) in [("leave-one-out", &r.leave_one_out), ("bootstrap", &r.bootstrap)] {
+            for (name, stats) in [
+                ("leave-one-out", &r.leave_one_out),
+                ("bootstrap", &r.bootstrap),
+            ] {
                 println!(
                     "  {name} ({}, {} runs, {} failed): rotation {:.5?} deg, translation {:.4?} mm",
                     r.method,

@@ -274,8 +274,8 @@ mod tests {
             )
             .unwrap();
             let full = refine(setup, &views, &x0, &y0, start, &options).unwrap();
-            let fast = Linearised::new(setup, &views, &full.noise, &options, &full.x, &full.y)
-                .unwrap();
+            let fast =
+                Linearised::new(setup, &views, &full.noise, &options, &full.x, &full.y).unwrap();
             let mut rng = Rng::new(5);
             let mut subsets: Vec<Vec<usize>> = (0..views.len())
                 .map(|k| (0..views.len()).filter(|&i| i != k).collect())
@@ -288,8 +288,15 @@ mod tests {
             let mut rows = Vec::new();
             for s in &subsets {
                 let picked: Vec<PoseMeasurement> = s.iter().map(|&i| views[i]).collect();
-                let reference =
-                    refine(setup, &picked, &full.x, &full.y, full.noise.clone(), &options).unwrap();
+                let reference = refine(
+                    setup,
+                    &picked,
+                    &full.x,
+                    &full.y,
+                    full.noise.clone(),
+                    &options,
+                )
+                .unwrap();
                 let (x, _) = fast.solve(s).unwrap();
                 rows.push((
                     pose_difference(&full.x, &reference.x),
@@ -300,15 +307,14 @@ mod tests {
             // The spread of X over the runs (root-sum-square of the
             // deviations; leave-one-out with the jackknife scale).
             let n = views.len() as f64;
-            let spread = |rows: &[((f64, f64), (f64, f64), (f64, f64))],
-                          pick: usize,
-                          scale: f64| {
-                let ss = rows.iter().fold((0.0, 0.0), |a, r| {
-                    let d = [r.0, r.1, r.2][pick];
-                    (a.0 + d.0 * d.0, a.1 + d.1 * d.1)
-                });
-                ((scale * ss.0).sqrt(), (scale * ss.1).sqrt())
-            };
+            let spread =
+                |rows: &[((f64, f64), (f64, f64), (f64, f64))], pick: usize, scale: f64| {
+                    let ss = rows.iter().fold((0.0, 0.0), |a, r| {
+                        let d = [r.0, r.1, r.2][pick];
+                        (a.0 + d.0 * d.0, a.1 + d.1 * d.1)
+                    });
+                    ((scale * ss.0).sqrt(), (scale * ss.1).sqrt())
+                };
             let (loo, boot) = rows.split_at(views.len());
             let b = boot.len() as f64;
             let parts = [
@@ -316,8 +322,11 @@ mod tests {
                 ("bootstrap", boot, 1.0 / b, (0.7, 1.15)),
             ];
             for (name, part, scale, (low, high)) in parts {
-                let (reference, new, apart) =
-                    (spread(part, 0, scale), spread(part, 1, scale), spread(part, 2, scale));
+                let (reference, new, apart) = (
+                    spread(part, 0, scale),
+                    spread(part, 1, scale),
+                    spread(part, 2, scale),
+                );
                 eprintln!(
                     "{setup:?} kinematic {kinematic} mm, {name}: spread full {reference:.5?}, \
                      fast {new:.5?}, fast against full {apart:.5?} (mm, deg)"
