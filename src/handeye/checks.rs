@@ -10,7 +10,7 @@ use super::report::{motion_residuals, motion_rms};
 use super::solve::{HandEyeInput, HandEyeOptions};
 use super::{Chain, HandEyeMethod, MotionPairs, Pose, Setup, MIN_MOTION_ROTATION_DEG};
 use crate::error::{Error, Result};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, SMatrix, Vector3, Vector4};
 use serde::{Deserialize, Serialize};
 
 /// Fewest pose pairs hand-eye calibration accepts.
@@ -60,18 +60,24 @@ pub fn consistency(
     let (t, r) = motion_rms(&motion_residuals(&set.kept, &x));
     let r_x = x.rotation.to_rotation_matrix();
     // (R_A - I) t - s t_A... unknowns [t, k]: (R_A - I) t + k t_A = R_X t_B.
-    let mut normal = DMatrix::zeros(4, 4);
-    let mut rhs = DVector::zeros(4);
+    // Fixed-size per motion (half a million motions at 1,000 poses); the
+    // 4 x 4 normal equations are summed as before.
+    let mut normal = Matrix4::zeros();
+    let mut rhs = Vector4::zeros();
     for m in &set.kept {
-        let mut a = DMatrix::zeros(3, 4);
+        let mut a = SMatrix::<f64, 3, 4>::zeros();
         let c = m.robot.rotation.to_rotation_matrix().into_inner() - Matrix3::identity();
-        a.view_mut((0, 0), (3, 3)).copy_from(&c);
-        a.view_mut((0, 3), (3, 1))
+        a.fixed_view_mut::<3, 3>(0, 0).copy_from(&c);
+        a.fixed_view_mut::<3, 1>(0, 3)
             .copy_from(&m.robot.translation.vector);
         let b = r_x * m.camera.translation.vector;
-        rhs += a.transpose() * DVector::from_column_slice(b.as_slice());
+        rhs += a.transpose() * b;
         normal += a.transpose() * a;
     }
+    let (normal, rhs) = (
+        DMatrix::from_column_slice(4, 4, normal.as_slice()),
+        DVector::from_column_slice(rhs.as_slice()),
+    );
     let scale = super::math::least_squares(&normal, &rhs)
         .map(|(w, _)| w[3])
         .unwrap_or(1.0);

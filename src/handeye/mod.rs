@@ -58,6 +58,7 @@ pub mod pairing;
 pub mod pnp;
 pub mod pose_noise;
 pub mod pose_refine;
+pub mod pose_resample;
 pub mod pose_residual;
 pub mod pose_shape;
 pub mod refine_closed_form;
@@ -74,10 +75,10 @@ pub mod solve;
 pub mod trust;
 
 /// Most robot/camera pose pairs one hand-eye calibration takes. Motions are
-/// formed between every two poses and the repeatability check re-solves per
-/// pose, so time and memory grow with the square of the count: 1,000 poses
-/// take about 4 s and 160 MB (docs/bounds.md), 4,000 took 48 s and 2.4 GB.
-/// Real data sets have 10 to a few hundred poses.
+/// formed between every two poses and each leave-one-out run re-measures the
+/// residuals of every view, so time and memory grow with the square of the
+/// count (docs/bounds.md, BENCHMARKS.md "Hand-eye speed"). Real data sets
+/// have 10 to a few hundred poses.
 pub const MAX_POSES: usize = 1000;
 
 #[cfg(test)]

@@ -79,7 +79,7 @@ fn poses_of(p: &[f64]) -> (Pose, Pose) {
 }
 
 /// `x`'s translation columns expressed in `basis`.
-fn in_basis(j: &SMatrix<f64, 6, 12>, basis: &Matrix3<f64>) -> SMatrix<f64, 6, 12> {
+pub(crate) fn in_basis(j: &SMatrix<f64, 6, 12>, basis: &Matrix3<f64>) -> SMatrix<f64, 6, 12> {
     let mut out = *j;
     let cols = j.fixed_view::<6, 3>(0, 3) * basis;
     out.fixed_view_mut::<6, 3>(0, 3).copy_from(&cols);
@@ -132,7 +132,7 @@ impl BlockProblem for Problem<'_> {
 }
 
 /// `L^-1` of a covariance (`None` when not positive definite).
-fn whitening(c: &Matrix6<f64>) -> Option<Matrix6<f64>> {
+pub(crate) fn whitening(c: &Matrix6<f64>) -> Option<Matrix6<f64>> {
     let sym = (c + c.transpose()) * 0.5;
     sym.cholesky()?.l().try_inverse()
 }
@@ -220,7 +220,7 @@ fn parameter_covariance(
 }
 
 /// A basis whose last column is `axis` (identity without one).
-fn translation_basis(axis: Option<Vector3<f64>>) -> Matrix3<f64> {
+pub(crate) fn translation_basis(axis: Option<Vector3<f64>>) -> Matrix3<f64> {
     let Some(k) = axis.map(|a| a.normalize()) else {
         return Matrix3::identity();
     };

@@ -14,18 +14,18 @@
 use super::motion::build_motions;
 use super::noise_choice::choose_noise_model;
 use super::pnp::camera_from_target_with_covariance;
-use super::pose_noise::{CameraNoise, NoiseLevels, NoiseModel};
+use super::pose_noise::{CameraNoise, NoiseLevels};
 use super::pose_refine::{evaluate, refine, Covariance12, PoseRefineOptions, HUBER_SCALE};
+use super::pose_resample::refined_repeatability;
 use super::pose_residual::PoseMeasurement;
 use super::pose_shape::NominalTarget;
 use super::refine_closed_form::reprojection_rms_per_view_px;
-use super::repeat::{repeatability_with, Repeatability};
+use super::repeat::{repeatability, Repeatability};
 use super::report::{errors, motion_residuals, pose_difference, view_residuals};
 use super::reprojection_refine::ViewPoints;
 use super::solve::{solve_method, HandEyeInput, HandEyeOptions, HandEyeResult};
 use super::HandEyeMethod;
-use super::Setup;
-use super::{Chain, MotionPairs, Pose};
+use super::{Chain, Motion, MotionPairs, Pose};
 use crate::camera::Camera;
 use crate::error::Result;
 use nalgebra::Vector3;
@@ -302,6 +302,32 @@ pub fn apply_pose_refinement_with(
     motion_pairs: MotionPairs,
     predict_shape: bool,
 ) -> Result<()> {
+    let resampling = result
+        .repeatability
+        .as_ref()
+        .map(|r| (r.bootstrap_samples, r.seed));
+    apply_pose_refinement_resampled(
+        result,
+        input,
+        camera_noise,
+        (motion_pairs, None),
+        predict_shape,
+        resampling,
+    )
+}
+
+/// [`apply_pose_refinement_with`] whose repeatability, with `resampling`
+/// `(bootstrap samples, seed)`, is that of the refined estimate
+/// ([`super::pose_resample`]), whether or not `result` holds the closed
+/// form's; the motions of `motion_pairs` when the caller has them built.
+pub(crate) fn apply_pose_refinement_resampled(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    camera_noise: CameraNoise,
+    (motion_pairs, motions): (MotionPairs, Option<&[Motion]>),
+    predict_shape: bool,
+    resampling: Option<(usize, u64)>,
+) -> Result<()> {
     let views = measurements(input);
     let setup = input.setup;
     let axis = result.unobservable_translation.first().copied();
@@ -384,13 +410,17 @@ pub fn apply_pose_refinement_with(
         }
     }
     let model_for_resamples = chosen.noise.clone();
+    let final_noise = refined.noise.clone();
     let chain = Chain::new(setup, &input.base_from_gripper, &input.camera_from_target)?;
     result.x = refined.x;
     result.y = refined.y;
     result.method = format!("refined from {started_from}");
     result.per_view = view_residuals(&chain, &result.x, &result.y);
     result.errors = errors(&result.per_view);
-    result.per_motion = motion_residuals(&build_motions(&chain, motion_pairs).kept, &result.x);
+    result.per_motion = match motions {
+        Some(kept) => motion_residuals(kept, &result.x),
+        None => motion_residuals(&build_motions(&chain, motion_pairs).kept, &result.x),
+    };
     for m in &mut result.methods {
         if let Ok((mx, _, _)) = &m.outcome {
             m.disagreement = Some(pose_difference(&result.x, mx));
@@ -431,17 +461,30 @@ pub fn apply_pose_refinement_with(
         work_distance_m: None,
         work_point_std_mm: None,
     });
-    if let Some(previous) = &result.repeatability {
-        let resampled = ResampleSetup {
+    if let Some((samples, seed)) = resampling {
+        let name = format!("refined from {started_from}");
+        let resampled = refined_repeatability(
             setup,
-            views: &views,
-            chain: &chain,
-            noise: &model_for_resamples,
-            options: &options,
-            motion_pairs,
-        };
-        if let Some(r) = resampled.repeatability(previous, &started_from, &result.x, &result.y) {
-            result.repeatability = Some(r);
+            &views,
+            &chain,
+            &final_noise,
+            &options,
+            &name,
+            (samples, seed, motion_pairs),
+            &result.x,
+            &result.y,
+        );
+        match resampled {
+            Ok(r) => result.repeatability = Some(r),
+            Err(e) => {
+                result.warnings.push(format!(
+                    "repeatability: the resamples of the refined estimate could not be solved \
+                     ({e}); the closed form's are reported"
+                ));
+                result.repeatability = result.repeatability.take().or_else(|| {
+                    closed_form_repeatability(&chain, &started_from, samples, seed, motion_pairs)
+                });
+            }
         }
     }
     super::trust::check_translation_scale(result, input, &views, &model_for_resamples, &options);
@@ -449,66 +492,23 @@ pub fn apply_pose_refinement_with(
     Ok(())
 }
 
-/// What re-solving a resample of the views with the pose refinement needs.
-struct ResampleSetup<'a> {
-    setup: Setup,
-    views: &'a [PoseMeasurement],
-    chain: &'a Chain,
-    /// The full data's noise model (shape and pivots per view); each
-    /// resample re-estimates the levels from it, as the full solve did.
-    noise: &'a NoiseModel,
-    options: &'a PoseRefineOptions,
+/// The repeatability of the closed form `name` (when it is a method name)
+/// over the same resamples: what the report holds when the refined
+/// estimate's resamples cannot be solved.
+fn closed_form_repeatability(
+    chain: &Chain,
+    name: &str,
+    bootstrap_samples: usize,
+    seed: u64,
     motion_pairs: MotionPairs,
-}
-
-impl ResampleSetup<'_> {
-    /// The repeatability of the report's main estimate: every resample of
-    /// `previous` (the same leave-one-out runs and seeded bootstrap) solved
-    /// by the closed form the refinement started from, then refined.
-    /// `None` when that closed form is not a method name.
-    fn repeatability(
-        &self,
-        previous: &Repeatability,
-        started_from: &str,
-        x: &Pose,
-        y: &Pose,
-    ) -> Option<Repeatability> {
-        let method: HandEyeMethod = started_from.parse().ok()?;
-        let solve = |indices: &[usize]| -> Result<(Pose, Pose)> {
-            let sub = self.chain.subset(indices);
-            let (x0, y0, _) = solve_method(method, &sub, self.motion_pairs)?;
-            let views: Vec<PoseMeasurement> = indices.iter().map(|&i| self.views[i]).collect();
-            let noise = noise_subset(self.noise, indices);
-            let r = refine(self.setup, &views, &x0, &y0, noise, self.options)?;
-            Ok((r.x, r.y))
-        };
-        let options = HandEyeOptions {
-            bootstrap_samples: previous.bootstrap_samples,
-            seed: previous.seed,
-            motion_pairs: self.motion_pairs,
-            ..HandEyeOptions::default()
-        };
-        let name = format!("refined from {started_from}");
-        Some(repeatability_with(
-            self.chain, &name, &solve, &options, x, y,
-        ))
-    }
-}
-
-/// The noise model of the views at `indices` (its per-view parts picked).
-fn noise_subset(noise: &NoiseModel, indices: &[usize]) -> NoiseModel {
-    fn pick<T: Copy>(list: &[T], indices: &[usize]) -> Vec<T> {
-        indices
-            .iter()
-            .filter_map(|&i| list.get(i).copied())
-            .collect()
-    }
-    NoiseModel {
-        camera: match &noise.camera {
-            CameraNoise::Diagonal => CameraNoise::Diagonal,
-            CameraNoise::PerView(c) => CameraNoise::PerView(pick(c, indices)),
-        },
-        variances: noise.variances.clone(),
-        pivot_levers: pick(&noise.pivot_levers, indices),
-    }
+) -> Option<Repeatability> {
+    let method: HandEyeMethod = name.parse().ok()?;
+    let (x, y, _) = solve_method(method, chain, motion_pairs).ok()?;
+    let options = HandEyeOptions {
+        bootstrap_samples,
+        seed,
+        motion_pairs,
+        ..HandEyeOptions::default()
+    };
+    Some(repeatability(chain, method, &options, &x, &y))
 }

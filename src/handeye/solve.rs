@@ -4,13 +4,13 @@
 use super::checks;
 use super::motion::{build_motions, motion_stats, MotionStats};
 use super::pose_noise::CameraNoise;
-use super::refine_poses::apply_pose_refinement;
+use super::refine_poses::apply_pose_refinement_resampled;
 use super::repeat::{repeatability, Repeatability};
 use super::report::{
     combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
     view_residuals, Errors, MotionResidual, ViewResidual,
 };
-use super::{axxb, axzb, scara, Chain, HandEyeMethod, MotionPairs, Pose, Setup};
+use super::{axxb, axzb, scara, Chain, HandEyeMethod, Motion, MotionPairs, Pose, Setup};
 use crate::error::{Error, Result};
 use nalgebra::Vector3;
 
@@ -119,11 +119,24 @@ pub fn solve_method(
     pairs: MotionPairs,
 ) -> Result<(Pose, Pose, Vec<Vector3<f64>>)> {
     if method.is_axzb() {
+        return solve_with_motions(method, chain, &[]);
+    }
+    solve_with_motions(method, chain, &build_motions(chain, pairs).kept)
+}
+
+/// [`solve_method`] with the chain's motions built once by the caller
+/// (unused by the AX = ZB methods): at 1,000 poses each build is half a
+/// million motions.
+fn solve_with_motions(
+    method: HandEyeMethod,
+    chain: &Chain,
+    motions: &[Motion],
+) -> Result<(Pose, Pose, Vec<Vector3<f64>>)> {
+    if method.is_axzb() {
         let (x, y) = axzb::solve(method, chain)?;
         return Ok((x, y, Vec::new()));
     }
-    let set = build_motions(chain, pairs);
-    let (x, unobservable) = axxb::solve(method, &set.kept)?;
+    let (x, unobservable) = axxb::solve(method, motions)?;
     let y = estimate_target(chain, &x)?;
     Ok((x, y, unobservable))
 }
@@ -185,13 +198,13 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             refinement: None,
             pose_refinement: None,
         };
-        return with_pose_refinement(result, input, options);
+        return with_pose_refinement(result, input, options, &set.kept);
     }
     // 3. Every requested method; a failing one is reported, not fatal.
     let mut methods = Vec::new();
     let mut best: Option<(f64, usize, Pose, Pose, Vec<Vector3<f64>>)> = None;
     for (i, &method) in options.methods.iter().enumerate() {
-        let outcome = solve_method(method, &chain, options.motion_pairs).map(|(x, y, u)| {
+        let outcome = solve_with_motions(method, &chain, &set.kept).map(|(x, y, u)| {
             let e = errors(&view_residuals(&chain, &x, &y));
             let score = combined_score_mm(&e, lever);
             if best.as_ref().map_or(true, |b| score < b.0) {
@@ -227,9 +240,11 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         }
     }
     let primary = methods[best_index].method;
-    // 4. Residuals and repeatability of the primary solution.
+    // 4. Residuals and repeatability of the primary solution; with the
+    // pose refinement on, that of the refined estimate instead (below), and
+    // the closed form's only when the refinement does not run.
     let per_view = view_residuals(&chain, &x, &y);
-    let repeat = if options.bootstrap_samples > 0 {
+    let repeat = if options.bootstrap_samples > 0 && !options.refine_poses {
         Some(repeatability(&chain, primary, options, &x, &y))
     } else {
         None
@@ -250,7 +265,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         refinement: None,
         pose_refinement: None,
     };
-    with_pose_refinement(result, input, options)
+    with_pose_refinement(result, input, options, &set.kept)
 }
 
 /// `result` with the pose refinement applied when `options.refine_poses`;
@@ -259,14 +274,31 @@ fn with_pose_refinement(
     mut result: HandEyeResult,
     input: &HandEyeInput,
     options: &HandEyeOptions,
+    motions: &[Motion],
 ) -> Result<HandEyeResult> {
     if options.refine_poses {
-        apply_pose_refinement(
+        let resampling = (options.bootstrap_samples > 0 && result.method != "scara")
+            .then_some((options.bootstrap_samples, options.seed));
+        apply_pose_refinement_resampled(
             &mut result,
             input,
             CameraNoise::Diagonal,
-            options.motion_pairs,
+            (options.motion_pairs, Some(motions)),
+            true,
+            resampling,
         )?;
+        // The refinement did not run: the closed form's repeatability.
+        if result.pose_refinement.is_none() && resampling.is_some() {
+            if let Ok(method) = result.method.parse::<HandEyeMethod>() {
+                let chain = Chain::new(
+                    input.setup,
+                    &input.base_from_gripper,
+                    &input.camera_from_target,
+                )?;
+                result.repeatability =
+                    Some(repeatability(&chain, method, options, &result.x, &result.y));
+            }
+        }
     }
     refuse_metres(&result.errors)?;
     Ok(result)
