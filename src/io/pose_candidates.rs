@@ -92,7 +92,7 @@ pub fn parse_pose_candidates(text: &str, options: &PoseFileOptions) -> Result<Ve
             if readings.is_empty() {
                 return Err(table.rows[0].origin.error(
                     0,
-                    format!("{n} values, but pose formats have 6, 7 or 16 values a line"),
+                    format!("{n} values, but pose formats have 6, 7, 12 or 16 values a line"),
                 ));
             }
         }

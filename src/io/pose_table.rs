@@ -161,16 +161,27 @@ pub(crate) struct HeaderMap {
     pub angle_unit: Option<AngleUnit>,
 }
 
-/// The names a format's columns may have in a header (lowercase).
+/// The names a format's columns may have in a header (lowercase, units
+/// removed as [`split_unit`] removes them: `tx` is `x`).
 fn accepted_names(format: PoseFormat, column: usize) -> Vec<String> {
-    let base = format.columns()[column].to_ascii_lowercase();
-    let rpy = PoseFormat::XyzEuler {
-        order: EulerOrder::XYZ,
-        kind: EulerKind::Extrinsic,
-    };
+    let base = split_unit(format.columns()[column]).0;
     let mut names = vec![base];
-    if format == rpy && column >= 3 {
-        names.push(["roll", "pitch", "yaw"][column - 3].to_string());
+    match format {
+        PoseFormat::XyzEuler { order, kind } if column >= 3 => {
+            let rpy = order == EulerOrder::XYZ && kind == EulerKind::Extrinsic;
+            if rpy {
+                names.push(["roll", "pitch", "yaw"][column - 3].to_string());
+            }
+            // `rx ry rz` name the axis each angle turns about; proper Euler
+            // orders (zyz) repeat an axis, so only e1 e2 e3 name them.
+            let axes: Vec<char> = order.name().chars().collect();
+            if axes[0] != axes[2] {
+                names.push(format!("r{}", axes[column - 3]));
+            }
+        }
+        // `m00 .. m23` as the top rows of a 4x4.
+        PoseFormat::Matrix3x4 => names.push(format!("m{}{}", column / 4, column % 4)),
+        _ => {}
     }
     names
 }
@@ -202,7 +213,7 @@ pub(crate) fn map_header(
     let mut angle_unit = None;
     for (c, &f) in value_fields.iter().enumerate() {
         let Some(u) = parsed[f].1 else { continue };
-        let is_length = c < 3 || format == PoseFormat::Matrix4;
+        let is_length = format.is_length_column(c);
         let clash = |what: &str| {
             Error::parse(
                 line,
@@ -258,10 +269,12 @@ pub(crate) fn map_header(
 }
 
 /// The formats a header can select by its names alone, most specific first.
-/// `x y z rx ry rz` selects UR (rotation vector); Yaskawa and Stäubli files
-/// use the same names and need the format named explicitly.
-const HEADER_FORMATS: [PoseFormat; 8] = [
+/// `x y z rx ry rz` selects UR (rotation vector) unless the angles carry
+/// `_deg` ([`DEGREE_RXRYRZ`]); Yaskawa and Stäubli files use the same names
+/// and need the format named explicitly.
+const HEADER_FORMATS: [PoseFormat; 9] = [
     PoseFormat::Matrix4,
+    PoseFormat::Matrix3x4,
     PoseFormat::XyzQuatXyzw,
     PoseFormat::Abb,
     PoseFormat::Kuka,
@@ -274,14 +287,39 @@ const HEADER_FORMATS: [PoseFormat; 8] = [
     PoseFormat::XyzQuatWxyz,
 ];
 
+/// What `x y z rx ry rz` with angles in degrees (`rx_deg`) is read as:
+/// Euler angles about the fixed x, then y, then z axes, `R = Rz(rz) ·
+/// Ry(ry) · Rx(rx)` (ROS roll-pitch-yaw, the UR pendant's RPY view, FANUC W
+/// P R, Yaskawa Rx Ry Rz). A rotation vector is never written in degrees by
+/// the tools that write one (UR, OpenCV), while teach pendants show Euler
+/// angles in degrees under these names.
+pub const DEGREE_RXRYRZ: PoseFormat = PoseFormat::XyzEuler {
+    order: EulerOrder::XYZ,
+    kind: EulerKind::Extrinsic,
+};
+
+/// The note said when [`DEGREE_RXRYRZ`] was assumed.
+pub(crate) fn degree_rxryrz_note() -> String {
+    format!(
+        "rx ry rz in degrees read as Euler angles about the fixed x, then y, then z axes \
+         (R = Rz·Ry·Rx, format {}); name another convention with the format, e.g. staubli \
+         (xyz_euler_intrinsic_xyz) or xyz_euler_intrinsic_zyx",
+        DEGREE_RXRYRZ.name()
+    )
+}
+
 /// The format a header names, with its mapping. For quaternions, `qw`
-/// before `qx` selects `xyz_quat_wxyz`.
+/// before `qx` selects `xyz_quat_wxyz`; `rx ry rz` in degrees selects
+/// [`DEGREE_RXRYRZ`].
 pub(crate) fn detect_header(
     names: &[String],
     line: usize,
 ) -> Result<Option<(PoseFormat, HeaderMap)>> {
     for format in HEADER_FORMATS {
         if let Some(map) = map_header(names, format, line)? {
+            if format == PoseFormat::Ur && map.angle_unit == Some(AngleUnit::Degree) {
+                return Ok(map_header(names, DEGREE_RXRYRZ, line)?.map(|m| (DEGREE_RXRYRZ, m)));
+            }
             if format == PoseFormat::XyzQuatXyzw && map.value_fields[6] < map.value_fields[3] {
                 let wxyz = PoseFormat::XyzQuatWxyz;
                 return Ok(map_header(names, wxyz, line)?.map(|m| (wxyz, m)));
@@ -295,4 +333,9 @@ pub(crate) fn detect_header(
 /// Whether a header field is a name column.
 pub(crate) fn is_name_column(name: &str) -> bool {
     NAME_COLUMNS.contains(&split_unit(name).0.as_str())
+}
+
+/// Whether a header names `name` (units removed, case ignored).
+pub(crate) fn header_has(names: &[String], name: &str) -> bool {
+    names.iter().any(|n| split_unit(n).0 == name)
 }

@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 use super::pose_formats::{pose_from_values, AngleUnit, LengthUnit, PoseFormat, WHOLE_ROW};
 use super::pose_json::table_from_json;
 use super::pose_table::{
-    detect_header, map_header, number, table_from_text, HeaderMap, Row, Table,
+    degree_rxryrz_note, detect_header, header_has, map_header, number, table_from_text,
+    HeaderMap, Row, Table, DEGREE_RXRYRZ,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Pose;
@@ -152,6 +153,9 @@ pub(crate) fn header_reading(
         None => match detect_header(names, *line)? {
             Some((f, map)) => {
                 notes.push(format!("format {} from the header", f.name()));
+                if f == DEGREE_RXRYRZ && header_has(names, "rx") {
+                    notes.push(degree_rxryrz_note());
+                }
                 (f, Some(map))
             }
             None => {
@@ -207,7 +211,7 @@ fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
                 [] => {
                     return Err(table.rows[0].origin.error(
                         0,
-                        format!("{n} values, but pose formats have 6, 7 or 16 values a line"),
+                        format!("{n} values, but pose formats have 6, 7, 12 or 16 values a line"),
                     ))
                 }
                 many => {
