@@ -39,6 +39,26 @@ impl Origin {
 pub(crate) struct Row {
     pub origin: Origin,
     pub fields: Vec<String>,
+    /// For a row gathered from a whole file (one pose per file), the line
+    /// of each field (0 = unknown); empty for a row that is one line.
+    pub field_lines: Vec<usize>,
+}
+
+impl Row {
+    /// An error at field `column` (1-based; 0 = the whole row): at the
+    /// field's own line for a row gathered from a file, else at the row's
+    /// line and column.
+    pub fn error(&self, column: usize, message: impl Into<String>) -> Error {
+        if self.field_lines.is_empty() {
+            return self.origin.error(column, message);
+        }
+        let line = column
+            .checked_sub(1)
+            .and_then(|i| self.field_lines.get(i))
+            .copied()
+            .unwrap_or(self.origin.number());
+        Error::parse(line, 0, message)
+    }
 }
 
 /// A pose file as a table.
@@ -115,6 +135,7 @@ pub(crate) fn table_from_text(text: &str) -> Table {
         rows.push(Row {
             origin: Origin::Line(i + 1),
             fields,
+            field_lines: Vec::new(),
         });
     }
     Table { header, rows }
@@ -122,7 +143,7 @@ pub(crate) fn table_from_text(text: &str) -> Table {
 
 /// A header name without its unit: `(name, unit)` for `x_mm`, `x [mm]`,
 /// `x(mm)`, lowercased; `tx`/`px` become `x`.
-fn split_unit(raw: &str) -> (String, Option<&'static str>) {
+pub(crate) fn split_unit(raw: &str) -> (String, Option<&'static str>) {
     let lower = raw.trim().to_ascii_lowercase();
     let units = ["mm", "m", "deg", "rad"];
     let mut name = lower.clone();
@@ -338,4 +359,13 @@ pub(crate) fn is_name_column(name: &str) -> bool {
 /// Whether a header names `name` (units removed, case ignored).
 pub(crate) fn header_has(names: &[String], name: &str) -> bool {
     names.iter().any(|n| split_unit(n).0 == name)
+}
+
+/// Whether some format reads a header field of this name (`x_mm`, `qw`,
+/// `A`, `roll`, `r11`, ...).
+pub(crate) fn is_pose_column(name: &str) -> bool {
+    let own = split_unit(name).0;
+    PoseFormat::all()
+        .into_iter()
+        .any(|f| (0..f.value_count()).any(|c| accepted_names(f, c).contains(&own)))
 }

@@ -190,7 +190,7 @@ pub(crate) fn no_poses() -> Error {
     )
 }
 
-fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
+pub(crate) fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
     let (format, header, mut notes) = match header_reading(table, options)? {
         Some(found) => found,
         None => {
@@ -209,7 +209,7 @@ fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
                     vec![format!("format {} from {n} values a line", only.name())],
                 ),
                 [] => {
-                    return Err(table.rows[0].origin.error(
+                    return Err(table.rows[0].error(
                         0,
                         format!("{n} values, but pose formats have 6, 7, 12 or 16 values a line"),
                     ))
@@ -274,7 +274,7 @@ fn row_values(row: &Row, reading: &Reading) -> Result<(Vec<f64>, Option<String>)
             } else {
                 format!("'{shown}' is not a number")
             };
-            row.origin.error(i + 1, msg)
+            row.error(i + 1, msg)
         })
     };
     if let Some(h) = &reading.header {
@@ -305,7 +305,7 @@ fn row_values(row: &Row, reading: &Reading) -> Result<(Vec<f64>, Option<String>)
     }
     let named = n == k + 1 && number(&row.fields[0]).is_none();
     if n != k && !named {
-        return Err(row.origin.error(0, format!("{n} values, {needs}")));
+        return Err(row.error(0, format!("{n} values, {needs}")));
     }
     let start = usize::from(named);
     let values = (start..n).map(parse).collect::<Result<Vec<f64>>>()?;
@@ -336,7 +336,7 @@ pub(crate) fn read_rows(
                 Some(h) => h.value_fields.get(e.index).map_or(0, |i| i + 1),
                 None => e.index + 1 + usize::from(row.fields.len() > values.len()),
             };
-            row.origin.error(column, e.message)
+            row.error(column, e.message)
         })?;
         let base_from_gripper = match direction {
             PoseDirection::BaseFromGripper => pose,
