@@ -365,7 +365,7 @@ export const tests = [
   ['poses-zero-quaternion', posesCase(text('zeroq.csv', 'x,y,z,qx,qy,qz,qw\n0.1,0.2,0.3,0,0,0,0\n'), 'line 2, column 4: quaternion has norm 0: not a rotation')],
   ['poses-unknown-header', posesCase(text('header.csv', 'x y z\n1 2 3\n'),
     "line 1: the header 'x y z' names no known pose format; name the format, or use column names such as x,y,z,qx,qy,qz,qw or X,Y,Z,A,B,C")],
-  ['poses-three-values', posesCase(text('three.txt', '1 2 3\n4 5 6\n'), 'line 1: 3 values, but pose formats have 6, 7 or 16 values a line')],
+  ['poses-three-values', posesCase(text('three.txt', '1 2 3\n4 5 6\n'), 'line 1: 3 values, but pose formats have 6, 7, 12 or 16 values a line')],
   ['poses-not-a-rotation', posesCase(text('scaled.txt', '2 0 0 0.1 0 2 0 0.2 0 0 2 0.3 0 0 0 1\n'),
     'line 1: 4x4 matrix rotation block is not orthonormal: largest |RᵀR - I| entry is 3.000e0, tolerance 1e-3')],
   ['poses-count-mismatch', async (page, { url, shot }) => {
