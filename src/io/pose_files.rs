@@ -353,7 +353,7 @@ fn files_table(files: &[PoseFileText]) -> Result<(Table, Vec<&str>)> {
             header = one.header.clone();
             (one.fields, one.lines)
         } else {
-            let first = &order[0].name;
+            let first = (order[0].name.as_str(), rows_len(&rows));
             agree(header.as_deref(), one, first).map_err(|e| in_file(&file.name, e))?
         };
         rows.push(Row {
@@ -372,11 +372,17 @@ fn files_table(files: &[PoseFileText]) -> Result<(Table, Vec<&str>)> {
     ))
 }
 
-/// A later file's fields in the first file's header order.
+/// How many fields the first row has.
+fn rows_len(rows: &[Row]) -> usize {
+    rows.first().map_or(0, |r| r.fields.len())
+}
+
+/// A later file's fields in the first file's header order; `first` is the
+/// first file's name and field count.
 fn agree(
     header: Option<&[String]>,
     one: OnePose,
-    first: &str,
+    (first, first_count): (&str, usize),
 ) -> Result<(Vec<String>, Vec<usize>)> {
     let differ = |theirs: String, ours: String| {
         Error::invalid(
@@ -404,7 +410,10 @@ fn agree(
             h.join(" "),
             format!("{} numbers without names", one.fields.len()),
         )),
-        (None, Some(names)) => Err(differ("numbers without names".into(), names.join(" "))),
+        (None, Some(names)) => Err(differ(
+            format!("{first_count} numbers without names"),
+            names.join(" "),
+        )),
     }
 }
 
