@@ -600,6 +600,36 @@ fn one_pose_per_file_folders_and_lists_pair_by_stem() {
         })
         .collect();
     solved_right(&c.run("x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg", &rows, &[]), &c);
+    // Radians under a _deg header: read as the header says (tiny rotations),
+    // caught by the plausibility checks, not solved silently.
+    let radians: Vec<String> = poses
+        .iter()
+        .map(|(t, r)| {
+            let e = robocal::geometry::euler_from_rotation(
+                r,
+                robocal::geometry::EulerOrder::XYZ,
+                robocal::geometry::EulerKind::Extrinsic,
+            );
+            format!("{},{},{},{},{},{}", t[0] * 1e3, t[1] * 1e3, t[2] * 1e3, e[0], e[1], e[2])
+        })
+        .collect();
+    let out = c.run("x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg", &radians, &[]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let e = stderr(&out);
+    let file = c.dir.join("poses_user.csv");
+    let first = e.lines().next().unwrap_or_default();
+    assert!(
+        first.starts_with(&format!("warning: '{}': every pose is within ", file.display()))
+            && first.ends_with(
+                " deg of the base orientation with the angles read as degrees: radians read as \
+                 degrees? If the file holds radians, say so (a _rad header, --pose-units rad, or \
+                 Angles: radians on the page)"
+            ),
+        "{e}"
+    );
+    assert!(e.contains("robocal: robot poses: the robot translations fit the camera motion only when scaled by"), "{e}");
+    // Said in radians, the same numbers solve.
+    solved_right(&c.run("x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg", &radians, &["--pose-units", "rad"]), &c);
     // 4. A bad file is named with its line, before any image is read (the
     // images given do not exist).
     std::fs::write(

@@ -8,7 +8,8 @@ use robocal::handeye::Pose;
 use robocal::io::pose_pairing::natural_cmp;
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 use robocal::io::{
-    parse_pose_candidates, parse_pose_file_candidates, parse_pose_files, parse_poses, AngleUnit,
+    parse_pose_candidates, parse_pose_file_candidates, parse_pose_files, parse_poses,
+    radians_read_as_degrees, AngleUnit,
     Candidate, LengthUnit, PoseFileOptions, PoseFileText, PoseFormat, RobotPose,
 };
 
@@ -207,11 +208,19 @@ pub(super) fn read_robot_poses(
         angle_unit,
         ..Default::default()
     };
-    let parse = |options: &PoseFileOptions| match source {
-        PoseSource::Table { path, text } => {
-            parse_poses(text, options).map_err(|e| CliError::from(e).in_file(path))
+    // A reading in degrees that looks like radians is said on stderr (the
+    // hand-eye checks then refuse or warn about the tiny rotations).
+    let parse = |options: &PoseFileOptions| {
+        let parsed = match source {
+            PoseSource::Table { path, text } => {
+                parse_poses(text, options).map_err(|e| CliError::from(e).in_file(path))
+            }
+            PoseSource::Files { files, .. } => Ok(parse_pose_files(files, options)?),
+        }?;
+        if let Some(w) = radians_read_as_degrees(&parsed) {
+            eprintln!("warning: '{}': {w}", source.label());
         }
-        PoseSource::Files { files, .. } => Ok(parse_pose_files(files, options)?),
+        Ok::<_, CliError>(parsed)
     };
     if let Some(name) = format {
         if let Some(f) = PoseFormat::from_name(name) {

@@ -49,7 +49,10 @@ pub use pose_candidates::{parse_pose_candidates, Candidate};
 pub use pose_files::{parse_pose_file_candidates, parse_pose_files, PoseFileText};
 pub use pose_formats::{AngleUnit, LengthUnit, PoseFormat, QUATERNION_NORM_TOLERANCE};
 pub use pose_writer::format_poses;
-pub use poses::{parse_poses, ParsedPoses, PoseDirection, PoseFileOptions, RobotPose};
+pub use poses::{
+    parse_poses, radians_read_as_degrees, ParsedPoses, PoseDirection, PoseFileOptions, RobotPose,
+    RADIANS_AS_DEGREES_MAX_DEG,
+};
 
 /// The numbers of a JSON matrix given as rows of numbers (`[[..], [..]]`)
 /// or as one flat list, row-major; `None` if anything is not a number.

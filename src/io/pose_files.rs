@@ -450,14 +450,16 @@ pub fn parse_pose_files(files: &[PoseFileText], options: &PoseFileOptions) -> Re
             names.len()
         ),
     );
-    Ok(ParsedPoses {
+    let mut parsed = ParsedPoses {
         poses,
         format: reading.format,
         length_unit: reading.length_unit,
         angle_unit: reading.angle_unit,
         direction: options.direction,
         notes,
-    })
+    };
+    parsed.notes.extend(super::poses::radians_read_as_degrees(&parsed));
+    Ok(parsed)
 }
 
 /// Every plausible reading of one-pose-per-file files (see

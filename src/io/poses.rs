@@ -109,13 +109,41 @@ pub fn parse_poses(text: &str, options: &PoseFileOptions) -> Result<ParsedPoses>
     let table = table_from_input(text)?;
     let reading = resolve(&table, options)?;
     let poses = read_rows(&table.rows, &reading, options.direction)?;
-    Ok(ParsedPoses {
+    let mut parsed = ParsedPoses {
         poses,
         format: reading.format,
         length_unit: reading.length_unit,
         angle_unit: reading.angle_unit,
         direction: options.direction,
         notes: reading.notes,
+    };
+    parsed.notes.extend(radians_read_as_degrees(&parsed));
+    Ok(parsed)
+}
+
+/// Every pose within this rotation (degrees) of the base orientation, with
+/// the angles read as degrees, suggests radians read as degrees: three
+/// Euler angles within ±pi each, read as degrees, turn by at most 3 pi deg.
+pub const RADIANS_AS_DEGREES_MAX_DEG: f64 = 3.0 * std::f64::consts::PI;
+
+/// The suspicion that a reading in degrees holds radians: at least two
+/// poses, every one within [`RADIANS_AS_DEGREES_MAX_DEG`] of the base
+/// orientation (a robot's tool is rarely that close to the base axes in
+/// every pose). Also in [`ParsedPoses::notes`].
+pub fn radians_read_as_degrees(parsed: &ParsedPoses) -> Option<String> {
+    if !parsed.format.uses_angles() || parsed.angle_unit != AngleUnit::Degree || parsed.poses.len() < 2 {
+        return None;
+    }
+    let largest = parsed
+        .poses
+        .iter()
+        .map(|p| p.base_from_gripper.rotation.angle().to_degrees())
+        .fold(0.0f64, f64::max);
+    (largest > 0.0 && largest <= RADIANS_AS_DEGREES_MAX_DEG).then(|| {
+        format!(
+            "every pose is within {} deg of the base orientation with the angles read as degrees: radians read as degrees? If the file holds radians, say so (a _rad header, --pose-units rad, or Angles: radians on the page)",
+            super::pose_formats::short(largest)
+        )
     })
 }
 
