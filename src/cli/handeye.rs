@@ -73,7 +73,7 @@ pub struct HandeyeArgs {
     /// quaternion), each paired with the image of the same file stem. Several
     /// files take the values up to the next option: put IMAGES after another
     /// option or after --
-    #[arg(long, value_name = "FILE|FOLDER", num_args = 1..)]
+    #[arg(long, value_name = "FILE|FOLDER", num_args = 1.., action = clap::ArgAction::Set)]
     poses: Vec<String>,
     #[arg(long, value_name = "NAME", help = super::robot_poses::POSE_FORMAT_SHORT, long_help = super::robot_poses::POSE_FORMAT_HELP)]
     pose_format: Option<String>,

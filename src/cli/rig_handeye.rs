@@ -25,7 +25,7 @@ pub struct RigHandEyeFlags {
     /// an 'image' column naming a file of each frame (any robot pose file, as
     /// 'robocal handeye --poses'), or a folder or several files of one pose
     /// each (named by their stems)
-    #[arg(long, value_name = "FILE|FOLDER", num_args = 1..)]
+    #[arg(long, value_name = "FILE|FOLDER", num_args = 1.., action = clap::ArgAction::Set, overrides_with = "poses")]
     poses: Vec<String>,
     #[arg(long, value_name = "NAME", overrides_with = "pose_format", help = super::robot_poses::POSE_FORMAT_SHORT, long_help = super::robot_poses::POSE_FORMAT_HELP)]
     pose_format: Option<String>,
