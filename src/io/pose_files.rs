@@ -116,6 +116,11 @@ fn from_text(text: &str) -> Result<OnePose> {
     let lines_of = |row: &Row| vec![row.origin.number(); row.fields.len()];
     match (&table.header, table.rows.as_slice()) {
         (_, []) => Err(no_pose()),
+        (Some((names, _)), [row]) if row.fields.len() != names.len() => Err(Error::parse(
+            row.origin.number(),
+            0,
+            format!("{} values but the header names {}", row.fields.len(), names.len()),
+        )),
         (Some((names, _)), [row]) => Ok(OnePose {
             header: Some(names.clone()),
             fields: row.fields.clone(),

@@ -152,3 +152,32 @@ fn six_numbers_a_file_give_ranked_candidates() {
     let p = parse_pose_files(&files, &kuka).unwrap();
     close(&p.poses[0].base_from_gripper, &pose([0.1, 0.0, 0.5], [0.0, 0.0, H, H]));
 }
+
+#[test]
+fn a_header_and_a_row_of_another_length_is_an_error_in_any_file() {
+    let good = "x,y,z,qx,qy,qz,qw\n0,0,0,0,0,0,1\n";
+    let short = "x,y,z,qx,qy,qz,qw\n0,0,0,0,0,1\n";
+    assert_eq!(err(&[file("a.csv", good), file("b.csv", short)]), "'b.csv': line 2: 6 values but the header names 7");
+    assert_eq!(err(&[file("b.csv", short)]), "'b.csv': line 2: 6 values but the header names 7");
+}
+
+#[test]
+fn random_text_never_panics() {
+    // Pieces of every form, shuffled: each must read or be refused.
+    let pieces = [
+        "position:", "  x: 1", "orientation: {x: 0, w: 1}", "- 1", "- [1, 2]", "[[1,0,0,0],[0,1,0,0]", "{", "}", "]",
+        "x,y,z,qx,qy,qz,qw", "0 0 0 0 0 0 1", "\"a\": 1", "'q': [1,2,3,4]", "  - x: 1", "#", "---", ":", "a: b: c",
+        "translation: [1, 2, 3]", "rotation: [0, 0, 0, 1]", "\u{feff}", "\t", "é: ü", "data: [ 1.,", "  2. ]", "r11,tx",
+    ];
+    let mut rng = crate::synth::Rng::new(44);
+    for _ in 0..3000 {
+        let n = 1 + rng.below(6);
+        let text: Vec<&str> = (0..n).map(|_| pieces[rng.below(pieces.len())]).collect();
+        let a = text.join("\n");
+        let b: String = text.concat();
+        let files = [file("a.yaml", &a), file("b.txt", &b)];
+        let _ = parse_pose_files(&files, &PoseFileOptions::default());
+        let _ = parse_pose_file_candidates(&files, &PoseFileOptions::default());
+        let _ = parse_pose_files(&files[..1], &PoseFileOptions::default());
+    }
+}
