@@ -511,7 +511,8 @@ fn demo_poses(c: &Cell) -> Vec<([f64; 3], robocal::geometry::Rotation)> {
         .iter()
         .map(|row| {
             let v: Vec<f64> = row.split(',').map(|f| f.parse().unwrap()).collect();
-            let r = robocal::geometry::rotation_from_rotvec(&nalgebra::Vector3::new(v[3], v[4], v[5]));
+            let r =
+                robocal::geometry::rotation_from_rotvec(&nalgebra::Vector3::new(v[3], v[4], v[5]));
             ([v[0], v[1], v[2]], r)
         })
         .collect()
@@ -519,8 +520,18 @@ fn demo_poses(c: &Cell) -> Vec<([f64; 3], robocal::geometry::Rotation)> {
 
 impl Cell {
     /// `robocal handeye` with `--poses` given as `poses` (a folder or files).
-    fn run_poses(&self, poses: &[String], images: &[String], extra: &[&str]) -> std::process::Output {
-        let mut args: Vec<String> = vec!["handeye".into(), "--setup".into(), "eye-in-hand".into(), "--poses".into()];
+    fn run_poses(
+        &self,
+        poses: &[String],
+        images: &[String],
+        extra: &[&str],
+    ) -> std::process::Output {
+        let mut args: Vec<String> = vec![
+            "handeye".into(),
+            "--setup".into(),
+            "eye-in-hand".into(),
+            "--poses".into(),
+        ];
         args.extend(poses.iter().cloned());
         for a in [
             "--camera",
@@ -565,11 +576,17 @@ fn one_pose_per_file_folders_and_lists_pair_by_stem() {
         std::fs::write(folder.join(name), text).unwrap();
     }
     std::fs::write(folder.join("README.md"), "poses of the cell\n").unwrap();
-    let report = solved_right(&c.run_poses(&[folder.to_str().unwrap().into()], &c.images, &[]), &c);
+    let report = solved_right(
+        &c.run_poses(&[folder.to_str().unwrap().into()], &c.images, &[]),
+        &c,
+    );
     for p in report["pairs"].as_array().unwrap() {
         let i = p["pose_index"].as_u64().unwrap();
         let image = p["image"].as_str().unwrap();
-        assert!(image.ends_with(&format!("/img_{i}.png")), "pose {i}: {image}");
+        assert!(
+            image.ends_with(&format!("/img_{i}.png")),
+            "pose {i}: {image}"
+        );
     }
     // 2. Several files: 4x4 matrices as text, millimetres by --pose-units.
     let mats = c.dir.join("mats");
@@ -586,7 +603,10 @@ fn one_pose_per_file_folders_and_lists_pair_by_stem() {
         listed.push(path.to_str().unwrap().to_string());
     }
     listed.reverse();
-    solved_right(&c.run_poses(&listed, &c.images, &["--pose-units", "mm"]), &c);
+    solved_right(
+        &c.run_poses(&listed, &c.images, &["--pose-units", "mm"]),
+        &c,
+    );
     // 3. A table with units and Euler angles in degrees in its header.
     let rows: Vec<String> = poses
         .iter()
@@ -596,10 +616,21 @@ fn one_pose_per_file_folders_and_lists_pair_by_stem() {
                 robocal::geometry::EulerOrder::XYZ,
                 robocal::geometry::EulerKind::Extrinsic,
             );
-            format!("{},{},{},{},{},{}", t[0] * 1e3, t[1] * 1e3, t[2] * 1e3, e[0].to_degrees(), e[1].to_degrees(), e[2].to_degrees())
+            format!(
+                "{},{},{},{},{},{}",
+                t[0] * 1e3,
+                t[1] * 1e3,
+                t[2] * 1e3,
+                e[0].to_degrees(),
+                e[1].to_degrees(),
+                e[2].to_degrees()
+            )
         })
         .collect();
-    solved_right(&c.run("x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg", &rows, &[]), &c);
+    solved_right(
+        &c.run("x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg", &rows, &[]),
+        &c,
+    );
     // Radians under a _deg header: read as the header says (tiny rotations),
     // caught by the plausibility checks, not solved silently.
     let radians: Vec<String> = poses
@@ -610,7 +641,15 @@ fn one_pose_per_file_folders_and_lists_pair_by_stem() {
                 robocal::geometry::EulerOrder::XYZ,
                 robocal::geometry::EulerKind::Extrinsic,
             );
-            format!("{},{},{},{},{},{}", t[0] * 1e3, t[1] * 1e3, t[2] * 1e3, e[0], e[1], e[2])
+            format!(
+                "{},{},{},{},{},{}",
+                t[0] * 1e3,
+                t[1] * 1e3,
+                t[2] * 1e3,
+                e[0],
+                e[1],
+                e[2]
+            )
         })
         .collect();
     let out = c.run("x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg", &radians, &[]);
@@ -619,17 +658,26 @@ fn one_pose_per_file_folders_and_lists_pair_by_stem() {
     let file = c.dir.join("poses_user.csv");
     let first = e.lines().next().unwrap_or_default();
     assert!(
-        first.starts_with(&format!("warning: '{}': every pose is within ", file.display()))
-            && first.ends_with(
-                " deg of the base orientation with the angles read as degrees: radians read as \
+        first.starts_with(&format!(
+            "warning: '{}': every pose is within ",
+            file.display()
+        )) && first.ends_with(
+            " deg of the base orientation with the angles read as degrees: radians read as \
                  degrees? If the file holds radians, say so (a _rad header, --pose-units rad, or \
                  Angles: radians on the page)"
-            ),
+        ),
         "{e}"
     );
     assert!(e.contains("robocal: robot poses: the robot translations fit the camera motion only when scaled by"), "{e}");
     // Said in radians, the same numbers solve.
-    solved_right(&c.run("x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg", &radians, &["--pose-units", "rad"]), &c);
+    solved_right(
+        &c.run(
+            "x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg",
+            &radians,
+            &["--pose-units", "rad"],
+        ),
+        &c,
+    );
     // 4. A bad file is named with its line, before any image is read (the
     // images given do not exist).
     std::fs::write(
@@ -643,7 +691,10 @@ fn one_pose_per_file_folders_and_lists_pair_by_stem() {
     let bad = folder.join("img_4.yml");
     assert_eq!(
         stderr(&out).trim_end(),
-        format!("robocal: '{}': line 3: quaternion has norm 2: not a rotation", bad.display())
+        format!(
+            "robocal: '{}': line 3: quaternion has norm 2: not a rotation",
+            bad.display()
+        )
     );
     // 5. An empty folder, and --pose-format names only pose-file formats.
     let empty = c.dir.join("empty");

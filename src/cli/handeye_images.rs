@@ -5,6 +5,7 @@
 //! audited.
 
 use super::detect::{run_all, Outcome};
+pub(super) use super::robot_poses::RobotPoses;
 use super::CliError;
 use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
@@ -16,7 +17,6 @@ use robocal::handeye::reprojection_refine::ViewPoints;
 use robocal::handeye::{Pose, Setup};
 use robocal::io::pose_pairing::{alternatives, numeric_order, pair_poses};
 use robocal::io::RobotPose;
-pub(super) use super::robot_poses::RobotPoses;
 use robocal::target::Target;
 
 /// What the images gave: the used pairs and the audit of every pose.

@@ -9,8 +9,8 @@ use robocal::io::pose_pairing::natural_cmp;
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 use robocal::io::{
     parse_pose_candidates, parse_pose_file_candidates, parse_pose_files, parse_poses,
-    radians_read_as_degrees, AngleUnit,
-    Candidate, LengthUnit, PoseFileOptions, PoseFileText, PoseFormat, RobotPose,
+    radians_read_as_degrees, AngleUnit, Candidate, LengthUnit, PoseFileOptions, PoseFileText,
+    PoseFormat, RobotPose,
 };
 
 /// The help of `--pose-format`, listing every name (checked against
@@ -68,7 +68,12 @@ pub fn read_pose_source(command: &str, paths: &[String]) -> Result<PoseSource, C
         [one] if std::path::Path::new(one).is_dir() => {
             let files = folder_files(one)?
                 .into_iter()
-                .map(|name| Ok(PoseFileText { text: text(&name)?, name }))
+                .map(|name| {
+                    Ok(PoseFileText {
+                        text: text(&name)?,
+                        name,
+                    })
+                })
                 .collect::<Result<Vec<_>, CliError>>()?;
             Ok(PoseSource::Files {
                 label: one.clone(),
@@ -88,7 +93,12 @@ pub fn read_pose_source(command: &str, paths: &[String]) -> Result<PoseSource, C
             }
             let files = many
                 .iter()
-                .map(|name| Ok(PoseFileText { text: text(name)?, name: name.clone() }))
+                .map(|name| {
+                    Ok(PoseFileText {
+                        text: text(name)?,
+                        name: name.clone(),
+                    })
+                })
                 .collect::<Result<Vec<_>, CliError>>()?;
             Ok(PoseSource::Files {
                 label: many[0].clone(),
@@ -105,14 +115,16 @@ fn folder_files(dir: &str) -> Result<Vec<String>, CliError> {
         .map_err(|e| CliError::Io(format!("cannot read the folder '{dir}': {e}")))?;
     let mut out = Vec::new();
     for entry in entries {
-        let entry = entry.map_err(|e| CliError::Io(format!("cannot read the folder '{dir}': {e}")))?;
+        let entry =
+            entry.map_err(|e| CliError::Io(format!("cannot read the folder '{dir}': {e}")))?;
         let path = entry.path();
         let name = entry.file_name().to_string_lossy().into_owned();
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
-        if name.starts_with('.') || !path.is_file() || !POSE_FILE_EXTENSIONS.contains(&ext.as_str()) {
+        if name.starts_with('.') || !path.is_file() || !POSE_FILE_EXTENSIONS.contains(&ext.as_str())
+        {
             continue;
         }
         out.push(path.to_string_lossy().into_owned());
@@ -151,7 +163,12 @@ fn pose_units(
     units: Option<&str>,
 ) -> Result<(Option<LengthUnit>, Option<AngleUnit>), CliError> {
     let (mut length, mut angle) = (None, None);
-    for unit in units.unwrap_or_default().split(',').map(str::trim).filter(|u| !u.is_empty()) {
+    for unit in units
+        .unwrap_or_default()
+        .split(',')
+        .map(str::trim)
+        .filter(|u| !u.is_empty())
+    {
         match unit.to_ascii_lowercase().as_str() {
             "mm" => length = Some(LengthUnit::Millimetre),
             "m" => length = Some(LengthUnit::Metre),
@@ -160,7 +177,9 @@ fn pose_units(
             _ => {
                 return Err(CliError::usage(
                     command,
-                    format!("--pose-units: unknown unit '{unit}' (valid: mm, m, deg, rad, e.g. mm,deg)"),
+                    format!(
+                        "--pose-units: unknown unit '{unit}' (valid: mm, m, deg, rad, e.g. mm,deg)"
+                    ),
                 ))
             }
         }
@@ -227,7 +246,8 @@ pub(super) fn read_robot_poses(
             options.format = Some(f);
             return Ok(RobotPoses::Known(parse(&options)?.poses));
         }
-        let (PoseSource::Table { path, text }, Ok(f)) = (source, name.parse::<PoseTextFormat>()) else {
+        let (PoseSource::Table { path, text }, Ok(f)) = (source, name.parse::<PoseTextFormat>())
+        else {
             return Err(unknown_format(command, name, files));
         };
         let poses = parse_pose_text(text, Some(f)).map_err(|e| CliError::from(e).in_file(path))?;
@@ -285,9 +305,13 @@ mod tests {
             let name = f.name();
             let listed = match f {
                 PoseFormat::XyzEuler { order, .. } => {
-                    POSE_FORMAT_HELP.contains(order.name()) && POSE_FORMAT_HELP.contains("xyz_euler_intrinsic_ORDER")
+                    POSE_FORMAT_HELP.contains(order.name())
+                        && POSE_FORMAT_HELP.contains("xyz_euler_intrinsic_ORDER")
                 }
-                _ => POSE_FORMAT_HELP.contains(&format!("{name} ")) || POSE_FORMAT_HELP.contains(&format!("{name},")),
+                _ => {
+                    POSE_FORMAT_HELP.contains(&format!("{name} "))
+                        || POSE_FORMAT_HELP.contains(&format!("{name},"))
+                }
             };
             assert!(listed, "--pose-format help lacks {name}");
         }
@@ -299,8 +323,13 @@ mod tests {
             pose_units("handeye", Some("mm,deg")).unwrap(),
             (Some(LengthUnit::Millimetre), Some(AngleUnit::Degree))
         );
-        assert_eq!(pose_units("handeye", Some("rad")).unwrap(), (None, Some(AngleUnit::Radian)));
-        let CliError::Usage(e) = pose_units("rig", Some("mm,grad")).unwrap_err() else { panic!() };
+        assert_eq!(
+            pose_units("handeye", Some("rad")).unwrap(),
+            (None, Some(AngleUnit::Radian))
+        );
+        let CliError::Usage(e) = pose_units("rig", Some("mm,grad")).unwrap_err() else {
+            panic!()
+        };
         assert_eq!(
             e,
             "rig: --pose-units: unknown unit 'grad' (valid: mm, m, deg, rad, e.g. mm,deg) (see 'robocal rig --help')"

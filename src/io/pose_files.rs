@@ -32,9 +32,7 @@ use serde::{Deserialize, Serialize};
 use super::pose_candidates::{candidates_from_table, Candidate};
 use super::pose_json::json_error;
 use super::pose_pairing::natural_cmp;
-use super::pose_table::{
-    is_pose_column, number, split_unit, table_from_text, Origin, Row, Table,
-};
+use super::pose_table::{is_pose_column, number, split_unit, table_from_text, Origin, Row, Table};
 use super::pose_yaml::{looks_like_yaml, parse_yaml, Node};
 use super::poses::{read_rows, resolve, ParsedPoses, PoseFileOptions};
 use crate::error::{Error, Result};
@@ -61,14 +59,7 @@ const POSITION_KEYS: [&str; 7] = [
 ];
 
 /// Keys whose `x y z w` children are a quaternion.
-const QUATERNION_KEYS: [&str; 6] = [
-    "orientation",
-    "rotation",
-    "quaternion",
-    "quat",
-    "q",
-    "rot",
-];
+const QUATERNION_KEYS: [&str; 6] = ["orientation", "rotation", "quaternion", "quat", "q", "rot"];
 
 /// The pose of one file before the files are put together: header names
 /// (None = numbers by position), the fields and each field's line.
@@ -271,7 +262,13 @@ fn from_tree(node: &Node) -> Result<OnePose> {
             lines,
         }
     };
-    let at = |path: &str| if path.is_empty() { "the file".to_string() } else { format!("'{path}'") };
+    let at = |path: &str| {
+        if path.is_empty() {
+            "the file".to_string()
+        } else {
+            format!("'{path}'")
+        }
+    };
     match found.matrices.len() {
         0 => {}
         1 => return Ok(positional(found.matrices.remove(0).1)),
@@ -279,7 +276,10 @@ fn from_tree(node: &Node) -> Result<OnePose> {
             let paths: Vec<String> = found.matrices.iter().map(|(p, _)| at(p)).collect();
             return Err(Error::invalid(
                 "poses",
-                format!("two matrices ({}): a pose file holds one pose", paths.join(" and ")),
+                format!(
+                    "two matrices ({}): a pose file holds one pose",
+                    paths.join(" and ")
+                ),
             ));
         }
     }
@@ -463,7 +463,9 @@ pub fn parse_pose_files(files: &[PoseFileText], options: &PoseFileOptions) -> Re
         direction: options.direction,
         notes,
     };
-    parsed.notes.extend(super::poses::radians_read_as_degrees(&parsed));
+    parsed
+        .notes
+        .extend(super::poses::radians_read_as_degrees(&parsed));
     Ok(parsed)
 }
 
@@ -475,7 +477,8 @@ pub fn parse_pose_file_candidates(
     options: &PoseFileOptions,
 ) -> Result<Vec<Candidate>> {
     let (table, names) = files_table(files)?;
-    let mut candidates = candidates_from_table(&table, options).map_err(|e| in_file(names[0], e))?;
+    let mut candidates =
+        candidates_from_table(&table, options).map_err(|e| in_file(names[0], e))?;
     for c in &mut candidates {
         name_poses(&mut c.poses, &names);
     }

@@ -74,7 +74,8 @@ fn content_lines(text: &str) -> Vec<Line> {
             let raw = raw.trim_start_matches('\u{feff}');
             let body = strip_comment(raw).trim_end();
             let t = body.trim_start();
-            let marker = t == "---" || t == "..." || t.starts_with("%YAML") || t.starts_with("%TAG");
+            let marker =
+                t == "---" || t == "..." || t.starts_with("%YAML") || t.starts_with("%TAG");
             (!t.is_empty() && !marker).then(|| Line {
                 number: i + 1,
                 indent: body.len() - t.len(),
@@ -117,7 +118,8 @@ pub(crate) fn looks_like_yaml(text: &str) -> bool {
 /// A value with a tag (`!!opencv-matrix`, `!custom`) dropped.
 fn untagged(rest: &str) -> &str {
     if rest.starts_with('!') {
-        rest.split_once([' ', '\t']).map_or("", |(_, r)| r.trim_start())
+        rest.split_once([' ', '\t'])
+            .map_or("", |(_, r)| r.trim_start())
     } else {
         rest
     }
@@ -153,7 +155,10 @@ fn block(lines: &[Line], pos: &mut usize, indent: usize) -> Result<Node> {
     let is_item = |t: &str| t == "-" || t.starts_with("- ");
     if is_item(&lines[*pos].text) {
         let mut items = Vec::new();
-        while let Some(l) = lines.get(*pos).filter(|l| l.indent == indent && is_item(&l.text)) {
+        while let Some(l) = lines
+            .get(*pos)
+            .filter(|l| l.indent == indent && is_item(&l.text))
+        {
             *pos += 1;
             let rest = untagged(l.text[1..].trim());
             if split_key(rest).is_some() {
@@ -166,7 +171,11 @@ fn block(lines: &[Line], pos: &mut usize, indent: usize) -> Result<Node> {
     let mut entries: Vec<(String, Node)> = Vec::new();
     while let Some(l) = lines.get(*pos).filter(|l| l.indent == indent) {
         if is_item(&l.text) {
-            return Err(Error::parse(l.number, 0, "a list item where a 'key: value' was expected"));
+            return Err(Error::parse(
+                l.number,
+                0,
+                "a list item where a 'key: value' was expected",
+            ));
         }
         let Some((key, rest)) = split_key(&l.text) else {
             if l.text.starts_with('{') && entries.is_empty() {
@@ -175,10 +184,18 @@ fn block(lines: &[Line], pos: &mut usize, indent: usize) -> Result<Node> {
                 return after_block(lines, *pos, indent, node);
             }
             let shown: String = l.text.chars().take(40).collect();
-            return Err(Error::parse(l.number, 0, format!("expected 'key: value', found '{shown}'")));
+            return Err(Error::parse(
+                l.number,
+                0,
+                format!("expected 'key: value', found '{shown}'"),
+            ));
         };
         if entries.iter().any(|(k, _)| *k == key) {
-            return Err(Error::parse(l.number, 0, format!("the key '{key}' appears twice")));
+            return Err(Error::parse(
+                l.number,
+                0,
+                format!("the key '{key}' appears twice"),
+            ));
         }
         *pos += 1;
         let child = value(lines, pos, l, untagged(rest), indent)?;
@@ -200,7 +217,11 @@ fn value(lines: &[Line], pos: &mut usize, l: &Line, rest: &str, indent: usize) -
         return match lines.get(*pos) {
             Some(next) if next.indent > indent => block(lines, pos, next.indent),
             // `key:` followed by `- item` at the key's own indentation.
-            Some(next) if next.indent == indent && next.text.starts_with('-') && split_key(&l.text).is_some() => {
+            Some(next)
+                if next.indent == indent
+                    && next.text.starts_with('-')
+                    && split_key(&l.text).is_some() =>
+            {
                 block(lines, pos, indent)
             }
             _ => Ok(Node::Scalar(String::new(), l.number)),
@@ -216,7 +237,11 @@ fn value(lines: &[Line], pos: &mut usize, l: &Line, rest: &str, indent: usize) -
         let mut text = rest.to_string();
         while !balanced(&text) {
             let Some(next) = lines.get(*pos) else {
-                return Err(Error::parse(l.number, 0, format!("'{}' is not closed", &rest[..1])));
+                return Err(Error::parse(
+                    l.number,
+                    0,
+                    format!("'{}' is not closed", &rest[..1]),
+                ));
             };
             text.push('\n');
             text.push_str(&next.text);
@@ -336,7 +361,9 @@ impl Flow {
             if close == '}' {
                 let key = unquote(&self.scalar(&[':', ',', '}']));
                 if self.chars.get(self.at) != Some(&':') {
-                    return Err(self.error(format!("expected 'key: value' in '{{...}}', found '{key}'")));
+                    return Err(
+                        self.error(format!("expected 'key: value' in '{{...}}', found '{key}'"))
+                    );
                 }
                 self.at += 1;
                 if entries.iter().any(|(k, _)| *k == key) {
@@ -351,7 +378,9 @@ impl Flow {
             match self.chars.get(self.at) {
                 Some(',') => self.at += 1,
                 Some(&c) if c == close => {}
-                Some(&c) => return Err(self.error(format!("expected ',' or '{close}', found '{c}'"))),
+                Some(&c) => {
+                    return Err(self.error(format!("expected ',' or '{close}', found '{c}'")))
+                }
                 None => return Err(self.error(format!("'{close}' is missing"))),
             }
         }
@@ -376,32 +405,57 @@ mod tests {
         let text = "# a pose\n---\nheader:\n  frame_id: \"base\"  # the frame\npose:\n  position: {x: 0.1, y: -2e-3, z: 0.3}\n  orientation:\n    x: 0\n    w: 1\ndata: [ 1., 2.,\n   3. ]\nrows:\n- 4\n- 5\n";
         let node = parse_yaml(text).unwrap();
         let Node::Map(top) = node else { panic!() };
-        assert_eq!(top[0], ("header".into(), Node::Map(vec![("frame_id".into(), s("base", 4))])));
+        assert_eq!(
+            top[0],
+            (
+                "header".into(),
+                Node::Map(vec![("frame_id".into(), s("base", 4))])
+            )
+        );
         assert_eq!(
             top[1].1,
             Node::Map(vec![
                 (
                     "position".into(),
-                    Node::Map(vec![("x".into(), s("0.1", 6)), ("y".into(), s("-2e-3", 6)), ("z".into(), s("0.3", 6))])
+                    Node::Map(vec![
+                        ("x".into(), s("0.1", 6)),
+                        ("y".into(), s("-2e-3", 6)),
+                        ("z".into(), s("0.3", 6))
+                    ])
                 ),
-                ("orientation".into(), Node::Map(vec![("x".into(), s("0", 8)), ("w".into(), s("1", 9))])),
+                (
+                    "orientation".into(),
+                    Node::Map(vec![("x".into(), s("0", 8)), ("w".into(), s("1", 9))])
+                ),
             ])
         );
-        assert_eq!(top[2].1, Node::List(vec![s("1.", 10), s("2.", 10), s("3.", 11)]));
+        assert_eq!(
+            top[2].1,
+            Node::List(vec![s("1.", 10), s("2.", 10), s("3.", 11)])
+        );
         assert_eq!(top[3].1, Node::List(vec![s("4", 13), s("5", 14)]));
     }
 
     #[test]
     fn what_is_not_read_is_refused_with_its_line() {
         let err = |t: &str| parse_yaml(t).unwrap_err().to_string();
-        assert_eq!(err("a:\n  x: 1\n    y: 2\n"), "line 3: unexpected indentation");
+        assert_eq!(
+            err("a:\n  x: 1\n    y: 2\n"),
+            "line 3: unexpected indentation"
+        );
         assert_eq!(err("a: 1\na: 2\n"), "line 2: the key 'a' appears twice");
         assert_eq!(err("a: [1, 2\n"), "line 1: '[' is not closed");
-        assert_eq!(err("a: {x 1}\n"), "line 1: expected 'key: value' in '{...}', found 'x 1'");
+        assert_eq!(
+            err("a: {x 1}\n"),
+            "line 1: expected 'key: value' in '{...}', found 'x 1'"
+        );
         assert_eq!(
             err("a: &anchor 1\n"),
             "line 1: anchors and aliases are not read: a pose file holds numbers under keys, e.g. 'position: {x: 0.1, y: 0.2, z: 0.3}'"
         );
-        assert_eq!(err("a: 1\nnot a key\n"), "line 2: expected 'key: value', found 'not a key'");
+        assert_eq!(
+            err("a: 1\nnot a key\n"),
+            "line 2: expected 'key: value', found 'not a key'"
+        );
     }
 }

@@ -7,8 +7,8 @@ use serde::{Deserialize, Serialize};
 use super::pose_formats::{pose_from_values, AngleUnit, LengthUnit, PoseFormat, WHOLE_ROW};
 use super::pose_json::table_from_json;
 use super::pose_table::{
-    degree_rxryrz_note, detect_header, header_has, map_header, number, table_from_text,
-    HeaderMap, Row, Table, DEGREE_RXRYRZ,
+    degree_rxryrz_note, detect_header, header_has, map_header, number, table_from_text, HeaderMap,
+    Row, Table, DEGREE_RXRYRZ,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Pose;
@@ -131,7 +131,10 @@ pub const RADIANS_AS_DEGREES_MAX_DEG: f64 = 3.0 * std::f64::consts::PI;
 /// orientation (a robot's tool is rarely that close to the base axes in
 /// every pose). Also in [`ParsedPoses::notes`].
 pub fn radians_read_as_degrees(parsed: &ParsedPoses) -> Option<String> {
-    if !parsed.format.uses_angles() || parsed.angle_unit != AngleUnit::Degree || parsed.poses.len() < 2 {
+    if !parsed.format.uses_angles()
+        || parsed.angle_unit != AngleUnit::Degree
+        || parsed.poses.len() < 2
+    {
         return None;
     }
     let largest = parsed

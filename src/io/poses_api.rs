@@ -44,7 +44,10 @@ fn options_from_json(options_json: &str) -> Result<PoseFileOptions> {
 /// the file.
 pub fn read_pose_files_json(files_json: &str, options_json: &str) -> Result<String> {
     let files: Vec<PoseFileText> = serde_json::from_str(files_json).map_err(|e| {
-        Error::invalid("files", format!("expected [{{\"name\", \"text\"}}, ...]: {e}"))
+        Error::invalid(
+            "files",
+            format!("expected [{{\"name\", \"text\"}}, ...]: {e}"),
+        )
     })?;
     let options = options_from_json(options_json)?;
     let reading = match parse_pose_files(&files, &options) {
@@ -123,12 +126,19 @@ mod tests {
         assert_eq!(err, "'b/p10.yaml': poses: its values (x y z qx qy qz qw) are not those of 'b/p9.txt' (16 numbers without names): every pose file must have the same layout");
         let files = r#"[{"name": "p10.yaml", "text": "position: {x: 0.1, y: 0, z: 0}\norientation: {x: 0, y: 0, z: 0, w: 1}"},
                         {"name": "p9.yml", "text": "position: {x: 0.2, y: 0, z: 0}\norientation: {x: 0, y: 0, z: 0, w: 1}"}]"#;
-        let v: serde_json::Value = serde_json::from_str(&read_pose_files_json(files, "").unwrap()).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&read_pose_files_json(files, "").unwrap()).unwrap();
         assert_eq!(v["parsed"]["poses"][0]["name"], "p9");
-        assert_eq!(v["parsed"]["poses"][0]["base_from_gripper"]["translation_m"][0], 0.2);
+        assert_eq!(
+            v["parsed"]["poses"][0]["base_from_gripper"]["translation_m"][0],
+            0.2
+        );
         assert_eq!(v["parsed"]["poses"][1]["name"], "p10");
         let err = read_pose_files_json("{}", "").unwrap_err().to_string();
-        assert!(err.starts_with("files: expected [{\"name\", \"text\"}, ...]: invalid type"), "{err}");
+        assert!(
+            err.starts_with("files: expected [{\"name\", \"text\"}, ...]: invalid type"),
+            "{err}"
+        );
         let err = read_poses_json(bare, "{\"format\": 3}")
             .unwrap_err()
             .to_string();
