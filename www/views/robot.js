@@ -106,8 +106,9 @@ export class RobotView {
     }
     Object.assign(st, many ? { text: null, files } : { text: files[0].text, files: null });
     await this.parse();
-    // A single file the table reader refuses may be one pose (a ROS JSON).
-    if (!many && st.error) {
+    // A single file the table reader refuses may be one pose: a JSON object
+    // or `key: value` lines (a ROS pose as JSON, a YAML saved as .txt).
+    if (!many && st.error && /^\s*\{|^\s*[A-Za-z_][\w ]*:/m.test(files[0].text)) {
       const table = st.error;
       Object.assign(st, { text: null, files });
       await this.parse();
