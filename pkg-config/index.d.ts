@@ -1108,7 +1108,7 @@ export type PoseFormat =
   | 'ur' | 'kuka' | 'abb' | 'fanuc' | 'yaskawa' | 'staubli'
   | 'xyz_quat_xyzw' | 'xyz_quat_wxyz' | 'xyz_rotvec'
   | `xyz_euler_${EulerKind}_${EulerOrder}`
-  | 'matrix4';
+  | 'matrix4' | 'matrix3x4';
 export type LengthUnit = 'mm' | 'm';
 export type AngleUnit = 'deg' | 'rad';
 /** Which transform a file holds (poses are always returned as `base_from_gripper`). */
@@ -1124,11 +1124,17 @@ export interface PoseFileOptions {
   direction?: PoseDirection;
 }
 
+/** One pose file as the caller read it (`read_robot_pose_files`): its name (the stem names the pose) and text. */
+export interface PoseFileText {
+  name: string;
+  text: string;
+}
+
 /** One robot pose from a file. */
 export interface RobotPose {
   /** The `name`/`image` column, to pair the pose with an image. */
   name: string | null;
-  /** 1-based line of a text file, or 1-based element of a JSON array. */
+  /** 1-based line of a text file, 1-based element of a JSON array, or (one pose per file) the file's place in numeric order of the names. */
   line: number;
   /** The gripper (TCP) pose in the robot base frame (`geometry::pose_serde::PoseJson`): matrix, translation in metres, quaternion x y z w with w >= 0. */
   base_from_gripper: PoseReport;
@@ -1514,6 +1520,8 @@ export interface RobocalJson {
   rank_pose_conventions: [RankPoseInput, RankedCandidates];
   /** `read_robot_poses(text, JSON.stringify(options) or "")` -> the poses or candidates. */
   read_robot_poses: [PoseFileOptions, PoseReading];
+  /** `read_robot_pose_files(JSON.stringify(files), JSON.stringify(options) or "")` -> the poses or candidates, one pose per file (read in numeric order of the names, each named by its file's stem; docs/pose-formats.md). */
+  read_robot_pose_files: [PoseFileText[], PoseReading];
   /** `export_report(JSON.stringify(report), format, transform or "")` returns the file's text, not JSON. */
   export_report: [ExportableReport, never];
   /** `export_formats()` -> the format names. */

@@ -415,6 +415,15 @@ pub fn read_robot_poses(text: &str, options_json: &str) -> Result<String, JsErro
     crate::io::poses_api::read_poses_json(text, options_json).map_err(js_error)
 }
 
+/// Read one robot pose per file (a folder of ROS YAML, JSON or text files):
+/// `files_json` is `[{"name", "text"}, ...]`, the answer as
+/// [`read_robot_poses`], each pose named by its file's stem; errors name the
+/// file (see `robocal::io::poses_api::read_pose_files_json`).
+#[wasm_bindgen]
+pub fn read_robot_pose_files(files_json: &str, options_json: &str) -> Result<String, JsError> {
+    crate::io::poses_api::read_pose_files_json(files_json, options_json).map_err(js_error)
+}
+
 /// Parse a JSON request, run `solve`, return the JSON report.
 fn json_call<Req: serde::de::DeserializeOwned, Rep: Serialize>(
     what: &str,

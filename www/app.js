@@ -212,7 +212,7 @@ async function startSteps(versionPromise) {
     rig.render();
     $('engine-status').textContent = readyText();
   };
-  const hasWork = () => store.session.images.length || store.session.robot.text || store.session.camera.result || store.session.rig.cameras.some((c) => c.files.length);
+  const hasWork = () => store.session.images.length || store.session.robot.text || store.session.robot.files || store.session.camera.result || store.session.rig.cameras.some((c) => c.files.length);
   $('new-session').addEventListener('click', async () => {
     if (store.session.images.length && !confirm('Start a new session? Images, detections and results of this session are removed from this browser.')) return;
     await newSession();
@@ -229,7 +229,7 @@ async function startSteps(versionPromise) {
       store.session.target = t; // the core's target JSON
       store.changed('target-loaded');
       await images.addBytes(demo.images);
-      Object.assign(store.session.robot, { fileName: 'demo_poses.csv', text: demo.poses_csv, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper' });
+      Object.assign(store.session.robot, { fileName: 'demo_poses.csv', text: demo.poses_csv, files: null, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper' });
       robotView.render();
       await robotView.parse();
       if (!location.hash || location.hash === '#target') location.hash = 'images';

@@ -11,7 +11,7 @@ export function defaultSession() {
     target: { kind: 'chessboard', cols: 9, rows: 6, square_m: 0.03 }, // the core's target JSON (views/target.js)
     images: [], // { id, name, size, included, status, info, detection, error }
     camera: { model: 'brown', method: 'zhang', options: {}, result: null, comparison: null },
-    robot: { fileName: null, text: null, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper', parsed: null },
+    robot: { fileName: null, text: null, files: null, format: 'auto', lengthUnit: 'auto', angleUnit: 'auto', direction: 'base_from_gripper', parsed: null },
     handeye: { setup: 'eye-in-hand', method: 'all', result: null },
     workflows: { planar: null, xytable: null },
     // model, radial, tangential, options: the lens choice (views/lens.js); cameras: { name, files: [{ id, name, detection, error, spec }] }

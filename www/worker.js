@@ -78,6 +78,11 @@ handlers.poses = async ({ text, options }) => {
   return JSON.parse(robocal.read_robot_poses(text, options || ''));
 };
 
+handlers.poseFiles = async ({ files, options }) => {
+  await ready;
+  return JSON.parse(robocal.read_robot_pose_files(files, options || ''));
+};
+
 handlers.calibrate = async ({ input }) => {
   await ready;
   return JSON.parse(robocal.calibrate_camera(input));

@@ -2,8 +2,9 @@
 
 use super::detections_file::read_detections;
 use super::handeye_images::{
-    detect_images, image_pairs, pair_images, read_robot_poses, PairBy, PosePairs, RobotPoses,
+    detect_images, image_pairs, pair_images, PairBy, PosePairs, RobotPoses,
 };
+use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
 use robocal::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
@@ -18,7 +19,7 @@ use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
     about = "hand-eye calibration from robot poses and camera poses",
     long_about = "hand-eye calibration (camera on or beside a robot)
 
-  robocal handeye --setup eye-in-hand|eye-to-hand --poses FILE [--pose-format NAME]
+  robocal handeye --setup eye-in-hand|eye-to-hand --poses FILE|FOLDER|FILES... [--pose-format NAME]
                   --camera camera.json --target SPEC IMAGES... [--refine MODE] [--threads N]
                   [--method all|NAME] [--bootstrap N] [--seed N] [--lenient] -o handeye.json
   robocal handeye --setup ... --poses FILE --camera camera.json --detections detections.json [...]
@@ -54,6 +55,8 @@ Examples:
   robocal handeye --setup eye-in-hand --poses robot.csv --camera camera.json \\
                   --target chessboard:9x6:30mm view*.png -o handeye.json
   robocal handeye --setup eye-in-hand --poses robot.csv --camera-poses cam.txt -o handeye.json
+  robocal handeye --setup eye-in-hand --poses poses/ --camera camera.json \\
+                  --target chessboard:9x6:30mm images/*.png -o handeye.json   # one pose file per image
   robocal export handeye.json --format urdf",
     args_override_self = true
 )]
@@ -61,19 +64,23 @@ pub struct HandeyeArgs {
     /// eye-in-hand (camera on the gripper) or eye-to-hand (camera beside the robot)
     #[arg(long, value_name = "SETUP")]
     setup: Option<String>,
-    /// Robot poses base_from_gripper, one per view: any robot pose file
+    /// Robot poses base_from_gripper, one per view: a pose table
     /// (CSV/TSV/text/JSON with a header such as x,y,z,rx,ry,rz; 16 numbers a
-    /// line = row-major 4x4 in metres); an 'image' column pairs poses with
-    /// images by file name, otherwise poses and images pair by order
-    #[arg(long, value_name = "FILE")]
-    poses: Option<String>,
-    /// A pose-file format (ur, kuka, abb, fanuc, xyz_quat_xyzw, matrix4, ...)
-    /// or a line format: matrix (16 or 12 numbers), xyz-quaternion-xyzw,
-    /// xyz-quaternion-wxyz. Without it an ambiguous file is read every
-    /// plausible way and the reading that fits the camera motion is used (with
-    /// a warning)
-    #[arg(long, value_name = "NAME")]
+    /// line = row-major 4x4 in metres; an 'image' column pairs poses with
+    /// images by file name, otherwise poses and images pair by order), or a
+    /// folder or several files of one pose each (YAML such as ROS
+    /// position/orientation, JSON, text; a 4x4 or 3x4 matrix or x y z and a
+    /// quaternion), each paired with the image of the same file stem. Several
+    /// files take the values up to the next option: put IMAGES after another
+    /// option or after --
+    #[arg(long, value_name = "FILE|FOLDER", num_args = 1.., action = clap::ArgAction::Set)]
+    poses: Vec<String>,
+    #[arg(long, value_name = "NAME", help = super::robot_poses::POSE_FORMAT_SHORT, long_help = super::robot_poses::POSE_FORMAT_HELP)]
     pose_format: Option<String>,
+    /// Units of the pose files, overriding the header and the format's
+    /// defaults: mm or m, deg or rad, or both (mm,deg)
+    #[arg(long, value_name = "UNITS")]
+    pose_units: Option<String>,
     /// The camera (robocal camera JSON or calibration report, OpenCV YAML/XML,
     /// ROS camera_info)
     #[arg(long, value_name = "FILE")]
@@ -165,10 +172,9 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
         .as_deref()
         .ok_or_else(|| CliError::usage("handeye", "--setup eye-in-hand|eye-to-hand is required"))?
         .parse()?;
-    let poses_path = args
-        .poses
-        .as_deref()
-        .ok_or_else(|| CliError::usage("handeye", "--poses FILE is required"))?;
+    if args.poses.is_empty() {
+        return Err(CliError::usage("handeye", "--poses FILE is required"));
+    }
     let mut options = HandEyeOptions {
         strict_checks: !args.lenient,
         bootstrap_samples: args.bootstrap,
@@ -180,7 +186,17 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
         None | Some("all") => {}
         Some(name) => options.methods = vec![name.parse::<HandEyeMethod>()?],
     }
-    let poses_text = read_text(poses_path)?;
+    // Every pose file is read before any image (and checked just below).
+    let poses_source = read_pose_source("handeye", &args.poses)?;
+    let poses_path = poses_source.label().to_string();
+    let read_poses = || {
+        read_robot_poses(
+            "handeye",
+            &poses_source,
+            args.pose_format.as_deref(),
+            args.pose_units.as_deref(),
+        )
+    };
     let mut pairs = Vec::new();
     let mut pre_warnings = Vec::new();
     // The camera calibration's standard deviations, when --camera is a report.
@@ -193,9 +209,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                     "images need --camera and --target, not --camera-poses",
                 ));
             }
-            let robot = match read_robot_poses(&poses_text, args.pose_format.as_deref())
-                .map_err(|e| e.in_file(poses_path))?
-            {
+            let robot = match read_poses()? {
                 RobotPoses::Known(p) => p,
                 RobotPoses::Ambiguous(_) => {
                     return Err(CliError::usage(
@@ -230,12 +244,11 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
             let pair_by: PairBy = args.pair_by.parse()?;
             // The pose file is read and paired with the image names before
             // any image is detected: its mistakes come first.
-            let robot = read_robot_poses(&poses_text, args.pose_format.as_deref())
-                .map_err(|e| e.in_file(poses_path))?;
+            let robot = read_poses()?;
             let pair = |images: &[String]| -> Result<PosePairs, CliError> {
                 let (image_of_pose, how, unnamed_images) =
                     pair_images(robot.first(), images, pair_by)
-                        .map_err(|e| e.in_file(poses_path))?;
+                        .map_err(|e| e.in_file(&poses_path))?;
                 Ok(PosePairs {
                     image_of_pose,
                     how,

@@ -5,6 +5,7 @@
 //! audited.
 
 use super::detect::{run_all, Outcome};
+pub(super) use super::robot_poses::RobotPoses;
 use super::CliError;
 use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
@@ -15,93 +16,8 @@ use robocal::handeye::pnp::camera_from_target;
 use robocal::handeye::reprojection_refine::ViewPoints;
 use robocal::handeye::{Pose, Setup};
 use robocal::io::pose_pairing::{alternatives, numeric_order, pair_poses};
-use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
-use robocal::io::{parse_pose_candidates, parse_poses, PoseFileOptions, PoseFormat, RobotPose};
+use robocal::io::RobotPose;
 use robocal::target::Target;
-
-/// Robot poses as read: one reading, or ranked candidates of an ambiguous file.
-pub(super) enum RobotPoses {
-    /// The file's format is known.
-    Known(Vec<RobotPose>),
-    /// Several readings are plausible: (name, poses), most plausible first.
-    Ambiguous(Vec<(String, Vec<RobotPose>)>),
-}
-
-impl RobotPoses {
-    pub(super) fn first(&self) -> &[RobotPose] {
-        match self {
-            RobotPoses::Known(p) => p,
-            RobotPoses::Ambiguous(c) => c.first().map_or(&[], |c| &c.1),
-        }
-    }
-}
-
-/// Read robot poses: `--pose-format` names a pose-file format (`ur`,
-/// `xyz_quat_xyzw`, `matrix4`, ...) or a line format of the camera-pose
-/// reader (`matrix`, `xyz-quaternion-xyzw`); without it the file's header
-/// or value count decides, and ambiguous files give candidates.
-pub(super) fn read_robot_poses(text: &str, format: Option<&str>) -> Result<RobotPoses, CliError> {
-    let plain = |poses: Vec<Pose>| {
-        poses
-            .into_iter()
-            .enumerate()
-            .map(|(i, p)| RobotPose {
-                name: None,
-                line: i + 1,
-                base_from_gripper: p,
-            })
-            .collect()
-    };
-    if let Some(name) = format {
-        if let Some(f) = PoseFormat::from_name(name) {
-            let options = PoseFileOptions {
-                format: Some(f),
-                ..Default::default()
-            };
-            return Ok(RobotPoses::Known(parse_poses(text, &options)?.poses));
-        }
-        let Ok(f) = name.parse::<PoseTextFormat>() else {
-            let named: Vec<String> = PoseFormat::all()
-                .iter()
-                .filter(|f| !matches!(f, PoseFormat::XyzEuler { .. }))
-                .map(|f| f.name())
-                .collect();
-            return Err(CliError::usage(
-                "handeye",
-                format!(
-                    "--pose-format: unknown pose format '{name}' (valid: {}, \
-                     xyz_euler_intrinsic_ORDER or xyz_euler_extrinsic_ORDER with ORDER such as \
-                     zyx, or the line formats matrix, xyz-quaternion-xyzw, xyz-quaternion-wxyz)",
-                    named.join(", ")
-                ),
-            ));
-        };
-        return Ok(RobotPoses::Known(plain(parse_pose_text(text, Some(f))?)));
-    }
-    let options = PoseFileOptions::default();
-    match parse_poses(text, &options) {
-        Ok(parsed) => Ok(RobotPoses::Known(parsed.poses)),
-        Err(first) => match parse_pose_candidates(text, &options) {
-            Ok(c) if c.len() > 1 => Ok(RobotPoses::Ambiguous(
-                c.into_iter()
-                    .map(|c| {
-                        let name = format!(
-                            "{} ({}, {})",
-                            c.format.name(),
-                            c.length_unit.name(),
-                            c.angle_unit.name()
-                        );
-                        (name, c.poses)
-                    })
-                    .collect(),
-            )),
-            Ok(mut c) if c.len() == 1 => Ok(RobotPoses::Known(c.remove(0).poses)),
-            _ => parse_pose_text(text, None)
-                .map(|p| RobotPoses::Known(plain(p)))
-                .map_err(|_| first.into()),
-        },
-    }
-}
 
 /// What the images gave: the used pairs and the audit of every pose.
 pub(super) struct ImagePairs {

@@ -25,6 +25,7 @@ mod render_video;
 mod rig;
 mod rig_handeye;
 mod rig_summary;
+mod robot_poses;
 mod serve;
 mod stereo;
 mod target;

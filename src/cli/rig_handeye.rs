@@ -4,8 +4,8 @@
 //! forms and the pose refinement: `gripper_from_rig` or `base_from_rig`,
 //! written into the rig report under `handeye`.
 
-use super::handeye_images::{read_robot_poses, RobotPoses};
-use super::{read_text, CliError};
+use super::robot_poses::{read_pose_source, read_robot_poses, RobotPoses};
+use super::CliError;
 use robocal::calib::rig::RigCameraViews;
 use robocal::calib::rig_report::RigCalibration;
 use robocal::handeye::rig_json::solve_rig_on_robot;
@@ -23,12 +23,16 @@ pub struct RigHandEyeFlags {
     setup: Option<String>,
     /// Robot poses base_from_gripper, one per frame in frame order, or with
     /// an 'image' column naming a file of each frame (any robot pose file, as
-    /// 'robocal handeye --poses')
-    #[arg(long, value_name = "FILE", overrides_with = "poses")]
-    poses: Option<String>,
-    /// The pose file's format, as 'robocal handeye --pose-format'
-    #[arg(long, value_name = "NAME", overrides_with = "pose_format")]
+    /// 'robocal handeye --poses'), or a folder or several files of one pose
+    /// each (named by their stems)
+    #[arg(long, value_name = "FILE|FOLDER", num_args = 1.., action = clap::ArgAction::Set, overrides_with = "poses")]
+    poses: Vec<String>,
+    #[arg(long, value_name = "NAME", overrides_with = "pose_format", help = super::robot_poses::POSE_FORMAT_SHORT, long_help = super::robot_poses::POSE_FORMAT_HELP)]
     pose_format: Option<String>,
+    /// Units of the pose files, overriding the header and the format's
+    /// defaults: mm or m, deg or rad, or both (mm,deg)
+    #[arg(long, value_name = "UNITS", overrides_with = "pose_units")]
+    pose_units: Option<String>,
     /// Report suspected pose mistakes (units, inverted or shifted poses) as
     /// warnings instead of failing
     #[arg(long)]
@@ -38,11 +42,11 @@ pub struct RigHandEyeFlags {
 impl RigHandEyeFlags {
     /// Whether a hand-eye was asked for; both flags or neither.
     pub fn wanted(&self) -> Result<bool, CliError> {
-        match (&self.setup, &self.poses) {
-            (Some(_), Some(_)) => Ok(true),
-            (None, None) => Ok(false),
-            (Some(_), None) => Err(CliError::usage("rig", "--setup needs --poses FILE")),
-            (None, Some(_)) => Err(CliError::usage(
+        match (&self.setup, !self.poses.is_empty()) {
+            (Some(_), true) => Ok(true),
+            (None, false) => Ok(false),
+            (Some(_), false) => Err(CliError::usage("rig", "--setup needs --poses FILE")),
+            (None, true) => Err(CliError::usage(
                 "rig",
                 "--poses needs --setup eye-in-hand|eye-to-hand",
             )),
@@ -63,10 +67,14 @@ pub fn rig_handeye(
     source: &str,
 ) -> Result<Value, CliError> {
     let setup: Setup = flags.setup.as_deref().unwrap_or_default().parse()?;
-    let path = flags.poses.as_deref().unwrap_or_default();
-    let poses = match read_robot_poses(&read_text(path)?, flags.pose_format.as_deref())
-        .map_err(|e| e.in_file(path))?
-    {
+    let pose_source = read_pose_source("rig", &flags.poses)?;
+    let path = pose_source.label();
+    let poses = match read_robot_poses(
+        "rig",
+        &pose_source,
+        flags.pose_format.as_deref(),
+        flags.pose_units.as_deref(),
+    )? {
         RobotPoses::Known(p) => p,
         RobotPoses::Ambiguous(_) => {
             return Err(CliError::usage(

@@ -3,7 +3,8 @@
 //!
 //! Robot poses: [`parse_poses`] (format named, from a header, or unique by
 //! value count), [`parse_pose_candidates`] (every plausible reading, ranked),
-//! [`format_poses`] (the inverse). See [`PoseFormat`] for each vendor's
+//! [`format_poses`] (the inverse); one pose per file (a folder of YAML, JSON
+//! or text files): [`parse_pose_files`], [`parse_pose_file_candidates`]. See [`PoseFormat`] for each vendor's
 //! convention and formula. Camera poses as plain text (`--camera-poses`,
 //! camera_from_target per view): [`pose_text`].
 
@@ -19,12 +20,14 @@ pub mod import_camera;
 pub mod kalibr_target;
 pub mod pairing;
 mod pose_candidates;
+mod pose_files;
 mod pose_formats;
 mod pose_json;
 pub mod pose_pairing;
 mod pose_table;
 pub mod pose_text;
 mod pose_writer;
+mod pose_yaml;
 mod poses;
 pub mod poses_api;
 pub mod workflow_csv;
@@ -44,9 +47,13 @@ pub(crate) fn to_string_pretty(value: &serde_json::Value) -> String {
 }
 pub use kalibr_target::parse_kalibr_target;
 pub use pose_candidates::{parse_pose_candidates, Candidate};
+pub use pose_files::{parse_pose_file_candidates, parse_pose_files, PoseFileText};
 pub use pose_formats::{AngleUnit, LengthUnit, PoseFormat, QUATERNION_NORM_TOLERANCE};
 pub use pose_writer::format_poses;
-pub use poses::{parse_poses, ParsedPoses, PoseDirection, PoseFileOptions, RobotPose};
+pub use poses::{
+    parse_poses, radians_read_as_degrees, ParsedPoses, PoseDirection, PoseFileOptions, RobotPose,
+    RADIANS_AS_DEGREES_MAX_DEG,
+};
 
 /// The numbers of a JSON matrix given as rows of numbers (`[[..], [..]]`)
 /// or as one flat list, row-major; `None` if anything is not a number.

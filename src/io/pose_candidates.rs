@@ -47,8 +47,15 @@ const PLAUSIBLE_REACH_M: (f64, f64) = (0.05, 5.0);
 /// degrees (suggests radians), quaternion norms, and preset defaults. When
 /// no reading parses, the error of the first one tried is returned.
 pub fn parse_pose_candidates(text: &str, options: &PoseFileOptions) -> Result<Vec<Candidate>> {
-    let table = table_from_input(text)?;
-    let fixed = header_reading(&table, options)?;
+    candidates_from_table(&table_from_input(text)?, options)
+}
+
+/// [`parse_pose_candidates`] of a table.
+pub(crate) fn candidates_from_table(
+    table: &Table,
+    options: &PoseFileOptions,
+) -> Result<Vec<Candidate>> {
+    let fixed = header_reading(table, options)?;
     let header_len = table.header.as_ref().map(|(n, _)| n.len());
     let mut readings = Vec::new();
     match fixed {
@@ -71,7 +78,7 @@ pub fn parse_pose_candidates(text: &str, options: &PoseFileOptions) -> Result<Ve
             }
         }
         None => {
-            let Some(n) = first_row_value_count(&table) else {
+            let Some(n) = first_row_value_count(table) else {
                 return Err(no_poses());
             };
             for format in PoseFormat::all()
@@ -90,14 +97,14 @@ pub fn parse_pose_candidates(text: &str, options: &PoseFileOptions) -> Result<Ve
                 }
             }
             if readings.is_empty() {
-                return Err(table.rows[0].origin.error(
+                return Err(table.rows[0].error(
                     0,
-                    format!("{n} values, but pose formats have 6, 7 or 16 values a line"),
+                    format!("{n} values, but pose formats have 6, 7, 12 or 16 values a line"),
                 ));
             }
         }
     }
-    rank(&table, &readings, options)
+    rank(table, &readings, options)
 }
 
 /// The unit pairs to try: a fixed unit alone, else the default then the other.

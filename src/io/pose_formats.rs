@@ -16,7 +16,8 @@ use crate::geometry::{
 /// Names (for options, JSON and the CLI) are given by [`PoseFormat::name`]:
 /// `ur`, `kuka`, `abb`, `fanuc`, `yaskawa`, `staubli`, `xyz_quat_xyzw`,
 /// `xyz_quat_wxyz`, `xyz_rotvec`, `xyz_euler_<kind>_<order>` (e.g.
-/// `xyz_euler_intrinsic_zyx`, `xyz_euler_extrinsic_xyz`) and `matrix4`.
+/// `xyz_euler_intrinsic_zyx`, `xyz_euler_extrinsic_xyz`), `matrix4` and
+/// `matrix3x4`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(into = "String", try_from = "String")]
 pub enum PoseFormat {
@@ -73,6 +74,10 @@ pub enum PoseFormat {
     /// m10 ...`); default metres. Validated by
     /// [`crate::geometry::pose_from_matrix4`].
     Matrix4,
+    /// 12 numbers, the top three rows of the 4x4 matrix row by row (`r11
+    /// r12 r13 tx r21 r22 r23 ty r31 r32 r33 tz`); default metres. The
+    /// bottom row `0 0 0 1` is implied.
+    Matrix3x4,
 }
 
 /// The unit of lengths in a file.
@@ -143,7 +148,7 @@ pub(crate) enum RotationLayout {
     Matrix,
 }
 
-const NAMED: [PoseFormat; 10] = [
+const NAMED: [PoseFormat; 11] = [
     PoseFormat::Ur,
     PoseFormat::Kuka,
     PoseFormat::Abb,
@@ -154,6 +159,7 @@ const NAMED: [PoseFormat; 10] = [
     PoseFormat::XyzQuatWxyz,
     PoseFormat::XyzRotvec,
     PoseFormat::Matrix4,
+    PoseFormat::Matrix3x4,
 ];
 
 impl PoseFormat {
@@ -188,6 +194,7 @@ impl PoseFormat {
                 format!("xyz_euler_{k}_{}", order.name())
             }
             PoseFormat::Matrix4 => "matrix4".into(),
+            PoseFormat::Matrix3x4 => "matrix3x4".into(),
         }
     }
 
@@ -228,11 +235,14 @@ impl PoseFormat {
                 "m00", "m01", "m02", "m03", "m10", "m11", "m12", "m13", "m20", "m21", "m22", "m23",
                 "m30", "m31", "m32", "m33",
             ],
+            PoseFormat::Matrix3x4 => &[
+                "r11", "r12", "r13", "tx", "r21", "r22", "r23", "ty", "r31", "r32", "r33", "tz",
+            ],
         };
         cols.to_vec()
     }
 
-    /// How many numbers one pose has (6, 7 or 16).
+    /// How many numbers one pose has (6, 7, 12 or 16).
     pub fn value_count(&self) -> usize {
         self.columns().len()
     }
@@ -250,7 +260,17 @@ impl PoseFormat {
             | PoseFormat::XyzQuatWxyz
             | PoseFormat::XyzRotvec
             | PoseFormat::XyzEuler { .. }
-            | PoseFormat::Matrix4 => (LengthUnit::Metre, AngleUnit::Radian),
+            | PoseFormat::Matrix4
+            | PoseFormat::Matrix3x4 => (LengthUnit::Metre, AngleUnit::Radian),
+        }
+    }
+
+    /// Whether column `c` (0-based, in [`PoseFormat::columns`] order) is a
+    /// length: the first three, or a matrix's last column.
+    pub fn is_length_column(&self, c: usize) -> bool {
+        match self.layout() {
+            RotationLayout::Matrix => c % 4 == 3 && c < 12,
+            _ => c < 3,
         }
     }
 
@@ -273,7 +293,7 @@ impl PoseFormat {
             PoseFormat::XyzEuler { order, kind } => RotationLayout::Euler(order, kind),
             PoseFormat::Abb | PoseFormat::XyzQuatWxyz => RotationLayout::QuatWxyz,
             PoseFormat::XyzQuatXyzw => RotationLayout::QuatXyzw,
-            PoseFormat::Matrix4 => RotationLayout::Matrix,
+            PoseFormat::Matrix4 | PoseFormat::Matrix3x4 => RotationLayout::Matrix,
         }
     }
 }
@@ -387,11 +407,20 @@ pub(crate) fn pose_from_values(
 }
 
 fn matrix_pose(values: &[f64], metres_per_unit: f64) -> Result<Pose, ValueError> {
-    let mut m = Matrix4::from_row_slice(values);
+    // A 3x4 matrix is the 4x4 without its bottom row `0 0 0 1`.
+    let full: Vec<f64> = if values.len() == 12 {
+        values.iter().copied().chain([0.0, 0.0, 0.0, 1.0]).collect()
+    } else {
+        values.to_vec()
+    };
+    let mut m = Matrix4::from_row_slice(&full);
     m.fixed_view_mut::<3, 1>(0, 3).scale_mut(metres_per_unit);
     pose_from_matrix4(&m).map_err(|e| ValueError {
         index: WHOLE_ROW,
         message: match e {
+            crate::Error::Invalid { message, .. } if values.len() == 12 => {
+                format!("3x4 matrix {message}")
+            }
             crate::Error::Invalid { message, .. } => format!("4x4 matrix {message}"),
             other => other.to_string(),
         },
@@ -424,6 +453,7 @@ pub(crate) fn values_from_pose(
             let mut m = matrix4_from_pose(pose);
             m.fixed_view_mut::<3, 1>(0, 3).scale_mut(inv_l);
             out = m.transpose().iter().copied().collect();
+            out.truncate(format.value_count());
         }
     }
     out

@@ -8,7 +8,7 @@ use serde_json::Value;
 use super::pose_table::{Origin, Row, Table};
 use crate::error::{Error, Result};
 
-fn json_error(e: &serde_json::Error) -> Error {
+pub(crate) fn json_error(e: &serde_json::Error) -> Error {
     let text = e.to_string();
     let message = text
         .find(" at line ")
@@ -105,7 +105,11 @@ pub(crate) fn table_from_json(text: &str) -> Result<Table> {
                 ))
             }
         };
-        rows.push(Row { origin, fields });
+        rows.push(Row {
+            origin,
+            fields,
+            field_lines: Vec::new(),
+        });
     }
     Ok(Table {
         header: header.map(|h| (h, 0)),

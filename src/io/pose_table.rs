@@ -39,6 +39,26 @@ impl Origin {
 pub(crate) struct Row {
     pub origin: Origin,
     pub fields: Vec<String>,
+    /// For a row gathered from a whole file (one pose per file), the line
+    /// of each field (0 = unknown); empty for a row that is one line.
+    pub field_lines: Vec<usize>,
+}
+
+impl Row {
+    /// An error at field `column` (1-based; 0 = the whole row): at the
+    /// field's own line for a row gathered from a file, else at the row's
+    /// line and column.
+    pub fn error(&self, column: usize, message: impl Into<String>) -> Error {
+        if self.field_lines.is_empty() {
+            return self.origin.error(column, message);
+        }
+        let line = column
+            .checked_sub(1)
+            .and_then(|i| self.field_lines.get(i))
+            .copied()
+            .unwrap_or(self.origin.number());
+        Error::parse(line, 0, message)
+    }
 }
 
 /// A pose file as a table.
@@ -115,6 +135,7 @@ pub(crate) fn table_from_text(text: &str) -> Table {
         rows.push(Row {
             origin: Origin::Line(i + 1),
             fields,
+            field_lines: Vec::new(),
         });
     }
     Table { header, rows }
@@ -122,7 +143,7 @@ pub(crate) fn table_from_text(text: &str) -> Table {
 
 /// A header name without its unit: `(name, unit)` for `x_mm`, `x [mm]`,
 /// `x(mm)`, lowercased; `tx`/`px` become `x`.
-fn split_unit(raw: &str) -> (String, Option<&'static str>) {
+pub(crate) fn split_unit(raw: &str) -> (String, Option<&'static str>) {
     let lower = raw.trim().to_ascii_lowercase();
     let units = ["mm", "m", "deg", "rad"];
     let mut name = lower.clone();
@@ -161,16 +182,27 @@ pub(crate) struct HeaderMap {
     pub angle_unit: Option<AngleUnit>,
 }
 
-/// The names a format's columns may have in a header (lowercase).
+/// The names a format's columns may have in a header (lowercase, units
+/// removed as [`split_unit`] removes them: `tx` is `x`).
 fn accepted_names(format: PoseFormat, column: usize) -> Vec<String> {
-    let base = format.columns()[column].to_ascii_lowercase();
-    let rpy = PoseFormat::XyzEuler {
-        order: EulerOrder::XYZ,
-        kind: EulerKind::Extrinsic,
-    };
+    let base = split_unit(format.columns()[column]).0;
     let mut names = vec![base];
-    if format == rpy && column >= 3 {
-        names.push(["roll", "pitch", "yaw"][column - 3].to_string());
+    match format {
+        PoseFormat::XyzEuler { order, kind } if column >= 3 => {
+            let rpy = order == EulerOrder::XYZ && kind == EulerKind::Extrinsic;
+            if rpy {
+                names.push(["roll", "pitch", "yaw"][column - 3].to_string());
+            }
+            // `rx ry rz` name the axis each angle turns about; proper Euler
+            // orders (zyz) repeat an axis, so only e1 e2 e3 name them.
+            let axes: Vec<char> = order.name().chars().collect();
+            if axes[0] != axes[2] {
+                names.push(format!("r{}", axes[column - 3]));
+            }
+        }
+        // `m00 .. m23` as the top rows of a 4x4.
+        PoseFormat::Matrix3x4 => names.push(format!("m{}{}", column / 4, column % 4)),
+        _ => {}
     }
     names
 }
@@ -202,7 +234,7 @@ pub(crate) fn map_header(
     let mut angle_unit = None;
     for (c, &f) in value_fields.iter().enumerate() {
         let Some(u) = parsed[f].1 else { continue };
-        let is_length = c < 3 || format == PoseFormat::Matrix4;
+        let is_length = format.is_length_column(c);
         let clash = |what: &str| {
             Error::parse(
                 line,
@@ -258,10 +290,12 @@ pub(crate) fn map_header(
 }
 
 /// The formats a header can select by its names alone, most specific first.
-/// `x y z rx ry rz` selects UR (rotation vector); Yaskawa and Stäubli files
-/// use the same names and need the format named explicitly.
-const HEADER_FORMATS: [PoseFormat; 8] = [
+/// `x y z rx ry rz` selects UR (rotation vector) unless the angles carry
+/// `_deg` ([`DEGREE_RXRYRZ`]); Yaskawa and Stäubli files use the same names
+/// and need the format named explicitly.
+const HEADER_FORMATS: [PoseFormat; 9] = [
     PoseFormat::Matrix4,
+    PoseFormat::Matrix3x4,
     PoseFormat::XyzQuatXyzw,
     PoseFormat::Abb,
     PoseFormat::Kuka,
@@ -274,14 +308,39 @@ const HEADER_FORMATS: [PoseFormat; 8] = [
     PoseFormat::XyzQuatWxyz,
 ];
 
+/// What `x y z rx ry rz` with angles in degrees (`rx_deg`) is read as:
+/// Euler angles about the fixed x, then y, then z axes, `R = Rz(rz) ·
+/// Ry(ry) · Rx(rx)` (ROS roll-pitch-yaw, the UR pendant's RPY view, FANUC W
+/// P R, Yaskawa Rx Ry Rz). A rotation vector is never written in degrees by
+/// the tools that write one (UR, OpenCV), while teach pendants show Euler
+/// angles in degrees under these names.
+pub const DEGREE_RXRYRZ: PoseFormat = PoseFormat::XyzEuler {
+    order: EulerOrder::XYZ,
+    kind: EulerKind::Extrinsic,
+};
+
+/// The note said when [`DEGREE_RXRYRZ`] was assumed.
+pub(crate) fn degree_rxryrz_note() -> String {
+    format!(
+        "rx ry rz in degrees read as Euler angles about the fixed x, then y, then z axes \
+         (R = Rz·Ry·Rx, format {}); name another convention with the format, e.g. staubli \
+         (xyz_euler_intrinsic_xyz) or xyz_euler_intrinsic_zyx",
+        DEGREE_RXRYRZ.name()
+    )
+}
+
 /// The format a header names, with its mapping. For quaternions, `qw`
-/// before `qx` selects `xyz_quat_wxyz`.
+/// before `qx` selects `xyz_quat_wxyz`; `rx ry rz` in degrees selects
+/// [`DEGREE_RXRYRZ`].
 pub(crate) fn detect_header(
     names: &[String],
     line: usize,
 ) -> Result<Option<(PoseFormat, HeaderMap)>> {
     for format in HEADER_FORMATS {
         if let Some(map) = map_header(names, format, line)? {
+            if format == PoseFormat::Ur && map.angle_unit == Some(AngleUnit::Degree) {
+                return Ok(map_header(names, DEGREE_RXRYRZ, line)?.map(|m| (DEGREE_RXRYRZ, m)));
+            }
             if format == PoseFormat::XyzQuatXyzw && map.value_fields[6] < map.value_fields[3] {
                 let wxyz = PoseFormat::XyzQuatWxyz;
                 return Ok(map_header(names, wxyz, line)?.map(|m| (wxyz, m)));
@@ -295,4 +354,18 @@ pub(crate) fn detect_header(
 /// Whether a header field is a name column.
 pub(crate) fn is_name_column(name: &str) -> bool {
     NAME_COLUMNS.contains(&split_unit(name).0.as_str())
+}
+
+/// Whether a header names `name` (units removed, case ignored).
+pub(crate) fn header_has(names: &[String], name: &str) -> bool {
+    names.iter().any(|n| split_unit(n).0 == name)
+}
+
+/// Whether some format reads a header field of this name (`x_mm`, `qw`,
+/// `A`, `roll`, `r11`, ...).
+pub(crate) fn is_pose_column(name: &str) -> bool {
+    let own = split_unit(name).0;
+    PoseFormat::all()
+        .into_iter()
+        .any(|f| (0..f.value_count()).any(|c| accepted_names(f, c).contains(&own)))
 }

@@ -453,3 +453,120 @@ fn random_bytes_and_text_never_panic() {
         let _ = parse_pose_candidates(&text, &o);
     }
 }
+
+#[wasm_bindgen_test(unsupported = test)]
+fn matrix3x4_tables_by_header_names_in_any_order_or_twelve_numbers() {
+    let d = PoseFileOptions::default();
+    let t = |p: &Pose| p.translation.vector;
+    // r11..tz interleaved as rows, then the rotation first and the
+    // translation last, then m00..m23, then no header.
+    for text in [
+        "r11,r12,r13,tx,r21,r22,r23,ty,r31,r32,r33,tz\n0,-1,0,0.1,1,0,0,0.2,0,0,1,0.3\n",
+        "r11,r12,r13,r21,r22,r23,r31,r32,r33,tx,ty,tz\n0,-1,0,1,0,0,0,0,1,0.1,0.2,0.3\n",
+        "m00 m01 m02 m03 m10 m11 m12 m13 m20 m21 m22 m23\n0 -1 0 0.1 1 0 0 0.2 0 0 1 0.3\n",
+        "0 -1 0 0.1 1 0 0 0.2 0 0 1 0.3\n",
+    ] {
+        let parsed = parse_poses(text, &d).unwrap();
+        assert_eq!(parsed.format, PoseFormat::Matrix3x4, "{text}");
+        let p = parsed.poses[0].base_from_gripper;
+        assert_rotation(&p, RZ90);
+        assert!(
+            (t(&p) - Vector3::new(0.1, 0.2, 0.3)).norm() < 1e-12,
+            "{text}"
+        );
+    }
+    // Millimetres by the header, on the translation columns.
+    let mm =
+        "r11,r12,r13,r21,r22,r23,r31,r32,r33,tx_mm,ty_mm,tz_mm\n1,0,0,0,1,0,0,0,1,100,200,300\n";
+    let parsed = parse_poses(mm, &d).unwrap();
+    assert_eq!(parsed.length_unit, LengthUnit::Millimetre);
+    assert!((t(&parsed.poses[0].base_from_gripper) - Vector3::new(0.1, 0.2, 0.3)).norm() < 1e-12);
+    // Not a rotation: said for the 3x4 matrix, at the line.
+    let err = parse_poses("1 0 0 0 0 1 0 0 0 0 2 0\n", &d)
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with("line 1: 3x4 matrix "), "{err}");
+    // The writer's table reads back.
+    let text = format_poses(
+        &parsed.poses,
+        PoseFormat::Matrix3x4,
+        LengthUnit::Metre,
+        AngleUnit::Radian,
+    );
+    assert_eq!(
+        text.lines().next().unwrap(),
+        "r11,r12,r13,tx,r21,r22,r23,ty,r31,r32,r33,tz"
+    );
+    let back = parse_poses(&text, &d).unwrap();
+    assert!((t(&back.poses[0].base_from_gripper) - Vector3::new(0.1, 0.2, 0.3)).norm() < 1e-12);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn header_units_and_names_say_the_convention() {
+    let d = PoseFileOptions::default();
+    // _deg on rx ry rz: Euler about the fixed x, y, z (not a rotation vector).
+    let deg = "x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg\n100,200,300,90,0,90\n";
+    let parsed = parse_poses(deg, &d).unwrap();
+    let rpy = PoseFormat::XyzEuler {
+        order: EulerOrder::XYZ,
+        kind: EulerKind::Extrinsic,
+    };
+    assert_eq!(parsed.format, rpy);
+    assert_eq!(
+        (parsed.length_unit, parsed.angle_unit),
+        (LengthUnit::Millimetre, AngleUnit::Degree)
+    );
+    assert_rotation(&parsed.poses[0].base_from_gripper, RZ90_RX90);
+    assert!(
+        (parsed.poses[0].base_from_gripper.translation.vector - Vector3::new(0.1, 0.2, 0.3)).norm()
+            < 1e-12
+    );
+    assert_eq!(
+        parsed.notes[1],
+        "rx ry rz in degrees read as Euler angles about the fixed x, then y, then z axes (R = Rz·Ry·Rx, format xyz_euler_extrinsic_xyz); name another convention with the format, e.g. staubli (xyz_euler_intrinsic_xyz) or xyz_euler_intrinsic_zyx"
+    );
+    // The format overrides the assumed convention; columns by their names.
+    let staubli = parse_poses(deg, &opts(PoseFormat::Staubli)).unwrap();
+    assert_rotation(&staubli.poses[0].base_from_gripper, RX90_RZ90);
+    let zyx = PoseFormat::XyzEuler {
+        order: EulerOrder::ZYX,
+        kind: EulerKind::Intrinsic,
+    };
+    let p = parse_poses(deg, &opts(zyx)).unwrap();
+    // rz is e1 of zyx: Rz(90)·Ry(0)·Rx(90), the same product as extrinsic xyz.
+    assert_rotation(&p.poses[0].base_from_gripper, RZ90_RX90);
+    // Without units: UR's rotation vector in radians, as before.
+    assert_eq!(
+        parse_poses("x,y,z,rx,ry,rz\n0,0,0,0,0,1\n", &d)
+            .unwrap()
+            .format,
+        PoseFormat::Ur
+    );
+    // qw first or last by its place in the header.
+    let wxyz = parse_poses(
+        "x,y,z,qw,qx,qy,qz\n0,0,0,0.7071067811865476,0,0,0.7071067811865476\n",
+        &d,
+    )
+    .unwrap();
+    assert_eq!(wxyz.format, PoseFormat::XyzQuatWxyz);
+    assert_rotation(&wxyz.poses[0].base_from_gripper, RZ90);
+    let xyzw = parse_poses(
+        "x,y,z,qx,qy,qz,qw\n0,0,0,0,0,0.7071067811865476,0.7071067811865476\n",
+        &d,
+    )
+    .unwrap();
+    assert_eq!(xyzw.format, PoseFormat::XyzQuatXyzw);
+    assert_rotation(&xyzw.poses[0].base_from_gripper, RZ90);
+    // Radians under a _deg header read as degrees: tiny angles, left for the
+    // plausibility checks (the reading itself is what the header says).
+    let small = parse_poses(
+        "x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg\n100,0,0,1.5707963267948966,0,0\n",
+        &d,
+    )
+    .unwrap();
+    assert!(
+        (small.poses[0].base_from_gripper.rotation.angle() - 1.5707963267948966f64.to_radians())
+            .abs()
+            < 1e-12
+    );
+}

@@ -35,11 +35,7 @@ pub fn format_poses(
         header.push("name".into());
     }
     for (i, col) in format.columns().iter().enumerate() {
-        let is_length = if format == PoseFormat::Matrix4 {
-            i % 4 == 3 && i < 12
-        } else {
-            i < 3
-        };
+        let is_length = format.is_length_column(i);
         let suffix = if is_length && length_unit != dl {
             format!("_{}", length_unit.name())
         } else if !is_length && i >= 3 && format.uses_angles() && angle_unit != da {

@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 use super::pose_formats::{pose_from_values, AngleUnit, LengthUnit, PoseFormat, WHOLE_ROW};
 use super::pose_json::table_from_json;
 use super::pose_table::{
-    detect_header, map_header, number, table_from_text, HeaderMap, Row, Table,
+    degree_rxryrz_note, detect_header, header_has, map_header, number, table_from_text, HeaderMap,
+    Row, Table, DEGREE_RXRYRZ,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Pose;
@@ -108,13 +109,44 @@ pub fn parse_poses(text: &str, options: &PoseFileOptions) -> Result<ParsedPoses>
     let table = table_from_input(text)?;
     let reading = resolve(&table, options)?;
     let poses = read_rows(&table.rows, &reading, options.direction)?;
-    Ok(ParsedPoses {
+    let mut parsed = ParsedPoses {
         poses,
         format: reading.format,
         length_unit: reading.length_unit,
         angle_unit: reading.angle_unit,
         direction: options.direction,
         notes: reading.notes,
+    };
+    parsed.notes.extend(radians_read_as_degrees(&parsed));
+    Ok(parsed)
+}
+
+/// Every pose within this rotation (degrees) of the base orientation, with
+/// the angles read as degrees, suggests radians read as degrees: three
+/// Euler angles within ±pi each, read as degrees, turn by at most 3 pi deg.
+pub const RADIANS_AS_DEGREES_MAX_DEG: f64 = 3.0 * std::f64::consts::PI;
+
+/// The suspicion that a reading in degrees holds radians: at least two
+/// poses, every one within [`RADIANS_AS_DEGREES_MAX_DEG`] of the base
+/// orientation (a robot's tool is rarely that close to the base axes in
+/// every pose). Also in [`ParsedPoses::notes`].
+pub fn radians_read_as_degrees(parsed: &ParsedPoses) -> Option<String> {
+    if !parsed.format.uses_angles()
+        || parsed.angle_unit != AngleUnit::Degree
+        || parsed.poses.len() < 2
+    {
+        return None;
+    }
+    let largest = parsed
+        .poses
+        .iter()
+        .map(|p| p.base_from_gripper.rotation.angle().to_degrees())
+        .fold(0.0f64, f64::max);
+    (largest > 0.0 && largest <= RADIANS_AS_DEGREES_MAX_DEG).then(|| {
+        format!(
+            "every pose is within {} deg of the base orientation with the angles read as degrees: radians read as degrees? If the file holds radians, say so (a _rad header, --pose-units rad, or Angles: radians on the page)",
+            super::pose_formats::short(largest)
+        )
     })
 }
 
@@ -152,6 +184,9 @@ pub(crate) fn header_reading(
         None => match detect_header(names, *line)? {
             Some((f, map)) => {
                 notes.push(format!("format {} from the header", f.name()));
+                if f == DEGREE_RXRYRZ && header_has(names, "rx") {
+                    notes.push(degree_rxryrz_note());
+                }
                 (f, Some(map))
             }
             None => {
@@ -186,7 +221,7 @@ pub(crate) fn no_poses() -> Error {
     )
 }
 
-fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
+pub(crate) fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
     let (format, header, mut notes) = match header_reading(table, options)? {
         Some(found) => found,
         None => {
@@ -205,9 +240,9 @@ fn resolve(table: &Table, options: &PoseFileOptions) -> Result<Reading> {
                     vec![format!("format {} from {n} values a line", only.name())],
                 ),
                 [] => {
-                    return Err(table.rows[0].origin.error(
+                    return Err(table.rows[0].error(
                         0,
-                        format!("{n} values, but pose formats have 6, 7 or 16 values a line"),
+                        format!("{n} values, but pose formats have 6, 7, 12 or 16 values a line"),
                     ))
                 }
                 many => {
@@ -270,7 +305,7 @@ fn row_values(row: &Row, reading: &Reading) -> Result<(Vec<f64>, Option<String>)
             } else {
                 format!("'{shown}' is not a number")
             };
-            row.origin.error(i + 1, msg)
+            row.error(i + 1, msg)
         })
     };
     if let Some(h) = &reading.header {
@@ -301,7 +336,7 @@ fn row_values(row: &Row, reading: &Reading) -> Result<(Vec<f64>, Option<String>)
     }
     let named = n == k + 1 && number(&row.fields[0]).is_none();
     if n != k && !named {
-        return Err(row.origin.error(0, format!("{n} values, {needs}")));
+        return Err(row.error(0, format!("{n} values, {needs}")));
     }
     let start = usize::from(named);
     let values = (start..n).map(parse).collect::<Result<Vec<f64>>>()?;
@@ -332,7 +367,7 @@ pub(crate) fn read_rows(
                 Some(h) => h.value_fields.get(e.index).map_or(0, |i| i + 1),
                 None => e.index + 1 + usize::from(row.fields.len() > values.len()),
             };
-            row.origin.error(column, e.message)
+            row.error(column, e.message)
         })?;
         let base_from_gripper = match direction {
             PoseDirection::BaseFromGripper => pose,

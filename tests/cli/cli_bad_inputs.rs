@@ -301,7 +301,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "three.txt", "--camera-poses", "three.txt"],
         code: 1,
         stream: Stream::Stderr,
-        message: "robocal: 'three.txt': line 1: 3 values, but pose formats have 6, 7 or 16 values a line",
+        message: "robocal: 'three.txt': line 1: 3 values, but pose formats have 6, 7, 12 or 16 values a line",
     },
     Case {
         name: "poses-not-a-rotation",
@@ -475,7 +475,7 @@ const CASES: &[Case] = &[
         args: &["handeye", "--setup", "eye-in-hand", "--poses", "p.txt", "--pose-format", "furlong", "--camera-poses", "p.txt"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: handeye: --pose-format: unknown pose format 'furlong' (valid: ur, kuka, abb, fanuc, yaskawa, staubli, xyz_quat_xyzw, xyz_quat_wxyz, xyz_rotvec, matrix4, xyz_euler_intrinsic_ORDER or xyz_euler_extrinsic_ORDER with ORDER such as zyx, or the line formats matrix, xyz-quaternion-xyzw, xyz-quaternion-wxyz) (see 'robocal handeye --help')",
+        message: "robocal: handeye: --pose-format: unknown pose format 'furlong' (valid: ur, kuka, abb, fanuc, yaskawa, staubli, xyz_quat_xyzw, xyz_quat_wxyz, xyz_rotvec, matrix4, matrix3x4, xyz_euler_intrinsic_ORDER or xyz_euler_extrinsic_ORDER with ORDER such as zyx, or the line formats matrix, xyz-quaternion-xyzw, xyz-quaternion-wxyz) (see 'robocal handeye --help')",
     },
     Case {
         name: "xytable-empty-csv",

@@ -365,7 +365,7 @@ export const tests = [
   ['poses-zero-quaternion', posesCase(text('zeroq.csv', 'x,y,z,qx,qy,qz,qw\n0.1,0.2,0.3,0,0,0,0\n'), 'line 2, column 4: quaternion has norm 0: not a rotation')],
   ['poses-unknown-header', posesCase(text('header.csv', 'x y z\n1 2 3\n'),
     "line 1: the header 'x y z' names no known pose format; name the format, or use column names such as x,y,z,qx,qy,qz,qw or X,Y,Z,A,B,C")],
-  ['poses-three-values', posesCase(text('three.txt', '1 2 3\n4 5 6\n'), 'line 1: 3 values, but pose formats have 6, 7 or 16 values a line')],
+  ['poses-three-values', posesCase(text('three.txt', '1 2 3\n4 5 6\n'), 'line 1: 3 values, but pose formats have 6, 7, 12 or 16 values a line')],
   ['poses-not-a-rotation', posesCase(text('scaled.txt', '2 0 0 0.1 0 2 0 0.2 0 0 2 0.3 0 0 0 1\n'),
     'line 1: 4x4 matrix rotation block is not orthonormal: largest |RᵀR - I| entry is 3.000e0, tolerance 1e-3')],
   ['poses-count-mismatch', async (page, { url, shot }) => {
@@ -504,6 +504,40 @@ export const tests = [
     await page.click('#solve-handeye');
     await page.locator('#handeye-results .msg-error').waitFor({ timeout: 10000 });
     assert.equal(await page.textContent('#handeye-results'), "pairing: two poses name the same image: rows 3, 4 all name 'demo_01.png': each image pairs with one robot pose; fix the image column");
+  }],
+
+  // ---- One pose per file (issue 36): ROS YAML files chosen together pair by stem; a bad file is named ----
+  ['pose-files-one-per-image', async (page, { url, shot }) => {
+    await loadDemoImages(page, url);
+    assert.equal(await solveCamera(page), null);
+    await page.click('a[data-step=robot]');
+    const rows = demo().poses.trim().split('\n').slice(1).map((l) => l.split(','));
+    const files = rows.map(([name, ...v], i) => {
+      const [x, y, z, rx, ry, rz] = v.map(Number);
+      const a = Math.hypot(rx, ry, rz);
+      const k = a < 1e-12 ? 0.5 : Math.sin(a / 2) / a;
+      const stem = name.replace(/\.[^.]*$/, '');
+      const yaml = i % 2
+        ? `position: {x: ${x}, y: ${y}, z: ${z}}\norientation: {x: ${rx * k}, y: ${ry * k}, z: ${rz * k}, w: ${Math.cos(a / 2)}}\n`
+        : `header:\n  frame_id: base_link\npose:\n  position:\n    x: ${x}\n    y: ${y}\n    z: ${z}\n  orientation:\n    x: ${rx * k}\n    y: ${ry * k}\n    z: ${rz * k}\n    w: ${Math.cos(a / 2)}\n`;
+      return text(`${stem}.yaml`, yaml);
+    });
+    // Chosen in reverse order: read in numeric order of the names.
+    await page.setInputFiles('#pose-input', [...files].reverse());
+    await page.waitForFunction(() => /^12 pose files: 12 poses read as xyz_quat_xyzw/.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    await page.waitForFunction(() => /Paired by the name column: 12 pairs usable/.test(document.getElementById('pose-pairing')?.textContent || ''), null, { timeout: 20000 });
+    await page.click('a[data-step=handeye]');
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-errors').waitFor({ timeout: 60000 });
+    assert.equal(await page.$('#handeye-results .msg-error'), null);
+    // A file whose quaternion is not a rotation: refused, the file and line named.
+    await page.click('a[data-step=robot]');
+    const bad = [...files];
+    bad[4] = text(bad[4].name, 'position: {x: 0.1, y: 0.2, z: 0.3}\norientation:\n  {x: 0, y: 0, z: 0, w: 2}\n');
+    await page.setInputFiles('#pose-input', bad);
+    await page.locator('#pose-results .msg-error').waitFor({ timeout: 20000 });
+    assert.equal(await page.textContent('#pose-results'), `'${bad[4].name}': line 3: quaternion has norm 2: not a rotation`);
+    await shot('bad');
   }],
 
   // ---- New session (issue 34): every step starts anew, the hand-eye setup included ----

@@ -181,6 +181,15 @@ const bare = meta.poses_csv.trim().split('\n').slice(1).map((l) => l.split(',').
 const ambiguous = output('read_robot_poses', JSON.parse(robocal.read_robot_poses(bare, '')), 'read_robot_poses bare');
 assert.ok(ambiguous.parsed === null && ambiguous.candidates.length > 1, 'a bare 6-column file is ambiguous');
 
+// One pose per file: the demo rows as files named by their images, given in reverse.
+const perFileInput = meta.poses_csv.trim().split('\n').slice(1).map((l) => {
+  const [name, ...v] = l.split(',');
+  return { name: name.replace(/\.png$/, '.txt'), text: `x y z rx ry rz\n${v.join(' ')}\n` };
+}).reverse();
+const perFile = output('read_robot_pose_files', JSON.parse(robocal.read_robot_pose_files(JSON.stringify(input('read_robot_pose_files', perFileInput)), '')));
+assert.deepEqual(perFile.parsed.poses.map((p) => p.base_from_gripper.translation_m), poses.parsed.poses.map((p) => p.base_from_gripper.translation_m));
+assert.deepEqual(perFile.parsed.poses.map((p) => p.name), poses.parsed.poses.map((p) => p.name.replace(/\.png$/, '')));
+
 const base_from_gripper = poses.parsed.poses.map((p) => p.base_from_gripper);
 const eyeInHand = call('solve_handeye', { setup: 'eye-in-hand', base_from_gripper, detections, camera: all, bootstrap_samples: 5 }, 'solve_handeye detections');
 assert.equal(eyeInHand.setup, 'eye-in-hand');

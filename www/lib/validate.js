@@ -131,6 +131,8 @@ export function checkSession(raw, path = 'session') {
 
   s.robot = step('robot');
   for (const key of ['fileName', 'text']) s.robot[key] = check.stringOrNull(s.robot[key], `${path}.robot.${key}`);
+  s.robot.files = s.robot.files === undefined || s.robot.files === null ? null : check.list(s.robot.files, `${path}.robot.files`);
+  (s.robot.files || []).forEach((f, i) => { check.object(f, `${path}.robot.files[${i}]`); check.string(f.name, `${path}.robot.files[${i}].name`); check.string(f.text, `${path}.robot.files[${i}].text`); });
   for (const key of ['format', 'lengthUnit', 'angleUnit', 'direction']) check.string(s.robot[key], `${path}.robot.${key}`);
   s.robot.parsed = check.objectOrNull(s.robot.parsed, `${path}.robot.parsed`);
   if (s.robot.parsed && s.robot.parsed.poses !== undefined) check.list(s.robot.parsed.poses, `${path}.robot.parsed.poses`);

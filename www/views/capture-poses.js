@@ -54,6 +54,7 @@ export class CapturePoses {
     if (!lines.length || (st.fileName === TYPED_POSES && st.text === text)) return;
     st.fileName = TYPED_POSES;
     st.text = text;
+    st.files = null;
     const view = this.robot();
     if (view) { view.render(); await view.parse(); } else this.store.changed('robot');
   }

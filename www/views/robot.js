@@ -1,6 +1,8 @@
-// Step 4: robot poses. Drop a pose file; see how it was read (format, units,
-// direction: editable, with vendor presets), the parsed poses, and which
-// pose goes with which image.
+// Step 4: robot poses. Load a pose table, or several files of one pose each
+// (ROS YAML, JSON, text: read by one wasm call, paired with the images by
+// file stem); see how they were read (format, units, direction: editable,
+// with vendor presets), the parsed poses, and which pose goes with which
+// image.
 import { $, h, fill, table, num, message, readTextFile } from '../lib/dom.js';
 
 export const PRESETS = [
@@ -15,7 +17,18 @@ export const PRESETS = [
   ['xyz_quat_wxyz', 'Generic x y z qw qx qy qz'],
   ['xyz_rotvec', 'Generic x y z + rotation vector'],
   ['matrix4', '4×4 matrices (16 numbers a row)'],
+  ['matrix3x4', '3×4 matrices (12 numbers a row: r11 r12 r13 tx … tz)'],
+  ...['extrinsic', 'intrinsic'].flatMap((kind) => ['xyz', 'xzy', 'yxz', 'yzx', 'zxy', 'zyx', 'xyx', 'xzx', 'yxy', 'yzy', 'zxz', 'zyz']
+    .map((order) => [`xyz_euler_${kind}_${order}`, `Euler x y z + ${order} ${kind === 'extrinsic' ? 'about fixed axes' : 'about moving axes'}`])),
 ];
+
+/** What the page reads as one pose per file when loaded alone. */
+const ONE_POSE_FILE = /\.(ya?ml)$/i;
+
+/** The forms the step reads, for its hint. */
+const FORMS_HINT = 'A pose table (CSV, TSV, text or JSON: a header such as x,y,z,qx,qy,qz,qw, X,Y,Z,A,B,C, x_mm,…,rx_deg,… or r11,…,tz, or 6, 7, 12 or 16 numbers a line), '
+  + 'or several files of one pose each (choose them together: ROS YAML position/orientation, JSON, a 4×4 or 3×4 matrix as text), each paired with the image of the same file stem. '
+  + 'rx ry rz in degrees are read as Euler angles about the fixed x, y, z axes (R = Rz·Ry·Rx); choose another format above for another convention.';
 
 function rotvecDeg(q) {
   const [x, y, z, w] = q;
@@ -40,29 +53,19 @@ export class RobotView {
     const sel = (id, items, value, label) => h('label', {}, label, h('select', { id }, items.map(([v, t]) => h('option', { value: v, selected: v === value }, t))));
     // The native file field would say "No file chosen" once a file is read
     // (and after a reload): a button opens it, and the loaded file is named.
-    const input = h('input', { type: 'file', id: 'pose-input', 'aria-label': 'pose file', accept: '.csv,.tsv,.txt,.json,.dat,text/*,application/json', hidden: true, tabindex: -1 });
+    const input = h('input', { type: 'file', id: 'pose-input', 'aria-label': 'pose files', multiple: true, accept: '.csv,.tsv,.txt,.json,.dat,.yaml,.yml,text/*,application/json', hidden: true, tabindex: -1 });
     const fileName = h('span', { id: 'pose-file-name' }, st.fileName ? `loaded: ${st.fileName}` : 'no file loaded');
     input.addEventListener('change', async () => {
-      const f = input.files[0];
-      if (!f) return;
+      const chosen = [...input.files];
+      if (!chosen.length) return;
       input.value = '';
-      st.fileName = f.name;
-      fileName.textContent = `loaded: ${f.name}`;
-      try {
-        st.text = await readTextFile(f, 'one robot pose a line, one per image');
-      } catch (err) {
-        // Nothing of this file is used: the poses of an earlier file are not
-        // shown under its name.
-        Object.assign(st, { text: '', reading: null, parsed: null, error: err.message });
-        this.store.changed('robot');
-        this.show();
-        return;
-      }
-      await this.parse();
+      await this.load(chosen);
+      fileName.textContent = `loaded: ${st.fileName}`;
     });
     const form = h('div', { class: 'form', id: 'pose-form' },
       h('div', { class: 'row file-row' }, h('span', {}, 'Pose file'),
-        h('button', { type: 'button', id: 'pose-choose', 'aria-describedby': 'pose-file-name', onclick: () => input.click() }, 'Choose pose file…'), fileName, input),
+        h('button', { type: 'button', id: 'pose-choose', 'aria-describedby': 'pose-file-name', onclick: () => input.click() }, 'Choose pose file(s)…'), fileName, input),
+      h('p', { class: 'hint', id: 'pose-forms' }, FORMS_HINT),
       sel('pose-format', PRESETS, st.format, 'Format '),
       sel('pose-length', [['auto', 'from the file or preset'], ['mm', 'millimetres'], ['m', 'metres']], st.lengthUnit, 'Lengths '),
       sel('pose-angle', [['auto', 'from the file or preset'], ['deg', 'degrees'], ['rad', 'radians']], st.angleUnit, 'Angles '),
@@ -81,6 +84,38 @@ export class RobotView {
     this.show();
   }
 
+  /**
+   * Load chosen files: one file is a pose table (a .yaml/.yml file, or a
+   * file the table reader refuses but the one-pose reader takes, is one
+   * pose); several are one pose each. A file that is not text is named.
+   */
+  async load(chosen) {
+    const st = this.state;
+    const many = chosen.length > 1 || ONE_POSE_FILE.test(chosen[0].name);
+    st.fileName = chosen.length > 1 ? `${chosen.length} pose files` : chosen[0].name;
+    const files = [];
+    try {
+      for (const f of chosen) files.push({ name: f.name, text: await readTextFile(f, many ? 'one robot pose' : 'one robot pose a line, one per image').catch((err) => { throw new Error(chosen.length > 1 ? `'${f.name}': ${err.message}` : err.message); }) });
+    } catch (err) {
+      // Nothing of these files is used: the poses of earlier files are not
+      // shown under their names.
+      Object.assign(st, { text: '', files: null, reading: null, parsed: null, error: err.message });
+      this.store.changed('robot');
+      this.show();
+      return;
+    }
+    Object.assign(st, many ? { text: null, files } : { text: files[0].text, files: null });
+    await this.parse();
+    // A single file the table reader refuses may be one pose: a JSON object
+    // or `key: value` lines (a ROS pose as JSON, a YAML saved as .txt).
+    if (!many && st.error && /^\s*\{|^\s*[A-Za-z_][\w ]*:/m.test(files[0].text)) {
+      const table = st.error;
+      Object.assign(st, { text: null, files });
+      await this.parse();
+      if (st.error) { Object.assign(st, { text: files[0].text, files: null, error: table }); this.show(); }
+    }
+  }
+
   options() {
     const st = this.state;
     const o = { direction: st.direction };
@@ -92,9 +127,12 @@ export class RobotView {
 
   async parse() {
     const st = this.state;
-    if (!st.text) return;
+    if (!st.text && !(st.files && st.files.length)) return;
     try {
-      st.reading = await this.engine.call('poses', { text: st.text, options: JSON.stringify(this.options()) });
+      const options = JSON.stringify(this.options());
+      st.reading = st.files && st.files.length
+        ? await this.engine.call('poseFiles', { files: JSON.stringify(st.files), options })
+        : await this.engine.call('poses', { text: st.text, options });
       st.error = null;
       st.parsed = st.reading.parsed || (st.reading.candidates[0] ? { ...st.reading.candidates[0], notes: [] } : null);
     } catch (err) {
@@ -108,8 +146,9 @@ export class RobotView {
 
   show() {
     const st = this.state;
-    if (st.error) { fill(this.out, message('error', `${st.fileName}: ${st.error}`)); this.renderPairing(); return; }
-    if (!st.parsed) { fill(this.out, message('info', 'Load the robot\'s poses (one per image, in image order or with a name column).')); this.renderPairing(); return; }
+    // One-pose-file errors name the file themselves.
+    if (st.error) { fill(this.out, message('error', st.files ? st.error : `${st.fileName}: ${st.error}`)); this.renderPairing(); return; }
+    if (!st.parsed) { fill(this.out, message('info', 'Load the robot\'s poses (one per image, in image order or with a name column, or one file per image named as the image).')); this.renderPairing(); return; }
     const p = st.parsed;
     const r = st.reading;
     const how = h('p', { id: 'pose-format-used' }, `${st.fileName}: ${p.poses.length} poses read as `, h('b', {}, p.format), `, lengths in ${p.length_unit}, angles in ${p.angle_unit}, the file holds ${st.direction}.`);
