@@ -3,7 +3,7 @@
 
 use super::image_file::open_image;
 use super::memory_budget::{MemoryBudget, DETECT_BYTES_PER_PIXEL, DETECT_MEMORY_BUDGET};
-use super::{parse_target, CliError, ImageLimits};
+use super::{parse_target_print, CliError, ImageLimits};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use robocal::detect::{detect, detect_all, CentreModel, DetectOptions};
@@ -92,7 +92,7 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
             "--target is required, e.g. --target chessboard:9x6:30mm",
         ));
     };
-    let target = parse_target("detect", text)?;
+    let (target, print) = parse_target_print("detect", text)?;
     if args.images.is_empty() {
         return Err(CliError::usage("detect", "give at least one image file"));
     }
@@ -104,7 +104,7 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
             .into_iter()
             .find(|m| Some(m.name()) == args.circle_centres.as_deref())
             .unwrap_or_default(),
-        ..DetectOptions::default()
+        polarity: print,
     };
     let files = &args.images;
     let decode = args.limits.decode_options();

@@ -25,7 +25,7 @@
 
 mod decode;
 mod edges;
-mod homography;
+pub(crate) mod homography;
 mod quads;
 mod runs;
 
@@ -249,6 +249,7 @@ fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Det
         target: board.clone(),
         points,
         centre_model: None,
+        polarity: None,
     })
 }
 
