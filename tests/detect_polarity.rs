@@ -84,7 +84,21 @@ fn check(spec: &str, v: &View, print: Polarity, mean_bound: f64, max_bound: f64)
     let det = detect(&v.image, &v.target, &DetectOptions::default())
         .unwrap_or_else(|e| panic!("{spec} printed {print:?}: {e}"));
     assert_eq!(det.polarity, Some(print), "{spec}: the print found");
-    let (mean, max) = errors(spec, &det, &v.truth);
+    let symmetric = matches!(v.target, Target::Chessboard { cols, rows, .. } if (cols + rows) % 2 == 0);
+    let (mean, max) = if symmetric {
+        // A board with cols + rows even is the same after a half turn (both
+        // ends have the print's first square beyond them; the detector
+        // takes the one nearest the image's top-left): compare either way.
+        let n = v.truth.len();
+        let mut turned = det.clone();
+        turned.points.iter_mut().for_each(|p| p.id = n - 1 - p.id);
+        turned.points.reverse();
+        let direct = errors(spec, &det, &v.truth);
+        let half_turn = errors(spec, &turned, &v.truth);
+        if direct.0 <= half_turn.0 { direct } else { half_turn }
+    } else {
+        errors(spec, &det, &v.truth)
+    };
     assert!(
         mean <= mean_bound && max <= max_bound,
         "{spec} printed {print:?}: mean {mean} px (bound {mean_bound}), max {max} px (bound {max_bound})"
@@ -188,9 +202,9 @@ fn marker_boards_in_either_print_keep_their_marker_and_corner_ids() {
     // ids are those of the usual print (equal to the truth's, id by id).
     let cases = [
         ("charuco:5x7:30mm:22mm:DICT_4X4_50", 0.5),
-        ("charuco:12x9:20mm:15mm:DICT_5X5_100", 0.4),
+        ("charuco:12x9:20mm:15mm:DICT_5X5_100", 0.5),
         ("charuco:4x5:54mm:40.5mm:DICT_4X4_1000", 0.6),
-        ("aprilgrid:6x6:40mm:0.3", 0.55),
+        ("aprilgrid:6x6:40mm:0.3", 0.7),
     ];
     for (spec, dist) in cases {
         for (k, rpy) in [(0.3, -0.25, 0.1), (-0.2, 0.4, -2.5)].into_iter().enumerate() {
@@ -313,7 +327,7 @@ fn specs_take_a_print_option_on_every_kind() {
     let e = Target::parse_spec_print("chessboard:9x6:30mm:light-on-dark:dark-on-light").unwrap_err();
     assert_eq!(
         e.to_string(),
-        "invalid target: 'chessboard:9x6:30mm:light-on-dark:dark-on-light' asks for both dark-on-light and light-on-dark; give one"
+        "target: 'chessboard:9x6:30mm:light-on-dark:dark-on-light' asks for both dark-on-light and light-on-dark; give one"
     );
 }
 
@@ -324,7 +338,7 @@ fn the_detection_json_says_which_print_was_found() {
         Polarity::LightOnDark,
         (1280, 960),
         (0.3, -0.25, 0.1),
-        0.55,
+        0.7,
         9,
     );
     let det = detect(&v.image, &v.target, &DetectOptions::default()).unwrap();

@@ -32,6 +32,7 @@ Examples:
   robocal detect --target dots:7x7:25mm plate.tiff
   robocal detect --target squares:8x8:12.7mm:22.5778mm image*.gif
   robocal detect --target charuco:12x9:20mm:15mm:DICT_5X5_100 view*.png
+  robocal detect --target charuco:4x5:54mm:40.5mm:DICT_4X4_1000:light-on-dark inverted*.png
   robocal detect --target aprilgrid:6x6:88mm:0.3 cam0/*.png
   robocal detect --target circle:10mm --threads 1 table_*.png",
     args_override_self = true
@@ -45,7 +46,10 @@ pub struct DetectArgs {
     /// charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICT[:first=N][:ids=A,B,...][:legacy]
     /// (OpenCV's ChArUco board; legacy: made before OpenCV 4.6),
     /// aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO[:first=N] (Kalibr's)
-    /// (lengths with mm, cm or m), or a target JSON object
+    /// (lengths with mm, cm or m), or a target JSON object. Either print
+    /// (dark on light, light on dark) is found without an option; add
+    /// :dark-on-light or :light-on-dark to any spec to search only that one
+    /// (written to each detection as "polarity")
     #[arg(long, value_name = "SPEC")]
     target: Option<String>,
     /// Write the JSON result to FILE (default: standard output)

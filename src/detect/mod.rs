@@ -182,6 +182,8 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
                 }
             }
         }
+        // The other print would find the same corners or none: no retry.
+        (Target::Chessboard { .. }, Some(print)) => detect_printed(image, &target, print, options),
         (_, forced) => polarity::search(&target, forced, |print| {
             detect_printed(image, &target, print, options)
         }),
