@@ -26,5 +26,6 @@ for path in sys.argv[1:]:
 print(f"opencv {cv2.__version__}")
 for camera, counts in sorted(per_camera.items()):
     found = [c for c in counts if c > 0]
+    full = sum(1 for c in found if c == 12)
     mean = sum(found) / len(found) if found else 0.0
-    print(f"{camera}: {len(counts)} frames, {len(found)} with a board, {sum(found)} corners, {mean:.2f} per frame found")
+    print(f"{camera}: {len(counts)} frames, {len(found)} with a board, {full} with all 12 corners, {sum(found)} corners, {mean:.2f} per frame found")
