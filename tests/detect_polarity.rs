@@ -99,6 +99,7 @@ fn check(spec: &str, v: &View, print: Polarity, mean_bound: f64, max_bound: f64)
     } else {
         errors(spec, &det, &v.truth)
     };
+    eprintln!("{spec} {print:?}: {} points, mean {mean:.4} px, max {max:.4} px", v.truth.len());
     assert!(
         mean <= mean_bound && max <= max_bound,
         "{spec} printed {print:?}: mean {mean} px (bound {mean_bound}), max {max} px (bound {max_bound})"

@@ -20,6 +20,12 @@
 //!   square's four corners are where parabolas fitted to its sides'
 //!   sub-pixel edge points (gradient centroids across each side) meet.
 //!
+//! - **Either print** ([`polarity`] docs): every kind is found printed dark
+//!   on light or light on dark (the usual print first, the inverted one only
+//!   when that finds nothing; chessboards read their print off the found
+//!   board), with the ids of the usual print; [`DetectOptions::polarity`]
+//!   forces one, and the detection's `polarity` says which was found.
+//!
 //! # Perspective-correct circle centres
 //!
 //! Under perspective the centre of an imaged circle (an ellipse) is not the
