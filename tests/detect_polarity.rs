@@ -109,23 +109,34 @@ fn check(spec: &str, v: &View, print: Polarity, mean_bound: f64, max_bound: f64)
 const BOTH: [Polarity; 2] = [Polarity::DarkOnLight, Polarity::LightOnDark];
 
 #[test]
-fn chessboards_in_either_print_are_numbered_from_their_first_square() {
-    // 9x6 (cols + rows odd: the inverted print is the usual one turned 180
-    // degrees, told apart by the margin) and 8x6 (even: by the corner
-    // squares); the render's corner 0 has the print's first square beyond
-    // it (dark, or light when inverted), so equal ids prove the numbering.
+fn chessboards_in_either_print() {
+    // 8x6 (cols + rows even): the corner squares' colour says the print, and
+    // an inverted board is numbered from its light corner. 9x6 (odd): the
+    // inverted print is the usual one turned 180 degrees; found without an
+    // option it is numbered as dark on light (id k at the truth's 53 - k)
+    // and says so (src/detect/polarity.rs docs).
     let views = [
         ((0.1, -0.2, 0.05), 0.55),
         ((0.45, 0.3, -0.3), 0.6),
         ((-0.35, 0.5, 2.9), 0.6),
     ];
-    for spec in ["chessboard:9x6:30mm", "chessboard:8x6:30mm"] {
-        for (k, (rpy, dist)) in views.into_iter().enumerate() {
-            for print in BOTH {
-                let v = view(spec, print, (1280, 960), rpy, dist, 10 + k as u64);
-                check(spec, &v, print, 0.05, 0.25);
-            }
+    for (k, (rpy, dist)) in views.into_iter().enumerate() {
+        for print in BOTH {
+            let v = view("chessboard:8x6:30mm", print, (1280, 960), rpy, dist, 10 + k as u64);
+            check("chessboard:8x6:30mm", &v, print, 0.05, 0.25);
         }
+        let spec = "chessboard:9x6:30mm";
+        let v = view(spec, Polarity::DarkOnLight, (1280, 960), rpy, dist, 10 + k as u64);
+        check(spec, &v, Polarity::DarkOnLight, 0.05, 0.25);
+        let v = view(spec, Polarity::LightOnDark, (1280, 960), rpy, dist, 10 + k as u64);
+        let det = detect(&v.image, &v.target, &DetectOptions::default()).unwrap();
+        assert_eq!(det.polarity, Some(Polarity::DarkOnLight), "{spec} inverted");
+        let mut turned = det.clone();
+        turned.points.iter_mut().for_each(|p| p.id = 53 - p.id);
+        turned.points.reverse();
+        let (mean, max) = errors(spec, &turned, &v.truth);
+        eprintln!("{spec} LightOnDark, found as DarkOnLight: mean {mean:.4} px, max {max:.4} px");
+        assert!(mean <= 0.05 && max <= 0.25, "{spec} inverted, view {k}: mean {mean} px, max {max} px");
     }
 }
 

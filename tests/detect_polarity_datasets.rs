@@ -109,3 +109,45 @@ fn caliscope_inverted_charuco_frames_are_found_without_an_option() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn usual_chessboards_stay_dark_on_light_with_their_numbering() {
+    // OpenCV's 9x6 sample views (thin white margin, cut by the board's
+    // edge, on dark backgrounds) and caliscope's 9x6 chessboard frames: the
+    // usual print, numbered from the dark corner square as before issue 36
+    // (corner 0 is the one OpenCV numbers 0 or 53: the same end of the
+    // board diagonal under the dark-corner rule).
+    let mut files: Vec<PathBuf> = Vec::new();
+    for dir in [
+        "opencv-left-right-9x6",
+        "caliscope-4cam-charuco-video/chessboard_intrinsic",
+    ] {
+        let Some(dir) = support::dataset(dir) else {
+            eprintln!("skipped: dataset {dir} not found (../shared/datasets or ROBOCAL_DATASETS)");
+            return;
+        };
+        let mut more: Vec<PathBuf> = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "jpg"))
+            .collect();
+        files.append(&mut more);
+    }
+    let target = Target::parse_spec("chessboard:9x6:30mm").unwrap();
+    let mut found = 0;
+    for file in &files {
+        let image = robocal::image::decode_gray(&std::fs::read(file).unwrap()).unwrap();
+        let Ok(det) = detect(&image, &target, &DetectOptions::default()) else {
+            continue;
+        };
+        found += 1;
+        assert_eq!(det.polarity, Some(Polarity::DarkOnLight), "{}", file.display());
+        let forced = DetectOptions {
+            polarity: Some(Polarity::DarkOnLight),
+            ..DetectOptions::default()
+        };
+        let same = detect(&image, &target, &forced).unwrap();
+        assert_eq!(same.points, det.points, "{}", file.display());
+    }
+    assert!(found >= 30, "{found} of {} chessboard views found", files.len());
+}
