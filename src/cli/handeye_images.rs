@@ -205,13 +205,14 @@ pub(super) fn pair_images(
 pub(super) fn detect_images(
     images: &[String],
     target: &Target,
+    options: &DetectOptions,
     limits: &super::ImageLimits,
     threads: Option<usize>,
 ) -> Result<Vec<Outcome>, CliError> {
     run_all(
         images,
         target,
-        &DetectOptions::default(),
+        options,
         &limits.decode_options(),
         threads,
     )

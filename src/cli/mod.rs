@@ -301,6 +301,21 @@ pub fn parse_target(command: &str, text: &str) -> Result<Target, CliError> {
     Ok(parse_target_print(command, text)?.0)
 }
 
+/// The detection options of a `--target` spec: the print it forces
+/// (`:dark-on-light` / `:light-on-dark`), if any; defaults otherwise (a
+/// target JSON or an unreadable spec forces none; the spec's own errors are
+/// reported where it is parsed).
+pub fn detect_options_of(spec: Option<&str>) -> robocal::detect::DetectOptions {
+    let polarity = spec
+        .filter(|s| !s.trim_start().starts_with('{'))
+        .and_then(|s| Target::parse_spec_print(s).ok())
+        .and_then(|(_, print)| print);
+    robocal::detect::DetectOptions {
+        polarity,
+        ..robocal::detect::DetectOptions::default()
+    }
+}
+
 /// [`parse_target`] with the print the spec forces (`:dark-on-light` /
 /// `:light-on-dark`; a target JSON forces none), for `DetectOptions::polarity`.
 pub fn parse_target_print(
