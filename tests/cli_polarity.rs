@@ -61,3 +61,31 @@ fn the_sheet_of_a_light_on_dark_spec_is_refused_where_it_cannot_be_drawn() {
     assert_eq!(code, 0, "{err}");
     assert!(svg.contains("light on dark"), "{svg}");
 }
+
+#[test]
+fn intrinsics_from_images_finds_either_print_and_keeps_a_forced_one() {
+    let dir = temp_dir("polarity", "intrinsics");
+    let out = dir.to_str().unwrap();
+    let spec = "charuco:5x7:30mm:22mm:DICT_4X4_50";
+    let (code, _, err) = robocal(&[
+        "render", "--out", out, "--views", "4", "--seed", "11", "--target",
+        &format!("{spec}:light-on-dark"),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let images: Vec<String> = (1..=4)
+        .map(|k| dir.join(format!("view_{k:03}.png")).to_str().unwrap().to_string())
+        .collect();
+    let mut args = vec!["intrinsics", "--target", spec];
+    args.extend(images.iter().map(String::as_str));
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    let forced = format!("{spec}:dark-on-light");
+    args[2] = &forced;
+    let (code, _, err) = robocal(&args);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("printed light-on-dark the board is in view: the target spec forces ':dark-on-light'"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
