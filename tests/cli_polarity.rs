@@ -33,10 +33,24 @@ fn an_inverted_render_is_found_without_an_option_and_a_forced_print_names_the_ot
     let doc: serde_json::Value = serde_json::from_str(&json).unwrap();
     let detection = &doc["images"][0]["detection"];
     assert_eq!(detection["polarity"], "light_on_dark", "{json}");
-    assert_eq!(detection["points"].as_array().map(Vec::len), Some(24), "{json}");
-    let (code, _, err) = robocal(&["detect", "--target", &format!("{SPEC}:light-on-dark"), image]);
+    assert_eq!(
+        detection["points"].as_array().map(Vec::len),
+        Some(24),
+        "{json}"
+    );
+    let (code, _, err) = robocal(&[
+        "detect",
+        "--target",
+        &format!("{SPEC}:light-on-dark"),
+        image,
+    ]);
     assert_eq!(code, 0, "{err}");
-    let (code, json, err) = robocal(&["detect", "--target", &format!("{SPEC}:dark-on-light"), image]);
+    let (code, json, err) = robocal(&[
+        "detect",
+        "--target",
+        &format!("{SPEC}:dark-on-light"),
+        image,
+    ]);
     assert_eq!(code, 1, "{err}");
     let doc: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(
@@ -68,12 +82,24 @@ fn intrinsics_from_images_finds_either_print_and_keeps_a_forced_one() {
     let out = dir.to_str().unwrap();
     let spec = "charuco:5x7:30mm:22mm:DICT_4X4_50";
     let (code, _, err) = robocal(&[
-        "render", "--out", out, "--views", "4", "--seed", "11", "--target",
+        "render",
+        "--out",
+        out,
+        "--views",
+        "4",
+        "--seed",
+        "11",
+        "--target",
         &format!("{spec}:light-on-dark"),
     ]);
     assert_eq!(code, 0, "{err}");
     let images: Vec<String> = (1..=4)
-        .map(|k| dir.join(format!("view_{k:03}.png")).to_str().unwrap().to_string())
+        .map(|k| {
+            dir.join(format!("view_{k:03}.png"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        })
         .collect();
     let mut args = vec!["intrinsics", "--target", spec];
     args.extend(images.iter().map(String::as_str));
@@ -84,7 +110,9 @@ fn intrinsics_from_images_finds_either_print_and_keeps_a_forced_one() {
     let (code, _, err) = robocal(&args);
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains("printed light-on-dark the board is in view: the target spec forces ':dark-on-light'"),
+        err.contains(
+            "printed light-on-dark the board is in view: the target spec forces ':dark-on-light'"
+        ),
         "{err}"
     );
     let _ = std::fs::remove_dir_all(&dir);

@@ -84,7 +84,8 @@ fn check(spec: &str, v: &View, print: Polarity, mean_bound: f64, max_bound: f64)
     let det = detect(&v.image, &v.target, &DetectOptions::default())
         .unwrap_or_else(|e| panic!("{spec} printed {print:?}: {e}"));
     assert_eq!(det.polarity, Some(print), "{spec}: the print found");
-    let symmetric = matches!(v.target, Target::Chessboard { cols, rows, .. } if (cols + rows) % 2 == 0);
+    let symmetric =
+        matches!(v.target, Target::Chessboard { cols, rows, .. } if (cols + rows) % 2 == 0);
     let (mean, max) = if symmetric {
         // A board with cols + rows even is the same after a half turn (both
         // ends have the print's first square beyond them; the detector
@@ -95,11 +96,18 @@ fn check(spec: &str, v: &View, print: Polarity, mean_bound: f64, max_bound: f64)
         turned.points.reverse();
         let direct = errors(spec, &det, &v.truth);
         let half_turn = errors(spec, &turned, &v.truth);
-        if direct.0 <= half_turn.0 { direct } else { half_turn }
+        if direct.0 <= half_turn.0 {
+            direct
+        } else {
+            half_turn
+        }
     } else {
         errors(spec, &det, &v.truth)
     };
-    eprintln!("{spec} {print:?}: {} points, mean {mean:.4} px, max {max:.4} px", v.truth.len());
+    eprintln!(
+        "{spec} {print:?}: {} points, mean {mean:.4} px, max {max:.4} px",
+        v.truth.len()
+    );
     assert!(
         mean <= mean_bound && max <= max_bound,
         "{spec} printed {print:?}: mean {mean} px (bound {mean_bound}), max {max} px (bound {max_bound})"
@@ -122,13 +130,34 @@ fn chessboards_in_either_print() {
     ];
     for (k, (rpy, dist)) in views.into_iter().enumerate() {
         for print in BOTH {
-            let v = view("chessboard:8x6:30mm", print, (1280, 960), rpy, dist, 10 + k as u64);
+            let v = view(
+                "chessboard:8x6:30mm",
+                print,
+                (1280, 960),
+                rpy,
+                dist,
+                10 + k as u64,
+            );
             check("chessboard:8x6:30mm", &v, print, 0.05, 0.25);
         }
         let spec = "chessboard:9x6:30mm";
-        let v = view(spec, Polarity::DarkOnLight, (1280, 960), rpy, dist, 10 + k as u64);
+        let v = view(
+            spec,
+            Polarity::DarkOnLight,
+            (1280, 960),
+            rpy,
+            dist,
+            10 + k as u64,
+        );
         check(spec, &v, Polarity::DarkOnLight, 0.05, 0.25);
-        let v = view(spec, Polarity::LightOnDark, (1280, 960), rpy, dist, 10 + k as u64);
+        let v = view(
+            spec,
+            Polarity::LightOnDark,
+            (1280, 960),
+            rpy,
+            dist,
+            10 + k as u64,
+        );
         let det = detect(&v.image, &v.target, &DetectOptions::default()).unwrap();
         assert_eq!(det.polarity, Some(Polarity::DarkOnLight), "{spec} inverted");
         let mut turned = det.clone();
@@ -136,7 +165,10 @@ fn chessboards_in_either_print() {
         turned.points.reverse();
         let (mean, max) = errors(spec, &turned, &v.truth);
         eprintln!("{spec} LightOnDark, found as DarkOnLight: mean {mean:.4} px, max {max:.4} px");
-        assert!(mean <= 0.05 && max <= 0.25, "{spec} inverted, view {k}: mean {mean} px, max {max} px");
+        assert!(
+            mean <= 0.05 && max <= 0.25,
+            "{spec} inverted, view {k}: mean {mean} px, max {max} px"
+        );
     }
 }
 
@@ -149,7 +181,10 @@ fn circle_grids_dot_plates_and_square_grids_in_either_print() {
         ("squares:8x8:12.7mm:22.5778mm", 0.5, 0.05, 0.2),
     ];
     for (spec, dist, mean, max) in cases {
-        for (k, rpy) in [(0.25, -0.2, 0.1), (-0.3, 0.35, -0.4)].into_iter().enumerate() {
+        for (k, rpy) in [(0.25, -0.2, 0.1), (-0.3, 0.35, -0.4)]
+            .into_iter()
+            .enumerate()
+        {
             for print in BOTH {
                 let v = view(spec, print, (1280, 960), rpy, dist, 20 + k as u64);
                 check(spec, &v, print, mean, max);
@@ -219,7 +254,10 @@ fn marker_boards_in_either_print_keep_their_marker_and_corner_ids() {
         ("aprilgrid:6x6:40mm:0.3", 0.7),
     ];
     for (spec, dist) in cases {
-        for (k, rpy) in [(0.3, -0.25, 0.1), (-0.2, 0.4, -2.5)].into_iter().enumerate() {
+        for (k, rpy) in [(0.3, -0.25, 0.1), (-0.2, 0.4, -2.5)]
+            .into_iter()
+            .enumerate()
+        {
             for print in BOTH {
                 let v = view(spec, print, (1280, 960), rpy, dist, 30 + k as u64);
                 check(spec, &v, print, 0.05, 0.25);
@@ -326,17 +364,22 @@ fn specs_take_a_print_option_on_every_kind() {
             "charuco:4x5:54mm:40.5mm:DICT_4X4_1000:first=8:light-on-dark",
             "charuco:4x5:54mm:40.5mm:DICT_4X4_1000:first=8",
         ),
-        ("aprilgrid:6x6:40mm:0.3:light-on-dark", "aprilgrid:6x6:40mm:0.3"),
+        (
+            "aprilgrid:6x6:40mm:0.3:light-on-dark",
+            "aprilgrid:6x6:40mm:0.3",
+        ),
     ] {
         let (target, print) = Target::parse_spec_print(spec).unwrap();
         assert_eq!(print, Some(Polarity::LightOnDark), "{spec}");
         assert_eq!(target.to_spec(), geometry, "{spec}");
-        let (_, print) = Target::parse_spec_print(&spec.replace("light-on-dark", "dark-on-light")).unwrap();
+        let (_, print) =
+            Target::parse_spec_print(&spec.replace("light-on-dark", "dark-on-light")).unwrap();
         assert_eq!(print, Some(Polarity::DarkOnLight), "{spec}");
         let (_, print) = Target::parse_spec_print(geometry).unwrap();
         assert_eq!(print, None, "{geometry}");
     }
-    let e = Target::parse_spec_print("chessboard:9x6:30mm:light-on-dark:dark-on-light").unwrap_err();
+    let e =
+        Target::parse_spec_print("chessboard:9x6:30mm:light-on-dark:dark-on-light").unwrap_err();
     assert_eq!(
         e.to_string(),
         "target: 'chessboard:9x6:30mm:light-on-dark:dark-on-light' asks for both dark-on-light and light-on-dark; give one"

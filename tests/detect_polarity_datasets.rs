@@ -35,7 +35,13 @@ fn extract(video: &Path, dir: &Path, camera: usize) -> Option<Vec<PathBuf>> {
     let status = Command::new("ffmpeg")
         .args(["-v", "error", "-y", "-i"])
         .arg(video)
-        .args(["-vf", "select=gte(n\\,21)*not(mod(n\\,3))", "-vsync", "0", "-frames:v"])
+        .args([
+            "-vf",
+            "select=gte(n\\,21)*not(mod(n\\,3))",
+            "-vsync",
+            "0",
+            "-frames:v",
+        ])
         .arg(FRAMES_PER_CAMERA.to_string())
         .arg(&pattern)
         .status()
@@ -73,17 +79,29 @@ fn caliscope_inverted_charuco_frames_are_found_without_an_option() {
     for camera in 0..4 {
         let video = videos.join(format!("cam_{camera}.mp4"));
         let Some(files) = extract(&video, &dir, camera) else {
-            eprintln!("skipped: ffmpeg could not extract frames from {}", video.display());
+            eprintln!(
+                "skipped: ffmpeg could not extract frames from {}",
+                video.display()
+            );
             return;
         };
-        assert_eq!(files.len(), FRAMES_PER_CAMERA, "camera {camera}: frames extracted");
+        assert_eq!(
+            files.len(),
+            FRAMES_PER_CAMERA,
+            "camera {camera}: frames extracted"
+        );
         let (mut found, mut full, mut corners) = (0, 0, 0);
         for file in &files {
             let image = robocal::image::decode_gray(&std::fs::read(file).unwrap()).unwrap();
             let Ok(det) = detect(&image, &target, &DetectOptions::default()) else {
                 continue;
             };
-            assert_eq!(det.polarity, Some(Polarity::LightOnDark), "{}", file.display());
+            assert_eq!(
+                det.polarity,
+                Some(Polarity::LightOnDark),
+                "{}",
+                file.display()
+            );
             assert!(det.points.iter().all(|p| p.id < 12), "{}", file.display());
             found += 1;
             full += usize::from(det.points.len() == 12);
@@ -141,7 +159,12 @@ fn usual_chessboards_stay_dark_on_light_with_their_numbering() {
             continue;
         };
         found += 1;
-        assert_eq!(det.polarity, Some(Polarity::DarkOnLight), "{}", file.display());
+        assert_eq!(
+            det.polarity,
+            Some(Polarity::DarkOnLight),
+            "{}",
+            file.display()
+        );
         let forced = DetectOptions {
             polarity: Some(Polarity::DarkOnLight),
             ..DetectOptions::default()
@@ -149,5 +172,9 @@ fn usual_chessboards_stay_dark_on_light_with_their_numbering() {
         let same = detect(&image, &target, &forced).unwrap();
         assert_eq!(same.points, det.points, "{}", file.display());
     }
-    assert!(found >= 30, "{found} of {} chessboard views found", files.len());
+    assert!(
+        found >= 30,
+        "{found} of {} chessboard views found",
+        files.len()
+    );
 }

@@ -209,13 +209,7 @@ pub(super) fn detect_images(
     limits: &super::ImageLimits,
     threads: Option<usize>,
 ) -> Result<Vec<Outcome>, CliError> {
-    run_all(
-        images,
-        target,
-        options,
-        &limits.decode_options(),
-        threads,
-    )
+    run_all(images, target, options, &limits.decode_options(), threads)
 }
 
 /// The pairing of poses with images, made before any image is detected.

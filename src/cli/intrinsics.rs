@@ -245,13 +245,7 @@ fn views_from_images(
     limits: &super::ImageLimits,
     threads: Option<usize>,
 ) -> Result<Vec<JsonView>, CliError> {
-    let outcomes = run_all(
-        files,
-        target,
-        options,
-        &limits.decode_options(),
-        threads,
-    )?;
+    let outcomes = run_all(files, target, options, &limits.decode_options(), threads)?;
     let mut views = vec![];
     for (file, outcome) in files.iter().zip(outcomes) {
         match outcome {

@@ -1,8 +1,8 @@
 //! `robocal target`: a target spec read back as JSON, or its printable sheet.
 
 use super::{write_output, CliError};
-use robocal::target::Target;
 use robocal::target::svg::board_svg;
+use robocal::target::Target;
 
 #[derive(clap::Args)]
 #[command(
