@@ -190,6 +190,12 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
         }
         // The other print would find the same corners or none: no retry.
         (Target::Chessboard { .. }, Some(print)) => detect_printed(image, &target, print, options),
+        (Target::Charuco { .. } | Target::Aprilgrid { .. }, forced) => {
+            let mut own = marker_boards(image, &target, forced, true)?;
+            own.pop().ok_or_else(|| Error::NotFound {
+                message: format!("board not found: {}", target.to_spec()),
+            })
+        }
         (_, forced) => polarity::search(&target, forced, |print| {
             detect_printed(image, &target, print, options)
         }),
@@ -289,16 +295,7 @@ pub fn detect_all(
     check_image(image)?;
     match target {
         Target::Charuco { .. } | Target::Aprilgrid { .. } => {
-            polarity::search(target, options.polarity, |print| {
-                let mut boards = match print {
-                    Polarity::DarkOnLight => markers::detect_boards(image, target, options)?,
-                    Polarity::LightOnDark => {
-                        markers::detect_boards(&polarity::inverted(image), target, options)?
-                    }
-                };
-                boards.iter_mut().for_each(|d| d.polarity = Some(print));
-                Ok(boards)
-            })
+            marker_boards(image, target, options.polarity, false)
         }
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
@@ -306,6 +303,35 @@ pub fn detect_all(
         | Target::SingleCircle { .. }
         | Target::SquareGrid { .. } => Ok(vec![detect(image, target, options)?]),
     }
+}
+
+/// Every board of a marker-board target's layout (`own`: the target's own
+/// board alone, an error when only others are seen), in either print
+/// (`polarity::search_markers`), each detection with the print found.
+fn marker_boards(
+    image: &GrayImage,
+    target: &Target,
+    forced: Option<Polarity>,
+    own: bool,
+) -> Result<Vec<Detection>> {
+    let mut inverted_image: Option<GrayImage> = None;
+    let large = markers::decimates(image);
+    polarity::search_markers(target, forced, large, |print, resolutions| {
+        let seen = match print {
+            Polarity::DarkOnLight => image,
+            Polarity::LightOnDark => inverted_image.get_or_insert_with(|| polarity::inverted(image)),
+        };
+        let (boards, read) = markers::boards_at(seen, target, resolutions);
+        let boards = match own {
+            true => markers::own_board(target, boards).map(|d| vec![d]),
+            false => boards,
+        };
+        let boards = boards.map(|mut b| {
+            b.iter_mut().for_each(|d| d.polarity = Some(print));
+            b
+        });
+        (boards, read)
+    })
 }
 
 /// Size checks shared by the entry points.

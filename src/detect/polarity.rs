@@ -30,6 +30,7 @@
 //!   from its own light corner.
 
 use super::markers::homography::Homography;
+use super::markers::Resolutions;
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
 use crate::target::{DetectedPoint, Polarity, Target};
@@ -80,6 +81,49 @@ pub(crate) fn search<T>(
         }),
         (_, Err(_)) => Err(Error::NotFound { message }),
     }
+}
+
+/// [`search`] for marker boards, whose search runs at half resolution on
+/// large frames before a full-resolution retry (`markers::Resolutions`):
+/// without a forced print, both prints are searched at half resolution
+/// before either is retried at full resolution, so an inverted board is
+/// not found only after the usual print's retry. `attempt` runs one print
+/// over some resolutions and says whether it read any marker (a print that
+/// read markers at half resolution is not retried, as in one print's
+/// search). The error is the usual print's, as [`search`]'s.
+pub(crate) fn search_markers<T>(
+    target: &Target,
+    forced: Option<Polarity>,
+    large: bool,
+    mut attempt: impl FnMut(Polarity, Resolutions) -> (Result<T>, bool),
+) -> Result<T> {
+    if forced.is_some() || !large {
+        return search(target, forced, |print| {
+            attempt(print, Resolutions::HalfThenFull).0
+        });
+    }
+    let first = usual(target);
+    let (found, first_read) = attempt(first, Resolutions::HalfOnly);
+    let mut message = match found {
+        Err(Error::NotFound { message }) => message,
+        other => return other,
+    };
+    let (found, other_read) = attempt(first.other(), Resolutions::HalfOnly);
+    if let Ok(found) = found {
+        return Ok(found);
+    }
+    if !first_read {
+        match attempt(first, Resolutions::FullOnly).0 {
+            Err(Error::NotFound { message: m }) => message = m,
+            other => return other,
+        }
+    }
+    if !other_read {
+        if let Ok(found) = attempt(first.other(), Resolutions::FullOnly).0 {
+            return Ok(found);
+        }
+    }
+    Err(Error::NotFound { message })
 }
 
 /// The message of a forced print that missed a board the other print sees.
