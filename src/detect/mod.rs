@@ -319,7 +319,9 @@ fn marker_boards(
     polarity::search_markers(target, forced, large, |print, resolutions| {
         let seen = match print {
             Polarity::DarkOnLight => image,
-            Polarity::LightOnDark => inverted_image.get_or_insert_with(|| polarity::inverted(image)),
+            Polarity::LightOnDark => {
+                inverted_image.get_or_insert_with(|| polarity::inverted(image))
+            }
         };
         let (boards, read) = markers::boards_at(seen, target, resolutions);
         let boards = match own {

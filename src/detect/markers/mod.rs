@@ -36,9 +36,9 @@ use crate::image::GrayImage;
 use crate::target::marker_board::{self, MarkerLayout};
 use crate::target::{DetectedPoint, Detection, Dictionary, Target};
 use decode::Marker;
-pub(crate) use quads::{decimates, Resolutions};
 use homography::Homography;
 use nalgebra::Point2;
+pub(crate) use quads::{decimates, Resolutions};
 use std::collections::HashMap;
 
 /// A marker is an outlier of its board when the board's homography puts
@@ -168,9 +168,12 @@ pub(crate) fn boards_at(
     resolutions: Resolutions,
 ) -> (Result<Vec<Detection>>, bool) {
     let markers = match target.clone().validated().and_then(|t| {
-        marker_board::layout(&t)
-            .map(|l| (t, l))
-            .ok_or_else(|| Error::invalid("target", format!("{} is not a marker board", target.to_spec())))
+        marker_board::layout(&t).map(|l| (t, l)).ok_or_else(|| {
+            Error::invalid(
+                "target",
+                format!("{} is not a marker board", target.to_spec()),
+            )
+        })
     }) {
         Ok((t, layout)) => {
             let found = find_markers(image, layout.dictionary, layout.border_bits, resolutions);
