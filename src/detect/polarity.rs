@@ -11,7 +11,9 @@
 //!   (circle grids and dot plates threshold for light blobs instead), so a
 //!   light-on-dark board's marker ids, corner ids and point order are those
 //!   of the same board printed dark on light: a search costs twice only
-//!   when it fails.
+//!   when it fails. Marker boards, whose search on large frames runs at
+//!   half resolution before a full-resolution retry, search both prints at
+//!   half resolution before either is retried ([`search_markers`]).
 //! - **Chessboards** are found in either print by the same saddle points,
 //!   but their corner 0 is defined by colour (the outer square beyond it is
 //!   the print's first square: dark on a dark-on-light print, light on a
