@@ -212,7 +212,8 @@ export type Target = { [K in TargetKind]: TargetOf<K> }[TargetKind];
  * `circle:10mm`, `squares:8x8:12.7mm:22.5778mm` (side, then pitch),
  * `charuco:12x9:20mm:15mm:DICT_5X5_100[:first=N][:ids=A,B,...][:legacy]` (squares, square side,
  * marker side, dictionary), `aprilgrid:6x6:88mm:0.3[:first=N]` (tags, tag size, spacing ratio);
- * lengths in mm, cm or m.
+ * lengths in mm, cm or m. Any spec may end in `:dark-on-light` or `:light-on-dark` to force
+ * that print (without, either print is found).
  */
 export type TargetSpec =
   | `chessboard:${number}x${number}:${string}`
@@ -257,6 +258,13 @@ export interface Detection {
    * `ellipse_centre`: uncorrected). Absent for other targets and in older files.
    */
   centre_model?: CentreModel;
+  /**
+   * The print the detector found the target in: `dark_on_light` (the usual print) or
+   * `light_on_dark` (the board inverted). Every target is found in either print without
+   * an option; a spec's `:dark-on-light` / `:light-on-dark` forces one
+   * (docs/detection-json.md, "Print polarity"). Absent in older files.
+   */
+  polarity?: Polarity;
 }
 
 /** How circle centres are estimated (docs/detection-json.md). */

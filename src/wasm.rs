@@ -256,6 +256,22 @@ fn target_from(spec_or_json: &str) -> Result<Target, JsError> {
     }
 }
 
+/// The detection options of a target spec or JSON: the print a spec's
+/// `:dark-on-light` / `:light-on-dark` forces (a JSON forces none).
+fn detect_options_from(spec_or_json: &str) -> crate::detect::DetectOptions {
+    let polarity = if spec_or_json.trim_start().starts_with('{') {
+        None
+    } else {
+        Target::parse_spec_print(spec_or_json)
+            .ok()
+            .and_then(|(_, print)| print)
+    };
+    crate::detect::DetectOptions {
+        polarity,
+        ..crate::detect::DetectOptions::default()
+    }
+}
+
 /// The target of a CLI spec or target JSON, checked by the core: the target
 /// JSON (`{"kind": "chessboard", "cols", "rows", "square_m"}`, ...; kinds
 /// and metres as in `docs/detection-json.md`), or the core's error.
@@ -313,7 +329,8 @@ pub fn target_svg(spec_or_json: &str) -> Result<String, JsError> {
 }
 
 /// Detect a calibration target in image bytes. `target_spec_or_json` is a
-/// CLI spec (see [`parse_target`]) or a target JSON object. Returns the
+/// CLI spec (see [`parse_target`]; `:dark-on-light` / `:light-on-dark`
+/// force that print, else either is found) or a target JSON object. Returns the
 /// Detection JSON (see `docs/detection-json.md`). ChArUco boards and
 /// AprilGrids give the corners seen (any subset) of the board whose
 /// markers carry the target's ids; another board in the same image (its
@@ -328,9 +345,8 @@ pub fn detect_target(
 ) -> Result<String, JsError> {
     let target = target_from(target_spec_or_json)?;
     let image = decode_gray(bytes, options_json)?;
-    let detection =
-        crate::detect::detect(&image, &target, &crate::detect::DetectOptions::default())
-            .map_err(js_error)?;
+    let options = detect_options_from(target_spec_or_json);
+    let detection = crate::detect::detect(&image, &target, &options).map_err(js_error)?;
     serde_json::to_string(&detection).map_err(|e| JsError::new(&e.to_string()))
 }
 
@@ -347,9 +363,8 @@ pub fn detect_boards(
 ) -> Result<String, JsError> {
     let target = target_from(target_spec_or_json)?;
     let image = decode_gray(bytes, options_json)?;
-    let detections =
-        crate::detect::detect_all(&image, &target, &crate::detect::DetectOptions::default())
-            .map_err(js_error)?;
+    let options = detect_options_from(target_spec_or_json);
+    let detections = crate::detect::detect_all(&image, &target, &options).map_err(js_error)?;
     serde_json::to_string(&detections).map_err(|e| JsError::new(&e.to_string()))
 }
 

@@ -102,6 +102,7 @@ fn detections_carry_the_image_size_and_method_all_adds_the_comparison() {
                 target: target.clone(),
                 points,
                 centre_model: None,
+                polarity: None,
             };
             json!({"name": v.name, "detection": detection})
         })
@@ -349,6 +350,7 @@ fn circle_views(s: &Scene, model_of_view: &dyn Fn(usize) -> Option<CentreModel>)
                 target: target.clone(),
                 points,
                 centre_model: model_of_view(k),
+                polarity: None,
             };
             json!({"name": v.name, "detection": detection})
         })

@@ -45,6 +45,7 @@ fn detection(
         target: v.target.clone(),
         points,
         centre_model: None,
+        polarity: None,
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::image_file::open_image;
 use super::memory_budget::{MemoryBudget, DETECT_BYTES_PER_PIXEL, DETECT_MEMORY_BUDGET};
-use super::{parse_target, CliError, ImageLimits};
+use super::{parse_target_print, CliError, ImageLimits};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use robocal::detect::{detect, detect_all, CentreModel, DetectOptions};
@@ -32,6 +32,7 @@ Examples:
   robocal detect --target dots:7x7:25mm plate.tiff
   robocal detect --target squares:8x8:12.7mm:22.5778mm image*.gif
   robocal detect --target charuco:12x9:20mm:15mm:DICT_5X5_100 view*.png
+  robocal detect --target charuco:4x5:54mm:40.5mm:DICT_4X4_1000:light-on-dark inverted*.png
   robocal detect --target aprilgrid:6x6:88mm:0.3 cam0/*.png
   robocal detect --target circle:10mm --threads 1 table_*.png",
     args_override_self = true
@@ -49,7 +50,10 @@ pub struct DetectArgs {
     /// GridBoard: 4 corners per marker),
     /// circles:COLSxROWS:PITCH:origin-dot (ROS-Industrial's modified circle
     /// grid, the big origin dot fixes the orientation)
-    /// (lengths with mm, cm or m), or a target JSON object
+    /// (lengths with mm, cm or m), or a target JSON object. Either print
+    /// (dark on light, light on dark) is found without an option; add
+    /// :dark-on-light or :light-on-dark to any spec to search only that one
+    /// (written to each detection as "polarity")
     #[arg(long, value_name = "SPEC")]
     target: Option<String>,
     /// Write the JSON result to FILE (default: standard output)
@@ -96,7 +100,7 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
             "--target is required, e.g. --target chessboard:9x6:30mm",
         ));
     };
-    let target = parse_target("detect", text)?;
+    let (target, print) = parse_target_print("detect", text)?;
     if args.images.is_empty() {
         return Err(CliError::usage("detect", "give at least one image file"));
     }
@@ -108,7 +112,7 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
             .into_iter()
             .find(|m| Some(m.name()) == args.circle_centres.as_deref())
             .unwrap_or_default(),
-        ..DetectOptions::default()
+        polarity: print,
     };
     let files = &args.images;
     let decode = args.limits.decode_options();

@@ -281,7 +281,13 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
                 }
                 (None, Some(t)) => {
                     let pairing = pair(&args.images)?;
-                    let outcomes = detect_images(&args.images, t, &args.limits, args.threads)?;
+                    let outcomes = detect_images(
+                        &args.images,
+                        t,
+                        &super::detect_options_of(args.target.as_deref()),
+                        &args.limits,
+                        args.threads,
+                    )?;
                     (args.images.clone(), outcomes, pairing)
                 }
             };

@@ -121,16 +121,11 @@ pub(super) fn pair_images(
 pub(super) fn detect_images(
     images: &[String],
     target: &Target,
+    options: &DetectOptions,
     limits: &super::ImageLimits,
     threads: Option<usize>,
 ) -> Result<Vec<Outcome>, CliError> {
-    run_all(
-        images,
-        target,
-        &DetectOptions::default(),
-        &limits.decode_options(),
-        threads,
-    )
+    run_all(images, target, options, &limits.decode_options(), threads)
 }
 
 /// The pairing of poses with images, made before any image is detected.

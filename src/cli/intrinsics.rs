@@ -121,7 +121,13 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
                     "--target is required with images, e.g. --target chessboard:9x6:30mm",
                 )
             })?;
-            views_from_images(&args.images, &target, &args.limits, args.threads)?
+            views_from_images(
+                &args.images,
+                &target,
+                &super::detect_options_of(args.target.as_deref()),
+                &args.limits,
+                args.threads,
+            )?
         }
         (None, true) => {
             return Err(CliError::usage(
@@ -235,16 +241,11 @@ fn views_from_file(file: &str, target: Option<&Target>) -> Result<Vec<JsonView>,
 fn views_from_images(
     files: &[String],
     target: &Target,
+    options: &DetectOptions,
     limits: &super::ImageLimits,
     threads: Option<usize>,
 ) -> Result<Vec<JsonView>, CliError> {
-    let outcomes = run_all(
-        files,
-        target,
-        &DetectOptions::default(),
-        &limits.decode_options(),
-        threads,
-    )?;
+    let outcomes = run_all(files, target, options, &limits.decode_options(), threads)?;
     let mut views = vec![];
     for (file, outcome) in files.iter().zip(outcomes) {
         match outcome {

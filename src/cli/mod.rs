@@ -299,12 +299,36 @@ fn parse_pixel_count(text: &str) -> Result<u64, String> {
 /// The target of `--target TEXT`: a spec (`chessboard:9x6:30mm`) or a target
 /// JSON object; mistakes are usage errors of `command`.
 pub fn parse_target(command: &str, text: &str) -> Result<Target, CliError> {
+    Ok(parse_target_print(command, text)?.0)
+}
+
+/// The detection options of a `--target` spec: the print it forces
+/// (`:dark-on-light` / `:light-on-dark`), if any; defaults otherwise (a
+/// target JSON or an unreadable spec forces none; the spec's own errors are
+/// reported where it is parsed).
+pub fn detect_options_of(spec: Option<&str>) -> robocal::detect::DetectOptions {
+    let polarity = spec
+        .filter(|s| !s.trim_start().starts_with('{'))
+        .and_then(|s| Target::parse_spec_print(s).ok())
+        .and_then(|(_, print)| print);
+    robocal::detect::DetectOptions {
+        polarity,
+        ..robocal::detect::DetectOptions::default()
+    }
+}
+
+/// [`parse_target`] with the print the spec forces (`:dark-on-light` /
+/// `:light-on-dark`; a target JSON forces none), for `DetectOptions::polarity`.
+pub fn parse_target_print(
+    command: &str,
+    text: &str,
+) -> Result<(Target, Option<robocal::target::Polarity>), CliError> {
     if text.trim_start().starts_with('{') {
         let t: Target = serde_json::from_str(text)
             .map_err(|e| CliError::usage(command, format!("--target JSON: {e}")))?;
-        return Ok(t.validated()?);
+        return Ok((t.validated()?, None));
     }
-    Target::parse_spec(text).map_err(|e| CliError::usage(command, e.to_string()))
+    Target::parse_spec_print(text).map_err(|e| CliError::usage(command, e.to_string()))
 }
 
 /// Write `text` to `path` (replaced atomically), or to stdout when `path`

@@ -7,7 +7,7 @@ use robocal::io::export_transform::transform_json;
 use robocal::synth::demo::{demo_camera, demo_session};
 use robocal::synth::effects::{Bayer, Effects, MotionBlur, Optics, Paper, SensorNoise};
 use robocal::synth::{render, RenderOptions, Scene};
-use robocal::target::Target;
+use robocal::target::{Polarity, Target};
 use std::path::Path;
 
 #[derive(clap::Args)]
@@ -76,7 +76,8 @@ pub struct RenderArgs {
     /// The folder to write into (created if missing)
     #[arg(long, value_name = "DIR")]
     out: Option<String>,
-    /// chessboard:9x6:30mm (default), circles:..., dots:..., squares:...
+    /// chessboard:9x6:30mm (default), circles:..., dots:..., squares:...;
+    /// add :light-on-dark for the print inverted (any kind)
     #[arg(long, value_name = "SPEC")]
     target: Option<String>,
     /// Number of images
@@ -293,7 +294,8 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
             render: render_options(&args),
         });
     }
-    let target = Target::parse_spec(args.target.as_deref().unwrap_or("chessboard:9x6:30mm"))?;
+    let (target, print) =
+        Target::parse_spec_print(args.target.as_deref().unwrap_or("chessboard:9x6:30mm"))?;
     if args.views == 0 || args.views > 1000 {
         return Err(CliError::usage(
             "render",
@@ -309,7 +311,17 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         effects: effects_of(&args.effects)?,
         ..render_options(&args)
     };
+    let options = board_print(options, &target, print);
     write_set(out, &camera, &target, args.views, args.seed, &options)
+}
+
+/// The print a spec's `:light-on-dark` asks for (a circle grid draws its
+/// own `polarity`).
+fn board_print(options: RenderOptions, target: &Target, print: Option<Polarity>) -> RenderOptions {
+    match (target, print) {
+        (Target::CircleGrid { .. }, _) | (_, None) => options,
+        (_, Some(print)) => options.printed(print),
+    }
 }
 
 fn render_options(args: &RenderArgs) -> RenderOptions {
@@ -323,7 +335,8 @@ fn render_options(args: &RenderArgs) -> RenderOptions {
 
 fn run_video(args: &RenderArgs, video: &str) -> Result<(), CliError> {
     check_sigmas(args)?;
-    let target = Target::parse_spec(args.target.as_deref().unwrap_or("chessboard:9x6:30mm"))?;
+    let (target, print) =
+        Target::parse_spec_print(args.target.as_deref().unwrap_or("chessboard:9x6:30mm"))?;
     let camera = match args.camera.as_deref() {
         Some(file) => Some(robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0),
         None => None,
@@ -334,9 +347,9 @@ fn run_video(args: &RenderArgs, video: &str) -> Result<(), CliError> {
         size: &args.size,
         fps: args.fps,
         camera,
-        target,
         seed: args.seed,
-        render: render_options(args),
+        render: board_print(render_options(args), &target, print),
+        target,
     })
 }
 

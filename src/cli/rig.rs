@@ -8,7 +8,6 @@ use robocal::calib::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOpt
 use robocal::calib::rig_report::RigCalibration;
 use robocal::calib::{CalibrationOptions, View};
 use robocal::camera::Camera;
-use robocal::detect::DetectOptions;
 use robocal::handeye::rig_json::rig_cameras_named;
 use robocal::io::import_camera::import_camera;
 use robocal::io::pairing::{default_grouping, frame_keys, FrameGrouping};
@@ -300,7 +299,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
     let mut outcomes = run_all(
         &all,
         &target,
-        &DetectOptions::default(),
+        &super::detect_options_of(Some(&target_spec)),
         &decode,
         args.threads,
     )?

@@ -6,7 +6,6 @@ use super::{write_output, CliError};
 use robocal::calib::json_api::model_from_name;
 use robocal::calib::stereo::calibrate_stereo;
 use robocal::calib::{CalibrationOptions, View};
-use robocal::detect::DetectOptions;
 use robocal::io::pairing::{pair_by_number, PairedBy};
 use robocal::target::{Detection, Target};
 
@@ -181,7 +180,7 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
         run_all(
             &images,
             target,
-            &DetectOptions::default(),
+            &super::detect_options_of(args.target.as_deref()),
             &args.limits.decode_options(),
             args.threads,
         )?

@@ -1,7 +1,8 @@
 //! `robocal target`: a target spec read back as JSON, or its printable sheet.
 
-use super::{parse_target, write_output, CliError};
+use super::{write_output, CliError};
 use robocal::target::svg::board_svg;
+use robocal::target::Target;
 
 #[derive(clap::Args)]
 #[command(
@@ -44,7 +45,18 @@ pub fn run(args: TargetArgs) -> Result<(), CliError> {
             "give the target, e.g. robocal target chessboard:9x6:30mm",
         ));
     };
-    let target = parse_target("target", spec)?;
+    let (target, print) = super::parse_target_print("target", spec)?;
+    if let (Some(_), Some(robocal::target::Polarity::LightOnDark)) = (&args.svg, print) {
+        if !matches!(target, Target::CircleGrid { .. }) {
+            return Err(CliError::usage(
+                "target",
+                format!(
+                    "the printable sheet of {} is drawn dark on light only; ':light-on-dark' is a detection option for it (print the sheet inverted, or leave the option out: detection finds either print)",
+                    target.to_spec()
+                ),
+            ));
+        }
+    }
     match args.svg.as_deref() {
         None => {
             let json = serde_json::to_string_pretty(&target)

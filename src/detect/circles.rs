@@ -433,10 +433,38 @@ fn seed_steps(blobs: &[Blob], seed: usize) -> Option<(Vector2<f64>, Vector2<f64>
     Some((v1, v2))
 }
 
+/// Whether blob `b` (found at pyramid `level`) is darker at its centre
+/// than around it, 1.5 equivalent radii out: true of a dark disc, false of
+/// a dark ring around a light one.
+fn is_filled(img: &GrayImage, b: &Blob, level: u32) -> bool {
+    let (c, _) = to_full_blob(b, level);
+    let s = (1u64 << level) as f64;
+    let radius = 1.5 * s * (b.area / std::f64::consts::PI).sqrt();
+    let grey = |x: f64, y: f64| {
+        let (x, y) = (x.round(), y.round());
+        (x >= 0.0 && y >= 0.0 && x < img.width as f64 && y < img.height as f64)
+            .then(|| img.get(x as u32, y as u32).map(f64::from))
+            .flatten()
+    };
+    let Some(centre) = grey(c.x, c.y) else {
+        return false;
+    };
+    let around: Vec<f64> = (0..16)
+        .filter_map(|k| {
+            let a = k as f64 * std::f64::consts::PI / 8.0;
+            grey(c.x + radius * a.cos(), c.y + radius * a.sin())
+        })
+        .collect();
+    around.is_empty() || centre < around.iter().sum::<f64>() / around.len() as f64
+}
+
 /// Detect one circle: the largest elliptical dark blob, with the covariance
 /// of its fitted centre. Two blobs of similar size are reported, not guessed.
 pub(crate) fn detect_single(img: &GrayImage, options: &DetectOptions) -> Result<DetectedPoint> {
-    let (level, blobs) = blobs_at_level(img, false, options);
+    let (level, mut blobs) = blobs_at_level(img, false, options);
+    // A dark ring (a light circle's dark surround, the other print) is a
+    // blob too; a filled circle is dark at its centre.
+    blobs.retain(|b| is_filled(img, b, level));
     let Some(first) = blobs.first() else {
         return Err(Error::NotFound {
             message: "board not found: no dark circle in the image".to_string(),

@@ -20,6 +20,12 @@
 //!   square's four corners are where parabolas fitted to its sides'
 //!   sub-pixel edge points (gradient centroids across each side) meet.
 //!
+//! - **Either print** ([`polarity`] docs): every kind is found printed dark
+//!   on light or light on dark (the usual print first, the inverted one only
+//!   when that finds nothing; chessboards read their print off the found
+//!   board), with the ids of the usual print; [`DetectOptions::polarity`]
+//!   forces one, and the detection's `polarity` says which was found.
+//!
 //! # Perspective-correct circle centres
 //!
 //! Under perspective the centre of an imaged circle (an ellipse) is not the
@@ -101,6 +107,7 @@ mod ellipse;
 pub(crate) mod filter;
 mod lattice;
 pub mod markers;
+pub mod polarity;
 mod refine;
 mod saddle;
 mod squares;
@@ -108,7 +115,7 @@ mod squares;
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
 pub use crate::target::CentreModel;
-use crate::target::{Detection, Target};
+use crate::target::{DetectedPoint, Detection, Polarity, Target};
 use filter::Plane;
 
 /// Smallest image side the detectors accept, pixels.
@@ -127,6 +134,10 @@ pub struct DetectOptions {
     /// the perspective correction off, for comparison). Recorded in the
     /// detection as `centre_model`.
     pub circle_centres: CentreModel,
+    /// The print to search (`Some`: only that one; the spec options
+    /// `:dark-on-light` / `:light-on-dark`, [`Target::parse_spec_print`]),
+    /// or `None` (default) to find either ([`polarity`] docs).
+    pub polarity: Option<Polarity>,
 }
 
 impl Default for DetectOptions {
@@ -134,20 +145,127 @@ impl Default for DetectOptions {
         DetectOptions {
             max_working_side_px: 256,
             circle_centres: CentreModel::default(),
+            polarity: None,
         }
     }
 }
 
-/// Find `target` in `image`.
+/// Find `target` in `image`, printed dark on light or light on dark
+/// (`polarity` docs; [`DetectOptions::polarity`] may force one). The
+/// detection's `polarity` says which print was found.
 ///
 /// Errors: [`Error::Image`] for images smaller than 16x16 pixels,
 /// [`Error::NotFound`] when the target is absent or incomplete (the message
-/// gives counts and likely causes), [`Error::Invalid`] for a bad target.
+/// gives counts and likely causes, and names the print option when a forced
+/// print missed a board the other print finds), [`Error::Invalid`] for a
+/// bad target.
 pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Result<Detection> {
     check_image(image)?;
-    let (w, h) = (image.width, image.height);
     let target = target.clone().validated()?;
-    let centre_model = match &target {
+    match (&target, options.polarity) {
+        // Found in either print by the same corners; the print is read off
+        // the found board (`polarity` docs), so a miss is not searched again.
+        (Target::Chessboard { cols, rows, .. }, None) => {
+            let points = chessboard::detect_chessboard(image, *cols, *rows, options)?;
+            match polarity::chessboard_print(image, &points, *cols, *rows) {
+                Polarity::DarkOnLight => Ok(detection(
+                    image,
+                    &target,
+                    points,
+                    Polarity::DarkOnLight,
+                    options,
+                )),
+                Polarity::LightOnDark => {
+                    detect_printed(image, &target, Polarity::LightOnDark, options).or_else(|_| {
+                        Ok(detection(
+                            image,
+                            &target,
+                            points,
+                            Polarity::DarkOnLight,
+                            options,
+                        ))
+                    })
+                }
+            }
+        }
+        // The other print would find the same corners or none: no retry.
+        (Target::Chessboard { .. }, Some(print)) => detect_printed(image, &target, print, options),
+        (Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. }, forced) => {
+            let mut own = marker_boards(image, &target, forced, true)?;
+            own.pop().ok_or_else(|| Error::NotFound {
+                message: format!("board not found: {}", target.to_spec()),
+            })
+        }
+        (_, forced) => polarity::search(&target, forced, |print| {
+            detect_printed(image, &target, print, options)
+        }),
+    }
+}
+
+/// `target` (validated) searched in one print.
+fn detect_printed(
+    image: &GrayImage,
+    target: &Target,
+    print: Polarity,
+    options: &DetectOptions,
+) -> Result<Detection> {
+    // Circle grids and dot plates threshold for either print; the other
+    // detectors see dark marks, so a light-on-dark print is inverted.
+    let inverted_image;
+    let seen = match (target, print) {
+        (Target::CircleGrid { .. } | Target::DotPlate { .. }, _) | (_, Polarity::DarkOnLight) => {
+            image
+        }
+        (_, Polarity::LightOnDark) => {
+            inverted_image = polarity::inverted(image);
+            &inverted_image
+        }
+    };
+    let points = match target {
+        Target::Chessboard { cols, rows, .. } => {
+            chessboard::detect_chessboard(seen, *cols, *rows, options)?
+        }
+        Target::CircleGrid { asymmetric, .. } => {
+            circles::detect_grid(seen, target, print, *asymmetric, None, options)?
+        }
+        Target::DotPlate {
+            pitch_m,
+            dot_diameter_m,
+            ..
+        } => circles::detect_grid(
+            seen,
+            target,
+            print,
+            false,
+            Some(dot_diameter_m / pitch_m),
+            options,
+        )?,
+        Target::OriginDotGrid { .. } => circles::detect_origin_dot_grid(seen, target, options)?,
+        Target::SingleCircle { .. } => vec![circles::detect_single(seen, options)?],
+        Target::SquareGrid {
+            cols,
+            rows,
+            side_m,
+            pitch_m,
+        } => squares::detect_square_grid(seen, *cols, *rows, side_m / pitch_m, options)?,
+        Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
+            let mut found = markers::detect_one(seen, target, options)?;
+            found.polarity = Some(print);
+            return Ok(found);
+        }
+    };
+    Ok(detection(image, target, points, print, options))
+}
+
+/// The detection of `points` of `target` found printed `print`.
+fn detection(
+    image: &GrayImage,
+    target: &Target,
+    points: Vec<DetectedPoint>,
+    print: Polarity,
+    options: &DetectOptions,
+) -> Detection {
+    let centre_model = match target {
         Target::CircleGrid { .. } | Target::DotPlate { .. } | Target::OriginDotGrid { .. } => {
             Some(options.circle_centres)
         }
@@ -158,45 +276,13 @@ pub fn detect(image: &GrayImage, target: &Target, options: &DetectOptions) -> Re
         | Target::Aprilgrid { .. }
         | Target::ArucoGrid { .. } => None,
     };
-    let points = match &target {
-        Target::Chessboard { cols, rows, .. } => {
-            chessboard::detect_chessboard(image, *cols, *rows, options)?
-        }
-        Target::CircleGrid {
-            polarity,
-            asymmetric,
-            ..
-        } => circles::detect_grid(image, &target, *polarity, *asymmetric, None, options)?,
-        Target::DotPlate {
-            pitch_m,
-            dot_diameter_m,
-            ..
-        } => circles::detect_grid(
-            image,
-            &target,
-            crate::target::Polarity::DarkOnLight,
-            false,
-            Some(dot_diameter_m / pitch_m),
-            options,
-        )?,
-        Target::OriginDotGrid { .. } => circles::detect_origin_dot_grid(image, &target, options)?,
-        Target::SingleCircle { .. } => vec![circles::detect_single(image, options)?],
-        Target::SquareGrid {
-            cols,
-            rows,
-            side_m,
-            pitch_m,
-        } => squares::detect_square_grid(image, *cols, *rows, side_m / pitch_m, options)?,
-        Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
-            return markers::detect_one(image, &target, options)
-        }
-    };
-    Ok(Detection {
-        image_size_px: [w, h],
-        target,
+    Detection {
+        image_size_px: [image.width, image.height],
+        target: target.clone(),
         points,
         centre_model,
-    })
+        polarity: Some(print),
+    }
 }
 
 /// Every board of `target` in `image`: for ChArUco boards, AprilGrids and
@@ -214,7 +300,7 @@ pub fn detect_all(
     check_image(image)?;
     match target {
         Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. } => {
-            markers::detect_boards(image, target, options)
+            marker_boards(image, target, options.polarity, false)
         }
         Target::Chessboard { .. }
         | Target::CircleGrid { .. }
@@ -223,6 +309,37 @@ pub fn detect_all(
         | Target::SquareGrid { .. }
         | Target::OriginDotGrid { .. } => Ok(vec![detect(image, target, options)?]),
     }
+}
+
+/// Every board of a marker-board target's layout (`own`: the target's own
+/// board alone, an error when only others are seen), in either print
+/// (`polarity::search_markers`), each detection with the print found.
+fn marker_boards(
+    image: &GrayImage,
+    target: &Target,
+    forced: Option<Polarity>,
+    own: bool,
+) -> Result<Vec<Detection>> {
+    let mut inverted_image: Option<GrayImage> = None;
+    let large = markers::decimates(image);
+    polarity::search_markers(target, forced, large, |print, resolutions| {
+        let seen = match print {
+            Polarity::DarkOnLight => image,
+            Polarity::LightOnDark => {
+                inverted_image.get_or_insert_with(|| polarity::inverted(image))
+            }
+        };
+        let (boards, read) = markers::boards_at(seen, target, resolutions);
+        let boards = match own {
+            true => markers::own_board(target, boards).map(|d| vec![d]),
+            false => boards,
+        };
+        let boards = boards.map(|mut b| {
+            b.iter_mut().for_each(|d| d.polarity = Some(print));
+            b
+        });
+        (boards, read)
+    })
 }
 
 /// Size checks shared by the entry points.

@@ -17,7 +17,9 @@
 //! AprilGrids are drawn as printed (`crate::target::marker_board`: OpenCV's
 //! and Kalibr's layouts) with a white quiet zone of one square (ChArUco) or
 //! half a tag beyond the corner squares (AprilGrid). Beyond the
-//! print the scene is a uniform grey wall.
+//! print the scene is a uniform grey wall. [`RenderOptions::light_on_dark`]
+//! inverts the print (margins included): the same board printed light on
+//! dark.
 
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
@@ -129,6 +131,30 @@ impl Default for RenderOptions {
             circle_diameter_ratio: 0.5,
             seed: 1,
             effects: Effects::default(),
+        }
+    }
+}
+
+impl RenderOptions {
+    /// The same options with the print inverted (its black and white
+    /// swapped, margins and quiet zones included): a board printed light on
+    /// dark. Its points and ids are the normal print's; a chessboard's
+    /// outer square beyond corner 0 becomes light, as a light-on-dark
+    /// chessboard defines it.
+    pub fn light_on_dark(self) -> RenderOptions {
+        RenderOptions {
+            black: self.white,
+            white: self.black,
+            ..self
+        }
+    }
+
+    /// The options for a target printed `print` (`Polarity::DarkOnLight`:
+    /// unchanged; a circle grid's own `polarity` is drawn on top of this).
+    pub fn printed(self, print: Polarity) -> RenderOptions {
+        match print {
+            Polarity::DarkOnLight => self,
+            Polarity::LightOnDark => self.light_on_dark(),
         }
     }
 }

@@ -68,14 +68,46 @@ use crate::error::{Error, Result};
 use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 
-/// Which way round a circle target is printed.
+/// Which way round a target is printed: a circle grid's `polarity` field,
+/// a detection's `polarity` (what the detector found) and the spec options
+/// `:dark-on-light` / `:light-on-dark` that force one on any kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Polarity {
-    /// Dark circles on a light background (the usual print).
+    /// Dark marks (squares, circles, markers) on a light background (the
+    /// usual print).
     DarkOnLight,
-    /// Light circles on a dark background.
+    /// Light marks on a dark background (the usual print inverted: backlit
+    /// and laser-cut boards, caliscope's ChArUco).
     LightOnDark,
+}
+
+impl Polarity {
+    /// The other print.
+    pub fn other(self) -> Polarity {
+        match self {
+            Polarity::DarkOnLight => Polarity::LightOnDark,
+            Polarity::LightOnDark => Polarity::DarkOnLight,
+        }
+    }
+
+    /// The spec option that forces this print: `dark-on-light` or
+    /// `light-on-dark`.
+    pub fn spec_option(self) -> &'static str {
+        match self {
+            Polarity::DarkOnLight => "dark-on-light",
+            Polarity::LightOnDark => "light-on-dark",
+        }
+    }
+
+    /// The spec option `text` names, if it names one.
+    pub fn from_spec_option(text: &str) -> Option<Polarity> {
+        match text {
+            "dark-on-light" => Some(Polarity::DarkOnLight),
+            "light-on-dark" => Some(Polarity::LightOnDark),
+            _ => None,
+        }
+    }
 }
 
 /// A calibration target's geometry (see the module docs for the point order).
@@ -238,6 +270,10 @@ pub struct Detection {
     /// the key existed, whose circle centres are ellipse centres).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub centre_model: Option<CentreModel>,
+    /// The print the detector found the target in (written by every
+    /// detection; absent in files written before the key existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polarity: Option<Polarity>,
 }
 
 impl Detection {

@@ -5,7 +5,7 @@ use super::*;
 
 impl Target {
     /// Parse a CLI target spec: `chessboard:9x6:30mm`,
-    /// `circles:4x11:20mm[:asymmetric][:light-on-dark]`, `dots:7x7:25mm[:12.5mm]`
+    /// `circles:4x11:20mm[:asymmetric]`, `dots:7x7:25mm[:12.5mm]`
     /// (dot diameter defaults to half the pitch), `circle:10mm`,
     /// `squares:8x8:12.7mm:22.5778mm` (squares per row x rows, side, pitch),
     /// `charuco:12x9:20mm:15mm:DICT_5X5_100[:first=N][:ids=A,B,...][:legacy]`
@@ -16,11 +16,50 @@ impl Target {
     /// markers, marker side, separation, dictionary; first marker id),
     /// `circles:10x10:25mm:origin-dot` (ROS-Industrial's modified circle
     /// grid: dots, pitch; the origin dot is twice as large).
-    /// Lengths take a unit: `mm`, `cm` or `m`.
+    /// Lengths take a unit: `mm`, `cm` or `m`. Any spec may add
+    /// `:dark-on-light` or `:light-on-dark` (see [`Target::parse_spec_print`]);
+    /// this function keeps only the geometry (and a circle grid's polarity).
     pub fn parse_spec(spec: &str) -> Result<Target> {
-        let parts: Vec<&str> = spec.trim().split(':').collect();
-        let bad = |m: String| Error::invalid("target", m);
-        match parts.as_slice() {
+        Ok(Target::parse_spec_print(spec)?.0)
+    }
+
+    /// Parse a CLI target spec ([`Target::parse_spec`]) with its print
+    /// option: `:dark-on-light` or `:light-on-dark` anywhere after the kind
+    /// forces the detector to that print (`DetectOptions::polarity`);
+    /// without one the detector finds the print itself. A circle grid's
+    /// `polarity` field takes the option too.
+    pub fn parse_spec_print(spec: &str) -> Result<(Target, Option<Polarity>)> {
+        let all: Vec<&str> = spec.trim().split(':').collect();
+        let mut print: Option<Polarity> = None;
+        let mut parts = Vec::with_capacity(all.len());
+        for (k, part) in all.iter().enumerate() {
+            match Polarity::from_spec_option(part) {
+                Some(p) if k > 0 => {
+                    if print.is_some_and(|q| q != p) {
+                        return Err(Error::invalid(
+                            "target",
+                            format!(
+                                "'{spec}' asks for both dark-on-light and light-on-dark; give one"
+                            ),
+                        ));
+                    }
+                    print = Some(p);
+                }
+                _ => parts.push(*part),
+            }
+        }
+        let mut target = parse_parts(spec, &parts)?;
+        if let (Target::CircleGrid { polarity, .. }, Some(p)) = (&mut target, print) {
+            *polarity = p;
+        }
+        Ok((target, print))
+    }
+}
+
+/// The geometry of a spec split at ':' (print options taken out).
+fn parse_parts(spec: &str, parts: &[&str]) -> Result<Target> {
+    let bad = |m: String| Error::invalid("target", m);
+    match parts {
             ["chessboard", grid, size] => {
                 let (cols, rows) = parse_grid(grid)?;
                 Target::Chessboard {
@@ -36,13 +75,12 @@ impl Target {
             ["circles", grid, size, flags @ ..] => {
                 let (cols, rows) = parse_grid(grid)?;
                 let mut asymmetric = false;
-                let mut polarity = Polarity::DarkOnLight;
+                // The print option was taken out by `parse_spec_print`.
+                let polarity = Polarity::DarkOnLight;
                 for f in flags {
                     match *f {
                         "asymmetric" => asymmetric = true,
                         "symmetric" => asymmetric = false,
-                        "dark-on-light" => polarity = Polarity::DarkOnLight,
-                        "light-on-dark" => polarity = Polarity::LightOnDark,
                         other => {
                             return Err(bad(format!(
                                 "unknown circle-grid option '{other}' (expected asymmetric, symmetric, dark-on-light, light-on-dark or origin-dot)"
@@ -98,8 +136,9 @@ impl Target {
                 "'{spec}' is not a target spec; expected chessboard:COLSxROWS:SIZE, circles:COLSxROWS:SIZE[:asymmetric], dots:COLSxROWS:PITCH[:DIAMETER], squares:COLSxROWS:SIDE:PITCH, charuco:SQUARESXxSQUARESY:SQUARE:MARKER:DICTIONARY, aprilgrid:TAGCOLSxTAGROWS:TAGSIZE:SPACINGRATIO, arucogrid:COLSxROWS:MARKER:SEPARATION:DICTIONARY, circles:COLSxROWS:PITCH:origin-dot or circle:DIAMETER (e.g. chessboard:9x6:30mm)"
             ))),
         }
-    }
+}
 
+impl Target {
     /// The CLI spec of this target, the inverse of [`Target::parse_spec`]:
     /// `parse_spec(&t.to_spec())` gives `t` back bit for bit. Lengths are
     /// written in millimetres with the fewest decimals that read back to

@@ -148,6 +148,7 @@ fn detection_round_trips_through_json() {
             },
         ],
         centre_model: None,
+        polarity: None,
     };
     let json = serde_json::to_string(&d).unwrap();
     assert!(json.contains("\"kind\":\"chessboard\""), "{json}");
@@ -158,6 +159,7 @@ fn detection_round_trips_through_json() {
     let circles = Detection {
         target: Target::parse_spec("circles:4x11:20mm:asymmetric").unwrap(),
         centre_model: Some(CentreModel::PerspectivePole),
+        polarity: None,
         ..d.clone()
     };
     let json = serde_json::to_string(&circles).unwrap();

@@ -20,3 +20,4 @@ mod cli_render_video;
 mod cli_rig;
 mod cli_stereo;
 mod cli_workflows;
+mod cli_polarity;

@@ -13,3 +13,5 @@ mod detect_markers_datasets;
 mod detect_render;
 mod fuzz_regressions;
 mod detect_grid_boards;
+mod detect_polarity;
+mod detect_polarity_datasets;

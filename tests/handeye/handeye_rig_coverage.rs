@@ -234,7 +234,7 @@ fn rig_hand_eye_std_cover_the_truth_with_the_rig_solved_from_the_same_pixels() {
 }
 
 #[test]
-#[ignore = "200 seeded trials (several minutes in release): cargo test --release --test handeye handeye:: handeye_rig_coverage:: -- --ignored --nocapture"]
+#[ignore = "200 seeded trials (several minutes in release): cargo test --release --test handeye handeye_rig_coverage:: -- --ignored --nocapture"]
 fn rig_hand_eye_std_cover_the_truth_in_200_trials() {
     let (inside, total) = coverage(200);
     assert!(

@@ -324,6 +324,7 @@ export class ImagesView {
     card.li.className = `card ${img.status === 'error' ? 'warn' : 'ok'}${img.included ? '' : ' excluded'}`;
     const parts = [describe(img.info)];
     if (img.detection) parts.push(pointCount(img.detection.points, this.board));
+    if (img.detection && img.detection.polarity === 'light_on_dark') parts.push(PRINTED_INVERTED);
     if (img.largerGrid) parts.push(img.largerGrid);
     if (img.note) parts.push(img.note); // e.g. a camera capture that repeats an earlier one
     if (img.status === 'error') parts.push(img.error);
@@ -387,11 +388,14 @@ export class ImagesView {
     drawImage($('inspector-canvas'), this.full, img.detection ? img.detection.points : [], this.full.scale, zoom, res, true, img.otherBoards || []);
     const rms = res.length ? Math.sqrt(res.reduce((s, r) => s + r.dx * r.dx + r.dy * r.dy, 0) / res.length) : null;
     $('inspector-info').textContent = `${describe(img.info)} · ${img.detection ? pointCount(img.detection.points, this.board) : img.error || 'not detected'}` +
+      (img.detection && img.detection.polarity === 'light_on_dark' ? ` · ${PRINTED_INVERTED}` : '') +
       (rms !== null ? ` · reprojection RMS ${rms.toFixed(3)} px (residual vectors drawn ×${RESIDUAL_GAIN})` : '');
   }
 }
 
 const RESIDUAL_GAIN = 20;
+/** Shown when the detector found the board printed light on dark (the detection's "polarity"). */
+const PRINTED_INVERTED = 'printed light on dark';
 
 function describe(info) {
   if (!info) return '';

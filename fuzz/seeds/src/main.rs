@@ -112,6 +112,7 @@ fn small_renders() -> Res<Vec<Render>> {
                 // Exact projections of the board points (for circle
                 // targets what `perspective_pole` estimates); no model key.
                 centre_model: None,
+                polarity: None,
             };
             out.push(Render {
                 kind,

@@ -31,7 +31,7 @@
 mod decode;
 mod edges;
 mod grid_corners;
-mod homography;
+pub(crate) mod homography;
 mod quads;
 mod runs;
 
@@ -44,6 +44,7 @@ use crate::target::{DetectedPoint, Detection, Dictionary, Target};
 use decode::Marker;
 use homography::Homography;
 use nalgebra::Point2;
+pub(crate) use quads::{decimates, Resolutions};
 use std::collections::HashMap;
 
 /// A marker is an outlier of its board when the board's homography puts
@@ -93,10 +94,15 @@ impl MarkerOptions {
 }
 
 /// Every marker of `dictionary` in `img` (each once).
-pub(crate) fn find_markers(img: &GrayImage, dictionary: Dictionary, border: usize) -> Vec<Marker> {
+pub(crate) fn find_markers(
+    img: &GrayImage,
+    dictionary: Dictionary,
+    border: usize,
+    resolutions: Resolutions,
+) -> Vec<Marker> {
     let max_errors = MarkerOptions::default().max_bit_errors(dictionary);
     let mut found: Vec<Marker> = Vec::new();
-    quads::find_quads(img, |q| {
+    quads::find_quads(img, resolutions, |q| {
         let Some(m) = decode::read_marker(img, q, dictionary, border, max_errors) else {
             return false;
         };
@@ -129,7 +135,13 @@ pub(crate) fn detect_one(
     target: &Target,
     options: &DetectOptions,
 ) -> Result<Detection> {
-    let boards = detect_boards(image, target, options)?;
+    own_board(target, detect_boards(image, target, options))
+}
+
+/// The target's own board among `boards` (an error naming the others when
+/// it is not there).
+pub(crate) fn own_board(target: &Target, boards: Result<Vec<Detection>>) -> Result<Detection> {
+    let boards = boards?;
     let others: Vec<String> = boards.iter().map(|d| d.target.to_spec()).collect();
     boards
         .into_iter()
@@ -151,15 +163,40 @@ pub fn detect_boards(
     target: &Target,
     _options: &DetectOptions,
 ) -> Result<Vec<Detection>> {
-    let target = target.clone().validated()?;
-    let Some(layout) = marker_board::layout(&target) else {
-        return Err(Error::invalid(
-            "target",
-            format!("{} is not a marker board", target.to_spec()),
-        ));
+    boards_at(image, target, Resolutions::HalfThenFull).0
+}
+
+/// [`detect_boards`] over some of the marker search's resolutions; the
+/// flag says whether any marker of the dictionary was read.
+pub(crate) fn boards_at(
+    image: &GrayImage,
+    target: &Target,
+    resolutions: Resolutions,
+) -> (Result<Vec<Detection>>, bool) {
+    let markers = match target.clone().validated().and_then(|t| {
+        marker_board::layout(&t).map(|l| (t, l)).ok_or_else(|| {
+            Error::invalid(
+                "target",
+                format!("{} is not a marker board", target.to_spec()),
+            )
+        })
+    }) {
+        Ok((t, layout)) => {
+            let found = find_markers(image, layout.dictionary, layout.border_bits, resolutions);
+            (t, layout, found)
+        }
+        Err(e) => return (Err(e), false),
     };
+    let read = !markers.2.is_empty();
+    (boards_from(image, markers), read)
+}
+
+/// The boards the found markers make up.
+fn boards_from(
+    image: &GrayImage,
+    (target, layout, markers): (Target, MarkerLayout, Vec<Marker>),
+) -> Result<Vec<Detection>> {
     let dictionary = layout.dictionary;
-    let markers = find_markers(image, dictionary, layout.border_bits);
     if markers.is_empty() {
         return Err(Error::NotFound {
             message: format!(
@@ -259,6 +296,7 @@ fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Det
         target: board.clone(),
         points,
         centre_model: None,
+        polarity: None,
     })
 }
 

@@ -132,16 +132,42 @@ impl Tried {
 
 /// Hands every candidate quad of `img` to `read` (corners refined on
 /// `img`), which says whether it read a marker there; see the module docs.
-pub(crate) fn find_quads(img: &GrayImage, mut read: impl FnMut(&Quad) -> bool) {
+pub(crate) fn find_quads(
+    img: &GrayImage,
+    resolutions: Resolutions,
+    mut read: impl FnMut(&Quad) -> bool,
+) {
     let mut tried = Tried::default();
-    if img.width.max(img.height) >= DECIMATE_FROM_PX {
+    let large = decimates(img);
+    if large && resolutions != Resolutions::FullOnly {
         let half = runs::decimate(img);
         search(img, &half, 2.0, &mut tried, &mut read);
-        if !tried.markers.is_empty() {
+        if !tried.markers.is_empty() || resolutions == Resolutions::HalfOnly {
             return;
         }
     }
-    search(img, img, 1.0, &mut tried, &mut read);
+    if large || resolutions != Resolutions::FullOnly {
+        search(img, img, 1.0, &mut tried, &mut read);
+    }
+}
+
+/// Which of the searches of steps 1 and 6 (module docs) to run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Resolutions {
+    /// Half resolution on large frames, then full resolution when that
+    /// read no marker (small frames: full resolution).
+    HalfThenFull,
+    /// The first search alone: half resolution on large frames (small
+    /// frames: full resolution).
+    HalfOnly,
+    /// The full-resolution retry alone: large frames only (nothing on
+    /// small ones, which `HalfOnly` searched at full resolution).
+    FullOnly,
+}
+
+/// Whether `img` is searched at half resolution first.
+pub(crate) fn decimates(img: &GrayImage) -> bool {
+    img.width.max(img.height) >= DECIMATE_FROM_PX
 }
 
 /// One search on `small` (the frame `img` scaled by 1 / `scale`).
