@@ -135,7 +135,12 @@ pub fn distortion_fold(camera: &Camera) -> Option<(f64, f64)> {
             if r.is_nan() || r < last {
                 // r_d rose up to sample i - 1 and fell (or ended) by sample
                 // i: its peak lies between samples i - 2 and i.
-                let fold = peak(&radius, step * (i as f64 - 2.0).max(0.0), step * i as f64, last);
+                let fold = peak(
+                    &radius,
+                    step * (i as f64 - 2.0).max(0.0),
+                    step * i as f64,
+                    last,
+                );
                 if worst.map_or(true, |(f, _)| fold < f) {
                     worst = Some((fold, corner_r));
                 }
@@ -157,7 +162,10 @@ fn peak(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, known: f64) -> f64 {
     let (mut fc, mut fd) = (f(c), f(d));
     let mut best = known;
     for _ in 0..FOLD_REFINE_STEPS {
-        best = [fc, fd].into_iter().filter(|v| !v.is_nan()).fold(best, f64::max);
+        best = [fc, fd]
+            .into_iter()
+            .filter(|v| !v.is_nan())
+            .fold(best, f64::max);
         if higher(fd, fc) {
             lo = c;
             (c, fc) = (d, fd);
@@ -170,7 +178,10 @@ fn peak(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, known: f64) -> f64 {
             fc = f(c);
         }
     }
-    [fc, fd].into_iter().filter(|v| !v.is_nan()).fold(best, f64::max)
+    [fc, fd]
+        .into_iter()
+        .filter(|v| !v.is_nan())
+        .fold(best, f64::max)
 }
 
 /// Whether a camera shows a signature of a wrong minimum (principal point

@@ -8,10 +8,10 @@ mod support;
 
 mod detect_circles;
 mod detect_datasets;
+mod detect_grid_boards;
 mod detect_markers;
 mod detect_markers_datasets;
-mod detect_render;
-mod fuzz_regressions;
-mod detect_grid_boards;
 mod detect_polarity;
 mod detect_polarity_datasets;
+mod detect_render;
+mod fuzz_regressions;

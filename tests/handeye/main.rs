@@ -8,8 +8,8 @@ mod support;
 
 mod handeye;
 mod handeye_charuco;
+mod handeye_grid_boards;
 mod handeye_image_path;
 mod handeye_repeatability;
 mod handeye_rig;
 mod handeye_rig_coverage;
-mod handeye_grid_boards;
