@@ -87,14 +87,23 @@ fn bad_aruco_grid_and_origin_dot_specs_say_what_is_wrong() {
     );
     assert!(err("arucogrid:5x7:40mm:10mm:DICT_9X9_1")
         .starts_with("target: unknown marker dictionary 'DICT_9X9_1'; known: DICT_4X4_50, "));
-    let origin_dot_only = "is not an origin-dot grid spec; expected circles:COLSxROWS:PITCH:origin-dot with no other option (ROS-Industrial's grid is symmetric, dark dots on light; e.g. circles:10x10:25mm:origin-dot)";
+    let origin_dot_only = "is not an origin-dot grid spec; expected circles:COLSxROWS:PITCH:origin-dot with no other option than the print (:dark-on-light or :light-on-dark; ROS-Industrial's grid is symmetric; e.g. circles:10x10:25mm:origin-dot)";
     assert_eq!(
         err("circles:10x10:25mm:origin-dot:asymmetric"),
         format!("target: 'circles:10x10:25mm:origin-dot:asymmetric' {origin_dot_only}")
     );
+    // The print is an option of every kind: it is taken off before the
+    // grid's own options are read.
     assert_eq!(
-        err("circles:10x10:25mm:light-on-dark:origin-dot"),
-        format!("target: 'circles:10x10:25mm:light-on-dark:origin-dot' {origin_dot_only}")
+        Target::parse_spec_print("circles:10x10:25mm:light-on-dark:origin-dot").unwrap(),
+        (
+            Target::OriginDotGrid {
+                cols: 10,
+                rows: 10,
+                spacing_m: 0.025,
+            },
+            Some(Polarity::LightOnDark)
+        )
     );
     assert_eq!(
         err("circles:1x10:25mm:origin-dot"),

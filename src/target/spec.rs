@@ -474,13 +474,14 @@ fn parse_aruco_grid(spec: &str, rest: &[&str]) -> Result<Target> {
 }
 
 /// Parse `circles:COLSxROWS:PITCH:origin-dot` (ROS-Industrial's modified
-/// circle grid: symmetric, dark dots on light, no other option).
+/// circle grid: symmetric, no other option than the print, which
+/// [`Target::parse_spec_print`] takes off first).
 fn parse_origin_dot(spec: &str, grid: &str, pitch: &str, flags: &[&str]) -> Result<Target> {
     if flags != ["origin-dot"] {
         return Err(Error::invalid(
             "target",
             format!(
-                "'{spec}' is not an origin-dot grid spec; expected circles:COLSxROWS:PITCH:origin-dot with no other option (ROS-Industrial's grid is symmetric, dark dots on light; e.g. circles:10x10:25mm:origin-dot)"
+                "'{spec}' is not an origin-dot grid spec; expected circles:COLSxROWS:PITCH:origin-dot with no other option than the print (:dark-on-light or :light-on-dark; ROS-Industrial's grid is symmetric; e.g. circles:10x10:25mm:origin-dot)"
             ),
         ));
     }

@@ -405,3 +405,25 @@ fn the_detection_json_says_which_print_was_found() {
     let back: Detection = serde_json::from_value(old).unwrap();
     assert_eq!(back.polarity, None);
 }
+
+#[test]
+fn aruco_grids_and_origin_dot_grids_in_either_print() {
+    // The two kinds of issue 36's second half: found in either print without
+    // an option, ids as in the usual print (the origin-dot grid's ids are
+    // fixed by its big dot, so a half turn would show as a large error).
+    let cases = [
+        ("arucogrid:5x7:40mm:10mm:DICT_6X6_250", 0.9, 0.05, 0.3),
+        ("circles:10x10:25mm:origin-dot", 0.7, 0.03, 0.15),
+    ];
+    for (spec, dist, mean_bound, max_bound) in cases {
+        for (k, rpy) in [(0.3, -0.25, 0.1), (-0.2, 0.35, 3.0)]
+            .into_iter()
+            .enumerate()
+        {
+            for print in BOTH {
+                let v = view(spec, print, (1280, 960), rpy, dist, 50 + k as u64);
+                check(spec, &v, print, mean_bound, max_bound);
+            }
+        }
+    }
+}
