@@ -523,7 +523,7 @@ const CASES: &[Case] = &[
         args: &["rig", "--target", "chessboard:9x6:30mm", "--camera", "a", "a1.png", "--camera", "b", "b1.png", "--group-by", "sideways"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: rig: --group-by takes number or order, got 'sideways' (see 'robocal rig --help')",
+        message: "robocal: rig: --group-by takes number or last (the last number in the name, the default), first (the first number), order (the position in each camera's list), or a pattern with one (\\d+) such as sync(\\d+); got 'sideways': not a rule name, and no (\\d+) in it (see 'robocal rig --help')",
     },
     Case {
         name: "rig-name-without-number",
@@ -531,7 +531,7 @@ const CASES: &[Case] = &[
         args: &["rig", "--target", "chessboard:9x6:30mm", "--camera", "a", "a1.png", "a.png", "--camera", "b", "b1.png", "--group-by", "number"],
         code: 2,
         stream: Stream::Stderr,
-        message: "robocal: rig: frames are grouped by the last number in the file names, but camera a has names without one: a.png (number every file, or group by order) (see 'robocal rig --help')",
+        message: "robocal: rig: frames are grouped by the last number in the file names, but camera a has names without one: a.png (group by number or last (the last number in the name, the default), first (the first number), order (the position in each camera's list), or a pattern with one (\\d+) such as sync(\\d+)) (see 'robocal rig --help')",
     },
     Case {
         name: "rig-camera-file-without-name",

@@ -657,7 +657,7 @@ export const tests = [
     await ready(page);
     // Some names have a number: frames go by the number, and the others are named.
     const error = await rigAdd(page, ['a.png', 'b.png', 'c3.png'], ['x1.png', 'y2.png', 'z3.png'], 'cannot be grouped');
-    assert.equal(error, 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam0 has names without one: a.png, b.png (number every file, or group by order)');
+    assert.equal(error, 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but camera cam0 has names without one: a.png, b.png (group by number or last (the last number in the name, the default), first (the first number), order (the position in each camera\'s list), or a pattern with one (\\d+) such as sync(\\d+))');
     assert.equal(await page.isDisabled('#rig-solve'), true);
     await shot('bad');
     // No name with a number: by order (sorted names); a camera with fewer images misses the last frames.

@@ -291,7 +291,7 @@ const rigNames = input('rig_frame_keys', [{ name: 'front', images: ['front07.png
 const rigFrames = output('rig_frame_keys', JSON.parse(robocal.rig_frame_keys(JSON.stringify(rigNames), '')), 'rig_frame_keys number');
 assert.deepEqual(rigFrames, { grouped_by: 'number', keys: [['7', '2'], ['2']], frames: ['2', '7'] });
 assert.deepEqual(JSON.parse(robocal.rig_frame_keys('[{"name":"a","images":["x.png","y.png"]}]', '')), { grouped_by: 'order', keys: [['0', '1']], frames: ['0', '1'] });
-assert.throws(() => robocal.rig_frame_keys('[{"name":"a","images":["a1.png","x.png"]}]', ''), { message: 'images: frames are grouped by the last number in the file names, but camera a has names without one: x.png (number every file, or group by order)' });
+assert.throws(() => robocal.rig_frame_keys('[{"name":"a","images":["a1.png","x.png"]}]', ''), { message: 'images: frames are grouped by the last number in the file names, but camera a has names without one: x.png (group by number or last (the last number in the name, the default), first (the first number), order (the position in each camera\'s list), or a pattern with one (\\d+) such as sync(\\d+))' });
 
 // The checker itself: it must reject what the declarations do not allow.
 const rejects = (what, value, type) => {
