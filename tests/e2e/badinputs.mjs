@@ -645,7 +645,7 @@ export const tests = [
     await ready(page);
     await rigAdd(page, ['l1.png', 'l2.png', 'l3.png'], ['r1.png', 'r2.png', 'r3.png'], '3 frames');
     const error = await rigAdd(page, ['l01.png'], [], 'cannot be grouped');
-    assert.equal(error, 'The images cannot be grouped into frames: images: frames are grouped by the last number in their file names, but number 1 is in two camera cam0 images: l1.png, l01.png');
+    assert.equal(error, 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but number 1 is in two camera cam0 images: l1.png, l01.png (group by number or last (the last number in the name, the default), first (the first number), order (the position in each camera\'s list), or a pattern with one (\\d+) such as sync(\\d+))');
     assert.equal(await page.isDisabled('#rig-solve'), true);
     await shot('bad');
     // The files are kept (the message names them); removing them and loading a clean set groups.

@@ -150,7 +150,7 @@ export const tests = [
     // Number 2 twice in the right camera: the core's error, naming both files.
     await page.setInputFiles('#rig-input-1', [png('right2.png')]);
     await page.waitForFunction(() => /cannot be grouped/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
-    assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in their file names, but number 2 is in two camera cam1 images: right002.png, right2.png');
+    assert.equal(await page.textContent('#rig-grouping'), 'The images cannot be grouped into frames: images: frames are grouped by the last number in the file names, but number 2 is in two camera cam1 images: right002.png, right2.png (group by number or last (the last number in the name, the default), first (the first number), order (the position in each camera\'s list), or a pattern with one (\\d+) such as sync(\\d+))');
     assert.equal(await page.isDisabled('#rig-solve'), true);
     await shot('mismatch');
     // No numbers anywhere: by order of the sorted names.
