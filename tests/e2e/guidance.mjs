@@ -1,4 +1,4 @@
-// Issue 23, first half: what a newcomer tripped over on the page. Images in
+// Suite 'guidance' (was newcomer.mjs). Issue 23, first half: what a newcomer tripped over on the page. Images in
 // natural order (numbered, movable, pairing follows), failed cards unticked,
 // a remove button per card, a target change re-detecting and marking the
 // result stale, "inner corners" in the labels and messages, a grid larger

@@ -1,4 +1,4 @@
-// Issue 23, second half: what a newcomer trips over in sharing, reports,
+// Suite 'reports' (was newcomer2.mjs). Issue 23, second half: what a newcomer trips over in sharing, reports,
 // reload, layout and keyboard use, the robust option's rejections and the
 // frame names of the hand-eye exports. Each test asserts the fixed
 // behaviour; the layout ones also save screenshots (looked at by hand).
@@ -223,7 +223,7 @@ export const tests = [
       assert.ok(results.handeye.result.gripper_from_camera.translation_m, 'transform in the attached JSON');
       const height = await reportPage.evaluate(() => document.documentElement.scrollHeight);
       assert.ok(height < 8000, `report ${height} px tall`);
-      await reportPage.screenshot({ path: join(shotsDir, 'newcomer2-report.png'), fullPage: true });
+      await reportPage.screenshot({ path: join(shotsDir, 'reports-report.png'), fullPage: true });
       await reportPage.close();
       // The session file: detections (no image bytes); loading it restores the session.
       const session = await downloaded(page, '#download-session');
