@@ -12,6 +12,7 @@ mod cli_bad_inputs_scenes;
 mod cli_detect;
 mod cli_export;
 mod cli_handeye;
+mod cli_handeye_pairing;
 mod cli_intrinsics;
 mod cli_output;
 mod cli_partial_views;
