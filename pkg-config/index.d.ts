@@ -328,7 +328,18 @@ export interface Camera {
 }
 
 // ---------------------------------------------------------------------------
-// Camera calibration (src/calib/json_api.rs, report.rs, compare.rs)
+// Reports (src/report_kind.rs, docs/report-json.md)
+
+/**
+ * What a report is: every report says it in `kind`, and which robocal wrote
+ * it in `robocal_version`. Reports written before `kind` existed have none
+ * (and camera and rig reports said `crate_version`); `export_report` still
+ * reads them, by their keys.
+ */
+export type ReportKind = 'camera' | 'stereo' | 'rig' | 'handeye' | 'rig_handeye';
+
+// ---------------------------------------------------------------------------
+// Camera calibration (src/api/camera.rs, src/calib/report.rs, compare.rs)
 
 /** A calibration method; `all` (input only) runs every one and compares. */
 export type CalibrationMethod = 'zhang' | 'dlt' | 'tsai' | 'ekf';
@@ -448,8 +459,9 @@ export interface ViewReport {
 
 /** The calibration report (`calib::CameraCalibration`): the `report` of `calibrate_camera`. */
 export interface CameraCalibration {
+  kind: 'camera';
   /** robocal version that produced the report. */
-  crate_version: string;
+  robocal_version: string;
   /** `[width, height]`, px. */
   image_size_px: ImageSize;
   model: LensModel;
@@ -560,6 +572,7 @@ export interface StereoInput {
 
 /** The output JSON of `calibrate_stereo` (the report `robocal stereo` writes). */
 export interface StereoCalibration {
+  kind: 'stereo';
   /** The left camera at the joint optimum. */
   left: CameraCalibration;
   /** The right camera; its views' `camera_from_target` is `right_from_left * left camera_from_target`. */
@@ -598,7 +611,7 @@ export interface ModelAdvice {
 }
 
 // ---------------------------------------------------------------------------
-// Camera rigs (src/calib/rig_json.rs, rig_report.rs)
+// Camera rigs (src/api/rig.rs, src/calib/rig_report.rs)
 
 /** One view of a rig camera: `key` names its frame (views with one key saw one board pose). */
 export interface RigInputView {
@@ -662,7 +675,10 @@ export interface RigFrame {
 
 /** The output JSON of `calibrate_rig` (the report `robocal rig` writes). */
 export interface RigCalibration {
-  crate_version: string;
+  /** `rig_handeye` when the report carries `handeye` (a rig on a robot). */
+  kind: 'rig' | 'rig_handeye';
+  /** robocal version that produced the report. */
+  robocal_version: string;
   /** Name of the camera whose frame is the rig frame. */
   rig_frame: string;
   target: string;
@@ -752,6 +768,7 @@ export interface RigHandEyeInput {
 }
 
 export interface RigOnRobotReport extends RigCalibration {
+  kind: 'rig_handeye';
   handeye: RigHandEyeReport;
 }
 
@@ -766,7 +783,7 @@ export interface ExportFile {
 }
 
 // ---------------------------------------------------------------------------
-// Hand-eye (src/handeye/json_api.rs, output.rs)
+// Hand-eye (src/api/handeye.rs, src/handeye/output.rs)
 
 /** Camera on the gripper (`eye-in-hand`) or fixed in the robot's world (`eye-to-hand`). */
 export type Setup = 'eye-in-hand' | 'eye-to-hand';
@@ -1027,6 +1044,7 @@ export interface PairAudit {
 }
 
 export interface HandEyeReportBase {
+  kind: 'handeye';
   /** The primary solution's method: a solver name, `scara`, or `refined from <name>`. */
   method: string;
   errors: HandEyeErrors;
@@ -1104,7 +1122,7 @@ export interface RankedCandidates {
 }
 
 // ---------------------------------------------------------------------------
-// Robot pose files (src/io/poses.rs, pose_formats.rs, pose_candidates.rs, poses_api.rs)
+// Robot pose files (src/io/poses.rs, pose_formats.rs, pose_candidates.rs, src/api/poses.rs)
 
 /**
  * A pose file layout: vendor formats (`kuka` mm/deg A B C intrinsic ZYX,

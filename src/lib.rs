@@ -32,6 +32,7 @@
 //!   board frame has z = 0 on the board plane.
 #![deny(missing_docs)]
 
+pub mod api;
 pub mod calib;
 pub mod camera;
 pub mod capture;
@@ -43,6 +44,7 @@ pub mod handeye;
 pub mod image;
 pub mod io;
 pub mod optim;
+pub mod report_kind;
 pub mod synth;
 pub mod target;
 pub mod workflows;

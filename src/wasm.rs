@@ -339,20 +339,20 @@ pub fn export_formats() -> String {
 }
 
 /// Read a robot pose file: `{"parsed": {...} | null, "ambiguity": null |
-/// "why", "candidates": [...]}` (see `robocal::io::poses_api`).
+/// "why", "candidates": [...]}` (see `robocal::api::poses`).
 /// `options_json` may be empty or `{"format", "length_unit", "angle_unit", "direction"}`.
 #[wasm_bindgen]
 pub fn read_robot_poses(text: &str, options_json: &str) -> Result<String, JsError> {
-    crate::io::poses_api::read_poses_json(text, options_json).map_err(js_error)
+    crate::api::poses::read_poses_json(text, options_json).map_err(js_error)
 }
 
 /// Read one robot pose per file (a folder of ROS YAML, JSON or text files):
 /// `files_json` is `[{"name", "text"}, ...]`, the answer as
 /// [`read_robot_poses`], each pose named by its file's stem; errors name the
-/// file (see `robocal::io::poses_api::read_pose_files_json`).
+/// file (see `robocal::api::poses::read_pose_files_json`).
 #[wasm_bindgen]
 pub fn read_robot_pose_files(files_json: &str, options_json: &str) -> Result<String, JsError> {
-    crate::io::poses_api::read_pose_files_json(files_json, options_json).map_err(js_error)
+    crate::api::poses::read_pose_files_json(files_json, options_json).map_err(js_error)
 }
 
 /// Parse a JSON request, run `solve`, return the JSON report.
@@ -374,7 +374,7 @@ fn json_call<Req: serde::de::DeserializeOwned, Rep: Serialize>(
 /// ...}}, rejected_heights_mm, predictions, input}`.
 #[wasm_bindgen]
 pub fn planar_fit(json: &str) -> Result<String, JsError> {
-    json_call("planar_fit", json, crate::workflows::planar_api::planar_fit)
+    json_call("planar_fit", json, crate::api::planar::planar_fit)
 }
 
 /// Planar calibration at any height from point pairs. JSON in:
@@ -388,7 +388,7 @@ pub fn planar_solve(json: &str) -> Result<String, JsError> {
     json_call(
         "planar_solve",
         json,
-        crate::workflows::planar_api::planar_solve,
+        crate::api::planar::planar_solve,
     )
 }
 
@@ -420,13 +420,13 @@ pub fn known_motion_solve(json: &str) -> Result<String, JsError> {
 }
 
 /// Hand-eye calibration: input JSON as documented in
-/// `robocal::handeye::json_api` (setup, base_from_gripper,
+/// `robocal::api::handeye` (setup, base_from_gripper,
 /// camera_from_target, method, ...); returns the report JSON
 /// (`gripper_from_camera` or `base_from_camera`, the target pose, `methods`,
 /// `errors`, `warnings`, ...).
 #[wasm_bindgen]
 pub fn solve_handeye(input_json: &str) -> Result<String, JsError> {
-    crate::handeye::json_api::solve_handeye_json(input_json).map_err(js_error)
+    crate::api::handeye::solve_handeye_json(input_json).map_err(js_error)
 }
 
 /// Which reading of the robot poses fits the camera motion: input
@@ -434,10 +434,10 @@ pub fn solve_handeye(input_json: &str) -> Result<String, JsError> {
 /// "camera_from_target": [pose...]}`; returns `{"scores": [{"name",
 /// "consistency": {"rotation_rms_deg", "translation_rms_mm",
 /// "robot_translation_scale"} | null}...] (best first), "recommendation":
-/// text | null}` (see `robocal::handeye::json_api::rank_candidates_json`).
+/// text | null}` (see `robocal::api::handeye::rank_candidates_json`).
 #[wasm_bindgen]
 pub fn rank_pose_conventions(input_json: &str) -> Result<String, JsError> {
-    crate::handeye::json_api::rank_candidates_json(input_json).map_err(js_error)
+    crate::api::handeye::rank_candidates_json(input_json).map_err(js_error)
 }
 
 /// Read a workflow CSV (the files of `robocal planar` / `robocal xytable`)
@@ -452,7 +452,7 @@ pub fn workflow_csv(kind: &str, text: &str) -> Result<String, JsError> {
     // between: one serializer instantiation per type in the wasm).
     #[derive(Serialize)]
     struct Matrices {
-        matrices: Vec<crate::workflows::planar_api::HeightMatrix>,
+        matrices: Vec<crate::api::planar::HeightMatrix>,
     }
     #[derive(Serialize)]
     struct Points {
@@ -478,32 +478,32 @@ pub fn workflow_csv(kind: &str, text: &str) -> Result<String, JsError> {
 
 /// Calibrate a camera from views (detections or point pairs) with one
 /// method or all of them: the JSON input and output of
-/// `robocal::calib::json_api::calibrate_json`.
+/// `robocal::api::camera::calibrate_json`.
 #[wasm_bindgen]
 pub fn calibrate_camera(input_json: &str) -> Result<String, JsError> {
-    crate::calib::json_api::calibrate_json(input_json).map_err(js_error)
+    crate::api::camera::calibrate_json(input_json).map_err(js_error)
 }
 
 /// Calibrate a stereo pair: the JSON input and output of
-/// `robocal::calib::stereo_json::calibrate_stereo_json` (`left` and `right`
+/// `robocal::api::stereo::calibrate_stereo_json` (`left` and `right`
 /// views paired by index; returns `left`, `right`, `right_from_left`,
 /// `baseline_m`, `rms_px`, ...).
 #[wasm_bindgen]
 pub fn calibrate_stereo(input_json: &str) -> Result<String, JsError> {
-    crate::calib::stereo_json::calibrate_stereo_json(input_json).map_err(js_error)
+    crate::api::stereo::calibrate_stereo_json(input_json).map_err(js_error)
 }
 
 /// Calibrate a camera rig: the JSON input and output of
-/// `robocal::calib::rig_json::calibrate_rig_json` (`cameras`, each with
+/// `robocal::api::rig::calibrate_rig_json` (`cameras`, each with
 /// `views` keyed by frame; returns every camera's `camera_from_rig` with
 /// its std, the frames, the co-observation graph, `rms_px`, ...).
 #[wasm_bindgen]
 pub fn calibrate_rig(input_json: &str) -> Result<String, JsError> {
-    crate::calib::rig_json::calibrate_rig_json(input_json).map_err(js_error)
+    crate::api::rig::calibrate_rig_json(input_json).map_err(js_error)
 }
 
 /// A camera rig on a robot: the JSON input and output of
-/// `robocal::handeye::rig_json::calibrate_rig_handeye_json` (`setup`,
+/// `robocal::api::rig_handeye::calibrate_rig_handeye_json` (`setup`,
 /// `base_from_gripper` one per frame in key order, `calibration` the input
 /// of `calibrate_rig`, optionally `rig` a calibrated rig report to hold;
 /// returns the rig report with `handeye`: `gripper_from_rig` or
@@ -511,7 +511,7 @@ pub fn calibrate_rig(input_json: &str) -> Result<String, JsError> {
 /// writes.
 #[wasm_bindgen]
 pub fn calibrate_rig_handeye(input_json: &str) -> Result<String, JsError> {
-    crate::handeye::rig_json::calibrate_rig_handeye_json(input_json).map_err(js_error)
+    crate::api::rig_handeye::calibrate_rig_handeye_json(input_json).map_err(js_error)
 }
 
 /// An undistorted preview of image bytes taken by `camera_json` (the

@@ -25,12 +25,12 @@
 //! [`ComparisonRow`] per method; with circle-grid or dot-plate detections
 //! also `centre_model` (the views' circle-centre model, or `mixed` with
 //! `centre_models` listing the views of each; see
-//! [`super::centre_models`]).
+//! [`crate::calib::centre_models`]).
 
-use super::centre_models::{centre_models, CentreModelViews};
-use super::compare::{calibrate_with, compare_methods, ComparisonRow, Method};
-use super::usable::{left_out_clause, usable_views, LeftOut};
-use super::{CalibrationOptions, CameraCalibration, View};
+use crate::calib::centre_models::{centre_models, CentreModelViews};
+use crate::calib::compare::{calibrate_with, compare_methods, ComparisonRow, Method};
+use crate::calib::usable::{left_out_clause, usable_views, LeftOut};
+use crate::calib::{CalibrationOptions, CameraCalibration, View};
 use crate::camera::Distortion;
 use crate::error::{Error, Result};
 use crate::optim::Loss;
@@ -138,16 +138,115 @@ pub struct JsonView {
     pub image_px: Option<Vec<[f64; 2]>>,
 }
 
+/// The lens model of a request: written as its name (`brown`, ...), read
+/// from it by serde; an unknown name is an error naming the known ones.
+/// Holds the model with the coefficients the solver starts from
+/// ([`model_from_name`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LensModel(Distortion);
+
+impl LensModel {
+    /// The model of a name; unknown names are an error listing the known ones.
+    pub fn from_name(name: &str) -> Result<LensModel> {
+        model_from_name(name).map(LensModel)
+    }
+
+    /// The model's name.
+    pub fn name(&self) -> &'static str {
+        self.0.model_name()
+    }
+
+    /// The model with the coefficients the solver starts from.
+    pub fn start(&self) -> &Distortion {
+        &self.0
+    }
+}
+
+impl Default for LensModel {
+    /// `brown`.
+    fn default() -> Self {
+        LensModel(Distortion::Brown {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+        })
+    }
+}
+
+impl Serialize for LensModel {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for LensModel {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        LensModel::from_name(&name).map_err(serde::de::Error::custom)
+    }
+}
+
+/// The method of a camera calibration request: one method, or `all`
+/// (every method, compared). Written and read as its name; an unknown name
+/// is an error naming the known ones.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MethodChoice {
+    /// One method.
+    One(Method),
+    /// Every method, compared; the report is Zhang's (or better).
+    All,
+}
+
+impl MethodChoice {
+    /// The choice of a name (`zhang`, ..., `all`).
+    pub fn from_name(name: &str) -> Result<MethodChoice> {
+        match name {
+            "all" => Ok(MethodChoice::All),
+            _ => Method::from_name(name).map(MethodChoice::One),
+        }
+    }
+
+    /// The choice's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodChoice::One(m) => m.name(),
+            MethodChoice::All => "all",
+        }
+    }
+}
+
+impl Default for MethodChoice {
+    /// `zhang`.
+    fn default() -> Self {
+        MethodChoice::One(Method::Zhang)
+    }
+}
+
+impl Serialize for MethodChoice {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for MethodChoice {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        MethodChoice::from_name(&name).map_err(serde::de::Error::custom)
+    }
+}
+
 /// The whole input of [`calibrate_json`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CalibrationInput {
-    /// Lens model name (default `brown`).
-    #[serde(default = "default_model")]
-    pub model: String,
-    /// Method name or `all` (default `zhang`).
-    #[serde(default = "default_method")]
-    pub method: String,
+    /// Lens model (default `brown`).
+    #[serde(default)]
+    pub model: LensModel,
+    /// Method or `all` (default `zhang`).
+    #[serde(default)]
+    pub method: MethodChoice,
     /// Options.
     #[serde(default)]
     pub options: JsonOptions,
@@ -158,13 +257,6 @@ pub struct CalibrationInput {
     pub image_size_px: Option<[u32; 2]>,
 }
 
-fn default_model() -> String {
-    "brown".into()
-}
-
-fn default_method() -> String {
-    "zhang".into()
-}
 
 /// The output of [`calibrate_json`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -192,7 +284,7 @@ pub struct CalibrationOutput {
 /// output JSON.
 pub fn calibrate_json(input_json: &str) -> Result<String> {
     let input: CalibrationInput = serde_json::from_str(input_json)
-        .map_err(|e| Error::parse(e.line(), e.column(), format!("calibration input: {e}")))?;
+        .map_err(|e| super::request_error("calibration input", e))?;
     let output = calibrate_input(&input)?;
     serde_json::to_string(&output)
         .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
@@ -235,9 +327,14 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     let size = image_size(input)?;
     // 2. The options, and the circle-centre model the views were detected with.
     let options = calibration_options(&input.model, &input.options)?;
-    let (centre_model, models) = centre_models(&input.views);
+    let (centre_model, models) = centre_models(
+        input
+            .views
+            .iter()
+            .map(|v| (v.name.as_str(), v.detection.as_ref())),
+    );
     // 3. The method(s).
-    if input.method == "all" {
+    if input.method == MethodChoice::All {
         let outcomes = compare_methods(&views, size, &options);
         let zhang = outcomes
             .iter()
@@ -260,14 +357,17 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
         return Ok(CalibrationOutput {
             report,
             comparison: Some(comparison),
-            comparison_note: super::compare::left_out(&views),
+            comparison_note: crate::calib::compare::left_out(&views),
             centre_model,
             centre_models: models,
         });
     }
-    let method = Method::from_name(&input.method)?;
+    let method = match input.method {
+        MethodChoice::One(method) => method,
+        MethodChoice::All => Method::Zhang,
+    };
     let mut report = calibrate_with(method, &views, size, &options)?;
-    let advice = super::model_advice::advise_model(&views, size, &options, &report);
+    let advice = crate::calib::model_advice::advise_model(&views, size, &options, &report);
     report.warnings.extend(advice);
     report
         .warnings
@@ -310,7 +410,7 @@ pub(crate) fn at_least_as_good(
             initial_camera: Some(other.camera.clone()),
             ..options.clone()
         };
-        match super::calibrate(views, size, &from_other) {
+        match crate::calib::calibrate(views, size, &from_other) {
             Ok(mut refined) if refined.rms_px < report.rms_px => {
                 refined.warnings.insert(
                     0,
@@ -356,7 +456,7 @@ pub fn model_from_name(name: &str) -> Result<Distortion> {
 }
 
 /// The solver options of the JSON options.
-pub fn calibration_options(model: &str, o: &JsonOptions) -> Result<CalibrationOptions> {
+pub fn calibration_options(model: &LensModel, o: &JsonOptions) -> Result<CalibrationOptions> {
     let (loss, outlier_sigma) = if o.robust {
         (
             Loss::Huber {
@@ -368,7 +468,7 @@ pub fn calibration_options(model: &str, o: &JsonOptions) -> Result<CalibrationOp
         (Loss::Squared, None)
     };
     Ok(CalibrationOptions {
-        model: model_from_name(model)?,
+        model: model.start().clone(),
         fix_principal_point: o.fix_principal_point,
         fix_aspect_ratio: o.fix_aspect_ratio || o.aspect_ratio.is_some(),
         aspect_ratio: o.aspect_ratio,

@@ -1,7 +1,7 @@
 //! Tests of the calibration JSON API: the contract the web app codes
 //! against (keys, errors), on seeded synthetic scenes.
 
-use super::json_api::{calibrate_json, MAX_POINTS, MAX_VIEWS};
+use super::camera::{calibrate_json, MAX_POINTS, MAX_VIEWS};
 use crate::camera::Camera;
 use crate::synth::Scene;
 use crate::target::{CentreModel, DetectedPoint, Detection, Polarity, Target};
@@ -401,8 +401,8 @@ fn the_output_says_which_circle_centre_model_the_views_used() {
 /// relative: the same minimum), named `comparison:ekf` with a warning.
 #[wasm_bindgen_test(unsupported = test)]
 fn a_comparison_row_below_the_chosen_result_is_taken() {
-    use super::compare::Method;
-    use super::{calibrate, calibrate_tsai, CalibrationOptions};
+    use crate::calib::compare::Method;
+    use crate::calib::{calibrate, calibrate_tsai, CalibrationOptions};
     let s = scene(0.1);
     let size = (s.camera.width, s.camera.height);
     let options = CalibrationOptions::default();
@@ -416,7 +416,7 @@ fn a_comparison_row_below_the_chosen_result_is_taken() {
     );
     let outcomes = vec![(Method::Ekf, Ok(zhang.clone()))];
     let chosen =
-        super::json_api::at_least_as_good(tsai.clone(), &outcomes, &s.views, size, &options);
+        super::camera::at_least_as_good(tsai.clone(), &outcomes, &s.views, size, &options);
     assert!(
         (chosen.rms_px - zhang.rms_px).abs() <= 1e-9 * zhang.rms_px,
         "{} px vs {} px",

@@ -5,12 +5,12 @@
 //! [pose...], "camera_from_target": [pose...], "method": "all" | NAME,
 //! "bootstrap_samples": 100, "seed": 1, "strict_checks": true, "refine_poses":
 //! true}` (`refine_poses`: the maximum-likelihood pose refinement of
-//! [`super::refine_poses`], on by default for pose input and for image
+//! [`crate::handeye::refine_poses`], on by default for pose input and for image
 //! points under `refine` none, the default; unused by the other modes) where a pose
 //! is a [`PoseInput`]: `{"matrix_row_major": [[4 numbers] x 4]}`,
 //! `{"translation_m": [x, y, z], "quaternion_xyzw": [x, y, z, w]}` (metres)
 //! or all three (a report's [`crate::geometry::PoseJson`]). Output: the
-//! [`super::output::HandEyeReport`] JSON.
+//! [`crate::handeye::output::HandEyeReport`] JSON.
 //!
 //! Image points (optional): `"camera"` (a camera JSON: the robocal camera
 //! serde, a calibration report, or a string holding any format
@@ -22,21 +22,21 @@
 //! `"pixel_sigma_px"` (default 0.5), and `"camera_std"` (optional, `{"fx": std, ...}` in
 //! pixels; read from `camera` when that is a calibration report): with it, a
 //! joint refinement that moves an intrinsic by many standard deviations is
-//! warned about ([`super::intrinsics_move`]). With views, `camera_from_target` may be
-//! left out: it is then computed per view by [`super::pnp`]. Instead of
+//! warned about ([`crate::handeye::intrinsics_move`]). With views, `camera_from_target` may be
+//! left out: it is then computed per view by [`crate::handeye::pnp`]. Instead of
 //! `"views"`, `"detections"` may give one detection JSON per pose (the
 //! [`crate::target::Detection`] format, as `detect_target` returns it): the
 //! board points then come from each detection's own target.
 
-use super::checks::{
+use crate::handeye::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };
-use super::intrinsics_move::{std_from_json, warn_intrinsic_move};
-use super::output::HandEyeReport;
-use super::refine_closed_form::{apply_refinement, RefineMode};
-use super::reprojection_refine::ViewPoints;
-use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
-use super::{HandEyeMethod, Pose, Setup};
+use crate::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
+use crate::handeye::output::HandEyeReport;
+use crate::handeye::refine_closed_form::{apply_refinement, RefineMode};
+use crate::handeye::reprojection_refine::ViewPoints;
+use crate::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
+use crate::handeye::{HandEyeMethod, Pose, Setup};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::PoseInput;
@@ -352,7 +352,7 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                super::pnp::camera_from_target(camera, v)
+                crate::handeye::pnp::camera_from_target(camera, v)
                     .map(|p| p.0)
                     .map_err(|e| Error::invalid(format!("views[{i}]"), e.to_string()))
             })
@@ -364,40 +364,83 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         base_from_gripper: poses(&input.base_from_gripper, "base_from_gripper")?,
         camera_from_target,
     };
-    let mut result = calibrate(&request, &options).map_err(|e| match e {
+    let std = (input.camera_std.clone()).or_else(|| input.camera.as_ref().and_then(std_from_json));
+    let points = images.as_ref().map(|(views, camera)| ImagePoints {
+        views,
+        camera,
+        camera_std: std.as_ref(),
+        refine: mode,
+        pixel_sigma_px: input.pixel_sigma_px.unwrap_or(DEFAULT_PIXEL_SIGMA_PX),
+        refine_poses: input.refine_poses.unwrap_or(true),
+    });
+    let with_left_out = |e: Error| match e {
         Error::TooFew { .. } if !left_out.is_empty() => {
             Error::invalid("views", format!("{e}; {}", left_out.join(", ")))
         }
         other => other,
-    })?;
-    result.warnings.splice(0..0, left_out);
-    if let Some((views, camera)) = &images {
+    };
+    let report = solve_handeye(&request, &options, points.as_ref(), left_out.clone())
+        .map_err(with_left_out)?;
+    serde_json::to_string(&report).map_err(|e| Error::invalid("report", e.to_string()))
+}
+
+/// The image points of a hand-eye calibration and what to do with them.
+#[derive(Clone, Copy, Debug)]
+pub struct ImagePoints<'a> {
+    /// The board points and pixels of each pose pair's view, in pair order.
+    pub views: &'a [ViewPoints],
+    /// The camera that took them (held unless `refine` moves it).
+    pub camera: &'a Camera,
+    /// The camera calibration's standard deviations (`{"fx": std, ...}`,
+    /// px), when known: a joint refinement that moves an intrinsic by many
+    /// of them is warned about.
+    pub camera_std: Option<&'a std::collections::BTreeMap<String, f64>>,
+    /// The refinement over pixels ([`RefineMode::None`]: none).
+    pub refine: RefineMode,
+    /// Expected pixel noise of that refinement, px.
+    pub pixel_sigma_px: f64,
+    /// Without a refinement over pixels: the pose refinement with each
+    /// view's PnP covariance from its image points.
+    pub refine_poses: bool,
+}
+
+/// The one hand-eye orchestration of `solve_handeye` (wasm, npm) and
+/// `robocal handeye`: the closed forms and checks of [`calibrate`], then,
+/// with image points, the refinement over pixels or the pose refinement
+/// from each view's PnP covariance; `warnings_first` (views or images left
+/// out before the solve) lead the report's warnings.
+pub fn solve_handeye(
+    input: &HandEyeInput,
+    options: &HandEyeOptions,
+    images: Option<&ImagePoints>,
+    warnings_first: Vec<String>,
+) -> Result<HandEyeReport> {
+    let mut result = calibrate(input, options)?;
+    if let Some(points) = images {
         apply_refinement(
             &mut result,
-            &request,
-            views,
-            camera,
-            mode,
+            input,
+            points.views,
+            points.camera,
+            points.refine,
             options.motion_pairs,
-            input.pixel_sigma_px.unwrap_or(DEFAULT_PIXEL_SIGMA_PX),
+            points.pixel_sigma_px,
         )?;
-        let std =
-            (input.camera_std.clone()).or_else(|| input.camera.as_ref().and_then(std_from_json));
-        warn_intrinsic_move(&mut result, camera, std.as_ref());
+        warn_intrinsic_move(&mut result, points.camera, points.camera_std);
         // No refinement over pixels: the pose refinement, with each view's
         // PnP covariance from its image points.
-        if mode == RefineMode::None && input.refine_poses.unwrap_or(true) {
-            super::refine_poses::apply_pose_refinement_from_views(
+        if points.refine == RefineMode::None && points.refine_poses {
+            crate::handeye::refine_poses::apply_pose_refinement_from_views(
                 &mut result,
-                &request,
-                views,
-                camera,
+                input,
+                points.views,
+                points.camera,
                 options.motion_pairs,
             )?;
         }
     }
-    serde_json::to_string(&HandEyeReport::checked(&result)?)
-        .map_err(|e| Error::invalid("report", e.to_string()))
+    result.warnings.splice(0..0, warnings_first);
+    HandEyeReport::checked(&result)
 }
 
 #[cfg(test)]

@@ -2,10 +2,10 @@
 //! (`robocal planar ...`) and the wasm boundary (`planar_fit`,
 //! `planar_solve`): JSON in, JSON out.
 
-use super::linear_fit::LinearFit;
-use super::planar::PlanarMatrix;
-use super::planar_height::{ByParameter, HeightModel, MappedPoint};
-use super::planar_solve::{solve_planar, HeightPoint, PlanarSolveOptions, PlanarSolveReport};
+use crate::workflows::linear_fit::LinearFit;
+use crate::workflows::planar::PlanarMatrix;
+use crate::workflows::planar_height::{ByParameter, HeightModel, MappedPoint};
+use crate::workflows::planar_solve::{solve_planar, HeightPoint, PlanarSolveOptions, PlanarSolveReport};
 use crate::error::Result;
 use serde::{Deserialize, Serialize};
 
@@ -154,7 +154,7 @@ mod tests {
                 .unwrap();
         assert_eq!(
             solve.options.transform,
-            super::super::planar::TransformKind::Similarity
+            crate::workflows::planar::TransformKind::Similarity
         );
         assert_eq!(solve.options.reject_threshold, None);
         assert_eq!(

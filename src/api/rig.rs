@@ -22,7 +22,7 @@
 //! a camera has at most one view per key and may miss any key. Frames are
 //! ordered by key (integer keys numerically, before any other key, which
 //! sort as text). A view is a detection or explicit correspondences, as in
-//! [`super::json_api`]. `camera` (a calibration report's `camera` object)
+//! [`super::camera`]. `camera` (a calibration report's `camera` object)
 //! gives a camera's intrinsics and holds them; `image_size_px` may be left
 //! out when the views are detections (which must then agree) or a camera
 //! is given. `rig_frame` (default: the first camera) names the camera whose
@@ -33,12 +33,12 @@
 //! and `camera_from_rig_std`, `frames`, `co_observation`, `rms_px`, ...),
 //! the report `robocal rig` writes.
 
-use super::json_api::{
+use super::camera::{
     agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
-    JsonView,
+    JsonView, LensModel,
 };
-use super::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
-use super::rig_report::RigCalibration;
+use crate::calib::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
+use crate::calib::rig_report::RigCalibration;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::target::Detection;
@@ -83,9 +83,9 @@ pub struct RigJsonCamera {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigInput {
-    /// Lens model name of the solved cameras (default `brown`).
-    #[serde(default = "default_model")]
-    pub model: String,
+    /// Lens model of the solved cameras (default `brown`).
+    #[serde(default)]
+    pub model: LensModel,
     /// Options of the solved cameras.
     #[serde(default)]
     pub options: JsonOptions,
@@ -100,11 +100,13 @@ pub struct RigInput {
     /// How the caller grouped the images into frames (default `number`).
     #[serde(default = "default_grouping")]
     pub grouping: String,
+    /// Keys of frames in which no camera found the board, beside those of
+    /// the views (`robocal rig` gives every image's key: a rig on a robot
+    /// pairs one robot pose with each frame, found or not).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame_keys: Option<Vec<String>>,
 }
 
-fn default_model() -> String {
-    "brown".into()
-}
 
 fn default_grouping() -> String {
     "number".into()
@@ -114,7 +116,7 @@ fn default_grouping() -> String {
 /// returns the [`RigCalibration`] JSON.
 pub fn calibrate_rig_json(input_json: &str) -> Result<String> {
     let input: RigInput = serde_json::from_str(input_json)
-        .map_err(|e| Error::parse(e.line(), e.column(), format!("rig input: {e}")))?;
+        .map_err(|e| super::request_error("rig input", e))?;
     let report = calibrate_rig_input(&input)?;
     serde_json::to_string(&report)
         .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
@@ -136,11 +138,11 @@ pub fn calibrate_rig_input(input: &RigInput) -> Result<RigCalibration> {
 /// frame keys in report order.
 pub fn rig_views(input: &RigInput) -> Result<(Vec<RigCameraViews>, Vec<String>)> {
     let mut keys: Vec<String> = Vec::new();
-    for c in &input.cameras {
-        for v in &c.views {
-            if !keys.contains(&v.key) {
-                keys.push(v.key.clone());
-            }
+    let given = input.frame_keys.iter().flatten();
+    let of_views = input.cameras.iter().flat_map(|c| c.views.iter().map(|v| &v.key));
+    for key in given.chain(of_views) {
+        if !keys.contains(key) {
+            keys.push(key.clone());
         }
     }
     sort_frame_keys(&mut keys);
@@ -229,12 +231,13 @@ mod tests {
             })
             .collect();
         let input = RigInput {
-            model: "brown".into(),
+            model: LensModel::default(),
             options: JsonOptions::default(),
             cameras,
             target: "chessboard:11x8:60mm".into(),
             rig_frame: None,
             grouping: "number".into(),
+            frame_keys: None,
         };
         (input, scene.camera_from_rig)
     }

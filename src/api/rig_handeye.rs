@@ -12,7 +12,7 @@
 //!  "lenient": false}
 //! ```
 //!
-//! `calibration` is the input of `calibrate_rig` ([`crate::calib::rig_json`]):
+//! `calibration` is the input of `calibrate_rig` ([`super::rig`]):
 //! the cameras and their views keyed by frame. Without `rig` the rig is
 //! calibrated from them first; with `rig` (a rig report, the output of
 //! `robocal rig -o rig.json` or `calibrate_rig`) its intrinsics and
@@ -25,15 +25,16 @@
 //! Output: the rig report (solved, or the one given) with `handeye`, the
 //! JSON `robocal rig --setup ... -o rig.json` writes.
 
-use super::reprojection_refine::ViewPoints;
-use super::rig::{add_rig_uncertainty, calibrate_rig_handeye, rig_handeye_report};
-use super::rig_uncertainty::{held_rig, rig_sigma_points};
-use super::{HandEyeOptions, Pose, Setup};
+use crate::handeye::reprojection_refine::ViewPoints;
+use crate::handeye::rig::{add_rig_uncertainty, calibrate_rig_handeye, rig_handeye_report};
+use crate::handeye::rig_uncertainty::{held_rig, rig_sigma_points};
+use crate::handeye::{HandEyeOptions, Pose, Setup};
 use crate::calib::rig::RigCameraViews;
-use crate::calib::rig_json::{calibrate_rig_input, rig_views, RigInput};
+use super::rig::{calibrate_rig_input, rig_views, RigInput};
 use crate::calib::rig_report::RigCalibration;
 use crate::error::{Error, Result};
 use crate::geometry::PoseInput;
+use crate::report_kind::ReportKind;
 use serde::Deserialize;
 use serde_json::Value;
 
@@ -145,7 +146,7 @@ pub fn rig_cameras_named(
 /// rig report with `handeye`.
 pub fn calibrate_rig_handeye_json(input_json: &str) -> Result<String> {
     let mut input: RigHandEyeInput = serde_json::from_str(input_json)
-        .map_err(|e| Error::parse(e.line(), e.column(), format!("rig hand-eye input: {e}")))?;
+        .map_err(|e| super::request_error("rig hand-eye input", e))?;
     let base_from_gripper = input
         .base_from_gripper
         .iter()
@@ -191,13 +192,24 @@ pub fn calibrate_rig_handeye_json(input_json: &str) -> Result<String> {
         &options,
         source,
     )?;
-    let mut json = serde_json::to_value(&report)
+    serde_json::to_string(&with_handeye(&report, handeye)?)
+        .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
+}
+
+/// The rig report with the hand-eye report `handeye` beside its keys and
+/// `kind` `rig_handeye`: what `robocal rig --setup` and
+/// [`calibrate_rig_handeye_json`] write.
+pub fn with_handeye(report: &RigCalibration, handeye: Value) -> Result<Value> {
+    let tagged = RigCalibration {
+        kind: ReportKind::RigHandeye,
+        ..report.clone()
+    };
+    let mut json = serde_json::to_value(&tagged)
         .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))?;
     if let Some(o) = json.as_object_mut() {
         o.insert("handeye".into(), handeye);
     }
-    serde_json::to_string(&json)
-        .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
+    Ok(json)
 }
 
 /// An error of a pose, its field prefixed.

@@ -15,19 +15,19 @@
 //! `left[i]` and `right[i]` are one pair (the same board pose seen by both
 //! cameras): the caller pairs the images (by order or by name) and leaves out
 //! pairs where either image has no detection. Views are detections or
-//! explicit correspondences, as in [`super::json_api`]; the image sizes may
+//! explicit correspondences, as in [`super::camera`]; the image sizes may
 //! be left out when the views are detections (which must then agree). The
-//! options apply to both cameras, with the meaning of [`super::json_api`]'s.
+//! options apply to both cameras, with the meaning of [`super::camera`]'s.
 //!
 //! Output: the [`StereoCalibration`] JSON (`left`, `right`,
 //! `right_from_left`, `initial_right_from_left`, `baseline_m`,
 //! `right_from_left_std`, `rms_px`, ...), the report `robocal stereo` writes.
 
-use super::json_api::{
+use super::camera::{
     agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
-    JsonView, MIN_VIEWS,
+    JsonView, LensModel, MIN_VIEWS,
 };
-use super::stereo::{calibrate_stereo, StereoCalibration};
+use crate::calib::stereo::{calibrate_stereo, StereoCalibration};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -35,9 +35,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StereoInput {
-    /// Lens model name of both cameras (default `brown`).
-    #[serde(default = "default_model")]
-    pub model: String,
+    /// Lens model of both cameras (default `brown`).
+    #[serde(default)]
+    pub model: LensModel,
     /// Options of both cameras.
     #[serde(default)]
     pub options: JsonOptions,
@@ -53,15 +53,12 @@ pub struct StereoInput {
     pub right_image_size_px: Option<[u32; 2]>,
 }
 
-fn default_model() -> String {
-    "brown".into()
-}
 
 /// Calibrate a stereo pair from the JSON input described in the module
 /// docs; returns the [`StereoCalibration`] JSON.
 pub fn calibrate_stereo_json(input_json: &str) -> Result<String> {
     let input: StereoInput = serde_json::from_str(input_json)
-        .map_err(|e| Error::parse(e.line(), e.column(), format!("stereo input: {e}")))?;
+        .map_err(|e| super::request_error("stereo input", e))?;
     let report = calibrate_stereo_input(&input)?;
     serde_json::to_string(&report)
         .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
@@ -167,7 +164,7 @@ mod tests {
         }
         let size = Some([left_camera.width, left_camera.height]);
         let input = StereoInput {
-            model: "brown".into(),
+            model: LensModel::default(),
             options: JsonOptions::default(),
             left,
             right,

@@ -2,8 +2,7 @@
 //! with (circle grids and dot plates; see [`crate::target::CentreModel`]),
 //! carried into the calibration output as `centre_model`.
 
-use super::json_api::JsonView;
-use crate::target::{CentreModel, Target};
+use crate::target::{CentreModel, Detection, Target};
 use serde::{Deserialize, Serialize};
 
 /// The views that used one centre model (listed when the views mix models).
@@ -23,8 +22,8 @@ pub const MIXED: &str = "mixed";
 /// dot detections (chessboards, square grids, explicit correspondences);
 /// circle detections without the key were written before it existed and
 /// are ellipse centres.
-fn model_of(view: &JsonView) -> Option<CentreModel> {
-    let d = view.detection.as_ref()?;
+fn model_of(detection: Option<&Detection>) -> Option<CentreModel> {
+    let d = detection?;
     match d.target {
         Target::CircleGrid { .. } | Target::DotPlate { .. } | Target::OriginDotGrid { .. } => {
             Some(d.centre_model.unwrap_or(CentreModel::EllipseCentre))
@@ -41,15 +40,17 @@ fn model_of(view: &JsonView) -> Option<CentreModel> {
 /// `(centre_model, centre_models)` of the output: the one model all circle
 /// and dot views used, or [`MIXED`] with the views of each model; `(None,
 /// None)` when no view is a circle or dot detection.
-pub fn centre_models(views: &[JsonView]) -> (Option<String>, Option<Vec<CentreModelViews>>) {
+pub fn centre_models<'a>(
+    views: impl IntoIterator<Item = (&'a str, Option<&'a Detection>)>,
+) -> (Option<String>, Option<Vec<CentreModelViews>>) {
     let mut groups: Vec<CentreModelViews> = Vec::new();
-    for v in views {
-        let Some(model) = model_of(v) else { continue };
+    for (name, detection) in views {
+        let Some(model) = model_of(detection) else { continue };
         match groups.iter_mut().find(|g| g.centre_model == model.name()) {
-            Some(g) => g.views.push(v.name.clone()),
+            Some(g) => g.views.push(name.to_string()),
             None => groups.push(CentreModelViews {
                 centre_model: model.name().to_string(),
-                views: vec![v.name.clone()],
+                views: vec![name.to_string()],
             }),
         }
     }

@@ -4,9 +4,9 @@
 //! report that carries residuals, uncertainties and warnings.
 //!
 //! Two cameras with shared views: [`stereo`] (right_from_left, seed 000),
-//! with its JSON boundary in [`stereo_json`]; N cameras in synchronised
+//! with its JSON boundary in [`crate::api::stereo`]; N cameras in synchronised
 //! frames: [`rig`] (every camera_from_rig), its result in [`rig_report`],
-//! its JSON boundary in [`rig_json`].
+//! its JSON boundary in [`crate::api::rig`].
 //!
 //! From 3-D/2-D point pairs of a non-planar target (seed 002):
 //! - [`dlt`]: the 12-parameter projection matrix, decomposed into K, R, t;
@@ -21,9 +21,6 @@ pub mod dlt_kalman;
 pub mod ekf;
 mod evaluate;
 mod homography;
-pub mod json_api;
-#[cfg(test)]
-mod json_api_tests;
 pub mod model_advice;
 pub mod plausibility;
 mod refine;
@@ -33,13 +30,11 @@ mod residuals;
 pub mod rig;
 mod rig_graph;
 mod rig_init;
-pub mod rig_json;
 mod rig_problem;
 pub mod rig_report;
 mod same_images;
 pub mod starts;
 pub mod stereo;
-pub mod stereo_json;
 mod stereo_problem;
 pub mod stereo_rectify;
 #[cfg(test)]

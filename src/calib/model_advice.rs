@@ -37,7 +37,7 @@
 //! to solve is left out.
 
 use super::compare::{calibrate_with, Method};
-use super::json_api::model_from_name;
+use crate::api::camera::model_from_name;
 use super::report::CameraCalibration;
 use super::zhang::CalibrationOptions;
 use super::View;

@@ -1,6 +1,6 @@
 use super::*;
-use crate::calib::json_api::calibrate_json;
-use crate::calib::json_api_tests::point_views;
+use crate::api::camera::calibrate_json;
+use crate::api::camera_tests::point_views;
 use crate::camera::Camera;
 use crate::synth::Scene;
 use serde_json::{json, Value};

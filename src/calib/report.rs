@@ -11,6 +11,7 @@ use crate::camera::Camera;
 use crate::error::Result;
 use crate::geometry::{Pose, PoseJson};
 use crate::optim::{BlockProblem, LmResult, Termination};
+use crate::report_kind::ReportKind;
 use nalgebra::{DMatrix, Point2, Point3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -96,8 +97,14 @@ pub struct ProjectionUncertainty {
 /// Result of [`super::calibrate`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CameraCalibration {
-    /// robocal version that produced the report.
-    pub crate_version: String,
+    /// What the report is: `camera` (absent from reports written before
+    /// the key existed).
+    #[serde(default = "ReportKind::camera")]
+    pub kind: ReportKind,
+    /// robocal version that produced the report (`crate_version` in reports
+    /// written before every report said `robocal_version`).
+    #[serde(alias = "crate_version")]
+    pub robocal_version: String,
     /// Image width and height, px.
     pub image_size_px: [u32; 2],
     /// Lens model name.
@@ -232,7 +239,8 @@ pub(crate) fn build_report(
     let k = camera.camera_matrix();
     let warnings = warnings(problem, &poses, &correlation, covariance.is_none());
     Ok(CameraCalibration {
-        crate_version: crate::VERSION.to_string(),
+        kind: ReportKind::Camera,
+        robocal_version: crate::VERSION.to_string(),
         image_size_px: [size.0, size.1],
         model: camera.distortion.model_name().to_string(),
         camera_matrix: [0, 1, 2].map(|r| [k[(r, 0)], k[(r, 1)], k[(r, 2)]]),

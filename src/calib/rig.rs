@@ -269,7 +269,8 @@ pub fn calibrate_rig(
         .as_ref()
         .map(|c| rig_covariance(&problem, &alone, &names, c));
     Ok(RigCalibration {
-        crate_version: env!("CARGO_PKG_VERSION").to_string(),
+        kind: crate::report_kind::ReportKind::Rig,
+        robocal_version: crate::VERSION.to_string(),
         rig_frame: names[rig_camera].clone(),
         target: options.target.clone(),
         grouping: options.grouping.clone(),

@@ -15,6 +15,7 @@ use super::stereo::TransformStd;
 use super::CameraCalibration;
 use crate::geometry::PoseJson;
 use crate::optim::Termination;
+use crate::report_kind::ReportKind;
 use serde::{Deserialize, Serialize};
 
 /// One camera of the rig.
@@ -68,8 +69,15 @@ pub struct CoObservation {
 /// The result of a rig calibration.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RigCalibration {
-    /// robocal version that produced the report.
-    pub crate_version: String,
+    /// What the report is: `rig`, or `rig_handeye` when a `handeye` object
+    /// was added beside the keys (absent from reports written before the
+    /// key existed).
+    #[serde(default = "ReportKind::rig")]
+    pub kind: ReportKind,
+    /// robocal version that produced the report (`crate_version` in reports
+    /// written before every report said `robocal_version`).
+    #[serde(alias = "crate_version")]
+    pub robocal_version: String,
     /// Name of the camera whose frame is the rig frame.
     pub rig_frame: String,
     /// The target spec (`robocal detect --target` spelling).

@@ -33,6 +33,10 @@ pub struct TransformStd {
 /// The result of [`calibrate_stereo`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StereoCalibration {
+    /// What the report is: `stereo` (absent from reports written before
+    /// the key existed).
+    #[serde(default = "crate::report_kind::ReportKind::stereo")]
+    pub kind: crate::report_kind::ReportKind,
     /// The left camera at the joint optimum (its `std` and correlations are
     /// from its own observations, with the right camera held).
     pub left: CameraCalibration,
@@ -193,6 +197,7 @@ pub fn calibrate_stereo(
         warnings.extend(a.warnings.iter().map(|w| format!("{side} camera: {w}")));
     }
     Ok(StereoCalibration {
+        kind: crate::report_kind::ReportKind::Stereo,
         model_advice: Some(advice),
         left: left_report,
         right: right_report,

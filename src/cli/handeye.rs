@@ -6,12 +6,10 @@ use super::handeye_images::{
 };
 use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
-use robocal::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
-use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
-use robocal::handeye::output::HandEyeReport;
-use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
-use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
-use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
+use robocal::api::handeye::{camera_from_json, solve_handeye, ImagePoints, DEFAULT_PIXEL_SIGMA_PX};
+use robocal::handeye::intrinsics_move::std_from_json;
+use robocal::handeye::refine_closed_form::RefineMode;
+use robocal::handeye::{HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 
 #[derive(clap::Args)]
@@ -331,47 +329,27 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
         Some(name) => name.parse::<RefineMode>()?,
         None => RefineMode::None,
     };
-    let mut result = calibrate(&input, &options).map_err(|e| with_dropped(e, &pairs))?;
-    match &images {
-        Some((views, camera)) => {
-            apply_refinement(
-                &mut result,
-                &input,
-                views,
-                camera,
-                mode,
-                options.motion_pairs,
-                DEFAULT_PIXEL_SIGMA_PX,
-            )?;
-            warn_intrinsic_move(&mut result, camera, camera_std.as_ref());
-            // No refinement over pixels: the pose refinement, with each
-            // view's PnP covariance from its image points.
-            if mode == RefineMode::None && !args.no_refine {
-                apply_pose_refinement_from_views(
-                    &mut result,
-                    &input,
-                    views,
-                    camera,
-                    options.motion_pairs,
-                )?;
-            }
-        }
-        None if mode != RefineMode::None => {
-            return Err(CliError::usage(
-                "handeye",
-                "--refine needs images (--camera, --target, IMAGES)",
-            ))
-        }
-        None => {}
+    if images.is_none() && mode != RefineMode::None {
+        return Err(CliError::usage(
+            "handeye",
+            "--refine needs images (--camera, --target, IMAGES)",
+        ));
     }
-    pre_warnings.append(&mut result.warnings);
-    result.warnings = pre_warnings;
-    let mut report = HandEyeReport::checked(&result)?;
+    let points = images.as_ref().map(|(views, camera)| ImagePoints {
+        views,
+        camera,
+        camera_std: camera_std.as_ref(),
+        refine: mode,
+        pixel_sigma_px: DEFAULT_PIXEL_SIGMA_PX,
+        refine_poses: !args.no_refine,
+    });
+    let mut report = solve_handeye(&input, &options, points.as_ref(), pre_warnings)
+        .map_err(|e| with_dropped(e, &pairs))?;
     report.pairs = pairs;
     let json = serde_json::to_string_pretty(&report)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
     super::write_output(args.output.as_deref(), &(json + "\n"))?;
-    for w in &result.warnings {
+    for w in &report.warnings {
         eprintln!("warning: {w}");
     }
     Ok(())

@@ -5,8 +5,9 @@ use super::detect::{run_all, Outcome};
 use super::detections_file::read_detections;
 use super::{write_output, CliError};
 use robocal::calib::compare::ComparisonRow;
-use robocal::calib::json_api::{
-    calibrate_input, CalibrationInput, CalibrationOutput, JsonOptions, JsonView,
+use robocal::api::camera::{
+    calibrate_input, CalibrationInput, CalibrationOutput, JsonOptions, JsonView, LensModel,
+    MethodChoice,
 };
 use robocal::detect::DetectOptions;
 use robocal::target::Target;
@@ -137,8 +138,8 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
         }
     };
     let input = CalibrationInput {
-        model: args.model.unwrap_or_else(|| "brown".to_string()),
-        method: args.method.unwrap_or_else(|| "zhang".to_string()),
+        model: LensModel::from_name(args.model.as_deref().unwrap_or("brown"))?,
+        method: MethodChoice::from_name(args.method.as_deref().unwrap_or("zhang"))?,
         options: JsonOptions {
             fix_principal_point: args.fix_principal_point,
             fix_aspect_ratio: args.fix_aspect_ratio,

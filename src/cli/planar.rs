@@ -3,7 +3,7 @@
 use super::{read_text, write_output, CliError};
 use robocal::io::workflow_csv::{parse_planar_matrices, parse_planar_points};
 use robocal::workflows::planar::TransformKind;
-use robocal::workflows::planar_api::{
+use robocal::api::planar::{
     planar_fit, planar_solve, PlanarFitRequest, PlanarSolveRequest, PredictRequest,
 };
 use robocal::workflows::planar_solve::PlanarSolveOptions;

@@ -3,12 +3,12 @@
 
 use super::detect::{run_all, Outcome};
 use super::{read_text, write_output, CliError};
-use robocal::calib::json_api::model_from_name;
-use robocal::calib::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
+use robocal::api::camera::{JsonOptions, LensModel};
+use robocal::api::rig::{calibrate_rig_input, rig_views, RigInput, RigJsonCamera, RigJsonView};
+use robocal::calib::rig::{sort_frame_keys, RigCameraViews};
 use robocal::calib::rig_report::RigCalibration;
-use robocal::calib::{CalibrationOptions, View};
 use robocal::camera::Camera;
-use robocal::handeye::rig_json::rig_cameras_named;
+use robocal::api::rig_handeye::{rig_cameras_named, with_handeye};
 use robocal::io::import_camera::import_camera;
 use robocal::io::pairing::{default_grouping, frame_keys, FrameGrouping};
 use robocal::target::Target;
@@ -304,7 +304,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
         args.threads,
     )?
     .into_iter();
-    let mut inputs = Vec::with_capacity(cameras.len());
+    let mut request_cameras = Vec::with_capacity(cameras.len());
     for ((c, camera_keys), held) in cameras.iter().zip(&keys_per_camera).zip(held) {
         let mut views = Vec::new();
         let mut size: Option<(u32, u32)> = None;
@@ -327,8 +327,13 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
                         }
                     }
                     size = Some(s);
-                    let frame = keys.iter().position(|k| k == key).unwrap_or(0);
-                    views.push((frame, View::from_detection(file, &d)));
+                    views.push(RigJsonView {
+                        key: key.clone(),
+                        name: file.clone(),
+                        detection: Some(d),
+                        object_m: None,
+                        image_px: None,
+                    });
                 }
                 Some(Outcome::Failed(_, m)) => {
                     eprintln!("robocal rig: camera {}: {file} left out: {m}", c.name)
@@ -336,21 +341,38 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
                 None => {}
             }
         }
-        let image_size_px = size
-            .or(held.as_ref().map(|h| (h.width, h.height)))
-            .ok_or_else(|| {
-                CliError::Io(format!(
-                    "rig: the target was found in no image of camera {}",
-                    c.name
-                ))
-            })?;
-        inputs.push(RigCameraViews {
+        if size.is_none() && held.is_none() {
+            return Err(CliError::Io(format!(
+                "rig: the target was found in no image of camera {}",
+                c.name
+            )));
+        }
+        request_cameras.push(RigJsonCamera {
             name: c.name.clone(),
-            image_size_px,
             views,
+            image_size_px: size.map(|(w, h)| [w, h]),
             camera: held,
         });
     }
+    // The request `calibrate_rig` takes, with every image's frame key (a
+    // robot pose pairs with each frame, the board found in it or not).
+    let request = RigInput {
+        model: LensModel::from_name(model.as_deref().unwrap_or("brown"))?,
+        options: JsonOptions {
+            // The flags replace the file's list (as every flag overrides its key).
+            fixed_coefficients: match &file {
+                Some(f) if args.fix.is_empty() => f.fix.clone(),
+                _ => args.fix.clone(),
+            },
+            ..JsonOptions::default()
+        },
+        cameras: request_cameras,
+        target: target.to_spec(),
+        rig_frame: pick(&args.rig_frame, |r| &r.rig_frame),
+        grouping: grouping.rule(),
+        frame_keys: Some(keys),
+    };
+    let (inputs, keys) = rig_views(&request)?;
     // 3. Solve (or hold the given rig), summarise, write.
     if let Some((report, path)) = given {
         eprintln!(
@@ -365,21 +387,7 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
         let source = format!("the covariance in '{path}'");
         return write_with_handeye(&args, &report, &inputs, &index, &keys, &grouping, &source);
     }
-    let options = RigOptions {
-        calibration: CalibrationOptions {
-            model: model_from_name(model.as_deref().unwrap_or("brown"))?,
-            // The flags replace the file's list (as every flag overrides its key).
-            fixed_coefficients: match &file {
-                Some(f) if args.fix.is_empty() => f.fix.clone(),
-                _ => args.fix.clone(),
-            },
-            ..CalibrationOptions::default()
-        },
-        rig_frame: pick(&args.rig_frame, |r| &r.rig_frame),
-        target: target.to_spec(),
-        grouping: grouping.rule(),
-    };
-    let report = calibrate_rig(&inputs, &keys, &options)?;
+    let report = calibrate_rig_input(&request)?;
     eprint!("{}", super::rig_summary::summary(&report));
     if !handeye {
         return write_report(&args, &report, None);
@@ -416,11 +424,11 @@ fn write_report(
     report: &RigCalibration,
     handeye: Option<serde_json::Value>,
 ) -> Result<(), CliError> {
-    let mut json = serde_json::to_value(report)
-        .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
-    if let (Some(h), Some(o)) = (handeye, json.as_object_mut()) {
-        o.insert("handeye".into(), h);
-    }
+    let json = match handeye {
+        Some(h) => with_handeye(report, h)?,
+        None => serde_json::to_value(report)
+            .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?,
+    };
     let text = serde_json::to_string_pretty(&json)
         .map_err(|e| CliError::Io(format!("cannot serialise the report: {e}")))?;
     write_output(args.output.as_deref(), &(text + "\n"))

@@ -3,9 +3,8 @@
 use super::detect::{run_all, Outcome};
 use super::detections_file::read_detections;
 use super::{write_output, CliError};
-use robocal::calib::json_api::model_from_name;
-use robocal::calib::stereo::calibrate_stereo;
-use robocal::calib::{CalibrationOptions, View};
+use robocal::api::camera::{JsonOptions, JsonView, LensModel};
+use robocal::api::stereo::{calibrate_stereo_input, StereoInput};
 use robocal::io::pairing::{pair_by_number, PairedBy};
 use robocal::target::{Detection, Target};
 
@@ -155,10 +154,8 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
     if pairing.paired_by == PairedBy::Order {
         eprintln!("robocal stereo: no file name has a number: images paired by order");
     }
-    let options = CalibrationOptions {
-        model: model_from_name(args.model.as_deref().unwrap_or("brown"))?,
-        ..CalibrationOptions::default()
-    };
+    // An unknown model is refused before any image is detected.
+    let model = LensModel::from_name(args.model.as_deref().unwrap_or("brown"))?;
     // 2. Detect in every image of both sides at once (detection files are
     // read as they are).
     let images: Vec<String> = [&left_side, &right_side]
@@ -224,8 +221,16 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
             "stereo: the target was found in no pair of images".into(),
         ));
     };
-    // 4. Solve and report.
-    let report = calibrate_stereo(&left, &right, ls, rs, &options)?;
+    // 4. Solve (the request `calibrate_stereo` takes) and report.
+    let request = StereoInput {
+        model,
+        options: JsonOptions::default(),
+        left,
+        right,
+        left_image_size_px: Some([ls.0, ls.1]),
+        right_image_size_px: Some([rs.0, rs.1]),
+    };
+    let report = calibrate_stereo_input(&request)?;
     for w in &report.warnings {
         eprintln!("robocal stereo: warning: {w}");
     }
@@ -252,7 +257,7 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
 }
 
 /// The view of a detection; all images of one camera must share a size.
-fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<View, CliError> {
+fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<JsonView, CliError> {
     let s = (d.image_size_px[0], d.image_size_px[1]);
     match size {
         Some(prev) if *prev != s => {
@@ -266,5 +271,10 @@ fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<View
         }
         _ => *size = Some(s),
     }
-    Ok(View::from_detection(file, d))
+    Ok(JsonView {
+        name: file.to_string(),
+        detection: Some(d.clone()),
+        object_m: None,
+        image_px: None,
+    })
 }

@@ -128,7 +128,7 @@ mod tests {
 
     #[wasm_bindgen_test(unsupported = test)]
     fn the_json_api_warns_when_the_joint_refinement_moves_fx_and_not_when_trusted() {
-        use super::super::json_api::solve_handeye_json;
+        use crate::api::handeye::solve_handeye_json;
         use super::super::reprojection_refine_tests::{camera, looking_scene};
         use super::super::Setup;
         use crate::geometry::PoseJson;

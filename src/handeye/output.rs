@@ -71,6 +71,10 @@ pub struct MethodJson {
 /// The full report.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct HandEyeReport {
+    /// What the report is: `handeye` (absent from reports written before
+    /// the key existed).
+    #[serde(default = "crate::report_kind::ReportKind::handeye")]
+    pub kind: crate::report_kind::ReportKind,
     /// `eye-in-hand` or `eye-to-hand`.
     pub setup: Setup,
     /// The primary solution's method.
@@ -190,6 +194,7 @@ impl HandEyeReport {
             .fold(0.0, f64::max);
         let k = keyed(result.setup, &result.x, &result.y);
         HandEyeReport {
+            kind: crate::report_kind::ReportKind::Handeye,
             setup: result.setup,
             method: result.method.clone(),
             gripper_from_camera: k.0,

@@ -48,7 +48,7 @@ fn solve(setup: Setup, sigma_px: f64, seed: u64) -> (Value, usize) {
         "bootstrap_samples": 0,
         "strict_checks": false,
     });
-    let out = super::json_api::solve_handeye_json(&input.to_string()).unwrap();
+    let out = crate::api::handeye::solve_handeye_json(&input.to_string()).unwrap();
     (serde_json::from_str(&out).unwrap(), points)
 }
 

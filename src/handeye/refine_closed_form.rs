@@ -251,7 +251,7 @@ pub fn apply_refinement(
 
 #[cfg(test)]
 mod tests {
-    use super::super::json_api::solve_handeye_json;
+    use crate::api::handeye::solve_handeye_json;
     use super::super::reprojection_refine_tests::{camera, looking_scene};
     use super::super::Setup;
     use super::*;

@@ -4,7 +4,10 @@
 //! A report is the JSON of a camera calibration (top-level `image_size_px`,
 //! `model`, `camera_matrix`, `distortion`, `rms_px`) or of a hand-eye
 //! calibration (transforms such as `gripper_from_camera` in the one pose
-//! shape, [`crate::geometry::PoseJson`]), or both.
+//! shape, [`crate::geometry::PoseJson`]), or both; or a stereo or rig
+//! report. The report's `kind` ([`ReportKind`]) says which; a report
+//! written before `kind` existed is recognised by its keys, as then
+//! (docs/report-json.md, "Migration").
 
 use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
 use super::export_rig::{export_rig, is_rig_report, RigFormat};
@@ -14,6 +17,7 @@ use super::export_transform::{export_transform, FrameNames, TransformFormat};
 use super::import_camera::import_camera;
 use crate::calib::rig_report::RigCalibration;
 use crate::error::{Error, Result};
+use crate::report_kind::ReportKind;
 use crate::geometry::{Pose, PoseInput};
 use serde::Deserialize;
 
@@ -69,13 +73,48 @@ pub struct ExportOptions<'a> {
 /// and `mrcal`) come as one text, see [`join_files`].
 pub fn export_with(report_json: &str, format: &str, options: &ExportOptions) -> Result<String> {
     let report = parse_report(report_json)?;
-    if is_rig_report(&report) && format != "report" {
-        return export_rig_report(&report, format, options).map(|files| join_files(&files));
+    match Report::read(&report)? {
+        Report::Rig if format != "report" => {
+            export_rig_report(&report, format, options).map(|files| join_files(&files))
+        }
+        Report::Stereo if format != "report" => {
+            match export_stereo_report(&report, format, options)? {
+                Some(files) => Ok(join_files(&files)),
+                None => export_value(report_json, &report, format, options),
+            }
+        }
+        _ => export_value(report_json, &report, format, options),
     }
-    if let Some(files) = export_stereo_report(&report, format, options)? {
-        return Ok(join_files(&files));
+}
+
+/// What a report is for export: what its `kind` says or, without `kind`,
+/// what its keys say.
+enum Report {
+    /// A rig report, with or without `handeye` (read as [`RigCalibration`]
+    /// once the format is known to be a rig format).
+    Rig,
+    /// A stereo report.
+    Stereo,
+    /// A camera or hand-eye report (or a plain camera JSON), written from
+    /// its keys.
+    Other,
+}
+
+impl Report {
+    fn read(report: &serde_json::Value) -> Result<Report> {
+        let kind = match ReportKind::of_report(report)? {
+            Some(kind) => kind,
+            // Written before `kind` existed: recognised by its keys.
+            None if is_rig_report(report) => ReportKind::Rig,
+            None if is_stereo_report(report) => ReportKind::Stereo,
+            None => ReportKind::Camera,
+        };
+        Ok(match kind {
+            ReportKind::Rig | ReportKind::RigHandeye => Report::Rig,
+            ReportKind::Stereo => Report::Stereo,
+            ReportKind::Camera | ReportKind::Handeye => Report::Other,
+        })
     }
-    export_value(report_json, &report, format, options)
 }
 
 /// [`export_with`] as files: several for a rig's `ros` and `mrcal`, else
@@ -86,11 +125,14 @@ pub fn export_files(
     options: &ExportOptions,
 ) -> Result<Vec<ExportFile>> {
     let report = parse_report(report_json)?;
-    if is_rig_report(&report) && format != "report" {
-        return export_rig_report(&report, format, options);
-    }
-    if let Some(files) = export_stereo_report(&report, format, options)? {
-        return Ok(files);
+    match Report::read(&report)? {
+        Report::Rig if format != "report" => return export_rig_report(&report, format, options),
+        Report::Stereo if format != "report" => {
+            if let Some(files) = export_stereo_report(&report, format, options)? {
+                return Ok(files);
+            }
+        }
+        _ => {}
     }
     let text = export_value(report_json, &report, format, options)?;
     let extension = match CameraFormat::from_name(format) {
@@ -134,9 +176,6 @@ fn export_stereo_report(
     format: &str,
     options: &ExportOptions,
 ) -> Result<Option<Vec<ExportFile>>> {
-    if !is_stereo_report(report) || format == "report" {
-        return Ok(None);
-    }
     match StereoFormat::from_name(format) {
         Some(f) => export_stereo(report, f, &options.frames).map(Some),
         None if CameraFormat::from_name(format).is_ok() => Err(not_a_stereo_format(format)),

@@ -29,7 +29,6 @@ pub mod pose_text;
 mod pose_writer;
 mod pose_yaml;
 mod poses;
-pub mod poses_api;
 pub mod workflow_csv;
 
 #[cfg(test)]

@@ -17,7 +17,7 @@ use crate::calib::dlt_kalman::KalmanMode;
 use crate::error::{Error, Result};
 use crate::workflows::known_motion::KnownMotionRequest;
 use crate::workflows::planar::PlanarMatrix;
-use crate::workflows::planar_api::HeightMatrix;
+use crate::api::planar::HeightMatrix;
 use crate::workflows::planar_solve::HeightPoint;
 use crate::workflows::xytable::{StageObservation, XyTableRequest};
 

@@ -5,8 +5,8 @@
 //!   [`planar`] (one height), [`planar_height`] (parameters against height,
 //!   mapping at any height, pixel density), [`planar_solve`] (the whole
 //!   workflow from point pairs), [`planar_exact`] (the exact homography
-//!   family, the physically grounded alternative), [`planar_api`] (JSON
-//!   requests and reports for the CLI and wasm);
+//!   family, the physically grounded alternative), [`crate::api::planar`]
+//!   (JSON requests and reports for the CLI and wasm);
 //! - XY-table calibration with one circular target (seed 002): [`xytable`]
 //!   (batch DLT vs recursive Kalman filter, verification point);
 //! - camera-to-reference frame from known motions of one point (seed 000,
@@ -16,7 +16,6 @@
 pub mod known_motion;
 pub mod linear_fit;
 pub mod planar;
-pub mod planar_api;
 pub mod planar_exact;
 pub mod planar_height;
 pub mod planar_solve;

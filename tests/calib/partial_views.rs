@@ -10,8 +10,8 @@
 //! expectation `sigma sqrt(2 (1 - p / 2N))`.
 
 use nalgebra::{Point2, Point3, Translation3, Vector3};
-use robocal::calib::json_api::calibrate_input;
-use robocal::calib::json_api::{CalibrationInput, JsonOptions, JsonView};
+use robocal::api::camera::calibrate_input;
+use robocal::api::camera::{CalibrationInput, JsonOptions, JsonView, LensModel, MethodChoice};
 use robocal::calib::stereo::calibrate_stereo;
 use robocal::calib::{calibrate, CalibrationOptions, View};
 use robocal::geometry::{rotation_from_rotvec, Pose};
@@ -184,8 +184,8 @@ fn json_view(v: &View) -> JsonView {
 
 fn input(views: &[View]) -> CalibrationInput {
     CalibrationInput {
-        model: "brown".into(),
-        method: "zhang".into(),
+        model: LensModel::default(),
+        method: MethodChoice::default(),
         options: JsonOptions::default(),
         views: views.iter().map(json_view).collect(),
         image_size_px: Some([1280, 960]),
@@ -376,7 +376,7 @@ fn handeye_from_partial_views_recovers_x_exactly_in_both_setups() {
         ("eye-to-hand", robocal::handeye::Setup::EyeToHand),
     ] {
         let (input, x_true) = handeye_input(name, setup, 31);
-        let out = robocal::handeye::json_api::solve_handeye_json(&input.to_string())
+        let out = robocal::api::handeye::solve_handeye_json(&input.to_string())
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let report: Value = serde_json::from_str(&out).expect("report");
         let key = if name == "eye-in-hand" {
@@ -489,7 +489,7 @@ fn handeye_with_too_few_usable_views_names_the_views_left_out() {
         .as_array()
         .map_or(0, Vec::len);
     assert!(n >= 2, "column 3 keeps {n} points");
-    let e = robocal::handeye::json_api::solve_handeye_json(&input.to_string())
+    let e = robocal::api::handeye::solve_handeye_json(&input.to_string())
         .map_err(|e| e.to_string());
     let reason = |k: usize| {
         if k < 4 {

@@ -80,7 +80,8 @@ const pose: PoseReport = {
   quaternion_xyzw: [0, 0, 0, 1],
 };
 const calibration: CameraCalibration = {
-  crate_version: '0.1.0',
+  kind: 'camera',
+  robocal_version: '0.1.0',
   image_size_px: [1024, 768],
   model: 'brown',
   camera,
@@ -109,7 +110,7 @@ const output: CalibrationOutput = {
 const wrongTermination: CameraCalibration = { ...calibration, termination: 'CostTolerance' };
 const stereoInput: StereoInput = { model: 'brown', left: calibrationInput.views, right: calibrationInput.views, left_image_size_px: [640, 480] };
 const stereo: StereoCalibration = {
-  left: calibration, right: calibration, right_from_left: pose, initial_right_from_left: pose, baseline_m: 0.1,
+  kind: 'stereo', left: calibration, right: calibration, right_from_left: pose, initial_right_from_left: pose, baseline_m: 0.1,
   right_from_left_std: null, rms_px: 0.2, iterations: 5, termination: 'gradient_tolerance',
   warnings: ['pair 3 left out: right r03.png: 3 points: a homography needs at least 4'],
 };
@@ -161,6 +162,7 @@ const runStats = {
   rotation_max_deg_samples: [0.05], camera_translation_deviation_mm_samples: [0.1], camera_rotation_deviation_deg_samples: [0.01],
 };
 const report: HandEyeReport = {
+  kind: 'handeye',
   setup: 'eye-in-hand',
   method: 'refined from park-martin',
   gripper_from_camera: pose,

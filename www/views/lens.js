@@ -1,7 +1,7 @@
 // The lens-model choice shared by the camera step and the rig step: the
 // model, Brown-Conrady's radial terms and tangential switch, and the
 // options that hold parameters; read into the core's JSON `model` and
-// `options` (robocal::calib::json_api::JsonOptions).
+// `options` (robocal::api::camera::JsonOptions).
 import { h } from '../lib/dom.js';
 
 export const MODELS = [

@@ -18,7 +18,7 @@ import { lensFields, readLens, jsonOptions } from './lens.js';
 import { stereoOfRig, stereoOfLegacy, stereoSection } from './rig-stereo.js';
 import { frustum, invert, rotvecDeg, boardOutline, apply, flat } from '../lib/rig3d.js';
 
-/** Frames a rig solve needs (each camera's intrinsics need 3 views: calib::json_api::MIN_VIEWS). */
+/** Frames a rig solve needs (each camera's intrinsics need 3 views: api::camera::MIN_VIEWS). */
 const MIN_FRAMES = 3;
 const byName = (a, b) => a.name.localeCompare(b.name, undefined, { numeric: true });
 /** The rules of `robocal rig --group-by` ('' = by number unless no name has one). */
