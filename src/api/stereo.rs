@@ -222,5 +222,13 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("stereo input: missing field `right`"), "{err}");
+        // The model is a choice read by serde: an unknown name says the known ones.
+        let err = calibrate_stereo_json(r#"{"model": "fisheye", "left": [], "right": []}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("model: unknown model 'fisheye' (expected one of brown, "),
+            "{err}"
+        );
     }
 }

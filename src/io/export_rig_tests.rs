@@ -34,7 +34,8 @@ fn calibration_of(camera: Camera, rms_px: f64) -> CameraCalibration {
         distortion.insert(n.to_string(), v);
     }
     CameraCalibration {
-        crate_version: crate::VERSION.into(),
+        kind: crate::report_kind::ReportKind::Camera,
+        robocal_version: crate::VERSION.into(),
         image_size_px: [camera.width, camera.height],
         model: camera.distortion.model_name().into(),
         camera_matrix: [
@@ -126,7 +127,8 @@ pub(super) fn example_rig() -> (RigCalibration, Vec<Pose>) {
     let frames_seen = [vec![0, 1, 2], vec![1, 2, 3, 4], vec![3, 4]];
     let names: Vec<String> = cameras.iter().map(|c| c.0.to_string()).collect();
     let rig = RigCalibration {
-        crate_version: crate::VERSION.into(),
+        kind: crate::report_kind::ReportKind::Rig,
+        robocal_version: crate::VERSION.into(),
         rig_frame: "left".into(),
         target: "chessboard:9x6:30mm".into(),
         grouping: "number".into(),
@@ -432,6 +434,24 @@ fn the_one_entry_detects_a_rig_report_and_joins_multi_file_formats() {
             .unwrap_err()
             .to_string(),
         "format: format 'ros-yaml' is not a rig format: a rig report exports as kalibr, opencv-yaml, ros, urdf, mrcal (or report)"
+    );
+    // A report written before `kind` existed, with `crate_version`: known by
+    // its keys, exported the same.
+    assert!(json.starts_with("{\"kind\":\"rig\",\"robocal_version\":"), "{json}");
+    let old = json
+        .replacen("\"kind\":\"rig\",", "", 1)
+        .replacen("\"robocal_version\"", "\"crate_version\"", 1)
+        .replace("\"kind\":\"camera\",", "")
+        .replace("\"robocal_version\"", "\"crate_version\"");
+    assert_eq!(files_text(&old, "kalibr"), files_text(&json, "kalibr"));
+    assert_eq!(files_text(&old, "ros"), files_text(&json, "ros"));
+    // With `kind`, the kind decides; an unknown one names the known ones.
+    let unknown = json.replacen("\"kind\":\"rig\"", "\"kind\":\"mono\"", 1);
+    assert_eq!(
+        export_with(&unknown, "kalibr", &options)
+            .unwrap_err()
+            .to_string(),
+        "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye)"
     );
     let broken = json.replacen("\"rig_frame\"", "\"rig_frame_x\"", 1);
     assert_eq!(
