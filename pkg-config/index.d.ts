@@ -646,6 +646,11 @@ export interface RigInput {
   rig_frame?: string;
   /** How the caller grouped the images into frames (default `number`). */
   grouping?: string;
+  /**
+   * Keys of frames in which no camera found the board, beside those of the
+   * views (a rig on a robot pairs one robot pose with each frame).
+   */
+  frame_keys?: string[];
 }
 
 /** One camera of a rig report. */
