@@ -12,6 +12,8 @@
 //!  "image_size_px": [640, 480]}
 //! ```
 //!
+//! `model` ([`LensModel`]) and `method` ([`MethodChoice`]) are read by serde
+//! as choices: an unknown name is an error naming the known ones.
 //! `model` is one of `brown` (default), `radial_k1_k2_k5`, `rational`,
 //! `division`, `kannala_brandt`, `eucm`, `none`; `method` one of `zhang`
 //! (default), `dlt` (non-coplanar points), `tsai` (planar), `ekf` (planar)

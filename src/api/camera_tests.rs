@@ -14,7 +14,7 @@ fn scene(noise_px: f64) -> Scene {
 
 /// The scene's views as the JSON API's point views (also used by the
 /// model-advice tests).
-pub(super) fn point_views(scene: &Scene) -> Value {
+pub(crate) fn point_views(scene: &Scene) -> Value {
     scene
         .views
         .iter()

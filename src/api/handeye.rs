@@ -1,5 +1,8 @@
-//! The JSON-in, JSON-out entry point used by the wasm boundary
-//! (`solve_handeye`) and by anything else that speaks JSON.
+//! The request and report of hand-eye calibration: the JSON entry point of
+//! the wasm boundary and npm (`solve_handeye`, [`solve_handeye_json`]), and
+//! [`solve_handeye`], the one orchestration (closed forms, then the
+//! refinement over pixels or over the poses) it shares with `robocal
+//! handeye`, whose pose files, images and pairing audit stay in the CLI.
 //!
 //! Input: `{"setup": "eye-in-hand" | "eye-to-hand", "base_from_gripper":
 //! [pose...], "camera_from_target": [pose...], "method": "all" | NAME,

@@ -1,5 +1,7 @@
-//! The JSON boundary of rig calibration: the wasm function
-//! `calibrate_rig` and the npm call (same solver as `robocal rig`).
+//! The request and report of rig calibration: the wasm function
+//! `calibrate_rig`, the npm call and `robocal rig` (which builds a
+//! [`RigInput`] from its flags and detections) all call
+//! [`calibrate_rig_input`].
 //!
 //! Input:
 //!

@@ -1,5 +1,7 @@
-//! The JSON boundary of stereo calibration: the wasm function
-//! `calibrate_stereo` (same solver as `robocal stereo`).
+//! The request and report of stereo calibration: the wasm function
+//! `calibrate_stereo`, the npm call and `robocal stereo` (which builds a
+//! [`StereoInput`] from its flags and detections) all call
+//! [`calibrate_stereo_input`].
 //!
 //! Input:
 //!
