@@ -104,7 +104,10 @@ mod tests {
             let report = serde_json::json!({ "kind": kind.name() });
             assert_eq!(ReportKind::of_report(&report).expect("kind"), Some(kind));
         }
-        assert_eq!(ReportKind::of_report(&serde_json::json!({})).expect("none"), None);
+        assert_eq!(
+            ReportKind::of_report(&serde_json::json!({})).expect("none"),
+            None
+        );
         assert_eq!(
             ReportKind::of_report(&serde_json::json!({"kind": "mono"}))
                 .unwrap_err()

@@ -385,11 +385,7 @@ pub fn planar_fit(json: &str) -> Result<String, JsError> {
 /// `pixel_density`, `density_fit`, `predictions`.
 #[wasm_bindgen]
 pub fn planar_solve(json: &str) -> Result<String, JsError> {
-    json_call(
-        "planar_solve",
-        json,
-        crate::api::planar::planar_solve,
-    )
+    json_call("planar_solve", json, crate::api::planar::planar_solve)
 }
 
 /// XY-table calibration with one target. JSON in: `{"observations":

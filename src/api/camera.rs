@@ -259,7 +259,6 @@ pub struct CalibrationInput {
     pub image_size_px: Option<[u32; 2]>,
 }
 
-
 /// The output of [`calibrate_json`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CalibrationOutput {

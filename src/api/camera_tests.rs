@@ -415,8 +415,7 @@ fn a_comparison_row_below_the_chosen_result_is_taken() {
         zhang.rms_px
     );
     let outcomes = vec![(Method::Ekf, Ok(zhang.clone()))];
-    let chosen =
-        super::camera::at_least_as_good(tsai.clone(), &outcomes, &s.views, size, &options);
+    let chosen = super::camera::at_least_as_good(tsai.clone(), &outcomes, &s.views, size, &options);
     assert!(
         (chosen.rms_px - zhang.rms_px).abs() <= 1e-9 * zhang.rms_px,
         "{} px vs {} px",

@@ -31,6 +31,9 @@
 //! [`crate::target::Detection`] format, as `detect_target` returns it): the
 //! board points then come from each detection's own target.
 
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::geometry::PoseInput;
 use crate::handeye::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };
@@ -40,9 +43,6 @@ use crate::handeye::refine_closed_form::{apply_refinement, RefineMode};
 use crate::handeye::reprojection_refine::ViewPoints;
 use crate::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
 use crate::handeye::{HandEyeMethod, Pose, Setup};
-use crate::camera::Camera;
-use crate::error::{Error, Result};
-use crate::geometry::PoseInput;
 use crate::target::Detection;
 use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};

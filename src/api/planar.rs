@@ -2,11 +2,13 @@
 //! (`robocal planar ...`) and the wasm boundary (`planar_fit`,
 //! `planar_solve`): JSON in, JSON out.
 
+use crate::error::Result;
 use crate::workflows::linear_fit::LinearFit;
 use crate::workflows::planar::PlanarMatrix;
 use crate::workflows::planar_height::{ByParameter, HeightModel, MappedPoint};
-use crate::workflows::planar_solve::{solve_planar, HeightPoint, PlanarSolveOptions, PlanarSolveReport};
-use crate::error::Result;
+use crate::workflows::planar_solve::{
+    solve_planar, HeightPoint, PlanarSolveOptions, PlanarSolveReport,
+};
 use serde::{Deserialize, Serialize};
 
 /// One per-height matrix, as in the article's Table 4. In JSON one flat

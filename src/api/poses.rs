@@ -2,11 +2,11 @@
 //! web app's robot step): one call that either reads the file or, when its
 //! layout is ambiguous, returns every plausible reading ranked.
 
+use crate::error::{Error, Result};
 use crate::io::{
     parse_pose_candidates, parse_pose_file_candidates, parse_pose_files, parse_poses, Candidate,
     ParsedPoses, PoseFileOptions, PoseFileText,
 };
-use crate::error::{Error, Result};
 use serde::Serialize;
 
 /// What [`read_poses_json`] returns.

@@ -109,7 +109,6 @@ pub struct RigInput {
     pub frame_keys: Option<Vec<String>>,
 }
 
-
 fn default_grouping() -> String {
     "number".into()
 }
@@ -117,8 +116,8 @@ fn default_grouping() -> String {
 /// Calibrate a rig from the JSON input described in the module docs;
 /// returns the [`RigCalibration`] JSON.
 pub fn calibrate_rig_json(input_json: &str) -> Result<String> {
-    let input: RigInput = serde_json::from_str(input_json)
-        .map_err(|e| super::request_error("rig input", e))?;
+    let input: RigInput =
+        serde_json::from_str(input_json).map_err(|e| super::request_error("rig input", e))?;
     let report = calibrate_rig_input(&input)?;
     serde_json::to_string(&report)
         .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))
@@ -141,7 +140,10 @@ pub fn calibrate_rig_input(input: &RigInput) -> Result<RigCalibration> {
 pub fn rig_views(input: &RigInput) -> Result<(Vec<RigCameraViews>, Vec<String>)> {
     let mut keys: Vec<String> = Vec::new();
     let given = input.frame_keys.iter().flatten();
-    let of_views = input.cameras.iter().flat_map(|c| c.views.iter().map(|v| &v.key));
+    let of_views = input
+        .cameras
+        .iter()
+        .flat_map(|c| c.views.iter().map(|v| &v.key));
     for key in given.chain(of_views) {
         if !keys.contains(key) {
             keys.push(key.clone());

@@ -25,15 +25,15 @@
 //! Output: the rig report (solved, or the one given) with `handeye`, the
 //! JSON `robocal rig --setup ... -o rig.json` writes.
 
+use super::rig::{calibrate_rig_input, rig_views, RigInput};
+use crate::calib::rig::RigCameraViews;
+use crate::calib::rig_report::RigCalibration;
+use crate::error::{Error, Result};
+use crate::geometry::PoseInput;
 use crate::handeye::reprojection_refine::ViewPoints;
 use crate::handeye::rig::{add_rig_uncertainty, calibrate_rig_handeye, rig_handeye_report};
 use crate::handeye::rig_uncertainty::{held_rig, rig_sigma_points};
 use crate::handeye::{HandEyeOptions, Pose, Setup};
-use crate::calib::rig::RigCameraViews;
-use super::rig::{calibrate_rig_input, rig_views, RigInput};
-use crate::calib::rig_report::RigCalibration;
-use crate::error::{Error, Result};
-use crate::geometry::PoseInput;
 use crate::report_kind::ReportKind;
 use serde::Deserialize;
 use serde_json::Value;

@@ -55,12 +55,11 @@ pub struct StereoInput {
     pub right_image_size_px: Option<[u32; 2]>,
 }
 
-
 /// Calibrate a stereo pair from the JSON input described in the module
 /// docs; returns the [`StereoCalibration`] JSON.
 pub fn calibrate_stereo_json(input_json: &str) -> Result<String> {
-    let input: StereoInput = serde_json::from_str(input_json)
-        .map_err(|e| super::request_error("stereo input", e))?;
+    let input: StereoInput =
+        serde_json::from_str(input_json).map_err(|e| super::request_error("stereo input", e))?;
     let report = calibrate_stereo_input(&input)?;
     serde_json::to_string(&report)
         .map_err(|e| Error::invalid("report", format!("cannot serialise: {e}")))

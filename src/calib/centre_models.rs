@@ -45,7 +45,9 @@ pub fn centre_models<'a>(
 ) -> (Option<String>, Option<Vec<CentreModelViews>>) {
     let mut groups: Vec<CentreModelViews> = Vec::new();
     for (name, detection) in views {
-        let Some(model) = model_of(detection) else { continue };
+        let Some(model) = model_of(detection) else {
+            continue;
+        };
         match groups.iter_mut().find(|g| g.centre_model == model.name()) {
             Some(g) => g.views.push(name.to_string()),
             None => groups.push(CentreModelViews {

@@ -37,10 +37,10 @@
 //! to solve is left out.
 
 use super::compare::{calibrate_with, Method};
-use crate::api::camera::model_from_name;
 use super::report::CameraCalibration;
 use super::zhang::CalibrationOptions;
 use super::View;
+use crate::api::camera::model_from_name;
 use crate::camera::Camera;
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};

@@ -4,11 +4,11 @@
 use super::detect::{run_all, Outcome};
 use super::detections_file::read_detections;
 use super::{write_output, CliError};
-use robocal::calib::compare::ComparisonRow;
 use robocal::api::camera::{
     calibrate_input, CalibrationInput, CalibrationOutput, JsonOptions, JsonView, LensModel,
     MethodChoice,
 };
+use robocal::calib::compare::ComparisonRow;
 use robocal::detect::DetectOptions;
 use robocal::target::Target;
 

@@ -1,11 +1,11 @@
 //! `robocal planar fit|solve`: eye-to-hand calibration at any height (seed 001).
 
 use super::{read_text, write_output, CliError};
-use robocal::io::workflow_csv::{parse_planar_matrices, parse_planar_points};
-use robocal::workflows::planar::TransformKind;
 use robocal::api::planar::{
     planar_fit, planar_solve, PlanarFitRequest, PlanarSolveRequest, PredictRequest,
 };
+use robocal::io::workflow_csv::{parse_planar_matrices, parse_planar_points};
+use robocal::workflows::planar::TransformKind;
 use robocal::workflows::planar_solve::PlanarSolveOptions;
 
 #[derive(clap::Args)]

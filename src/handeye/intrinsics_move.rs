@@ -128,9 +128,9 @@ mod tests {
 
     #[wasm_bindgen_test(unsupported = test)]
     fn the_json_api_warns_when_the_joint_refinement_moves_fx_and_not_when_trusted() {
-        use crate::api::handeye::solve_handeye_json;
         use super::super::reprojection_refine_tests::{camera, looking_scene};
         use super::super::Setup;
+        use crate::api::handeye::solve_handeye_json;
         use crate::geometry::PoseJson;
         use crate::synth::handeye::project_grid;
         // Noise-free views of a camera with fx = fy = 800, solved from a

@@ -291,7 +291,8 @@ fn the_json_option_and_report_keys() {
         "bootstrap_samples": 0,
     });
     let run = |v: &serde_json::Value| -> serde_json::Value {
-        serde_json::from_str(&crate::api::handeye::solve_handeye_json(&v.to_string()).unwrap()).unwrap()
+        serde_json::from_str(&crate::api::handeye::solve_handeye_json(&v.to_string()).unwrap())
+            .unwrap()
     };
     let out = run(&input);
     assert!(out["method"].as_str().unwrap().starts_with("refined from "));

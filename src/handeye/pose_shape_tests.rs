@@ -157,7 +157,8 @@ fn image_points_without_pixel_refinement_feed_the_pnp_covariance() {
         "strict_checks": false,
     });
     let run = |v: &serde_json::Value| -> serde_json::Value {
-        serde_json::from_str(&crate::api::handeye::solve_handeye_json(&v.to_string()).unwrap()).unwrap()
+        serde_json::from_str(&crate::api::handeye::solve_handeye_json(&v.to_string()).unwrap())
+            .unwrap()
     };
     let out = run(&input);
     assert!(out["method"].as_str().unwrap().starts_with("refined from "));

@@ -251,10 +251,10 @@ pub fn apply_refinement(
 
 #[cfg(test)]
 mod tests {
-    use crate::api::handeye::solve_handeye_json;
     use super::super::reprojection_refine_tests::{camera, looking_scene};
     use super::super::Setup;
     use super::*;
+    use crate::api::handeye::solve_handeye_json;
     use crate::geometry::PoseJson;
     use crate::synth::handeye::project_grid;
     use wasm_bindgen_test::wasm_bindgen_test;

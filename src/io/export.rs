@@ -17,8 +17,8 @@ use super::export_transform::{export_transform, FrameNames, TransformFormat};
 use super::import_camera::import_camera;
 use crate::calib::rig_report::RigCalibration;
 use crate::error::{Error, Result};
-use crate::report_kind::ReportKind;
 use crate::geometry::{Pose, PoseInput};
+use crate::report_kind::ReportKind;
 use serde::Deserialize;
 
 /// Transforms looked for, in order, when the caller names none.

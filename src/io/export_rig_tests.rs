@@ -437,7 +437,10 @@ fn the_one_entry_detects_a_rig_report_and_joins_multi_file_formats() {
     );
     // A report written before `kind` existed, with `crate_version`: known by
     // its keys, exported the same.
-    assert!(json.starts_with("{\"kind\":\"rig\",\"robocal_version\":"), "{json}");
+    assert!(
+        json.starts_with("{\"kind\":\"rig\",\"robocal_version\":"),
+        "{json}"
+    );
     let old = json
         .replacen("\"kind\":\"rig\",", "", 1)
         .replacen("\"robocal_version\"", "\"crate_version\"", 1)

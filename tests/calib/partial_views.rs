@@ -489,8 +489,8 @@ fn handeye_with_too_few_usable_views_names_the_views_left_out() {
         .as_array()
         .map_or(0, Vec::len);
     assert!(n >= 2, "column 3 keeps {n} points");
-    let e = robocal::api::handeye::solve_handeye_json(&input.to_string())
-        .map_err(|e| e.to_string());
+    let e =
+        robocal::api::handeye::solve_handeye_json(&input.to_string()).map_err(|e| e.to_string());
     let reason = |k: usize| {
         if k < 4 {
             format!("{k} points: a homography needs at least 4")
