@@ -1,7 +1,8 @@
 //! The request and report of stereo calibration: the wasm function
-//! `calibrate_stereo`, the npm call and `robocal stereo` (which builds a
-//! [`StereoInput`] from its flags and detections) all call
-//! [`calibrate_stereo_input`].
+//! `calibrate_stereo` and the npm call take a [`StereoInput`]
+//! ([`calibrate_stereo_input`]); `robocal stereo`, whose detections are
+//! read by the CLI, enters at [`calibrate_stereo_views`], the same option
+//! mapping and solve.
 //!
 //! Input:
 //!
@@ -30,6 +31,7 @@ use super::camera::{
     JsonView, LensModel, MIN_VIEWS,
 };
 use crate::calib::stereo::{calibrate_stereo, StereoCalibration};
+use crate::calib::View;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -86,8 +88,31 @@ pub fn calibrate_stereo_input(input: &StereoInput) -> Result<StereoCalibration> 
     let right_size = side_size("right", &input.right, input.right_image_size_px)?;
     let left = views_of(&input.left).map_err(|e| within("left", e))?;
     let right = views_of(&input.right).map_err(|e| within("right", e))?;
-    let options = calibration_options(&input.model, &input.options)?;
-    calibrate_stereo(&left, &right, left_size, right_size, &options)
+    calibrate_stereo_views(
+        &input.model,
+        &input.options,
+        &left,
+        &right,
+        left_size,
+        right_size,
+    )
+}
+
+/// [`calibrate_stereo_input`] from the views on: the request's model and
+/// options mapped to the solver's, then the solve. `robocal stereo` enters
+/// here with the views of its own detections (images it detected, or
+/// detection files taken as they are, every point kept as before), so the
+/// CLI, the page and npm share the option mapping and the solve.
+pub fn calibrate_stereo_views(
+    model: &LensModel,
+    options: &JsonOptions,
+    left: &[View],
+    right: &[View],
+    left_size_px: (u32, u32),
+    right_size_px: (u32, u32),
+) -> Result<StereoCalibration> {
+    let options = calibration_options(model, options)?;
+    calibrate_stereo(left, right, left_size_px, right_size_px, &options)
 }
 
 /// Field names of a view error point into the side it came from

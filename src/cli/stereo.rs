@@ -3,8 +3,9 @@
 use super::detect::{run_all, Outcome};
 use super::detections_file::read_detections;
 use super::{write_output, CliError};
-use robocal::api::camera::{JsonOptions, JsonView, LensModel};
-use robocal::api::stereo::{calibrate_stereo_input, StereoInput};
+use robocal::api::camera::{JsonOptions, LensModel};
+use robocal::api::stereo::calibrate_stereo_views;
+use robocal::calib::View;
 use robocal::io::pairing::{pair_by_number, PairedBy};
 use robocal::target::{Detection, Target};
 
@@ -221,16 +222,8 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
             "stereo: the target was found in no pair of images".into(),
         ));
     };
-    // 4. Solve (the request `calibrate_stereo` takes) and report.
-    let request = StereoInput {
-        model,
-        options: JsonOptions::default(),
-        left,
-        right,
-        left_image_size_px: Some([ls.0, ls.1]),
-        right_image_size_px: Some([rs.0, rs.1]),
-    };
-    let report = calibrate_stereo_input(&request)?;
+    // 4. Solve (as `calibrate_stereo` does from its views on) and report.
+    let report = calibrate_stereo_views(&model, &JsonOptions::default(), &left, &right, ls, rs)?;
     for w in &report.warnings {
         eprintln!("robocal stereo: warning: {w}");
     }
@@ -257,7 +250,7 @@ pub fn run(args: StereoArgs) -> Result<(), CliError> {
 }
 
 /// The view of a detection; all images of one camera must share a size.
-fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<JsonView, CliError> {
+fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<View, CliError> {
     let s = (d.image_size_px[0], d.image_size_px[1]);
     match size {
         Some(prev) if *prev != s => {
@@ -271,10 +264,5 @@ fn view(file: &str, d: &Detection, size: &mut Option<(u32, u32)>) -> Result<Json
         }
         _ => *size = Some(s),
     }
-    Ok(JsonView {
-        name: file.to_string(),
-        detection: Some(d.clone()),
-        object_m: None,
-        image_px: None,
-    })
+    Ok(View::from_detection(file, d))
 }
