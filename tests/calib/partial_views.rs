@@ -422,7 +422,7 @@ fn every_planar_method_takes_partial_views() {
     let scene = Scene::calibration(25, &truth, (COLS, ROWS), PITCH_M, 12, 0.0).expect("scene");
     let rows = |views: &[View]| {
         let mut all = input(views);
-        all.method = "all".into();
+        all.method = MethodChoice::All;
         let out = calibrate_input(&all).unwrap_or_else(|e| panic!("{e}"));
         out.comparison.expect("rows")
     };
