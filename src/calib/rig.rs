@@ -9,16 +9,22 @@
 //!    rig camera; each edge's child_from_parent is averaged over the shared
 //!    frames (rotations by the quaternion mean, as stereo's
 //!    [`initial_right_from_left`]) and chained into every camera_from_rig.
+//!    Before that, the frame grouping is tested along each edge
+//!    ([`super::rig_frame_check`]): the board's motions seen by two cameras
+//!    must rotate by the same angles.
 //! 3. Each frame's rig_from_target from the camera that saw most of it.
 //! 4. One Levenberg-Marquardt ([`super::rig_problem`]) over every camera's
 //!    intrinsics (unless held), every camera_from_rig but the rig camera's
 //!    and every frame's board pose; the covariance gives each extrinsic's
-//!    standard deviation.
+//!    standard deviation, widened to the spread of leave-frames-out refits
+//!    where that is larger ([`super::rig_jackknife`]).
 //! 5. The report ([`RigCalibration`]).
 
 use super::refine::{block_from_pose, pose_from_block};
+use super::rig_frame_check::{check_pair, message as frame_message, CameraFrames, FrameFinding};
 use super::rig_graph::{co_observation_counts, spanning_tree};
 use super::rig_init::{camera_alone, Alone};
+use super::rig_jackknife::{leave_frames_out, WARN_FACTOR};
 use super::rig_problem::{RigProblem, Sighting};
 use super::rig_report::{
     CoObservation, RigCalibration, RigCamera, RigCovariance, RigFrame, RigParameter,
@@ -84,6 +90,29 @@ pub fn calibrate_rig(
     let frames_of: Vec<Vec<usize>> = alone.iter().map(|a| a.frames.clone()).collect();
     let counts = co_observation_counts(&frames_of);
     let tree = spanning_tree(&counts, rig_camera, &names)?;
+    // Is each frame's group of images taken at one moment? The board's
+    // motions tell, before any joint fit ([`super::rig_frame_check`]): a
+    // camera whose images sit shifted in the frames is refused with the
+    // shift named; a grouping that no shift explains is warned.
+    for &[parent, child] in &tree {
+        let frames_of = |k: usize| CameraFrames {
+            frames: &alone[k].frames,
+            camera_from_target: &alone[k].poses,
+        };
+        if let Some(finding) = check_pair(&frames_of(parent), &frames_of(child)) {
+            let text = frame_message(
+                &finding,
+                &names[parent],
+                &names[child],
+                frame_keys,
+                &options.grouping,
+            );
+            match finding {
+                FrameFinding::Shifted { .. } => return Err(Error::invalid("rig frames", text)),
+                FrameFinding::Disagree { .. } => warnings.push(text),
+            }
+        }
+    }
     let mut camera_from_rig = vec![Pose::identity(); cameras.len()];
     for &[parent, child] in &tree {
         let shared: Vec<(Pose, Pose)> = alone[parent]
@@ -142,12 +171,11 @@ pub fn calibrate_rig(
             fixed_global.extend([false; 6]);
         }
     }
-    let lm = lm_options(&alone[rig_camera].camera, &options.calibration)?;
-    let result = solve(
-        &problem,
-        &BlockParams { global, blocks },
-        &LmOptions { fixed_global, ..lm },
-    )?;
+    let lm = LmOptions {
+        fixed_global,
+        ..lm_options(&alone[rig_camera].camera, &options.calibration)?
+    };
+    let result = solve(&problem, &BlockParams { global, blocks }, &lm)?;
     // 5. The report.
     let residuals = problem.residuals_and_jacobian(&result.params, false)?;
     let owners = problem.residual_cameras();
@@ -166,7 +194,49 @@ pub fn calibrate_rig(
         }
     }
     let rms = |sq: f64, n: usize| if n == 0 { 0.0 } else { (sq / n as f64).sqrt() };
-    let std = result.std_global();
+    // The extrinsics' std checked against the spread of leave-frames-out
+    // refits ([`super::rig_jackknife`]) and widened to it axis by axis.
+    let mut covariance_global = result.covariance_global.clone();
+    let spread = leave_frames_out(
+        &|| alone.iter().map(Alone::problem).collect(),
+        &problem,
+        &result,
+        &lm,
+        &names,
+    );
+    if let (Some(c), Some(spread)) = (covariance_global.as_mut(), &spread) {
+        for k in 0..cameras.len() {
+            let Some(o) = problem.pose_offset(k) else {
+                continue;
+            };
+            let mut worst: f64 = 1.0;
+            for i in 0..6 {
+                let model = c[(o + i, o + i)].max(0.0).sqrt();
+                let factor = if model > 0.0 {
+                    (spread.std[k][i] / model).max(1.0)
+                } else {
+                    1.0
+                };
+                c.row_mut(o + i).scale_mut(factor);
+                c.column_mut(o + i).scale_mut(factor);
+                worst = worst.max(factor);
+            }
+            if worst > WARN_FACTOR {
+                warnings.push(format!(
+                    "camera {}: leaving frames out moves its camera_from_rig {worst:.1}x more \
+                     than the joint fit's std says ({} refits): the frames disagree beyond the \
+                     pixel noise (images of a frame not taken at one moment while the board \
+                     moved, a board that bends, a camera that moved between frames); its std \
+                     is widened to that spread. Hold the board still for each frame or trigger \
+                     the cameras together",
+                    names[k], spread.runs
+                ));
+            }
+        }
+    }
+    let std: Option<Vec<f64>> = covariance_global
+        .as_ref()
+        .map(|c| c.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect());
     let g = &result.params.global;
     let rig_from_target: Vec<Pose> = result
         .params
@@ -264,8 +334,7 @@ pub fn calibrate_rig(
             }
         })
         .collect();
-    let covariance = result
-        .covariance_global
+    let covariance = covariance_global
         .as_ref()
         .map(|c| rig_covariance(&problem, &alone, &names, c));
     Ok(RigCalibration {
