@@ -74,7 +74,12 @@ pub(crate) fn leave_frames_out<'a>(
             }
         }
         if frames_of.iter().any(Vec::is_empty)
-            || spanning_tree(&co_observation_counts(&frames_of), problem.rig_camera, names).is_err()
+            || spanning_tree(
+                &co_observation_counts(&frames_of),
+                problem.rig_camera,
+                names,
+            )
+            .is_err()
         {
             continue;
         }
@@ -85,7 +90,10 @@ pub(crate) fn leave_frames_out<'a>(
         };
         let start = BlockParams {
             global: full.params.global.clone(),
-            blocks: keep.iter().map(|&f| full.params.blocks[f].clone()).collect(),
+            blocks: keep
+                .iter()
+                .map(|&f| full.params.blocks[f].clone())
+                .collect(),
         };
         let options = LmOptions {
             max_iterations: ITERATIONS,

@@ -272,10 +272,7 @@ fn opencv_9x6_pair_as_a_rig_gives_the_stereo_result() {
     // On these 13 real frames the spread is about twice the model's (0.22
     // against 0.11 mm in x): never narrower, and within 3x.
     for (a, b) in s_rig.translation_m.iter().zip(&s_st.translation_m) {
-        assert!(
-            *a >= b * (1.0 - 1e-6) && *a <= 3.0 * b,
-            "std {a} vs {b} m"
-        );
+        assert!(*a >= b * (1.0 - 1e-6) && *a <= 3.0 * b, "std {a} vs {b} m");
     }
     eprintln!(
         "baseline std: rig {:?} m (widened), stereo {:?} m",
@@ -322,7 +319,10 @@ fn frames_of_one_camera_shifted_are_named_before_the_joint_fit() {
         err.contains("the board's motions agree only when cam1's frames are taken 2 frames late"),
         "{err}"
     );
-    assert!(err.contains("rename them or choose another grouping rule"), "{err}");
+    assert!(
+        err.contains("rename them or choose another grouping rule"),
+        "{err}"
+    );
 }
 
 /// Free-running cameras 5 ms apart (std per view) filming a hand-held
@@ -349,8 +349,9 @@ fn timing_error_is_covered_or_warned() {
             e.iter().zip(&std).all(|(err, sd)| err.abs() <= 3.0 * sd)
         });
         let warned = rig.warnings.iter().any(|w| {
-            w.contains("disagree on how the board moved") || w.contains("moved its intrinsics beyond")
-                    || w.contains("leaving frames out moves")
+            w.contains("disagree on how the board moved")
+                || w.contains("moved its intrinsics beyond")
+                || w.contains("leaving frames out moves")
         });
         if !covered && !warned {
             silent.push(seed);
