@@ -15,7 +15,7 @@
 //! it is not a bias of ours: (1) after undistorting both corner sets with
 //! OpenCV's own calibration (left_intrinsics.yml) a homography fits
 //! robocal's corners better than OpenCV's (median RMS 0.166 vs 0.186 px
-//! over the 13 left images, BENCHMARKS.md); (2) on renders degraded like
+//! over the 13 left images, docs/benchmark-history.md); (2) on renders degraded like
 //! these photos (blur, noise, JPEG; benches/detect_jpeg_truth.py) robocal is
 //! closer to the truth than OpenCV in every case. Single corners differ
 //! by up to 6 px where the board's thin outer row meets its frame:
