@@ -12,7 +12,7 @@
 //! inverse Fisher information of `(X, Z)` at the truth with the true robot
 //! noise and each view's PnP covariance at the true pose times the pixel
 //! variance. `--trials-json` writes every trial's poses and truth for
-//! bench/handeye_crb_opencv.py (OpenCV 4.14 on the same trials).
+//! benches/handeye_crb_opencv.py (OpenCV 4.14 on the same trials).
 
 use nalgebra::Vector6;
 use robocal::camera::Camera;

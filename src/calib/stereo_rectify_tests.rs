@@ -116,7 +116,7 @@ fn rectification_matches_opencv() {
     let (left, right, right_from_left) = pair();
     let rect = rectify(&left, &right, &right_from_left).unwrap();
     // cv2.stereoRectify(K1, D1, K2, D2, (640, 480), R, T, flags=CALIB_ZERO_DISPARITY, alpha=-1)
-    // with D = [k1, 0.01, 0.0005, -0.0003, 0] (bench/stereo_rectify_opencv.py).
+    // with D = [k1, 0.01, 0.0005, -0.0003, 0] (benches/stereo_rectify_opencv.py).
     // Rotations to 1e-9; pixels to 1e-4 px (OpenCV undistorts the corners
     // with a fixed number of iterations, we to convergence).
     let close = |what: &str, ours: Vec<f64>, theirs: &[f64], tolerance: f64| {

@@ -82,7 +82,7 @@
 //! (vignetting, gradients) one image was at 0.033 px mean, 0.11 px max
 //! without the radial step, the error on the board's edge circles, whose
 //! windows lie on one side of them and extrapolate the lens's bending;
-//! with it 0.008 / 0.021 px (BENCHMARKS.md, Session 10; the test
+//! with it 0.008 / 0.021 px (docs/benchmark-history.md, Session 10; the test
 //! `large_steep_circles_with_vignetting_through_strong_distortion`). A
 //! quadratic term on top of each local homography changes the centres by
 //! less than 0.001 px, so the default is the plain homography. No

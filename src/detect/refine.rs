@@ -15,8 +15,8 @@
 //! Fitting at the pixels themselves, whose offsets from a centre between
 //! pixels are not symmetric, biased the corner with its sub-pixel phase
 //! (+-0.007 px on a frontal board, the mean over a board shifted by
-//! fractions of a pixel; BENCHMARKS.md, "Chessboard corners: the fit
-//! points' phase").
+//! fractions of a pixel; docs/benchmark-history.md, "Session 14: chessboard
+//! corners: the fit points' phase").
 //!
 //! Cost: the smoothing is never applied to the patch. Weights, basis and
 //! smoothing are all separable, so each right-hand side of the normal

@@ -337,7 +337,7 @@ fn joint_linear_solvers_beat_rotation_only_ones_on_noisy_data() {
     // Andreff and Li solve rotation and translation rows in one least
     // squares, so the translations add information to the rotation: over
     // OpenCV-style noisy scenes their median rotation error must be below
-    // Horaud's (rotation rows only). bench/compare_handeye.py measures ~17 %
+    // Horaud's (rotation rows only). benches/compare_handeye.py measures ~17 %
     // (Andreff) and 16-37 % (Li) better over 100 trials; over 40 scenes we
     // require 5 %, which a rotation-only solve (equal to Horaud) cannot pass.
     for setup in [Setup::EyeInHand, Setup::EyeToHand] {

@@ -203,7 +203,7 @@ fn opencv_9x6_pair_as_a_rig_gives_the_stereo_result() {
     };
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/opencv-left-right-9x6.json"
+        "/fixtures/opencv-left-right-9x6.json"
     );
     let fixture: Value =
         serde_json::from_str(&std::fs::read_to_string(path).expect("fixture")).expect("JSON");

@@ -6,7 +6,7 @@
 //! Skipped with a message when the dataset or ffmpeg is absent.
 //!
 //! Bounds: before issue 36 robocal found the board in none of these frames.
-//! Measured on 2026-12-06 (bench/inverted_charuco.sh, BENCHMARKS.md
+//! Measured on 2026-12-06 (benches/inverted_charuco.sh, BENCHMARKS.md
 //! "Inverted boards"): frames with a board 16 / 26 / 15 / 14 and corners
 //! 181 / 130 / 139 / 93 for cameras 0-3 (OpenCV 4.14's CharucoDetector on
 //! the inverted frames: 15 / 23 / 14 / 15 frames, 180 / 121 / 166 / 170

@@ -1,6 +1,6 @@
 //! Writes the seed corpus of every fuzz target: `robocal-fuzz-seeds REPO OUT`
-//! fills `OUT/<target>/` from the project's fixtures (`fixtures/`,
-//! `tests/fixtures/`) and from small seeded renders and synthetic scenes,
+//! fills `OUT/<target>/` from the project's fixtures (`fixtures/`) and
+//! from small seeded renders and synthetic scenes,
 //! each input in the layout its target reads (`fuzz/src/cases.rs`).
 //! Deterministic: the same files on every run.
 

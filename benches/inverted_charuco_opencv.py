@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """OpenCV's ChArUco detector on the caliscope inverted-board frames, for the
 "Inverted boards" table of BENCHMARKS.md (robocal's side: `robocal detect`
-on the same frames, see bench/inverted_charuco.sh).
+on the same frames, see benches/inverted_charuco.sh).
 
-usage: inverted_charuco_opencv.py FRAME.png...  (frames as bench/inverted_charuco.sh extracts them)
+usage: inverted_charuco_opencv.py FRAME.png...  (frames as benches/inverted_charuco.sh extracts them)
 prints one line per camera (the file name's prefix before '_'):
 frames, frames with a board, corners per frame with a board, mean.
 OpenCV needs the image inverted by hand: cv2.aruco.CharucoDetector on 255 - grey.

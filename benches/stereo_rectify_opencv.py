@@ -12,7 +12,7 @@ with cv2.FileStorage instead and prints how far E, F and R1 R2 P1 P2 Q are
 from [T]x R, K2^-T E K1^-1 and cv2.stereoRectify of the file's K, D, R, T
 (with 5.1.0: E 7e-18, F 1e-20, R1 R2 4e-15, P1 P2 Q 1.5e-5 px).
 
-Usage: python3 bench/stereo_rectify_opencv.py [FILE]   (needs cv2 and numpy)
+Usage: python3 benches/stereo_rectify_opencv.py [FILE]   (needs cv2 and numpy)
 """
 import sys
 import cv2

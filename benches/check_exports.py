@@ -4,7 +4,7 @@
 For a few cameras (Brown, rational with thin prism, fisheye) this script
 asks `robocal export` for OpenCV YAML and XML, ROS camera_info and Kalibr
 YAML, then reads them back with cv2.FileStorage (opencv-python-headless
-4.14.0.94, pinned in bench/opencv_venv.py) and PyYAML, and compares every number with the input.
+4.14.0.94, pinned in benches/opencv_venv.py) and PyYAML, and compares every number with the input.
 For the 3-camera rig of fixtures/exports/rig.json (issue 22) it reads the
 rig's OpenCV FileStorage (R_k, T_k, camera_matrix_k per camera) with
 cv2.FileStorage, and its Kalibr camchain and ROS camera_infos with PyYAML,
@@ -14,8 +14,8 @@ Debian's python3-mrcal, run with the system python3 since mrcal is not on
 the venv): lens model, intrinsics and extrinsics_rt_fromref against the
 report; skipped with a note when `import mrcal` fails.
 
-Usage (creates bench/.venv on first run; needs target/release/robocal):
-    cargo build --release && python3 bench/check_exports.py
+Usage (creates benches/.venv on first run; needs target/release/robocal):
+    cargo build --release && python3 benches/check_exports.py
 Exit code 0 when every file reads back exactly.
 """
 import json

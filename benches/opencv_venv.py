@@ -1,5 +1,5 @@
 """The one Python environment of every script that compares robocal with
-OpenCV: bench/.venv with the pinned reference (issue 5:
+OpenCV: benches/.venv with the pinned reference (issue 5:
 opencv-python-headless 4.14.0.94; the 4.12 wheels are 4-12x slower through
 their IPP path and the 5.0 bindings lack calibrateHandEye) plus numpy and
 PyYAML.
@@ -9,7 +9,7 @@ creates the venv on first use, installs the pinned packages when the venv's
 stamp file does not list exactly PINNED, and re-runs the script with the
 venv's python (same arguments); inside the venv it returns at once.
 
-    sys.path.insert(0, <this folder>)   # only for scripts outside bench/
+    sys.path.insert(0, <this folder>)   # only for scripts outside benches/
     from opencv_venv import ensure_venv
     ensure_venv()
     import cv2
@@ -36,7 +36,7 @@ def _installed_pins():
 
 
 def ensure_venv():
-    """Return inside bench/.venv; otherwise create/update it and re-exec."""
+    """Return inside benches/.venv; otherwise create/update it and re-exec."""
     if os.path.abspath(sys.prefix) == os.path.abspath(VENV):
         return
     if not os.path.exists(PYTHON):

@@ -5,7 +5,7 @@
 // same decode alone); detection ~ the difference of the two medians.
 // Usage (crate root, after `make pkg cli`):
 //   robocal render --out DIR --target SPEC --camera cam1280x720.yaml --views N
-//   node bench/wasm_detect_markers.mjs [--repeat N] DIR...
+//   node benches/wasm_detect_markers.mjs [--repeat N] DIR...
 // Each DIR's truth.json names the target; corners are checked against it.
 import { createRequire } from "node:module";
 import { readFileSync } from "node:fs";

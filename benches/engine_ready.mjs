@@ -14,12 +14,12 @@
 // ...), so that a slow spell of the machine hits them alike.
 //
 // Usage (crate root, after `make web`, `make cli` and `tools/setup.sh e2e`):
-//   node bench/engine_ready.mjs [--runs N] [--warm-loads K] [--cli PATH] [--throttle MBIT,RTT_MS] LABEL=DIR [LABEL=DIR ...]
+//   node benches/engine_ready.mjs [--runs N] [--warm-loads K] [--cli PATH] [--throttle MBIT,RTT_MS] LABEL=DIR [LABEL=DIR ...]
 // --throttle: Chromium's network emulation on the page (and its dedicated
 // worker), e.g. 20,40 for 20 Mbit/s and 40 ms round trips; `robocal serve`
 // sends files uncompressed, so this charges the raw size of the wasm.
 // Without it, loads come over loopback at memory speed.
-// e.g. node bench/engine_ready.mjs --runs 9 before=/tmp/before/www after=www
+// e.g. node benches/engine_ready.mjs --runs 9 before=/tmp/before/www after=www
 // Prints every run and the medians (ms) per build: cold, warm 1..K.
 import { spawn } from 'node:child_process';
 import { createRequire } from 'node:module';
@@ -50,7 +50,7 @@ for (let i = 0; i < args.length; i++) {
   }
 }
 if (builds.length === 0) {
-  console.error('usage: node bench/engine_ready.mjs [--runs N] [--warm-loads K] [--cli PATH] LABEL=DIR ...');
+  console.error('usage: node benches/engine_ready.mjs [--runs N] [--warm-loads K] [--cli PATH] LABEL=DIR ...');
   process.exit(2);
 }
 

@@ -15,7 +15,7 @@
 // and the share of frames the board was found in.
 //
 // Usage (crate root, after `make web cli` and `tools/setup.sh e2e`):
-//   node bench/live_fps.mjs [--seconds N] [--sizes 640x480,1280x720,1920x1080] [--boards chessboard,charuco,aprilgrid] [--shots DIR]
+//   node benches/live_fps.mjs [--seconds N] [--sizes 640x480,1280x720,1920x1080] [--boards chessboard,charuco,aprilgrid] [--shots DIR]
 // --shots: a screenshot of the page at the end of each measurement, to look at.
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';

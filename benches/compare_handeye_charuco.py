@@ -27,8 +27,8 @@ translation (mm) error of X (gripper_from_camera / base_from_camera)
 against the rendered truth.
 
 Usage (crate root, after `make cli`):
-  python3 bench/compare_handeye_charuco.py [--trials 20] [--views 12] [--skip-render]
-It runs in bench/.venv (opencv-python-headless==4.14.0.94, bench/opencv_venv.py).
+  python3 benches/compare_handeye_charuco.py [--trials 20] [--views 12] [--skip-render]
+It runs in benches/.venv (opencv-python-headless==4.14.0.94, benches/opencv_venv.py).
 """
 import glob
 import json

@@ -9,8 +9,8 @@ cv2.calibrateRobotWorldHandEye (Shah, Li), and prints per scenario the mean
 X error of OpenCV's best method (by mean translation error, and by mean
 rotation error) next to robocal's refined estimate.
 
-Usage: python3 bench/handeye_crb_opencv.py /tmp/crb.json
-It runs in bench/.venv (opencv-python-headless==4.14.0.94, bench/opencv_venv.py).
+Usage: python3 benches/handeye_crb_opencv.py /tmp/crb.json
+It runs in benches/.venv (opencv-python-headless==4.14.0.94, benches/opencv_venv.py).
 """
 import json
 import sys

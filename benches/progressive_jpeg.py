@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Writes a progressive JPEG with thousands of scans, for bench/bounds.sh.
+"""Writes a progressive JPEG with thousands of scans, for benches/bounds.sh.
 
-A progressive JPEG is encoded by OpenCV (bench/.venv, see opencv_venv.py)
+A progressive JPEG is encoded by OpenCV (benches/.venv, see opencv_venv.py)
 from a smooth image (so that its AC scans are a few bytes of end-of-band
 runs); then its smallest scan (the SOS segment and its entropy-coded data, up
 to the next marker) is repeated until the file has SCANS scans. Every extra
@@ -9,7 +9,7 @@ scan can make a decoder walk the whole coefficient buffer again: the
 pathological input of issue 17 ("a progressive JPEG with thousands of
 scans"), a small file for a large image.
 
-Usage: python3 bench/progressive_jpeg.py OUT.jpg [SIDE_PX] [SCANS]
+Usage: python3 benches/progressive_jpeg.py OUT.jpg [SIDE_PX] [SCANS]
 """
 import sys
 

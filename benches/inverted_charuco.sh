@@ -3,9 +3,9 @@
 # (../shared/datasets/caliscope-4cam-charuco-video, SOURCE.md), every third
 # frame from frame 21 of each camera's video (30 per camera), detected by
 # robocal without a print option and by OpenCV's CharucoDetector on the
-# inverted frames (bench/inverted_charuco_opencv.py).
+# inverted frames (benches/inverted_charuco_opencv.py).
 #
-# usage: bench/inverted_charuco.sh [ROBOCAL]   (default target/release/robocal)
+# usage: benches/inverted_charuco.sh [ROBOCAL]   (default target/release/robocal)
 # needs ffmpeg and python3 with opencv-python-headless (4.14.0.94 for the table).
 set -eu
 robocal=${1:-target/release/robocal}

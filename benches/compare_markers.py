@@ -16,7 +16,7 @@ AprilGrids (markerBorderBits 2: Kalibr's tags have a two-bit black
 border). Errors are against the renderer's exact truth, by corner id.
 
 Usage (crate root):
-  python3 bench/compare_markers.py [--views N] [--repeat N] [--skip-render]
+  python3 benches/compare_markers.py [--views N] [--repeat N] [--skip-render]
 """
 import json
 import os

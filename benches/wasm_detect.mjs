@@ -1,8 +1,8 @@
 // Time the wasm build's detect_target (PNG decoding + detection) under node
 // on rendered images; compare with the native
 // `cargo run --release --example detect_time -- --decode FILES`.
-// Usage (crate root, after `make pkg` and bench/compare_opencv.py):
-//   node bench/wasm_detect.mjs [--repeat N] [--decode-only] FILES...
+// Usage (crate root, after `make pkg` and benches/compare_opencv.py):
+//   node benches/wasm_detect.mjs [--repeat N] [--decode-only] FILES...
 import { createRequire } from "node:module";
 import { readFileSync } from "node:fs";
 import { performance } from "node:perf_hooks";

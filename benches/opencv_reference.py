@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Write tests/fixtures/opencv-left-right-9x6.json: OpenCV's refined chessboard
+"""Write fixtures/opencv-left-right-9x6.json: OpenCV's refined chessboard
 corners for the public OpenCV left/right 9x6 images, the reference that
 tests/detect/detect_datasets.rs compares robocal's detector with.
 
-Usage (from the crate root; runs in bench/.venv, see bench/opencv_venv.py):
-  python3 bench/opencv_reference.py [DATASET_DIR]
+Usage (from the crate root; runs in benches/.venv, see benches/opencv_venv.py):
+  python3 benches/opencv_reference.py [DATASET_DIR]
 """
 import json
 import os
@@ -38,14 +38,14 @@ def main():
         corners = cv2.cornerSubPix(gray, corners, (11, 11), (-1, -1), crit)
         images[name] = [[round(float(x), 4), round(float(y), 4)] for x, y in corners.reshape(-1, 2)]
     doc = {
-        "provenance": "bench/opencv_reference.py with opencv-python-headless "
+        "provenance": "benches/opencv_reference.py with opencv-python-headless "
         + cv2.__version__
         + ": findChessboardCorners(9x6, default flags) + cornerSubPix(11x11, eps 1e-4, 100 iterations); "
         "corners in OpenCV's order (pixel centre = integer coordinates, as robocal); null = OpenCV found no board",
         "pattern": [9, 6],
         "images": images,
     }
-    out = os.path.join(ROOT, "tests", "fixtures", "opencv-left-right-9x6.json")
+    out = os.path.join(ROOT, "fixtures", "opencv-left-right-9x6.json")
     with open(out, "w") as f:
         json.dump(doc, f, indent=1)
         f.write("\n")

@@ -1,11 +1,11 @@
 // Time marker-board detection (ChArUco, AprilGrid) in headless Chromium
 // (issue 18's goal: at most 15 ms per 1280x720 frame in wasm), the page's
 // own wasm build (www/pkg, after `make web`) loaded in a page served by
-// `robocal serve`. As bench/wasm_detect_markers.mjs does in node, each frame
+// `robocal serve`. As benches/wasm_detect_markers.mjs does in node, each frame
 // is timed twice: detect_target (PNG decode + detection) and image_info
 // (the same decode alone); detection ~ the difference of the two medians.
 // Usage (crate root, after `make web cli`; frames from `robocal render`):
-//   node bench/chromium_detect_markers.mjs [--repeat N] [--www DIR] DIR...
+//   node benches/chromium_detect_markers.mjs [--repeat N] [--www DIR] DIR...
 // Each DIR's truth.json names the target; corners are checked against it.
 import { createRequire } from "node:module";
 import { spawn } from "node:child_process";

@@ -12,7 +12,7 @@ latency median/p90 and the server's peak RSS (VmHWM) and thread count from
 serves a temporary copy of --dir's files plus the 16 MiB big.wasm.
 Standard library only.
 
-usage: bench/serve_load.py [--bin target/release/robocal] [--dir www]
+usage: benches/serve_load.py [--bin target/release/robocal] [--dir www]
                            [--slow 60] [--big 8] [--stalled 0] [--seconds 30]
 """
 import argparse, os, shutil, socket, statistics, subprocess, tempfile, threading, time

@@ -4,15 +4,15 @@
 On the public OpenCV left/right 9x6 JPEGs robocal's corners differ from
 OpenCV's findChessboardCorners + cornerSubPix(11x11) by a per-image median
 of up to ~0.15 px, and there is no ground truth. This script degrades the
-rendered VGA set (bench/out/chessboard_vga, made by compare_opencv.py) the
+rendered VGA set (benches/out/chessboard_vga, made by compare_opencv.py) the
 way those photos are degraded (extra Gaussian blur and noise, then JPEG
 at a given quality), runs both detectors and prints, per degradation: each detector's
 error against the renderer's truth and the robocal-OpenCV distance (the
 quantity measured on the public set). Blur is symmetric and JPEG noise has
 no preferred direction, so the truth does not move.
 
-Usage (crate root, after compare_opencv.py has rendered bench/out and a
-release build exists): python3 bench/detect_jpeg_truth.py
+Usage (crate root, after compare_opencv.py has rendered benches/out and a
+release build exists): python3 benches/detect_jpeg_truth.py
 """
 import json
 import os

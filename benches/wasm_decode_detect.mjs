@@ -5,11 +5,11 @@
 // worker runs per image), the builds taking turns call by call (A B A B
 // ...), so their ratio comes from the same run. Native counterpart:
 // `target/release/examples/detect_time --decode --no-blank FILES`.
-// (This replaces bench/wasm_jpeg.mjs, which timed decode_image_preview in
+// (This replaces benches/wasm_jpeg.mjs, which timed decode_image_preview in
 // two builds: --per-file prints that per-file table, for any format.)
 // Usage (crate root; each PKG_JS a wasm-bindgen --target nodejs build, e.g.
 // `make pkg`'s pkg/node/robocal.js):
-//   node bench/wasm_decode_detect.mjs [--repeat N] [--target SPEC] [--per-file] LABEL=PKG_JS [LABEL=PKG_JS ...] FILES...
+//   node benches/wasm_decode_detect.mjs [--repeat N] [--target SPEC] [--per-file] LABEL=PKG_JS [LABEL=PKG_JS ...] FILES...
 // Prints, per build, the median over files of the per-file medians (ms) and
 // the ratios to the first build (median over files of the per-file ratios);
 // with --per-file also one line per file and build.
@@ -47,7 +47,7 @@ for (let i = 0; i < args.length; i++) {
   } else files.push(args[i]);
 }
 if (builds.length === 0 || files.length === 0) {
-  console.error('usage: node bench/wasm_decode_detect.mjs [--repeat N] [--target SPEC] [--per-file] LABEL=PKG_JS ... FILES...');
+  console.error('usage: node benches/wasm_decode_detect.mjs [--repeat N] [--target SPEC] [--per-file] LABEL=PKG_JS ... FILES...');
   process.exit(2);
 }
 

@@ -21,9 +21,9 @@ seed, seeds 1..S: robocal intrinsics on robocal's corners, OpenCV
 calibrateCamera on its cornerSubPix corners; fx error against the truth
 (600 px) and robocal's reported std.
 
-Usage (crate root; runs in bench/.venv, see bench/opencv_venv.py):
+Usage (crate root; runs in benches/.venv, see benches/opencv_venv.py):
   cargo build --release --bin robocal
-  python3 bench/corner_study.py [--views 200] [--rows all|name,...] [--calib 5]
+  python3 benches/corner_study.py [--views 200] [--rows all|name,...] [--calib 5]
 """
 import json
 import os

@@ -3,7 +3,7 @@
 // rational model), stereo, hand-eye from detections with refinement and
 // bootstrap repeatability, joint refinement with intrinsics, planar fit.
 // Usage (crate root, after `make pkg`):
-//   node bench/wasm_solvers.mjs [--repeat N] [PKG_JS]
+//   node benches/wasm_solvers.mjs [--repeat N] [PKG_JS]
 // PKG_JS defaults to pkg/node/robocal.js. Prints medians in ms.
 import { createRequire } from 'node:module';
 import { resolve } from 'node:path';

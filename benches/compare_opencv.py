@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Compare robocal's target detection with OpenCV on rendered image sets.
 
-Creates bench/.venv with the pinned reference (opencv-python-headless
+Creates benches/.venv with the pinned reference (opencv-python-headless
 4.14.0.94), renders the sets with `cargo run --release --example
 render_set`, runs both detectors single-threaded (robocal: `robocal detect
 --threads 1`, detection time measured inside the process without decoding;
@@ -11,7 +11,7 @@ the renderer's ground truth, median times and the median of the per-image
 time ratio robocal / OpenCV.
 
 Usage (crate root):
-  python3 bench/compare_opencv.py [--quick] [--skip-render] [--repeat N [--interleave]]
+  python3 benches/compare_opencv.py [--quick] [--skip-render] [--repeat N [--interleave]]
 
 Circle sets also get a row for `robocal detect --circle-centres
 ellipse_centre` (the centres without the perspective correction).

@@ -3,7 +3,7 @@
 // detect_target on the demo images and on dataset JPEGs, calibrate_camera
 // (Zhang + refinement) on the demo detections, render_demo itself.
 // Usage (crate root, after `make pkg` or a wasm-bindgen --target nodejs build):
-//   node bench/wasm_profile.mjs [--repeat N] [PKG_JS ...] [IMAGES...]
+//   node benches/wasm_profile.mjs [--repeat N] [PKG_JS ...] [IMAGES...]
 // PKG_JS (any argument ending in .js) defaults to pkg/node/robocal.js. With
 // several, every build is loaded into this one process and they take turns,
 // repetition by repetition (A B C A B C ...), so that they are compared in

@@ -11,9 +11,9 @@ Printed: per method, the median and 90th percentile of the rotation error
 (deg) and translation error (mm) of the camera transform against the truth.
 
 Usage (from the crate root, after `cargo build`):
-  python3 bench/compare_handeye.py [--trials 100] [--seed 7] [--robocal target/debug/robocal]
-It runs in bench/.venv (opencv-python-headless==4.14.0.94, pinned in
-bench/opencv_venv.py; created on first run).
+  python3 benches/compare_handeye.py [--trials 100] [--seed 7] [--robocal target/debug/robocal]
+It runs in benches/.venv (opencv-python-headless==4.14.0.94, pinned in
+benches/opencv_venv.py; created on first run).
 """
 import argparse
 import json

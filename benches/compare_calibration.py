@@ -28,9 +28,9 @@ loaded machine wall times swing by 2-3x, so CPU times are printed too:
 OpenCV's per call (time.process_time), robocal's from the child process
 (CPU of `--repeat R+1` minus CPU of a single solve, over R).
 
-Usage (crate root; runs in bench/.venv, see bench/opencv_venv.py):
+Usage (crate root; runs in benches/.venv, see benches/opencv_venv.py):
   cargo build --release --bin robocal
-  python3 bench/compare_calibration.py [--repeat 21] [--quick] [--robocal PATH]
+  python3 benches/compare_calibration.py [--repeat 21] [--quick] [--robocal PATH]
 """
 import argparse
 import glob

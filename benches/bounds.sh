@@ -3,15 +3,15 @@
 # runs, with peak RSS (GNU time %M), on
 #  - blank and noise images of 4, 50 and 99 MP (the native pixel limit is 100
 #    MP) for every target kind;
-#  - progressive JPEGs with 5,000 and 50,000 scans (bench/progressive_jpeg.py,
-#    needs bench/.venv: created on first use);
+#  - progressive JPEGs with 5,000 and 50,000 scans (benches/progressive_jpeg.py,
+#    needs benches/.venv: created on first use);
 #  - hostile and awkward image files (issue 37): a 4 MB PNG whose iCCP
 #    profile inflates to 3.9 GiB, a 10000x10000 16-bit RGBA PNG (alone and
 #    four at once on 4 threads), 3 GB of zeros named .png, /dev/zero, a FIFO
 #    with no writer, a JPEG cut at 10 %;
 #  - camera calibrations of 100 to 10,000 views (detections JSON of a 9x6
 #    board, random poses), and the refusal above calib::json_api::MAX_VIEWS.
-# Usage: bench/bounds.sh [CLI] (default target/release/robocal). Prints
+# Usage: benches/bounds.sh [CLI] (default target/release/robocal). Prints
 # markdown tables. Not a test: the machine is shared and noisy.
 set -euo pipefail
 CLI=$(realpath "${1:-target/release/robocal}")
