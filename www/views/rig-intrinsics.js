@@ -6,7 +6,7 @@
 // calibration the joint fit's drift warning compares with). A held camera
 // goes into the rig input as `cameras[i].camera`: the joint fit keeps it
 // exactly.
-import { h, message, num, readTextFile } from '../lib/dom.js';
+import { h, message, num, readTextFile, download } from '../lib/dom.js';
 
 export const CHOICES = [
   ['solve', 'solve with the rig'],
@@ -56,13 +56,15 @@ export function intrinsicsControl(c, k, engine, changed) {
     }
     changed();
   });
-  return h('label', {}, 'intrinsics ', select, file, status);
+  // Its own calibration as a file: what `robocal rig --camera-file NAME=FILE` takes.
+  const save = c.solo ? h('button', { type: 'button', id: `rig-solo-save-${k}`, onclick: () => download(`${c.name}_calibration.json`, `${JSON.stringify(c.solo, null, 2)}\n`, 'application/json') }, 'Save its own calibration') : null;
+  return h('span', { class: 'rig-intrinsics' }, h('label', {}, 'intrinsics ', select), file, status, save);
 }
 
 function statusText(c) {
   switch (c.intrinsics || 'solve') {
     case 'file': return c.cameraFile ? `held from ${c.cameraFile.name} (${c.cameraFile.format}): ${summary(c.cameraFile.camera)}` : 'choose a camera file';
-    case 'solo': return c.solo ? `held from its own calibration: ${summary(c.solo)}` : 'its own calibration is made when the rig is solved';
+    case 'solo': return c.solo ? `held from its own calibration: ${summary(c.solo.camera)}` : 'its own calibration is made when the rig is solved';
     default: return '';
   }
 }
@@ -71,7 +73,7 @@ function statusText(c) {
  * The camera to hold for camera `c` of the rig input `cam` (its views),
  * or null to solve it: a camera file's camera, or the camera calibrated
  * from its own views alone (`calibrate_camera` with the rig's `model` and
- * `options`, kept in `c.solo`). Errors name the camera.
+ * `options`; its report is kept in `c.solo`). Errors name the camera.
  */
 export async function heldCamera(c, cam, model, options, engine) {
   switch (c.intrinsics || 'solve') {
@@ -86,8 +88,8 @@ export async function heldCamera(c, cam, model, options, engine) {
       } catch (err) {
         throw new Error(`camera ${c.name}: its own calibration: ${err.message}`);
       }
-      c.solo = (out.report || out).camera;
-      return c.solo;
+      c.solo = out.report || out;
+      return c.solo.camera;
     }
     default:
       return null;

@@ -84,6 +84,7 @@ export class RigView {
       h('label', { for: 'rig-group-by' }, 'Frames from file names'), groupSelect, pattern);
     this.progress = h('p', { id: 'rig-progress', class: 'hint', 'aria-live': 'polite' });
     this.out = h('div', { id: 'rig-results', 'aria-live': 'polite' });
+    this.robotOut = h('div', { id: 'rig-robot-part' });
     fill(this.panel,
       h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. Choose another rule when the last number is not the frame\'s: the first number (sync036_cam0.jpg), order, or a pattern: plain text with one (\\d+), such as sync(\\d+) for sync036_cam0.jpg with cam1_sync36.png. The rig frame is the first camera\'s.'),
       this.camerasOut,
@@ -94,7 +95,7 @@ export class RigView {
         h('p', { class: 'hint' }, 'As in step 3. Kalibr\'s radtan model is k1 k2 p1 p2: choose Brown-Conrady with 2 radial terms to export the rig to Kalibr.'),
         form),
       h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'rig-clear', onclick: () => this.clear() }, 'Remove the rig images')),
-      this.progress, this.framesOut, this.out);
+      this.progress, this.framesOut, this.out, this.robotOut);
     this.showCameras();
     this.showFrames();
     if (st.result) this.show(st.result);
@@ -153,6 +154,7 @@ export class RigView {
     this.state.result = null;
     this.store.changed('rig');
     fill(this.out);
+    fill(this.robotOut);
     this.showCameras();
     this.showFrames();
   }
@@ -286,6 +288,7 @@ export class RigView {
       this.progress.textContent = '';
       this.state.result = null; // the error replaces an earlier result, in the session too
       this.store.changed('rig-result');
+      fill(this.robotOut);
       fill(this.out, h('p', { id: 'rig-error', class: 'msg msg-error', role: 'alert' }, err.message));
     } finally {
       this.solveButton.disabled = false;
@@ -326,8 +329,8 @@ export class RigView {
       h('h3', {}, 'The rig in 3-D'),
       this.canvas,
       h('h3', {}, 'Export'),
-      this.exportsOut,
-      this.robot.render(r));
+      this.exportsOut);
+    fill(this.robotOut, this.robot.render(r));
     await this.draw3d(r);
     await this.showExports(r);
   }
