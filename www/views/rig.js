@@ -86,7 +86,7 @@ export class RigView {
     this.out = h('div', { id: 'rig-results', 'aria-live': 'polite' });
     this.robotOut = h('div', { id: 'rig-robot-part' });
     fill(this.panel,
-      h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. Choose another rule when the last number is not the frame\'s: the first number (sync036_cam0.jpg), order, or a pattern: plain text with one (\\d+), such as sync(\\d+) for sync036_cam0.jpg with cam1_sync36.png. The rig frame is the first camera\'s.'),
+      h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. Choose another rule when the last number is not the frame\'s: the first number (sync036_cam0.jpg), order, or a pattern: plain text with one (\\d+), such as sync(\\d+) for sync036_cam0.jpg with cam1_sync36.png. The rig frame is the first camera\'s. Each camera\'s intrinsics are solved with the rig, or held: from a camera file (robocal JSON, OpenCV YAML/XML, ROS camera_info; robocal rig --camera-file NAME=FILE) or from its own calibration (its images alone), the fix when the joint fit drags a camera\'s intrinsics away from what its own images say. Once solved, the rig can be put on a robot: a robot pose file, one pose per frame, gives gripper_from_rig or base_from_rig (robocal rig --setup … --poses FILE).'),
       this.camerasOut,
       h('div', { class: 'row' }, h('button', { type: 'button', id: 'rig-add', onclick: () => this.addCamera() }, 'Add a camera')),
       grouping,
@@ -227,7 +227,8 @@ export class RigView {
    * frame), without held intrinsics; `spec` defaults to the target of step 1.
    */
   rigInput(spec = targetSpec(this.store.session.target)) {
-    const { keys, grouped_by: groupedBy } = this.grouping;
+    const { keys, grouped_by: groupedBy, error } = this.grouping;
+    if (error || keys.length !== this.state.cameras.length) throw new Error(error || 'the images are not grouped into frames yet: wait for the frame table');
     return {
       model: this.state.model,
       options: jsonOptions(this.state),
