@@ -343,6 +343,8 @@ export const tests = [
       assert.deepEqual(rows[1], ['std T (mm)', ...he.pose_refinement.camera_transform_std.translation_mm.map((v) => v.toFixed(3))]);
       assert.deepEqual(await page.$$eval('#rig-robot-results .msg-warning', (ps) => ps.map((p) => p.textContent)), he.warnings);
       assert.equal(await page.locator('#rig-robot-cameras tbody tr').count(), names.length);
+      assert.equal(he.rig_uncertainty.included, true);
+      assert.ok((await page.textContent('#rig-robot-uncertainty')).slice(1).startsWith(he.rig_uncertainty.note.slice(1)), he.rig_uncertainty.note);
       // An export of the rig with its hand-eye, as robocal export gives it.
       const [urdf] = await Promise.all([page.waitForEvent('download'), page.click('#rig-robot-export-urdf')]);
       writeFileSync(join(dir, 'rig_robot.json'), JSON.stringify(report));
@@ -391,7 +393,7 @@ export const tests = [
       assert.match(await page.textContent(`#rig-drift-hint-${k}`), new RegExp(`set camera ${k + 1} \\(${name}\\)'s intrinsics to "hold from its own calibration"`));
       await shot('drift');
       // Held from its own calibration (the warning's button): solved again.
-      await page.$eval('#rig-results', (el) => el.replaceChildren());
+      await page.$eval('#rig-summary', (el) => { el.id = 'rig-summary-before'; });
       await page.click(`#rig-hold-solo-${k}`);
       await page.locator('#rig-summary').waitFor({ timeout: 600000 });
       assert.equal(await page.inputValue(`#rig-intrinsics-${k}`), 'solo');

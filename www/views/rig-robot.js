@@ -184,7 +184,7 @@ export class RigRobot {
         ['rotation vector (deg)', ...rv.map((v) => num(v, 4))],
         ['std rotation (deg)', ...(std ? std.rotation_deg.map((v) => num(v, 4)) : dash)],
       ], { id: 'rig-robot-transform' }),
-      h('p', { id: 'rig-robot-uncertainty', class: 'hint' }, unc.included ? `The std include the rig's own uncertainty (${unc.note}).` : `The std are conditional on the rig: ${unc.note}`),
+      h('p', { id: 'rig-robot-uncertainty', class: 'hint' }, `${unc.note.charAt(0).toUpperCase()}${unc.note.slice(1)}${/\.$/.test(unc.note) ? '' : '.'}`),
       table(['camera', `${camKey} T x (mm)`, 'T y (mm)', 'T z (mm)'], he.cameras.map((c) => [c.name, ...c[camKey].translation_m.map((v) => num(v * 1000, 3))]), { id: 'rig-robot-cameras' }),
       table(['frame', 'cameras', 'used'], he.frames.map((f) => [f.key, f.cameras.join(', '), f.used ? 'used' : `not used${f.reason ? `: ${f.reason}` : ''}`]), { id: 'rig-robot-frames', class: 'scroll' }),
       (he.warnings || []).map((w) => message('warning', w)),
