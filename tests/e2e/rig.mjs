@@ -354,6 +354,15 @@ export const tests = [
       const numbers = (t) => t.match(/-?\d+\.\d+(e-?\d+)?/g).map(Number);
       assert.equal(pageUrdf.replace(/-?\d+\.\d+(e-?\d+)?/g, '#'), cliUrdf.replace(/-?\d+\.\d+(e-?\d+)?/g, '#'));
       numbers(pageUrdf).forEach((x, i) => assert.ok(Math.abs(x - numbers(cliUrdf)[i]) <= 1e-12, `urdf number ${i}: page ${x}, CLI ${numbers(cliUrdf)[i]}`));
+      // Kept in the session: after a reload the part shows the same result.
+      const summary = await page.textContent('#rig-robot-summary');
+      await page.waitForTimeout(500); // the store saves 300 ms after the last change
+      await page.reload();
+      await ready(page);
+      await page.locator('#rig-robot-summary').waitFor({ timeout: 30000 });
+      assert.equal(await page.textContent('#rig-robot-summary'), summary);
+      assert.equal(await page.inputValue('#rig-robot-setup'), 'eye-in-hand');
+      assert.equal(await page.isDisabled('#rig-robot-solve'), false);
       // A pose file that misses a frame: named, no solve.
       writeFileSync(robotCsv, csv.split('\n').filter((l, i) => i !== 2).join('\n'));
       await page.setInputFiles('#rig-robot-input', robotCsv);
