@@ -736,7 +736,6 @@ export type RigHandEyeReport = Omit<HandEyeReportBase, 'methods'> & {
   | { setup: 'eye-to-hand'; base_from_rig: PoseReport; gripper_from_target: PoseReport }
 );
 
-/** The output of `robocal rig --setup` (a camera rig on a robot): the rig report with `handeye`. */
 /** The input JSON of `calibrate_rig_handeye`: a camera rig on a robot. */
 export interface RigHandEyeInput {
   /** `eye-in-hand` (the rig on the gripper) or `eye-to-hand` (the rig fixed, the target on the gripper). */
@@ -751,6 +750,7 @@ export interface RigHandEyeInput {
   lenient?: boolean;
 }
 
+/** The output of `robocal rig --setup` (a camera rig on a robot): the rig report with `handeye`. */
 export interface RigOnRobotReport extends RigCalibration {
   handeye: RigHandEyeReport;
 }
@@ -1568,6 +1568,14 @@ export interface RobocalJson {
   pair_images: [string[], ImagePairing];
   /** `rig_frame_keys(JSON.stringify(cameras), groupBy)` (groupBy `'number'` or `'last'` (the last number in the name), `'first'`, `'order'`, a pattern with one `(\\d+)` such as `'sync(\\d+)'`, or `''`: by number unless no name has one) -> each image's frame key, as `robocal rig --group-by` groups them. */
   rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
+  /** `read_camera_file(text)` -> the camera of a robocal JSON (camera export or calibration report), OpenCV YAML/XML or ROS camera_info file, as `robocal rig --camera-file` reads it. */
+  read_camera_file: [never, CameraFileReading];
+}
+
+/** What `read_camera_file` returns: the camera (what a rig input's `cameras[i].camera` takes to hold its intrinsics) and the format it was read as. */
+export interface CameraFileReading {
+  camera: Camera;
+  format: 'json' | 'opencv-yaml' | 'opencv-xml' | 'ros-yaml';
 }
 
 /** One camera's image names, the input of `rig_frame_keys`. */

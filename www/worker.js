@@ -136,6 +136,18 @@ handlers.rig = async ({ input }) => {
   return JSON.parse(robocal.calibrate_rig(input));
 };
 
+/** The rig on a robot: `robocal rig ... --setup SETUP --poses FILE`. */
+handlers.rigHandeye = async ({ input }) => {
+  await ready;
+  return JSON.parse(robocal.calibrate_rig_handeye(input));
+};
+
+/** A camera file (robocal JSON, OpenCV YAML/XML, ROS camera_info): `{camera, format}`. */
+handlers.cameraFile = async ({ text }) => {
+  await ready;
+  return JSON.parse(robocal.read_camera_file(text));
+};
+
 handlers.rigFormats = async () => {
   await ready;
   return JSON.parse(robocal.rig_export_formats());

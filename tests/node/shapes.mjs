@@ -172,6 +172,15 @@ const report = all.report;
   const image = robocal.undistort_preview(png(meta.images[0]), JSON.stringify(input('undistort_preview', report.camera)), 200);
   if (image.width !== 200 || image.data.length !== 4 * image.width * image.height) throw new Error(`undistort_preview: ${image.width}x${image.height}`);
 }
+// Camera files (robocal rig --camera-file): a calibration report, and its OpenCV YAML export.
+{
+  const fromReport = output('read_camera_file', JSON.parse(robocal.read_camera_file(JSON.stringify(report))), 'read_camera_file report');
+  assert.equal(fromReport.format, 'json');
+  assert.deepEqual(fromReport.camera, report.camera);
+  const yaml = output('read_camera_file', JSON.parse(robocal.read_camera_file(robocal.export_report(JSON.stringify(report), 'opencv-yaml', ''))), 'read_camera_file opencv-yaml');
+  assert.equal(yaml.format, 'opencv-yaml');
+  assert.throws(() => robocal.read_camera_file('hello'), { message: /not a camera file: expected robocal JSON, OpenCV YAML\/XML/ });
+}
 
 const poses = JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', {}))));
 output('read_robot_poses', poses);
