@@ -24,7 +24,7 @@ use crate::geometry::{rotvec_from_rotation, Pose};
 use crate::optim::{solve, BlockParams, LmOptions, LmResult};
 
 /// Most groups of frames left out (one refit each).
-pub const MAX_GROUPS: usize = 30;
+pub const MAX_GROUPS: usize = 20;
 /// Fewest groups for a spread worth reporting.
 pub const MIN_GROUPS: usize = 6;
 /// Solver steps per refit, from the full solution.
