@@ -43,6 +43,7 @@ pub mod handeye;
 pub mod image;
 pub mod io;
 pub mod optim;
+pub mod rng;
 pub mod synth;
 pub mod target;
 pub mod workflows;

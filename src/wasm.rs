@@ -530,7 +530,7 @@ pub fn undistort_preview(
         .map_err(|e| JsError::new(&format!("camera JSON: {e}")))?;
     let image = decode_gray(bytes, options_json)?;
     let preview = camera.pinhole_preview(max_side).map_err(js_error)?;
-    let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
+    let out = crate::image::undistort_image(&image, &camera, &preview).map_err(js_error)?;
     let rgba: Vec<u8> = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();
     image_data(&rgba, out.width, out.height)
 }

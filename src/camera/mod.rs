@@ -25,7 +25,7 @@ mod undistort;
 mod tests;
 
 pub use distortion::Distortion;
-pub use undistort::{remap_gray, undistort_image, UndistortMap};
+pub use undistort::UndistortMap;
 
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, Matrix2, Matrix2x3, Matrix3, Point2, Point3, Vector2, Vector3};
