@@ -1,5 +1,6 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
-//! and demo.rs, live_capture.rs, rig_frames.rs and targets.rs beside it).
+//! and demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs and targets.rs
+//! beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
 //! errors as `JsError` whose message is the library's error text. Pixels
@@ -14,10 +15,12 @@
 //! JS side can show it ([`last_panic_message`]) instead of a dead worker.
 
 mod demo;
+mod lens_models;
 mod live_capture;
 mod rig_frames;
 mod targets;
 pub use demo::{render_demo, DemoData};
+pub use lens_models::lens_models;
 pub use live_capture::LiveCapture;
 pub use rig_frames::rig_frame_keys;
 use targets::{detect_options_from, target_from};
