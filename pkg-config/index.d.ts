@@ -300,6 +300,27 @@ export interface DistortionModels {
 
 /** A lens model name (`model` of the calibration inputs and reports). */
 export type LensModel = keyof DistortionModels;
+/** A camera export format that holds a lens model, with the condition on its coefficients when there is one, e.g. `kalibr (with k3 held at 0)`. */
+export type LensExportFormat = CameraExportFormat | `${CameraExportFormat} (${string})`;
+/** One row of the core's lens-model table (src/camera/models.rs), as `lens_models()` lists it. */
+export interface LensModelInfo {
+  /** The `model` of the JSON and `--model`. */
+  name: LensModel;
+  /** Other names accepted for the model (`brown5` for `brown`), each with what it means. */
+  aliases: { name: string; means: string }[];
+  /** The short name the model advice writes ("Brown-Conrady"). */
+  label: string;
+  /** The text of the page's lens list: the label with the coefficients and the tools that know the model. */
+  description: string;
+  /** Coefficient names, in the order of the camera's parameter vector. */
+  coefficients: string[];
+  /** Where the solvers start each coefficient (same order). */
+  start_values: number[];
+  /** The camera export formats that hold the model (`json` always first). */
+  export_formats: LensExportFormat[];
+  /** A model for lenses past 90 degrees (always compared for a wide-angle lens). */
+  wide_angle: boolean;
+}
 /** A lens model with its coefficients: `{"model": "brown", "k1": -0.2, ...}`. */
 export type Distortion = { [M in LensModel]: { model: M } & DistortionModels[M] }[LensModel];
 
@@ -1534,6 +1555,8 @@ export interface RobocalJson {
   export_report: [ExportableReport, never];
   /** `export_formats()` -> the format names. */
   export_formats: [never, ExportFormatListEntry[]];
+  /** `lens_models()` -> the lens-model table, in menu order (the default, `brown`, first). */
+  lens_models: [never, LensModelInfo[]];
   /** `calibrate_rig(input)` -> the rig report. */
   calibrate_rig: [RigInput, RigCalibration];
   /** `calibrate_rig_handeye(input)` -> the rig report with `handeye` (a rig on a robot). */

@@ -1,6 +1,6 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
-//! and camera_file.rs, demo.rs, live_capture.rs, rig_frames.rs, rig_handeye.rs
-//! and targets.rs beside it).
+//! and camera_file.rs, demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs,
+//! rig_handeye.rs and targets.rs beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
 //! errors as `JsError` whose message is the library's error text. Pixels
@@ -16,12 +16,14 @@
 
 mod camera_file;
 mod demo;
+mod lens_models;
 mod live_capture;
 mod rig_frames;
 mod rig_handeye;
 mod targets;
 pub use camera_file::read_camera_file;
 pub use demo::{render_demo, DemoData};
+pub use lens_models::lens_models;
 pub use live_capture::LiveCapture;
 pub use rig_frames::rig_frame_keys;
 pub use rig_handeye::calibrate_rig_handeye;
@@ -523,7 +525,7 @@ pub fn undistort_preview(
         .map_err(|e| JsError::new(&format!("camera JSON: {e}")))?;
     let image = decode_gray(bytes, options_json)?;
     let preview = camera.pinhole_preview(max_side).map_err(js_error)?;
-    let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
+    let out = crate::image::undistort_image(&image, &camera, &preview).map_err(js_error)?;
     let rgba: Vec<u8> = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();
     image_data(&rgba, out.width, out.height)
 }

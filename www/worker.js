@@ -27,6 +27,11 @@ const handlers = {
   async version() {
     return { version: await ready };
   },
+  /** The core's lens-model table (camera::LENS_MODELS): the page's lens list. */
+  async lensModels() {
+    await ready;
+    return JSON.parse(robocal.lens_models());
+  },
   async preview({ bytes, maxSide, maxPixels }) {
     await ready;
     const p = robocal.decode_image_preview(new Uint8Array(bytes), maxSide, imageOptions(maxPixels));

@@ -286,7 +286,7 @@ fn camera_uses(camera: &robocal::Camera) {
         let (w, h) = (32u32, 24u32);
         let pixels = (0..w * h).map(|i| (i * 7 % 251) as u8).collect();
         if let Ok(image) = GrayImage::new(w, h, pixels) {
-            let _ = robocal::camera::undistort_image(&image, camera, &preview);
+            let _ = robocal::image::undistort_image(&image, camera, &preview);
         }
     }
 }

@@ -5,7 +5,8 @@ use super::{CalibrationOptions, View};
 use crate::camera::Camera;
 use crate::error::Error;
 use crate::geometry::{rotation_from_rotvec, Pose};
-use crate::synth::{Rng, Scene};
+use crate::rng::Rng;
+use crate::synth::Scene;
 use nalgebra::{Point2, Translation3, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
 

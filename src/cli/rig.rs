@@ -106,9 +106,7 @@ pub struct RigArgs {
     /// each camera's list), or a pattern with one (\d+) such as 'sync(\d+)'
     #[arg(long, value_name = "RULE", overrides_with = "group_by")]
     group_by: Option<String>,
-    /// Lens model of the solved cameras: brown (default), radial_k1_k2_k5,
-    /// rational, division, kannala_brandt, eucm, none
-    #[arg(long, value_name = "NAME", overrides_with = "model")]
+    #[arg(long, value_name = "NAME", overrides_with = "model", help = robocal::camera::model_help("the solved cameras"))]
     model: Option<String>,
     /// Hold a distortion coefficient of every solved camera at 0
     /// (repeatable: --fix k3 gives Kalibr's radtan k1 k2 p1 p2)

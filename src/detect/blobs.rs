@@ -8,7 +8,7 @@
 //! step below, not from the threshold.
 
 use super::ellipse::{fit_ellipse, EllipseFit};
-use super::filter::Plane;
+use crate::image::filter::Plane;
 use crate::image::GrayImage;
 use nalgebra::{Matrix2, Point2, Vector2};
 

@@ -17,12 +17,12 @@
 //!    90 degrees: use a board with `cols + rows` odd (e.g. 9x6) for
 //!    multi-view work.
 
-use super::filter::{box_level, to_full, Plane};
 use super::lattice::{self, Cells, PointIndex};
 use super::refine::refine_saddle;
 use super::saddle::{self, Candidate};
 use super::DetectOptions;
 use crate::error::{Error, Result};
+use crate::image::filter::{box_level, to_full, Plane};
 use crate::image::GrayImage;
 use crate::target::DetectedPoint;
 use nalgebra::{Point2, Vector2};

@@ -104,7 +104,6 @@ mod centres;
 pub(crate) mod chessboard;
 mod circles;
 mod ellipse;
-pub(crate) mod filter;
 mod lattice;
 pub mod markers;
 pub mod polarity;
@@ -113,10 +112,10 @@ mod saddle;
 mod squares;
 
 use crate::error::{Error, Result};
+use crate::image::filter::Plane;
 use crate::image::GrayImage;
 pub use crate::target::CentreModel;
 use crate::target::{DetectedPoint, Detection, Polarity, Target};
-use filter::Plane;
 
 /// Smallest image side the detectors accept, pixels.
 pub const MIN_IMAGE_SIDE_PX: u32 = 16;
@@ -424,7 +423,7 @@ fn downsample_gray(img: &GrayImage) -> Plane {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     #[wasm_bindgen_test(unsupported = test)]

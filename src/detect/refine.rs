@@ -25,7 +25,7 @@
 //! per iteration and the patch is reduced row by row (three dot products
 //! per row). The normal matrix is a product of 1-D weight moments.
 
-use super::filter::gaussian_radius;
+use crate::image::filter::gaussian_radius;
 use crate::image::GrayImage;
 use nalgebra::{Matrix2, Matrix6, Point2, Vector2, Vector6};
 

@@ -344,7 +344,7 @@ mod tests {
     use super::super::Setup;
     use super::*;
     use crate::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     /// [`NoiseModel::update`] as it was before the per-view terms were

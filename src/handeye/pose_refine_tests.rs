@@ -11,7 +11,7 @@ use super::report::pose_difference;
 use super::solve::{calibrate, HandEyeInput, HandEyeOptions};
 use super::{Pose, Setup};
 use crate::synth::handeye_looking::{looking_scene, perturbed, LookingConfig, LookingScene};
-use crate::synth::Rng;
+use crate::rng::Rng;
 use nalgebra::{SMatrix, Translation3, UnitQuaternion, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
 

@@ -7,7 +7,7 @@ use crate::camera::Camera;
 use crate::geometry::PoseJson;
 use crate::handeye::Setup;
 use crate::synth::handeye_looking::{grid_pixels, looking_scene, LookingConfig};
-use crate::synth::Rng;
+use crate::rng::Rng;
 use serde_json::{json, Value};
 use wasm_bindgen_test::wasm_bindgen_test;
 

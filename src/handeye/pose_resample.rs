@@ -203,7 +203,7 @@ mod tests {
     use super::super::report::pose_difference;
     use super::*;
     use crate::synth::handeye_looking::{kinematic_error, looking_scene, perturbed, LookingConfig};
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     /// 20 views at 0.5 m, robot noise 0.1 mm / 0.02 deg, camera noise

@@ -12,7 +12,7 @@ use super::solve::{calibrate, HandEyeInput, HandEyeOptions};
 use super::{MotionPairs, Pose, Setup};
 use crate::camera::Camera;
 use crate::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
-use crate::synth::Rng;
+use crate::rng::Rng;
 use serde::Deserialize;
 use wasm_bindgen_test::wasm_bindgen_test;
 

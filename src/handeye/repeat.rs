@@ -6,7 +6,7 @@ use super::report::{errors, pose_difference, view_residuals, Errors};
 use super::solve::{solve_method, HandEyeOptions};
 use super::{Chain, HandEyeMethod, Pose};
 use crate::error::Result;
-use crate::synth::Rng;
+use crate::rng::Rng;
 use serde::{Deserialize, Serialize};
 
 /// Median and inter-quartile range of one quantity.

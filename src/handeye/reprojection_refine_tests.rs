@@ -7,7 +7,7 @@ use super::solve::solve_method;
 use super::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
 use crate::camera::Camera;
 use crate::synth::handeye::{project_grid, HandEyeScene};
-use crate::synth::Rng;
+use crate::rng::Rng;
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
 

@@ -224,6 +224,14 @@ const ranked = call('rank_pose_conventions', {
 assert.equal(ranked.scores[0].name, 'ur');
 
 const formats = output('export_formats', JSON.parse(robocal.export_formats()));
+// The lens-model table: its rows are LensModelInfo, and its names are
+// exactly the models the types declare (DistortionModels' keys), so a model
+// added to the core without its types (or the other way) fails here.
+const lensModels = output('lens_models', JSON.parse(robocal.lens_models()));
+const declaredModels = checker.getPropertiesOfType(declared('DistortionModels')).map((p) => p.name).sort();
+assert.deepEqual(lensModels.map((m) => m.name).sort(), declaredModels, 'lens_models() and index.d.ts DistortionModels list the same models');
+assert.equal(lensModels[0].name, 'brown', 'the default model first');
+for (const m of lensModels) assert.equal(m.coefficients.length, m.start_values.length, `${m.name}: a start value per coefficient`);
 assert.ok(formats.includes('urdf') && formats.includes('opencv-yaml'));
 for (const r of [report, eyeInHand, eyeToHand]) input('export_report', r);
 assert.match(robocal.export_report(JSON.stringify(eyeInHand), 'euler-intrinsic-zyx-deg', 'gripper_from_camera'), /gripper/);

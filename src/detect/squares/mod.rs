@@ -61,9 +61,9 @@
 
 use super::blobs::{bilinear_line, bilinear_u8, find_blobs, Blob};
 use super::circles::{blob_working_level, blobs_at_level, search_grid, GridSearch};
-use super::filter::{box_level, to_full};
 use super::DetectOptions;
 use crate::error::{Error, Result};
+use crate::image::filter::{box_level, to_full};
 use crate::image::GrayImage;
 use crate::target::DetectedPoint;
 use nalgebra::{Matrix2, Matrix3, Point2, Vector2, Vector3};

@@ -1,7 +1,8 @@
 //! Float image planes, separable Gaussian smoothing, 2x pyramid reduction and
-//! bilinear sampling: the low-level pixel work shared by the detectors.
+//! bilinear sampling: the low-level pixel work shared by the detectors and
+//! the renderer.
 
-use crate::image::GrayImage;
+use super::GrayImage;
 
 /// A single-channel f32 image, row-major.
 #[derive(Debug, Clone)]

@@ -1,7 +1,8 @@
 //! A small seeded random generator (SplitMix64), identical on every target.
 //!
-//! Not cryptographic; used only to make synthetic scenes and noise
-//! reproducible from a seed.
+//! Not cryptographic: it makes synthetic scenes and noise reproducible from
+//! a seed ([`crate::synth`]) and draws the hand-eye bootstrap's resamples
+//! (`handeye::repeat`), so a report is the same on every run and target.
 
 /// SplitMix64 generator with uniform and Gaussian draws.
 #[derive(Debug, Clone)]
