@@ -26,6 +26,7 @@ pub mod json_api;
 mod json_api_tests;
 pub mod model_advice;
 pub mod plausibility;
+pub mod pnp;
 mod refine;
 mod rejected;
 mod report;

@@ -6,11 +6,11 @@ use super::handeye_images::{
 };
 use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
-use robocal::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::output::HandEyeReport;
-use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
-use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
+use robocal::handeye::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
+use robocal::handeye::refine::over_pixels::{apply_refinement, RefineMode};
+use robocal::handeye::refine::over_poses::apply_pose_refinement_from_views;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 

@@ -7,13 +7,13 @@
 use super::detect::{run_all, Outcome};
 pub(super) use super::robot_poses::RobotPoses;
 use super::CliError;
+use robocal::calib::pnp::camera_from_target;
 use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
-use robocal::handeye::checks::{rank_pose_candidates, recommend_candidate};
 use robocal::handeye::output::PairAudit;
-use robocal::handeye::pairing::better_rule;
-use robocal::handeye::pnp::camera_from_target;
-use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::quality::checks::{rank_pose_candidates, recommend_candidate};
+use robocal::handeye::quality::pairing::better_rule;
+use robocal::handeye::refine::pixel_problem::ViewPoints;
 use robocal::handeye::{Pose, Setup};
 use robocal::io::pose_pairing::{alternatives, numeric_order, pair_poses};
 use robocal::io::RobotPose;
@@ -262,7 +262,7 @@ pub(super) fn image_pairs(
 /// Prove the pairing against the camera motion: when another simple rule
 /// (numeric or lexicographic order, the order given) fits the rotation
 /// angles of the motions and the pairing made does not, say which
-/// (`robocal::handeye::pairing`).
+/// (`robocal::handeye::quality::pairing`).
 fn check_pairing(
     setup: Setup,
     robot: &[RobotPose],

@@ -5,7 +5,7 @@
 //! [pose...], "camera_from_target": [pose...], "method": "all" | NAME,
 //! "bootstrap_samples": 100, "seed": 1, "strict_checks": true, "refine_poses":
 //! true}` (`refine_poses`: the maximum-likelihood pose refinement of
-//! [`super::refine_poses`], on by default for pose input and for image
+//! [`super::refine::over_poses`], on by default for pose input and for image
 //! points under `refine` none, the default; unused by the other modes) where a pose
 //! is a [`PoseInput`]: `{"matrix_row_major": [[4 numbers] x 4]}`,
 //! `{"translation_m": [x, y, z], "quaternion_xyzw": [x, y, z, w]}` (metres)
@@ -22,19 +22,19 @@
 //! `"pixel_sigma_px"` (default 0.5), and `"camera_std"` (optional, `{"fx": std, ...}` in
 //! pixels; read from `camera` when that is a calibration report): with it, a
 //! joint refinement that moves an intrinsic by many standard deviations is
-//! warned about ([`super::intrinsics_move`]). With views, `camera_from_target` may be
-//! left out: it is then computed per view by [`super::pnp`]. Instead of
+//! warned about ([`super::quality::intrinsics_move`]). With views, `camera_from_target` may be
+//! left out: it is then computed per view by [`crate::calib::pnp`]. Instead of
 //! `"views"`, `"detections"` may give one detection JSON per pose (the
 //! [`crate::target::Detection`] format, as `detect_target` returns it): the
 //! board points then come from each detection's own target.
 
-use super::checks::{
+use super::output::HandEyeReport;
+use super::quality::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };
-use super::intrinsics_move::{std_from_json, warn_intrinsic_move};
-use super::output::HandEyeReport;
-use super::refine_closed_form::{apply_refinement, RefineMode};
-use super::reprojection_refine::ViewPoints;
+use super::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
+use super::refine::over_pixels::{apply_refinement, RefineMode};
+use super::refine::pixel_problem::ViewPoints;
 use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
 use super::{HandEyeMethod, Pose, Setup};
 use crate::camera::Camera;
@@ -352,7 +352,7 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                super::pnp::camera_from_target(camera, v)
+                crate::calib::pnp::camera_from_target(camera, v)
                     .map(|p| p.0)
                     .map_err(|e| Error::invalid(format!("views[{i}]"), e.to_string()))
             })
@@ -387,7 +387,7 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         // No refinement over pixels: the pose refinement, with each view's
         // PnP covariance from its image points.
         if mode == RefineMode::None && input.refine_poses.unwrap_or(true) {
-            super::refine_poses::apply_pose_refinement_from_views(
+            super::refine::over_poses::apply_pose_refinement_from_views(
                 &mut result,
                 &request,
                 views,

@@ -3,14 +3,14 @@
 //! target pose, `methods`, `errors`, `warnings`, plus per-view residuals,
 //! motion statistics and repeatability.
 
-use super::motion::MotionStats;
-use super::refine_closed_form::RefinementSummary;
-use super::refine_poses::PoseRefinementSummary;
-use super::repeat::Repeatability;
-use super::report::{Errors, MotionResidual, ViewResidual};
-use super::solve::HandEyeResult;
-use super::{Pose, Setup};
 use crate::geometry::PoseJson;
+use crate::handeye::closed_form::motion::MotionStats;
+use crate::handeye::quality::repeat::Repeatability;
+use crate::handeye::quality::residuals::{Errors, MotionResidual, ViewResidual};
+use crate::handeye::refine::over_pixels::RefinementSummary;
+use crate::handeye::refine::over_poses::PoseRefinementSummary;
+use crate::handeye::solve::HandEyeResult;
+use crate::handeye::{Pose, Setup};
 use serde::{Deserialize, Serialize};
 
 /// One robot pose and the image paired with it.

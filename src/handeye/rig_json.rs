@@ -25,9 +25,9 @@
 //! Output: the rig report (solved, or the one given) with `handeye`, the
 //! JSON `robocal rig --setup ... -o rig.json` writes.
 
-use super::reprojection_refine::ViewPoints;
+use super::refine::pixel_problem::ViewPoints;
+use super::rig::uncertainty::{held_rig, rig_sigma_points};
 use super::rig::{add_rig_uncertainty, calibrate_rig_handeye, rig_handeye_report};
-use super::rig_uncertainty::{held_rig, rig_sigma_points};
 use super::{HandEyeOptions, Pose, Setup};
 use crate::calib::rig::RigCameraViews;
 use crate::calib::rig_json::{calibrate_rig_input, rig_views, RigInput};

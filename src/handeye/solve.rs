@@ -1,17 +1,18 @@
 //! The orchestrator: checks, every requested solver, a primary result,
 //! residual reports and repeatability.
 
-use super::checks;
-use super::motion::{build_motions, motion_stats, MotionStats};
-use super::pose_noise::CameraNoise;
-use super::refine_poses::apply_pose_refinement_resampled;
-use super::repeat::{repeatability, Repeatability};
-use super::report::{
+use crate::error::{Error, Result};
+use crate::handeye::closed_form::motion::{build_motions, motion_stats, MotionStats};
+use crate::handeye::closed_form::{axxb, axzb, scara};
+use crate::handeye::quality::checks;
+use crate::handeye::quality::repeat::{repeatability, Repeatability};
+use crate::handeye::quality::residuals::{
     combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
     view_residuals, Errors, MotionResidual, ViewResidual,
 };
-use super::{axxb, axzb, scara, Chain, HandEyeMethod, Motion, MotionPairs, Pose, Setup};
-use crate::error::{Error, Result};
+use crate::handeye::refine::over_poses::apply_pose_refinement_resampled;
+use crate::handeye::refine::pose_noise::CameraNoise;
+use crate::handeye::{Chain, HandEyeMethod, Motion, MotionPairs, Pose, Setup};
 use nalgebra::Vector3;
 
 /// Default number of bootstrap resamples.
@@ -44,7 +45,7 @@ pub struct HandEyeOptions {
     /// Seed of the bootstrap resampling.
     pub seed: u64,
     /// Refine the closed forms by the maximum-likelihood pose refinement
-    /// ([`super::refine_poses`]; default true). The image path turns it off
+    /// ([`crate::handeye::refine::over_poses`]; default true). The image path turns it off
     /// and refines over image points instead.
     pub refine_poses: bool,
 }
@@ -77,7 +78,7 @@ pub struct MethodResult {
 }
 
 /// Everything a calibration produces (serialise with
-/// [`super::output::HandEyeReport::new`]).
+/// [`crate::handeye::output::HandEyeReport::new`]).
 #[derive(Debug, Clone)]
 pub struct HandEyeResult {
     /// The setup solved.
@@ -106,10 +107,10 @@ pub struct HandEyeResult {
     /// Everything the user should know.
     pub warnings: Vec<String>,
     /// The image-based refinement, when run
-    /// ([`super::refine_closed_form::apply_refinement`]).
-    pub refinement: Option<super::refine_closed_form::RefinementSummary>,
-    /// The pose refinement, when run ([`super::refine_poses`]).
-    pub pose_refinement: Option<super::refine_poses::PoseRefinementSummary>,
+    /// ([`crate::handeye::refine::over_pixels::apply_refinement`]).
+    pub refinement: Option<crate::handeye::refine::over_pixels::RefinementSummary>,
+    /// The pose refinement, when run ([`crate::handeye::refine::over_poses`]).
+    pub pose_refinement: Option<crate::handeye::refine::over_poses::PoseRefinementSummary>,
 }
 
 /// Solve one method on a chain; returns `(x, y, unobservable directions)`.
@@ -158,7 +159,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             "{} of {} motion pairs were discarded because they rotate less than {} deg",
             set.discarded,
             set.discarded + set.kept.len(),
-            super::MIN_MOTION_ROTATION_DEG
+            crate::handeye::MIN_MOTION_ROTATION_DEG
         ));
     }
     let distances: Vec<f64> = input
@@ -166,7 +167,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         .iter()
         .map(|p| p.translation.vector.norm())
         .collect();
-    warnings.extend(super::trust::geometry_warnings(
+    warnings.extend(crate::handeye::quality::trust::geometry_warnings(
         chain.len(),
         &motion,
         &distances,

@@ -188,7 +188,7 @@ pub fn project_grid(
     grid: (usize, usize, f64),
     pixel_sigma: f64,
     seed: u64,
-) -> Vec<crate::handeye::reprojection_refine::ViewPoints> {
+) -> Vec<crate::handeye::refine::pixel_problem::ViewPoints> {
     let mut rng = Rng::new(seed);
     let (cols, rows, spacing) = grid;
     let object: Vec<nalgebra::Point3<f64>> = (0..rows)
@@ -201,7 +201,7 @@ pub fn project_grid(
         .camera_from_target_true
         .iter()
         .map(|pose| {
-            let mut view = crate::handeye::reprojection_refine::ViewPoints {
+            let mut view = crate::handeye::refine::pixel_problem::ViewPoints {
                 object_points: Vec::new(),
                 image_points: Vec::new(),
             };

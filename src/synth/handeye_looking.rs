@@ -5,13 +5,13 @@
 //! follow from the chain `robot[i] * x * camera[i] = y`. Used by the pose
 //! refinement's tests and the Cramér-Rao benchmark (`examples/handeye_crb.rs`).
 //!
-//! Noise is applied the way [`crate::handeye::pose_residual`] models it:
+//! Noise is applied the way [`crate::handeye::refine::pose_residual`] models it:
 //! decoupled left perturbations, `R <- exp(w) R`, `t <- t + v`.
 
 use super::Rng;
 use crate::camera::Camera;
-use crate::handeye::pose_residual::perturb;
-use crate::handeye::reprojection_refine::ViewPoints;
+use crate::handeye::refine::pixel_problem::ViewPoints;
+use crate::handeye::refine::pose_residual::perturb;
 use crate::handeye::{Pose, Setup};
 use nalgebra::{Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 

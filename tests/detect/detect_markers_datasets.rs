@@ -114,9 +114,9 @@ fn moveit_charuco_image_is_detected() {
 #[test]
 fn moveit_charuco_board_pose_within_the_published_tolerance() {
     use nalgebra::{Point2, Point3, Rotation3, Vector3};
+    use robocal::calib::pnp::camera_from_target;
     use robocal::camera::{Camera, Distortion};
-    use robocal::handeye::pnp::camera_from_target;
-    use robocal::handeye::reprojection_refine::ViewPoints;
+    use robocal::handeye::refine::pixel_problem::ViewPoints;
     let Some(dir) = dataset("moveit-handeye-pose-samples") else {
         return;
     };

@@ -5,9 +5,9 @@
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use robocal::geometry::{rotvec_from_rotation, Pose};
-use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::refine::pixel_problem::ViewPoints;
+use robocal::handeye::rig::pnp::HeldRig;
 use robocal::handeye::rig::{calibrate_rig_handeye, rig_handeye_report, RigHandEyeResult};
-use robocal::handeye::rig_pnp::HeldRig;
 use robocal::handeye::{HandEyeOptions, Setup};
 use robocal::synth::rig::{rig_scene, robot_poses, RigScene, RigSceneConfig};
 

@@ -17,10 +17,10 @@ use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use robocal::calib::rig::{calibrate_rig, RigCameraViews, RigOptions};
 use robocal::calib::{calibrate, CalibrationOptions};
 use robocal::geometry::{rotvec_from_rotation, Pose};
-use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::refine::pixel_problem::ViewPoints;
+use robocal::handeye::rig::pnp::HeldRig;
+use robocal::handeye::rig::uncertainty::{held_rig, rig_sigma_points};
 use robocal::handeye::rig::{add_rig_uncertainty, calibrate_rig_handeye};
-use robocal::handeye::rig_pnp::HeldRig;
-use robocal::handeye::rig_uncertainty::{held_rig, rig_sigma_points};
 use robocal::handeye::{HandEyeOptions, Setup};
 use robocal::synth::rig::{rig_scene, robot_poses, RigScene, RigSceneConfig};
 
@@ -150,7 +150,7 @@ fn trial(seed: u64, setup: Setup) -> Trial {
         .as_ref()
         .expect("conditional std");
     let e = errors(&solved.result.x, &x);
-    let std_of = |s: &robocal::handeye::refine_poses::TransformStd| {
+    let std_of = |s: &robocal::handeye::refine::over_poses::TransformStd| {
         let r = s.rotation_deg;
         let t = s.translation_mm;
         [r[0], r[1], r[2], t[0], t[1], t[2]]
