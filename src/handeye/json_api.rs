@@ -10,7 +10,7 @@
 //! is a [`PoseInput`]: `{"matrix_row_major": [[4 numbers] x 4]}`,
 //! `{"translation_m": [x, y, z], "quaternion_xyzw": [x, y, z, w]}` (metres)
 //! or all three (a report's [`crate::geometry::PoseJson`]). Output: the
-//! [`super::output::HandEyeReport`] JSON.
+//! [`super::report::HandEyeReport`] JSON.
 //!
 //! Image points (optional): `"camera"` (a camera JSON: the robocal camera
 //! serde, a calibration report, or a string holding any format
@@ -28,13 +28,13 @@
 //! [`crate::target::Detection`] format, as `detect_target` returns it): the
 //! board points then come from each detection's own target.
 
-use super::output::HandEyeReport;
 use super::quality::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };
 use super::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use super::refine::over_pixels::{apply_refinement, RefineMode};
 use super::refine::pixel_problem::ViewPoints;
+use super::report::HandEyeReport;
 use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
 use super::{HandEyeMethod, Pose, Setup};
 use crate::camera::Camera;

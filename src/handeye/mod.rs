@@ -37,7 +37,7 @@
 //! the image path), and it alone writes the [`HandEyeResult`]: the refiners
 //! return what they found. [`quality`] measures the result (closure
 //! residuals, repeatability, whether the reported uncertainty can be
-//! trusted) and catches input mistakes; [`output`] is the JSON report.
+//! trusted) and catches input mistakes; [`report`] is the JSON report.
 //! [`rig`] solves a whole camera rig's transform (`gripper_from_rig`,
 //! `base_from_rig`) from every camera's views together. The camera pose of
 //! one view from its points (PnP) is [`crate::calib::pnp`].
@@ -45,9 +45,9 @@
 pub mod closed_form;
 pub mod json_api;
 pub mod math;
-pub mod output;
 pub mod quality;
 pub mod refine;
+pub mod report;
 pub mod rig;
 pub mod rig_json;
 pub mod solve;

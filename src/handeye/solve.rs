@@ -78,7 +78,7 @@ pub struct MethodResult {
 }
 
 /// Everything a calibration produces (serialise with
-/// [`crate::handeye::output::HandEyeReport::new`]).
+/// [`crate::handeye::report::HandEyeReport::new`]).
 #[derive(Debug, Clone)]
 pub struct HandEyeResult {
     /// The setup solved.

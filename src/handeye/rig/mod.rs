@@ -18,11 +18,11 @@ pub mod uncertainty;
 
 use crate::error::{Error, Result};
 use crate::geometry::{rotvec_from_rotation, PoseJson};
-use crate::handeye::output::HandEyeReport;
 use crate::handeye::refine::over_poses::{apply_pose_refinement, transform_std, TransformStd};
 use crate::handeye::refine::pixel_problem::ViewPoints;
 use crate::handeye::refine::pose_noise::CameraNoise;
 use crate::handeye::refine::pose_problem::Covariance12;
+use crate::handeye::report::HandEyeReport;
 use crate::handeye::rig::pnp::{rig_from_target, HeldRig};
 use crate::handeye::{calibrate, HandEyeInput, HandEyeOptions, HandEyeResult, Pose, Setup};
 use serde::{Deserialize, Serialize};
