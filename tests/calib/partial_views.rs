@@ -12,7 +12,7 @@
 use nalgebra::{Point2, Point3, Translation3, Vector3};
 use robocal::calib::json_api::calibrate_input;
 use robocal::calib::json_api::{CalibrationInput, JsonOptions, JsonView};
-use robocal::calib::stereo::calibrate_stereo;
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::{calibrate, CalibrationOptions, View};
 use robocal::geometry::{rotation_from_rotvec, Pose};
 use robocal::synth::handeye_looking::{grid_pixels, looking_scene, LookingConfig};

@@ -14,7 +14,7 @@
 //! BENCHMARKS.md.
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
-use robocal::calib::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
 use robocal::calib::{calibrate, CalibrationOptions};
 use robocal::geometry::{rotvec_from_rotation, Pose};
 use robocal::handeye::refine::pixel_problem::ViewPoints;

@@ -15,7 +15,7 @@
 //! `+-sqrt(l_i) v_i`, and `d_i = (x(+) - x(-)) / 2` gives `sum_i d_i d_i^T`.
 //! Exact for a linear map, it needs no derivative of the solvers.
 
-use crate::calib::rig_report::{RigCalibration, RigCovariance, POSE_PARAMETERS};
+use crate::calib::multi::rig_report::{RigCalibration, RigCovariance, POSE_PARAMETERS};
 use crate::error::{Error, Result};
 use crate::geometry::rotation_from_rotvec;
 use crate::handeye::rig::pnp::HeldRig;

@@ -1,33 +1,33 @@
 //! Camera-rig calibration (issue 22): N cameras that saw one board in
 //! synchronised frames, any camera missing the board in any frame.
 //!
-//! 1. Each camera alone: its views that fix a homography ([`super::usable`]),
+//! 1. Each camera alone: its views that fix a homography ([`crate::calib::usable`]),
 //!    then Zhang ([`calibrate`]), or, with intrinsics given, only the board
-//!    poses under the held camera ([`super::rig_init::held_camera`]).
-//! 2. The co-observation graph ([`super::rig_graph`]): an error naming the
+//!    poses under the held camera ([`crate::calib::multi::rig_init::held_camera`]).
+//! 2. The co-observation graph ([`crate::calib::multi::rig_graph`]): an error naming the
 //!    groups when it is not connected, else a maximum spanning tree from the
 //!    rig camera; each edge's child_from_parent is averaged over the shared
 //!    frames (rotations by the quaternion mean, as stereo's
 //!    [`initial_right_from_left`]) and chained into every camera_from_rig.
 //! 3. Each frame's rig_from_target from the camera that saw most of it.
-//! 4. One Levenberg-Marquardt ([`super::rig_problem`]) over every camera's
+//! 4. One Levenberg-Marquardt ([`crate::calib::multi::rig_problem`]) over every camera's
 //!    intrinsics (unless held), every camera_from_rig but the rig camera's
 //!    and every frame's board pose; the covariance gives each extrinsic's
 //!    standard deviation.
 //! 5. The report ([`RigCalibration`]).
 
-use super::refine::{block_from_pose, pose_from_block};
-use super::rig_graph::{co_observation_counts, spanning_tree};
-use super::rig_init::{camera_alone, Alone};
-use super::rig_problem::{RigProblem, Sighting};
-use super::rig_report::{
+use crate::calib::multi::rig_graph::{co_observation_counts, spanning_tree};
+use crate::calib::multi::rig_init::{camera_alone, Alone};
+use crate::calib::multi::rig_problem::{RigProblem, Sighting};
+use crate::calib::multi::rig_report::{
     CoObservation, RigCalibration, RigCamera, RigCovariance, RigFrame, RigParameter,
     POSE_PARAMETERS,
 };
-use super::same_images::{refuse_identical_views, refuse_zero_baseline};
-use super::stereo::{camera_report_with, initial_right_from_left, TransformStd};
-use super::zhang::lm_options;
-use super::{CalibrationOptions, View};
+use crate::calib::multi::same_images::{refuse_identical_views, refuse_zero_baseline};
+use crate::calib::multi::stereo::{camera_report_with, initial_right_from_left, TransformStd};
+use crate::calib::refine::{block_from_pose, pose_from_block};
+use crate::calib::zhang::lm_options;
+use crate::calib::{CalibrationOptions, View};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{Pose, PoseJson};

@@ -11,8 +11,8 @@
 //! each frame's board pose is `rig_from_target`, and camera k saw the board
 //! at `camera_from_rig[k] * rig_from_target`.
 
-use super::stereo::TransformStd;
-use super::CameraCalibration;
+use crate::calib::multi::stereo::TransformStd;
+use crate::calib::CameraCalibration;
 use crate::geometry::PoseJson;
 use crate::optim::Termination;
 use serde::{Deserialize, Serialize};

@@ -1,7 +1,7 @@
 //! Tests of stereo calibration on seeded synthetic two-camera scenes.
 
-use super::stereo::{calibrate_stereo, initial_right_from_left};
-use super::{CalibrationOptions, View};
+use crate::calib::multi::stereo::{calibrate_stereo, initial_right_from_left};
+use crate::calib::{CalibrationOptions, View};
 use crate::camera::Camera;
 use crate::error::Error;
 use crate::geometry::{rotation_from_rotvec, Pose};

@@ -4,7 +4,7 @@
 //! left camera's board pose `[rotation vector, translation_m]`; the right
 //! camera sees the board at `right_from_left * left_from_target`.
 
-use super::refine::{pose_from_block, CalibProblem};
+use crate::calib::refine::{pose_from_block, CalibProblem};
 use crate::error::Result;
 use crate::geometry::{rotation_from_rotvec, rotvec_from_rotation, Pose};
 use crate::optim::{BlockParams, BlockProblem, ResidualBlock};

@@ -4,14 +4,14 @@
 //! camera given and held gets only its board poses (homography pose, then
 //! the bundle adjustment with every camera parameter held).
 
-use super::closed_form::pose_from_homography;
-use super::homography::homography;
-use super::refine::{block_from_pose, CalibProblem};
-use super::rig::RigCameraViews;
-use super::stereo::{report_poses, used_masks};
-use super::usable::usable_views;
-use super::zhang::{held_aspect, lm_options};
-use super::{calibrate, CalibrationOptions, Outlier, View};
+use crate::calib::closed_form::pose_from_homography;
+use crate::calib::homography::homography;
+use crate::calib::multi::rig::RigCameraViews;
+use crate::calib::multi::stereo::{report_poses, used_masks};
+use crate::calib::refine::{block_from_pose, CalibProblem};
+use crate::calib::usable::usable_views;
+use crate::calib::zhang::{held_aspect, lm_options};
+use crate::calib::{calibrate, CalibrationOptions, Outlier, View};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{pose_from_params, Pose};

@@ -5,7 +5,7 @@
 //! uncertainty is refused too (the same scene detected twice with
 //! different noise).
 
-use super::View;
+use crate::calib::View;
 use crate::error::{Error, Result};
 
 /// A baseline is "zero within its uncertainty" below this many times the

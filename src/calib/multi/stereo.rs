@@ -7,14 +7,14 @@
 //! right_from_left jointly (the right camera sees the board at
 //! `right_from_left * left_from_target`).
 
-use super::model_advice::{advise, ModelAdvice};
-use super::refine::{block_from_pose, CalibProblem};
-use super::report::build_report;
-use super::same_images::{refuse_identical_views, refuse_zero_baseline};
-use super::stereo_problem::StereoProblem;
-use super::usable::{usable_views, LeftOut};
-use super::zhang::lm_options;
-use super::{calibrate, CalibrationOptions, CameraCalibration, View};
+use crate::calib::model_advice::{advise, ModelAdvice};
+use crate::calib::multi::same_images::{refuse_identical_views, refuse_zero_baseline};
+use crate::calib::multi::stereo_problem::StereoProblem;
+use crate::calib::refine::{block_from_pose, CalibProblem};
+use crate::calib::report::build_report;
+use crate::calib::usable::{usable_views, LeftOut};
+use crate::calib::zhang::lm_options;
+use crate::calib::{calibrate, CalibrationOptions, CameraCalibration, View};
 use crate::error::{Error, Result};
 use crate::geometry::{average_rotations_quaternion, Pose, PoseJson};
 use crate::optim::{solve, BlockParams, BlockProblem, LmOptions, Termination};
@@ -58,7 +58,7 @@ pub struct StereoCalibration {
     /// every pair was used and both models fit.
     #[serde(default)]
     pub warnings: Vec<String>,
-    /// The lens-model advice of each camera ([`super::model_advice::advise`]);
+    /// The lens-model advice of each camera ([`crate::calib::model_advice::advise`]);
     /// absent in reports written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model_advice: Option<PairModelAdvice>,
@@ -77,7 +77,7 @@ pub struct PairModelAdvice {
 /// `right[i]` saw the same board pose; their point sets may differ: each
 /// camera's residuals are over its own points, through the shared board
 /// pose, so no point needs to be seen by both). A pair with a side whose
-/// points cannot fix a homography ([`super::usable`]) is left out, with a
+/// points cannot fix a homography ([`crate::calib::usable`]) is left out, with a
 /// warning. `options` apply to both cameras; points a single-camera
 /// calibration rejected as outliers stay out of the joint refinement.
 pub fn calibrate_stereo(
@@ -151,7 +151,7 @@ pub fn calibrate_stereo(
         .params
         .blocks
         .iter()
-        .map(|b| block_from_pose(&(rfl * super::refine::pose_from_block(b))))
+        .map(|b| block_from_pose(&(rfl * crate::calib::refine::pose_from_block(b))))
         .collect();
     let left_report = camera_report(
         &problem.left,
@@ -235,7 +235,7 @@ fn usable_pairs(
             left_out.push(format!("pair {i} left out: {}", why.join("; ")));
         }
     }
-    let required = super::zhang::required_views(options);
+    let required = crate::calib::zhang::required_views(options);
     if kept_l.len() < required && !left_out.is_empty() {
         return Err(Error::invalid(
             "pairs",
@@ -282,7 +282,7 @@ pub fn initial_right_from_left(
 }
 
 fn aspect(camera: &crate::camera::Camera, options: &CalibrationOptions) -> Option<f64> {
-    super::zhang::held_aspect(camera, options)
+    crate::calib::zhang::held_aspect(camera, options)
 }
 
 /// The camera_from_target of every view of a report.
@@ -332,7 +332,7 @@ pub(crate) fn camera_report_with(
     problem: &CalibProblem,
     params: &[f64],
     blocks: &[Vec<f64>],
-    outliers: Vec<Vec<super::Outlier>>,
+    outliers: Vec<Vec<crate::calib::Outlier>>,
     size: (u32, u32),
     options: &CalibrationOptions,
     lm: LmOptions,

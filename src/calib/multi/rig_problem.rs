@@ -10,8 +10,8 @@
 //! come frame by frame (all cameras of one frame together), the order the
 //! solver's Schur accumulation likes.
 
-use super::refine::{pose_from_block, CalibProblem};
-use super::stereo_problem::{fold_aspect, retract_pose, skew};
+use crate::calib::multi::stereo_problem::{fold_aspect, retract_pose, skew};
+use crate::calib::refine::{pose_from_block, CalibProblem};
 use crate::camera::Camera;
 use crate::error::Result;
 use crate::geometry::Pose;
