@@ -17,9 +17,9 @@
 //! `cargo run --release --example handeye_coverage -- [TRIALS]` (default 100).
 
 use robocal::calib::pnp::camera_from_target_with_covariance;
+use robocal::calib::View;
 use robocal::camera::Camera;
 use robocal::handeye::refine::over_poses::apply_pose_refinement_from_views;
-use robocal::handeye::refine::pixel_problem::ViewPoints;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
 use robocal::synth::handeye_looking::{
     grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,
@@ -80,7 +80,7 @@ fn trial(cell: &Cell, seed: u64) -> Option<(bool, bool, bool, bool, bool)> {
         ..Default::default()
     };
     let mut result = calibrate(&input, &options).ok()?;
-    let views: Vec<ViewPoints> = pixels;
+    let views: Vec<View> = pixels;
     apply_pose_refinement_from_views(&mut result, &input, &views, &used_camera, MotionPairs::All)
         .ok()?;
     let summary = result.pose_refinement.as_ref()?;

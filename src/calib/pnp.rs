@@ -5,11 +5,11 @@
 //! Levenberg-Marquardt ([`crate::optim`]) minimises the reprojection error
 //! over the 6 pose parameters.
 
+use crate::calib::View;
 use crate::calib::{homography, homography_problem, pose_from_homography};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params, rotation_from_rotvec};
-use crate::handeye::refine::pixel_problem::ViewPoints;
 use crate::handeye::Pose;
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
 use nalgebra::{
@@ -22,24 +22,24 @@ const PLANAR_TOLERANCE: f64 = 1e-9;
 
 /// Pose of the target in the camera frame from one view (at least 4 points
 /// on the target plane z = 0), with the reprojection RMS (px).
-pub fn camera_from_target(camera: &Camera, view: &ViewPoints) -> Result<(Pose, f64)> {
-    let n = view.object_points.len();
-    if view.image_points.len() != n {
+pub fn camera_from_target(camera: &Camera, view: &View) -> Result<(Pose, f64)> {
+    let n = view.object_m.len();
+    if view.image_px.len() != n {
         return Err(Error::invalid(
             "image_px",
-            format!("{} object points but {} pixels", n, view.image_points.len()),
+            format!("{} object points but {} pixels", n, view.image_px.len()),
         ));
     }
     if n < 4 {
         return Err(Error::too_few("target points for a pose", 4, n));
     }
     let extent = view
-        .object_points
+        .object_m
         .iter()
         .map(|p| p.coords.xy().norm())
         .fold(0.0, f64::max);
     if view
-        .object_points
+        .object_m
         .iter()
         .any(|p| p.z.abs() > PLANAR_TOLERANCE * extent.max(1.0))
     {
@@ -48,14 +48,14 @@ pub fn camera_from_target(camera: &Camera, view: &ViewPoints) -> Result<(Pose, f
             "the pose initialisation needs a planar target (every point at z = 0)",
         ));
     }
-    let plane: Vec<Point2<f64>> = view.object_points.iter().map(|p| p.xy()).collect();
+    let plane: Vec<Point2<f64>> = view.object_m.iter().map(|p| p.xy()).collect();
     if let Some(reason) = homography_problem(&plane) {
         return Err(Error::degenerate(format!(
             "the view's board points cannot fix a pose: {reason}"
         )));
     }
     let normalized = view
-        .image_points
+        .image_px
         .iter()
         .map(|px| {
             let ray = camera.unproject(px)?;
@@ -91,7 +91,7 @@ pub fn camera_from_target(camera: &Camera, view: &ViewPoints) -> Result<(Pose, f
 /// refinement's [`crate::handeye::refine::pose_noise::CameraNoise::PerView`] takes.
 pub fn camera_from_target_with_covariance(
     camera: &Camera,
-    view: &ViewPoints,
+    view: &View,
 ) -> Result<(Pose, f64, Matrix6<f64>)> {
     let (pose, rms) = camera_from_target(camera, view)?;
     let problem = PoseProblem { camera, view };
@@ -161,7 +161,7 @@ pub(crate) fn right_step_block(
 
 struct PoseProblem<'a> {
     camera: &'a Camera,
-    view: &'a ViewPoints,
+    view: &'a View,
 }
 
 impl BlockProblem for PoseProblem<'_> {
@@ -172,8 +172,8 @@ impl BlockProblem for PoseProblem<'_> {
     ) -> Result<Vec<ResidualBlock>> {
         let pose = pose_from_params(&params.global);
         let r = pose.rotation.to_rotation_matrix().into_inner();
-        let mut out = Vec::with_capacity(self.view.object_points.len());
-        for (p, obs) in self.view.object_points.iter().zip(&self.view.image_points) {
+        let mut out = Vec::with_capacity(self.view.object_m.len());
+        for (p, obs) in self.view.object_m.iter().zip(&self.view.image_px) {
             let w = pose * p;
             let (pixel, d_pt, _) = self.camera.project_with_jacobians(&w)?;
             out.push(right_step_block(pixel - obs, &d_pt, &r, p, jacobians));
@@ -232,24 +232,18 @@ mod tests {
             .iter()
             .map(|p| camera.project(&(truth * p)).unwrap())
             .collect();
-        let view = ViewPoints {
-            object_points: object.clone(),
-            image_points: image,
-        };
+        let view = View::new("", object.clone(), image);
         let (pose, rms) = camera_from_target(&camera, &view).unwrap();
         assert!(rms < 1e-9, "rms {rms}");
         assert!((pose.translation.vector - truth.translation.vector).norm() < 1e-9);
         assert!(pose.rotation.angle_to(&truth.rotation) < 1e-9);
-        let few = ViewPoints {
-            object_points: object[..3].to_vec(),
-            image_points: view.image_points[..3].to_vec(),
-        };
+        let few = View::new("", object[..3].to_vec(), view.image_px[..3].to_vec());
         assert_eq!(
             camera_from_target(&camera, &few).unwrap_err().to_string(),
             "requires at least 4 target points for a pose, got 3"
         );
         let mut bent = view.clone();
-        bent.object_points[5].z = 0.01;
+        bent.object_m[5].z = 0.01;
         assert_eq!(
             camera_from_target(&camera, &bent).unwrap_err().to_string(),
             "object_m: the pose initialisation needs a planar target (every point at z = 0)"

@@ -8,11 +8,11 @@ use super::detect::{run_all, Outcome};
 pub(super) use super::robot_poses::RobotPoses;
 use super::CliError;
 use robocal::calib::pnp::camera_from_target;
+use robocal::calib::View;
 use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
 use robocal::handeye::quality::checks::{rank_pose_candidates, recommend_candidate};
 use robocal::handeye::quality::pairing::better_rule;
-use robocal::handeye::refine::pixel_problem::ViewPoints;
 use robocal::handeye::report::PairAudit;
 use robocal::handeye::{Pose, Setup};
 use robocal::io::pose_pairing::{alternatives, numeric_order, pair_poses};
@@ -26,7 +26,7 @@ pub(super) struct ImagePairs {
     /// Target poses fitted to the used images.
     pub camera_from_target: Vec<Pose>,
     /// Image points of the used images.
-    pub views: Vec<ViewPoints>,
+    pub views: Vec<View>,
     /// Every pose with its image and fate.
     pub pairs: Vec<PairAudit>,
     /// Warnings about pairing and pose-format choice.
@@ -153,15 +153,12 @@ pub(super) fn image_pairs(
     strict: bool,
 ) -> Result<ImagePairs, CliError> {
     let mut warnings = Vec::new();
-    let mut fitted: Vec<Result<(ViewPoints, Pose, f64), String>> = Vec::new();
+    let mut fitted: Vec<Result<(View, Pose, f64), String>> = Vec::new();
     for outcome in outcomes {
         fitted.push(match outcome {
             Outcome::Found(detection, _) => {
                 let (object, image) = detection.correspondences();
-                let view = ViewPoints {
-                    object_points: object,
-                    image_points: image,
-                };
+                let view = View::new("", object, image);
                 camera_from_target(camera, &view)
                     .map(|(pose, rms)| (view, pose, rms))
                     .map_err(|e| format!("target pose failed: {e}"))
@@ -267,7 +264,7 @@ fn check_pairing(
     setup: Setup,
     robot: &[RobotPose],
     images: &[String],
-    fitted: &[Result<(ViewPoints, Pose, f64), String>],
+    fitted: &[Result<(View, Pose, f64), String>],
     pairing: &PosePairs,
     used: &[(usize, usize)],
 ) -> Option<String> {

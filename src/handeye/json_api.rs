@@ -33,10 +33,10 @@ use super::quality::checks::{
 };
 use super::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use super::refine::over_pixels::{apply_refinement, RefineMode};
-use super::refine::pixel_problem::ViewPoints;
 use super::report::HandEyeReport;
 use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
 use super::{HandEyeMethod, Pose, Setup};
+use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::PoseInput;
@@ -118,7 +118,7 @@ pub fn camera_from_json(value: &serde_json::Value) -> Result<Camera> {
     }
 }
 
-fn to_views(list: &[ViewIn]) -> Result<Vec<ViewPoints>> {
+fn to_views(list: &[ViewIn]) -> Result<Vec<View>> {
     list.iter()
         .enumerate()
         .map(|(i, v)| {
@@ -132,23 +132,21 @@ fn to_views(list: &[ViewIn]) -> Result<Vec<ViewPoints>> {
                     ),
                 ));
             }
-            Ok(ViewPoints {
-                object_points: v.object_m.iter().map(|p| Point3::from(*p)).collect(),
-                image_points: v.image_px.iter().map(|p| Point2::from(*p)).collect(),
-            })
+            Ok(View::new(
+                "",
+                v.object_m.iter().map(|p| Point3::from(*p)).collect(),
+                v.image_px.iter().map(|p| Point2::from(*p)).collect(),
+            ))
         })
         .collect()
 }
 
 /// The board points and pixels of each detection, in id order.
-fn views_from_detections(list: &[Detection]) -> Vec<ViewPoints> {
+fn views_from_detections(list: &[Detection]) -> Vec<View> {
     list.iter()
         .map(|d| {
             let (object_points, image_points) = d.correspondences();
-            ViewPoints {
-                object_points,
-                image_points,
-            }
+            View::new("", object_points, image_points)
         })
         .collect()
 }
@@ -158,18 +156,15 @@ fn views_from_detections(list: &[Detection]) -> Vec<ViewPoints> {
 /// with their robot pose (and given camera pose), each with a warning.
 /// A view list whose length differs from the poses' is kept whole, for the
 /// solver to refuse with its own message.
-fn leave_out_degenerate(
-    views: Vec<ViewPoints>,
-    input: &mut InputJson,
-) -> (Vec<ViewPoints>, Vec<String>) {
+fn leave_out_degenerate(views: Vec<View>, input: &mut InputJson) -> (Vec<View>, Vec<String>) {
     if views.len() != input.base_from_gripper.len() {
         return (views, Vec::new());
     }
     let problems: Vec<Option<String>> = views
         .iter()
         .map(|v| {
-            let planar = v.object_points.iter().all(|p| p.z == 0.0);
-            let board: Vec<Point2<f64>> = v.object_points.iter().map(|p| p.xy()).collect();
+            let planar = v.object_m.iter().all(|p| p.z == 0.0);
+            let board: Vec<Point2<f64>> = v.object_m.iter().map(|p| p.xy()).collect();
             crate::calib::homography_problem(&board).filter(|_| planar)
         })
         .collect();

@@ -346,9 +346,9 @@ fn handeye_input(setup: &str, scene_setup: robocal::handeye::Setup, seed: u64) -
             kept_ids(&mut rng)
         };
         let points: Vec<Value> = v
-            .object_points
+            .object_m
             .iter()
-            .zip(&v.image_points)
+            .zip(&v.image_px)
             .filter(|(o, _)| ids.contains(&grid_id(o)))
             .map(|(o, px)| json!({"id": grid_id(o), "x_px": px.x, "y_px": px.y}))
             .collect();

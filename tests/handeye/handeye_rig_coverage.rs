@@ -15,9 +15,9 @@
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::View;
 use robocal::calib::{calibrate, CalibrationOptions};
 use robocal::geometry::{rotvec_from_rotation, Pose};
-use robocal::handeye::refine::pixel_problem::ViewPoints;
 use robocal::handeye::rig::pnp::HeldRig;
 use robocal::handeye::rig::uncertainty::{held_rig, rig_sigma_points};
 use robocal::handeye::rig::{add_rig_uncertainty, calibrate_rig_handeye};
@@ -43,17 +43,11 @@ fn truth(setup: Setup) -> (Pose, Pose) {
 }
 
 /// The views of the cameras in `keep`, grouped per frame.
-fn frames(scene: &RigScene, keep: &[usize]) -> Vec<Vec<(usize, ViewPoints)>> {
+fn frames(scene: &RigScene, keep: &[usize]) -> Vec<Vec<(usize, View)>> {
     let mut out = vec![Vec::new(); scene.frame_keys.len()];
     for (slot, &k) in keep.iter().enumerate() {
         for (f, v) in &scene.views[k] {
-            out[*f].push((
-                slot,
-                ViewPoints {
-                    object_points: v.object_m.clone(),
-                    image_points: v.image_px.clone(),
-                },
-            ));
+            out[*f].push((slot, v.clone()));
         }
     }
     out

@@ -142,8 +142,8 @@ mod tests {
             .iter()
             .map(|v| {
                 json!({
-                    "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                    "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
                 })
             })
             .collect();

@@ -5,13 +5,14 @@
 //! filled, and every closed form stays listed in `methods` with its own
 //! reprojection RMS.
 
+use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::handeye::closed_form::motion::build_motions;
 use crate::handeye::quality::residuals::{
     errors, motion_residuals, pose_difference, view_residuals,
 };
-use crate::handeye::refine::pixel_problem::{refine, RefineOptions, RobotNoise, ViewPoints};
+use crate::handeye::refine::pixel_problem::{refine, RefineOptions, RobotNoise};
 use crate::handeye::solve::{HandEyeInput, HandEyeResult};
 use crate::handeye::{Chain, MotionPairs, Pose};
 use serde::{Deserialize, Serialize};
@@ -109,7 +110,7 @@ pub struct RefinementSummary {
 /// `x^-1 * robot[i]^-1 * y`.
 pub fn reprojection_rms_px(
     chain: &Chain,
-    views: &[ViewPoints],
+    views: &[View],
     camera: &Camera,
     x: &Pose,
     y: &Pose,
@@ -125,7 +126,7 @@ pub fn reprojection_rms_px(
 /// gripper_from_target`), not through the view's own PnP pose.
 pub fn reprojection_rms_per_view_px(
     chain: &Chain,
-    views: &[ViewPoints],
+    views: &[View],
     camera: &Camera,
     x: &Pose,
     y: &Pose,
@@ -135,7 +136,7 @@ pub fn reprojection_rms_per_view_px(
     for (i, (view, robot)) in views.iter().zip(&chain.robot).enumerate() {
         let camera_from_target = x.inverse() * robot.inverse() * y;
         let (mut view_sum, mut view_count) = (0.0, 0usize);
-        for (p, obs) in view.object_points.iter().zip(&view.image_points) {
+        for (p, obs) in view.object_m.iter().zip(&view.image_px) {
             let q = camera_from_target * p;
             let projected = camera.project(&q).map_err(|e| {
                 let what = if q.z <= 0.0 {
@@ -177,7 +178,7 @@ pub fn reprojection_rms_per_view_px(
 pub fn apply_refinement(
     result: &mut HandEyeResult,
     input: &HandEyeInput,
-    views: &[ViewPoints],
+    views: &[View],
     camera: &Camera,
     mode: RefineMode,
     motion_pairs: MotionPairs,
@@ -289,8 +290,8 @@ mod tests {
                 "base_from_gripper": scene.base_from_gripper.iter().map(pose_json).collect::<Vec<_>>(),
                 "camera": camera(),
                 "views": views.iter().map(|v| serde_json::json!({
-                    "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                    "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
                 })).collect::<Vec<_>>(),
                 "refine": "trusted",
                 "bootstrap_samples": 0,
@@ -329,13 +330,13 @@ mod tests {
     }
 
     /// The `views` input of the JSON API.
-    fn views_json(views: &[ViewPoints]) -> Vec<serde_json::Value> {
+    fn views_json(views: &[View]) -> Vec<serde_json::Value> {
         views
             .iter()
             .map(|v| {
                 serde_json::json!({
-                    "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                    "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                    "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                    "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
                 })
             })
             .collect()
@@ -354,9 +355,9 @@ mod tests {
             .iter()
             .map(|v| {
                 let points: Vec<serde_json::Value> = v
-                    .object_points
+                    .object_m
                     .iter()
-                    .zip(&v.image_points)
+                    .zip(&v.image_px)
                     .map(|(o, px)| {
                         let id = (o.x / square).round() as usize
                             + (o.y / square).round() as usize * cols;

@@ -12,6 +12,7 @@
 //! and only the observable part is refined.
 
 use crate::calib::pnp::camera_from_target_with_covariance;
+use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::Result;
 use crate::handeye::closed_form::motion::build_motions;
@@ -21,7 +22,6 @@ use crate::handeye::quality::residuals::{
 };
 use crate::handeye::refine::noise_choice::choose_noise_model;
 use crate::handeye::refine::over_pixels::reprojection_rms_per_view_px;
-use crate::handeye::refine::pixel_problem::ViewPoints;
 use crate::handeye::refine::pose_noise::{CameraNoise, NoiseLevels};
 use crate::handeye::refine::pose_problem::{
     evaluate, refine, Covariance12, PoseRefineOptions, HUBER_SCALE,
@@ -222,7 +222,7 @@ pub fn apply_pose_refinement(
 pub fn apply_pose_refinement_from_views(
     result: &mut HandEyeResult,
     input: &HandEyeInput,
-    views: &[ViewPoints],
+    views: &[View],
     camera: &Camera,
     motion_pairs: MotionPairs,
 ) -> Result<()> {
@@ -261,7 +261,7 @@ pub fn apply_pose_refinement_from_views(
 fn add_reprojection_rms(
     result: &mut HandEyeResult,
     input: &HandEyeInput,
-    views: &[ViewPoints],
+    views: &[View],
     camera: &Camera,
 ) -> Result<()> {
     let Some(summary) = result.pose_refinement.as_mut() else {

@@ -25,13 +25,13 @@ fn solve(setup: Setup, sigma_px: f64, seed: u64) -> (Value, usize) {
     };
     let scene = looking_scene(&config, seed);
     let pixels = grid_pixels(&scene, &camera, sigma_px, &mut Rng::new(seed + 1));
-    let points: usize = pixels.iter().map(|v| v.image_points.len()).sum();
+    let points: usize = pixels.iter().map(|v| v.image_px.len()).sum();
     let views: Vec<Value> = pixels
         .iter()
         .map(|v| {
             json!({
-                "object_m": v.object_points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-                "image_px": v.image_points.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
+                "object_m": v.object_m.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+                "image_px": v.image_px.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
             })
         })
         .collect();

@@ -21,6 +21,7 @@
 //! rotation noise through the lever arm from the base origin). Jacobians are
 //! analytic through the chain `pixel = project(x^-1 robot^-1 y p)`.
 
+use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params};
@@ -30,18 +31,8 @@ use crate::handeye::refine::pose_residual::{
 };
 use crate::handeye::{Chain, Pose, Setup};
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix3, Point2, Point3, SMatrix, Vector3, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
-
-/// Target points and their detections in one view.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct ViewPoints {
-    /// Points in the target frame (metres), or in the world frame with
-    /// [`RefineOptions::points_in_world`].
-    pub object_points: Vec<Point3<f64>>,
-    /// Their pixels, same order.
-    pub image_points: Vec<Point2<f64>>,
-}
 
 /// How far the robot poses are trusted.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -122,7 +113,7 @@ struct Problem<'a> {
     setup: Setup,
     /// The robot's `base_from_gripper` as given (the prior's centre).
     measured: &'a [Pose],
-    views: &'a [ViewPoints],
+    views: &'a [View],
     camera: &'a Camera,
     intrinsics: bool,
     pixel_weight: f64,
@@ -204,7 +195,7 @@ impl BlockProblem for Problem<'_> {
                 y.rotation.to_rotation_matrix().into_inner(),
             );
             let rr_inv = robot_inv.rotation.to_rotation_matrix().into_inner();
-            for (p, obs) in view.object_points.iter().zip(&view.image_points) {
+            for (p, obs) in view.object_m.iter().zip(&view.image_px) {
                 let q1 = y * p;
                 let u = robot_inv * q1;
                 let w = x.inverse() * u;
@@ -294,7 +285,7 @@ impl BlockProblem for Problem<'_> {
 pub fn refine(
     setup: Setup,
     base_from_gripper: &[Pose],
-    views: &[ViewPoints],
+    views: &[View],
     camera: &Camera,
     x0: &Pose,
     y0: &Pose,
@@ -388,7 +379,7 @@ pub fn refine(
     for (view, robot) in views.iter().zip(&robots) {
         let camera_from_target = x.inverse() * chain_robot_inverse(setup, robot) * y;
         let (mut s, mut n) = (0.0, 0usize);
-        for (p, obs) in view.object_points.iter().zip(&view.image_points) {
+        for (p, obs) in view.object_m.iter().zip(&view.image_px) {
             let px = camera_out.project(&(camera_from_target * p))?;
             s += (px - obs).norm_squared();
             n += 1;

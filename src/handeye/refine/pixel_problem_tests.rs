@@ -1,9 +1,10 @@
 //! Reprojection refinement on a seeded scene whose camera looks at a 9x6
 //! grid (0.03 m pitch) from about 0.6 m.
 
+use crate::calib::View;
 use crate::camera::Camera;
 use crate::handeye::quality::residuals::pose_difference;
-use crate::handeye::refine::pixel_problem::{refine, RefineOptions, RobotNoise, ViewPoints};
+use crate::handeye::refine::pixel_problem::{refine, RefineOptions, RobotNoise};
 use crate::handeye::solve::solve_method;
 use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
 use crate::synth::handeye::{project_grid, HandEyeScene};
@@ -64,7 +65,7 @@ fn refinement_is_exact_without_noise_in_both_setups() {
     for setup in [Setup::EyeInHand, Setup::EyeToHand] {
         let scene = looking_scene(setup, 8, 3);
         let views = project_grid(&scene, &camera(), (9, 6, 0.03), 0.0, 1);
-        assert!(views.iter().all(|v| v.image_points.len() == 54));
+        assert!(views.iter().all(|v| v.image_px.len() == 54));
         // Start away from the truth (1 cm, ~1 deg).
         let bump = Pose::from_parts(
             Translation3::new(0.01, -0.01, 0.005),
@@ -115,7 +116,7 @@ fn refinement_beats_the_closed_form_on_noisy_data() {
         .collect();
     let chain = Chain::new(setup, &scene.base_from_gripper, &noisy_cams).unwrap();
     let (x0, y0, _) = solve_method(HandEyeMethod::Daniilidis, &chain, MotionPairs::All).unwrap();
-    let views: Vec<ViewPoints> = project_grid(&scene, &camera(), (9, 6, 0.03), 0.3, 2);
+    let views: Vec<View> = project_grid(&scene, &camera(), (9, 6, 0.03), 0.3, 2);
     for noise in [RobotNoise::Trusted, RobotNoise::Estimate] {
         let options = RefineOptions {
             robot_noise: noise,
@@ -155,7 +156,7 @@ fn joint_intrinsics_and_control_points_recover_the_truth() {
     let cam = camera();
     let mut views = project_grid(&scene, &cam, (9, 6, 0.03), 0.0, 1);
     for v in &mut views {
-        for p in &mut v.object_points {
+        for p in &mut v.object_m {
             *p = scene.y_true * *p;
         }
     }

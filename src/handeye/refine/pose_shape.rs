@@ -147,16 +147,17 @@ mod tests {
             UnitQuaternion::from_scaled_axis(Vector3::new(0.3, -0.2, 0.5)),
         );
         let points = target.points();
-        let view = crate::handeye::refine::pixel_problem::ViewPoints {
-            object_points: points.iter().map(|p| (*p).into()).collect(),
-            image_points: points
+        let view = crate::calib::View::new(
+            "",
+            points.iter().map(|p| (*p).into()).collect(),
+            points
                 .iter()
                 .map(|p| {
                     let x = pose * nalgebra::Point3::from(*p);
                     Point2::new(f * x.x / x.z, f * x.y / x.z)
                 })
                 .collect(),
-        };
+        );
         let (_, _, pnp) = camera_from_target_with_covariance(&camera, &view).unwrap();
         let m = PoseMeasurement {
             base_from_gripper: Pose::identity(),

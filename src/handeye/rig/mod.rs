@@ -16,10 +16,10 @@
 pub mod pnp;
 pub mod uncertainty;
 
+use crate::calib::View;
 use crate::error::{Error, Result};
 use crate::geometry::{rotvec_from_rotation, PoseJson};
 use crate::handeye::refine::over_poses::{apply_pose_refinement, transform_std, TransformStd};
-use crate::handeye::refine::pixel_problem::ViewPoints;
 use crate::handeye::refine::pose_noise::CameraNoise;
 use crate::handeye::refine::pose_problem::Covariance12;
 use crate::handeye::report::HandEyeReport;
@@ -92,7 +92,7 @@ pub fn calibrate_rig_handeye(
     rig: &HeldRig,
     names: &[String],
     keys: &[String],
-    frames: &[Vec<(usize, ViewPoints)>],
+    frames: &[Vec<(usize, View)>],
     base_from_gripper: &[Pose],
     options: &HandEyeOptions,
 ) -> Result<RigHandEyeResult> {
@@ -194,7 +194,7 @@ pub fn add_rig_uncertainty(
     solved: &mut RigHandEyeResult,
     sigma_points: &[[HeldRig; 2]],
     source: &str,
-    frames: &[Vec<(usize, ViewPoints)>],
+    frames: &[Vec<(usize, View)>],
     base_from_gripper: &[Pose],
     options: &HandEyeOptions,
 ) -> Result<()> {
@@ -257,7 +257,7 @@ fn resolve(
     base: &HandEyeResult,
     rig: &HeldRig,
     used: &[usize],
-    frames: &[Vec<(usize, ViewPoints)>],
+    frames: &[Vec<(usize, View)>],
     base_from_gripper: &[Pose],
     options: &HandEyeOptions,
 ) -> Result<Vector12> {

@@ -6,10 +6,10 @@
 //! Levenberg-Marquardt over the 6 pose parameters and all cameras' pixels.
 
 use crate::calib::pnp::{camera_from_target, right_step_block, right_step_covariance};
+use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params};
-use crate::handeye::refine::pixel_problem::ViewPoints;
 use crate::handeye::Pose;
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
 use nalgebra::Matrix6;
@@ -39,7 +39,7 @@ pub struct RigPose {
 }
 
 /// The board pose of one frame from `views` (camera index, its points).
-pub fn rig_from_target(rig: &HeldRig, views: &[(usize, ViewPoints)]) -> Result<RigPose> {
+pub fn rig_from_target(rig: &HeldRig, views: &[(usize, View)]) -> Result<RigPose> {
     if let Some(&(k, _)) = views.iter().find(|(k, _)| *k >= rig.cameras.len()) {
         return Err(Error::invalid(
             "camera",
@@ -50,8 +50,8 @@ pub fn rig_from_target(rig: &HeldRig, views: &[(usize, ViewPoints)]) -> Result<R
         ));
     }
     // The start: the camera with the most points whose own pose is fixed.
-    let mut order: Vec<&(usize, ViewPoints)> = views.iter().collect();
-    order.sort_by_key(|(_, v)| std::cmp::Reverse(v.object_points.len()));
+    let mut order: Vec<&(usize, View)> = views.iter().collect();
+    order.sort_by_key(|(_, v)| std::cmp::Reverse(v.object_m.len()));
     let mut start = None;
     let mut why = Vec::new();
     for (k, v) in order {
@@ -83,7 +83,7 @@ pub fn rig_from_target(rig: &HeldRig, views: &[(usize, ViewPoints)]) -> Result<R
         &LmOptions::default(),
     )?;
     let pose = pose_from_params(&lm.params.global);
-    let points: usize = views.iter().map(|(_, v)| v.object_points.len()).sum();
+    let points: usize = views.iter().map(|(_, v)| v.object_m.len()).sum();
     let blocks = problem.residuals_and_jacobian(&lm.params, true)?;
     let covariance = right_step_covariance(&pose, &blocks, "board")?;
     Ok(RigPose {
@@ -96,7 +96,7 @@ pub fn rig_from_target(rig: &HeldRig, views: &[(usize, ViewPoints)]) -> Result<R
 
 struct RigPoseProblem<'a> {
     rig: &'a HeldRig,
-    views: &'a [(usize, ViewPoints)],
+    views: &'a [(usize, View)],
 }
 
 impl BlockProblem for RigPoseProblem<'_> {
@@ -111,7 +111,7 @@ impl BlockProblem for RigPoseProblem<'_> {
         for (k, view) in self.views {
             let camera_from_rig = self.rig.camera_from_rig[*k];
             let rc = camera_from_rig.rotation.to_rotation_matrix().into_inner();
-            for (p, obs) in view.object_points.iter().zip(&view.image_points) {
+            for (p, obs) in view.object_m.iter().zip(&view.image_px) {
                 let w = camera_from_rig * (pose * p);
                 let (pixel, d_pt, _) = self.rig.cameras[*k].project_with_jacobians(&w)?;
                 // The rig camera's rotation carries the board point on.
@@ -133,21 +133,15 @@ mod tests {
     use crate::synth::rig::{rig_scene, RigSceneConfig};
     use wasm_bindgen_test::wasm_bindgen_test;
 
-    fn views(scene: &crate::synth::rig::RigScene, frame: usize) -> Vec<(usize, ViewPoints)> {
+    fn views(scene: &crate::synth::rig::RigScene, frame: usize) -> Vec<(usize, View)> {
         scene
             .views
             .iter()
             .enumerate()
             .filter_map(|(k, list)| {
-                list.iter().find(|(f, _)| *f == frame).map(|(_, v)| {
-                    (
-                        k,
-                        ViewPoints {
-                            object_points: v.object_m.clone(),
-                            image_points: v.image_px.clone(),
-                        },
-                    )
-                })
+                list.iter()
+                    .find(|(f, _)| *f == frame)
+                    .map(|(_, v)| (k, v.clone()))
             })
             .collect()
     }
@@ -169,8 +163,8 @@ mod tests {
         // Three points in one camera fix nothing.
         let mut v = views(&scene, 0);
         v.truncate(1);
-        v[0].1.object_points.truncate(3);
-        v[0].1.image_points.truncate(3);
+        v[0].1.object_m.truncate(3);
+        v[0].1.image_px.truncate(3);
         let k = v[0].0;
         assert_eq!(
             rig_from_target(&rig, &v).unwrap_err().to_string(),
