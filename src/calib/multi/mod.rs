@@ -3,9 +3,11 @@
 //! [`stereo_rectify`]) and an N-camera rig ([`rig`]: the co-observation
 //! graph in `rig_graph`, each camera alone in `rig_init`, the joint problem
 //! in `rig_problem`, the report in [`rig_report`]). Both joint problems
-//! build their Jacobian blocks with one helper, `block_problem`;
+//! build their residual and Jacobian blocks with one helper,
+//! `block_problem`;
 //! `same_images` refuses one image set given for two cameras.
 
+mod block_problem;
 pub mod rig;
 mod rig_graph;
 mod rig_init;

@@ -8,15 +8,15 @@
 //! `camera_k_from_rig * rig_from_target_f * X` (the rig camera's
 //! camera_from_rig is the identity and not a parameter). Residual blocks
 //! come frame by frame (all cameras of one frame together), the order the
-//! solver's Schur accumulation likes.
+//! solver's Schur accumulation likes. The residual blocks and the
+//! retraction are those of [`crate::calib::multi::block_problem`].
 
-use crate::calib::multi::stereo_problem::{fold_aspect, retract_pose, skew};
+use crate::calib::multi::block_problem::{push_view_residuals, retract, Mount, Sight};
 use crate::calib::refine::{pose_from_block, CalibProblem};
 use crate::camera::Camera;
 use crate::error::Result;
 use crate::geometry::Pose;
 use crate::optim::{BlockParams, BlockProblem, ResidualBlock};
-use nalgebra::{DMatrix, DVector, Matrix2x3, Matrix3, Point3};
 
 /// One observation of a frame: camera `camera` used its view `view` (an
 /// index into that camera's problem views) of the frame.
@@ -106,92 +106,28 @@ impl BlockProblem for RigProblem<'_> {
         let cameras = (0..self.cameras.len())
             .map(|k| self.camera(g, k))
             .collect::<Result<Vec<_>>>()?;
-        let extrinsics: Vec<(Pose, Matrix3<f64>)> = (0..self.cameras.len())
-            .map(|k| {
-                let pose = self.camera_from_rig(g, k);
-                let r = pose.rotation.to_rotation_matrix().into_inner();
-                (pose, r)
-            })
+        // The rig camera's mount is the identity, held.
+        let mounts: Vec<Mount> = (0..self.cameras.len())
+            .map(|k| Mount::new(self.camera_from_rig(g, k), self.pose_offset(k)))
             .collect();
         let mut out = Vec::new();
         for (b, sightings) in self.frames.iter().enumerate() {
             let rig_from_target = pose_from_block(&params.blocks[b]);
             for s in sightings {
-                let problem = &self.cameras[s.camera];
-                let camera = &cameras[s.camera];
-                let (camera_from_rig, r_c) = &extrinsics[s.camera];
-                let view = &problem.views[s.view];
-                let points = view.object_m.iter().zip(&view.image_px).enumerate();
-                for (i, (object, observed)) in points {
-                    if !problem.used[s.view][i] {
-                        continue;
-                    }
-                    let rotated = rig_from_target.rotation * object.coords;
-                    let p_rig = rotated + rig_from_target.translation.vector;
-                    let p = camera_from_rig * Point3::from(p_rig);
-                    let (pixel, d_point, mut d_params) = if jacobians {
-                        camera.project_with_jacobians(&p)?
-                    } else {
-                        (
-                            camera.project(&p)?,
-                            Matrix2x3::zeros(),
-                            DMatrix::zeros(2, 0),
-                        )
-                    };
-                    let residuals =
-                        DVector::from_vec(vec![pixel.x - observed.x, pixel.y - observed.y]);
-                    let (jac_global, jac_block) = if jacobians {
-                        fold_aspect(&mut d_params, problem.aspect);
-                        let mut jg = DMatrix::zeros(2, n_global);
-                        let o = self.params_offset(s.camera);
-                        jg.view_mut((0, o), (2, d_params.ncols()))
-                            .copy_from(&d_params);
-                        if let Some(o) = self.pose_offset(s.camera) {
-                            // camera_from_rig <- exp(d) camera_from_rig: d p / d d = -[R_c p_rig]_x.
-                            jg.view_mut((0, o), (2, 3))
-                                .copy_from(&(d_point * (-skew(&(r_c * p_rig)))));
-                            jg.view_mut((0, o + 3), (2, 3)).copy_from(&d_point);
-                        }
-                        let d_rig = d_point * r_c;
-                        let mut jb = DMatrix::zeros(2, 6);
-                        jb.view_mut((0, 0), (2, 3))
-                            .copy_from(&(d_rig * (-skew(&rotated))));
-                        jb.view_mut((0, 3), (2, 3)).copy_from(&d_rig);
-                        (jg, jb)
-                    } else {
-                        (DMatrix::zeros(2, 0), DMatrix::zeros(2, 0))
-                    };
-                    out.push(ResidualBlock {
-                        block: Some(b),
-                        residuals,
-                        jac_global,
-                        jac_block,
-                    });
-                }
+                let sight = Sight {
+                    problem: &self.cameras[s.camera],
+                    camera: &cameras[s.camera],
+                    params_offset: self.params_offset(s.camera),
+                    mount: Some(&mounts[s.camera]),
+                    view: s.view,
+                };
+                push_view_residuals(&sight, b, &rig_from_target, n_global, jacobians, &mut out)?;
             }
         }
         Ok(out)
     }
 
     fn retract(&self, params: &BlockParams, step: &BlockParams) -> BlockParams {
-        let n_params = self.params_offset(self.cameras.len());
-        let mut global: Vec<f64> = params.global[..n_params]
-            .iter()
-            .zip(&step.global[..n_params])
-            .map(|(x, d)| x + d)
-            .collect();
-        for o in (n_params..params.global.len()).step_by(6) {
-            global.extend(retract_pose(
-                &params.global[o..o + 6],
-                &step.global[o..o + 6],
-            ));
-        }
-        let blocks = params
-            .blocks
-            .iter()
-            .zip(&step.blocks)
-            .map(|(b, d)| retract_pose(b, d))
-            .collect();
-        BlockParams { global, blocks }
+        retract(params, step, self.params_offset(self.cameras.len()))
     }
 }
