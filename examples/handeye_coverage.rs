@@ -19,7 +19,7 @@
 use robocal::calib::pnp::camera_from_target_with_covariance;
 use robocal::calib::View;
 use robocal::camera::Camera;
-use robocal::handeye::refine::over_poses::apply_pose_refinement_from_views;
+use robocal::handeye::solve::apply_pose_refinement_from_views;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
 use robocal::synth::handeye_looking::{
     grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,

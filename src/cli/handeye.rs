@@ -8,9 +8,10 @@ use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
 use robocal::handeye::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
-use robocal::handeye::refine::over_pixels::{apply_refinement, RefineMode};
-use robocal::handeye::refine::over_poses::apply_pose_refinement_from_views;
+use robocal::handeye::refine::over_pixels::RefineMode;
 use robocal::handeye::report::HandEyeReport;
+use robocal::handeye::solve::apply_pose_refinement_from_views;
+use robocal::handeye::solve::apply_refinement;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 

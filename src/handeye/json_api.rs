@@ -32,9 +32,11 @@ use super::quality::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };
 use super::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
-use super::refine::over_pixels::{apply_refinement, RefineMode};
+use super::refine::over_pixels::RefineMode;
 use super::report::HandEyeReport;
-use super::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
+use super::solve::{
+    apply_refinement, calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES,
+};
 use super::{HandEyeMethod, Pose, Setup};
 use crate::calib::View;
 use crate::camera::Camera;
@@ -382,7 +384,7 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
         // No refinement over pixels: the pose refinement, with each view's
         // PnP covariance from its image points.
         if mode == RefineMode::None && input.refine_poses.unwrap_or(true) {
-            super::refine::over_poses::apply_pose_refinement_from_views(
+            super::solve::apply_pose_refinement_from_views(
                 &mut result,
                 &request,
                 views,

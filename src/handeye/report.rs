@@ -8,7 +8,7 @@ use crate::handeye::closed_form::motion::MotionStats;
 use crate::handeye::quality::repeat::Repeatability;
 use crate::handeye::quality::residuals::{Errors, MotionResidual, ViewResidual};
 use crate::handeye::refine::over_pixels::RefinementSummary;
-use crate::handeye::refine::over_poses::PoseRefinementSummary;
+use crate::handeye::refine::pose_summary::PoseRefinementSummary;
 use crate::handeye::solve::HandEyeResult;
 use crate::handeye::{Pose, Setup};
 use serde::{Deserialize, Serialize};

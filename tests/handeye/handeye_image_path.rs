@@ -15,11 +15,12 @@
 
 use robocal::calib::pnp::camera_from_target_with_covariance;
 use robocal::camera::Camera;
-use robocal::handeye::refine::over_pixels::{apply_refinement, RefineMode};
+use robocal::handeye::refine::over_pixels::RefineMode;
 use robocal::handeye::refine::over_poses::paired;
 use robocal::handeye::refine::pose_noise::{CameraNoise, NoiseModel};
 use robocal::handeye::refine::pose_problem::fisher_information;
 use robocal::handeye::refine::pose_residual::difference;
+use robocal::handeye::solve::apply_refinement;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
 use robocal::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
 use robocal::synth::Rng;

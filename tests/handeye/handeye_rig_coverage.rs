@@ -144,7 +144,7 @@ fn trial(seed: u64, setup: Setup) -> Trial {
         .as_ref()
         .expect("conditional std");
     let e = errors(&solved.result.x, &x);
-    let std_of = |s: &robocal::handeye::refine::over_poses::TransformStd| {
+    let std_of = |s: &robocal::handeye::refine::pose_summary::TransformStd| {
         let r = s.rotation_deg;
         let t = s.translation_mm;
         [r[0], r[1], r[2], t[0], t[1], t[2]]

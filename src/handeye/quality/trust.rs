@@ -28,11 +28,11 @@ use crate::handeye::closed_form::motion::MotionStats;
 use crate::handeye::quality::checks::consistency;
 use crate::handeye::quality::repeat::Repeatability;
 use crate::handeye::quality::residuals::pose_difference;
-use crate::handeye::refine::over_poses::{transform_std, PoseRefinementSummary};
 use crate::handeye::refine::pose_noise::NoiseModel;
 use crate::handeye::refine::pose_problem::{refine, PoseRefineOptions};
 use crate::handeye::refine::pose_residual::PoseMeasurement;
-use crate::handeye::solve::{HandEyeInput, HandEyeResult};
+use crate::handeye::refine::pose_summary::{transform_std, PoseRefinementSummary};
+use crate::handeye::solve::HandEyeInput;
 use crate::handeye::{Pose, Setup};
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
@@ -275,22 +275,20 @@ pub fn pose_shift(a: &Pose, b: &Pose) -> [f64; 6] {
 /// transforms; the shift joins the covariance and a warning names the
 /// likely causes.
 pub(crate) fn check_translation_scale(
-    result: &mut HandEyeResult,
+    summary: &mut PoseRefinementSummary,
+    (x, y): (&Pose, &Pose),
     input: &HandEyeInput,
     views: &[PoseMeasurement],
-    noise: &NoiseModel,
-    options: &PoseRefineOptions,
-) {
-    let Some((k, sk)) = translation_scale(
+    (noise, options): (&NoiseModel, &PoseRefineOptions),
+) -> Option<String> {
+    let (k, sk) = translation_scale(
         input.setup,
         &input.base_from_gripper,
         &input.camera_from_target,
-    ) else {
-        return;
-    };
+    )?;
     let off = k - 1.0;
     if !(off.abs() > 3.0 * sk && off.abs() > SCALE_MIN) {
-        return;
+        return None;
     }
     let scaled: Vec<PoseMeasurement> = views
         .iter()
@@ -302,24 +300,12 @@ pub(crate) fn check_translation_scale(
             ),
         })
         .collect();
-    let Ok(refit) = refine(
-        input.setup,
-        &scaled,
-        &result.x,
-        &result.y,
-        noise.clone(),
-        options,
-    ) else {
-        return;
-    };
-    let dx = pose_shift(&result.x, &refit.x);
-    let dy = pose_shift(&result.y, &refit.y);
-    let Some(summary) = result.pose_refinement.as_mut() else {
-        return;
-    };
+    let refit = refine(input.setup, &scaled, x, y, noise.clone(), options).ok()?;
+    let dx = pose_shift(x, &refit.x);
+    let dy = pose_shift(y, &refit.y);
     add_shift_to_covariance(summary, &dx, &dy);
-    let (moved_mm, moved_deg) = pose_difference(&result.x, &refit.x);
-    result.warnings.push(format!(
+    let (moved_mm, moved_deg) = pose_difference(x, &refit.x);
+    Some(format!(
         "scale: the camera translations match the robot's only when scaled by {:.4} (+- {:.4}): \
          the camera's focal length or the target's square size is about {:.2} % off; a refit \
          with the camera translations rescaled moves {} by {moved_mm:.2} mm and {moved_deg:.3} \
@@ -328,23 +314,21 @@ pub(crate) fn check_translation_scale(
         sk / (k * k),
         100.0 * off.abs(),
         input.setup.camera_key()
-    ));
+    ))
 }
 
 /// The uncertainty checked against the data ([`crate::handeye::quality::trust`]): widened
-/// to the leave-one-out spread when that is larger, and the error at the
-/// working distance.
-pub(crate) fn check_uncertainty(result: &mut HandEyeResult, input: &HandEyeInput) {
+/// to the leave-one-out spread of `repeatability` when that is larger (the
+/// warning returned), and the error at the working distance.
+pub(crate) fn check_uncertainty(
+    summary: &mut PoseRefinementSummary,
+    x: &Pose,
+    repeatability: Option<&Repeatability>,
+    input: &HandEyeInput,
+) -> Option<String> {
     let n = input.camera_from_target.len();
-    let Some(summary) = result.pose_refinement.as_mut() else {
-        return;
-    };
-    let rotation = result.x.rotation.to_rotation_matrix().into_inner();
-    if let Some(rep) = &result.repeatability {
-        if let Some(w) = widen_to_leave_one_out(summary, rep, &rotation, n) {
-            result.warnings.push(w);
-        }
-    }
+    let rotation = x.rotation.to_rotation_matrix().into_inner();
+    let warning = repeatability.and_then(|rep| widen_to_leave_one_out(summary, rep, &rotation, n));
     let mut d: Vec<f64> = input
         .camera_from_target
         .iter()
@@ -352,12 +336,13 @@ pub(crate) fn check_uncertainty(result: &mut HandEyeResult, input: &HandEyeInput
         .filter(|v| v.is_finite())
         .collect();
     if d.is_empty() {
-        return;
+        return warning;
     }
     d.sort_by(f64::total_cmp);
     let distance = d[d.len() / 2];
     summary.work_distance_m = Some(distance);
     summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, distance));
+    warning
 }
 
 /// The frame name of the camera transform, for messages.

@@ -6,7 +6,8 @@
 //! noise models, [`pose_shape`] the per-view camera noise shape predicted
 //! from a planar target, [`noise_choice`] picks the model by likelihood,
 //! [`pose_problem`] is the maximum-likelihood least squares, [`over_poses`]
-//! runs it from the closed forms (noise, covariance, trust checks) and
+//! runs it from the closed forms (noise, covariance, trust checks),
+//! [`pose_summary`] is what it reports, and
 //! [`pose_resample`] gives the repeatability of its estimate.
 //!
 //! Over the pixels (`refine` trusted, stochastic, joint_intrinsics):
@@ -23,6 +24,7 @@ pub mod pose_problem;
 pub mod pose_resample;
 pub mod pose_residual;
 pub mod pose_shape;
+pub mod pose_summary;
 
 #[cfg(test)]
 mod over_poses_reprojection_tests;

@@ -1,20 +1,17 @@
-//! The image-based refinement ([`crate::handeye::refine::pixel_problem`]) applied to a closed-form
-//! [`HandEyeResult`]: the best closed form seeds the reprojection
-//! Levenberg-Marquardt, the refined transforms become the primary result
-//! (`method` = `refined from <closed form>`), `errors.reprojection_rms_px` is
-//! filled, and every closed form stays listed in `methods` with its own
-//! reprojection RMS.
+//! The refinement over pixels ([`crate::handeye::refine::pixel_problem`])
+//! run from a closed-form [`HandEyeResult`]: the primary closed form seeds
+//! the reprojection Levenberg-Marquardt, and the findings
+//! ([`PixelFindings`]) go back to the orchestrator, which makes the refined
+//! transforms the primary result (`method` = `refined from <closed form>`),
+//! fills `errors.reprojection_rms_px` and keeps every closed form listed in
+//! `methods` with its own reprojection RMS.
 
 use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::handeye::closed_form::motion::build_motions;
-use crate::handeye::quality::residuals::{
-    errors, motion_residuals, pose_difference, view_residuals,
-};
 use crate::handeye::refine::pixel_problem::{refine, RefineOptions, RobotNoise};
 use crate::handeye::solve::{HandEyeInput, HandEyeResult};
-use crate::handeye::{Chain, MotionPairs, Pose};
+use crate::handeye::{Chain, Pose};
 use serde::{Deserialize, Serialize};
 
 /// Which refinement to run after the closed forms.
@@ -172,18 +169,43 @@ pub fn reprojection_rms_per_view_px(
     Ok(((sum / count as f64).sqrt(), per_view))
 }
 
-/// Fill the reprojection RMS of every closed form and, unless `mode` is
-/// [`RefineMode::None`], replace the primary solution by the refined one and
-/// set `result.refinement`. `views` pair one to one with the input poses.
-pub fn apply_refinement(
-    result: &mut HandEyeResult,
+/// What the refinement over pixels found, for the orchestrator
+/// ([`crate::handeye::solve::apply_refinement`]) to write into the result.
+#[derive(Debug, Clone)]
+pub struct PixelFindings {
+    /// The reprojection RMS (px) of each closed form, in the order of the
+    /// result's `methods` (`None` for a method that failed).
+    pub method_rms_px: Vec<Option<f64>>,
+    /// The reprojection RMS (px) of the primary closed form.
+    pub closed_form_rms_px: f64,
+    /// The refined transforms, when a refinement ran.
+    pub refined: Option<PixelRefined>,
+    /// What the user should know, in the order found.
+    pub warnings: Vec<String>,
+}
+
+/// The refined solution of [`PixelFindings`].
+#[derive(Debug, Clone)]
+pub struct PixelRefined {
+    /// The refined `gripper_from_camera` or `base_from_camera`.
+    pub x: Pose,
+    /// The refined `base_from_target` or `gripper_from_target`.
+    pub y: Pose,
+    /// The report's `refinement` object.
+    pub summary: RefinementSummary,
+}
+
+/// Measure the reprojection RMS of every closed form and, unless `mode` is
+/// [`RefineMode::None`], refine the primary solution of `result` over the
+/// pixels. `views` pair one to one with the input poses.
+pub fn refine_over_pixels(
+    result: &HandEyeResult,
     input: &HandEyeInput,
     views: &[View],
     camera: &Camera,
     mode: RefineMode,
-    motion_pairs: MotionPairs,
     pixel_sigma_px: f64,
-) -> Result<()> {
+) -> Result<PixelFindings> {
     if views.len() != input.base_from_gripper.len() {
         return Err(Error::invalid(
             "views",
@@ -199,23 +221,30 @@ pub fn apply_refinement(
         &input.base_from_gripper,
         &input.camera_from_target,
     )?;
-    for m in &mut result.methods {
-        if let Ok((x, y, e)) = &mut m.outcome {
-            e.reprojection_rms_px = Some(reprojection_rms_px(&chain, views, camera, x, y)?);
-        }
+    let mut method_rms_px = Vec::with_capacity(result.methods.len());
+    for m in &result.methods {
+        method_rms_px.push(match &m.outcome {
+            Ok((x, y, _)) => Some(reprojection_rms_px(&chain, views, camera, x, y)?),
+            Err(_) => None,
+        });
     }
     let start_rms = reprojection_rms_px(&chain, views, camera, &result.x, &result.y)?;
-    result.errors.reprojection_rms_px = Some(start_rms);
+    let mut found = PixelFindings {
+        method_rms_px,
+        closed_form_rms_px: start_rms,
+        refined: None,
+        warnings: Vec::new(),
+    };
     let Some(options) = mode.options(pixel_sigma_px) else {
-        return Ok(());
+        return Ok(found);
     };
     if result.method == "scara" {
-        result.warnings.push(
+        found.warnings.push(
             "refinement skipped: with parallel rotation axes part of the translation is \
              unobservable, so the closed-form observable solution is kept"
                 .to_string(),
         );
-        return Ok(());
+        return Ok(found);
     }
     let refined = refine(
         input.setup,
@@ -226,30 +255,21 @@ pub fn apply_refinement(
         &result.y,
         &options,
     )?;
-    let started_from = result.method.clone();
-    result.x = refined.x;
-    result.y = refined.y;
-    result.method = format!("refined from {started_from}");
-    result.per_view = view_residuals(&chain, &result.x, &result.y);
-    result.errors = errors(&result.per_view);
-    result.errors.reprojection_rms_px = Some(refined.reprojection_rms_px);
-    result.per_motion = motion_residuals(&build_motions(&chain, motion_pairs).kept, &result.x);
-    for m in &mut result.methods {
-        if let Ok((mx, _, _)) = &m.outcome {
-            m.disagreement = Some(pose_difference(&result.x, mx));
-        }
-    }
-    result.refinement = Some(RefinementSummary {
-        mode,
-        started_from,
-        closed_form_reprojection_rms_px: start_rms,
-        reprojection_rms_px: refined.reprojection_rms_px,
-        per_view_reprojection_rms_px: refined.per_view_rms_px,
-        robot_rotation_noise_deg: refined.robot_noise_estimate.map(|n| n.0.to_degrees()),
-        robot_translation_noise_mm: refined.robot_noise_estimate.map(|n| n.1 * 1e3),
-        camera: options.intrinsics.then_some(refined.camera),
+    found.refined = Some(PixelRefined {
+        x: refined.x,
+        y: refined.y,
+        summary: RefinementSummary {
+            mode,
+            started_from: result.method.clone(),
+            closed_form_reprojection_rms_px: start_rms,
+            reprojection_rms_px: refined.reprojection_rms_px,
+            per_view_reprojection_rms_px: refined.per_view_rms_px,
+            robot_rotation_noise_deg: refined.robot_noise_estimate.map(|n| n.0.to_degrees()),
+            robot_translation_noise_mm: refined.robot_noise_estimate.map(|n| n.1 * 1e3),
+            camera: options.intrinsics.then_some(refined.camera),
+        },
     });
-    Ok(())
+    Ok(found)
 }
 
 #[cfg(test)]
@@ -257,6 +277,7 @@ mod tests {
     use super::*;
     use crate::geometry::PoseJson;
     use crate::handeye::json_api::solve_handeye_json;
+    use crate::handeye::quality::residuals::pose_difference;
     use crate::handeye::refine::pixel_problem_tests::{camera, looking_scene};
     use crate::handeye::Setup;
     use crate::synth::handeye::project_grid;

@@ -5,10 +5,11 @@
 
 use crate::calib::pnp::camera_from_target_with_covariance;
 use crate::camera::Camera;
-use crate::handeye::refine::over_poses::{apply_pose_refinement_with, paired};
+use crate::handeye::refine::over_poses::paired;
 use crate::handeye::refine::pose_noise::{CameraNoise, NoiseModel};
 use crate::handeye::refine::pose_problem::fisher_information;
 use crate::handeye::refine::pose_residual::difference;
+use crate::handeye::solve::apply_pose_refinement_with;
 use crate::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions};
 use crate::handeye::{MotionPairs, Pose, Setup};
 use crate::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
