@@ -11,7 +11,7 @@
 //! disagree (the grouping check, the intrinsics drift or the leave-frames-out
 //! spread).
 
-use robocal::calib::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
 use robocal::calib::CalibrationOptions;
 use robocal::geometry::{rotvec_from_rotation, Pose};
 use robocal::synth::rig::{rig_scene, RigSceneConfig};

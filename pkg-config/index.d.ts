@@ -787,7 +787,7 @@ export interface ExportFile {
 }
 
 // ---------------------------------------------------------------------------
-// Hand-eye (src/handeye/json_api.rs, output.rs)
+// Hand-eye (src/handeye/json_api.rs, report.rs)
 
 /** Camera on the gripper (`eye-in-hand`) or fixed in the robot's world (`eye-to-hand`). */
 export type Setup = 'eye-in-hand' | 'eye-to-hand';

@@ -37,8 +37,8 @@ use super::json_api::{
     agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
     JsonView,
 };
-use super::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
-use super::rig_report::RigCalibration;
+use super::multi::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
+use super::multi::rig_report::RigCalibration;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::target::Detection;

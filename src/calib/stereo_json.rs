@@ -27,7 +27,7 @@ use super::json_api::{
     agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
     JsonView, MIN_VIEWS,
 };
-use super::stereo::{calibrate_stereo, StereoCalibration};
+use super::multi::stereo::{calibrate_stereo, StereoCalibration};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 

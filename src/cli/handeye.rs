@@ -6,11 +6,12 @@ use super::handeye_images::{
 };
 use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
-use robocal::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
 use robocal::handeye::json_api::{camera_from_json, DEFAULT_PIXEL_SIGMA_PX};
-use robocal::handeye::output::HandEyeReport;
-use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
-use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
+use robocal::handeye::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
+use robocal::handeye::refine::over_pixels::RefineMode;
+use robocal::handeye::report::HandEyeReport;
+use robocal::handeye::solve::apply_pose_refinement_from_views;
+use robocal::handeye::solve::apply_refinement;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 
@@ -379,7 +380,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
 
 /// Too few pose pairs after images were dropped: the error lists them and
 /// why (the report that would say so is not written).
-fn with_dropped(e: robocal::Error, pairs: &[robocal::handeye::output::PairAudit]) -> CliError {
+fn with_dropped(e: robocal::Error, pairs: &[robocal::handeye::report::PairAudit]) -> CliError {
     let dropped: Vec<String> = pairs
         .iter()
         .filter(|p| !p.used)

@@ -4,8 +4,8 @@
 use super::detect::{run_all, Outcome};
 use super::{read_text, write_output, CliError};
 use robocal::calib::json_api::model_from_name;
-use robocal::calib::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
-use robocal::calib::rig_report::RigCalibration;
+use robocal::calib::multi::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig_report::RigCalibration;
 use robocal::calib::{CalibrationOptions, View};
 use robocal::camera::Camera;
 use robocal::handeye::rig_json::rig_cameras_named;

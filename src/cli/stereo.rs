@@ -4,7 +4,7 @@ use super::detect::{run_all, Outcome};
 use super::detections_file::read_detections;
 use super::{write_output, CliError};
 use robocal::calib::json_api::model_from_name;
-use robocal::calib::stereo::calibrate_stereo;
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::{CalibrationOptions, View};
 use robocal::io::pairing::{pair_by_number, PairedBy};
 use robocal::target::{Detection, Target};

@@ -25,13 +25,12 @@
 //! Output: the rig report (solved, or the one given) with `handeye`, the
 //! JSON `robocal rig --setup ... -o rig.json` writes.
 
-use super::reprojection_refine::ViewPoints;
+use super::rig::uncertainty::{held_rig, rig_sigma_points};
 use super::rig::{add_rig_uncertainty, calibrate_rig_handeye, rig_handeye_report};
-use super::rig_uncertainty::{held_rig, rig_sigma_points};
 use super::{HandEyeOptions, Pose, Setup};
-use crate::calib::rig::RigCameraViews;
+use crate::calib::multi::rig::RigCameraViews;
+use crate::calib::multi::rig_report::RigCalibration;
 use crate::calib::rig_json::{calibrate_rig_input, rig_views, RigInput};
-use crate::calib::rig_report::RigCalibration;
 use crate::error::{Error, Result};
 use crate::geometry::PoseInput;
 use serde::Deserialize;
@@ -78,13 +77,7 @@ pub fn solve_rig_on_robot(
                     format!("frame index {f}, but there are {} frames", keys.len()),
                 )
             })?;
-            slot.push((
-                k,
-                ViewPoints {
-                    object_points: view.object_m.clone(),
-                    image_points: view.image_px.clone(),
-                },
-            ));
+            slot.push((k, view.clone()));
         }
     }
     let names: Vec<String> = report.cameras.iter().map(|c| c.name.clone()).collect();

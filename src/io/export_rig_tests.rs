@@ -9,7 +9,7 @@
 use super::export::{export_files, export_with, ExportOptions};
 use super::export_rig::{export_rig, RigFormat};
 use super::import_camera::{import_camera, CameraSource};
-use crate::calib::rig_report::{CoObservation, RigCalibration, RigCamera, RigFrame};
+use crate::calib::multi::rig_report::{CoObservation, RigCalibration, RigCamera, RigFrame};
 use crate::calib::{CalibrationOptions, CameraCalibration, Correlation, ProjectionUncertainty};
 use crate::camera::{Camera, Distortion};
 use crate::geometry::{

@@ -14,7 +14,7 @@ use crate::support;
 use support::dataset;
 
 use nalgebra::{Point2, Point3, Vector3};
-use robocal::calib::stereo::calibrate_stereo;
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::{calibrate, CalibrationOptions, View};
 use robocal::camera::Distortion;
 use serde_json::Value;

@@ -14,9 +14,9 @@ use crate::support;
 use support::dataset;
 
 use nalgebra::{Point2, Point3};
-use robocal::calib::rig::{calibrate_rig, RigCameraViews, RigOptions};
-use robocal::calib::rig_report::RigCalibration;
-use robocal::calib::stereo::calibrate_stereo;
+use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig_report::RigCalibration;
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::{CalibrationOptions, View};
 use robocal::camera::Distortion;
 use robocal::geometry::{rotvec_from_rotation, Pose};
