@@ -9,8 +9,8 @@
 //! that moves with it.
 //!
 //! Usage: cargo run --release --example corner_phase -- [TILT_RAD]
-//! (default 0: frontal; 0.5 tilts the board about x). BENCHMARKS.md,
-//! "Chessboard corners: the fit points' phase".
+//! (default 0: frontal; 0.5 tilts the board about x). docs/benchmark-history.md,
+//! "Session 14: chessboard corners: the fit points' phase".
 
 use robocal::detect::{detect, DetectOptions};
 use robocal::synth::{board_pose, render, Pinhole, RenderOptions};

@@ -2,9 +2,9 @@
 //! also a blank and a noise image of the first file's size.
 //!
 //! Usage: cargo run --release --example detect_time -- [--target SPEC]
-//! [--repeat N] [--no-blank] [--decode] [--truth bench/out/truth.json] FILES...   (default target chessboard:9x6:30mm, 11 repeats)
+//! [--repeat N] [--no-blank] [--decode] [--truth benches/out/truth.json] FILES...   (default target chessboard:9x6:30mm, 11 repeats)
 //! `--decode` times decoding + detection (as the wasm `detect_target`
-//! does, for bench/wasm_detect.mjs). Prints one line per file (median ms, points found) and the median over
+//! does, for benches/wasm_detect.mjs). Prints one line per file (median ms, points found) and the median over
 //! files; used for profiling (`valgrind --tool=callgrind ... --repeat 1`).
 
 use robocal::detect::{detect, DetectOptions};

@@ -1,5 +1,5 @@
 //! Render seeded ChArUco hand-eye image sets (eye-in-hand and eye-to-hand)
-//! for bench/compare_handeye_charuco.py: robocal's image path against
+//! for benches/compare_handeye_charuco.py: robocal's image path against
 //! OpenCV's ChArUco detector, PnP and hand-eye methods on the same images.
 //!
 //! Usage: cargo run --release --example handeye_charuco -- OUT_DIR

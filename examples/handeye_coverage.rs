@@ -3,7 +3,7 @@
 //! at a 9x6 board (30 mm) at 0.5 m, 1280x960 at f = 1100 px, through the
 //! image path of `robocal handeye` (PnP with its covariance per view, the
 //! closed forms, the pose refinement, its leave-one-out repeatability and
-//! the checks of `handeye::trust`).
+//! the checks of `handeye::quality::trust`).
 //!
 //! Each cell: eye-in-hand, pixel noise 0.2 px, robot noise 0.1 mm / 0.02 deg
 //! per axis, plus the misspecification named by the row. Columns: trials
@@ -16,10 +16,10 @@
 //!
 //! `cargo run --release --example handeye_coverage -- [TRIALS]` (default 100).
 
+use robocal::calib::pnp::camera_from_target_with_covariance;
+use robocal::calib::View;
 use robocal::camera::Camera;
-use robocal::handeye::pnp::camera_from_target_with_covariance;
-use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
-use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::solve::apply_pose_refinement_from_views;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
 use robocal::synth::handeye_looking::{
     grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,
@@ -80,7 +80,7 @@ fn trial(cell: &Cell, seed: u64) -> Option<(bool, bool, bool, bool, bool)> {
         ..Default::default()
     };
     let mut result = calibrate(&input, &options).ok()?;
-    let views: Vec<ViewPoints> = pixels;
+    let views: Vec<View> = pixels;
     apply_pose_refinement_from_views(&mut result, &input, &views, &used_camera, MotionPairs::All)
         .ok()?;
     let summary = result.pose_refinement.as_ref()?;

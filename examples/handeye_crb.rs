@@ -7,22 +7,24 @@
 //!
 //! Per trial: a seeded scene whose camera looks at a grid
 //! ([`robocal::synth::handeye_looking`]), pixels with Gaussian noise, camera
-//! poses by PnP ([`robocal::handeye::pnp`]), robot poses with Gaussian noise
+//! poses by PnP ([`robocal::calib::pnp`]), robot poses with Gaussian noise
 //! (`R <- exp(w) R`, `t <- t + v` in the base frame). The bound is the
 //! inverse Fisher information of `(X, Z)` at the truth with the true robot
 //! noise and each view's PnP covariance at the true pose times the pixel
 //! variance. `--trials-json` writes every trial's poses and truth for
-//! bench/handeye_crb_opencv.py (OpenCV 4.14 on the same trials).
+//! benches/handeye_crb_opencv.py (OpenCV 4.14 on the same trials).
 
 use nalgebra::Vector6;
+use robocal::calib::pnp::camera_from_target_with_covariance;
 use robocal::camera::Camera;
-use robocal::handeye::pnp::camera_from_target_with_covariance;
-use robocal::handeye::pose_noise::{CameraNoise, NoiseModel};
-use robocal::handeye::pose_refine::fisher_information;
-use robocal::handeye::pose_residual::difference;
-use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
-use robocal::handeye::refine_poses::{apply_pose_refinement, apply_pose_refinement_with, paired};
-use robocal::handeye::report::Errors;
+use robocal::handeye::quality::residuals::Errors;
+use robocal::handeye::refine::over_pixels::RefineMode;
+use robocal::handeye::refine::over_poses::paired;
+use robocal::handeye::refine::pose_noise::{CameraNoise, NoiseModel};
+use robocal::handeye::refine::pose_problem::fisher_information;
+use robocal::handeye::refine::pose_residual::difference;
+use robocal::handeye::solve::apply_refinement;
+use robocal::handeye::solve::{apply_pose_refinement, apply_pose_refinement_with};
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
 use robocal::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
 use robocal::synth::Rng;

@@ -1,6 +1,6 @@
 //! Render the marker-board comparison sets, detect them with robocal in this
 //! process (one thread, decoding excluded) and write everything for
-//! bench/compare_markers.py.
+//! benches/compare_markers.py.
 //!
 //! Usage: cargo run --release --example marker_compare -- OUT_DIR [--views N] [--repeat N]
 //!

@@ -1,5 +1,5 @@
 //! Render the benchmark image sets with ground truth (used by
-//! bench/compare_opencv.py).
+//! benches/compare_opencv.py).
 //!
 //! Usage: cargo run --release --example render_set -- OUT_DIR [--quick]
 //! Writes OUT_DIR/<set>/NNN.png and OUT_DIR/truth.json:
@@ -43,7 +43,11 @@ fn pose(target: &Target, cam: &Camera, rng: &mut Rng, set: &Set) -> Isometry3<f6
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let out = std::path::PathBuf::from(args.first().cloned().unwrap_or_else(|| "bench/out".into()));
+    let out = std::path::PathBuf::from(
+        args.first()
+            .cloned()
+            .unwrap_or_else(|| "benches/out".into()),
+    );
     let quick = args.iter().any(|a| a == "--quick");
     let n = |k: usize| if quick { k.div_ceil(4) } else { k };
     let pin = Camera::example_pinhole();

@@ -300,6 +300,27 @@ export interface DistortionModels {
 
 /** A lens model name (`model` of the calibration inputs and reports). */
 export type LensModel = keyof DistortionModels;
+/** A camera export format that holds a lens model, with the condition on its coefficients when there is one, e.g. `kalibr (with k3 held at 0)`. */
+export type LensExportFormat = CameraExportFormat | `${CameraExportFormat} (${string})`;
+/** One row of the core's lens-model table (src/camera/models.rs), as `lens_models()` lists it. */
+export interface LensModelInfo {
+  /** The `model` of the JSON and `--model`. */
+  name: LensModel;
+  /** Other names accepted for the model (`brown5` for `brown`), each with what it means. */
+  aliases: { name: string; means: string }[];
+  /** The short name the model advice writes ("Brown-Conrady"). */
+  label: string;
+  /** The text of the page's lens list: the label with the coefficients and the tools that know the model. */
+  description: string;
+  /** Coefficient names, in the order of the camera's parameter vector. */
+  coefficients: string[];
+  /** Where the solvers start each coefficient (same order). */
+  start_values: number[];
+  /** The camera export formats that hold the model (`json` always first). */
+  export_formats: LensExportFormat[];
+  /** A model for lenses past 90 degrees (always compared for a wide-angle lens). */
+  wide_angle: boolean;
+}
 /** A lens model with its coefficients: `{"model": "brown", "k1": -0.2, ...}`. */
 export type Distortion = { [M in LensModel]: { model: M } & DistortionModels[M] }[LensModel];
 
@@ -757,7 +778,6 @@ export type RigHandEyeReport = Omit<HandEyeReportBase, 'methods'> & {
   | { setup: 'eye-to-hand'; base_from_rig: PoseReport; gripper_from_target: PoseReport }
 );
 
-/** The output of `robocal rig --setup` (a camera rig on a robot): the rig report with `handeye`. */
 /** The input JSON of `calibrate_rig_handeye`: a camera rig on a robot. */
 export interface RigHandEyeInput {
   /** `eye-in-hand` (the rig on the gripper) or `eye-to-hand` (the rig fixed, the target on the gripper). */
@@ -772,6 +792,7 @@ export interface RigHandEyeInput {
   lenient?: boolean;
 }
 
+/** The output of `robocal rig --setup` (a camera rig on a robot): the rig report with `handeye`. */
 export interface RigOnRobotReport extends RigCalibration {
   kind: 'rig_handeye';
   handeye: RigHandEyeReport;
@@ -788,7 +809,7 @@ export interface ExportFile {
 }
 
 // ---------------------------------------------------------------------------
-// Hand-eye (src/api/handeye.rs, src/handeye/output.rs)
+// Hand-eye (src/api/handeye.rs, src/handeye/report.rs)
 
 /** Camera on the gripper (`eye-in-hand`) or fixed in the robot's world (`eye-to-hand`). */
 export type Setup = 'eye-in-hand' | 'eye-to-hand';
@@ -1557,6 +1578,8 @@ export interface RobocalJson {
   export_report: [ExportableReport, never];
   /** `export_formats()` -> the format names. */
   export_formats: [never, ExportFormatListEntry[]];
+  /** `lens_models()` -> the lens-model table, in menu order (the default, `brown`, first). */
+  lens_models: [never, LensModelInfo[]];
   /** `calibrate_rig(input)` -> the rig report. */
   calibrate_rig: [RigInput, RigCalibration];
   /** `calibrate_rig_handeye(input)` -> the rig report with `handeye` (a rig on a robot). */
@@ -1591,6 +1614,14 @@ export interface RobocalJson {
   pair_images: [string[], ImagePairing];
   /** `rig_frame_keys(JSON.stringify(cameras), groupBy)` (groupBy `'number'` or `'last'` (the last number in the name), `'first'`, `'order'`, a pattern with one `(\\d+)` such as `'sync(\\d+)'`, or `''`: by number unless no name has one) -> each image's frame key, as `robocal rig --group-by` groups them. */
   rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
+  /** `read_camera_file(text)` -> the camera of a robocal JSON (camera export or calibration report), OpenCV YAML/XML or ROS camera_info file, as `robocal rig --camera-file` reads it. */
+  read_camera_file: [never, CameraFileReading];
+}
+
+/** What `read_camera_file` returns: the camera (what a rig input's `cameras[i].camera` takes to hold its intrinsics) and the format it was read as. */
+export interface CameraFileReading {
+  camera: Camera;
+  format: 'json' | 'opencv-yaml' | 'opencv-xml' | 'ros-yaml';
 }
 
 /** One camera's image names, the input of `rig_frame_keys`. */

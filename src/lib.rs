@@ -45,12 +45,18 @@ pub mod image;
 pub mod io;
 pub mod optim;
 pub mod report_kind;
+pub mod rng;
 pub mod synth;
 pub mod target;
 pub mod workflows;
 
 #[cfg(feature = "wasm")]
 pub mod wasm;
+
+/// The layering rules of docs/architecture.md, checked from the imports
+/// (native only: it reads the source tree).
+#[cfg(all(test, not(target_arch = "wasm32")))]
+mod architecture_tests;
 
 pub use camera::{Camera, Distortion};
 pub use error::{Error, Result};

@@ -1,5 +1,6 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
-//! and demo.rs, live_capture.rs, rig_frames.rs and targets.rs beside it).
+//! and camera_file.rs, demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs,
+//! rig_handeye.rs and targets.rs beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
 //! errors as `JsError` whose message is the library's error text. Pixels
@@ -13,13 +14,19 @@
 //! a panic hook writes the message to `console.error` and records it so the
 //! JS side can show it ([`last_panic_message`]) instead of a dead worker.
 
+mod camera_file;
 mod demo;
+mod lens_models;
 mod live_capture;
 mod rig_frames;
+mod rig_handeye;
 mod targets;
+pub use camera_file::read_camera_file;
 pub use demo::{render_demo, DemoData};
+pub use lens_models::lens_models;
 pub use live_capture::LiveCapture;
 pub use rig_frames::rig_frame_keys;
+pub use rig_handeye::calibrate_rig_handeye;
 use targets::{detect_options_from, target_from};
 pub use targets::{parse_target, read_kalibr_target, target_points, target_spec, target_svg};
 
@@ -498,18 +505,6 @@ pub fn calibrate_rig(input_json: &str) -> Result<String, JsError> {
     crate::api::rig::calibrate_rig_json(input_json).map_err(js_error)
 }
 
-/// A camera rig on a robot: the JSON input and output of
-/// `robocal::api::rig_handeye::calibrate_rig_handeye_json` (`setup`,
-/// `base_from_gripper` one per frame in key order, `calibration` the input
-/// of `calibrate_rig`, optionally `rig` a calibrated rig report to hold;
-/// returns the rig report with `handeye`: `gripper_from_rig` or
-/// `base_from_rig` with its std), what `robocal rig --setup ... --poses`
-/// writes.
-#[wasm_bindgen]
-pub fn calibrate_rig_handeye(input_json: &str) -> Result<String, JsError> {
-    crate::api::rig_handeye::calibrate_rig_handeye_json(input_json).map_err(js_error)
-}
-
 /// An undistorted preview of image bytes taken by `camera_json` (the
 /// `camera` object of a calibration report): resampled through the same
 /// camera without distortion, longer side at most `max_side` px, as grey
@@ -526,7 +521,7 @@ pub fn undistort_preview(
         .map_err(|e| JsError::new(&format!("camera JSON: {e}")))?;
     let image = decode_gray(bytes, options_json)?;
     let preview = camera.pinhole_preview(max_side).map_err(js_error)?;
-    let out = crate::camera::undistort_image(&image, &camera, &preview).map_err(js_error)?;
+    let out = crate::image::undistort_image(&image, &camera, &preview).map_err(js_error)?;
     let rgba: Vec<u8> = out.pixels.iter().flat_map(|&g| [g, g, g, 255]).collect();
     image_data(&rgba, out.width, out.height)
 }

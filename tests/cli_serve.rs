@@ -2,7 +2,7 @@
 //! paths and folders without index, loopback-only binding; and the bounds
 //! (src/cli/serve_http.rs): 431 for an oversized head, 408 for a client that
 //! sends nothing while others are still served, 503 beyond the worker pool
-//! and its queue. Correctness only: the load test is bench/serve_load.py.
+//! and its queue. Correctness only: the load test is benches/serve_load.py.
 //!
 //! A test binary of its own (the others are one per capability): its tests
 //! time a server's answers, so they do not share the process with the

@@ -12,8 +12,8 @@ DICT_nXn_1000 (with other correction limits); the script checks that and
 stores each such bit table once (`table` lines), the dictionaries naming the
 table and how many of its first markers they use (`dict` lines).
 
-Usage (creates bench/.venv with the pinned OpenCV on first run, shared with
-the other OpenCV scripts, see bench/opencv_venv.py):
+Usage (creates benches/.venv with the pinned OpenCV on first run, shared with
+the other OpenCV scripts, see benches/opencv_venv.py):
     python3 tools/gen_marker_dictionaries.py
 The reference is opencv-python-headless==4.14.0.94. Running it again must
 reproduce the committed file byte for byte (`git diff` shows nothing).
@@ -31,8 +31,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(ROOT, "src", "target", "dictionaries.txt")
 
-sys.path.insert(0, os.path.join(ROOT, "bench"))
-from opencv_venv import ensure_venv  # noqa: E402  (the shared bench/.venv)
+sys.path.insert(0, os.path.join(ROOT, "benches"))
+from opencv_venv import ensure_venv  # noqa: E402  (the shared benches/.venv)
 
 # Every predefined dictionary in OpenCV's enum order, spelled as OpenCV's
 # documentation spells them.

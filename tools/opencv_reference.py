@@ -7,8 +7,8 @@ camera-frame points and the pixels cv2.projectPoints /
 cv2.fisheye.projectPoints give for them (identity pose, so the inputs are
 camera-frame points as robocal's Camera::project takes them).
 
-Usage (creates bench/.venv with the pinned OpenCV on first run, see
-bench/opencv_venv.py):
+Usage (creates benches/.venv with the pinned OpenCV on first run, see
+benches/opencv_venv.py):
     python3 tools/opencv_reference.py
 The reference is opencv-python-headless==4.14.0.94 (see issue 5).
 """
@@ -21,8 +21,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(ROOT, "fixtures", "opencv_project_points.json")
 
-sys.path.insert(0, os.path.join(ROOT, "bench"))
-from opencv_venv import ensure_venv  # noqa: E402  (the shared bench/.venv)
+sys.path.insert(0, os.path.join(ROOT, "benches"))
+from opencv_venv import ensure_venv  # noqa: E402  (the shared benches/.venv)
 
 
 def random_points(rng, n, max_angle_deg):

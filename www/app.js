@@ -8,6 +8,7 @@ import { initTarget } from './views/target.js';
 import { ImagesView } from './views/images.js';
 import { CaptureView } from './views/capture.js';
 import { CameraView } from './views/camera.js';
+import { loadLensModels } from './views/lens.js';
 import { RobotView } from './views/robot.js';
 import { HandEyeView } from './views/handeye.js';
 import { WorkflowsView } from './views/workflows.js';
@@ -104,6 +105,7 @@ async function openShared(fragment) {
   $('readonly-banner').hidden = false;
   for (const id of ['demo-button', 'new-session']) $(id).hidden = true;
   const images = { setResiduals() {} };
+  await loadLensModels(engine);
   const camera = new CameraView(store, engine, images, { readonly: true });
   new HandEyeView(store, engine, { pairs: () => [] }, { readonly: true });
   new ExportView(store, engine);
@@ -170,12 +172,14 @@ async function startSteps(versionPromise) {
     restoring.hidden = false;
   }
   initTarget(store, engine);
+  const lensModels = loadLensModels(engine);
   // Decoding and detection use up to 4 workers (one per core).
   const pool = new EnginePool(engine, Math.min(4, navigator.hardwareConcurrency || 1));
   const images = new ImagesView(store, engine, pool);
   await images.restore();
   // The live camera detects in a worker of its own: solves never hold up the preview.
   new CaptureView(store, images, engine, () => new Engine(), () => robotView);
+  await lensModels;
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);
   robotView = robot;

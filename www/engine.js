@@ -13,7 +13,7 @@ const STEPS = {
   preview: 'decoding', detect: 'detecting the target in', boards: 'detecting the boards in', undistort: 'undistorting', calibrate: 'solving the camera',
   handeye: 'solving the hand-eye calibration', rig: 'solving the rig', rigFrames: 'grouping the rig images into frames', export: 'exporting', poses: 'reading the robot poses',
   demo: 'rendering the demo', target: 'checking the target', kalibrTarget: 'reading the Kalibr target file', conventions: 'ranking the pose conventions',
-  workflow: 'solving the workflow', 'workflow-csv': 'reading the workflow file', frame: 'detecting the target in the live video', guide: 'updating the capture guide',
+  workflow: 'solving the workflow', lensModels: 'listing the lens models', 'workflow-csv': 'reading the workflow file', frame: 'detecting the target in the live video', guide: 'updating the capture guide',
 };
 
 export function stepText(op, args = {}) {

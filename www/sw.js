@@ -40,6 +40,8 @@ const SHELL = [
   'views/share.js',
   'views/rig.js',
   'views/rig-stereo.js',
+  'views/rig-robot.js',
+  'views/rig-intrinsics.js',
   'views/lens.js',
   'views/target.js',
   'views/workflows.js',

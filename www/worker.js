@@ -27,6 +27,11 @@ const handlers = {
   async version() {
     return { version: await ready };
   },
+  /** The core's lens-model table (camera::LENS_MODELS): the page's lens list. */
+  async lensModels() {
+    await ready;
+    return JSON.parse(robocal.lens_models());
+  },
   async preview({ bytes, maxSide, maxPixels }) {
     await ready;
     const p = robocal.decode_image_preview(new Uint8Array(bytes), maxSide, imageOptions(maxPixels));
@@ -134,6 +139,18 @@ handlers.rigFrames = async ({ cameras, groupBy }) => {
 handlers.rig = async ({ input }) => {
   await ready;
   return JSON.parse(robocal.calibrate_rig(input));
+};
+
+/** The rig on a robot: `robocal rig ... --setup SETUP --poses FILE`. */
+handlers.rigHandeye = async ({ input }) => {
+  await ready;
+  return JSON.parse(robocal.calibrate_rig_handeye(input));
+};
+
+/** A camera file (robocal JSON, OpenCV YAML/XML, ROS camera_info): `{camera, format}`. */
+handlers.cameraFile = async ({ text }) => {
+  await ready;
+  return JSON.parse(robocal.read_camera_file(text));
 };
 
 handlers.rigFormats = async () => {

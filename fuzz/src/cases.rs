@@ -183,7 +183,7 @@ pub fn robot_poses(data: &[u8]) {
     };
     let options = pose_options(format_byte, unit_byte);
     let options_json = serde_json::to_string(&options).unwrap_or_default();
-    let _ = robocal::io::poses_api::read_poses_json(text, &options_json);
+    let _ = robocal::api::poses::read_poses_json(text, &options_json);
     let _ = robocal::io::parse_pose_candidates(text, &options);
     if let Ok(parsed) = robocal::io::parse_poses(text, &options) {
         pose_round_trip(&parsed);
@@ -253,7 +253,7 @@ pub fn camera_files(data: &[u8]) {
                 camera_uses(&camera);
             }
             if let Ok(value) = serde_json::from_str::<serde_json::Value>(text) {
-                let _ = robocal::handeye::json_api::camera_from_json(&value);
+                let _ = robocal::api::handeye::camera_from_json(&value);
             }
         }
         _ => {
@@ -286,7 +286,7 @@ fn camera_uses(camera: &robocal::Camera) {
         let (w, h) = (32u32, 24u32);
         let pixels = (0..w * h).map(|i| (i * 7 % 251) as u8).collect();
         if let Ok(image) = GrayImage::new(w, h, pixels) {
-            let _ = robocal::camera::undistort_image(&image, camera, &preview);
+            let _ = robocal::image::undistort_image(&image, camera, &preview);
         }
     }
 }
@@ -375,14 +375,14 @@ fn detections(text: &str) {
             .unwrap_or_else(|e| panic!("written detection does not read back: {e}\n{written}"));
         assert_eq!(back, d, "{written}");
         let _ = d.correspondences();
-        views.push(robocal::calib::json_api::JsonView {
+        views.push(robocal::api::camera::JsonView {
             name: format!("view{i}"),
             detection: Some(d),
             object_m: None,
             image_px: None,
         });
     }
-    let _ = robocal::calib::json_api::views_of(&views);
+    let _ = robocal::api::camera::views_of(&views);
 }
 
 /// The camera calibration JSON entries: selector % 2 = 0 `calibrate_json`,
@@ -392,8 +392,8 @@ pub fn calib_json(data: &[u8]) {
         return;
     };
     let _ = match selector % 2 {
-        0 => robocal::calib::json_api::calibrate_json(text),
-        _ => robocal::calib::stereo_json::calibrate_stereo_json(text),
+        0 => robocal::api::camera::calibrate_json(text),
+        _ => robocal::api::stereo::calibrate_stereo_json(text),
     };
 }
 
@@ -404,8 +404,8 @@ pub fn handeye_json(data: &[u8]) {
         return;
     };
     let _ = match selector % 2 {
-        0 => robocal::handeye::json_api::solve_handeye_json(text),
-        _ => robocal::handeye::json_api::rank_candidates_json(text),
+        0 => robocal::api::handeye::solve_handeye_json(text),
+        _ => robocal::api::handeye::rank_candidates_json(text),
     };
 }
 
@@ -416,14 +416,14 @@ pub fn handeye_json(data: &[u8]) {
 /// `known_motion_solve`.
 pub fn workflows(data: &[u8]) {
     use robocal::io::workflow_csv as csv;
-    use robocal::workflows::{known_motion, planar_api, xytable};
+    use robocal::workflows::{known_motion, xytable};
     let Some((selector, text)) = selector_and_text(data) else {
         return;
     };
     match selector % 8 {
         0 => {
             if let Ok(matrices) = csv::parse_planar_matrices(text) {
-                let _ = planar_api::planar_fit(&planar_api::PlanarFitRequest {
+                let _ = robocal::api::planar::planar_fit(&robocal::api::planar::PlanarFitRequest {
                     matrices,
                     reject_threshold: None,
                     predict: vec![],
@@ -432,7 +432,7 @@ pub fn workflows(data: &[u8]) {
         }
         1 => {
             if let Ok(points) = csv::parse_planar_points(text) {
-                let _ = planar_api::planar_solve(&planar_api::PlanarSolveRequest {
+                let _ = robocal::api::planar::planar_solve(&robocal::api::planar::PlanarSolveRequest {
                     points,
                     options: Default::default(),
                     predict: vec![],
@@ -449,8 +449,8 @@ pub fn workflows(data: &[u8]) {
                 let _ = known_motion::solve_known_motion(&request);
             }
         }
-        4 => json_call(text, planar_api::planar_fit),
-        5 => json_call(text, planar_api::planar_solve),
+        4 => json_call(text, robocal::api::planar::planar_fit),
+        5 => json_call(text, robocal::api::planar::planar_solve),
         6 => json_call(text, xytable::solve_xytable),
         _ => json_call(text, known_motion::solve_known_motion),
     }

@@ -444,16 +444,17 @@ pub(crate) fn at_least_as_good(
 }
 
 /// The lens model of a name, with the coefficients the solver starts from
-/// (0, except EUCM's alpha 0.5 and beta 1: at alpha = 0 beta has no effect).
+/// (the table `camera::LENS_MODELS`).
 pub fn model_from_name(name: &str) -> Result<Distortion> {
-    match Distortion::zeroed(name) {
-        Some(Distortion::Eucm { beta, .. }) => Ok(Distortion::Eucm { alpha: 0.5, beta }),
-        Some(model) => Ok(model),
-        None => Err(Error::invalid(
+    Distortion::named(name).ok_or_else(|| {
+        Error::invalid(
             "model",
-            format!("unknown model '{name}' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none)"),
-        )),
-    }
+            format!(
+                "unknown model '{name}' (expected one of {})",
+                crate::camera::model_list()
+            ),
+        )
+    })
 }
 
 /// The solver options of the JSON options.

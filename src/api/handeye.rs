@@ -8,12 +8,12 @@
 //! [pose...], "camera_from_target": [pose...], "method": "all" | NAME,
 //! "bootstrap_samples": 100, "seed": 1, "strict_checks": true, "refine_poses":
 //! true}` (`refine_poses`: the maximum-likelihood pose refinement of
-//! [`crate::handeye::refine_poses`], on by default for pose input and for image
+//! [`crate::handeye::refine::over_poses`], on by default for pose input and for image
 //! points under `refine` none, the default; unused by the other modes) where a pose
 //! is a [`PoseInput`]: `{"matrix_row_major": [[4 numbers] x 4]}`,
 //! `{"translation_m": [x, y, z], "quaternion_xyzw": [x, y, z, w]}` (metres)
 //! or all three (a report's [`crate::geometry::PoseJson`]). Output: the
-//! [`crate::handeye::output::HandEyeReport`] JSON.
+//! [`crate::handeye::report::HandEyeReport`] JSON.
 //!
 //! Image points (optional): `"camera"` (a camera JSON: the robocal camera
 //! serde, a calibration report, or a string holding any format
@@ -25,8 +25,8 @@
 //! `"pixel_sigma_px"` (default 0.5), and `"camera_std"` (optional, `{"fx": std, ...}` in
 //! pixels; read from `camera` when that is a calibration report): with it, a
 //! joint refinement that moves an intrinsic by many standard deviations is
-//! warned about ([`crate::handeye::intrinsics_move`]). With views, `camera_from_target` may be
-//! left out: it is then computed per view by [`crate::handeye::pnp`]. Instead of
+//! warned about ([`crate::handeye::quality::intrinsics_move`]). With views, `camera_from_target` may be
+//! left out: it is then computed per view by [`crate::calib::pnp`]. Instead of
 //! `"views"`, `"detections"` may give one detection JSON per pose (the
 //! [`crate::target::Detection`] format, as `detect_target` returns it): the
 //! board points then come from each detection's own target.
@@ -34,14 +34,16 @@
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::PoseInput;
-use crate::handeye::checks::{
+use crate::calib::View;
+use crate::handeye::quality::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };
-use crate::handeye::intrinsics_move::{std_from_json, warn_intrinsic_move};
-use crate::handeye::output::HandEyeReport;
-use crate::handeye::refine_closed_form::{apply_refinement, RefineMode};
-use crate::handeye::reprojection_refine::ViewPoints;
-use crate::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
+use crate::handeye::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
+use crate::handeye::refine::over_pixels::RefineMode;
+use crate::handeye::report::HandEyeReport;
+use crate::handeye::solve::{
+    apply_refinement, calibrate, HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES,
+};
 use crate::handeye::{HandEyeMethod, Pose, Setup};
 use crate::target::Detection;
 use nalgebra::{Point2, Point3};
@@ -121,7 +123,7 @@ pub fn camera_from_json(value: &serde_json::Value) -> Result<Camera> {
     }
 }
 
-fn to_views(list: &[ViewIn]) -> Result<Vec<ViewPoints>> {
+fn to_views(list: &[ViewIn]) -> Result<Vec<View>> {
     list.iter()
         .enumerate()
         .map(|(i, v)| {
@@ -135,23 +137,21 @@ fn to_views(list: &[ViewIn]) -> Result<Vec<ViewPoints>> {
                     ),
                 ));
             }
-            Ok(ViewPoints {
-                object_points: v.object_m.iter().map(|p| Point3::from(*p)).collect(),
-                image_points: v.image_px.iter().map(|p| Point2::from(*p)).collect(),
-            })
+            Ok(View::new(
+                "",
+                v.object_m.iter().map(|p| Point3::from(*p)).collect(),
+                v.image_px.iter().map(|p| Point2::from(*p)).collect(),
+            ))
         })
         .collect()
 }
 
 /// The board points and pixels of each detection, in id order.
-fn views_from_detections(list: &[Detection]) -> Vec<ViewPoints> {
+fn views_from_detections(list: &[Detection]) -> Vec<View> {
     list.iter()
         .map(|d| {
             let (object_points, image_points) = d.correspondences();
-            ViewPoints {
-                object_points,
-                image_points,
-            }
+            View::new("", object_points, image_points)
         })
         .collect()
 }
@@ -161,18 +161,15 @@ fn views_from_detections(list: &[Detection]) -> Vec<ViewPoints> {
 /// with their robot pose (and given camera pose), each with a warning.
 /// A view list whose length differs from the poses' is kept whole, for the
 /// solver to refuse with its own message.
-fn leave_out_degenerate(
-    views: Vec<ViewPoints>,
-    input: &mut InputJson,
-) -> (Vec<ViewPoints>, Vec<String>) {
+fn leave_out_degenerate(views: Vec<View>, input: &mut InputJson) -> (Vec<View>, Vec<String>) {
     if views.len() != input.base_from_gripper.len() {
         return (views, Vec::new());
     }
     let problems: Vec<Option<String>> = views
         .iter()
         .map(|v| {
-            let planar = v.object_points.iter().all(|p| p.z == 0.0);
-            let board: Vec<Point2<f64>> = v.object_points.iter().map(|p| p.xy()).collect();
+            let planar = v.object_m.iter().all(|p| p.z == 0.0);
+            let board: Vec<Point2<f64>> = v.object_m.iter().map(|p| p.xy()).collect();
             crate::calib::homography_problem(&board).filter(|_| planar)
         })
         .collect();
@@ -355,7 +352,7 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                crate::handeye::pnp::camera_from_target(camera, v)
+                crate::calib::pnp::camera_from_target(camera, v)
                     .map(|p| p.0)
                     .map_err(|e| Error::invalid(format!("views[{i}]"), e.to_string()))
             })
@@ -391,7 +388,7 @@ pub fn solve_handeye_json(input_json: &str) -> Result<String> {
 #[derive(Clone, Copy, Debug)]
 pub struct ImagePoints<'a> {
     /// The board points and pixels of each pose pair's view, in pair order.
-    pub views: &'a [ViewPoints],
+    pub views: &'a [View],
     /// The camera that took them (held unless `refine` moves it).
     pub camera: &'a Camera,
     /// The camera calibration's standard deviations (`{"fx": std, ...}`,
@@ -433,7 +430,7 @@ pub fn solve_handeye(
         // No refinement over pixels: the pose refinement, with each view's
         // PnP covariance from its image points.
         if points.refine == RefineMode::None && points.refine_poses {
-            crate::handeye::refine_poses::apply_pose_refinement_from_views(
+            crate::handeye::solve::apply_pose_refinement_from_views(
                 &mut result,
                 input,
                 points.views,

@@ -39,8 +39,8 @@ use super::camera::{
     agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
     JsonView, LensModel,
 };
-use crate::calib::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
-use crate::calib::rig_report::RigCalibration;
+use crate::calib::multi::rig::{calibrate_rig, sort_frame_keys, RigCameraViews, RigOptions};
+use crate::calib::multi::rig_report::RigCalibration;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::target::Detection;

@@ -26,13 +26,12 @@
 //! JSON `robocal rig --setup ... -o rig.json` writes.
 
 use super::rig::{calibrate_rig_input, rig_views, RigInput};
-use crate::calib::rig::RigCameraViews;
-use crate::calib::rig_report::RigCalibration;
+use crate::calib::multi::rig::RigCameraViews;
+use crate::calib::multi::rig_report::RigCalibration;
 use crate::error::{Error, Result};
 use crate::geometry::PoseInput;
-use crate::handeye::reprojection_refine::ViewPoints;
 use crate::handeye::rig::{add_rig_uncertainty, calibrate_rig_handeye, rig_handeye_report};
-use crate::handeye::rig_uncertainty::{held_rig, rig_sigma_points};
+use crate::handeye::rig::uncertainty::{held_rig, rig_sigma_points};
 use crate::handeye::{HandEyeOptions, Pose, Setup};
 use crate::report_kind::ReportKind;
 use serde::Deserialize;
@@ -79,13 +78,7 @@ pub fn solve_rig_on_robot(
                     format!("frame index {f}, but there are {} frames", keys.len()),
                 )
             })?;
-            slot.push((
-                k,
-                ViewPoints {
-                    object_points: view.object_m.clone(),
-                    image_points: view.image_px.clone(),
-                },
-            ));
+            slot.push((k, view.clone()));
         }
     }
     let names: Vec<String> = report.cameras.iter().map(|c| c.name.clone()).collect();

@@ -30,7 +30,7 @@ use super::camera::{
     agreed_image_size, calibration_options, check_size, detection_sizes, views_of, JsonOptions,
     JsonView, LensModel, MIN_VIEWS,
 };
-use crate::calib::stereo::{calibrate_stereo, StereoCalibration};
+use crate::calib::multi::stereo::{calibrate_stereo, StereoCalibration};
 use crate::calib::View;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

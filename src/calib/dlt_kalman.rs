@@ -289,7 +289,7 @@ fn normalizers(
 mod tests {
     use super::super::dlt::scene;
     use super::*;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     fn relative_error(a: &Matrix3x4<f64>, b: &Matrix3x4<f64>) -> f64 {

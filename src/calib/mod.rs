@@ -3,10 +3,12 @@
 //! over intrinsics, distortion and every view pose ([`calibrate`]), with a
 //! report that carries residuals, uncertainties and warnings.
 //!
-//! Two cameras with shared views: [`stereo`] (right_from_left, seed 000),
-//! with its JSON boundary in [`crate::api::stereo`]; N cameras in synchronised
-//! frames: [`rig`] (every camera_from_rig), its result in [`rig_report`],
-//! its JSON boundary in [`crate::api::rig`].
+//! Several cameras ([`multi`]): two with shared views,
+//! [`multi::stereo`] (right_from_left, seed 000), with its JSON boundary in
+//! [`crate::api::stereo`]; N cameras in synchronised frames: [`multi::rig`]
+//! (every camera_from_rig), its result in [`multi::rig_report`], its JSON
+//! boundary in [`crate::api::rig`]. The camera pose of one view from its
+//! points: [`pnp`].
 //!
 //! From 3-D/2-D point pairs of a non-planar target (seed 002):
 //! - [`dlt`]: the 12-parameter projection matrix, decomposed into K, R, t;
@@ -22,23 +24,14 @@ pub mod ekf;
 mod evaluate;
 mod homography;
 pub mod model_advice;
+pub mod multi;
 pub mod plausibility;
+pub mod pnp;
 mod refine;
 mod rejected;
 mod report;
 mod residuals;
-pub mod rig;
-mod rig_graph;
-mod rig_init;
-mod rig_problem;
-pub mod rig_report;
-mod same_images;
 pub mod starts;
-pub mod stereo;
-mod stereo_problem;
-pub mod stereo_rectify;
-#[cfg(test)]
-mod stereo_tests;
 mod tsai;
 pub mod usable;
 mod zhang;

@@ -24,7 +24,7 @@
 //!
 //! Only a model fitted to the same views is ever recommended; among those
 //! that fit about equally (within [`SAME_FIT_RATIO`]), the one more export
-//! formats hold ([`EXPORT_FORMATS`]), so a fisheye gets kannala_brandt
+//! formats hold ([`export_formats`]), so a fisheye gets kannala_brandt
 //! (OpenCV's fisheye, ROS equidistant, Kalibr) before division (JSON and
 //! Halcon only). A wide-angle lens (half the diagonal field of view above
 //! [`WIDE_ANGLE_HALF_DIAGONAL_DEG`]) always has kannala_brandt and EUCM in
@@ -40,8 +40,7 @@ use super::compare::{calibrate_with, Method};
 use super::report::CameraCalibration;
 use super::zhang::CalibrationOptions;
 use super::View;
-use crate::api::camera::model_from_name;
-use crate::camera::Camera;
+use crate::camera::{Camera, Distortion, LensModel, MODEL_NAMES};
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};
 
@@ -89,108 +88,37 @@ pub const SAME_FIT_RATIO: f64 = 1.02;
 /// See [`SAME_FIT_RATIO`].
 pub const SAME_FIT_PX: f64 = 0.002;
 
-/// The models tried, with the names people know them by.
-const MODELS: [(&str, &str); 6] = [
-    ("brown", "Brown-Conrady"),
-    ("radial_k1_k2_k5", "radial k1 k2 k5"),
-    ("rational", "rational"),
-    ("division", "division"),
-    ("kannala_brandt", "Kannala-Brandt (fisheye)"),
-    ("eucm", "EUCM"),
-];
+/// The row of `model` in the lens-model table.
+fn row(model: &str) -> Option<&'static LensModel> {
+    LensModel::named(model)
+}
 
+/// The short name of `model` for a message (its name when unknown).
 fn label(model: &str) -> &str {
-    MODELS
-        .iter()
-        .find(|(n, _)| *n == model)
-        .map_or(model, |(_, l)| l)
+    row(model).map_or(model, |m| m.label)
 }
 
 fn coefficient_count(model: &str) -> usize {
-    model_from_name(model).map_or(0, |d| d.coefficients().len())
+    row(model).map_or(0, |m| m.coefficients.len())
 }
 
-/// What `robocal export` can write a camera of each model to (camera
-/// formats; `text` holds no lens model and is left out). A condition in
-/// parentheses says what the coefficients must be. Mirrors
-/// `io::export_camera` (the io tests check every entry against it).
-pub const EXPORT_FORMATS: [(&str, &[&str]); 7] = [
-    (
-        "none",
-        &[
-            "json",
-            "opencv-yaml",
-            "opencv-xml",
-            "ros-yaml",
-            "kalibr",
-            "mrcal",
-            "halcon",
-            "matlab",
-        ],
-    ),
-    (
-        "brown",
-        &[
-            "json",
-            "opencv-yaml",
-            "opencv-xml",
-            "ros-yaml",
-            "kalibr (with k3 held at 0)",
-            "mrcal",
-            "halcon",
-            "matlab",
-        ],
-    ),
-    (
-        "radial_k1_k2_k5",
-        &[
-            "json",
-            "opencv-yaml",
-            "opencv-xml",
-            "ros-yaml",
-            "kalibr (with k5 held at 0)",
-            "mrcal",
-            "halcon",
-            "matlab",
-        ],
-    ),
-    (
-        "rational",
-        &["json", "opencv-yaml", "opencv-xml", "ros-yaml", "mrcal"],
-    ),
-    ("division", &["json", "halcon"]),
-    (
-        "kannala_brandt",
-        &[
-            "json",
-            "opencv-yaml (cv2.fisheye)",
-            "opencv-xml (cv2.fisheye)",
-            "ros-yaml (equidistant)",
-            "kalibr (equidistant)",
-        ],
-    ),
-    ("eucm", &["json", "kalibr (eucm)"]),
-];
-
-/// The export formats of `model` (see [`EXPORT_FORMATS`]).
+/// What `robocal export` can write a camera of `model` to: the table's
+/// `export_formats` (camera formats; `text` holds no lens model and is left
+/// out). A condition in parentheses says what the coefficients must be. The
+/// io tests check every entry against `io::export_camera`.
 pub fn export_formats(model: &str) -> &'static [&'static str] {
-    EXPORT_FORMATS
-        .iter()
-        .find(|(m, _)| *m == model)
-        .map_or(&[], |(_, f)| f)
+    row(model).map_or(&[], |m| m.export_formats)
 }
 
 /// The format names of `model`, without conditions.
 fn format_names(model: &str) -> Vec<&'static str> {
-    export_formats(model)
-        .iter()
-        .map(|f| f.split(" (").next().unwrap_or(f))
-        .collect()
+    row(model).map_or_else(Vec::new, |m| m.format_names().collect())
 }
 
-/// Kannala-Brandt and EUCM: the models for lenses past 90 degrees.
+/// The models for lenses past 90 degrees (the table's `wide_angle`:
+/// Kannala-Brandt and EUCM).
 fn is_fisheye(model: &str) -> bool {
-    matches!(model, "kannala_brandt" | "eucm")
+    row(model).is_some_and(|m| m.wide_angle)
 }
 
 fn can_go_to_opencv(model: &str) -> bool {
@@ -292,10 +220,9 @@ pub fn advise(
 ) -> ModelAdvice {
     let chosen = report.model.as_str();
     // Coefficients held at 0 are not fitted: they count for nothing.
-    let held = model_from_name(chosen).map_or(0, |d| {
-        let names = d.coefficient_names();
+    let held = row(chosen).map_or(0, |m| {
         let held = &options.fixed_coefficients;
-        names
+        m.coefficients
             .iter()
             .filter(|n| held.iter().any(|h| h == *n))
             .count()
@@ -309,13 +236,14 @@ pub fn advise(
     // 1. The models to fit: all when the model does not fit; else those with
     // fewer coefficients, and the fisheye models for a wide-angle lens.
     let mut fits: Vec<ModelFit> = Vec::new();
-    for (name, _) in MODELS {
+    // Every model of the table but the pinhole (no model is simpler).
+    for name in MODEL_NAMES.into_iter().filter(|n| *n != "none") {
         let n = coefficient_count(name);
         let fisheye = is_fisheye(name);
         if name == chosen || !(far_off || n < n_chosen || (wide && fisheye)) {
             continue;
         }
-        let Ok(model) = model_from_name(name) else {
+        let Some(model) = Distortion::named(name) else {
             continue;
         };
         let alternative = CalibrationOptions {

@@ -136,7 +136,7 @@ fn advice_of(truth: &Camera, model: &str, n: usize) -> ModelAdvice {
         })
         .collect();
     let options = CalibrationOptions {
-        model: model_from_name(model).unwrap(),
+        model: Distortion::named(model).unwrap(),
         ..CalibrationOptions::default()
     };
     let size = (truth.width, truth.height);

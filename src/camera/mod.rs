@@ -18,6 +18,7 @@ mod division;
 mod eucm;
 mod examples;
 mod kannala_brandt;
+mod models;
 mod polynomial;
 mod undistort;
 
@@ -25,7 +26,8 @@ mod undistort;
 mod tests;
 
 pub use distortion::Distortion;
-pub use undistort::{remap_gray, undistort_image, UndistortMap};
+pub use models::{model_help, model_list, LensModel, LENS_MODELS, MODEL_NAMES};
+pub use undistort::UndistortMap;
 
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, Matrix2, Matrix2x3, Matrix3, Point2, Point3, Vector2, Vector3};
@@ -238,66 +240,5 @@ impl Camera {
         let my = (pixel.y - self.cy) / self.fy;
         let mx = (pixel.x - self.cx - self.skew * my) / self.fx;
         Ok(Vector2::new(mx, my))
-    }
-}
-
-/// The lens-model names of [`Distortion::model_name`], in menu order.
-pub const MODEL_NAMES: [&str; 7] = [
-    "none",
-    "brown",
-    "rational",
-    "division",
-    "radial_k1_k2_k5",
-    "kannala_brandt",
-    "eucm",
-];
-
-impl Distortion {
-    /// The model called `name` (see [`Distortion::model_name`]; `brown5`,
-    /// OpenCV's five coefficients, is another name for `brown`) with every
-    /// coefficient 0 (EUCM: alpha 0, beta 1); `None` for an unknown name.
-    pub fn zeroed(name: &str) -> Option<Distortion> {
-        let template = match name {
-            "none" => Distortion::None,
-            "brown" | "brown5" => Distortion::Brown {
-                k1: 0.0,
-                k2: 0.0,
-                k3: 0.0,
-                p1: 0.0,
-                p2: 0.0,
-            },
-            "rational" => Distortion::Rational {
-                k1: 0.0,
-                k2: 0.0,
-                k3: 0.0,
-                k4: 0.0,
-                k5: 0.0,
-                k6: 0.0,
-                p1: 0.0,
-                p2: 0.0,
-                s1: 0.0,
-                s2: 0.0,
-                s3: 0.0,
-                s4: 0.0,
-            },
-            "division" => Distortion::Division { kappa: 0.0 },
-            "radial_k1_k2_k5" => Distortion::RadialK1K2K5 {
-                k1: 0.0,
-                k2: 0.0,
-                k5: 0.0,
-            },
-            "kannala_brandt" => Distortion::KannalaBrandt {
-                k1: 0.0,
-                k2: 0.0,
-                k3: 0.0,
-                k4: 0.0,
-            },
-            "eucm" => Distortion::Eucm {
-                alpha: 0.0,
-                beta: 1.0,
-            },
-            _ => return None,
-        };
-        Some(template)
     }
 }

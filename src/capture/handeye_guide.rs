@@ -1,9 +1,9 @@
 //! Hand-eye capture guidance: how diverse the robot's rotations between the
 //! kept frames are, with the core's motion-diversity measure
-//! ([`crate::handeye::motion::axis_spread`]).
+//! ([`crate::handeye::closed_form::motion::axis_spread`]).
 
 use crate::geometry::Pose;
-use crate::handeye::motion::axis_spread;
+use crate::handeye::closed_form::motion::axis_spread;
 use crate::handeye::MIN_MOTION_ROTATION_DEG;
 use serde::Serialize;
 

@@ -13,7 +13,7 @@ use crate::detect::{detect, DetectOptions};
 use crate::error::{Error, Result};
 use crate::geometry::Pose;
 use crate::image::GrayImage;
-use crate::synth::video::board_side_m;
+use crate::target::placement::board_side_m;
 use crate::target::{DetectedPoint, Detection, Target};
 use nalgebra::Point2;
 use serde::Serialize;

@@ -36,7 +36,7 @@ use super::coverage::{cell_counts, signature, Coverage, Signature};
 use crate::calib::CameraCalibration;
 use crate::camera::Camera;
 use crate::geometry::{Pose, PoseJson};
-use crate::synth::video::{board_side_m, fitted_pose, print_outline};
+use crate::target::placement::{board_side_m, fitted_pose, print_outline};
 use crate::target::Target;
 use nalgebra::{DMatrix, Matrix3, Point2, Point3, SymmetricEigen, UnitQuaternion, Vector3};
 use serde::Serialize;

@@ -4,7 +4,8 @@
 
 use super::*;
 use crate::geometry::rotation_from_rotvec;
-use crate::synth::{render, BoardVideo, RenderOptions, Rng, VideoOptions};
+use crate::rng::Rng;
+use crate::synth::{render, BoardVideo, RenderOptions, VideoOptions};
 use crate::target::{DetectedPoint, Detection, Target};
 use nalgebra::{Translation3, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;

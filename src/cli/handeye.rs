@@ -7,8 +7,8 @@ use super::handeye_images::{
 use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
 use robocal::api::handeye::{camera_from_json, solve_handeye, ImagePoints, DEFAULT_PIXEL_SIGMA_PX};
-use robocal::handeye::intrinsics_move::std_from_json;
-use robocal::handeye::refine_closed_form::RefineMode;
+use robocal::handeye::quality::intrinsics_move::std_from_json;
+use robocal::handeye::refine::over_pixels::RefineMode;
 use robocal::handeye::{HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
 use robocal::io::pose_text::{parse_pose_text, PoseTextFormat};
 
@@ -357,7 +357,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
 
 /// Too few pose pairs after images were dropped: the error lists them and
 /// why (the report that would say so is not written).
-fn with_dropped(e: robocal::Error, pairs: &[robocal::handeye::output::PairAudit]) -> CliError {
+fn with_dropped(e: robocal::Error, pairs: &[robocal::handeye::report::PairAudit]) -> CliError {
     let dropped: Vec<String> = pairs
         .iter()
         .filter(|p| !p.used)

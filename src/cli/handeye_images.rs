@@ -7,13 +7,13 @@
 use super::detect::{run_all, Outcome};
 pub(super) use super::robot_poses::RobotPoses;
 use super::CliError;
+use robocal::calib::pnp::camera_from_target;
+use robocal::calib::View;
 use robocal::camera::Camera;
 use robocal::detect::DetectOptions;
-use robocal::handeye::checks::{rank_pose_candidates, recommend_candidate};
-use robocal::handeye::output::PairAudit;
-use robocal::handeye::pairing::better_rule;
-use robocal::handeye::pnp::camera_from_target;
-use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::quality::checks::{rank_pose_candidates, recommend_candidate};
+use robocal::handeye::quality::pairing::better_rule;
+use robocal::handeye::report::PairAudit;
 use robocal::handeye::{Pose, Setup};
 use robocal::io::pose_pairing::{alternatives, numeric_order, pair_poses};
 use robocal::io::RobotPose;
@@ -26,7 +26,7 @@ pub(super) struct ImagePairs {
     /// Target poses fitted to the used images.
     pub camera_from_target: Vec<Pose>,
     /// Image points of the used images.
-    pub views: Vec<ViewPoints>,
+    pub views: Vec<View>,
     /// Every pose with its image and fate.
     pub pairs: Vec<PairAudit>,
     /// Warnings about pairing and pose-format choice.
@@ -153,15 +153,12 @@ pub(super) fn image_pairs(
     strict: bool,
 ) -> Result<ImagePairs, CliError> {
     let mut warnings = Vec::new();
-    let mut fitted: Vec<Result<(ViewPoints, Pose, f64), String>> = Vec::new();
+    let mut fitted: Vec<Result<(View, Pose, f64), String>> = Vec::new();
     for outcome in outcomes {
         fitted.push(match outcome {
             Outcome::Found(detection, _) => {
                 let (object, image) = detection.correspondences();
-                let view = ViewPoints {
-                    object_points: object,
-                    image_points: image,
-                };
+                let view = View::new("", object, image);
                 camera_from_target(camera, &view)
                     .map(|(pose, rms)| (view, pose, rms))
                     .map_err(|e| format!("target pose failed: {e}"))
@@ -262,12 +259,12 @@ pub(super) fn image_pairs(
 /// Prove the pairing against the camera motion: when another simple rule
 /// (numeric or lexicographic order, the order given) fits the rotation
 /// angles of the motions and the pairing made does not, say which
-/// (`robocal::handeye::pairing`).
+/// (`robocal::handeye::quality::pairing`).
 fn check_pairing(
     setup: Setup,
     robot: &[RobotPose],
     images: &[String],
-    fitted: &[Result<(ViewPoints, Pose, f64), String>],
+    fitted: &[Result<(View, Pose, f64), String>],
     pairing: &PosePairs,
     used: &[(usize, usize)],
 ) -> Option<String> {

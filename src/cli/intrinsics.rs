@@ -44,9 +44,7 @@ pub struct IntrinsicsArgs {
     /// Use the JSON written by 'robocal detect' instead of images
     #[arg(long, value_name = "FILE")]
     detections: Option<String>,
-    /// brown (default: k1 k2 p1 p2 k3; also called brown5, OpenCV's 5
-    /// coefficients), radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none
-    #[arg(long, value_name = "NAME")]
+    #[arg(long, value_name = "NAME", help = robocal::camera::model_help("the camera"))]
     model: Option<String>,
     /// zhang (default), dlt (non-coplanar points), tsai, ekf, or all (every
     /// method side by side, as seed 000's Table II; the report is Zhang's, the

@@ -42,6 +42,7 @@ pub fn write_rig(args: RigArgs) -> Result<(), CliError> {
         side_frames: args.side_frames,
         noise_px: 0.0,
         partial_fraction: 0.0,
+        timing_ms: 0.0,
     };
     let scene = rig_scene(&config, args.seed);
     let target = rig_target();

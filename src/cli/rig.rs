@@ -6,8 +6,8 @@ use super::{read_text, write_output, CliError};
 use robocal::api::camera::{JsonOptions, LensModel};
 use robocal::api::rig::{calibrate_rig_input, rig_views, RigInput, RigJsonCamera, RigJsonView};
 use robocal::api::rig_handeye::{rig_cameras_named, with_handeye};
-use robocal::calib::rig::{sort_frame_keys, RigCameraViews};
-use robocal::calib::rig_report::RigCalibration;
+use robocal::calib::multi::rig::{sort_frame_keys, RigCameraViews};
+use robocal::calib::multi::rig_report::RigCalibration;
 use robocal::camera::Camera;
 use robocal::io::import_camera::import_camera;
 use robocal::io::pairing::{default_grouping, frame_keys, FrameGrouping};
@@ -106,9 +106,7 @@ pub struct RigArgs {
     /// each camera's list), or a pattern with one (\d+) such as 'sync(\d+)'
     #[arg(long, value_name = "RULE", overrides_with = "group_by")]
     group_by: Option<String>,
-    /// Lens model of the solved cameras: brown (default), radial_k1_k2_k5,
-    /// rational, division, kannala_brandt, eucm, none
-    #[arg(long, value_name = "NAME", overrides_with = "model")]
+    #[arg(long, value_name = "NAME", overrides_with = "model", help = robocal::camera::model_help("the solved cameras"))]
     model: Option<String>,
     /// Hold a distortion coefficient of every solved camera at 0
     /// (repeatable: --fix k3 gives Kalibr's radtan k1 k2 p1 p2)

@@ -7,8 +7,8 @@
 use super::robot_poses::{read_pose_source, read_robot_poses, RobotPoses};
 use super::CliError;
 use robocal::api::rig_handeye::solve_rig_on_robot;
-use robocal::calib::rig::RigCameraViews;
-use robocal::calib::rig_report::RigCalibration;
+use robocal::calib::multi::rig::RigCameraViews;
+use robocal::calib::multi::rig_report::RigCalibration;
 use robocal::handeye::{HandEyeOptions, Setup};
 use robocal::io::pairing::FrameGrouping;
 use robocal::io::RobotPose;

@@ -1,6 +1,6 @@
 //! The summary `robocal rig` writes on standard error.
 
-use robocal::calib::rig_report::RigCalibration;
+use robocal::calib::multi::rig_report::RigCalibration;
 
 /// The summary on standard error: per camera views, rms, extrinsics with
 /// std; the co-observation table; warnings.

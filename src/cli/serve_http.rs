@@ -36,7 +36,7 @@
 //! Threads are `workers + 1`, memory about `workers * (max_head_bytes +
 //! CHUNK)` plus the queued sockets, whatever the load. The price of blocking
 //! workers: a flood of more than `workers + queue` connections at once is
-//! answered 503 while it lasts (measured with bench/serve_load.py:
+//! answered 503 while it lasts (measured with benches/serve_load.py:
 //! BENCHMARKS.md, "robocal serve under load").
 //!
 //! GET and HEAD only (405 otherwise), `Connection: close` on every response,

@@ -68,9 +68,7 @@ pub struct StereoArgs {
     /// The right camera's detections (instead of --right)
     #[arg(long, value_name = "FILE", overrides_with = "right_detections")]
     right_detections: Option<String>,
-    /// Lens model of both cameras: brown (default), radial_k1_k2_k5, rational,
-    /// division, kannala_brandt, eucm, none
-    #[arg(long, value_name = "NAME", overrides_with = "model")]
+    #[arg(long, value_name = "NAME", overrides_with = "model", help = robocal::camera::model_help("both cameras"))]
     model: Option<String>,
     /// Images detected in parallel (default: all cores)
     #[arg(long, value_name = "N", overrides_with = "threads")]

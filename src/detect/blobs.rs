@@ -8,7 +8,7 @@
 //! step below, not from the threshold.
 
 use super::ellipse::{fit_ellipse, EllipseFit};
-use super::filter::Plane;
+use crate::image::filter::Plane;
 use crate::image::GrayImage;
 use nalgebra::{Matrix2, Point2, Vector2};
 
@@ -264,7 +264,7 @@ pub(crate) fn refine_blob(
 /// radius so a small dot's window stays on its own edge). It covers the
 /// edge of the renders' 0.7 px blur and of a lens slightly out of focus;
 /// 1.5-3.5 px gave the same centre errors on the renders of
-/// tests/detect/detect_circles.rs (BENCHMARKS.md, issue 20, session 16).
+/// tests/detect/detect_circles.rs (docs/benchmark-history.md, issue 20, session 16).
 const EDGE_HALF_WINDOW_PX: f64 = 2.5;
 /// Sample spacing of that window, px.
 const EDGE_SAMPLE_PX: f64 = 0.25;
@@ -334,7 +334,7 @@ fn edge_on_ray(
 /// the centres, the centroid 0.0023-0.0038 px, and the intrinsics error
 /// from the twelve views fell from 0.136 to 0.041 px through the strongly
 /// distorted camera, from 0.056 to 0.009 px through the 'std' one
-/// (BENCHMARKS.md, issue 20, session 16).
+/// (docs/benchmark-history.md, issue 20, session 16).
 fn gradient_centroid(at: &dyn Fn(f64) -> f64, t0: f64, hw: f64) -> f64 {
     let ds = EDGE_SAMPLE_PX;
     // Offsets of the gradient's sample points from t0, in grid steps: the

@@ -165,7 +165,8 @@ fn pole_iteration(
 /// undistorted centres are best fitted by one homography. Without it the
 /// local maps of circles at the board's edges, whose windows lie on one
 /// side of them, extrapolate the lens's bending (0.03 px mean, 0.11 px max
-/// on ~40-px circles at 45 degrees through k1 = -0.28, BENCHMARKS.md).
+/// on ~40-px circles at 45 degrees through k1 = -0.28,
+/// docs/benchmark-history.md).
 struct Radial {
     c: Vector2<f64>,
     s: f64,

@@ -17,12 +17,12 @@
 //!    90 degrees: use a board with `cols + rows` odd (e.g. 9x6) for
 //!    multi-view work.
 
-use super::filter::{box_level, to_full, Plane};
 use super::lattice::{self, Cells, PointIndex};
 use super::refine::refine_saddle;
 use super::saddle::{self, Candidate};
 use super::DetectOptions;
 use crate::error::{Error, Result};
+use crate::image::filter::{box_level, to_full, Plane};
 use crate::image::GrayImage;
 use crate::target::DetectedPoint;
 use nalgebra::{Point2, Vector2};
@@ -202,7 +202,7 @@ fn grow_from(
 
 /// Refinement window (half-side) as a fraction 1 / this of the local grid
 /// step, capped at [`MAX_WINDOW_PX`]. Measured on the bench sets
-/// (bench/compare_opencv.py): step / 6 capped at 6 px gives 0.015 px mean
+/// (benches/compare_opencv.py): step / 6 capped at 6 px gives 0.015 px mean
 /// error at noise sigma 2 where step / 3 capped at 12 px gave 0.025 px:
 /// larger windows take in more of the pattern the quadratic model does not
 /// describe and more clutter (the board's frame, thin outer squares).

@@ -5,10 +5,10 @@
 
 use super::blobs::{find_blobs, refine_blob, Blob};
 use super::centres::circle_centres;
-use super::filter::to_full;
 use super::lattice::{self, PointIndex};
 use super::DetectOptions;
 use crate::error::{Error, Result};
+use crate::image::filter::to_full;
 use crate::image::GrayImage;
 use crate::target::{DetectedPoint, Polarity, Target};
 use nalgebra::{Matrix2, Point2, Vector2};

@@ -89,7 +89,7 @@ pub(crate) fn fit_ellipse(points: &[Point2<f64>]) -> Option<EllipseFit> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     #[wasm_bindgen_test(unsupported = test)]

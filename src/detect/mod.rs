@@ -82,7 +82,7 @@
 //! (vignetting, gradients) one image was at 0.033 px mean, 0.11 px max
 //! without the radial step, the error on the board's edge circles, whose
 //! windows lie on one side of them and extrapolate the lens's bending;
-//! with it 0.008 / 0.021 px (BENCHMARKS.md, Session 10; the test
+//! with it 0.008 / 0.021 px (docs/benchmark-history.md, Session 10; the test
 //! `large_steep_circles_with_vignetting_through_strong_distortion`). A
 //! quadratic term on top of each local homography changes the centres by
 //! less than 0.001 px, so the default is the plain homography. No
@@ -104,7 +104,6 @@ mod centres;
 pub(crate) mod chessboard;
 mod circles;
 mod ellipse;
-pub(crate) mod filter;
 mod lattice;
 pub mod markers;
 pub mod polarity;
@@ -113,10 +112,10 @@ mod saddle;
 mod squares;
 
 use crate::error::{Error, Result};
+use crate::image::filter::Plane;
 use crate::image::GrayImage;
 pub use crate::target::CentreModel;
 use crate::target::{DetectedPoint, Detection, Polarity, Target};
-use filter::Plane;
 
 /// Smallest image side the detectors accept, pixels.
 pub const MIN_IMAGE_SIDE_PX: u32 = 16;
@@ -424,7 +423,7 @@ fn downsample_gray(img: &GrayImage) -> Plane {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     #[wasm_bindgen_test(unsupported = test)]

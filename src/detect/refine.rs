@@ -15,8 +15,8 @@
 //! Fitting at the pixels themselves, whose offsets from a centre between
 //! pixels are not symmetric, biased the corner with its sub-pixel phase
 //! (+-0.007 px on a frontal board, the mean over a board shifted by
-//! fractions of a pixel; BENCHMARKS.md, "Chessboard corners: the fit
-//! points' phase").
+//! fractions of a pixel; docs/benchmark-history.md, "Session 14: chessboard
+//! corners: the fit points' phase").
 //!
 //! Cost: the smoothing is never applied to the patch. Weights, basis and
 //! smoothing are all separable, so each right-hand side of the normal
@@ -25,7 +25,7 @@
 //! per iteration and the patch is reduced row by row (three dot products
 //! per row). The normal matrix is a product of 1-D weight moments.
 
-use super::filter::gaussian_radius;
+use crate::image::filter::gaussian_radius;
 use crate::image::GrayImage;
 use nalgebra::{Matrix2, Matrix6, Point2, Vector2, Vector6};
 

@@ -7,7 +7,7 @@
 //! relative to the strongest response become candidates. The Hessian also
 //! gives each candidate's polarity for the grid growth.
 
-use super::filter::Plane;
+use crate::image::filter::Plane;
 use nalgebra::{Matrix2, Point2};
 
 /// Smoothing of the working pyramid level before differentiation, pixels.

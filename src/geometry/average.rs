@@ -88,7 +88,7 @@ pub fn average_rotations_chordal(
 mod tests {
     use super::*;
     use crate::geometry::{rotation_angle_between, rotation_from_rotvec};
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use nalgebra::Vector3;
     use std::f64::consts::PI;
     use wasm_bindgen_test::wasm_bindgen_test;

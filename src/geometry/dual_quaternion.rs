@@ -84,7 +84,7 @@ impl DualQuaternion {
 mod tests {
     use super::*;
     use crate::geometry::rotation_from_rotvec;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use std::f64::consts::PI;
     use wasm_bindgen_test::wasm_bindgen_test;
 

@@ -215,7 +215,7 @@ fn intrinsic_angles(rotation: &Rotation, order: EulerOrder) -> [f64; 3] {
 mod tests {
     use super::*;
     use crate::geometry::rotation_angle_between;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use std::f64::consts::{FRAC_PI_2, PI};
     use wasm_bindgen_test::wasm_bindgen_test;
 

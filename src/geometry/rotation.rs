@@ -224,7 +224,7 @@ pub fn matrix4_from_pose(pose: &Pose) -> Matrix4<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use std::f64::consts::PI;
     use wasm_bindgen_test::wasm_bindgen_test;
 

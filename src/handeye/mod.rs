@@ -29,48 +29,26 @@
 //! `robot[i] * X = Z * camera[i]^-1` with `Z = y`, solved for both at once
 //! without forming motions.
 //!
-//! Pipeline: [`checks`] catches degenerate data and input mistakes before
-//! solving, [`solve`] runs the closed forms, [`report`] measures closure
-//! residuals and motion diversity, [`repeat`] gives leave-one-out and
-//! bootstrap repeatability. [`reprojection_refine`] is the image-based
-//! maximum-likelihood problem (reprojection error over X, the target pose
-//! and optionally the intrinsics); [`refine_closed_form`] applies it to a
-//! closed-form result and makes the refined transform the primary one.
-//! [`pose_refine`] is the maximum-likelihood problem over the poses alone
-//! (`A_i X = Z B_i` per view, weighted by robot and camera pose noise
-//! estimated from the data); [`refine_poses`] applies it by default on the
-//! pose path (`HandEyeOptions::refine_poses`). [`rig`] solves a whole camera
-//! rig's transform (`gripper_from_rig`, `base_from_rig`) from every camera's
-//! views together ([`rig_pnp`]: one board pose per frame over the held rig).
+//! # Layout, by stage
+//!
+//! [`solve`] is the orchestrator: it runs [`quality::checks`] on the input,
+//! the [`closed_form`] solvers, picks the primary solution, then the
+//! refinements of [`refine`] (over the poses by default, over the pixels of
+//! the image path), and it alone writes the [`HandEyeResult`]: the refiners
+//! return what they found. [`quality`] measures the result (closure
+//! residuals, repeatability, whether the reported uncertainty can be
+//! trusted) and catches input mistakes; [`report`] is the JSON report.
+//! [`rig`] solves a whole camera rig's transform (`gripper_from_rig`,
+//! `base_from_rig`) from every camera's views together. The camera pose of
+//! one view from its points (PnP) is [`crate::calib::pnp`].
 
-pub mod axxb;
-pub mod axzb;
-pub mod checks;
-pub mod daniilidis;
-pub mod gross;
-pub mod intrinsics_move;
+pub mod closed_form;
 pub mod math;
-pub mod motion;
-pub mod noise_choice;
-pub mod output;
-pub mod pairing;
-pub mod pnp;
-pub mod pose_noise;
-pub mod pose_refine;
-pub mod pose_resample;
-pub mod pose_residual;
-pub mod pose_shape;
-pub mod refine_closed_form;
-pub mod refine_poses;
-pub mod repeat;
+pub mod quality;
+pub mod refine;
 pub mod report;
-pub mod reprojection_refine;
 pub mod rig;
-pub mod rig_pnp;
-pub mod rig_uncertainty;
-pub mod scara;
 pub mod solve;
-pub mod trust;
 
 /// Most robot/camera pose pairs one hand-eye calibration takes. Motions are
 /// formed between every two poses and each leave-one-out run re-measures the
@@ -80,20 +58,12 @@ pub mod trust;
 pub const MAX_POSES: usize = 1000;
 
 #[cfg(test)]
-mod pose_refine_tests;
-#[cfg(test)]
-mod pose_reprojection_tests;
-#[cfg(test)]
-mod pose_shape_tests;
-#[cfg(test)]
-mod reprojection_refine_tests;
-#[cfg(test)]
 mod solver_tests;
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
-pub use motion::{Motion, MotionPairs};
+pub use closed_form::motion::{Motion, MotionPairs};
 pub use solve::{calibrate, HandEyeInput, HandEyeOptions, HandEyeResult};
 
 pub use crate::geometry::Pose;

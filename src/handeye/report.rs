@@ -1,146 +1,224 @@
-//! Quality measures: closure residuals per view and per motion, summary
-//! errors (seed 004's translation/rotation RMS and max), and the distance
-//! between two solutions.
+//! The JSON report (the output contract of `robocal handeye` and of the
+//! wasm `solve_handeye`): `gripper_from_camera` or `base_from_camera`, the
+//! target pose, `methods`, `errors`, `warnings`, plus per-view residuals,
+//! motion statistics and repeatability.
 
-use super::math::mean_pose;
-use super::{Chain, Motion, Pose};
-use crate::error::Result;
+use crate::geometry::PoseJson;
+use crate::handeye::closed_form::motion::MotionStats;
+use crate::handeye::quality::repeat::Repeatability;
+use crate::handeye::quality::residuals::{Errors, MotionResidual, ViewResidual};
+use crate::handeye::refine::over_pixels::RefinementSummary;
+use crate::handeye::refine::pose_summary::PoseRefinementSummary;
+use crate::handeye::solve::HandEyeResult;
+use crate::handeye::{Pose, Setup};
 use serde::{Deserialize, Serialize};
 
-/// Residual of one view: how far `robot[i] * x * camera[i]` lands from the
-/// solved target pose `y`.
+/// One robot pose and the image paired with it.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-pub struct ViewResidual {
-    /// View index (position in the input lists).
-    pub view: usize,
-    /// Translation residual (mm).
-    pub translation_mm: f64,
-    /// Rotation residual (degrees).
-    pub rotation_deg: f64,
+pub struct PairAudit {
+    /// Index of the pose in the pose file (0-based, data rows).
+    pub pose_index: usize,
+    /// The image paired with it (`None` when no image was found for it).
+    pub image: Option<String>,
+    /// Whether the pair entered the calibration.
+    pub used: bool,
+    /// Its index among the used views (the `view` of `per_view`), when used.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub view: Option<usize>,
+    /// Why it was dropped (detection or pose failure, no image).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub reason: Option<String>,
+    /// Reprojection RMS of the target pose fitted to this image alone (px).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_fit_rms_px: Option<f64>,
 }
 
-/// Residual of one motion pair: `(A X)^-1 (X B)`, and the difference of the
-/// robot and camera rotation angles (which must be equal whatever X is).
+/// One solver in the side-by-side comparison.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-pub struct MotionResidual {
-    /// First view.
-    pub from: usize,
-    /// Second view.
-    pub to: usize,
-    /// Translation residual (mm).
-    pub translation_mm: f64,
-    /// Rotation residual (degrees).
-    pub rotation_deg: f64,
-    /// |robot angle - camera angle| (degrees).
-    pub angle_mismatch_deg: f64,
+pub struct MethodJson {
+    /// Method name.
+    pub method: String,
+    /// The camera transform (key named by the setup), absent when the method failed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_camera: Option<PoseJson>,
+    /// Eye-to-hand camera transform.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_camera: Option<PoseJson>,
+    /// Eye-in-hand target transform.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_target: Option<PoseJson>,
+    /// Eye-to-hand target transform.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_target: Option<PoseJson>,
+    /// Closure errors of this method's solution.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub errors: Option<Errors>,
+    /// Translation distance of its camera transform from the primary one (mm).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub disagreement_translation_mm: Option<f64>,
+    /// Rotation distance of its camera transform from the primary one (degrees).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub disagreement_rotation_deg: Option<f64>,
+    /// Why the method failed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub error: Option<String>,
+    /// Robust cost of this solution under the pose refinement's estimated
+    /// noise model (the lowest one seeds the refinement), when it ran.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_cost: Option<f64>,
 }
 
-/// Summary errors (the `errors` object of the JSON contract).
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, Default)]
-pub struct Errors {
-    /// RMS of the per-view translation residuals (mm).
-    pub translation_rms_mm: f64,
-    /// Largest per-view translation residual (mm).
-    pub translation_max_mm: f64,
-    /// RMS of the per-view rotation residuals (degrees).
-    pub rotation_rms_deg: f64,
-    /// Largest per-view rotation residual (degrees).
-    pub rotation_max_deg: f64,
-    /// Reprojection RMS (pixels) when image points were given, else `None`.
-    pub reprojection_rms_px: Option<f64>,
+/// The full report.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct HandEyeReport {
+    /// What the report is: `handeye` (absent from reports written before
+    /// the key existed).
+    #[serde(default = "crate::report_kind::ReportKind::handeye")]
+    pub kind: crate::report_kind::ReportKind,
+    /// `eye-in-hand` or `eye-to-hand`.
+    pub setup: Setup,
+    /// The primary solution's method.
+    pub method: String,
+    /// Eye-in-hand result.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_camera: Option<PoseJson>,
+    /// Eye-to-hand result.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_camera: Option<PoseJson>,
+    /// Eye-in-hand target pose.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub base_from_target: Option<PoseJson>,
+    /// Eye-to-hand target pose.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub gripper_from_target: Option<PoseJson>,
+    /// Summary errors of the primary solution.
+    pub errors: Errors,
+    /// Every solver side by side.
+    pub methods: Vec<MethodJson>,
+    /// Largest disagreement between any solver and the primary: (mm).
+    pub methods_max_disagreement_translation_mm: f64,
+    /// ... and (degrees).
+    pub methods_max_disagreement_rotation_deg: f64,
+    /// Per-view residuals.
+    pub per_view: Vec<ViewResidual>,
+    /// Per-motion residuals.
+    pub per_motion: Vec<MotionResidual>,
+    /// Motion diversity.
+    pub motion: MotionStats,
+    /// Unit directions along which the camera transform's translation is unobservable.
+    pub unobservable_translation_axes: Vec<[f64; 3]>,
+    /// Leave-one-out and bootstrap.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub repeatability: Option<Repeatability>,
+    /// Everything the user should know.
+    pub warnings: Vec<String>,
+    /// Pairing audit of robot poses and images (image input only): every
+    /// pose with its image, whether it was used and why not.
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub pairs: Vec<PairAudit>,
+    /// The image-based refinement, when run (the primary transforms are then
+    /// the refined ones).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub refinement: Option<RefinementSummary>,
+    /// The maximum-likelihood pose refinement, when run (the primary
+    /// transforms are then the refined ones): covariance, per-axis std,
+    /// estimated noise levels, outlier views.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_refinement: Option<PoseRefinementSummary>,
+    /// robocal version that produced the report.
+    pub robocal_version: String,
 }
 
-/// Translation (mm) and rotation (degrees) between two poses.
-pub fn pose_difference(a: &Pose, b: &Pose) -> (f64, f64) {
-    let d = a.inverse() * b;
-    (
-        (a.translation.vector - b.translation.vector).norm() * 1e3,
-        d.rotation.angle().to_degrees(),
-    )
-}
+type PosePair = (
+    Option<PoseJson>,
+    Option<PoseJson>,
+    Option<PoseJson>,
+    Option<PoseJson>,
+);
 
-/// The target pose `y` that best fits `x`: the mean of the per-view
-/// `robot[i] * x * camera[i]` (chordal rotation mean, mean translation).
-pub fn estimate_target(chain: &Chain, x: &Pose) -> Result<Pose> {
-    let implied: Vec<Pose> = (0..chain.len())
-        .map(|i| chain.implied_target(i, x))
-        .collect();
-    mean_pose(&implied)
-}
-
-/// Per-view closure residuals of a solution.
-pub fn view_residuals(chain: &Chain, x: &Pose, y: &Pose) -> Vec<ViewResidual> {
-    (0..chain.len())
-        .map(|i| {
-            let (t, r) = pose_difference(y, &chain.implied_target(i, x));
-            ViewResidual {
-                view: i,
-                translation_mm: t,
-                rotation_deg: r,
-            }
-        })
-        .collect()
-}
-
-/// Per-motion residuals of a solution.
-pub fn motion_residuals(motions: &[Motion], x: &Pose) -> Vec<MotionResidual> {
-    motions
-        .iter()
-        .map(|m| {
-            let (t, r) = pose_difference(&(m.robot * x), &(x * m.camera));
-            MotionResidual {
-                from: m.from,
-                to: m.to,
-                translation_mm: t,
-                rotation_deg: r,
-                angle_mismatch_deg: (m.robot_angle() - m.camera_angle()).abs().to_degrees(),
-            }
-        })
-        .collect()
-}
-
-fn rms_max(values: impl Iterator<Item = f64> + Clone) -> (f64, f64) {
-    let n = values.clone().count().max(1) as f64;
-    let rms = (values.clone().map(|v| v * v).sum::<f64>() / n).sqrt();
-    (rms, values.fold(0.0, f64::max))
-}
-
-/// Summary errors of per-view residuals.
-pub fn errors(residuals: &[ViewResidual]) -> Errors {
-    let (t_rms, t_max) = rms_max(residuals.iter().map(|r| r.translation_mm));
-    let (r_rms, r_max) = rms_max(residuals.iter().map(|r| r.rotation_deg));
-    Errors {
-        translation_rms_mm: t_rms,
-        translation_max_mm: t_max,
-        rotation_rms_deg: r_rms,
-        rotation_max_deg: r_max,
-        reprojection_rms_px: None,
+/// The four optional keys for `(x, y)` in `setup`: (gripper_from_camera,
+/// base_from_camera, base_from_target, gripper_from_target).
+fn keyed(setup: Setup, x: &Pose, y: &Pose) -> PosePair {
+    match setup {
+        Setup::EyeInHand => (Some(x.into()), None, Some(y.into()), None),
+        Setup::EyeToHand => (None, Some(x.into()), None, Some(y.into())),
     }
 }
 
-/// RMS translation (mm) and rotation (degrees) of motion residuals.
-pub fn motion_rms(residuals: &[MotionResidual]) -> (f64, f64) {
-    let (t, _) = rms_max(residuals.iter().map(|r| r.translation_mm));
-    let (r, _) = rms_max(residuals.iter().map(|r| r.rotation_deg));
-    (t, r)
-}
+impl HandEyeReport {
+    /// [`HandEyeReport::new`], refused when any number in it is NaN or
+    /// infinite (the error names the field: `report.per_view[3].translation_mm`).
+    pub fn checked(result: &HandEyeResult) -> crate::error::Result<Self> {
+        let report = HandEyeReport::new(result);
+        crate::finite::check_finite("report", &report)?;
+        Ok(report)
+    }
 
-/// One number to rank solutions: the RMS displacement (mm) at the target,
-/// combining the translation residual with the rotation residual times the
-/// RMS camera-to-target distance `lever_m`.
-pub fn combined_score_mm(errors: &Errors, lever_m: f64) -> f64 {
-    let rot_mm = errors.rotation_rms_deg.to_radians() * lever_m * 1e3;
-    (errors.translation_rms_mm.powi(2) + rot_mm.powi(2)).sqrt()
-}
-
-/// RMS camera-to-target distance (metres), the lever arm of rotation errors.
-pub fn lever_arm_m(chain: &Chain) -> f64 {
-    let n = chain.len().max(1) as f64;
-    (chain
-        .camera
-        .iter()
-        .map(|c| c.translation.vector.norm_squared())
-        .sum::<f64>()
-        / n)
-        .sqrt()
+    /// Build the serialisable report of a result.
+    pub fn new(result: &HandEyeResult) -> Self {
+        let methods: Vec<MethodJson> = result
+            .methods
+            .iter()
+            .map(|m| {
+                let mut j = MethodJson {
+                    method: m.method.name().to_string(),
+                    gripper_from_camera: None,
+                    base_from_camera: None,
+                    base_from_target: None,
+                    gripper_from_target: None,
+                    errors: None,
+                    disagreement_translation_mm: m.disagreement.map(|d| d.0),
+                    disagreement_rotation_deg: m.disagreement.map(|d| d.1),
+                    error: None,
+                    pose_cost: m.pose_cost,
+                };
+                match &m.outcome {
+                    Ok((x, y, e)) => {
+                        let k = keyed(result.setup, x, y);
+                        (j.gripper_from_camera, j.base_from_camera) = (k.0, k.1);
+                        (j.base_from_target, j.gripper_from_target) = (k.2, k.3);
+                        j.errors = Some(e.clone());
+                    }
+                    Err(e) => j.error = Some(e.to_string()),
+                }
+                j
+            })
+            .collect();
+        let max_t = methods
+            .iter()
+            .filter_map(|m| m.disagreement_translation_mm)
+            .fold(0.0, f64::max);
+        let max_r = methods
+            .iter()
+            .filter_map(|m| m.disagreement_rotation_deg)
+            .fold(0.0, f64::max);
+        let k = keyed(result.setup, &result.x, &result.y);
+        HandEyeReport {
+            kind: crate::report_kind::ReportKind::Handeye,
+            setup: result.setup,
+            method: result.method.clone(),
+            gripper_from_camera: k.0,
+            base_from_camera: k.1,
+            base_from_target: k.2,
+            gripper_from_target: k.3,
+            errors: result.errors.clone(),
+            methods,
+            methods_max_disagreement_translation_mm: max_t,
+            methods_max_disagreement_rotation_deg: max_r,
+            per_view: result.per_view.clone(),
+            per_motion: result.per_motion.clone(),
+            motion: result.motion.clone(),
+            unobservable_translation_axes: result
+                .unobservable_translation
+                .iter()
+                .map(|v| [v.x, v.y, v.z])
+                .collect(),
+            repeatability: result.repeatability.clone(),
+            warnings: result.warnings.clone(),
+            pairs: Vec::new(),
+            refinement: result.refinement.clone(),
+            pose_refinement: result.pose_refinement.clone(),
+            robocal_version: crate::VERSION.to_string(),
+        }
+    }
 }

@@ -1,17 +1,27 @@
 //! The orchestrator: checks, every requested solver, a primary result,
-//! residual reports and repeatability.
+//! residual reports and repeatability, then the refinements. It alone
+//! writes the [`HandEyeResult`]: the refiners ([`crate::handeye::refine`])
+//! return their findings and the `apply_*` functions here write them.
 
-use super::checks;
-use super::motion::{build_motions, motion_stats, MotionStats};
-use super::pose_noise::CameraNoise;
-use super::refine_poses::apply_pose_refinement_resampled;
-use super::repeat::{repeatability, Repeatability};
-use super::report::{
+use crate::calib::View;
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::handeye::closed_form::motion::{build_motions, motion_stats, MotionStats};
+use crate::handeye::closed_form::{axxb, axzb, scara};
+use crate::handeye::quality::checks;
+use crate::handeye::quality::repeat::{repeatability, Repeatability};
+use crate::handeye::quality::residuals::{
     combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
     view_residuals, Errors, MotionResidual, ViewResidual,
 };
-use super::{axxb, axzb, scara, Chain, HandEyeMethod, Motion, MotionPairs, Pose, Setup};
-use crate::error::{Error, Result};
+use crate::handeye::refine::over_pixels::{
+    refine_over_pixels, reprojection_rms_per_view_px, RefineMode,
+};
+use crate::handeye::refine::over_poses::{
+    camera_noise_from_views, refine_over_poses, PoseFindings,
+};
+use crate::handeye::refine::pose_noise::CameraNoise;
+use crate::handeye::{Chain, HandEyeMethod, Motion, MotionPairs, Pose, Setup};
 use nalgebra::Vector3;
 
 /// Default number of bootstrap resamples.
@@ -44,7 +54,7 @@ pub struct HandEyeOptions {
     /// Seed of the bootstrap resampling.
     pub seed: u64,
     /// Refine the closed forms by the maximum-likelihood pose refinement
-    /// ([`super::refine_poses`]; default true). The image path turns it off
+    /// ([`crate::handeye::refine::over_poses`]; default true). The image path turns it off
     /// and refines over image points instead.
     pub refine_poses: bool,
 }
@@ -77,7 +87,7 @@ pub struct MethodResult {
 }
 
 /// Everything a calibration produces (serialise with
-/// [`super::output::HandEyeReport::new`]).
+/// [`crate::handeye::report::HandEyeReport::new`]).
 #[derive(Debug, Clone)]
 pub struct HandEyeResult {
     /// The setup solved.
@@ -106,10 +116,10 @@ pub struct HandEyeResult {
     /// Everything the user should know.
     pub warnings: Vec<String>,
     /// The image-based refinement, when run
-    /// ([`super::refine_closed_form::apply_refinement`]).
-    pub refinement: Option<super::refine_closed_form::RefinementSummary>,
-    /// The pose refinement, when run ([`super::refine_poses`]).
-    pub pose_refinement: Option<super::refine_poses::PoseRefinementSummary>,
+    /// ([`crate::handeye::refine::over_pixels::apply_refinement`]).
+    pub refinement: Option<crate::handeye::refine::over_pixels::RefinementSummary>,
+    /// The pose refinement, when run ([`crate::handeye::refine::over_poses`]).
+    pub pose_refinement: Option<crate::handeye::refine::pose_summary::PoseRefinementSummary>,
 }
 
 /// Solve one method on a chain; returns `(x, y, unobservable directions)`.
@@ -158,7 +168,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
             "{} of {} motion pairs were discarded because they rotate less than {} deg",
             set.discarded,
             set.discarded + set.kept.len(),
-            super::MIN_MOTION_ROTATION_DEG
+            crate::handeye::MIN_MOTION_ROTATION_DEG
         ));
     }
     let distances: Vec<f64> = input
@@ -166,7 +176,7 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
         .iter()
         .map(|p| p.translation.vector.norm())
         .collect();
-    warnings.extend(super::trust::geometry_warnings(
+    warnings.extend(crate::handeye::quality::trust::geometry_warnings(
         chain.len(),
         &motion,
         &distances,
@@ -279,13 +289,19 @@ fn with_pose_refinement(
     if options.refine_poses {
         let resampling = (options.bootstrap_samples > 0 && result.method != "scara")
             .then_some((options.bootstrap_samples, options.seed));
-        apply_pose_refinement_resampled(
-            &mut result,
+        let found = refine_over_poses(
+            &result,
             input,
             CameraNoise::Diagonal,
-            (options.motion_pairs, Some(motions)),
+            options.motion_pairs,
             true,
             resampling,
+        )?;
+        write_pose_findings(
+            &mut result,
+            found,
+            input,
+            (options.motion_pairs, Some(motions)),
         )?;
         // The refinement did not run: the closed form's repeatability.
         if result.pose_refinement.is_none() && resampling.is_some() {
@@ -302,6 +318,211 @@ fn with_pose_refinement(
     }
     refuse_metres(&result.errors)?;
     Ok(result)
+}
+
+/// Make `(x, y)` the primary solution under the name `method`: its
+/// residuals per view and per motion, its summary errors, and every
+/// method's distance from it.
+fn make_primary(
+    result: &mut HandEyeResult,
+    chain: &Chain,
+    motions: &[Motion],
+    (x, y): (Pose, Pose),
+    method: String,
+) {
+    result.x = x;
+    result.y = y;
+    result.method = method;
+    result.per_view = view_residuals(chain, &result.x, &result.y);
+    result.errors = errors(&result.per_view);
+    result.per_motion = motion_residuals(motions, &result.x);
+    for m in &mut result.methods {
+        if let Ok((mx, _, _)) = &m.outcome {
+            m.disagreement = Some(pose_difference(&result.x, mx));
+        }
+    }
+}
+
+/// Fill the reprojection RMS of every closed form and, unless `mode` is
+/// [`RefineMode::None`], replace the primary solution by the one refined
+/// over the pixels ([`refine_over_pixels`]) and set `result.refinement`.
+/// `views` pair one to one with the input poses.
+pub fn apply_refinement(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[View],
+    camera: &Camera,
+    mode: RefineMode,
+    motion_pairs: MotionPairs,
+    pixel_sigma_px: f64,
+) -> Result<()> {
+    let found = refine_over_pixels(result, input, views, camera, mode, pixel_sigma_px)?;
+    for (m, rms) in result.methods.iter_mut().zip(found.method_rms_px) {
+        if let (Ok((_, _, e)), Some(rms)) = (&mut m.outcome, rms) {
+            e.reprojection_rms_px = Some(rms);
+        }
+    }
+    result.errors.reprojection_rms_px = Some(found.closed_form_rms_px);
+    result.warnings.extend(found.warnings);
+    let Some(refined) = found.refined else {
+        return Ok(());
+    };
+    let chain = Chain::new(
+        input.setup,
+        &input.base_from_gripper,
+        &input.camera_from_target,
+    )?;
+    let method = format!("refined from {}", refined.summary.started_from);
+    make_primary(
+        result,
+        &chain,
+        &build_motions(&chain, motion_pairs).kept,
+        (refined.x, refined.y),
+        method,
+    );
+    result.errors.reprojection_rms_px = Some(refined.summary.reprojection_rms_px);
+    result.refinement = Some(refined.summary);
+    Ok(())
+}
+
+/// Score every closed form, refine from the best over the poses
+/// ([`refine_over_poses`]), make the refined transforms primary. A
+/// refinement that fails leaves the closed form primary with a warning
+/// (never an error: the closed forms stand).
+pub fn apply_pose_refinement(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    camera_noise: CameraNoise,
+    motion_pairs: MotionPairs,
+) -> Result<()> {
+    apply_pose_refinement_with(result, input, camera_noise, motion_pairs, true)
+}
+
+/// The pose refinement with each view's PnP covariance from its image
+/// points ([`camera_noise_from_views`]): for image input whose refinement
+/// over pixels is off (`refine` none); then the reprojection RMS of the
+/// refined transforms.
+pub fn apply_pose_refinement_from_views(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[View],
+    camera: &Camera,
+    motion_pairs: MotionPairs,
+) -> Result<()> {
+    let (camera_noise, warning) = camera_noise_from_views(input, views, camera);
+    result.warnings.extend(warning);
+    apply_pose_refinement(result, input, camera_noise, motion_pairs)?;
+    add_reprojection_rms(result, input, views, camera)
+}
+
+/// With image points and the pose refinement run: the reprojection RMS of
+/// the refined transforms (`errors.reprojection_rms_px` and the summary's
+/// keys, as the refinement over pixels reports them), every view's target
+/// points projected through the chain's implied `camera_from_target`
+/// ([`reprojection_rms_per_view_px`]). Not computable (a point behind the
+/// camera): a warning, the key left out.
+fn add_reprojection_rms(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[View],
+    camera: &Camera,
+) -> Result<()> {
+    let Some(summary) = result.pose_refinement.as_mut() else {
+        return Ok(());
+    };
+    let chain = Chain::new(
+        input.setup,
+        &input.base_from_gripper,
+        &input.camera_from_target,
+    )?;
+    let closed_form = result
+        .methods
+        .iter()
+        .find(|m| m.method.name() == summary.started_from)
+        .and_then(|m| m.outcome.as_ref().ok())
+        .and_then(|(_, _, e)| e.reprojection_rms_px);
+    match reprojection_rms_per_view_px(&chain, views, camera, &result.x, &result.y) {
+        Ok((rms, per_view)) => {
+            result.errors.reprojection_rms_px = Some(rms);
+            summary.reprojection_rms_px = Some(rms);
+            summary.per_view_reprojection_rms_px = Some(per_view);
+            summary.closed_form_reprojection_rms_px = closed_form;
+        }
+        Err(e) => {
+            result.errors.reprojection_rms_px = None;
+            result.warnings.push(format!(
+                "pose refinement: no reprojection RMS of the refined transforms: {e}; check the \
+                 robot poses' units and convention"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// [`apply_pose_refinement`]; with `predict_shape` false, a
+/// [`CameraNoise::Diagonal`] request never switches to the predicted
+/// per-view shape (the diagonal model alone, for comparisons).
+pub fn apply_pose_refinement_with(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    camera_noise: CameraNoise,
+    motion_pairs: MotionPairs,
+    predict_shape: bool,
+) -> Result<()> {
+    let resampling = result
+        .repeatability
+        .as_ref()
+        .map(|r| (r.bootstrap_samples, r.seed));
+    let found = refine_over_poses(
+        result,
+        input,
+        camera_noise,
+        motion_pairs,
+        predict_shape,
+        resampling,
+    )?;
+    write_pose_findings(result, found, input, (motion_pairs, None))
+}
+
+/// Write what the pose refinement found: every closed form's `pose_cost`,
+/// its warnings, and, when it ran, the refined transforms as the primary
+/// solution with their summary and repeatability; the motions of
+/// `motion_pairs` when the caller has them built.
+fn write_pose_findings(
+    result: &mut HandEyeResult,
+    found: PoseFindings,
+    input: &HandEyeInput,
+    (motion_pairs, motions): (MotionPairs, Option<&[Motion]>),
+) -> Result<()> {
+    for (m, cost) in result.methods.iter_mut().zip(found.pose_costs) {
+        if cost.is_some() {
+            m.pose_cost = cost;
+        }
+    }
+    result.warnings.extend(found.warnings);
+    let Some(refined) = found.refined else {
+        return Ok(());
+    };
+    let chain = Chain::new(
+        input.setup,
+        &input.base_from_gripper,
+        &input.camera_from_target,
+    )?;
+    let built;
+    let motions = match motions {
+        Some(kept) => kept,
+        None => {
+            built = build_motions(&chain, motion_pairs).kept;
+            &built
+        }
+    };
+    let method = format!("refined from {}", refined.summary.started_from);
+    make_primary(result, &chain, motions, (refined.x, refined.y), method);
+    result.pose_refinement = Some(refined.summary);
+    if let Some(r) = refined.repeatability {
+        result.repeatability = Some(r);
+    }
+    Ok(())
 }
 
 /// A translation RMS (mm) from which a solution is no calibration: the

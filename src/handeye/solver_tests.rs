@@ -1,9 +1,9 @@
 //! Solver accuracy on seeded synthetic scenes and the exact degeneracy and
 //! mistake messages.
 
-use super::report::pose_difference;
-use super::solve::{calibrate, solve_method, HandEyeInput, HandEyeOptions};
-use super::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
+use crate::handeye::quality::residuals::pose_difference;
+use crate::handeye::solve::{calibrate, solve_method, HandEyeInput, HandEyeOptions};
+use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
 use crate::synth::handeye::{handeye_scene, HandEyeScene, HandEyeSceneConfig};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
@@ -260,7 +260,7 @@ fn candidate_conventions_are_ranked_against_the_camera_motion() {
         .iter()
         .map(|p| Pose::from_parts(p.translation, p.rotation.inverse()))
         .collect();
-    let ranked = super::checks::rank_pose_candidates(
+    let ranked = crate::handeye::quality::checks::rank_pose_candidates(
         Setup::EyeToHand,
         &[
             ("transposed".to_string(), wrong),
@@ -273,7 +273,7 @@ fn candidate_conventions_are_ranked_against_the_camera_motion() {
     let worse = ranked[1].consistency.as_ref().unwrap().rotation_rms_deg;
     // Right convention: residual from 0.002 rad noise, well below 1 deg.
     assert!(best < 1.0 && worse > 5.0 * best, "{best} vs {worse} deg");
-    let msg = super::checks::recommend_candidate(&ranked).unwrap();
+    let msg = crate::handeye::quality::checks::recommend_candidate(&ranked).unwrap();
     assert!(
         msg.starts_with("pose format 'right' fits the camera motion best"),
         "{msg}"
@@ -297,7 +297,7 @@ fn conventions_that_only_permute_axes_are_told_apart_by_the_translations() {
         .iter()
         .map(|q| Pose::from_parts(q.translation, p * q.rotation * p.inverse()))
         .collect();
-    let ranked = super::checks::rank_pose_candidates(
+    let ranked = crate::handeye::quality::checks::rank_pose_candidates(
         Setup::EyeInHand,
         &[
             ("permuted".to_string(), permuted),
@@ -321,7 +321,7 @@ fn conventions_that_only_permute_axes_are_told_apart_by_the_translations() {
         c[1].translation_rms_mm > 5.0 * c[0].translation_rms_mm,
         "{c:?}"
     );
-    let msg = super::checks::recommend_candidate(&ranked).unwrap();
+    let msg = crate::handeye::quality::checks::recommend_candidate(&ranked).unwrap();
     assert!(
         msg.starts_with("pose format 'right' fits the camera motion best"),
         "{msg}"
@@ -337,7 +337,7 @@ fn joint_linear_solvers_beat_rotation_only_ones_on_noisy_data() {
     // Andreff and Li solve rotation and translation rows in one least
     // squares, so the translations add information to the rotation: over
     // OpenCV-style noisy scenes their median rotation error must be below
-    // Horaud's (rotation rows only). bench/compare_handeye.py measures ~17 %
+    // Horaud's (rotation rows only). benches/compare_handeye.py measures ~17 %
     // (Andreff) and 16-37 % (Li) better over 100 trials; over 40 scenes we
     // require 5 %, which a rotation-only solve (equal to Horaud) cannot pass.
     for setup in [Setup::EyeInHand, Setup::EyeToHand] {

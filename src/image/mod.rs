@@ -37,6 +37,7 @@ use truncation::JpegEnd;
 
 #[cfg(test)]
 mod bounds_tests;
+pub(crate) mod filter;
 #[cfg(test)]
 mod format_tests;
 mod messages;
@@ -45,6 +46,8 @@ mod png_rows;
 use messages::{byte_count, check_size, decode_error, MEMORY_ADVICE};
 use orientation::{exif_orientation, orient, orient_rgba};
 mod truncation;
+mod undistort;
+pub use undistort::{remap_gray, undistort_image};
 
 /// Largest image accepted by default, in pixels: a 100 MP sensor natively
 /// (twice the 50 MP the detectors are specified for), 64 MP in wasm.

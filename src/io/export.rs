@@ -15,7 +15,7 @@ pub use super::export_rig::{join_files, ExportFile};
 use super::export_stereo::{export_stereo, is_stereo_report, not_a_stereo_format, StereoFormat};
 use super::export_transform::{export_transform, FrameNames, TransformFormat};
 use super::import_camera::import_camera;
-use crate::calib::rig_report::RigCalibration;
+use crate::calib::multi::rig_report::RigCalibration;
 use crate::error::{Error, Result};
 use crate::geometry::{Pose, PoseInput};
 use crate::report_kind::ReportKind;

@@ -25,7 +25,7 @@ use super::export_camera::{
 use super::export_camera_tools::{kalibr_camera, mrcal_model};
 use super::export_ros::{ros1_args, ros1_launch_nodes, ros2_args, ros2_launch_nodes, urdf_joint};
 use super::export_transform::FrameNames;
-use crate::calib::rig_report::RigCalibration;
+use crate::calib::multi::rig_report::RigCalibration;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{rotvec_from_rotation, Pose};

@@ -1,7 +1,7 @@
 //! Round trips of the rig exports: a rig built by hand from known cameras
 //! and poses is written in every rig format, the numbers are read back from
 //! the text and compared with the truth. The reading here is by line and
-//! key (no YAML crate); bench/check_exports.py reads the same files with
+//! key (no YAML crate); benches/check_exports.py reads the same files with
 //! cv2.FileStorage and PyYAML. Tolerance: 1e-12 (the writers print the
 //! shortest round-trip decimal; only the pose conversions — matrix, quaternion,
 //! rotation vector, Euler angles — add rounding).
@@ -9,7 +9,7 @@
 use super::export::{export_files, export_with, ExportOptions};
 use super::export_rig::{export_rig, RigFormat};
 use super::import_camera::{import_camera, CameraSource};
-use crate::calib::rig_report::{CoObservation, RigCalibration, RigCamera, RigFrame};
+use crate::calib::multi::rig_report::{CoObservation, RigCalibration, RigCamera, RigFrame};
 use crate::calib::{CalibrationOptions, CameraCalibration, Correlation, ProjectionUncertainty};
 use crate::camera::{Camera, Distortion};
 use crate::geometry::{

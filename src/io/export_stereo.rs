@@ -7,7 +7,7 @@
 //! - `opencv-yaml`: one FileStorage file with the keys of OpenCV's stereo
 //!   samples, `image_width`, `image_height`, `K1`, `D1`, `K2`, `D2`, `R`,
 //!   `T`, `E` (`[T]x R`), `F` (`K2^-T E K1^-1`) and the rectification
-//!   `R1`, `R2`, `P1`, `P2`, `Q` of [`crate::calib::stereo_rectify::rectify`]
+//!   `R1`, `R2`, `P1`, `P2`, `Q` of [`crate::calib::multi::stereo_rectify::rectify`]
 //!   (`cv2.stereoRectify` with `CALIB_ZERO_DISPARITY`, `alpha = -1`).
 //! - `ros`: `left.yaml` and `right.yaml`, the camera_info files ROS's
 //!   `camera_calibration` writes for a stereo pair: each camera's K and D,
@@ -27,7 +27,7 @@ use super::export_camera::{
 };
 use super::export_camera_tools::kalibr_camera;
 use super::import_camera::import_camera;
-use crate::calib::stereo_rectify::{essential_matrix, fundamental_matrix, rectify};
+use crate::calib::multi::stereo_rectify::{essential_matrix, fundamental_matrix, rectify};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::Pose;

@@ -337,22 +337,38 @@ fn transform_names_that_are_not_frame_names_are_refused() {
     }
 }
 
-/// The model advice's table of formats per model
-/// ([`crate::calib::model_advice::EXPORT_FORMATS`]) is what the writers do:
+/// The lens-model table's formats per model ([`crate::camera::LENS_MODELS`],
+/// `export_formats`: what the model advice names) are what the writers do:
 /// every camera format but `text` (no lens model) is listed for a model
 /// exactly when it writes the example camera of that model (zero skew, and
-/// the coefficient a condition names held at 0).
+/// the coefficient a condition names held at 0); every model of the table
+/// has its example.
 #[test]
 #[wasm_bindgen_test]
-fn the_model_advice_names_the_formats_the_writers_accept() {
-    use crate::calib::model_advice::export_formats;
-    for example in Camera::examples() {
+fn the_lens_model_table_names_the_formats_the_writers_accept() {
+    use crate::camera::{LensModel, LENS_MODELS};
+    let examples = Camera::examples();
+    for row in &LENS_MODELS {
+        assert!(
+            examples
+                .iter()
+                .any(|c| c.distortion.model_name() == row.name),
+            "{} has no example camera",
+            row.name
+        );
+    }
+    for example in examples {
         let mut camera = Camera {
             skew: 0.0,
             ..example
         };
         let model = camera.distortion.model_name();
-        let listed = export_formats(model);
+        let listed = LensModel::named(model).map_or(&[][..], |m| m.export_formats);
+        assert_eq!(
+            listed,
+            crate::calib::model_advice::export_formats(model),
+            "the model advice names the table's formats"
+        );
         assert!(!listed.is_empty(), "{model} is not in the table");
         for format in CameraFormat::ALL {
             if format == CameraFormat::Text {

@@ -93,14 +93,14 @@ fn missing(key: &str, expected: &str) -> Error {
     Error::invalid(key, format!("the camera JSON needs {expected}"))
 }
 
-/// A model with zero coefficients, from its name.
+/// A model from its name (its coefficients are read from the file).
 pub fn distortion_template(model: &str) -> Result<Distortion> {
-    Distortion::zeroed(model).ok_or_else(|| {
+    Distortion::named(model).ok_or_else(|| {
         Error::invalid(
             "model",
             format!(
                 "unknown lens model '{model}' (known: {})",
-                crate::camera::MODEL_NAMES.join(", ")
+                crate::camera::model_list()
             ),
         )
     })

@@ -279,7 +279,7 @@ fn random_text_never_panics() {
         "  2. ]",
         "r11,tx",
     ];
-    let mut rng = crate::synth::Rng::new(44);
+    let mut rng = crate::rng::Rng::new(44);
     for _ in 0..3000 {
         let n = 1 + rng.below(6);
         let text: Vec<&str> = (0..n).map(|_| pieces[rng.below(pieces.len())]).collect();

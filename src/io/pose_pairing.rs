@@ -25,10 +25,10 @@
 //! Either way the pairing is then proven against the data: the hand-eye
 //! checks compare it with [`alternatives`] (lexicographic order, the order
 //! given, numeric order) through the rotation angles of the motions
-//! ([`crate::handeye::pairing`]).
+//! ([`crate::handeye::quality::pairing`]).
 
 use crate::error::{Error, Result};
-use crate::handeye::pairing::PairingRule;
+use crate::handeye::quality::pairing::PairingRule;
 use std::cmp::Ordering;
 
 /// How [`pair_poses`] paired the poses with the images.

@@ -6,7 +6,7 @@ use wasm_bindgen_test::wasm_bindgen_test;
 
 use super::*;
 use crate::geometry::{rotation_angle_between, rotation_from_rotvec, EulerKind, EulerOrder, Pose};
-use crate::synth::Rng;
+use crate::rng::Rng;
 
 fn opts(format: PoseFormat) -> PoseFileOptions {
     PoseFileOptions {

@@ -1,7 +1,7 @@
 //! Solver tests on problems with known optima.
 
 use super::*;
-use crate::synth::Rng;
+use crate::rng::Rng;
 use wasm_bindgen_test::wasm_bindgen_test;
 
 /// Rosenbrock as least squares: r = (10 (y - x^2), 1 - x), minimum at (1, 1).

@@ -29,8 +29,8 @@
 //! locates edges by their mid-level or by a symmetric model does not when
 //! the blur is asymmetric.
 
-use crate::detect::filter::Plane;
-use crate::synth::Rng;
+use crate::image::filter::Plane;
+use crate::rng::Rng;
 
 /// Camera effects, each `None` (off) by default.
 #[derive(Debug, Clone, PartialEq, Default)]

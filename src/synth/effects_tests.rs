@@ -5,7 +5,7 @@
 
 use super::effects::*;
 use super::{board_pose, render, Pinhole, RenderOptions, Rng};
-use crate::detect::filter::Plane;
+use crate::image::filter::Plane;
 use crate::target::Target;
 use wasm_bindgen_test::wasm_bindgen_test;
 

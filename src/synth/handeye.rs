@@ -188,7 +188,7 @@ pub fn project_grid(
     grid: (usize, usize, f64),
     pixel_sigma: f64,
     seed: u64,
-) -> Vec<crate::handeye::reprojection_refine::ViewPoints> {
+) -> Vec<crate::calib::View> {
     let mut rng = Rng::new(seed);
     let (cols, rows, spacing) = grid;
     let object: Vec<nalgebra::Point3<f64>> = (0..rows)
@@ -201,14 +201,11 @@ pub fn project_grid(
         .camera_from_target_true
         .iter()
         .map(|pose| {
-            let mut view = crate::handeye::reprojection_refine::ViewPoints {
-                object_points: Vec::new(),
-                image_points: Vec::new(),
-            };
+            let mut view = crate::calib::View::new("", Vec::new(), Vec::new());
             for p in &object {
                 if let Ok(px) = camera.project(&(pose * p)) {
-                    view.object_points.push(*p);
-                    view.image_points.push(nalgebra::Point2::new(
+                    view.object_m.push(*p);
+                    view.image_px.push(nalgebra::Point2::new(
                         px.x + rng.gaussian(pixel_sigma),
                         px.y + rng.gaussian(pixel_sigma),
                     ));

@@ -5,13 +5,13 @@
 //! follow from the chain `robot[i] * x * camera[i] = y`. Used by the pose
 //! refinement's tests and the Cramér-Rao benchmark (`examples/handeye_crb.rs`).
 //!
-//! Noise is applied the way [`crate::handeye::pose_residual`] models it:
+//! Noise is applied the way [`crate::handeye::refine::pose_residual`] models it:
 //! decoupled left perturbations, `R <- exp(w) R`, `t <- t + v`.
 
 use super::Rng;
+use crate::calib::View;
 use crate::camera::Camera;
-use crate::handeye::pose_residual::perturb;
-use crate::handeye::reprojection_refine::ViewPoints;
+use crate::handeye::refine::pose_residual::perturb;
 use crate::handeye::{Pose, Setup};
 use nalgebra::{Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 
@@ -181,16 +181,13 @@ pub fn grid_pixels(
     camera: &Camera,
     pixel_sigma: f64,
     rng: &mut Rng,
-) -> Vec<ViewPoints> {
+) -> Vec<View> {
     let (w, h) = (camera.width as f64, camera.height as f64);
     scene
         .camera_from_target
         .iter()
         .map(|pose| {
-            let mut view = ViewPoints {
-                object_points: Vec::new(),
-                image_points: Vec::new(),
-            };
+            let mut view = View::new("", Vec::new(), Vec::new());
             for p in &scene.object_points {
                 if let Ok(px) = camera.project(&(pose * p)) {
                     let q = Point2::new(
@@ -198,8 +195,8 @@ pub fn grid_pixels(
                         px.y + rng.gaussian(pixel_sigma),
                     );
                     if q.x >= -0.5 && q.y >= -0.5 && q.x <= w - 0.5 && q.y <= h - 0.5 {
-                        view.object_points.push(*p);
-                        view.image_points.push(q);
+                        view.object_m.push(*p);
+                        view.image_px.push(q);
                     }
                 }
             }

@@ -9,16 +9,17 @@ pub mod handeye;
 pub mod handeye_looking;
 pub mod render;
 pub mod rig;
-pub mod rng;
 pub mod scene;
 pub mod video;
 
 pub use scene::Scene;
 
+/// The seeded generator of every scene (at the crate root: the hand-eye
+/// bootstrap draws from it too).
+pub use crate::rng::Rng;
 pub use clutter::clutter;
 pub use effects::Effects;
 pub use render::{render, Pinhole, Projection, RenderOptions, Rendered};
-pub use rng::Rng;
 pub use video::{video_camera, BoardVideo, VideoOptions};
 
 use crate::target::Target;

@@ -23,8 +23,8 @@
 
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
+use crate::rng::Rng;
 use crate::synth::effects::{self, Effects};
-use crate::synth::Rng;
 use crate::target::{DetectedPoint, Polarity, Target};
 use nalgebra::{Isometry3, Point2, Point3, Vector3};
 
@@ -231,7 +231,7 @@ pub fn render(
     if let Some(paper) = &fx.paper {
         apply_paper(&mut img, &corners, w as usize, paper);
     }
-    let mut plane = crate::detect::filter::Plane {
+    let mut plane = crate::image::filter::Plane {
         w: w as usize,
         h: h as usize,
         data: img,

@@ -41,7 +41,20 @@ pub struct RigSceneConfig {
     pub noise_px: f64,
     /// Fraction of views cut to a part of the board.
     pub partial_fraction: f64,
+    /// Timing error of free-running cameras: each view is taken this many
+    /// milliseconds (standard deviation, drawn per view) off its frame's
+    /// moment while the board moves by hand ([`BOARD_DEG_PER_S`],
+    /// [`BOARD_M_PER_S`]); 0: every frame's images at one moment. The truth
+    /// (`rig_from_target`) is the board at the frame's moment.
+    pub timing_ms: f64,
 }
+
+/// Speed of the hand-held board while the cameras are off their frame's
+/// moment ([`RigSceneConfig::timing_ms`]): rotation, degrees per second ...
+pub const BOARD_DEG_PER_S: f64 = 30.0;
+/// ... and translation, metres per second, each in a random direction per
+/// frame.
+pub const BOARD_M_PER_S: f64 = 0.15;
 
 impl Default for RigSceneConfig {
     fn default() -> Self {
@@ -50,6 +63,7 @@ impl Default for RigSceneConfig {
             side_frames: 4,
             noise_px: 0.0,
             partial_fraction: 0.25,
+            timing_ms: 0.0,
         }
     }
 }
@@ -128,6 +142,9 @@ pub fn rig_scene(config: &RigSceneConfig, seed: u64) -> RigScene {
     facing.extend(std::iter::repeat((90.0, 0.08)).take(config.side_frames));
     let mut rig_from_target = Vec::new();
     let mut views = vec![Vec::new(); 4];
+    // The timing draws have a generator of their own, so that a scene
+    // without timing error is the same as before the option existed.
+    let mut timing_rng = Rng::new(seed ^ 0x7131_6d73_0000_0001);
     for (f, &(deg, tilt)) in facing.iter().enumerate() {
         let tilt_rv = Vector3::new(
             rng.range(-tilt, tilt),
@@ -144,7 +161,25 @@ pub fn rig_scene(config: &RigSceneConfig, seed: u64) -> RigScene {
             Pose::from_parts(Translation3::from(centre - rotation * half), rotation);
         rig_from_target.push(world_from_rig.inverse() * world_from_target);
         let front = -(rotation * Vector3::z());
+        // The board's motion during this frame (hand-held), when the
+        // cameras are off its moment.
+        let (spin, drift) = if config.timing_ms > 0.0 {
+            (
+                random_direction(&mut timing_rng) * BOARD_DEG_PER_S.to_radians(),
+                random_direction(&mut timing_rng) * BOARD_M_PER_S,
+            )
+        } else {
+            (Vector3::zeros(), Vector3::zeros())
+        };
         for k in 0..4 {
+            let world_from_target = if config.timing_ms > 0.0 {
+                let dt = timing_rng.gaussian(config.timing_ms) / 1000.0;
+                let turned = rotation_from_rotvec(&(spin * dt)) * rotation;
+                let moved = centre + drift * dt;
+                Pose::from_parts(Translation3::from(moved - turned * half), turned)
+            } else {
+                world_from_target
+            };
             let to_camera = world_from_cameras[k].translation.vector - centre;
             let cos = front.dot(&to_camera) / to_camera.norm();
             if cos < MAX_VIEW_ANGLE_DEG.to_radians().cos() {
@@ -186,6 +221,17 @@ pub fn rig_scene(config: &RigSceneConfig, seed: u64) -> RigScene {
         frame_keys: (0..facing.len()).map(|f| f.to_string()).collect(),
         rig_from_target,
         views,
+    }
+}
+
+/// A unit vector in a uniformly random direction.
+fn random_direction(rng: &mut Rng) -> Vector3<f64> {
+    loop {
+        let v = Vector3::new(rng.normal(), rng.normal(), rng.normal());
+        let n = v.norm();
+        if n > 1e-9 {
+            return v / n;
+        }
     }
 }
 

@@ -1,5 +1,5 @@
 use super::*;
-use crate::synth::rng::Rng;
+use crate::rng::Rng;
 
 /// OpenCV 4.14's marker counts, marker sizes and maxCorrectionBits
 /// (`cv2.aruco.getPredefinedDictionary(d)`: `bytesList.shape[0]`,

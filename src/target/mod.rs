@@ -560,6 +560,7 @@ mod centre_model;
 pub mod dictionary;
 pub mod marker_board;
 pub mod origin_dot;
+pub mod placement;
 mod spec;
 pub mod svg;
 

@@ -2,7 +2,7 @@
 //! (`robocal::io::pairing`).
 
 use super::js_error;
-use crate::calib::rig::sort_frame_keys;
+use crate::calib::multi::rig::sort_frame_keys;
 use crate::io::pairing::{default_grouping, frame_keys, FrameGrouping};
 use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;

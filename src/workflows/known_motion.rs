@@ -154,7 +154,7 @@ pub fn solve_known_motion(request: &KnownMotionRequest) -> Result<KnownMotionRep
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::Rng;
+    use crate::rng::Rng;
     use wasm_bindgen_test::wasm_bindgen_test;
 
     fn scene(noise: &mut dyn FnMut() -> f64) -> (KnownMotionRequest, Pose) {

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::calib::dlt::scene;
-use crate::synth::Rng;
+use crate::rng::Rng;
 use wasm_bindgen_test::wasm_bindgen_test;
 
 fn observe(stage_mm: [f64; 3], noise: &mut dyn FnMut() -> f64) -> StageObservation {

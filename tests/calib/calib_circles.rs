@@ -16,12 +16,12 @@
 //!   mm), reported and bounded, not held to the chessboard: it is a smaller
 //!   board with fewer points, weaker geometry even without noise (noise-free
 //!   renders through the strongly distorted camera, one draw: 0.060 px
-//!   against the chessboard's 0.031; BENCHMARKS.md, issue 20, session 16).
+//!   against the chessboard's 0.031; docs/benchmark-history.md, session 16).
 //!
 //! Why averaged, and why twelve views: one noise draw of six views moved
 //! the error by 0.1-0.2 px from seed to seed on the strongly distorted
 //! camera, several times the differences between the centre models, and
-//! flipped their ranking (BENCHMARKS.md, issue 20, sessions 12 and 13).
+//! flipped their ranking (docs/benchmark-history.md, sessions 12 and 13).
 //! The test is to measure the centres, not one draw.
 //!
 //! History: the circles led the chessboard (session 13) until the

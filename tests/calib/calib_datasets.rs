@@ -1,7 +1,7 @@
 //! Public calibration sets reproduce their published results:
 //! - OpenCV's `left_intrinsics.yml` (13 left images of the OpenCV/Bouguet
 //!   9x6 stereo set, fixed aspect ratio fx = fy), from OpenCV's own corners
-//!   (tests/fixtures/opencv-left-right-9x6.json);
+//!   (fixtures/opencv-left-right-9x6.json);
 //! - Bouguet's result on OpenCV's `calib1.dat` points (fc, cc, kc with the
 //!   uncertainty block the file carries);
 //! - Bouguet's stereo result of his 5th example (right_from_left) from the
@@ -14,7 +14,7 @@ use crate::support;
 use support::dataset;
 
 use nalgebra::{Point2, Point3, Vector3};
-use robocal::calib::stereo::calibrate_stereo;
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::{calibrate, CalibrationOptions, View};
 use robocal::camera::Distortion;
 use serde_json::Value;
@@ -63,7 +63,7 @@ fn fixture_view(fixture: &Value, image: &str, square_m: f64) -> View {
 fn opencv_corners() -> Value {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/opencv-left-right-9x6.json"
+        "/fixtures/opencv-left-right-9x6.json"
     );
     serde_json::from_str(&std::fs::read_to_string(path).expect("fixture")).expect("JSON")
 }
@@ -110,8 +110,8 @@ fn opencv_left_intrinsics_yml_is_reproduced_with_fx_equal_fy() {
     // finds slightly different ones (the fixture; any findChessboardCorners
     // flags and 30 or 100 cornerSubPix iterations give the same), on which
     // its own calibrateCamera gives fx = fy 536.1088, cx 342.3736, cy
-    // 235.5954, rms 0.40879 (bench/.venv, FIX_ASPECT_RATIO), as we do to
-    // 1e-3 px (bench/compare_calibration.py shows the solvers agree to
+    // 235.5954, rms 0.40879 (benches/.venv, FIX_ASPECT_RATIO), as we do to
+    // 1e-3 px (benches/compare_calibration.py shows the solvers agree to
     // 1e-3 std on equal points). The published values then lie within one
     // of our standard deviations (fx: 0.19 px of 0.92 px).
     let got = [c.fx, c.cx, c.cy];

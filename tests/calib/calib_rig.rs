@@ -14,9 +14,9 @@ use crate::support;
 use support::dataset;
 
 use nalgebra::{Point2, Point3};
-use robocal::calib::rig::{calibrate_rig, RigCameraViews, RigOptions};
-use robocal::calib::rig_report::RigCalibration;
-use robocal::calib::stereo::calibrate_stereo;
+use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig_report::RigCalibration;
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::{CalibrationOptions, View};
 use robocal::camera::Distortion;
 use robocal::geometry::{rotvec_from_rotation, Pose};
@@ -203,7 +203,7 @@ fn opencv_9x6_pair_as_a_rig_gives_the_stereo_result() {
     };
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/opencv-left-right-9x6.json"
+        "/fixtures/opencv-left-right-9x6.json"
     );
     let fixture: Value =
         serde_json::from_str(&std::fs::read_to_string(path).expect("fixture")).expect("JSON");
@@ -267,12 +267,17 @@ fn opencv_9x6_pair_as_a_rig_gives_the_stereo_result() {
         rig.cameras[1].camera_from_rig_std.as_ref().expect("std"),
         stereo.right_from_left_std.as_ref().expect("std"),
     );
+    // The rig widens its std to the leave-frames-out spread where that is
+    // larger (calib::rig_jackknife); stereo reports the joint covariance's.
+    // On these 13 real frames the spread is about twice the model's (0.22
+    // against 0.11 mm in x): never narrower, and within 3x.
     for (a, b) in s_rig.translation_m.iter().zip(&s_st.translation_m) {
-        assert!(
-            (a - b).abs() < 1e-6 * b.abs().max(1e-12) + 1e-12,
-            "std {a} vs {b} m"
-        );
+        assert!(*a >= b * (1.0 - 1e-6) && *a <= 3.0 * b, "std {a} vs {b} m");
     }
+    eprintln!(
+        "baseline std: rig {:?} m (widened), stereo {:?} m",
+        s_rig.translation_m, s_st.translation_m
+    );
     assert!(
         (rig.rms_px - stereo.rms_px).abs() < 1e-9,
         "rms {} vs {}",
@@ -280,4 +285,77 @@ fn opencv_9x6_pair_as_a_rig_gives_the_stereo_result() {
         stereo.rms_px
     );
     assert!((rig.cameras[1].calibration.camera.fx - stereo.right.camera.fx).abs() < 1e-6);
+}
+
+/// A camera whose images sit two frames late (its files numbered from 2
+/// where the others start at 0) is refused before the joint fit, with the
+/// shift and a pair of frames named; the same scene grouped right solves
+/// without a grouping warning (issue 35: the rig's frame grouping proven).
+#[test]
+fn frames_of_one_camera_shifted_are_named_before_the_joint_fit() {
+    let config = RigSceneConfig {
+        noise_px: 0.3,
+        ..RigSceneConfig::default()
+    };
+    let scene = rig_scene(&config, 5);
+    let right = solve(&scene, &[], None);
+    assert!(
+        !right.warnings.iter().any(|w| w.contains("frames")),
+        "{:?}",
+        right.warnings
+    );
+    let mut cameras = inputs(&scene, &[]);
+    let n = scene.frame_keys.len();
+    cameras[1].views = cameras[1]
+        .views
+        .iter()
+        .filter(|(f, _)| f + 2 < n)
+        .map(|(f, v)| (f + 2, v.clone()))
+        .collect();
+    let err = calibrate_rig(&cameras, &scene.frame_keys, &options(None))
+        .expect_err("shifted frames")
+        .to_string();
+    assert!(
+        err.contains("the board's motions agree only when cam1's frames are taken 2 frames late"),
+        "{err}"
+    );
+    assert!(
+        err.contains("rename them or choose another grouping rule"),
+        "{err}"
+    );
+}
+
+/// Free-running cameras 5 ms apart (std per view) filming a hand-held
+/// board (30 deg/s, 0.15 m/s): over 10 seeded rigs every result either
+/// holds the true extrinsics within 3 reported std or carries a warning
+/// (the grouping check's or the intrinsics drift): never a silent wrong
+/// rig. The full table is `cargo run --release --example rig_coverage`.
+#[test]
+fn timing_error_is_covered_or_warned() {
+    let mut silent = Vec::new();
+    for seed in 0..10 {
+        let config = RigSceneConfig {
+            noise_px: 0.3,
+            timing_ms: 5.0,
+            ..RigSceneConfig::default()
+        };
+        let scene = rig_scene(&config, 300 + seed);
+        let rig = solve(&scene, &[], None);
+        let covered = rig.cameras.iter().enumerate().skip(1).all(|(k, camera)| {
+            let got = camera.camera_from_rig.to_pose().expect("pose");
+            let e = errors(&got, &scene.camera_from_rig[k]);
+            let s = camera.camera_from_rig_std.as_ref().expect("std");
+            let std = [s.rotation_rad, s.translation_m].concat();
+            e.iter().zip(&std).all(|(err, sd)| err.abs() <= 3.0 * sd)
+        });
+        let warned = rig.warnings.iter().any(|w| {
+            w.contains("disagree on how the board moved")
+                || w.contains("moved its intrinsics beyond")
+                || w.contains("leaving frames out moves")
+        });
+        if !covered && !warned {
+            silent.push(seed);
+        }
+    }
+    assert!(silent.is_empty(), "silent wrong rigs at seeds {silent:?}");
 }

@@ -6,6 +6,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod calib_caliscope_starts;
 mod calib_circles;
 mod calib_datasets;
 mod calib_ekf;

@@ -12,7 +12,7 @@
 use nalgebra::{Point2, Point3, Translation3, Vector3};
 use robocal::api::camera::calibrate_input;
 use robocal::api::camera::{CalibrationInput, JsonOptions, JsonView, LensModel, MethodChoice};
-use robocal::calib::stereo::calibrate_stereo;
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::{calibrate, CalibrationOptions, View};
 use robocal::geometry::{rotation_from_rotvec, Pose};
 use robocal::synth::handeye_looking::{grid_pixels, looking_scene, LookingConfig};
@@ -346,9 +346,9 @@ fn handeye_input(setup: &str, scene_setup: robocal::handeye::Setup, seed: u64) -
             kept_ids(&mut rng)
         };
         let points: Vec<Value> = v
-            .object_points
+            .object_m
             .iter()
-            .zip(&v.image_points)
+            .zip(&v.image_px)
             .filter(|(o, _)| ids.contains(&grid_id(o)))
             .map(|(o, px)| json!({"id": grid_id(o), "x_px": px.x, "y_px": px.y}))
             .collect();

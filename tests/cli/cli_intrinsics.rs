@@ -418,3 +418,24 @@ fn circle_grid_detections_report_their_centre_model() {
     assert_eq!(code, 0, "{stderr}");
     assert!(yaml.contains("camera_matrix: !!opencv-matrix"), "{yaml}");
 }
+
+/// The `--model` help of every command that solves cameras is made from the
+/// lens-model table: each lists every model of `camera::LENS_MODELS`.
+#[test]
+fn the_model_help_lists_every_model_of_the_table() {
+    for (command, subject) in [
+        ("intrinsics", "the camera"),
+        ("stereo", "both cameras"),
+        ("rig", "the solved cameras"),
+    ] {
+        let (code, stdout, stderr) = robocal(&[command, "--help"]);
+        assert_eq!(code, 0, "{command} --help: {stderr}");
+        // clap wraps long help lines: compare with the white space collapsed.
+        let help = stdout.split_whitespace().collect::<Vec<_>>().join(" ");
+        let wanted = robocal::camera::model_help(subject);
+        assert!(help.contains(&wanted), "{command} --help lacks '{wanted}':\n{stdout}");
+        for name in robocal::camera::MODEL_NAMES {
+            assert!(help.contains(name), "{command} --help lacks {name}");
+        }
+    }
+}

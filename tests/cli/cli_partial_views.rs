@@ -205,7 +205,7 @@ fn handeye_from_partial_detections_recovers_x_in_both_setups() {
             .enumerate()
             .map(|(i, v)| {
                 let ids = if i == 4 { column() } else { kept_ids(&mut rng) };
-                let d = detection((640, 480), &v.object_points, &v.image_points, &ids);
+                let d = detection((640, 480), &v.object_m, &v.image_px, &ids);
                 (format!("img{i}.png"), d)
             })
             .collect();

@@ -38,6 +38,7 @@ fn rendered_rig(dir: &Path) -> (Vec<Vec<String>>, RigScene) {
         side_frames: 3,
         noise_px: 0.0,
         partial_fraction: 0.0,
+        timing_ms: 0.0,
     };
     let scene = rig_scene(&config, 11);
     let target = Target::parse_spec(TARGET).expect("target");

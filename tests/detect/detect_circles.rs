@@ -167,7 +167,7 @@ fn large_circles_through_strong_distortion_within_003_px_mean() {
 
 #[test]
 fn large_steep_circles_with_vignetting_through_strong_distortion() {
-    // bench/compare_opencv.py's set circles_symmetric_steep_distorted
+    // benches/compare_opencv.py's set circles_symmetric_steep_distorted
     // (examples/render_set.rs): the 7x5 grid filling half the image width
     // (circles ~40 px across) through the strong-distortion lens, tilted
     // 45-50 degrees, off the image centre, with vignetting and an

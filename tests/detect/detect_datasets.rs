@@ -4,8 +4,8 @@
 //! OpenCV left/right 9x6 (Bouguet's stereo example, 640x480 JPEG): every
 //! board OpenCV finds must be found (all 26), and the corners must agree
 //! with OpenCV's refined corners (fixture
-//! tests/fixtures/opencv-left-right-9x6.json, written by
-//! bench/opencv_reference.py; OpenCV 4.14, cornerSubPix 11x11).
+//! fixtures/opencv-left-right-9x6.json, written by
+//! benches/opencv_reference.py; OpenCV 4.14, cornerSubPix 11x11).
 //!
 //! Tolerances (measured 2026-11-22): over all 1404 corners the median
 //! distance to OpenCV is 0.092 px, asserted <= 0.1 px (the bound,
@@ -15,8 +15,8 @@
 //! it is not a bias of ours: (1) after undistorting both corner sets with
 //! OpenCV's own calibration (left_intrinsics.yml) a homography fits
 //! robocal's corners better than OpenCV's (median RMS 0.166 vs 0.186 px
-//! over the 13 left images, BENCHMARKS.md); (2) on renders degraded like
-//! these photos (blur, noise, JPEG; bench/detect_jpeg_truth.py) robocal is
+//! over the 13 left images, docs/benchmark-history.md); (2) on renders degraded like
+//! these photos (blur, noise, JPEG; benches/detect_jpeg_truth.py) robocal is
 //! closer to the truth than OpenCV in every case. Single corners differ
 //! by up to 6 px where the board's thin outer row meets its frame:
 //! OpenCV's 23x23 window is pulled by the frame edge, while the saddle of
@@ -49,7 +49,7 @@ fn opencv_left_right_9x6_agrees_with_opencv() {
     let fixture: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/tests/fixtures/opencv-left-right-9x6.json"
+            "/fixtures/opencv-left-right-9x6.json"
         ))
         .unwrap(),
     )

@@ -114,9 +114,9 @@ fn moveit_charuco_image_is_detected() {
 #[test]
 fn moveit_charuco_board_pose_within_the_published_tolerance() {
     use nalgebra::{Point2, Point3, Rotation3, Vector3};
+    use robocal::calib::pnp::camera_from_target;
+    use robocal::calib::View;
     use robocal::camera::{Camera, Distortion};
-    use robocal::handeye::pnp::camera_from_target;
-    use robocal::handeye::reprojection_refine::ViewPoints;
     let Some(dir) = dataset("moveit-handeye-pose-samples") else {
         return;
     };
@@ -151,14 +151,14 @@ fn moveit_charuco_board_pose_within_the_published_tolerance() {
     };
     let objects: std::collections::HashMap<usize, Point3<f64>> =
         t.object_points().into_iter().collect();
-    let view = ViewPoints {
-        object_points: det.points.iter().map(|p| objects[&p.id]).collect(),
-        image_points: det
-            .points
+    let view = View::new(
+        "",
+        det.points.iter().map(|p| objects[&p.id]).collect(),
+        det.points
             .iter()
             .map(|p| Point2::new(p.x_px, p.y_px))
             .collect(),
-    };
+    );
     let (camera_from_board, rms) = camera_from_target(&camera, &view).unwrap();
     let expected_t = Vector3::new(0.09752, 0.102848, 0.325596);
     let expected_r = Rotation3::from_axis_angle(&Vector3::x_axis(), 2.88409)

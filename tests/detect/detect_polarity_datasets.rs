@@ -6,7 +6,7 @@
 //! Skipped with a message when the dataset or ffmpeg is absent.
 //!
 //! Bounds: before issue 36 robocal found the board in none of these frames.
-//! Measured on 2026-12-06 (bench/inverted_charuco.sh, BENCHMARKS.md
+//! Measured on 2026-12-06 (benches/inverted_charuco.sh, BENCHMARKS.md
 //! "Inverted boards"): frames with a board 16 / 26 / 15 / 14 and corners
 //! 181 / 130 / 139 / 93 for cameras 0-3 (OpenCV 4.14's CharucoDetector on
 //! the inverted frames: 15 / 23 / 14 / 15 frames, 180 / 121 / 166 / 170
@@ -22,7 +22,6 @@ use robocal::detect::{detect, DetectOptions};
 use robocal::error::Error;
 use robocal::target::{Polarity, Target};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 const SPEC: &str = "charuco:4x5:54mm:40.5mm:DICT_4X4_1000";
 const FRAMES_PER_CAMERA: usize = 30;
@@ -31,35 +30,14 @@ const FRAMES_PER_CAMERA: usize = 30;
 /// near frame 63 of 111), [`FRAMES_PER_CAMERA`] of them, as PNGs in
 /// `dir`; `None` when ffmpeg cannot run.
 fn extract(video: &Path, dir: &Path, camera: usize) -> Option<Vec<PathBuf>> {
-    let pattern = dir.join(format!("cam{camera}_%03d.png"));
-    let status = Command::new("ffmpeg")
-        .args(["-v", "error", "-y", "-i"])
-        .arg(video)
-        .args([
-            "-vf",
-            "select=gte(n\\,21)*not(mod(n\\,3))",
-            "-vsync",
-            "0",
-            "-frames:v",
-        ])
-        .arg(FRAMES_PER_CAMERA.to_string())
-        .arg(&pattern)
-        .status()
-        .ok()?;
-    if !status.success() {
-        return None;
-    }
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .ok()?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with(&format!("cam{camera}_")))
-        })
-        .collect();
-    files.sort();
-    Some(files)
+    support::video_frames(
+        video,
+        dir,
+        &format!("cam{camera}"),
+        21,
+        3,
+        FRAMES_PER_CAMERA,
+    )
 }
 
 #[test]

@@ -43,6 +43,26 @@ fn image_decode() {
     replay("image_decode", cases::image_decode);
 }
 
+/// image-webp 0.2.4 sums a lossless stream's Huffman code-length histogram
+/// in a u16 (its src/huffman.rs line 65) and a crafted histogram overflows
+/// it: a panic under overflow checks (the fuzzers' builds, session 20),
+/// while the shipped builds (release, wasm) wrap and the tree check after
+/// it rejects the file. Cargo.toml's dev profile turns overflow checks off
+/// for that one crate, so the tests see what users get: this error.
+#[test]
+fn webp_huffman_histogram_overflow_is_a_corrupt_file() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/fuzz/image_decode/webp-huffman-histogram-overflow");
+    let bytes = std::fs::read(&path).expect("fixture");
+    let err = robocal::image::decode(&bytes, &robocal::image::DecodeOptions::default())
+        .expect_err("a corrupt WebP")
+        .to_string();
+    assert_eq!(
+        err,
+        "corrupt or truncated WebP file: Format error decoding WebP: Invalid Huffman code"
+    );
+}
+
 #[test]
 fn detect() {
     replay("detect", cases::detect);

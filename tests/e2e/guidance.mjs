@@ -191,6 +191,18 @@ export const tests = [
     assert.ok(models[0].startsWith('Brown-Conrady'), models[0]);
     assert.ok(models.some((m) => m.startsWith('Kannala-Brandt')), models.join(' | '));
     assert.ok(!models.some((m) => /seed/.test(m)), models.join(' | '));
+    // The page keeps no list of its own: the camera and rig steps offer
+    // exactly the core's table (the wasm call lens_models()), in its order.
+    const table = await page.evaluate(async () => {
+      const wasm = await import('./pkg/robocal.js');
+      await wasm.default();
+      return JSON.parse(wasm.lens_models()).map((m) => [m.name, m.description]);
+    });
+    assert.ok(table.length >= 7 && table[0][0] === 'brown', JSON.stringify(table));
+    for (const select of ['#camera-model', '#rig-model']) {
+      const offered = await page.$$eval(`${select} option`, (os) => os.map((o) => [o.value, o.textContent]));
+      assert.deepEqual(offered, table, `${select} offers the core's lens models`);
+    }
     await page.selectOption('#camera-radial', '2');
     await solveCamera(page);
     assert.equal(await cell(page, '#camera-params', 'k3', 1), '0.000000');

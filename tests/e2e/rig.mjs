@@ -10,7 +10,15 @@
 // shows the core's error naming the two groups. OpenCV's left/right set as a
 // 2-camera rig gives the stereo result (right_from_left, its tables, the
 // export step's transform), kept over a reload; an earlier session's stereo
-// result still opens.
+// result still opens. The rig on a robot: a rendered rig carried by an
+// eye-in-hand robot of known gripper_from_rig, solved in the page within
+// 3 mm / 3 mrad of the truth and equal to `robocal rig --setup eye-in-hand
+// --poses` to 1e-6. Held intrinsics: a pair whose second camera's frames
+// disagree with the first's (half its images shifted, as a board that moved
+// between the shots) draws the drift warning; holding the named camera from
+// its own calibration (the warning's button) or from a camera file (that
+// calibration saved) removes it, the camera's intrinsics exactly the held ones
+// and the rig equal to `robocal rig --camera-file NAME=FILE`.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
@@ -81,6 +89,72 @@ function logSmall(r) {
   const s = angle < 1e-12 ? 0.5 : angle / (2 * Math.sin(angle));
   return v.map((x) => x * s);
 }
+
+// 4x4 row-major poses for the robot of the rig on a robot.
+const mul4 = (a, b) => a.map((row) => [0, 1, 2, 3].map((j) => row.reduce((s, v, k) => s + v * b[k][j], 0)));
+function inv4(m) {
+  const r = R3(m);
+  const rt = [0, 1, 2].map((i) => [0, 1, 2].map((j) => r[j][i]));
+  const t = [0, 1, 2].map((i) => -(rt[i][0] * m[0][3] + rt[i][1] * m[1][3] + rt[i][2] * m[2][3]));
+  return [...rt.map((row, i) => [...row, t[i]]), [0, 0, 0, 1]];
+}
+/** The pose of a translation (m) and a rotation vector (rad). */
+function pose4(t, w) {
+  const a = Math.hypot(...w);
+  const [x, y, z] = a < 1e-15 ? [0, 0, 0] : w.map((v) => v / a);
+  const c = Math.cos(a), s = Math.sin(a), C = 1 - c;
+  const r = [[c + x * x * C, x * y * C - z * s, x * z * C + y * s], [y * x * C + z * s, c + y * y * C, y * z * C - x * s], [z * x * C - y * s, z * y * C + x * s, c + z * z * C]];
+  return [...r.map((row, i) => [...row, t[i]]), [0, 0, 0, 1]];
+}
+/** quaternion x, y, z, w of a rotation matrix (Shepperd). */
+function quaternion(m) {
+  const tr = m[0][0] + m[1][1] + m[2][2];
+  if (tr > 0) { const s = 2 * Math.sqrt(tr + 1); return [(m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, s / 4]; }
+  if (m[0][0] > m[1][1] && m[0][0] > m[2][2]) { const s = 2 * Math.sqrt(1 + m[0][0] - m[1][1] - m[2][2]); return [s / 4, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s]; }
+  if (m[1][1] > m[2][2]) { const s = 2 * Math.sqrt(1 + m[1][1] - m[0][0] - m[2][2]); return [(m[0][1] + m[1][0]) / s, s / 4, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s]; }
+  const s = 2 * Math.sqrt(1 + m[2][2] - m[0][0] - m[1][1]);
+  return [(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, s / 4, (m[1][0] - m[0][1]) / s];
+}
+
+/**
+ * An eye-in-hand robot pose file for a rendered rig: base_from_gripper =
+ * base_from_target * rig_from_target^-1 * gripper_from_rig^-1 per frame, in
+ * metres and quaternions, each row naming an image of its frame (the robot
+ * of the CLI's test: tests/cli/cli_rig.rs).
+ */
+function robotPoses(truth) {
+  const gripperFromRig = pose4([0.05, -0.12, 0.2], [0.3, -1.1, 0.4]);
+  const baseFromTarget = pose4([0.8, 0.1, -0.3], [2.0, 0.2, -0.5]);
+  const imageOf = new Map();
+  for (const c of truth.cameras) for (const i of c.images) if (!imageOf.has(i.frame)) imageOf.set(i.frame, i.image.split('/').pop());
+  const rows = truth.frames.filter((f) => imageOf.has(f.key)).map((f) => {
+    const m = mul4(mul4(baseFromTarget, inv4(f.rig_from_target.matrix_row_major)), inv4(gripperFromRig));
+    return [imageOf.get(f.key), m[0][3], m[1][3], m[2][3], ...quaternion(m)].join(',');
+  });
+  return { gripperFromRig, csv: `image,x,y,z,qx,qy,qz,qw\n${rows.join('\n')}\n` };
+}
+
+/** PNG bytes with the picture moved `dx` px to the right (the uncovered band in the corner pixel's grey), drawn by the page's canvas. */
+async function shiftedPng(page, bytes, dx) {
+  const b64 = await page.evaluate(async ([data, dx]) => {
+    const raw = Uint8Array.from(atob(data), (c) => c.charCodeAt(0));
+    const bitmap = await createImageBitmap(new Blob([raw], { type: 'image/png' }));
+    const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
+    const ctx = canvas.getContext('2d');
+    ctx.drawImage(bitmap, 0, 0);
+    const [r, g, b] = ctx.getImageData(0, 0, 1, 1).data;
+    ctx.fillStyle = `rgb(${r},${g},${b})`;
+    ctx.fillRect(0, 0, canvas.width, canvas.height);
+    ctx.drawImage(bitmap, dx, 0);
+    const out = new Uint8Array(await (await canvas.convertToBlob({ type: 'image/png' })).arrayBuffer());
+    let s = '';
+    for (let i = 0; i < out.length; i += 0x8000) s += String.fromCharCode(...out.subarray(i, i + 0x8000));
+    return btoa(s);
+  }, [Buffer.from(bytes).toString('base64'), dx]);
+  return Buffer.from(b64, 'base64');
+}
+
+const DRIFT = /^camera (\S+): the joint rig fit moved its intrinsics beyond their own uncertainty/;
 
 export const tests = [
   ['four-camera rig: extrinsics within 3 reported std of the truth, page = robocal rig, co-observation, 3-D view, exports', async (page, { url, shot }) => {
@@ -217,6 +291,148 @@ export const tests = [
       await page.click('#rig-remove-3');
       await page.waitForFunction(() => /over 3 cameras/.test(document.getElementById('rig-grouping')?.textContent || ''), null, { timeout: 10000 });
       await shot('removed');
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+  ['the rig on a robot: gripper_from_rig within 3 mm / 3 mrad of the truth, equal to robocal rig --setup eye-in-hand --poses to 1e-6', async (page, { url, shot }) => {
+    const { dir, truth, files } = renderRig(3);
+    try {
+      const names = truth.cameras.map((c) => c.name);
+      const { gripperFromRig, csv } = robotPoses(truth);
+      const robotCsv = join(dir, 'robot.csv');
+      writeFileSync(robotCsv, csv);
+      await page.goto(`${url}#stereo`);
+      await ready(page);
+      await setTarget(page, 10, 7, 60);
+      await loadCameras(page, names, files);
+      await page.click('#rig-solve');
+      await page.locator('#rig-summary').waitFor({ timeout: 600000 });
+      // The rig on a robot: setup, the pose file (paired by the frame number of its image column), solve.
+      await page.locator('#rig-robot').scrollIntoViewIfNeeded();
+      await page.selectOption('#rig-robot-setup', 'eye-in-hand');
+      await page.setInputFiles('#rig-robot-input', robotCsv);
+      const frames = truth.frames.length;
+      await page.waitForFunction((n) => (document.getElementById('rig-robot-poses')?.textContent || '').endsWith(`paired with the ${n} frames by the frame number of the image column.`), frames, { timeout: 20000 });
+      assert.equal(await page.locator('#rig-robot-pairing-table tbody tr').count(), frames);
+      assert.equal(await page.isDisabled('#rig-robot-solve'), false);
+      await page.click('#rig-robot-solve');
+      await page.locator('#rig-robot-summary').waitFor({ timeout: 600000 });
+      await page.locator('#rig-robot-summary').scrollIntoViewIfNeeded();
+      await shot('robot-solved');
+      const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#rig-robot-export-json')]);
+      assert.equal(dl.suggestedFilename(), 'rig_robot.json');
+      const report = JSON.parse(readFileSync(await dl.path(), 'utf8'));
+      const he = report.handeye;
+      assert.equal(he.setup, 'eye-in-hand');
+      assert.equal(he.frames.length, frames);
+      const got = he.gripper_from_rig.matrix_row_major;
+      // The truth: the rig is calibrated from the same renders, as in the CLI's test (3 mm, 3 mrad).
+      const dt = Math.hypot(...[0, 1, 2].map((i) => got[i][3] - gripperFromRig[i][3]));
+      const dr = Math.hypot(...logSmall(mulT(R3(got), R3(gripperFromRig))));
+      assert.ok(dt < 3e-3 && dr < 3e-3, `gripper_from_rig off by ${dt} m, ${dr} rad`);
+      // The CLI on the same files and poses: the same transform to 1e-6.
+      const cli = JSON.parse(execFileSync(CLI, ['rig', ...files.flatMap((f, k) => ['--camera', names[k], ...f]), '--target', 'chessboard:10x7:60mm', '--setup', 'eye-in-hand', '--poses', robotCsv], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+      const want = cli.handeye.gripper_from_rig.matrix_row_major.flat();
+      got.flat().forEach((x, i) => assert.ok(Math.abs(x - want[i]) <= 1e-6, `gripper_from_rig entry ${i}: page ${x}, CLI ${want[i]}`));
+      ['translation_mm', 'rotation_deg'].forEach((k) => he.pose_refinement.camera_transform_std[k].forEach((v, i) => assert.ok(Math.abs(v - cli.handeye.pose_refinement.camera_transform_std[k][i]) <= 1e-6 * Math.max(1, v), `std ${k}[${i}]: page ${v}, CLI`)));
+      assert.deepEqual(he.frames.map((f) => [f.key, f.used]), cli.handeye.frames.map((f) => [f.key, f.used]));
+      // The page shows the report's numbers, its std and its warnings.
+      const rows = await page.$$eval('#rig-robot-transform tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+      assert.deepEqual(rows[0], ['T (mm)', ...he.gripper_from_rig.translation_m.map((v) => (v * 1000).toFixed(3))]);
+      assert.deepEqual(rows[1], ['std T (mm)', ...he.pose_refinement.camera_transform_std.translation_mm.map((v) => v.toFixed(3))]);
+      assert.deepEqual(await page.$$eval('#rig-robot-results .msg-warning', (ps) => ps.map((p) => p.textContent)), he.warnings);
+      assert.equal(await page.locator('#rig-robot-cameras tbody tr').count(), names.length);
+      assert.equal(he.rig_uncertainty.included, true);
+      assert.ok((await page.textContent('#rig-robot-uncertainty')).slice(1).startsWith(he.rig_uncertainty.note.slice(1)), he.rig_uncertainty.note);
+      // An export of the rig with its hand-eye, as robocal export gives it.
+      const [urdf] = await Promise.all([page.waitForEvent('download'), page.click('#rig-robot-export-urdf')]);
+      writeFileSync(join(dir, 'rig_robot.json'), JSON.stringify(report));
+      // (The same text but for the last digit of an angle: wasm's and the native libm's atan2.)
+      const pageUrdf = readFileSync(await urdf.path(), 'utf8');
+      const cliUrdf = execFileSync(CLI, ['export', join(dir, 'rig_robot.json'), '--format', 'urdf']).toString();
+      const numbers = (t) => t.match(/-?\d+\.\d+(e-?\d+)?/g).map(Number);
+      assert.equal(pageUrdf.replace(/-?\d+\.\d+(e-?\d+)?/g, '#'), cliUrdf.replace(/-?\d+\.\d+(e-?\d+)?/g, '#'));
+      numbers(pageUrdf).forEach((x, i) => assert.ok(Math.abs(x - numbers(cliUrdf)[i]) <= 1e-12, `urdf number ${i}: page ${x}, CLI ${numbers(cliUrdf)[i]}`));
+      // Kept in the session: after a reload the part shows the same result.
+      const summary = await page.textContent('#rig-robot-summary');
+      await page.waitForTimeout(500); // the store saves 300 ms after the last change
+      await page.reload();
+      await ready(page);
+      await page.locator('#rig-robot-summary').waitFor({ timeout: 30000 });
+      assert.equal(await page.textContent('#rig-robot-summary'), summary);
+      assert.equal(await page.inputValue('#rig-robot-setup'), 'eye-in-hand');
+      assert.equal(await page.isDisabled('#rig-robot-solve'), false);
+      // A pose file that misses a frame: named, no solve.
+      writeFileSync(robotCsv, csv.split('\n').filter((l, i) => i !== 2).join('\n'));
+      await page.setInputFiles('#rig-robot-input', robotCsv);
+      await page.locator('#rig-robot-pairing-error').waitFor({ timeout: 20000 });
+      assert.match(await page.textContent('#rig-robot-pairing-error'), /^no robot pose for frame\(s\) \S+: give a pose for every frame, or leave those frames' images out$/);
+      assert.equal(await page.isDisabled('#rig-robot-solve'), true);
+      console.log(`     rig on a robot: gripper_from_rig ${(dt * 1000).toFixed(3)} mm, ${(dr * 1000).toFixed(3)} mrad from the truth`);
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+  ['held intrinsics: the drift warning names a camera; held from its own calibration or a camera file it is gone, the intrinsics exactly the held ones', async (page, { url, shot }) => {
+    const { dir, truth, files } = renderRig(0);
+    try {
+      // cam0 and cam1 face the same frames: a pair. Every other image of
+      // cam1 moved 6 px: its frames disagree with cam0's.
+      const names = truth.cameras.slice(0, 2).map((c) => c.name);
+      await page.goto(`${url}#stereo`);
+      await ready(page);
+      const moved = [];
+      for (const [i, f] of files[1].entries()) {
+        const out = join(dir, `moved_${f.split('/').pop()}`);
+        writeFileSync(out, i % 2 ? await shiftedPng(page, readFileSync(f), 6) : readFileSync(f));
+        moved.push(out);
+      }
+      const pair = [files[0], moved];
+      await setTarget(page, 10, 7, 60);
+      await loadCameras(page, names, pair);
+      await page.click('#rig-solve');
+      await page.locator('#rig-summary').waitFor({ timeout: 600000 });
+      const first = await downloadedReport(page);
+      const drifted = first.warnings.map((w) => DRIFT.exec(w)).filter(Boolean).map((m) => m[1]);
+      assert.ok(drifted.length > 0, `no drift warning: ${first.warnings.join('\n')}`);
+      const name = drifted[0];
+      const k = names.indexOf(name);
+      // The page names its per-camera control under the warning.
+      assert.match(await page.textContent(`#rig-drift-hint-${k}`), new RegExp(`set camera ${k + 1} \\(${name}\\)'s intrinsics to "hold from its own calibration"`));
+      await shot('drift');
+      // Held from its own calibration (the warning's button): solved again.
+      await page.$eval('#rig-summary', (el) => { el.id = 'rig-summary-before'; });
+      await page.click(`#rig-hold-solo-${k}`);
+      await page.locator('#rig-summary').waitFor({ timeout: 600000 });
+      assert.equal(await page.inputValue(`#rig-intrinsics-${k}`), 'solo');
+      const held = await downloadedReport(page);
+      assert.ok(!held.warnings.some((w) => DRIFT.exec(w)?.[1] === name), held.warnings.join('\n'));
+      assert.equal(held.cameras[k].intrinsics_held, true);
+      const [saved] = await Promise.all([page.waitForEvent('download'), page.click(`#rig-solo-save-${k}`)]);
+      const soloFile = join(dir, `${name}_calibration.json`);
+      writeFileSync(soloFile, readFileSync(await saved.path()));
+      const solo = JSON.parse(readFileSync(soloFile, 'utf8'));
+      assert.deepEqual(held.cameras[k].calibration.camera, solo.camera);
+      await shot('held-solo');
+      // The same calibration as a camera file (robocal rig --camera-file NAME=FILE): the same rig, the CLI's too.
+      await page.selectOption(`#rig-intrinsics-${k}`, 'file');
+      await page.setInputFiles(`#rig-camera-file-${k}`, soloFile);
+      await page.waitForFunction((k) => /^held from .*_calibration\.json \(json\): fx /.test(document.getElementById(`rig-held-${k}`)?.textContent || ''), k, { timeout: 10000 });
+      await page.$eval('#rig-results', (el) => el.replaceChildren());
+      await page.click('#rig-solve');
+      await page.locator('#rig-summary').waitFor({ timeout: 600000 });
+      const fromFile = await downloadedReport(page);
+      assert.deepEqual(fromFile.cameras[k].calibration.camera, solo.camera);
+      assert.ok(!fromFile.warnings.some((w) => DRIFT.exec(w)?.[1] === name), fromFile.warnings.join('\n'));
+      const cli = JSON.parse(execFileSync(CLI, ['rig', ...pair.flatMap((f, j) => ['--camera', names[j], ...f]), '--target', 'chessboard:10x7:60mm', '--camera-file', `${name}=${soloFile}`], { stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 << 20 }).toString());
+      fromFile.cameras.forEach((c, j) => c.camera_from_rig.matrix_row_major.flat().forEach((x, i) => assert.ok(Math.abs(x - cli.cameras[j].camera_from_rig.matrix_row_major.flat()[i]) <= 1e-9, `${c.name} entry ${i}: page ${x}, CLI`)));
+      assert.deepEqual(cli.cameras[k].calibration.camera, solo.camera);
+      // A file that is no camera: the core's words, nothing held.
+      await page.setInputFiles(`#rig-camera-file-${k}`, { name: 'notes.txt', mimeType: 'text/plain', buffer: Buffer.from('hello\n') });
+      await page.waitForFunction((k) => /^notes\.txt: not a camera file/.test(document.getElementById(`rig-held-${k}`)?.textContent || ''), k, { timeout: 10000 });
+      await shot('held-file');
+      console.log(`     held intrinsics: ${name} named (${drifted.join(', ')}), held from its own calibration and from a file`);
     } finally {
       rmSync(dir, { recursive: true, force: true });
     }

@@ -13,13 +13,14 @@
 //! about 1 / sqrt(2 * 72) = 8 %; an estimator at the bound stays below
 //! 1.3x (3.5 std) and the old correction (2.3x in translation) does not.
 
+use robocal::calib::pnp::camera_from_target_with_covariance;
 use robocal::camera::Camera;
-use robocal::handeye::pnp::camera_from_target_with_covariance;
-use robocal::handeye::pose_noise::{CameraNoise, NoiseModel};
-use robocal::handeye::pose_refine::fisher_information;
-use robocal::handeye::pose_residual::difference;
-use robocal::handeye::refine_closed_form::{apply_refinement, RefineMode};
-use robocal::handeye::refine_poses::paired;
+use robocal::handeye::refine::over_pixels::RefineMode;
+use robocal::handeye::refine::over_poses::paired;
+use robocal::handeye::refine::pose_noise::{CameraNoise, NoiseModel};
+use robocal::handeye::refine::pose_problem::fisher_information;
+use robocal::handeye::refine::pose_residual::difference;
+use robocal::handeye::solve::apply_refinement;
 use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
 use robocal::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
 use robocal::synth::Rng;

@@ -150,9 +150,9 @@ fn misspecified(
     kinematic: bool,
     focal_error: f64,
 ) -> (robocal::handeye::HandEyeResult, robocal::handeye::Pose) {
+    use robocal::calib::pnp::camera_from_target_with_covariance;
     use robocal::camera::Camera;
-    use robocal::handeye::pnp::camera_from_target_with_covariance;
-    use robocal::handeye::refine_poses::apply_pose_refinement_from_views;
+    use robocal::handeye::solve::apply_pose_refinement_from_views;
     use robocal::handeye::{MotionPairs, Pose};
     use robocal::synth::handeye_looking::{grid_pixels, kinematic_error};
     let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);

@@ -4,10 +4,10 @@
 //! standard deviations, and the errors for poses that do not pair up.
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
+use robocal::calib::View;
 use robocal::geometry::{rotvec_from_rotation, Pose};
-use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::rig::pnp::HeldRig;
 use robocal::handeye::rig::{calibrate_rig_handeye, rig_handeye_report, RigHandEyeResult};
-use robocal::handeye::rig_pnp::HeldRig;
 use robocal::handeye::{HandEyeOptions, Setup};
 use robocal::synth::rig::{rig_scene, robot_poses, RigScene, RigSceneConfig};
 
@@ -30,17 +30,11 @@ fn truth(setup: Setup) -> (Pose, Pose) {
 }
 
 /// The scene's views grouped per frame (camera index, points).
-fn frames(scene: &RigScene) -> Vec<Vec<(usize, ViewPoints)>> {
+fn frames(scene: &RigScene) -> Vec<Vec<(usize, View)>> {
     let mut out = vec![Vec::new(); scene.frame_keys.len()];
     for (k, views) in scene.views.iter().enumerate() {
         for (f, v) in views {
-            out[*f].push((
-                k,
-                ViewPoints {
-                    object_points: v.object_m.clone(),
-                    image_points: v.image_px.clone(),
-                },
-            ));
+            out[*f].push((k, v.clone()));
         }
     }
     out

@@ -14,13 +14,13 @@
 //! BENCHMARKS.md.
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
-use robocal::calib::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::View;
 use robocal::calib::{calibrate, CalibrationOptions};
 use robocal::geometry::{rotvec_from_rotation, Pose};
-use robocal::handeye::reprojection_refine::ViewPoints;
+use robocal::handeye::rig::pnp::HeldRig;
+use robocal::handeye::rig::uncertainty::{held_rig, rig_sigma_points};
 use robocal::handeye::rig::{add_rig_uncertainty, calibrate_rig_handeye};
-use robocal::handeye::rig_pnp::HeldRig;
-use robocal::handeye::rig_uncertainty::{held_rig, rig_sigma_points};
 use robocal::handeye::{HandEyeOptions, Setup};
 use robocal::synth::rig::{rig_scene, robot_poses, RigScene, RigSceneConfig};
 
@@ -43,17 +43,11 @@ fn truth(setup: Setup) -> (Pose, Pose) {
 }
 
 /// The views of the cameras in `keep`, grouped per frame.
-fn frames(scene: &RigScene, keep: &[usize]) -> Vec<Vec<(usize, ViewPoints)>> {
+fn frames(scene: &RigScene, keep: &[usize]) -> Vec<Vec<(usize, View)>> {
     let mut out = vec![Vec::new(); scene.frame_keys.len()];
     for (slot, &k) in keep.iter().enumerate() {
         for (f, v) in &scene.views[k] {
-            out[*f].push((
-                slot,
-                ViewPoints {
-                    object_points: v.object_m.clone(),
-                    image_points: v.image_px.clone(),
-                },
-            ));
+            out[*f].push((slot, v.clone()));
         }
     }
     out
@@ -150,7 +144,7 @@ fn trial(seed: u64, setup: Setup) -> Trial {
         .as_ref()
         .expect("conditional std");
     let e = errors(&solved.result.x, &x);
-    let std_of = |s: &robocal::handeye::refine_poses::TransformStd| {
+    let std_of = |s: &robocal::handeye::refine::pose_summary::TransformStd| {
         let r = s.rotation_deg;
         let t = s.translation_mm;
         [r[0], r[1], r[2], t[0], t[1], t[2]]

@@ -30,6 +30,13 @@ assert.ok(worstR < 1e-9, 'camera_from_rig rotation entry error ' + worstR);
 assert.ok(rig.rms_px < 1e-6, 'rms px ' + rig.rms_px);
 assert.equal(rig.cameras[0].camera_from_rig_std, null);
 
+// The frame grouping proven from the data (issue 35): the right camera's
+// images keyed one frame late are refused before the joint fit, naming the
+// shift, through npm as through the CLI.
+const shifted = rigInput();
+shifted.cameras[2].views = shifted.cameras[2].views.map((v) => ({ ...v, key: String(Number(v.key) + 1) }));
+assert.throws(() => robocal.calibrate_rig(JSON.stringify(shifted)), { message: /^rig frames: cameras middle and right: the board's motions agree only when right's frames are taken 1 frame late/ });
+
 // Exports: the files robocal export -o DIR writes, the one-text form, the formats.
 const report = JSON.stringify(rig);
 assert.deepEqual(JSON.parse(robocal.rig_export_formats()), ['kalibr', 'opencv-yaml', 'ros', 'urdf', 'mrcal']);

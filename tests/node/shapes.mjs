@@ -172,6 +172,15 @@ const report = all.report;
   const image = robocal.undistort_preview(png(meta.images[0]), JSON.stringify(input('undistort_preview', report.camera)), 200);
   if (image.width !== 200 || image.data.length !== 4 * image.width * image.height) throw new Error(`undistort_preview: ${image.width}x${image.height}`);
 }
+// Camera files (robocal rig --camera-file): a calibration report, and its OpenCV YAML export.
+{
+  const fromReport = output('read_camera_file', JSON.parse(robocal.read_camera_file(JSON.stringify(report))), 'read_camera_file report');
+  assert.equal(fromReport.format, 'json');
+  assert.deepEqual(fromReport.camera, report.camera);
+  const yaml = output('read_camera_file', JSON.parse(robocal.read_camera_file(robocal.export_report(JSON.stringify(report), 'opencv-yaml', ''))), 'read_camera_file opencv-yaml');
+  assert.equal(yaml.format, 'opencv-yaml');
+  assert.throws(() => robocal.read_camera_file('hello'), { message: /not a camera file: expected robocal JSON, OpenCV YAML\/XML/ });
+}
 
 const poses = JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', {}))));
 output('read_robot_poses', poses);
@@ -215,6 +224,14 @@ const ranked = call('rank_pose_conventions', {
 assert.equal(ranked.scores[0].name, 'ur');
 
 const formats = output('export_formats', JSON.parse(robocal.export_formats()));
+// The lens-model table: its rows are LensModelInfo, and its names are
+// exactly the models the types declare (DistortionModels' keys), so a model
+// added to the core without its types (or the other way) fails here.
+const lensModels = output('lens_models', JSON.parse(robocal.lens_models()));
+const declaredModels = checker.getPropertiesOfType(declared('DistortionModels')).map((p) => p.name).sort();
+assert.deepEqual(lensModels.map((m) => m.name).sort(), declaredModels, 'lens_models() and index.d.ts DistortionModels list the same models');
+assert.equal(lensModels[0].name, 'brown', 'the default model first');
+for (const m of lensModels) assert.equal(m.coefficients.length, m.start_values.length, `${m.name}: a start value per coefficient`);
 assert.ok(formats.includes('urdf') && formats.includes('opencv-yaml'));
 for (const r of [report, eyeInHand, eyeToHand]) input('export_report', r);
 assert.match(robocal.export_report(JSON.stringify(eyeInHand), 'euler-intrinsic-zyx-deg', 'gripper_from_camera'), /gripper/);

@@ -152,6 +152,8 @@ if (!(Math.abs(fxPrinted - 900) < 1.5 && Math.abs(cxPrinted - 511.5) < 1.5 && rm
 console.log('README TypeScript example ran: ' + printed.split('\n')[0]);
 process.stdout.write(execFileSync('node', [join(here, 'shapes.mjs'), work]).toString());
 process.stdout.write(execFileSync('node', [join(here, 'rig.mjs'), work]).toString());
+// The rig on a robot on rendered images of known truth (the CLI's renderer).
+process.stdout.write(execFileSync('node', [join(here, 'rig_robot.mjs'), work]).toString());
 // LiveCapture on the renderer's test video (320x240, 5 fps: a hold is 5 frames).
 execFileSync(join(root, 'target/release/robocal'), ['render', '--video', join(work, 'live.y4m'), '--size', '320x240', '--fps', '5', '--seed', '11'], { stdio: 'ignore' });
 process.stdout.write(execFileSync('node', [join(here, 'live.mjs'), work]).toString());

@@ -52,3 +52,45 @@ pub fn dataset(rel: &str) -> Option<PathBuf> {
     roots.push(PathBuf::from("/work/shared/datasets"));
     roots.into_iter().map(|r| r.join(rel)).find(|p| p.exists())
 }
+
+/// Every `step`-th frame of `video` from frame `first`, `count` of them,
+/// as PNGs `<prefix>_NNN.png` in `dir` (sorted paths); `None` when ffmpeg
+/// cannot run (the caller skips with a message).
+pub fn video_frames(
+    video: &Path,
+    dir: &Path,
+    prefix: &str,
+    first: usize,
+    step: usize,
+    count: usize,
+) -> Option<Vec<PathBuf>> {
+    let pattern = dir.join(format!("{prefix}_%03d.png"));
+    let status = Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-i"])
+        .arg(video)
+        .args([
+            "-vf",
+            &format!("select=gte(n\\,{first})*not(mod(n\\,{step}))"),
+            "-vsync",
+            "0",
+            "-frames:v",
+        ])
+        .arg(count.to_string())
+        .arg(&pattern)
+        .status()
+        .ok()?;
+    if !status.success() {
+        return None;
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with(&format!("{prefix}_")))
+        })
+        .collect();
+    files.sort();
+    Some(files)
+}

@@ -157,7 +157,17 @@ export function checkSession(raw, path = 'session') {
       if (!(typeof f.id === 'string' && f.id) && !Number.isFinite(f.id)) fail(`${p}.files[${j}].id`, 'a text or number', f.id);
       check.string(f.name, `${p}.files[${j}].name`);
     });
+    // Held intrinsics (rig-intrinsics.js); absent in sessions saved before them.
+    if (cam.intrinsics !== undefined) check.oneOf(cam.intrinsics, `${p}.intrinsics`, ['solve', 'file', 'solo']);
+    for (const key of ['cameraFile', 'solo']) if (cam[key] !== undefined) cam[key] = check.objectOrNull(cam[key], `${p}.${key}`);
   });
+  // The rig on a robot (rig-robot.js).
+  if (s.rig.robot !== undefined && s.rig.robot !== null) {
+    check.object(s.rig.robot, `${path}.rig.robot`);
+    check.oneOf(s.rig.robot.setup, `${path}.rig.robot.setup`, ['eye-in-hand', 'eye-to-hand']);
+    s.rig.robot.result = check.objectOrNull(s.rig.robot.result, `${path}.rig.robot.result`);
+    s.rig.robot.parsed = check.objectOrNull(s.rig.robot.parsed, `${path}.rig.robot.parsed`);
+  }
   s.stereo = check.objectOrNull(raw.stereo, `${path}.stereo`);
   return s;
 }

@@ -4,15 +4,23 @@
 // `options` (robocal::api::camera::JsonOptions).
 import { h } from '../lib/dom.js';
 
-export const MODELS = [
-  ['brown', 'Brown-Conrady (radial k1 k2 k3, tangential p1 p2: OpenCV, MATLAB, Bouguet, Kalibr radtan)'],
-  ['radial_k1_k2_k5', 'Brown-Conrady radial only, Bouguet numbering (k1 k2 k5)'],
-  ['rational', 'OpenCV rational (k1..k6, p1 p2, thin prism s1..s4)'],
-  ['division', 'Division (Fitzgibbon, Halcon)'],
-  ['kannala_brandt', 'Kannala-Brandt fisheye (OpenCV fisheye, Kalibr equidistant)'],
-  ['eucm', 'Enhanced unified camera model (EUCM, wide angle)'],
-  ['none', 'Pinhole, no distortion'],
-];
+/**
+ * The lens models as `[name, description]`, in menu order: the core's table
+ * (camera::LENS_MODELS through the wasm call `lens_models()`), filled by
+ * `loadLensModels` before the steps render. No list is kept here.
+ */
+export const MODELS = [];
+
+/** Fill `MODELS` from the engine (worker.js `lensModels`); an engine that cannot start leaves it empty. */
+export async function loadLensModels(engine) {
+  try {
+    const rows = await engine.call('lensModels');
+    MODELS.splice(0, MODELS.length, ...rows.map((m) => [m.name, m.description]));
+  } catch (err) {
+    // The engine's own status line says why it could not start.
+    console.error(err);
+  }
+}
 /** Brown-Conrady as users know it: 2 or 3 radial coefficients, tangential on or off (held at 0 otherwise). */
 const RADIAL = [['3', '3 radial (k1 k2 k3: OpenCV default)'], ['2', '2 radial (k1 k2, k3 held at 0: MATLAB, Bouguet, Kalibr default)']];
 const OPTIONS = [

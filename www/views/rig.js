@@ -9,14 +9,18 @@
 // Shows every camera_from_rig with its standard deviation, per-camera and
 // per-frame residuals, the co-observation graph, a 3-D view of the rig and
 // the rig exports; two cameras are also shown as the stereo pair
-// (right_from_left, exported in step 8). Images, detections and the result
-// are kept in the session.
+// (right_from_left, exported in step 8). Each camera's intrinsics are solved
+// with the rig or held (from a camera file or its own calibration:
+// rig-intrinsics.js); a solved rig can be put on a robot (rig-robot.js).
+// Images, detections and the result are kept in the session.
 import { h, fill, table, num, message, download } from '../lib/dom.js';
 import { FrameView } from '../lib/view3d.js';
 import { targetSpec } from './target.js';
 import { lensFields, readLens, jsonOptions } from './lens.js';
 import { stereoOfRig, stereoOfLegacy, stereoSection } from './rig-stereo.js';
 import { frustum, invert, rotvecDeg, boardOutline, apply, flat } from '../lib/rig3d.js';
+import { intrinsicsControl, heldCamera, driftCamera, driftHint } from './rig-intrinsics.js';
+import { RigRobot } from './rig-robot.js';
 
 /** Frames a rig solve needs (each camera's intrinsics need 3 views: api::camera::MIN_VIEWS). */
 const MIN_FRAMES = 3;
@@ -43,6 +47,7 @@ export class RigView {
     this.engine = engine;
     this.panel = panel;
     this.grouping = { error: null, frames: [], keys: [] };
+    this.robot = new RigRobot(store, engine, () => this.rigInput());
     this.render();
   }
 
@@ -79,8 +84,9 @@ export class RigView {
       h('label', { for: 'rig-group-by' }, 'Frames from file names'), groupSelect, pattern);
     this.progress = h('p', { id: 'rig-progress', class: 'hint', 'aria-live': 'polite' });
     this.out = h('div', { id: 'rig-results', 'aria-live': 'polite' });
+    this.robotOut = h('div', { id: 'rig-robot-part' });
     fill(this.panel,
-      h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. Choose another rule when the last number is not the frame\'s: the first number (sync036_cam0.jpg), order, or a pattern: plain text with one (\\d+), such as sync(\\d+) for sync036_cam0.jpg with cam1_sync36.png. The rig frame is the first camera\'s.'),
+      h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. Choose another rule when the last number is not the frame\'s: the first number (sync036_cam0.jpg), order, or a pattern: plain text with one (\\d+), such as sync(\\d+) for sync036_cam0.jpg with cam1_sync36.png. The rig frame is the first camera\'s. Each camera\'s intrinsics are solved with the rig, or held: from a camera file (robocal JSON, OpenCV YAML/XML, ROS camera_info; robocal rig --camera-file NAME=FILE) or from its own calibration (its images alone), the fix when the joint fit drags a camera\'s intrinsics away from what its own images say. Once solved, the rig can be put on a robot: a robot pose file, one pose per frame, gives gripper_from_rig or base_from_rig (robocal rig --setup … --poses FILE).'),
       this.camerasOut,
       h('div', { class: 'row' }, h('button', { type: 'button', id: 'rig-add', onclick: () => this.addCamera() }, 'Add a camera')),
       grouping,
@@ -89,7 +95,7 @@ export class RigView {
         h('p', { class: 'hint' }, 'As in step 3. Kalibr\'s radtan model is k1 k2 p1 p2: choose Brown-Conrady with 2 radial terms to export the rig to Kalibr.'),
         form),
       h('div', { class: 'row' }, this.solveButton, h('button', { type: 'button', id: 'rig-clear', onclick: () => this.clear() }, 'Remove the rig images')),
-      this.progress, this.framesOut, this.out);
+      this.progress, this.framesOut, this.out, this.robotOut);
     this.showCameras();
     this.showFrames();
     if (st.result) this.show(st.result);
@@ -110,7 +116,8 @@ export class RigView {
       const files = h('input', { type: 'file', id: `rig-input-${k}`, multiple: true, accept: 'image/*,.pgm,.ppm,.pnm,.tif,.tiff,.bmp' });
       files.addEventListener('change', () => { this.addFiles(c, [...files.files]); files.value = ''; });
       const remove = cams.length > 2 ? h('button', { type: 'button', id: `rig-remove-${k}`, onclick: () => this.removeCamera(k) }, 'Remove this camera') : null;
-      return h('div', { class: 'row rig-camera' }, h('label', {}, `Camera ${k + 1} `, name), h('label', {}, 'images ', files), h('span', { class: 'hint', id: `rig-count-${k}` }, `${c.files.length} image${c.files.length === 1 ? '' : 's'}`), remove);
+      const intrinsics = intrinsicsControl(c, k, this.engine, () => this.store.changed('rig'));
+      return h('div', { class: 'row rig-camera' }, h('label', {}, `Camera ${k + 1} `, name), h('label', {}, 'images ', files), h('span', { class: 'hint', id: `rig-count-${k}` }, `${c.files.length} image${c.files.length === 1 ? '' : 's'}`), intrinsics, remove);
     }));
   }
 
@@ -147,6 +154,7 @@ export class RigView {
     this.state.result = null;
     this.store.changed('rig');
     fill(this.out);
+    fill(this.robotOut);
     this.showCameras();
     this.showFrames();
   }
@@ -214,11 +222,37 @@ export class RigView {
     }
   }
 
+  /**
+   * The calibrate_rig input of the detected views (each view keyed by its
+   * frame), without held intrinsics; `spec` defaults to the target of step 1.
+   */
+  rigInput(spec = targetSpec(this.store.session.target)) {
+    const { keys, grouped_by: groupedBy, error } = this.grouping;
+    if (error || keys.length !== this.state.cameras.length) throw new Error(error || 'the images are not grouped into frames yet: wait for the frame table');
+    return {
+      model: this.state.model,
+      options: jsonOptions(this.state),
+      target: spec,
+      grouping: groupedBy,
+      cameras: this.state.cameras.map((c, k) => ({
+        name: c.name,
+        views: c.files.map((f, i) => ({ f, key: keys[k][i] })).filter(({ f }) => f.detection).map(({ f, key }) => ({ key, name: f.name, detection: f.detection })),
+      })),
+    };
+  }
+
+  /** Camera `k`'s intrinsics held from its own calibration, then the rig solved again. */
+  async holdSolo(k) {
+    this.state.cameras[k].intrinsics = 'solo';
+    this.store.changed('rig');
+    this.showCameras();
+    await this.solve();
+  }
+
   async solve() {
     let spec;
     try { spec = targetSpec(this.store.session.target); } catch (err) { fill(this.out, message('error', err.message)); return; }
     const cams = this.state.cameras;
-    const { keys, grouped_by: groupedBy } = this.grouping;
     this.solveButton.disabled = true;
     try {
       const total = cams.reduce((s, c) => s + c.files.length, 0);
@@ -231,22 +265,22 @@ export class RigView {
       }
       this.store.changed('rig');
       await this.showFrames();
-      const input = {
-        model: this.state.model,
-        options: jsonOptions(this.state),
-        target: spec,
-        grouping: groupedBy,
-        cameras: cams.map((c, k) => ({
-          name: c.name,
-          views: c.files.map((f, i) => ({ f, key: keys[k][i] })).filter(({ f }) => f.detection).map(({ f, key }) => ({ key, name: f.name, detection: f.detection })),
-        })),
-      };
+      const input = this.rigInput(spec);
       const blind = input.cameras.find((c) => !c.views.length);
       if (blind) throw new Error(`the target was found in no image of camera ${blind.name}`); // as robocal rig says it
+      // Held intrinsics (robocal rig --camera-file NAME=FILE): a camera
+      // file's camera, or the camera's own calibration made now.
+      for (const [k, c] of cams.entries()) {
+        if ((c.intrinsics || 'solve') === 'solo') this.progress.textContent = `calibrating camera ${c.name} alone to hold its intrinsics…`;
+        const held = await heldCamera(c, input.cameras[k], input.model, input.options, this.engine);
+        if (held) input.cameras[k].camera = held;
+      }
+      this.showCameras();
       const used = input.cameras.reduce((s, c) => s + c.views.length, 0);
       this.progress.textContent = `detected ${total} images: the target in ${used}; solving…`;
       const result = await this.engine.call('rig', { input: JSON.stringify(input) });
       this.state.result = result;
+      if (this.state.robot) this.state.robot.result = null; // the rig on a robot was of the earlier rig
       this.store.session.stereo = null; // an earlier session's stereo result is replaced by the rig's
       this.store.changed('rig-result');
       this.progress.textContent = `solved with ${used} views in ${result.frames.length} frames.`;
@@ -255,6 +289,7 @@ export class RigView {
       this.progress.textContent = '';
       this.state.result = null; // the error replaces an earlier result, in the session too
       this.store.changed('rig-result');
+      fill(this.robotOut);
       fill(this.out, h('p', { id: 'rig-error', class: 'msg msg-error', role: 'alert' }, err.message));
     } finally {
       this.solveButton.disabled = false;
@@ -291,12 +326,22 @@ export class RigView {
       h('h3', {}, 'Frames'),
       table(['frame', 'cameras', 'RMS (px)'], r.frames.map((f) => [f.key, f.cameras.join(', '), num(f.rms_px, 4)]), { id: 'rig-frame-residuals', class: 'scroll' }),
       (r.warnings || []).map((w) => message('warning', w)),
+      this.driftHints(r),
       h('h3', {}, 'The rig in 3-D'),
       this.canvas,
       h('h3', {}, 'Export'),
       this.exportsOut);
+    fill(this.robotOut, this.robot.render(r));
     await this.draw3d(r);
     await this.showExports(r);
+  }
+
+  /** Under a drift warning, the per-camera control that holds that camera (rig-intrinsics.js). */
+  driftHints(r) {
+    return (r.warnings || []).map(driftCamera).filter(Boolean).map((name) => {
+      const k = this.state.cameras.findIndex((c) => c.name === name);
+      return k < 0 ? null : driftHint(name, k, () => this.holdSolo(k));
+    });
   }
 
   async draw3d(r) {

@@ -38,6 +38,54 @@ function rotvecDeg(q) {
   return [x * k, y * k, z * k].map((v) => (v * 180) / Math.PI);
 }
 
+/**
+ * Read a pose source ({text} a pose table, or {files: [{name, text}]} one
+ * pose each) with the worker under `options` (format, units, direction):
+ * `{reading, parsed, error}`; `parsed` is the reading's poses, or its most
+ * plausible candidate when the layout is ambiguous.
+ */
+export async function readPoseSource(engine, source, options) {
+  try {
+    const o = JSON.stringify(options);
+    const reading = source.files && source.files.length
+      ? await engine.call('poseFiles', { files: JSON.stringify(source.files), options: o })
+      : await engine.call('poses', { text: source.text, options: o });
+    const parsed = reading.parsed || (reading.candidates[0] ? { ...reading.candidates[0], notes: [] } : null);
+    return { reading, parsed, error: null };
+  } catch (err) {
+    return { reading: null, parsed: null, error: err.message };
+  }
+}
+
+/**
+ * Chosen files as read poses: one file is a pose table (a .yaml/.yml file,
+ * or a file the table reader refuses but the one-pose reader takes, is one
+ * pose); several are one pose each. A file that is not text is named.
+ * Returns `{fileName, text, files, reading, parsed, error}` (the robot
+ * step's state; the rig step's rig on a robot reads its poses the same way).
+ */
+export async function loadPoseFiles(engine, chosen, options) {
+  const many = chosen.length > 1 || ONE_POSE_FILE.test(chosen[0].name);
+  const fileName = chosen.length > 1 ? `${chosen.length} pose files` : chosen[0].name;
+  const files = [];
+  try {
+    for (const f of chosen) files.push({ name: f.name, text: await readTextFile(f, many ? 'one robot pose' : 'one robot pose a line, one per image').catch((err) => { throw new Error(chosen.length > 1 ? `'${f.name}': ${err.message}` : err.message); }) });
+  } catch (err) {
+    // Nothing of these files is used: the poses of earlier files are not
+    // shown under their names.
+    return { fileName, text: '', files: null, reading: null, parsed: null, error: err.message };
+  }
+  const source = many ? { text: null, files } : { text: files[0].text, files: null };
+  const read = await readPoseSource(engine, source, options);
+  // A single file the table reader refuses may be one pose: a JSON object
+  // or `key: value` lines (a ROS pose as JSON, a YAML saved as .txt).
+  if (!many && read.error && /^\s*\{|^\s*[A-Za-z_][\w ]*:/m.test(files[0].text)) {
+    const one = await readPoseSource(engine, { files }, options);
+    if (!one.error) return { fileName, text: null, files, ...one };
+  }
+  return { fileName, ...source, ...read };
+}
+
 export class RobotView {
   constructor(store, engine) {
     this.store = store;
@@ -84,36 +132,11 @@ export class RobotView {
     this.show();
   }
 
-  /**
-   * Load chosen files: one file is a pose table (a .yaml/.yml file, or a
-   * file the table reader refuses but the one-pose reader takes, is one
-   * pose); several are one pose each. A file that is not text is named.
-   */
+  /** Load chosen files (see loadPoseFiles), then show them. */
   async load(chosen) {
-    const st = this.state;
-    const many = chosen.length > 1 || ONE_POSE_FILE.test(chosen[0].name);
-    st.fileName = chosen.length > 1 ? `${chosen.length} pose files` : chosen[0].name;
-    const files = [];
-    try {
-      for (const f of chosen) files.push({ name: f.name, text: await readTextFile(f, many ? 'one robot pose' : 'one robot pose a line, one per image').catch((err) => { throw new Error(chosen.length > 1 ? `'${f.name}': ${err.message}` : err.message); }) });
-    } catch (err) {
-      // Nothing of these files is used: the poses of earlier files are not
-      // shown under their names.
-      Object.assign(st, { text: '', files: null, reading: null, parsed: null, error: err.message });
-      this.store.changed('robot');
-      this.show();
-      return;
-    }
-    Object.assign(st, many ? { text: null, files } : { text: files[0].text, files: null });
-    await this.parse();
-    // A single file the table reader refuses may be one pose: a JSON object
-    // or `key: value` lines (a ROS pose as JSON, a YAML saved as .txt).
-    if (!many && st.error && /^\s*\{|^\s*[A-Za-z_][\w ]*:/m.test(files[0].text)) {
-      const table = st.error;
-      Object.assign(st, { text: null, files });
-      await this.parse();
-      if (st.error) { Object.assign(st, { text: files[0].text, files: null, error: table }); this.show(); }
-    }
+    Object.assign(this.state, await loadPoseFiles(this.engine, chosen, this.options()));
+    this.store.changed('robot');
+    this.show();
   }
 
   options() {
@@ -128,18 +151,7 @@ export class RobotView {
   async parse() {
     const st = this.state;
     if (!st.text && !(st.files && st.files.length)) return;
-    try {
-      const options = JSON.stringify(this.options());
-      st.reading = st.files && st.files.length
-        ? await this.engine.call('poseFiles', { files: JSON.stringify(st.files), options })
-        : await this.engine.call('poses', { text: st.text, options });
-      st.error = null;
-      st.parsed = st.reading.parsed || (st.reading.candidates[0] ? { ...st.reading.candidates[0], notes: [] } : null);
-    } catch (err) {
-      st.reading = null;
-      st.parsed = null;
-      st.error = err.message;
-    }
+    Object.assign(st, await readPoseSource(this.engine, st, this.options()));
     this.store.changed('robot');
     this.show();
   }

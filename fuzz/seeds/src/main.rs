@@ -1,6 +1,6 @@
 //! Writes the seed corpus of every fuzz target: `robocal-fuzz-seeds REPO OUT`
-//! fills `OUT/<target>/` from the project's fixtures (`fixtures/`,
-//! `tests/fixtures/`) and from small seeded renders and synthetic scenes,
+//! fills `OUT/<target>/` from the project's fixtures (`fixtures/`) and
+//! from small seeded renders and synthetic scenes,
 //! each input in the layout its target reads (`fuzz/src/cases.rs`).
 //! Deterministic: the same files on every run.
 
@@ -286,7 +286,7 @@ fn calib_seeds(out: &Path, renders: &[Render]) -> Res<Vec<String>> {
         });
         let text = input.to_string();
         if model == "brown" && method == "zhang" {
-            camera_report = robocal::calib::json_api::calibrate_json(&text)?;
+            camera_report = robocal::api::camera::calibrate_json(&text)?;
         }
         corpus.text(&format!("{model}-{method}.json"), 0, &text)?;
     }
@@ -344,7 +344,7 @@ fn handeye_seeds(out: &Path, camera: &robocal::Camera) -> Res<String> {
         });
         let text = input.to_string();
         if k == 0 {
-            report = robocal::handeye::json_api::solve_handeye_json(&text)?;
+            report = robocal::api::handeye::solve_handeye_json(&text)?;
         }
         corpus.text(&format!("{}.json", setup.name()), 0, &text)?;
         // Image points of a 4 x 3 grid per view instead of camera poses.

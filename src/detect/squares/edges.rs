@@ -390,8 +390,8 @@ pub(super) fn edge_on_profile(
 /// window; counting whole samples made them jump by a sample's weight
 /// whenever the window's end crossed one, which left the fixed point of
 /// the centroid iteration (and the corner) to jitter with the sampling
-/// phase from pass to pass (BENCHMARKS.md, "Square grids: the window's
-/// ends", session 14). `sums[k]` holds the sums over the samples before
+/// phase from pass to pass (docs/benchmark-history.md, "Session 14:
+/// square grids, the window's ends"). `sums[k]` holds the sums over the samples before
 /// `k`; the window is cut to the profile's cells.
 fn window_sums(
     sums: &[[f64; 3]],

@@ -33,7 +33,8 @@
 //! profile per pixel) until one moves no corner by more than 0.05 px
 //! (usually the first: fine passes agree to ~0.005 px), at most four
 //! passes in all. Only the fine passes decide the corners; the coarse one
-//! brings the sides within the fine search (BENCHMARKS.md, "Square grids").
+//! brings the sides within the fine search (docs/benchmark-history.md,
+//! "Square grids: speed" and sessions 9-14).
 
 //! The curve is a straight line over the whole side, chosen by numbers
 //! (test `side_models_compared_on_distorted_renders`: four 1280x960 views
@@ -60,9 +61,9 @@
 
 use super::blobs::{bilinear_line, bilinear_u8, find_blobs, Blob};
 use super::circles::{blob_working_level, blobs_at_level, search_grid, GridSearch};
-use super::filter::{box_level, to_full};
 use super::DetectOptions;
 use crate::error::{Error, Result};
+use crate::image::filter::{box_level, to_full};
 use crate::image::GrayImage;
 use crate::target::DetectedPoint;
 use nalgebra::{Matrix2, Matrix3, Point2, Vector2, Vector3};
@@ -86,7 +87,7 @@ const COARSE_PROFILE_STEP_PX: f64 = 0.5;
 /// profiles every `FIRST_PASS_SPACING_PX` (the first with a wide search).
 /// One is enough: a second coarse pass (session 9-12) moved the result of
 /// the fine pass after it by ~0.001 px on the renders and took 15 % of a
-/// VGA detection (BENCHMARKS.md, "Square grids: speed", session 13).
+/// VGA detection (docs/benchmark-history.md, "Session 13").
 const COARSE_PASSES: usize = 1;
 /// Most edge measurement passes (coarse and fine).
 const PASSES: usize = 4;
