@@ -15,6 +15,15 @@ fn main() {
         eprintln!("robocal: {message}");
         std::process::exit(2);
     }
+    // A codec's panic on a crafted file is caught and reported as that
+    // file's decode error (robocal::image::decode): the default hook's
+    // backtrace would only be noise then. Every other panic prints as usual.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !robocal::image::inside_codec_guard() {
+            default_hook(info);
+        }
+    }));
     let args = cli::Cli::parse();
     if let Err(e) = cli::run(args) {
         // A closed stdout ends quietly, as with other Unix tools.

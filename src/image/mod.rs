@@ -230,27 +230,27 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
     let fail = |e: ImageError| decode_error(format, e, bytes.len(), options);
     // The grey image, and the decoded image when its pixels are not grey
     // already (PNG rows are converted as they come).
-    let (gray, image) = match opened.source {
+    let (gray, image) = codec_guard(format, || match opened.source {
         Source::PngRows(reader) => {
             let pixels = reader
                 .read_gray(opened.width, opened.height)
                 .map_err(fail)?;
-            (
+            Ok((
                 Some(GrayImage::new(opened.width, opened.height, pixels)?),
                 None,
-            )
+            ))
         }
         Source::PngWhole(reader) => {
             let image = reader
                 .read_whole(opened.width, opened.height)
                 .map_err(fail)?;
-            (None, Some(image))
+            Ok((None, Some(image)))
         }
-        Source::Other(decoder) => (
+        Source::Other(decoder) => Ok((
             None,
             Some(DynamicImage::from_decoder(decoder).map_err(fail)?),
-        ),
-    };
+        )),
+    })?;
     let (mut channels, mut bits_per_channel) = (opened.channels, opened.bits_per_channel);
     let mut small = None;
     let gray = match (gray, image) {
@@ -284,6 +284,45 @@ pub fn decode(bytes: &[u8], options: &DecodeOptions) -> Result<Decoded> {
         info,
         gray,
         preview,
+    })
+}
+
+thread_local! {
+    /// How many [`codec_guard`]s this thread is inside.
+    static GUARDED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+}
+
+/// Whether this thread is decoding inside [`codec_guard`]: a host's panic
+/// hook stays quiet then (the panic becomes the file's decode error).
+pub fn inside_codec_guard() -> bool {
+    GUARDED.with(|g| g.get() > 0)
+}
+
+/// Runs a codec, a panic inside it becoming this file's decode error
+/// instead of the end of the process. The codec crates can panic on
+/// crafted files: zune-jpeg 0.5.15's AVX2 inverse DCT unwraps a slice past
+/// the end of its output on one found by the image_decode fuzzer (session
+/// 20; fixtures/fuzz/image_decode/jpeg-avx2-idct-unwrap), where its scalar
+/// path and its first store do not. The codec holds no state of ours, so
+/// `AssertUnwindSafe` holds. Where panics abort (the wasm build) this does
+/// nothing; the page's worker trap names the file instead.
+fn codec_guard<T>(format: ImageFormat, decode: impl FnOnce() -> Result<T>) -> Result<T> {
+    GUARDED.with(|g| g.set(g.get() + 1));
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(decode));
+    GUARDED.with(|g| g.set(g.get().saturating_sub(1)));
+    outcome.unwrap_or_else(|payload| {
+        let why = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "no message".into());
+        Err(Error::Image {
+            message: format!(
+                "corrupt {} file: its decoder failed inside ({why}); the file is damaged or uses \
+                 a coding the decoder mishandles: re-save it (e.g. as PNG) or take it again",
+                format.name()
+            ),
+        })
     })
 }
 

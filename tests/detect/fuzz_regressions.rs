@@ -63,6 +63,37 @@ fn webp_huffman_histogram_overflow_is_a_corrupt_file() {
     );
 }
 
+/// zune-jpeg 0.5.15's AVX2 inverse DCT unwraps a slice past the end of
+/// its output on this crafted JPEG (found by the image_decode fuzzer with
+/// the shipped build's settings, session 20): the panic is caught inside
+/// `image::decode` and becomes this file's error, and `robocal info`
+/// names the file and exits 1 without a backtrace. Without AVX2 the
+/// scalar path runs, which does not panic.
+#[test]
+fn a_jpeg_decoder_panic_is_this_files_error() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/fuzz/image_decode/jpeg-avx2-idct-unwrap");
+    let bytes = std::fs::read(&path).expect("fixture");
+    let decoded = robocal::image::decode(&bytes, &robocal::image::DecodeOptions::default());
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        let err = decoded.as_ref().map(|_| ()).expect_err("the AVX2 path panics").to_string();
+        assert!(
+            err.starts_with("corrupt JPEG file: its decoder failed inside ("),
+            "{err}"
+        );
+        assert!(err.ends_with("re-save it (e.g. as PNG) or take it again"), "{err}");
+    }
+    let _ = decoded;
+    let (code, stdout, stderr) = crate::support::robocal(&["info", &path.to_string_lossy()]);
+    if code == 1 {
+        assert!(stdout.contains("corrupt JPEG file: its decoder failed inside ("), "{stdout}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    } else {
+        assert_eq!(code, 0, "{stdout}{stderr}");
+    }
+}
+
 #[test]
 fn detect() {
     replay("detect", cases::detect);
