@@ -432,11 +432,12 @@ pub fn workflows(data: &[u8]) {
         }
         1 => {
             if let Ok(points) = csv::parse_planar_points(text) {
-                let _ = robocal::api::planar::planar_solve(&robocal::api::planar::PlanarSolveRequest {
-                    points,
-                    options: Default::default(),
-                    predict: vec![],
-                });
+                let _ =
+                    robocal::api::planar::planar_solve(&robocal::api::planar::PlanarSolveRequest {
+                        points,
+                        options: Default::default(),
+                        predict: vec![],
+                    });
             }
         }
         2 => {

@@ -31,10 +31,10 @@
 //! [`crate::target::Detection`] format, as `detect_target` returns it): the
 //! board points then come from each detection's own target.
 
+use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::PoseInput;
-use crate::calib::View;
 use crate::handeye::quality::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };

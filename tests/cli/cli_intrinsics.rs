@@ -433,7 +433,10 @@ fn the_model_help_lists_every_model_of_the_table() {
         // clap wraps long help lines: compare with the white space collapsed.
         let help = stdout.split_whitespace().collect::<Vec<_>>().join(" ");
         let wanted = robocal::camera::model_help(subject);
-        assert!(help.contains(&wanted), "{command} --help lacks '{wanted}':\n{stdout}");
+        assert!(
+            help.contains(&wanted),
+            "{command} --help lacks '{wanted}':\n{stdout}"
+        );
         for name in robocal::camera::MODEL_NAMES {
             assert!(help.contains(name), "{command} --help lacks {name}");
         }

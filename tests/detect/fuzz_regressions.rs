@@ -77,17 +77,27 @@ fn a_jpeg_decoder_panic_is_this_files_error() {
     let decoded = robocal::image::decode(&bytes, &robocal::image::DecodeOptions::default());
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
-        let err = decoded.as_ref().map(|_| ()).expect_err("the AVX2 path panics").to_string();
+        let err = decoded
+            .as_ref()
+            .map(|_| ())
+            .expect_err("the AVX2 path panics")
+            .to_string();
         assert!(
             err.starts_with("corrupt JPEG file: its decoder failed inside ("),
             "{err}"
         );
-        assert!(err.ends_with("re-save it (e.g. as PNG) or take it again"), "{err}");
+        assert!(
+            err.ends_with("re-save it (e.g. as PNG) or take it again"),
+            "{err}"
+        );
     }
     let _ = decoded;
     let (code, stdout, stderr) = crate::support::robocal(&["info", &path.to_string_lossy()]);
     if code == 1 {
-        assert!(stdout.contains("corrupt JPEG file: its decoder failed inside ("), "{stdout}");
+        assert!(
+            stdout.contains("corrupt JPEG file: its decoder failed inside ("),
+            "{stdout}"
+        );
         assert!(!stderr.contains("panicked"), "{stderr}");
     } else {
         assert_eq!(code, 0, "{stdout}{stderr}");

@@ -20,10 +20,10 @@
 //!    where that is larger ([`super::rig_jackknife`]).
 //! 5. The report ([`RigCalibration`]).
 
-use crate::calib::multi::rig_graph::{co_observation_counts, spanning_tree};
 use crate::calib::multi::rig_frame_check::{
     check_pair, message as frame_message, CameraFrames, FrameFinding,
 };
+use crate::calib::multi::rig_graph::{co_observation_counts, spanning_tree};
 use crate::calib::multi::rig_init::{camera_alone, Alone};
 use crate::calib::multi::rig_jackknife::{leave_frames_out, WARN_FACTOR};
 use crate::calib::multi::rig_problem::{RigProblem, Sighting};

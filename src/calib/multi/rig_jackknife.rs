@@ -17,9 +17,9 @@
 //! widened to it axis by axis where it is larger (with the model right the
 //! factor stays near 1); a factor beyond [`WARN_FACTOR`] is also said.
 
-use crate::calib::refine::CalibProblem;
 use super::rig_graph::{co_observation_counts, spanning_tree};
 use super::rig_problem::{RigProblem, Sighting};
+use crate::calib::refine::CalibProblem;
 use crate::geometry::{rotvec_from_rotation, Pose};
 use crate::optim::{solve, BlockParams, LmOptions, LmResult};
 

@@ -6,8 +6,8 @@
 use crate::camera::Camera;
 use crate::geometry::PoseJson;
 use crate::handeye::Setup;
-use crate::synth::handeye_looking::{grid_pixels, looking_scene, LookingConfig};
 use crate::rng::Rng;
+use crate::synth::handeye_looking::{grid_pixels, looking_scene, LookingConfig};
 use serde_json::{json, Value};
 use wasm_bindgen_test::wasm_bindgen_test;
 

@@ -10,8 +10,8 @@ use crate::handeye::refine::pose_problem::fisher_information;
 use crate::handeye::refine::pose_residual::difference;
 use crate::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions};
 use crate::handeye::{Pose, Setup};
-use crate::synth::handeye_looking::{looking_scene, perturbed, LookingConfig, LookingScene};
 use crate::rng::Rng;
+use crate::synth::handeye_looking::{looking_scene, perturbed, LookingConfig, LookingScene};
 use nalgebra::{SMatrix, Translation3, UnitQuaternion, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
 

@@ -7,8 +7,8 @@ use crate::handeye::quality::residuals::pose_difference;
 use crate::handeye::refine::pixel_problem::{refine, RefineOptions, RobotNoise};
 use crate::handeye::solve::solve_method;
 use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
-use crate::synth::handeye::{project_grid, HandEyeScene};
 use crate::rng::Rng;
+use crate::synth::handeye::{project_grid, HandEyeScene};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use wasm_bindgen_test::wasm_bindgen_test;
 

@@ -343,8 +343,8 @@ mod tests {
     use crate::handeye::refine::pose_residual::{linearise, PoseMeasurement};
     use crate::handeye::refine::pose_shape::{predicted_covariances, NominalTarget};
     use crate::handeye::Setup;
-    use crate::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
     use crate::rng::Rng;
+    use crate::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
     use wasm_bindgen_test::wasm_bindgen_test;
 
     /// [`NoiseModel::update`] as it was before the per-view terms were

@@ -204,8 +204,8 @@ mod tests {
     use crate::handeye::quality::residuals::pose_difference;
     use crate::handeye::refine::pose_noise::CameraNoise;
     use crate::handeye::refine::pose_problem::refine;
-    use crate::synth::handeye_looking::{kinematic_error, looking_scene, perturbed, LookingConfig};
     use crate::rng::Rng;
+    use crate::synth::handeye_looking::{kinematic_error, looking_scene, perturbed, LookingConfig};
     use wasm_bindgen_test::wasm_bindgen_test;
 
     /// 20 views at 0.5 m, robot noise 0.1 mm / 0.02 deg, camera noise

@@ -12,8 +12,8 @@ use crate::handeye::refine::pose_residual::difference;
 use crate::handeye::solve::apply_pose_refinement_with;
 use crate::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions};
 use crate::handeye::{MotionPairs, Pose, Setup};
-use crate::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
 use crate::rng::Rng;
+use crate::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
 use serde::Deserialize;
 use wasm_bindgen_test::wasm_bindgen_test;
 
