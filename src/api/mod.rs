@@ -23,6 +23,7 @@
 pub mod camera;
 #[cfg(test)]
 pub(crate) mod camera_tests;
+mod choices;
 pub mod handeye;
 pub mod planar;
 pub mod poses;

@@ -26,6 +26,7 @@
 mod average;
 mod dual_quaternion;
 mod euler;
+mod motions;
 pub mod pose_serde;
 mod rotation;
 
@@ -34,6 +35,7 @@ pub use pose_serde::{PoseInput, PoseJson};
 pub use average::{average_rotations_chordal, average_rotations_quaternion};
 pub use dual_quaternion::DualQuaternion;
 pub use euler::{euler_from_rotation, rotation_from_euler, EulerKind, EulerOrder};
+pub use motions::motion_partners;
 pub use rotation::{
     matrix4_from_pose, nearest_rotation, params_from_pose, pose_from_matrix4,
     pose_from_matrix4_with_tolerance, pose_from_params, quaternion_wxyz_from_rotation,

@@ -28,7 +28,7 @@
 //! Cost: at most [`MAX_PARTNERS`] motion pairs per frame, linear in the
 //! frames.
 
-use crate::geometry::Pose;
+use crate::geometry::{motion_partners, Pose};
 
 /// Motions rotating less than this (both sides) are left out.
 pub const MIN_ANGLE_DEG: f64 = 1.0;
@@ -96,7 +96,7 @@ pub fn angle_mismatch_deg(pairs: &[(Pose, Pose)]) -> Option<f64> {
     }
     let mut diffs = Vec::new();
     for i in 0..n {
-        for j in partners(i, n) {
+        for j in motion_partners(i, n, MAX_PARTNERS) {
             let a = (pairs[j].0 * pairs[i].0.inverse()).rotation.angle();
             let b = (pairs[j].1 * pairs[i].1.inverse()).rotation.angle();
             let (a, b) = (a.to_degrees(), b.to_degrees());
@@ -110,22 +110,6 @@ pub fn angle_mismatch_deg(pairs: &[(Pose, Pose)]) -> Option<f64> {
     }
     diffs.sort_by(f64::total_cmp);
     Some(diffs[diffs.len() / 2])
-}
-
-/// The frames `j > i` whose motion from frame `i` is compared: all of them
-/// for small sets, else the next few and a spread of far ones.
-fn partners(i: usize, n: usize) -> Vec<usize> {
-    if n <= 2 * MAX_PARTNERS + 1 {
-        return (i + 1..n).collect();
-    }
-    let half = MAX_PARTNERS / 2;
-    let stride = n / (half + 1);
-    let mut js: Vec<usize> = (1..=half).map(|k| i + k).collect();
-    js.extend((1..=half).map(|k| i + k * stride));
-    js.retain(|&j| j < n);
-    js.sort_unstable();
-    js.dedup();
-    js
 }
 
 /// The parent's and child's poses of the frames where the parent saw frame

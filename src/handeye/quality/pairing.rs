@@ -84,7 +84,7 @@ pub fn angle_mismatch_deg(
     let n = chain.len();
     let mut diffs = Vec::new();
     for i in 0..n {
-        for j in motion_partners(i, n) {
+        for j in crate::geometry::motion_partners(i, n, MAX_PAIRS_PER_VIEW) {
             let a = (chain.robot[j].inverse() * chain.robot[i]).rotation.angle();
             let b = (chain.camera[j] * chain.camera[i].inverse())
                 .rotation
@@ -100,20 +100,6 @@ pub fn angle_mismatch_deg(
     }
     diffs.sort_by(f64::total_cmp);
     Some(diffs[diffs.len() / 2])
-}
-
-/// The views `j > i` paired with view `i`: all of them for small sets, else
-/// the next few and a spread of far ones.
-fn motion_partners(i: usize, n: usize) -> Vec<usize> {
-    if n <= 2 * MAX_PAIRS_PER_VIEW + 1 {
-        return (i + 1..n).collect();
-    }
-    let mut js: Vec<usize> = (1..=MAX_PAIRS_PER_VIEW / 2).map(|k| i + k).collect();
-    let stride = n / (MAX_PAIRS_PER_VIEW / 2 + 1);
-    js.extend((1..=MAX_PAIRS_PER_VIEW / 2).map(|k| i + k * stride));
-    js.retain(|&j| j < n);
-    js.dedup();
-    js
 }
 
 /// The rules for two lists paired by position (robot `i` with camera `i`):
@@ -191,6 +177,11 @@ pub fn better_rule(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The partners of the pairing test (its bound of pairs per view).
+    fn motion_partners(i: usize, n: usize) -> Vec<usize> {
+        crate::geometry::motion_partners(i, n, MAX_PAIRS_PER_VIEW)
+    }
     use crate::synth::handeye::{handeye_scene, HandEyeScene, HandEyeSceneConfig};
     use wasm_bindgen_test::wasm_bindgen_test;
 
