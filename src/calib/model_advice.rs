@@ -236,8 +236,13 @@ pub fn advise(
     // 1. The models to fit: all when the model does not fit; else those with
     // fewer coefficients, and the fisheye models for a wide-angle lens.
     let mut fits: Vec<ModelFit> = Vec::new();
-    // Every model of the table but the pinhole (no model is simpler).
-    for name in MODEL_NAMES.into_iter().filter(|n| *n != "none") {
+    // Every model of the table but the pinhole (no model is simpler) and
+    // the splined one (a grid of knots to choose, seconds to fit: chosen
+    // by the user, never fitted on the side).
+    for name in MODEL_NAMES
+        .into_iter()
+        .filter(|n| *n != "none" && *n != "splined")
+    {
         let n = coefficient_count(name);
         let fisheye = is_fisheye(name);
         if name == chosen || !(far_off || n < n_chosen || (wide && fisheye)) {

@@ -2,7 +2,7 @@
 //! ray in the camera frame to a distorted normalised image point `m`
 //! (pixel = K m).
 
-use super::{division, eucm, kannala_brandt, polynomial::col, polynomial::Poly};
+use super::{division, eucm, kannala_brandt, polynomial::col, polynomial::Poly, splined::Spline};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix2, Matrix2x3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -107,6 +107,10 @@ pub enum Distortion {
         /// Ellipsoid shape (1 = sphere, the unified model).
         beta: f64,
     },
+    /// Splined stereographic ([`super::splined`]): the stereographic
+    /// projection plus a B-spline correction over a grid of control points;
+    /// coefficients `dx0 dy0 dx1 ...`, their count set by the layout.
+    Splined(Spline),
 }
 
 /// A ray's distorted normalised point and its derivatives.
@@ -131,6 +135,7 @@ impl Distortion {
             Distortion::RadialK1K2K5 { .. } => "radial_k1_k2_k5",
             Distortion::KannalaBrandt { .. } => "kannala_brandt",
             Distortion::Eucm { .. } => "eucm",
+            Distortion::Splined(_) => "splined",
         }
     }
 
@@ -146,6 +151,7 @@ impl Distortion {
             Distortion::RadialK1K2K5 { .. } => &["k1", "k2", "k5"],
             Distortion::KannalaBrandt { .. } => &["k1", "k2", "k3", "k4"],
             Distortion::Eucm { .. } => &["alpha", "beta"],
+            Distortion::Splined(s) => s.names(),
         }
     }
 
@@ -153,6 +159,7 @@ impl Distortion {
     /// (OpenCV's order for the polynomial models).
     pub fn coefficients(&self) -> Vec<f64> {
         match *self {
+            Distortion::Splined(ref s) => s.control.clone(),
             Distortion::None => vec![],
             Distortion::Brown { k1, k2, k3, p1, p2 } => vec![k1, k2, p1, p2, k3],
             Distortion::Rational {
@@ -239,15 +246,20 @@ impl Distortion {
                 alpha: c[0],
                 beta: c[1],
             },
+            Distortion::Splined(s) => Distortion::Splined(Spline {
+                control: c.to_vec(),
+                ..s.clone()
+            }),
         })
     }
 
     /// The model's math family; the polynomial models share one
     /// implementation, with their own coefficients' columns in
     /// [`Poly::distort`]'s Jacobian.
-    fn family(&self) -> Family {
+    fn family(&self) -> Family<'_> {
         use col::*;
         match *self {
+            Distortion::Splined(ref s) => Family::Splined(s),
             Distortion::None => Family::Pinhole,
             Distortion::Brown { k1, k2, k3, p1, p2 } => Family::Poly(
                 Poly {
@@ -299,6 +311,7 @@ impl Distortion {
         match self.family() {
             Family::KannalaBrandt(k) => Ok(kannala_brandt::project(&k, p)?.0),
             Family::Eucm(alpha, beta) => Ok(eucm::project(alpha, beta, p)?.0),
+            Family::Splined(s) => s.project_point(p),
             Family::Pinhole | Family::Poly(..) | Family::Division(_) => {
                 if !(p.z > 0.0) || !p.iter().all(|v| v.is_finite()) {
                     return Err(not_in_front(p));
@@ -319,7 +332,7 @@ impl Distortion {
                 Ok(poly.distort_value(n))
             }
             Family::Division(kappa) => Ok(division::distort(kappa, n)?.0),
-            Family::KannalaBrandt(_) | Family::Eucm(..) => {
+            Family::KannalaBrandt(_) | Family::Eucm(..) | Family::Splined(_) => {
                 self.project_point(&Vector3::new(n.x, n.y, 1.0))
             }
         }
@@ -354,6 +367,14 @@ impl Distortion {
                     m,
                     d_point,
                     d_coeffs: d_ab.to_vec(),
+                })
+            }
+            Family::Splined(s) => {
+                let (m, d_point, d_coeffs) = s.project(p)?;
+                Ok(RayProjection {
+                    m,
+                    d_point,
+                    d_coeffs,
                 })
             }
             Family::Pinhole | Family::Poly(..) | Family::Division(_) => {
@@ -392,7 +413,7 @@ impl Distortion {
                 let (m, d_n, d_k) = division::distort(kappa, n)?;
                 Ok((m, d_n, vec![d_k]))
             }
-            Family::KannalaBrandt(_) | Family::Eucm(..) => {
+            Family::KannalaBrandt(_) | Family::Eucm(..) | Family::Splined(_) => {
                 let r = self.project_ray(&Vector3::new(n.x, n.y, 1.0))?;
                 // d m / d(x, y) at z = 1 is the first two columns.
                 Ok((
@@ -418,6 +439,7 @@ impl Distortion {
             }
             Family::KannalaBrandt(k) => kannala_brandt::unproject(&k, m)?,
             Family::Eucm(alpha, beta) => eucm::unproject(alpha, beta, m)?,
+            Family::Splined(s) => s.unproject(m)?,
         };
         let norm = ray.norm();
         if !(norm > 0.0) || !norm.is_finite() {
@@ -430,12 +452,13 @@ impl Distortion {
 }
 
 /// The math behind each variant.
-enum Family {
+enum Family<'a> {
     Pinhole,
     Poly(Poly, &'static [usize]),
     Division(f64),
     KannalaBrandt([f64; 4]),
     Eucm(f64, f64),
+    Splined(&'a Spline),
 }
 
 /// The refusal of a point at or behind the camera (or not finite).

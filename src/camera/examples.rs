@@ -112,6 +112,25 @@ impl Camera {
         }
     }
 
+    /// A wide-angle 1280x960 lens no parametric model fits: stereographic
+    /// with a smooth bump field of a few pixels (12x8 cubic spline).
+    pub fn example_splined() -> Camera {
+        let mut spline = super::Spline::new(3, 12, 8);
+        spline.u_max = [1.55, 1.2];
+        for row in 0..8 {
+            for col in 0..12 {
+                let k = 2 * (row * 12 + col);
+                let (c, r) = (col as f64, row as f64);
+                spline.control[k] = 0.006 * (0.9 * c).sin() * (0.7 * r).cos();
+                spline.control[k + 1] = 0.005 * (0.5 * c).cos() * (0.8 * r).sin();
+            }
+        }
+        Camera {
+            distortion: Distortion::Splined(spline),
+            ..Camera::example_eucm()
+        }
+    }
+
     /// One example per lens model, in the order of the [`Distortion`]
     /// variants.
     pub fn examples() -> Vec<Camera> {
@@ -123,6 +142,7 @@ impl Camera {
             Camera::example_radial_k1_k2_k5(),
             Camera::example_kannala_brandt(),
             Camera::example_eucm(),
+            Camera::example_splined(),
         ]
     }
 }

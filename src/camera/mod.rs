@@ -20,12 +20,14 @@ mod examples;
 mod kannala_brandt;
 mod models;
 mod polynomial;
+pub mod splined;
 mod undistort;
 
 #[cfg(test)]
 mod tests;
 
 pub use distortion::Distortion;
+pub use splined::Spline;
 pub use models::{model_help, model_list, LensModel, LENS_MODELS, MODEL_NAMES};
 pub use undistort::UndistortMap;
 

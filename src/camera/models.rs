@@ -6,7 +6,7 @@
 //! plus one row here (the tests below check the row against the variant,
 //! `io`'s tests check the export formats against the writers).
 
-use super::Distortion;
+use super::{splined, Distortion, Spline};
 
 /// One lens model: its name in JSON and on the command line, what people
 /// call it, its coefficients and where the solvers start them, and the
@@ -49,8 +49,12 @@ const ALL_CAMERA_FORMATS: &[&str] = &[
     "matlab",
 ];
 
+/// How many lens models the table holds.
+const N_MODELS: usize = 8;
+
 /// The lens models, in the order of the menus (the default, `brown`, first).
-pub const LENS_MODELS: [LensModel; 7] = [
+/// A static (not a const): the splined model's start owns a (empty) vector.
+pub static LENS_MODELS: [LensModel; N_MODELS] = [
     LensModel {
         name: "brown",
         aliases: &[("brown5", "OpenCV's 5 coefficients")],
@@ -178,11 +182,34 @@ pub const LENS_MODELS: [LensModel; 7] = [
         export_formats: ALL_CAMERA_FORMATS,
         wide_angle: false,
     },
+    // Its coefficients (`dx0 dy0 dx1 ...`, two per control point) come
+    // with the layout: the start has none and the calibration makes
+    // `2 nx ny` of them (`--spline-knots`, `--spline-order`).
+    LensModel {
+        name: "splined",
+        aliases: &[(
+            "splined_stereographic",
+            "a stereographic projection with a B-spline correction",
+        )],
+        label: "splined stereographic",
+        description: "Splined stereographic (a B-spline correction over a grid of knots, after mrcal; fits lenses no parametric model does)",
+        coefficients: &[],
+        start: Distortion::Splined(Spline {
+            order: splined::DEFAULT_ORDER,
+            nx: splined::DEFAULT_KNOTS.0,
+            ny: splined::DEFAULT_KNOTS.1,
+            u_max: [0.0, 0.0],
+            smoothness: splined::DEFAULT_SMOOTHNESS,
+            control: Vec::new(),
+        }),
+        export_formats: &["json"],
+        wide_angle: false,
+    },
 ];
 
 /// The names of [`LENS_MODELS`], in menu order.
-pub const MODEL_NAMES: [&str; LENS_MODELS.len()] = {
-    let mut names = [""; LENS_MODELS.len()];
+pub static MODEL_NAMES: [&str; N_MODELS] = {
+    let mut names = [""; N_MODELS];
     let mut i = 0;
     while i < names.len() {
         names[i] = LENS_MODELS[i].name;
@@ -308,7 +335,7 @@ mod tests {
     fn names_aliases_and_the_texts_made_from_the_table() {
         assert_eq!(
             model_list(),
-            "brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none"
+            "brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none, splined"
         );
         assert_eq!(
             Distortion::named("brown5"),
@@ -327,7 +354,8 @@ mod tests {
             model_help("the camera"),
             "Lens model of the camera: brown (default: k1 k2 p1 p2 k3; also called brown5, \
              OpenCV's 5 coefficients), radial_k1_k2_k5, rational, division, kannala_brandt, \
-             eucm, none"
+             eucm, none, splined (also called splined_stereographic, a stereographic projection \
+             with a B-spline correction)"
         );
         let kb = LensModel::named("kannala_brandt").map(|m| m.format_names().collect::<Vec<_>>());
         assert_eq!(

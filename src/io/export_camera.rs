@@ -177,10 +177,10 @@ pub(super) fn opencv_distortion(c: &Camera) -> Result<(Vec<f64>, bool)> {
             (if prism { v } else { v[..8].to_vec() }, false)
         }
         Distortion::KannalaBrandt { k1, k2, k3, k4 } => (vec![*k1, *k2, *k3, *k4], true),
-        Distortion::Division { .. } | Distortion::Eucm { .. } => {
+        Distortion::Division { .. } | Distortion::Eucm { .. } | Distortion::Splined(_) => {
             return Err(unsupported(
                 c,
-                "OpenCV (use robocal JSON, Halcon for division, Kalibr for EUCM)",
+                "OpenCV (use robocal JSON, Halcon for division, Kalibr for EUCM, the undistortion map for splined)",
             ))
         }
     })

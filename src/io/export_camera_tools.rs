@@ -41,7 +41,7 @@ pub(super) fn kalibr_camera(c: &Camera, name: &str) -> Result<String> {
                 "Kalibr's radtan model has no k3: calibrate with k3 fixed at 0 to export to Kalibr",
             ))
         }
-        Distortion::Rational { .. } | Distortion::Division { .. } => {
+        Distortion::Rational { .. } | Distortion::Division { .. } | Distortion::Splined(_) => {
             return Err(unsupported(
                 c,
                 &format!("Kalibr (it takes {KALIBR_MODELS})"),
@@ -97,7 +97,8 @@ pub(super) fn mrcal_model(c: &Camera, rt_cam_ref: Option<[f64; 6]>) -> Result<St
         }
         Distortion::KannalaBrandt { .. }
         | Distortion::Division { .. }
-        | Distortion::Eucm { .. } => {
+        | Distortion::Eucm { .. }
+        | Distortion::Splined(_) => {
             return Err(unsupported(c, "mrcal (it has no equivalent model)"))
         }
     };
@@ -145,7 +146,8 @@ pub(super) fn halcon(c: &Camera, info: &CameraExportInfo) -> Result<String> {
         ),
         Distortion::Rational { .. }
         | Distortion::KannalaBrandt { .. }
-        | Distortion::Eucm { .. } => return Err(unsupported(c, "Halcon area-scan parameters")),
+        | Distortion::Eucm { .. }
+        | Distortion::Splined(_) => return Err(unsupported(c, "Halcon area-scan parameters")),
     };
     let mut values = vec![focus];
     values.extend(distortion);
@@ -173,7 +175,8 @@ pub(super) fn matlab(c: &Camera) -> Result<String> {
         Distortion::Rational { .. }
         | Distortion::Division { .. }
         | Distortion::KannalaBrandt { .. }
-        | Distortion::Eucm { .. } => return Err(unsupported(c, "MATLAB cameraIntrinsics")),
+        | Distortion::Eucm { .. }
+        | Distortion::Splined(_) => return Err(unsupported(c, "MATLAB cameraIntrinsics")),
     };
     Ok(format!(
         "% robocal {}: MATLAB conventions (1-based pixels: principal point = robocal's + 1)\n\
