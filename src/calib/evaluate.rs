@@ -83,6 +83,7 @@ fn refine_with(
         views,
         used: &used,
         aspect,
+        warp: None,
     };
     let params = BlockParams {
         global: camera.params(),

@@ -15,6 +15,7 @@
 //! - [`dlt_kalman`]: the recursive Kalman-filter estimate of the same
 //!   12 parameters, with the measurement noise from repeated observations.
 
+mod board_warp;
 pub mod centre_models;
 mod closed_form;
 pub mod compare;
@@ -31,6 +32,9 @@ mod refine;
 mod rejected;
 mod report;
 mod residuals;
+mod splined;
+#[cfg(test)]
+mod splined_tests;
 pub mod starts;
 mod tsai;
 pub mod usable;
@@ -45,6 +49,8 @@ pub use report::{
     ViewReport,
 };
 pub use residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
+pub use board_warp::{BoardWarp, WARP_WARNING_MM};
+pub use splined::SplineSupport;
 pub use tsai::calibrate_tsai;
 pub use usable::{homography_problem, usable_views, LeftOut};
 pub use zhang::{calibrate, CalibrationOptions};

@@ -1,11 +1,14 @@
 //! The bundle-adjustment problem of planar calibration for the shared
 //! solver: global parameters = the camera's [`Camera::params`], one block
 //! per view = its pose `[rotation vector (3), translation_m (3)]`, one
-//! residual block per used point = projected - observed pixel.
+//! residual block per used point = projected - observed pixel. With the
+//! board warp estimated ([`BoardExtent`]), two more global parameters
+//! follow the camera's; a splined lens adds its smoothness prior as
+//! residual blocks of no view.
 
 use super::View;
-use crate::camera::Camera;
-use crate::error::Result;
+use crate::camera::{Camera, Distortion, N_PINHOLE_PARAMS};
+use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, rotation_from_rotvec, rotvec_from_rotation, Pose};
 use crate::optim::{BlockParams, BlockProblem, ResidualBlock};
 use nalgebra::{DMatrix, DVector, Matrix2x3, Matrix3, Point3, Vector3};
@@ -19,6 +22,52 @@ pub(crate) struct CalibProblem<'a> {
     pub used: &'a [Vec<bool>],
     /// With a fixed aspect ratio, `fy = aspect * fx` and fy's column folds into fx's.
     pub aspect: Option<f64>,
+    /// With the board warp estimated: the board's point extent; the warp's
+    /// two parameters (metres) follow the camera's in the global vector.
+    pub warp: Option<BoardExtent>,
+}
+
+/// The extent of a planar board's points, for mrcal's two-parameter warp:
+/// a point at board (x, y) moves along the board's z by
+/// `warp_x (1 - xr^2) + warp_y (1 - yr^2)`, with `xr = 2 (x - x0) / width - 1`
+/// and `yr` likewise (-1 to 1 over the points): 0 at the edges, the sum at
+/// the centre (mrcal's `calobject_warp`, in metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct BoardExtent {
+    pub x0: f64,
+    pub width: f64,
+    pub y0: f64,
+    pub height: f64,
+}
+
+impl BoardExtent {
+    /// The extent of every view's points; `None` when they span no area.
+    pub fn of(views: &[View]) -> Option<BoardExtent> {
+        let pts = views.iter().flat_map(|v| v.object_m.iter());
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in pts {
+            lo = [lo[0].min(p.x), lo[1].min(p.y)];
+            hi = [hi[0].max(p.x), hi[1].max(p.y)];
+        }
+        let (width, height) = (hi[0] - lo[0], hi[1] - lo[1]);
+        (width > 0.0 && height > 0.0 && width.is_finite() && height.is_finite()).then_some(
+            BoardExtent {
+                x0: lo[0],
+                width,
+                y0: lo[1],
+                height,
+            },
+        )
+    }
+
+    /// The z offset of board point (x, y) under warp `w` and its
+    /// derivatives with respect to `w`.
+    pub fn bow(&self, x: f64, y: f64, w: [f64; 2]) -> (f64, [f64; 2]) {
+        let xr = 2.0 * (x - self.x0) / self.width - 1.0;
+        let yr = 2.0 * (y - self.y0) / self.height - 1.0;
+        let d = [1.0 - xr * xr, 1.0 - yr * yr];
+        (w[0] * d[0] + w[1] * d[1], d)
+    }
 }
 
 /// The 6-vector of a pose (rotation vector, translation) as an LM block.
@@ -31,11 +80,89 @@ pub(crate) use crate::geometry::pose_from_params as pose_from_block;
 impl CalibProblem<'_> {
     /// The camera of a global parameter vector.
     pub fn camera(&self, global: &[f64]) -> Result<Camera> {
-        let mut g = global.to_vec();
+        let n = self.n_camera();
+        let expected = n + if self.warp.is_some() { 2 } else { 0 };
+        if global.len() != expected || n < 2 {
+            return Err(Error::invalid(
+                "params",
+                format!(
+                    "the calibration has {expected} global parameters, got {}",
+                    global.len()
+                ),
+            ));
+        }
+        let mut g = global[..n].to_vec();
         if let Some(a) = self.aspect {
             g[1] = a * g[0];
         }
         self.template.with_params(&g)
+    }
+
+    /// The camera's parameter count (the global vector's first entries).
+    pub fn n_camera(&self) -> usize {
+        N_PINHOLE_PARAMS + self.template.distortion.coefficient_names().len()
+    }
+
+    /// The global vector of `camera` (and a flat board when warped).
+    pub fn global_of(&self, camera: &Camera) -> Vec<f64> {
+        let mut g = camera.params();
+        if self.warp.is_some() {
+            g.extend([0.0, 0.0]);
+        }
+        g
+    }
+
+    /// The warp `[warp_x, warp_y]` (metres) of a global vector; zero
+    /// without the warp.
+    pub fn warp_of(&self, global: &[f64]) -> [f64; 2] {
+        let n = self.n_camera();
+        match (self.warp, global.get(n), global.get(n + 1)) {
+            (Some(_), Some(&x), Some(&y)) => [x, y],
+            _ => [0.0, 0.0],
+        }
+    }
+
+    /// The smoothness prior of a splined lens: per second difference of
+    /// neighbouring control values, `weight * f * (c0 - 2 c1 + c2)` for
+    /// the x and the y correction (pixels; f the mean focal length of the
+    /// template, a constant).
+    fn smoothness_blocks(
+        &self,
+        camera: &Camera,
+        n_global: usize,
+        jacobians: bool,
+    ) -> Vec<ResidualBlock> {
+        let (Distortion::Splined(start), Distortion::Splined(s)) =
+            (&self.template.distortion, &camera.distortion)
+        else {
+            return Vec::new();
+        };
+        let scale = start.smoothness * 0.5 * (self.template.fx + self.template.fy);
+        if !(scale > 0.0) {
+            return Vec::new();
+        }
+        s.smoothness_stencils()
+            .into_iter()
+            .map(|idx| {
+                let coef = [1.0, -2.0, 1.0];
+                let mut r = DVector::zeros(2);
+                let mut j = DMatrix::zeros(2, if jacobians { n_global } else { 0 });
+                for (k, c) in idx.iter().zip(coef) {
+                    for comp in 0..2 {
+                        r[comp] += scale * c * s.control[k + comp];
+                        if jacobians {
+                            j[(comp, N_PINHOLE_PARAMS + k + comp)] = scale * c;
+                        }
+                    }
+                }
+                ResidualBlock {
+                    block: None,
+                    residuals: r,
+                    jac_global: j,
+                    jac_block: DMatrix::zeros(2, 0),
+                }
+            })
+            .collect()
     }
 }
 
@@ -50,6 +177,8 @@ impl BlockProblem for CalibProblem<'_> {
         jacobians: bool,
     ) -> Result<Vec<ResidualBlock>> {
         let camera = self.camera(&params.global)?;
+        let n_global = params.global.len();
+        let warp = self.warp_of(&params.global);
         let n_used = self.used.iter().flatten().filter(|u| **u).count();
         let mut out = Vec::with_capacity(n_used);
         for (b, view) in self.views.iter().enumerate() {
@@ -58,7 +187,14 @@ impl BlockProblem for CalibProblem<'_> {
                 if !self.used[b][i] {
                     continue;
                 }
-                let rotated = pose.rotation * object.coords;
+                let mut board = object.coords;
+                let mut d_warp = [0.0; 2];
+                if let Some(extent) = &self.warp {
+                    let (dz, d) = extent.bow(board.x, board.y, warp);
+                    board.z += dz;
+                    d_warp = d;
+                }
+                let rotated = pose.rotation * board;
                 let p = Point3::from(rotated + pose.translation.vector);
                 let (pixel, d_point, mut d_params) = if jacobians {
                     camera.project_with_jacobians(&p)?
@@ -83,6 +219,16 @@ impl BlockProblem for CalibProblem<'_> {
                             d_params[(r, 1)] = 0.0;
                         }
                     }
+                    if self.warp.is_some() {
+                        // d p / d warp_i = R e_z d_i.
+                        let n = d_params.ncols();
+                        d_params = d_params.resize_horizontally(n_global, 0.0);
+                        let along = d_point * (pose.rotation * Vector3::z());
+                        for (i, d) in d_warp.iter().enumerate() {
+                            d_params[(0, n + i)] = along.x * d;
+                            d_params[(1, n + i)] = along.y * d;
+                        }
+                    }
                     j
                 } else {
                     DMatrix::zeros(2, 0)
@@ -95,6 +241,7 @@ impl BlockProblem for CalibProblem<'_> {
                 });
             }
         }
+        out.extend(self.smoothness_blocks(&camera, n_global, jacobians));
         Ok(out)
     }
 

@@ -127,6 +127,13 @@ pub struct CameraCalibration {
     pub correlation: Correlation,
     /// Projection uncertainty over the image.
     pub projection_uncertainty: ProjectionUncertainty,
+    /// With `board_warp`: the board's estimated flex; absent without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub board_warp: Option<super::BoardWarp>,
+    /// With the splined model: where the data constrain the spline;
+    /// absent for the other models.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spline_support: Option<super::SplineSupport>,
     /// Distorted minus undistorted pixel positions on a grid over the image.
     #[serde(default)]
     pub distortion_field: DistortionField,
@@ -174,7 +181,7 @@ pub(crate) fn build_report(
     // A singular J^T J at the optimum: some parameter is not determined.
     // The camera is still the least-squares solution; the uncertainty
     // outputs stay empty and a warning says why.
-    let covariance = parameter_covariance(result, problem.aspect);
+    let covariance = parameter_covariance(result, problem.aspect, names.len());
     let zero = DMatrix::zeros(0, 0);
     let cov = covariance.as_ref().unwrap_or(&zero);
     // Maps filled by insertion: `collect` into a BTreeMap sorts first and
@@ -258,6 +265,8 @@ pub(crate) fn build_report(
         n_points,
         options: options.clone(),
         camera,
+        board_warp: None,
+        spline_support: None,
         rejected,
         start: None,
         starts: Vec::new(),
@@ -266,8 +275,15 @@ pub(crate) fn build_report(
 
 /// The covariance of the camera parameters, with fy's row and column
 /// derived from fx's when the aspect ratio is fixed (fy = a fx).
-fn parameter_covariance(result: &LmResult, aspect: Option<f64>) -> Option<DMatrix<f64>> {
-    let mut c = result.covariance_global.clone()?;
+fn parameter_covariance(
+    result: &LmResult,
+    aspect: Option<f64>,
+    n_camera: usize,
+) -> Option<DMatrix<f64>> {
+    // The camera's block (a board warp's parameters follow it).
+    let full = result.covariance_global.as_ref()?;
+    let n_camera = n_camera.min(full.nrows());
+    let mut c = full.view((0, 0), (n_camera, n_camera)).into_owned();
     if let Some(a) = aspect {
         let n = c.nrows();
         let mut t = DMatrix::<f64>::identity(n, n);

@@ -205,7 +205,7 @@ fn other_starts(
             Some((
                 name,
                 BlockParams {
-                    global: c.params(),
+                    global: problem.global_of(&c),
                     blocks,
                 },
             ))

@@ -5,7 +5,7 @@
 use super::closed_form::{intrinsics_from_homographies, pose_from_homography};
 use super::homography::homography;
 use super::plausibility::{self, aspect_off, not_converged};
-use super::refine::{block_from_pose, CalibProblem};
+use super::refine::{block_from_pose, BoardExtent, CalibProblem};
 use super::report::{build_report, Outlier};
 use super::starts::{best_start, converged, StartOutcome};
 use super::usable::{left_out_clause, usable_views, LeftOut};
@@ -58,6 +58,10 @@ pub struct CalibrationOptions {
     pub max_outlier_rounds: usize,
     /// Most solver iterations per round (default 200).
     pub max_iterations: usize,
+    /// Estimate the board's flex with the calibration (mrcal's two-parameter
+    /// paraboloid, [`super::BoardWarp`]); default false.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub board_warp: bool,
 }
 
 impl Default for CalibrationOptions {
@@ -80,6 +84,7 @@ impl Default for CalibrationOptions {
             outlier_sigma: None,
             max_outlier_rounds: 5,
             max_iterations: 200,
+            board_warp: false,
         }
     }
 }
@@ -125,11 +130,23 @@ pub(crate) fn required_views(options: &CalibrationOptions) -> usize {
 }
 
 /// [`calibrate`] on views that each fix a homography.
-fn calibrate_usable(
+pub(crate) fn calibrate_usable(
     views: &[View],
     image_size_px: (u32, u32),
     options: &CalibrationOptions,
 ) -> Result<CameraCalibration> {
+    if let (Distortion::Splined(spline), None) = (&options.model, &options.initial_camera) {
+        return super::splined::calibrate_splined(views, image_size_px, options, spline);
+    }
+    let warp = match options.board_warp {
+        false => None,
+        true => Some(BoardExtent::of(views).ok_or_else(|| {
+            Error::invalid(
+                "board_warp",
+                "the board's points span no area: no warp to estimate",
+            )
+        })?),
+    };
     // 2. Homographies and the closed-form start (or the given guess).
     let homographies: Vec<Matrix3<f64>> = views
         .iter()
@@ -148,16 +165,21 @@ fn calibrate_usable(
     // 4. Bundle adjustment from the best start, with outlier rounds.
     let all_used: Vec<Vec<bool>> = views.iter().map(|v| vec![true; v.object_m.len()]).collect();
     let mut used = all_used.clone();
+    let mut global = initial.params();
+    let mut lm_options = lm_options(&initial, options)?;
+    if warp.is_some() {
+        global.extend([0.0, 0.0]);
+        lm_options.fixed_global.extend([false, false]);
+    }
     let params = BlockParams {
-        global: initial.params(),
+        global,
         blocks: poses,
     };
-    let lm_options = lm_options(&initial, options)?;
     let aspect = held_aspect(&initial, options);
-    let first_name = if options.initial_camera.is_some() {
-        "given"
-    } else {
-        "closed_form"
+    let first_name = match (&options.initial_camera, &options.model) {
+        (Some(_), Distortion::Splined(_)) => "parametric_fit",
+        (Some(_), _) => "given",
+        (None, _) => "closed_form",
     };
     let best = best_start(
         &CalibProblem {
@@ -165,6 +187,7 @@ fn calibrate_usable(
             views,
             used: &used,
             aspect,
+            warp,
         },
         &params,
         first_name,
@@ -180,6 +203,7 @@ fn calibrate_usable(
             views,
             used: &used,
             aspect,
+            warp,
         };
         let Some(k) = options.outlier_sigma else {
             let report = build_report(
@@ -224,6 +248,7 @@ fn calibrate_usable(
             views,
             used: &used,
             aspect,
+            warp,
         };
         result = solve(&next, &result.params, &lm_options)?;
     }
@@ -258,6 +283,10 @@ fn finish(
         report.rms_px,
         square,
     ));
+    report.board_warp = super::board_warp::board_warp(problem, result);
+    checks.extend(report.board_warp.as_ref().and_then(super::board_warp::warp_warning));
+    report.spline_support = super::splined::spline_support(problem, &report.camera);
+    checks.extend(report.spline_support.as_ref().and_then(super::splined::support_warning));
     checks.append(&mut report.warnings);
     report.warnings = checks;
     report.start = Some(start);
@@ -430,6 +459,11 @@ pub(crate) fn lm_options(initial: &Camera, options: &CalibrationOptions) -> Resu
     fixed[2] = options.fix_principal_point;
     fixed[3] = options.fix_principal_point;
     fixed[4] = options.zero_skew;
+    if let Distortion::Splined(_) = initial.distortion {
+        // The spline's constant and linear terms are the base projection's
+        // fx fy cx cy: those stay at the parametric fit's.
+        fixed[..4].fill(true);
+    }
     for (i, name) in names.iter().enumerate().skip(N_PINHOLE_PARAMS) {
         fixed[i] = options.fixed_coefficients.iter().any(|f| f == name);
     }

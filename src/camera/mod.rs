@@ -20,6 +20,7 @@ mod examples;
 mod kannala_brandt;
 mod models;
 mod polynomial;
+mod spline_fit;
 pub mod splined;
 mod undistort;
 

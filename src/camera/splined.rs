@@ -167,6 +167,12 @@ impl Spline {
         (value, Matrix2::from_columns(&[d_ux, d_uy]), touched)
     }
 
+    /// The coefficient index of each `dx` the correction at `u` touches,
+    /// with its weight.
+    pub(crate) fn touched(&self, u: &Vector2<f64>) -> Vec<(usize, f64)> {
+        self.eval(u).2
+    }
+
     /// The distorted normalised point of a ray, d m / d point and
     /// d m / d control value (one column per coefficient).
     pub(crate) fn project(

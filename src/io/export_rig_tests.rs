@@ -52,6 +52,8 @@ fn calibration_of(camera: Camera, rms_px: f64) -> CameraCalibration {
             names: Vec::new(),
             matrix: Vec::new(),
         },
+        board_warp: None,
+        spline_support: None,
         projection_uncertainty: ProjectionUncertainty {
             reference_depth_m: 1.0,
             x_px: Vec::new(),

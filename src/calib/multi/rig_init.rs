@@ -60,6 +60,7 @@ impl Alone {
             views: &self.views,
             used: &self.used,
             aspect: self.aspect,
+            warp: None,
         }
     }
 }
@@ -153,6 +154,7 @@ fn held_camera_poses(camera: &Camera, views: &[View], size: (u32, u32)) -> Resul
         views,
         used: &used,
         aspect: None,
+        warp: None,
     };
     let n = camera.params().len();
     let result = solve(

@@ -1,0 +1,141 @@
+//! The splined lens model and the board warp in the calibration: exact
+//! recovery on noise-free scenes, the warp's effect on the focal length.
+
+use super::{calibrate, CalibrationOptions, View};
+use crate::camera::{Camera, Distortion, Spline};
+use crate::synth::Scene;
+use nalgebra::{Point2, Point3};
+
+/// The splined model with `nx x ny` cubic knots.
+fn splined(nx: usize, ny: usize) -> Distortion {
+    Distortion::Splined(Spline {
+        control: Vec::new(),
+        ..Spline::new(3, nx, ny)
+    })
+}
+
+/// The largest projection difference (px) between two cameras over the
+/// pixels of `truth` where `views` put points (their bounding box, shrunk
+/// by 5 %), on a 40x30 grid.
+fn worst_difference_where_data_fall(truth: &Camera, fitted: &Camera, views: &[View]) -> f64 {
+    let px = views.iter().flat_map(|v| v.image_px.iter());
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in px {
+        lo = [lo[0].min(p.x), lo[1].min(p.y)];
+        hi = [hi[0].max(p.x), hi[1].max(p.y)];
+    }
+    let shrink = |a: f64, b: f64| (a + 0.05 * (b - a), b - 0.05 * (b - a));
+    let (x0, x1) = shrink(lo[0], hi[0]);
+    let (y0, y1) = shrink(lo[1], hi[1]);
+    let mut worst: f64 = 0.0;
+    for iy in 0..30 {
+        for ix in 0..40 {
+            let p = Point2::new(
+                x0 + (x1 - x0) * ix as f64 / 39.0,
+                y0 + (y1 - y0) * iy as f64 / 29.0,
+            );
+            let ray = truth.unproject(&p).expect("truth unprojects");
+            let q = fitted.project(&Point3::from(ray)).expect("fit projects");
+            worst = worst.max((q - p).norm());
+        }
+    }
+    worst
+}
+
+#[test]
+fn a_noise_free_splined_lens_is_recovered_where_the_data_fall() {
+    let truth = Camera::example_splined();
+    let scene = Scene::calibration(41, &truth, (12, 9), 0.03, 30, 0.0).expect("scene");
+    let options = CalibrationOptions {
+        model: splined(12, 8),
+        ..CalibrationOptions::default()
+    };
+    let report = calibrate(&scene.views, (truth.width, truth.height), &options).expect("fit");
+    assert_eq!(report.model, "splined");
+    assert!(report.rms_px < 0.01, "rms {}", report.rms_px);
+    let worst = worst_difference_where_data_fall(&truth, &report.camera, &scene.views);
+    assert!(worst < 0.05, "projection differs from the truth by {worst} px");
+    // The same machinery as the parametric models: uncertainty and support.
+    assert!(report.projection_uncertainty.max_std_px.is_finite());
+    let support = report.spline_support.as_ref().expect("support");
+    assert_eq!(support.knots, [12, 8]);
+    assert!(support.fraction > 0.5, "{support:?}");
+    assert_eq!(report.distortion.len(), 2 * 12 * 8);
+    assert!(report.start.as_deref() == Some("parametric_fit"));
+}
+
+/// `scene`'s views with the board bowed by `warp` (metres, mrcal's
+/// paraboloid over the points' extent), noise `noise_px`, seed `seed`.
+fn warped_views(scene: &Scene, warp: [f64; 2], noise_px: f64, seed: u64) -> Vec<View> {
+    let mut rng = crate::rng::Rng::new(seed);
+    let pts = &scene.target_points_m;
+    let w = pts.iter().map(|p| p.x).fold(0.0, f64::max);
+    let h = pts.iter().map(|p| p.y).fold(0.0, f64::max);
+    scene
+        .camera_from_target
+        .iter()
+        .enumerate()
+        .map(|(i, pose)| {
+            let mut view = View::new(format!("w{i}"), Vec::new(), Vec::new());
+            for p in pts {
+                let (xr, yr) = (2.0 * p.x / w - 1.0, 2.0 * p.y / h - 1.0);
+                let z = warp[0] * (1.0 - xr * xr) + warp[1] * (1.0 - yr * yr);
+                let q = scene
+                    .camera
+                    .project(&(pose * Point3::new(p.x, p.y, z)))
+                    .expect("projects");
+                let inside = q.x >= 0.0
+                    && q.y >= 0.0
+                    && q.x <= scene.camera.width as f64 - 1.0
+                    && q.y <= scene.camera.height as f64 - 1.0;
+                if inside {
+                    view.object_m.push(*p);
+                    view.image_px.push(Point2::new(
+                        q.x + rng.gaussian(noise_px),
+                        q.y + rng.gaussian(noise_px),
+                    ));
+                }
+            }
+            view
+        })
+        .collect()
+}
+
+#[test]
+fn a_bowed_board_is_estimated_and_estimating_it_improves_the_focal_length() {
+    let truth = Camera::example_brown();
+    // A 0.5 m x 0.35 m board (11 x 8 points, 50 mm pitch), bowed 1 mm at
+    // its centre.
+    let scene = Scene::calibration(7, &truth, (11, 8), 0.05, 20, 0.0).expect("scene");
+    let views = warped_views(&scene, [0.0006, 0.0004], 0.05, 3);
+    let size = (truth.width, truth.height);
+    let flat = calibrate(&views, size, &CalibrationOptions::default()).expect("flat");
+    let bowed = calibrate(
+        &views,
+        size,
+        &CalibrationOptions {
+            board_warp: true,
+            ..CalibrationOptions::default()
+        },
+    )
+    .expect("warped");
+    let warp = bowed.board_warp.as_ref().expect("warp reported");
+    assert!(flat.board_warp.is_none());
+    assert!((warp.x_mm - 0.6).abs() < 0.1, "{warp:?}");
+    assert!((warp.y_mm - 0.4).abs() < 0.1, "{warp:?}");
+    assert!((warp.centre_mm - 1.0).abs() < 0.1, "{warp:?}");
+    assert!(warp.std_x_mm > 0.0 && warp.std_x_mm < 0.1, "{warp:?}");
+    let err_flat = (flat.camera.fx - truth.fx).abs();
+    let err_bowed = (bowed.camera.fx - truth.fx).abs();
+    assert!(
+        err_bowed < err_flat,
+        "fx error {err_bowed} px with the warp, {err_flat} px without"
+    );
+    assert!(bowed.rms_px < flat.rms_px);
+    // No warning at 1 mm, the options say the warp was estimated.
+    assert!(!bowed.warnings.iter().any(|w| w.contains("bows")));
+    let json = serde_json::to_string(&bowed.options).expect("json");
+    assert!(json.contains("\"board_warp\":true"));
+    let flat_json = serde_json::to_string(&flat.options).expect("json");
+    assert!(!flat_json.contains("board_warp"));
+}

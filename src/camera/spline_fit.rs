@@ -1,0 +1,118 @@
+//! A splined camera that reproduces another camera: the start of a splined
+//! calibration (from a parametric fit) and the renderer's non-parametric
+//! true lens (a parametric lens plus a bump field).
+
+use super::splined::{stereographic, Spline};
+use super::{Camera, Distortion};
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, Point2, Vector2};
+
+/// Samples per image side of the least-squares fit.
+const FIT_SAMPLES: (usize, usize) = (48, 36);
+/// Samples per image side when the field is measured.
+const BORDER_SAMPLES: usize = 64;
+/// The knot field extends this much beyond the image's farthest ray.
+const FIELD_MARGIN: f64 = 1.02;
+/// Weight of the smoothness rows in the fit (keeps cells without samples
+/// determined).
+const FIT_SMOOTHNESS: f64 = 1e-4;
+
+impl Camera {
+    /// A splined camera (`spline`'s order and knots, its field set to cover
+    /// this camera's image) with this camera's fx fy cx cy skew, whose
+    /// projection matches this one's: the control values are the linear
+    /// least-squares fit to this camera's `m - u` on a grid of pixels.
+    /// Fails when this camera cannot unproject the image's border.
+    pub fn splined_like(&self, spline: &Spline) -> Result<Camera> {
+        let mut spline = Spline {
+            control: vec![0.0; 2 * spline.nx * spline.ny],
+            u_max: [1.0, 1.0],
+            ..spline.clone()
+        };
+        spline.check()?;
+        let (w, h) = (self.width as f64 - 1.0, self.height as f64 - 1.0);
+        let u_of = |px: Point2<f64>| -> Option<Vector2<f64>> {
+            let ray = self.unproject(&px).ok()?;
+            stereographic(&ray).ok().map(|(u, _)| u)
+        };
+        let mut u_max: [f64; 2] = [0.0, 0.0];
+        for i in 0..=BORDER_SAMPLES {
+            let t = i as f64 / BORDER_SAMPLES as f64;
+            for px in [
+                Point2::new(t * w, 0.0),
+                Point2::new(t * w, h),
+                Point2::new(0.0, t * h),
+                Point2::new(w, t * h),
+            ] {
+                let u = u_of(px).ok_or_else(|| {
+                    Error::invalid(
+                        "camera",
+                        format!(
+                            "pixel ({:.1}, {:.1}) does not unproject: no spline field to cover",
+                            px.x, px.y
+                        ),
+                    )
+                })?;
+                u_max[0] = u_max[0].max(u.x.abs());
+                u_max[1] = u_max[1].max(u.y.abs());
+            }
+        }
+        spline.u_max = u_max.map(|u| u * FIELD_MARGIN);
+        spline.check()?;
+        let n = spline.nx * spline.ny;
+        let mut normal = DMatrix::<f64>::zeros(n, n);
+        let mut rhs = DMatrix::<f64>::zeros(n, 2);
+        for iy in 0..FIT_SAMPLES.1 {
+            for ix in 0..FIT_SAMPLES.0 {
+                let px = Point2::new(
+                    ix as f64 * w / (FIT_SAMPLES.0 - 1) as f64,
+                    iy as f64 * h / (FIT_SAMPLES.1 - 1) as f64,
+                );
+                let Some(u) = u_of(px) else { continue };
+                let Ok(m) = self.normalized_from_pixel(&px) else {
+                    continue;
+                };
+                let target = m - u;
+                let touched = spline.weights(&u);
+                for &(a, wa) in &touched {
+                    for &(b, wb) in &touched {
+                        normal[(a, b)] += wa * wb;
+                    }
+                    rhs[(a, 0)] += wa * target.x;
+                    rhs[(a, 1)] += wa * target.y;
+                }
+            }
+        }
+        for [a, b, c] in spline.smoothness_stencils() {
+            let idx = [a / 2, b / 2, c / 2];
+            let coef = [1.0, -2.0, 1.0];
+            for i in 0..3 {
+                for j in 0..3 {
+                    normal[(idx[i], idx[j])] += FIT_SMOOTHNESS * coef[i] * coef[j];
+                }
+            }
+        }
+        let solution = normal.cholesky().map(|c| c.solve(&rhs)).ok_or_else(|| {
+            Error::degenerate("the spline fit to the camera's projection is singular")
+        })?;
+        for k in 0..n {
+            spline.control[2 * k] = solution[(k, 0)];
+            spline.control[2 * k + 1] = solution[(k, 1)];
+        }
+        Ok(Camera {
+            distortion: Distortion::Splined(spline),
+            ..self.clone()
+        })
+    }
+}
+
+impl Spline {
+    /// The control points (their index `k`, not the coefficient's) the
+    /// correction at `u` touches, with their weights.
+    pub(crate) fn weights(&self, u: &Vector2<f64>) -> Vec<(usize, f64)> {
+        self.touched(u)
+            .into_iter()
+            .map(|(i, w)| (i / 2, w))
+            .collect()
+    }
+}
