@@ -110,6 +110,15 @@ pub struct JsonOptions {
     pub robust: bool,
     /// Coefficient names of the model held at 0.
     pub fixed_coefficients: Vec<String>,
+    /// Estimate the board's flex (mrcal's two-parameter paraboloid).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub board_warp: bool,
+    /// The splined model's control points `[nx, ny]` (default 12 x 8).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spline_knots: Option<[usize; 2]>,
+    /// The splined model's degree, 2 or 3 (default 3).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spline_order: Option<usize>,
 }
 
 impl Default for JsonOptions {
@@ -121,6 +130,9 @@ impl Default for JsonOptions {
             zero_skew: true,
             robust: false,
             fixed_coefficients: vec![],
+            board_warp: false,
+            spline_knots: None,
+            spline_order: None,
         }
     }
 }
@@ -372,8 +384,34 @@ pub fn calibration_options(model: &LensModel, o: &JsonOptions) -> Result<Calibra
     } else {
         (Loss::Squared, None)
     };
+    let mut start = model.start().clone();
+    match &mut start {
+        Distortion::Splined(s) => {
+            if let Some([nx, ny]) = o.spline_knots {
+                (s.nx, s.ny) = (nx, ny);
+            }
+            s.order = o.spline_order.unwrap_or(s.order);
+            let check = crate::camera::Spline {
+                u_max: [1.0, 1.0],
+                control: vec![0.0; 2 * s.nx * s.ny],
+                ..s.clone()
+            };
+            check.check()?;
+        }
+        _ if o.spline_knots.is_some() || o.spline_order.is_some() => {
+            return Err(Error::invalid(
+                "spline_knots",
+                format!(
+                    "spline knots and order are options of the splined model, not of {}",
+                    start.model_name()
+                ),
+            ))
+        }
+        _ => {}
+    }
     Ok(CalibrationOptions {
-        model: model.start().clone(),
+        model: start,
+        board_warp: o.board_warp,
         fix_principal_point: o.fix_principal_point,
         fix_aspect_ratio: o.fix_aspect_ratio || o.aspect_ratio.is_some(),
         aspect_ratio: o.aspect_ratio,

@@ -33,8 +33,11 @@ pub const MAX_KNOTS: usize = 40;
 pub const DEFAULT_KNOTS: (usize, usize) = (12, 8);
 /// Default spline degree (cubic: continuous curvature, as mrcal's default).
 pub const DEFAULT_ORDER: usize = 3;
-/// Default weight of the smoothness prior (see [`Spline::smoothness`]).
-pub const DEFAULT_SMOOTHNESS: f64 = 0.1;
+/// Default weight of the smoothness prior (see [`Spline::smoothness`]):
+/// on a noise-free render through a bumpy lens (a few px of bumps per
+/// knot), 0.1 biased the fit by 0.28 px, 0.01 by 0.1 px, 0.001 by < 0.05 px;
+/// 0.01 keeps cells without data tame on 20-40 views.
+pub const DEFAULT_SMOOTHNESS: f64 = 0.01;
 /// Largest Newton steps of the inverse.
 const MAX_NEWTON_STEPS: usize = 50;
 /// Convergence of the inverse, normalised units.

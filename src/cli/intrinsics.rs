@@ -71,6 +71,17 @@ pub struct IntrinsicsArgs {
     /// Huber loss and rejection of points beyond 3 robust sigmas
     #[arg(long)]
     robust: bool,
+    /// Estimate the board's flex with the calibration (mrcal's two-parameter
+    /// paraboloid; reported in mm as board_warp, a warning above 1 mm)
+    #[arg(long)]
+    board_warp: bool,
+    /// With --model splined: control points across x and y (default 12x8;
+    /// 4 to 40 each, more than the order)
+    #[arg(long, value_name = "NXxNY")]
+    spline_knots: Option<String>,
+    /// With --model splined: the B-spline's degree, 2 or 3 (default 3)
+    #[arg(long, value_name = "N")]
+    spline_order: Option<usize>,
     /// Images detected in parallel (default: all cores)
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
@@ -87,6 +98,21 @@ pub struct IntrinsicsArgs {
     /// The images (instead of --detections)
     #[arg(value_name = "IMAGES")]
     images: Vec<String>,
+}
+
+/// `--spline-knots 12x8` as `[12, 8]`.
+fn parse_knots(text: &str) -> Result<[usize; 2], CliError> {
+    let bad = || {
+        CliError::usage(
+            "intrinsics",
+            format!("--spline-knots takes NXxNY, e.g. 12x8, got '{text}'"),
+        )
+    };
+    let (x, y) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    Ok([
+        x.trim().parse().map_err(|_| bad())?,
+        y.trim().parse().map_err(|_| bad())?,
+    ])
 }
 
 pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
@@ -145,6 +171,13 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
             zero_skew: !args.free_skew,
             robust: args.robust,
             fixed_coefficients: args.fix,
+            board_warp: args.board_warp,
+            spline_knots: args
+                .spline_knots
+                .as_deref()
+                .map(parse_knots)
+                .transpose()?,
+            spline_order: args.spline_order,
         },
         views,
         image_size_px: None,

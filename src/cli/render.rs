@@ -132,6 +132,16 @@ pub struct RenderArgs {
     /// With --video: the truth file (default: the video's name with .json)
     #[arg(long, value_name = "FILE", requires = "video")]
     truth: Option<String>,
+    /// Render through a lens no parametric model fits: the camera's own
+    /// projection as a 12x8 splined lens plus smooth bumps of PX pixels
+    /// (truth.json holds that splined camera)
+    #[arg(long, value_name = "PX")]
+    bumpy_lens: Option<f64>,
+    /// Bow the board: mrcal's paraboloid factors X,Y in mm along the board's
+    /// normal (the centre moves X+Y, the edges stay; truth.json says
+    /// board_warp_mm)
+    #[arg(long, value_name = "X,Y", allow_negative_numbers = true)]
+    board_warp_mm: Option<String>,
     #[command(flatten)]
     effects: EffectArgs,
 }
@@ -307,8 +317,31 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         Some(file) => robocal::io::import_camera::import_camera(&super::read_text(file)?)?.0,
         None => demo_camera(),
     };
+    let camera = match args.bumpy_lens {
+        Some(px) => robocal::synth::lens::bumpy_lens(&camera, px)?,
+        None => camera,
+    };
+    let board_warp_m = match args.board_warp_mm.as_deref() {
+        Some(text) => {
+            let bad = || {
+                CliError::usage(
+                    "render",
+                    format!("--board-warp-mm takes X,Y in mm, e.g. 0.5,0.5, got '{text}'"),
+                )
+            };
+            let (x, y) = text.split_once(',').ok_or_else(bad)?;
+            let x: f64 = x.trim().parse().map_err(|_| bad())?;
+            let y: f64 = y.trim().parse().map_err(|_| bad())?;
+            if !(x.is_finite() && y.is_finite()) {
+                return Err(bad());
+            }
+            [x * 1e-3, y * 1e-3]
+        }
+        None => [0.0, 0.0],
+    };
     let options = RenderOptions {
         effects: effects_of(&args.effects)?,
+        board_warp_m,
         ..render_options(&args)
     };
     let options = board_print(options, &target, print);
@@ -459,7 +492,10 @@ fn write_set(
             "points": rendered.points,
         }));
     }
-    let truth = serde_json::json!({ "camera": camera, "target": target, "seed": seed, "views": truth_views });
+    let mut truth = serde_json::json!({ "camera": camera, "target": target, "seed": seed, "views": truth_views });
+    if options.board_warp_m != [0.0, 0.0] {
+        truth["board_warp_mm"] = serde_json::json!(options.board_warp_m.map(|w| w * 1e3));
+    }
     write_json(&out.join("truth.json"), &truth)?;
     eprintln!(
         "robocal render: wrote {views} images and truth.json to {}",

@@ -2,11 +2,13 @@
 //! examples and the web app's demo button. Deterministic for a given seed on
 //! every platform (native and wasm).
 
+mod bow;
 pub mod clutter;
 pub mod demo;
 pub mod effects;
 pub mod handeye;
 pub mod handeye_looking;
+pub mod lens;
 pub mod render;
 pub mod rig;
 pub mod scene;

@@ -24,6 +24,7 @@
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
 use crate::rng::Rng;
+use crate::synth::bow::Bow;
 use crate::synth::effects::{self, Effects};
 use crate::target::{DetectedPoint, Polarity, Target};
 use nalgebra::{Isometry3, Point2, Point3, Vector3};
@@ -114,6 +115,10 @@ pub struct RenderOptions {
     /// Camera effects (gamma, lens PSF, motion, rolling shutter, Bayer,
     /// sensor noise, JPEG, paper texture); default: all off.
     pub effects: Effects,
+    /// The board's flex, metres: mrcal's paraboloid (`calib::BoardWarp`)
+    /// over the extent of the target's points, along the target's +z;
+    /// default flat.
+    pub board_warp_m: [f64; 2],
 }
 
 impl Default for RenderOptions {
@@ -131,6 +136,7 @@ impl Default for RenderOptions {
             circle_diameter_ratio: 0.5,
             seed: 1,
             effects: Effects::default(),
+            board_warp_m: [0.0, 0.0],
         }
     }
 }
@@ -191,6 +197,7 @@ pub fn render(
     let (hw, hh) = (0.5 * (w as f64 - 1.0), 0.5 * (h as f64 - 1.0));
     let skew = fx.rolling_shutter_px_per_row;
     // Board coordinates at the pixel corners (x - 0.5, y - 0.5).
+    let bow = Bow::of(&target, options.board_warp_m);
     let (cw, ch) = (w as usize + 1, h as usize + 1);
     let mut corners: Vec<Option<(f64, f64)>> = Vec::with_capacity(cw * ch);
     for y in 0..ch {
@@ -204,7 +211,10 @@ pub fn render(
                 let lambda = normal.dot(&origin) / den;
                 (den.abs() > 1e-12 && lambda > 0.0).then(|| {
                     let b = target_from_camera * Point3::from(ray * lambda);
-                    (b.x, b.y)
+                    match &bow {
+                        Some(bow) => bow.hit(&target_from_camera, &ray, (b.x, b.y)),
+                        None => (b.x, b.y),
+                    }
                 })
             }));
         }
@@ -277,6 +287,10 @@ pub fn render(
         .object_points()
         .into_iter()
         .filter_map(|(id, p)| {
+            let p = match &bow {
+                Some(bow) => Point3::new(p.x, p.y, p.z + bow.z(p.x, p.y)),
+                None => p,
+            };
             let mut q = camera.project_point(&(camera_from_target * p))?;
             if skew != 0.0 {
                 q.x += skew * (q.y - hh);
