@@ -159,3 +159,59 @@ fn a_bowed_board_is_estimated_and_estimating_it_improves_the_focal_length() {
     let flat_json = serde_json::to_string(&flat.options).expect("json");
     assert!(!flat_json.contains("board_warp"));
 }
+
+/// The figures of the report (not a check): run with
+/// `cargo test --lib measure_splined -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn measure_splined_against_the_parametric_models_and_the_warp() {
+    let truth = crate::synth::lens::bumpy_lens(&Camera::example_eucm(), 2.0).expect("lens");
+    let scene = Scene::calibration(5, &truth, (10, 10), 0.03, 40, 0.1).expect("scene");
+    let size = (truth.width, truth.height);
+    for name in ["brown", "rational", "kannala_brandt", "eucm", "splined"] {
+        let model = Distortion::named(name).expect("model");
+        let t0 = std::time::Instant::now();
+        let fitted = calibrate(
+            &scene.views,
+            size,
+            &CalibrationOptions {
+                model,
+                ..CalibrationOptions::default()
+            },
+        );
+        let secs = t0.elapsed().as_secs_f64();
+        match fitted {
+            Ok(r) => {
+                let worst = worst_difference_where_data_fall(&truth, &r.camera, &scene.views);
+                println!(
+                    "{name}: rms {:.3} px, worst projection error vs truth where data fall {:.3} px, max predicted std {:.3} px, {secs:.1} s",
+                    r.rms_px, worst, r.projection_uncertainty.max_std_px
+                );
+            }
+            Err(e) => println!("{name}: failed: {e}"),
+        }
+    }
+    let flat_truth = Camera::example_brown();
+    let scene = Scene::calibration(9, &flat_truth, (11, 8), 0.05, 20, 0.0).expect("scene");
+    for bow_mm in [0.5, 1.0, 2.0] {
+        let views = warped_views(&scene, [0.5e-3 * bow_mm, 0.5e-3 * bow_mm], 0.1, 4);
+        let fit = |board_warp| {
+            calibrate(
+                &views,
+                (flat_truth.width, flat_truth.height),
+                &CalibrationOptions {
+                    board_warp,
+                    ..CalibrationOptions::default()
+                },
+            )
+            .expect("fit")
+        };
+        let (flat, warped) = (fit(false), fit(true));
+        println!(
+            "bow {bow_mm} mm: fx error {:.3} px flat, {:.3} px with the warp (estimated centre bow {:.3} mm)",
+            flat.camera.fx - flat_truth.fx,
+            warped.camera.fx - flat_truth.fx,
+            warped.board_warp.map_or(f64::NAN, |w| w.centre_mm)
+        );
+    }
+}
