@@ -50,7 +50,11 @@ pub(crate) fn board_warp(problem: &CalibProblem, result: &LmResult) -> Option<Bo
 
 /// The warning of a large bow.
 pub(crate) fn warp_warning(warp: &BoardWarp) -> Option<String> {
-    let peak = warp.centre_mm.abs().max(warp.x_mm.abs()).max(warp.y_mm.abs());
+    let peak = warp
+        .centre_mm
+        .abs()
+        .max(warp.x_mm.abs())
+        .max(warp.y_mm.abs());
     (peak > WARP_WARNING_MM).then(|| {
         format!(
             "the board bows by {:.2} mm at its centre (x {:.2} mm, y {:.2} mm): more than \

@@ -40,6 +40,7 @@ mod tsai;
 pub mod usable;
 mod zhang;
 
+pub use board_warp::{BoardWarp, WARP_WARNING_MM};
 pub use closed_form::{intrinsics_from_homographies, pose_from_homography};
 pub use homography::homography;
 pub use plausibility::Severity;
@@ -49,7 +50,6 @@ pub use report::{
     ViewReport,
 };
 pub use residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
-pub use board_warp::{BoardWarp, WARP_WARNING_MM};
 pub use splined::SplineSupport;
 pub use tsai::calibrate_tsai;
 pub use usable::{homography_problem, usable_views, LeftOut};

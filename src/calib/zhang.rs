@@ -284,9 +284,19 @@ fn finish(
         square,
     ));
     report.board_warp = super::board_warp::board_warp(problem, result);
-    checks.extend(report.board_warp.as_ref().and_then(super::board_warp::warp_warning));
+    checks.extend(
+        report
+            .board_warp
+            .as_ref()
+            .and_then(super::board_warp::warp_warning),
+    );
     report.spline_support = super::splined::spline_support(problem, &report.camera);
-    checks.extend(report.spline_support.as_ref().and_then(super::splined::support_warning));
+    checks.extend(
+        report
+            .spline_support
+            .as_ref()
+            .and_then(super::splined::support_warning),
+    );
     checks.append(&mut report.warnings);
     report.warnings = checks;
     report.start = Some(start);

@@ -28,8 +28,8 @@ mod undistort;
 mod tests;
 
 pub use distortion::Distortion;
-pub use splined::Spline;
 pub use models::{model_help, model_list, LensModel, LENS_MODELS, MODEL_NAMES};
+pub use splined::Spline;
 pub use undistort::UndistortMap;
 
 use crate::error::{Error, Result};

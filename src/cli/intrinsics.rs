@@ -172,11 +172,7 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
             robust: args.robust,
             fixed_coefficients: args.fix,
             board_warp: args.board_warp,
-            spline_knots: args
-                .spline_knots
-                .as_deref()
-                .map(parse_knots)
-                .transpose()?,
+            spline_knots: args.spline_knots.as_deref().map(parse_knots).transpose()?,
             spline_order: args.spline_order,
         },
         views,

@@ -21,9 +21,11 @@ impl Bow {
         let lo = pts.iter().fold((f64::INFINITY, f64::INFINITY), |a, p| {
             (a.0.min(p.1.x), a.1.min(p.1.y))
         });
-        let hi = pts.iter().fold((f64::NEG_INFINITY, f64::NEG_INFINITY), |a, p| {
-            (a.0.max(p.1.x), a.1.max(p.1.y))
-        });
+        let hi = pts
+            .iter()
+            .fold((f64::NEG_INFINITY, f64::NEG_INFINITY), |a, p| {
+                (a.0.max(p.1.x), a.1.max(p.1.y))
+            });
         let size = (hi.0 - lo.0, hi.1 - lo.1);
         (size.0 > 0.0 && size.1 > 0.0).then_some(Bow { lo, size, warp })
     }
@@ -38,7 +40,12 @@ impl Bow {
     /// Where the ray (camera frame) meets the bowed board, in board (x, y),
     /// from its plane hit `start`: fixed-point steps along the ray (the
     /// bow's slope is tiny, each step gains orders of magnitude).
-    pub(crate) fn hit(&self, target_from_camera: &Isometry3<f64>, ray: &Vector3<f64>, start: (f64, f64)) -> (f64, f64) {
+    pub(crate) fn hit(
+        &self,
+        target_from_camera: &Isometry3<f64>,
+        ray: &Vector3<f64>,
+        start: (f64, f64),
+    ) -> (f64, f64) {
         let o = target_from_camera.translation.vector;
         let d = target_from_camera.rotation * ray;
         if d.z.abs() < 1e-12 {
@@ -52,4 +59,3 @@ impl Bow {
         xy
     }
 }
-
