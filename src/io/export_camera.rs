@@ -177,10 +177,16 @@ pub(super) fn opencv_distortion(c: &Camera) -> Result<(Vec<f64>, bool)> {
             (if prism { v } else { v[..8].to_vec() }, false)
         }
         Distortion::KannalaBrandt { k1, k2, k3, k4 } => (vec![*k1, *k2, *k3, *k4], true),
-        Distortion::Division { .. } | Distortion::Eucm { .. } | Distortion::Splined(_) => {
+        Distortion::Splined(_) => {
             return Err(unsupported(
                 c,
-                "OpenCV (use robocal JSON, Halcon for division, Kalibr for EUCM, the undistortion map for splined)",
+                "OpenCV (use robocal JSON, or resample its images with an undistortion map)",
+            ))
+        }
+        Distortion::Division { .. } | Distortion::Eucm { .. } => {
+            return Err(unsupported(
+                c,
+                "OpenCV (use robocal JSON, Halcon for division, Kalibr for EUCM)",
             ))
         }
     })
