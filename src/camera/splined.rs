@@ -25,6 +25,9 @@ use nalgebra::{Matrix2, Matrix2x3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 
+/// A distorted normalised point, d m / d point, d m / d coefficients.
+type Projected = (Vector2<f64>, Matrix2x3<f64>, Vec<Vector2<f64>>);
+
 /// Largest number of control points along either axis.
 pub const MAX_KNOTS: usize = 40;
 /// Default control points along x and y: 12 x 8 (mrcal's typical 30 x 18
@@ -178,10 +181,7 @@ impl Spline {
 
     /// The distorted normalised point of a ray, d m / d point and
     /// d m / d control value (one column per coefficient).
-    pub(crate) fn project(
-        &self,
-        p: &Vector3<f64>,
-    ) -> Result<(Vector2<f64>, Matrix2x3<f64>, Vec<Vector2<f64>>)> {
+    pub(crate) fn project(&self, p: &Vector3<f64>) -> Result<Projected> {
         let (u, du_dp) = stereographic(p)?;
         self.check()?;
         let (delta, d_delta, touched) = self.eval(&u);
