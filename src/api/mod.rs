@@ -25,6 +25,7 @@ pub mod camera;
 pub(crate) mod camera_tests;
 mod choices;
 pub mod handeye;
+pub mod laser;
 pub mod planar;
 pub mod poses;
 pub mod rig;

@@ -12,6 +12,7 @@ pub mod csv_table;
 pub mod export;
 pub mod export_camera;
 mod export_camera_tools;
+pub mod export_laser;
 pub mod export_rig;
 pub mod export_ros;
 pub mod export_stereo;

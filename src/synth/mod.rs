@@ -7,6 +7,7 @@ pub mod demo;
 pub mod effects;
 pub mod handeye;
 pub mod handeye_looking;
+pub mod laser;
 pub mod render;
 pub mod rig;
 pub mod scene;
