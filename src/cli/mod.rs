@@ -16,10 +16,12 @@ mod image_file;
 mod info;
 mod input;
 mod intrinsics;
+mod laser;
 mod memory_budget;
 pub mod output;
 mod planar;
 mod render;
+mod render_laser;
 mod render_rig;
 mod render_video;
 mod rig;
@@ -125,6 +127,7 @@ enum Command {
     Rig(rig::RigArgs),
     Info(info::InfoArgs),
     Render(render::RenderArgs),
+    Laser(laser::LaserArgs),
     Planar(planar::PlanarArgs),
     Xytable(xytable::XytableArgs),
     Target(target::TargetArgs),
@@ -168,6 +171,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Rig(a) => rig::run(a),
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
+        Command::Laser(a) => laser::run(a),
         Command::Planar(a) => planar::run(a),
         Command::Xytable(a) => xytable::run(a),
         Command::Target(a) => target::run(a),

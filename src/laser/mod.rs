@@ -22,3 +22,6 @@ pub mod stripe;
 pub use fit::{fit_plane, PlaneFit, PlaneFitOptions, PlaneResidual};
 pub use plane::{LaserPlane, StripeObservation};
 pub use stripe::{extract_stripe, ScanAxis, Stripe, StripeMethod, StripeOptions, StripePoint};
+
+#[cfg(test)]
+mod tests;

@@ -3,10 +3,12 @@
 //! or by a ridge detector ([`super::ridge`]).
 //!
 //! Each scan line (column or row) is searched for its peak with a top-hat
-//! response: the lightly smoothed signal minus the brighter of two flanking
+//! response: the lightly smoothed signal minus the mean of two flanking
 //! windows `max_width_px / 2 + 2` pixels away, so a light square of the
-//! board's pattern (both flanks light) or its edge (one flank light) does
-//! not answer, the stripe (both flanks darker) does. The local background
+//! board's pattern (both flanks light) does not answer and its edge only by
+//! half its step, the stripe (both flanks darker) by its full contrast. A
+//! centre far from the median of its 25 neighbours on either side is
+//! searched again near that median (the stripe is continuous). The local background
 //! is the straight line through the two flanks' means. When the image with
 //! the laser off is given it is subtracted first (the board's pattern and
 //! the ambient light cancel). The scan axis is chosen automatically (the
@@ -295,17 +297,42 @@ pub(crate) fn median(v: &mut [f64]) -> Option<f64> {
 }
 
 fn first_pass(scan: &Scan, options: &StripeOptions, noise: f64) -> Vec<Option<Peak>> {
-    (0..scan.lines)
+    let raw = |i: usize| &scan.raw[i * scan.len..(i + 1) * scan.len];
+    let mut peaks: Vec<Option<Peak>> = (0..scan.lines)
+        .map(|i| peak_in_line(scan.line(i), raw(i), options, noise, (0, scan.len)))
+        .collect();
+    // The stripe is continuous: a centre far from its neighbourhood's
+    // median (a light square of the pattern outshining a dim stretch of
+    // the stripe) is searched again near that median.
+    let reach = options.max_width_px;
+    let medians: Vec<Option<f64>> = (0..scan.lines)
         .map(|i| {
-            peak_in_line(
-                scan.line(i),
-                &scan.raw[i * scan.len..(i + 1) * scan.len],
-                options,
-                noise,
-            )
+            let lo = i.saturating_sub(TRACK);
+            let hi = (i + TRACK + 1).min(scan.lines);
+            let mut c: Vec<f64> = peaks[lo..hi].iter().flatten().map(|p| p.centre).collect();
+            if c.len() > TRACK {
+                median(&mut c)
+            } else {
+                None
+            }
         })
-        .collect()
+        .collect();
+    for (i, slot) in peaks.iter_mut().enumerate() {
+        let (Some(p), Some(m)) = (*slot, medians[i]) else {
+            continue;
+        };
+        if (p.centre - m).abs() > reach {
+            let lo = (m - reach).max(0.0) as usize;
+            let hi = ((m + reach) as usize + 1).min(scan.len);
+            *slot = peak_in_line(scan.line(i), raw(i), options, noise, (lo, hi))
+                .filter(|q| (q.centre - m).abs() <= reach);
+        }
+    }
+    peaks
 }
+
+/// Lines on either side whose centres make the neighbourhood's median.
+const TRACK: usize = 25;
 
 /// Flank length, pixels.
 const FLANK: usize = 5;
@@ -313,7 +340,13 @@ const FLANK: usize = 5;
 /// quantisation).
 const MIN_STD_PX: f64 = 0.01;
 
-fn peak_in_line(line: &[f32], raw: &[u8], options: &StripeOptions, noise: f64) -> Option<Peak> {
+fn peak_in_line(
+    line: &[f32],
+    raw: &[u8],
+    options: &StripeOptions,
+    noise: f64,
+    search: (usize, usize),
+) -> Option<Peak> {
     let n = line.len();
     let offset = (options.max_width_px / 2.0).ceil() as usize + 2;
     let mut prefix = vec![0f64; n + 1];
@@ -330,9 +363,9 @@ fn peak_in_line(line: &[f32], raw: &[u8], options: &StripeOptions, noise: f64) -
         0.25 * a + 0.5 * line[j] as f64 + 0.25 * c
     };
     let mut best: Option<(usize, f64)> = None;
-    for j in 0..n {
+    for j in search.0..search.1.min(n) {
         let flank = match (left(j), right(j)) {
-            (Some(a), Some(b)) => a.max(b),
+            (Some(a), Some(b)) => 0.5 * (a + b),
             (Some(a), None) => a,
             (None, Some(b)) => b,
             (None, None) => continue,

@@ -8,6 +8,7 @@ pub mod effects;
 pub mod handeye;
 pub mod handeye_looking;
 pub mod laser;
+pub mod laser_scene;
 pub mod render;
 pub mod rig;
 pub mod scene;
