@@ -141,7 +141,7 @@ pub fn fit_plane(obs: &[StripeObservation], options: &PlaneFitOptions) -> Result
     }
     let (start, singular) = total_least_squares(obs);
     let (s0, s1) = (singular[0], singular[1]);
-    if !(s1 > COLLINEAR_RATIO * s0) {
+    if !s1.is_finite() || s1 <= COLLINEAR_RATIO * s0 {
         return Err(Error::degenerate(format!(
             "the stripe points of all {} images lie on one line (singular values {:.3e}, {:.3e} m): \
              the plane is not constrained; move or tilt the board so the stripe falls elsewhere",

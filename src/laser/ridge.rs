@@ -117,6 +117,10 @@ pub(crate) fn refine(scan: &Scan, i: usize, p: &Peak, k: &Kernels, noise: f64) -
             (0.0, 1.0)
         };
         let t = -(ri * ni + rj * nj) / lambda;
+        // The scan axis runs within 45 deg of the line's normal.
+        if nj.abs() < 0.6 {
+            continue;
+        }
         let (di, dj) = (t * ni, t * nj);
         if di.abs() > 0.5 || dj.abs() > 0.5 {
             continue;
@@ -130,7 +134,7 @@ pub(crate) fn refine(scan: &Scan, i: usize, p: &Peak, k: &Kernels, noise: f64) -
         };
         let pos = j as f64 + along;
         let std = (noise * k.norm1 / lambda.abs()).max(0.01);
-        if best.is_none_or(|b| t.abs() < b.2) {
+        if best.map_or(true, |b| t.abs() < b.2) {
             best = Some((pos, std, t.abs()));
         }
     }

@@ -260,10 +260,10 @@ fn check(on: &GrayImage, off: Option<&GrayImage>, options: &StripeOptions) -> Re
         }
     }
     let o = options;
-    if !(o.min_contrast.is_finite() && o.min_contrast > 0.0)
-        || !(o.threshold > 0.0 && o.threshold < 1.0)
-        || !(o.max_width_px.is_finite() && o.max_width_px >= 2.0 && o.max_width_px <= 200.0)
-    {
+    let contrast_ok = o.min_contrast.is_finite() && o.min_contrast > 0.0;
+    let threshold_ok = o.threshold > 0.0 && o.threshold < 1.0;
+    let width_ok = (2.0..=200.0).contains(&o.max_width_px);
+    if !(contrast_ok && threshold_ok && width_ok) {
         return Err(Error::invalid(
             "stripe options",
             format!(
@@ -371,7 +371,7 @@ fn peak_in_line(
             (None, None) => continue,
         };
         let r = smooth(j) - flank;
-        if best.is_none_or(|(_, v)| r > v) {
+        if best.map_or(true, |(_, v)| r > v) {
             best = Some((j, r));
         }
     }
@@ -449,7 +449,7 @@ fn peak_in_line(
         width: right_edge - left_edge,
         peak,
         contrast,
-        saturated: raw[a..=b].iter().any(|&v| v == 255),
+        saturated: raw[a..=b].contains(&255),
     })
 }
 
