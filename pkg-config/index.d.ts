@@ -296,6 +296,12 @@ export interface DistortionModels {
   kannala_brandt: { k1: number; k2: number; k3: number; k4: number };
   /** Enhanced unified camera model: alpha in [0, 1), beta > 0. */
   eucm: { alpha: number; beta: number };
+  /** Scheimpflug (tilted sensor): OpenCV's rational + thin prism then the sensor tilt tau_x tau_y in radians (CALIB_TILTED_MODEL, OpenCV's 14 coefficients). */
+  tilted: {
+    k1: number; k2: number; k3: number; k4: number; k5: number; k6: number;
+    p1: number; p2: number; s1: number; s2: number; s3: number; s4: number;
+    tau_x: number; tau_y: number;
+  };
 }
 
 /** A lens model name (`model` of the calibration inputs and reports). */

@@ -172,10 +172,28 @@ fn distortion_from_opencv(d: &[f64], fisheye: bool) -> Result<Distortion> {
             s3: g(10),
             s4: g(11),
         },
+        (14, false) => Distortion::Tilted {
+            k1: g(0),
+            k2: g(1),
+            p1: g(2),
+            p2: g(3),
+            k3: g(4),
+            k4: g(5),
+            k5: g(6),
+            k6: g(7),
+            s1: g(8),
+            s2: g(9),
+            s3: g(10),
+            s4: g(11),
+            tau_x: g(12),
+            tau_y: g(13),
+        },
         (n, _) => {
             return Err(Error::invalid(
                 "distortion_coefficients",
-                format!("{n} coefficients: robocal reads 4 (fisheye or k1 k2 p1 p2), 5, 8 or 12"),
+                format!(
+                    "{n} coefficients: robocal reads 4 (fisheye or k1 k2 p1 p2), 5, 8, 12 or 14 (tilted)"
+                ),
             ))
         }
     })
