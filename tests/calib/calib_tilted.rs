@@ -55,27 +55,40 @@ fn noise_free_points_give_back_the_tilt_exactly() {
 }
 
 /// 0.2 px of noise on every coordinate, five seeded scenes of 15 views:
-/// the tilt comes back within 0.1 degree (measured: see the report of
-/// issue 40's tilt helper; the reported standard deviations cover it).
+/// the tilt comes back within 4 of its reported standard deviations (the
+/// tilt is seen only through the distortion, so its deviation is large:
+/// about 0.4 degree here, see docs/lens-models.md), and the deviation
+/// itself is honest (the RMS of the errors over the scenes, in deviations,
+/// between 0.3 and 2).
 #[test]
 fn noisy_points_give_back_the_tilt_within_its_uncertainty() {
     let truth = Camera::example_tilted();
     let (tx, ty) = tau_deg(&truth);
-    let mut worst: f64 = 0.0;
+    let (mut worst, mut sum_sq, mut n) = (0.0_f64, 0.0, 0.0);
     for seed in 21..26 {
         let scene = Scene::calibration(seed, &truth, (9, 6), 0.03, 15, 0.2).expect("scene");
         let report = calibrate(&scene.views, (truth.width, truth.height), &options())
             .unwrap_or_else(|e| panic!("{e}"));
         let (gx, gy) = tau_deg(&report.camera);
-        let err = (gx - tx).abs().max((gy - ty).abs());
+        let std = |k: &str| report.std.get(k).copied().unwrap_or(f64::NAN).to_degrees();
+        let (sx, sy) = (std("tau_x"), std("tau_y"));
         eprintln!(
-            "seed {seed}: tau_x {gx:.4} deg (truth {tx:.4}), tau_y {gy:.4} deg (truth {ty:.4}), rms {:.3} px",
+            "seed {seed}: tau_x {gx:.4} deg (truth {tx:.4}, std {sx:.4}), tau_y {gy:.4} deg (truth {ty:.4}, std {sy:.4}), rms {:.3} px",
             report.rms_px
         );
-        worst = worst.max(err);
+        for z in [(gx - tx) / sx, (gy - ty) / sy] {
+            assert!(z.is_finite(), "seed {seed}: no standard deviation for tau");
+            worst = worst.max(z.abs());
+            sum_sq += z * z;
+            n += 1.0;
+        }
     }
-    eprintln!("noise 0.2 px, 5 scenes of 15 views: worst tau error {worst:.4} deg");
-    assert!(worst < 0.1, "worst tau error {worst} deg");
+    let rms_z = (sum_sq / n).sqrt();
+    eprintln!(
+        "noise 0.2 px, 5 scenes of 15 views: tau errors {rms_z:.2} std RMS, worst {worst:.2} std"
+    );
+    assert!(worst < 4.0, "worst tau error {worst} std");
+    assert!(rms_z > 0.3 && rms_z < 2.0, "tau errors {rms_z} std RMS");
 }
 
 /// The renderer draws through the tilted camera (its truth points are the
@@ -126,10 +139,14 @@ fn rendered_boards_through_a_tilted_sensor_calibrate_back() {
         .unwrap_or_else(|e| panic!("{e}"));
     let (tx, ty) = tau_deg(&truth);
     let (gx, gy) = tau_deg(&report.camera);
+    let std = |k: &str| report.std.get(k).copied().unwrap_or(f64::NAN).to_degrees();
+    let (sx, sy) = (std("tau_x"), std("tau_y"));
     eprintln!(
-        "rendered: tau_x {gx:.4} deg (truth {tx:.4}), tau_y {gy:.4} deg (truth {ty:.4}), rms {:.4} px",
+        "rendered: tau_x {gx:.4} deg (truth {tx:.4}, std {sx:.4}), tau_y {gy:.4} deg (truth {ty:.4}, std {sy:.4}), rms {:.4} px",
         report.rms_px
     );
-    assert!((gx - tx).abs() < 0.1 && (gy - ty).abs() < 0.1);
+    // Measured: 0.08 degree off each at 0.012 px RMS (the renderer's noise).
+    assert!((gx - tx).abs() < 0.2 && (gy - ty).abs() < 0.2);
+    assert!((gx - tx).abs() < 4.0 * sx && (gy - ty).abs() < 4.0 * sy);
     assert!((report.camera.fx - truth.fx).abs() < 2.0);
 }
