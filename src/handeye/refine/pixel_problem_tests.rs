@@ -236,7 +236,7 @@ const SEED003_TABLE1: [([f64; 2], [f64; 3]); 6] = [
 /// hand-eye matrix (Eq. 9-10) are lost from the text, and its accuracy
 /// figure (0.12 mm mean over 20 seam points) uses points it does not list.
 /// What the table itself says, reproduced here: its image points lie on one
-/// row (y = 116) and its world points on one line (within 0.35 mm), so a
+/// row (y = 116) and its world points on one line (within 0.4 mm), so a
 /// central camera maps them by a 1-D projective map (3 numbers), and the six
 /// points fit such a map only to about 1.5 px RMS (the third point 2.7 px
 /// off, about 0.75 mm at the table's 0.28 mm per pixel). Six points give 12
@@ -255,16 +255,12 @@ fn seed003_table1_control_points_through_the_world_point_solver() {
         .iter()
         .map(|(p, _)| Point2::new(p[0], p[1]))
         .collect();
-    // The world points lie on one line within 0.35 mm.
+    // The world points lie on one line within 0.4 mm (0.35 mm at most).
     let (a, b) = (world[0], world[5]);
     let u = (b - a).normalize();
     for p in &world {
         let off = (p - a) - u * (p - a).dot(&u);
-        assert!(
-            off.norm() < 0.35 * mm,
-            "{} mm off the line",
-            off.norm() / mm
-        );
+        assert!(off.norm() < 0.4 * mm, "{} mm off the line", off.norm() / mm);
     }
     // Start: camera 100 mm above the line's middle, looking down (world -z),
     // its x axis along the line (image x grows from point 1 to point 6).
@@ -311,10 +307,12 @@ fn seed003_table1_control_points_through_the_world_point_solver() {
         "seed 003 Table 1: rms {:.3} px, per point {residuals:.2?} px",
         r.reprojection_rms_px
     );
-    // The 1-D projective bound: 1.49 px RMS (the off-line scatter of the
-    // world points lets a 3-D pose do a little better).
+    // The least-squares 1-D projective map of the six x coordinates (a
+    // separate fit, numpy, x = (a w + b) / (c w + 1) over wx) leaves
+    // 1.486 px RMS with the third and fifth points worst (2.67, 2.35 px):
+    // the solver lands there (measured 1.485 px).
     assert!(
-        r.reprojection_rms_px > 1.0 && r.reprojection_rms_px < 1.6,
+        r.reprojection_rms_px > 1.45 && r.reprojection_rms_px < 1.52,
         "{} px",
         r.reprojection_rms_px
     );
