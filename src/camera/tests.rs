@@ -260,6 +260,8 @@ fn undistortion_map_samples_where_the_distorted_camera_images_each_ray() {
 /// `cv2.projectPoints` (opencv-python-headless 4.14.0.94) with 14
 /// coefficients, every term non-zero, printed by benches/tilted_opencv.py.
 #[wasm_bindgen_test(unsupported = test)]
+// The pixels as OpenCV printed them (17 significant digits).
+#[allow(clippy::excessive_precision)]
 fn the_tilted_model_projects_as_opencv() {
     let camera = Camera {
         distortion: Distortion::Tilted {

@@ -27,6 +27,10 @@
 use crate::error::{Error, Result};
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
+/// A sensor point, its Jacobian with respect to the distorted point and its
+/// derivatives with respect to `tau_x` and `tau_y`.
+pub(crate) type TiltedPoint = (Vector2<f64>, Matrix2<f64>, [Vector2<f64>; 2]);
+
 /// The tilt homography `T` and its derivatives with respect to `tau_x` and
 /// `tau_y`.
 #[derive(Clone, Copy, Debug)]
@@ -75,10 +79,7 @@ impl Tilt {
     /// The sensor point of the distorted normalised point `m`, its 2x2
     /// Jacobian with respect to `m` and its derivatives with respect to
     /// `tau_x` and `tau_y`.
-    pub fn apply(
-        &self,
-        m: &Vector2<f64>,
-    ) -> Result<(Vector2<f64>, Matrix2<f64>, [Vector2<f64>; 2])> {
+    pub fn apply(&self, m: &Vector2<f64>) -> Result<TiltedPoint> {
         let v = self.t * Vector3::new(m.x, m.y, 1.0);
         let out = dehomogenise(&v, m)?;
         let w = 1.0 / v.z;
@@ -115,7 +116,8 @@ impl Tilt {
 /// `(v_x / v_z, v_y / v_z)`, refused when `v_z` is not positive (the point
 /// `m` lies on or beyond the horizon of the tilted sensor).
 fn dehomogenise(v: &Vector3<f64>, m: &Vector2<f64>) -> Result<Vector2<f64>> {
-    if !(v.z > 0.0) || !v.iter().all(|c| c.is_finite()) {
+    let in_front = v.z > 0.0 && v.iter().all(|c| c.is_finite());
+    if !in_front {
         return Err(Error::invalid(
             "point",
             format!(

@@ -57,7 +57,8 @@ impl Plane {
     /// The plane of `normal` (any length but 0) at `distance_m`.
     pub fn new(normal: Vector3<f64>, distance_m: f64) -> Result<Plane> {
         let norm = normal.norm();
-        if !(norm > 1e-12) || !norm.is_finite() || !distance_m.is_finite() {
+        let usable = norm > 1e-12 && norm.is_finite() && distance_m.is_finite();
+        if !usable {
             return Err(Error::invalid(
                 "plane",
                 format!(
