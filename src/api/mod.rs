@@ -25,6 +25,10 @@ pub mod camera;
 pub(crate) mod camera_tests;
 mod choices;
 pub mod handeye;
+pub mod handeye_field;
+#[cfg(test)]
+mod handeye_tests;
+pub mod plan;
 pub mod planar;
 pub mod poses;
 pub mod rig;

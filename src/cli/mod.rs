@@ -18,6 +18,7 @@ mod input;
 mod intrinsics;
 mod memory_budget;
 pub mod output;
+mod plan;
 mod planar;
 mod render;
 mod render_rig;
@@ -126,6 +127,7 @@ enum Command {
     Info(info::InfoArgs),
     Render(render::RenderArgs),
     Planar(planar::PlanarArgs),
+    Plan(plan::PlanArgs),
     Xytable(xytable::XytableArgs),
     Target(target::TargetArgs),
     Completions(CompletionsArgs),
@@ -169,6 +171,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
         Command::Planar(a) => planar::run(a),
+        Command::Plan(a) => plan::run(a),
         Command::Xytable(a) => xytable::run(a),
         Command::Target(a) => target::run(a),
         Command::Completions(a) => completions(a.shell),

@@ -18,6 +18,7 @@ pub mod export_stereo;
 pub mod export_transform;
 pub mod import_camera;
 pub mod kalibr_target;
+pub mod move_lists;
 pub mod pairing;
 mod pose_candidates;
 mod pose_files;
