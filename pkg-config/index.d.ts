@@ -865,6 +865,12 @@ export interface HandEyeInputBase {
    * ignored with image points, where `refine` applies).
    */
   refine_poses?: boolean;
+  /** The tool centre point in the flange frame (m): the report's `tcp_error`. */
+  tcp_m?: Vec3;
+  /** Hold the last N pose pairs out of the solve: the report's `holdout`. */
+  holdout?: number;
+  /** Points touched with the tool centre point (base frame, m) and seen at `image_px` from robot pose `view` (needs image points and the camera). */
+  touch?: { base_m: Vec3; image_px: [number, number]; view?: number }[];
 }
 
 /**
@@ -1093,7 +1099,59 @@ export interface HandEyeReportBase {
   refinement?: RefinementSummary;
   /** Present when the pose refinement ran (pose input; the primary transforms are then the refined ones). */
   pose_refinement?: PoseRefinementSummary;
+  /** The hand-eye error at the work point (the target centre on the camera's optical axis at the working distance); with the pose refinement. */
+  work_point_error?: WorkPointError;
+  /** The same at the tool centre point (`tcp_m` given). */
+  tcp_error?: WorkPointError;
+  /** Held-out poses (`holdout` given). */
+  holdout?: HoldoutReport;
+  /** Touch test (`touch` given). */
+  touch_test?: TouchReport;
   robocal_version: string;
+}
+
+/** The hand-eye error at one point (docs/handeye-field.md). */
+export interface WorkPointError {
+  /** `target centre` or `tool centre point`. */
+  point: string;
+  /** The point (m) in `frame`. */
+  point_m: Vec3;
+  /** `gripper` (eye-in-hand) or `base` (eye-to-hand). */
+  frame: 'gripper' | 'base';
+  point_camera_m: Vec3;
+  rms_mm: number;
+  /** sqrt(7.815 * largest eigenvalue of the point covariance): holds the 95 % ellipsoid. */
+  bound95_mm: number;
+  worst_direction_camera: Vec3;
+  rotation_share: number;
+  verdict: string;
+  shrink_by: string[];
+}
+
+/** One held-out pose: predicted against observed target position. */
+export interface HoldoutPose {
+  view: number;
+  translation_mm: number;
+  rotation_deg: number;
+}
+
+/** The report's `holdout`. */
+export interface HoldoutReport {
+  target_point_m: Vec3;
+  per_pose: HoldoutPose[];
+  rms_mm: number;
+  max_mm: number;
+  rotation_rms_deg: number;
+  in_sample_rms_mm: number;
+  expected_rms_mm: number;
+  verdict: string;
+}
+
+/** The report's `touch_test`. */
+export interface TouchReport {
+  points: { distance_mm: number; pixel_error_px: number; depth_m: number }[];
+  rms_mm: number;
+  max_mm: number;
 }
 
 /** Eye-in-hand report: the camera on the gripper, the target fixed in the base. */
