@@ -11,6 +11,7 @@ mod cli_bad_inputs;
 mod cli_bad_inputs_scenes;
 mod cli_detect;
 mod cli_export;
+mod cli_field;
 mod cli_handeye;
 mod cli_handeye_pairing;
 mod cli_intrinsics;
