@@ -62,7 +62,7 @@ pub struct PlanArgs {
     #[arg(long, value_name = "FILE")]
     image: Option<String>,
     /// Instead of --image: camera_from_target of the current view (one line:
-    /// 16 numbers of a 4x4 matrix, or x y z qx qy qz qw; metres)
+    /// 16 numbers of a row-major 4x4 matrix, metres)
     #[arg(long, value_name = "FILE")]
     camera_pose: Option<String>,
     /// A rough gripper_from_camera (eye-in-hand) or gripper_from_target
