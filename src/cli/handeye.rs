@@ -386,7 +386,7 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
 
 /// `--tcp X,Y,Z` with a unit (mm, cm or m) on the last number or on each.
 fn parse_tcp(text: &str) -> Result<[f64; 3], CliError> {
-    let bad = |why: &str| CliError::usage("handeye", &format!("--tcp '{text}': {why}"));
+    let bad = |why: &str| CliError::usage("handeye", format!("--tcp '{text}': {why}"));
     let t = text.trim();
     let (body, scale) = if let Some(b) = t.strip_suffix("mm") {
         (b, 1e-3)

@@ -10,9 +10,10 @@
 //!    the robot through a rough hand-eye guess (`guess`: `gripper_from_camera`
 //!    eye-in-hand, `gripper_from_target` eye-to-hand, e.g. from CAD;
 //!    identity when unknown): eye-in-hand `base_from_target = robot_now *
-//!    guess * camera_now`, eye-to-hand `base_from_camera = robot_now * guess
-//!    * camera_now^-1`. An error in the guess shifts every planned view by
-//!    about that error; the image margin absorbs a few centimetres.
+//!    guess * camera_now`, eye-to-hand `base_from_camera = robot_now *
+//!    guess * inverse(camera_now)`. An error in the guess shifts every
+//!    planned view by about that error; the image margin absorbs a few
+//!    centimetres.
 //! 2. **Candidate views.** The camera looks at the board's centre from a
 //!    direction tilted by `0..=max_tilt_deg` from the board normal (eight
 //!    azimuths), at three distances across the working range, rolled about

@@ -278,7 +278,14 @@ mod tests {
             image_px: [seen.x, seen.y],
             view: 0,
         };
-        let r = touch_test(Setup::EyeInHand, &x, &robot, &camera, &[touch.clone()]).unwrap();
+        let r = touch_test(
+            Setup::EyeInHand,
+            &x,
+            &robot,
+            &camera,
+            std::slice::from_ref(&touch),
+        )
+        .unwrap();
         assert!(r.rms_mm < 1e-9, "{r:?}");
         assert!((r.points[0].depth_m - 0.4).abs() < 1e-12);
         // Seen 8 px to the right: 8 / 800 * 0.4 m = 4 mm off the ray.
@@ -286,7 +293,14 @@ mod tests {
             image_px: [seen.x + 8.0, seen.y],
             ..touch
         };
-        let r = touch_test(Setup::EyeInHand, &x, &robot, &camera, &[moved.clone()]).unwrap();
+        let r = touch_test(
+            Setup::EyeInHand,
+            &x,
+            &robot,
+            &camera,
+            std::slice::from_ref(&moved),
+        )
+        .unwrap();
         assert!((r.max_mm - 4.0).abs() < 0.01, "{r:?}");
         assert!((r.points[0].pixel_error_px - 8.0).abs() < 1e-9);
         let bad = TouchPoint { view: 3, ..moved };
