@@ -14,7 +14,13 @@
 //!   rig --setup`);
 //! - [`poses`]: robot pose files (`read_robot_poses`, `read_robot_pose_files`);
 //! - [`planar`]: the planar workflow (`planar_fit`, `planar_solve`,
-//!   `robocal planar`).
+//!   `robocal planar`);
+//! - [`xytable`]: the XY-table and known-motion workflows (`xytable_solve`,
+//!   `known_motion_solve`, `robocal xytable`);
+//! - [`detect`]: which target to find and how (`detect_target`,
+//!   `detect_boards`, `robocal detect`, the images of `robocal intrinsics`);
+//! - [`export`]: a report in another format (`export_report`,
+//!   `export_report_files`, `robocal export`).
 //!
 //! Every report says what it is in `kind` ([`crate::report_kind::ReportKind`])
 //! and which robocal wrote it in `robocal_version`; `robocal export` and
@@ -24,12 +30,15 @@ pub mod camera;
 #[cfg(test)]
 pub(crate) mod camera_tests;
 mod choices;
+pub mod detect;
+pub mod export;
 pub mod handeye;
 pub mod planar;
 pub mod poses;
 pub mod rig;
 pub mod rig_handeye;
 pub mod stereo;
+pub mod xytable;
 
 pub use crate::report_kind::ReportKind;
 
