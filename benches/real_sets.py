@@ -255,7 +255,7 @@ def left_right(robocal, tmp):
         note(f"{name}: robocal {rc['views']} views rms {rc['rms']:.4f} px, OpenCV {cv['views']} views "
              f"rms {cv['rms']:.4f} px (cornerSubPix 15x15); Bouguet had 14 views (pair 10 not shipped)")
         det = robocal_detect(robocal, "chessboard:9x6:30mm", images, os.path.join(tmp, f"{side}-detect.json"))
-        corner_offsets(side, det, images, found, img)
+        corner_offsets(side, det, found, img, size)
         on = robocal_on_corners(robocal, img, size, 9, 6, ["--fix", "k3"], os.path.join(tmp, f"{side}-cv.json"))
         add_rows(f"same, robocal's solver on OpenCV's 15x15 {side} corners", ["fx", "fy", "cx", "cy"], ref, None,
                  on, cv)
@@ -279,26 +279,37 @@ def left_right(robocal, tmp):
     note(f"{name}: robocal rms {rc['rms']:.4f} px")
 
 
-def corner_offsets(side, det, images, found, cv_img):
-    """robocal's corners against OpenCV's: median distance, and the mean
-    outward component (along the direction from the view's corner centroid;
-    positive = robocal's board looks larger)."""
+def corner_offsets(side, det, found, cv_img, size):
+    """robocal's corners against OpenCV's: median distance, the mean
+    offset away from each view's corner centroid (positive = robocal's
+    board looks larger) and away from the image centre per radius band
+    (a field-dependent offset moves the focal length and k1)."""
     by_name = {os.path.basename(e["file"]): e.get("detection") for e in det["images"]}
-    dist, outward = [], []
+    centre_px = (np.array(size, np.float64) - 1) / 2
+    dist, outward, radial = [], [], []
     for name, c in zip(found, cv_img):
         d = by_name.get(name)
         if not d:
             continue
         rc = np.array([[p["x_px"], p["y_px"]] for p in d["points"]])
         cv = c.reshape(-1, 2).astype(np.float64)
-        centre = cv.mean(0)
+        centroid = cv.mean(0)
         for q in cv:
-            r = rc[np.argmin(((rc - q) ** 2).sum(1))]
-            dist.append(np.hypot(*(r - q)))
-            u = (q - centre) / max(np.hypot(*(q - centre)), 1e-9)
-            outward.append(float((r - q) @ u))
+            off = rc[np.argmin(((rc - q) ** 2).sum(1))] - q
+            dist.append(np.hypot(*off))
+            u = (q - centroid) / max(np.hypot(*(q - centroid)), 1e-9)
+            outward.append(float(off @ u))
+            r = np.hypot(*(q - centre_px))
+            radial.append((r, float(off @ (q - centre_px)) / max(r, 1e-9)))
+    radial = np.array(radial)
+    bands = []
+    for lo, hi in [(0, 100), (100, 200), (200, 300), (300, 800)]:
+        m = (radial[:, 0] >= lo) & (radial[:, 0] < hi)
+        if m.any():
+            bands.append(f"{lo}-{hi} px {radial[m, 1].mean():+.3f} (n {m.sum()})")
     note(f"{side} corners, robocal vs OpenCV 15x15 over {len(dist)}: median distance {np.median(dist):.3f} px, "
-         f"mean outward offset {np.mean(outward):+.4f} px (std of mean {np.std(outward) / np.sqrt(len(outward)):.4f})")
+         f"mean outward offset {np.mean(outward):+.4f} px (std of mean {np.std(outward) / np.sqrt(len(outward)):.4f}); "
+         f"away from the image centre by radius: {', '.join(bands)}")
 
 
 def numbers(path):
