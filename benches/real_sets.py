@@ -16,12 +16,13 @@ Sets (each skipped with a message when its folder is absent):
     so the ids and the board frame are robocal's); OpenCV takes them with
     Model.txt. OpenCV has no skew and finds no board in the photos.
   - opencv-calib1-dat: Bouguet's result in calib1.dat (k1 k2 p1 p2, 7 views
-    of point data, no images), with the std block of the file (its first
-    four numbers are three times the std of fc, cc, Bouguet's convention;
-    the script prints the factor that OpenCV's own std gives).
+    of point data, no images), with the uncertainty block of the file as
+    it stands (the toolbox's errors; the script prints their ratio to
+    OpenCV's std, 1.50).
   - caliscope-4cam-charuco-video: caliscope's camera_array.toml (brown5,
     fx and fy free) against every frame of each camera's video (inverted
-    ChArUco 4x5, 54 mm squares) and camera 0's chessboard_intrinsic frames.
+    ChArUco 4x5, 54 mm squares) and camera 0's chessboard_intrinsic frames
+    (fx fy cx cy only: four near-frontal views).
     caliscope calibrated from its own intrinsic recording, not shipped.
   - rwhe-calib-cs-synthetic-1: no published intrinsics (SOURCE.md), skipped.
 
@@ -44,7 +45,9 @@ within (the reference's std when published, else robocal's); a report at
 severity error (robocal's "these parameters are not a calibration") is
 marked as such.
 
-Usage (crate root): python3 benches/real_sets.py [--robocal PATH] [--keep DIR]
+Usage (crate root; about 2 minutes, most of it caliscope's 444 frames):
+  cargo build --release --bin robocal
+  python3 benches/real_sets.py [--robocal PATH] [--keep DIR] [--sets left_right,zhang,calib1,caliscope,rwhe]
 """
 import argparse
 import glob
