@@ -23,6 +23,7 @@ mod pose_candidates;
 mod pose_files;
 mod pose_formats;
 mod pose_json;
+mod pose_krl;
 pub mod pose_pairing;
 mod pose_table;
 pub mod pose_text;
