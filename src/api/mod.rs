@@ -14,7 +14,10 @@
 //!   rig --setup`);
 //! - [`poses`]: robot pose files (`read_robot_poses`, `read_robot_pose_files`);
 //! - [`planar`]: the planar workflow (`planar_fit`, `planar_solve`,
-//!   `robocal planar`).
+//!   `robocal planar`);
+//! - [`check`]: a saved calibration against new images, and the projection
+//!   difference of two calibrations (`check_camera`, `diff_cameras`,
+//!   `robocal check`, `robocal diff`).
 //!
 //! Every report says what it is in `kind` ([`crate::report_kind::ReportKind`])
 //! and which robocal wrote it in `robocal_version`; `robocal export` and
@@ -23,6 +26,7 @@
 pub mod camera;
 #[cfg(test)]
 pub(crate) mod camera_tests;
+pub mod check;
 mod choices;
 pub mod handeye;
 pub mod planar;
