@@ -222,24 +222,23 @@ pub fn run_diff(args: DiffArgs) -> Result<(), CliError> {
         Some(text) => parse_grid(text)?,
         None => DEFAULT_GRID,
     };
+    // Each file read as a camera first, so that its errors name it.
+    let read = |path: &str| -> Result<String, CliError> {
+        let text = read_text(path)?;
+        robocal::io::import_camera::import_camera(&text)
+            .map_err(|e| CliError::Io(format!("'{path}': {e}")))?;
+        Ok(text)
+    };
     let request = DiffRequest {
-        a: read_text(&args.a)?,
-        b: read_text(&args.b)?,
+        a: read(&args.a)?,
+        b: read(&args.b)?,
         options: DiffOptions {
             grid,
             focus_radius_px: args.focus_radius_px,
             ..DiffOptions::default()
         },
     };
-    let report = diff_request(&request).map_err(|e| match e {
-        robocal::Error::Invalid { field, message } if field == "a" => {
-            CliError::Io(format!("'{}': {message}", args.a))
-        }
-        robocal::Error::Invalid { field, message } if field == "b" => {
-            CliError::Io(format!("'{}': {message}", args.b))
-        }
-        e => CliError::Robocal(e),
-    })?;
+    let report = diff_request(&request)?;
     let d = &report.projection_shift_px;
     eprintln!(
         "robocal diff: projection shift worst {:.3} px at ({:.0}, {:.0}), median {:.3} px, rms {:.3} px, implied rotation {:.4} deg",
