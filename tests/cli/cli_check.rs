@@ -12,7 +12,7 @@ const TARGET: &str = "chessboard:9x6:30mm";
 
 /// A 640 x 480 camera file (robocal camera JSON) with mild barrel distortion.
 fn camera_file(dir: &Path, name: &str, fx: f64, cx: f64, k1: f64, size: [u32; 2]) -> PathBuf {
-    let (w, h) = (size[0] as f64, size[1] as f64);
+    let h = size[1] as f64;
     let camera = json!({
         "model": "brown", "image_size_px": size,
         "camera_matrix": [[fx, 0, cx], [0, fx, (h - 1.0) / 2.0], [0, 0, 1]],
@@ -20,7 +20,6 @@ fn camera_file(dir: &Path, name: &str, fx: f64, cx: f64, k1: f64, size: [u32; 2]
     });
     let path = dir.join(format!("{name}.json"));
     std::fs::write(&path, camera.to_string()).unwrap();
-    let _ = w;
     path
 }
 
