@@ -1,5 +1,5 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
-//! and camera_file.rs, demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs,
+//! and camera_file.rs, check.rs, demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs,
 //! rig_handeye.rs and targets.rs beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
@@ -15,6 +15,7 @@
 //! JS side can show it ([`last_panic_message`]) instead of a dead worker.
 
 mod camera_file;
+mod check;
 mod demo;
 mod lens_models;
 mod live_capture;
@@ -22,6 +23,7 @@ mod rig_frames;
 mod rig_handeye;
 mod targets;
 pub use camera_file::read_camera_file;
+pub use check::{check_camera, diff_cameras};
 pub use demo::{render_demo, DemoData};
 pub use lens_models::lens_models;
 pub use live_capture::LiveCapture;

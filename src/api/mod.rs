@@ -20,7 +20,10 @@
 //! - [`detect`]: which target to find and how (`detect_target`,
 //!   `detect_boards`, `robocal detect`, the images of `robocal intrinsics`);
 //! - [`export`]: a report in another format (`export_report`,
-//!   `export_report_files`, `robocal export`).
+//!   `export_report_files`, `robocal export`);
+//! - [`check`]: a saved calibration against new images, and the projection
+//!   difference of two calibrations (`check_camera`, `diff_cameras`,
+//!   `robocal check`, `robocal diff`).
 //!
 //! Every report says what it is in `kind` ([`crate::report_kind::ReportKind`])
 //! and which robocal wrote it in `robocal_version`; `robocal export` and
@@ -29,6 +32,7 @@
 pub mod camera;
 #[cfg(test)]
 pub(crate) mod camera_tests;
+pub mod check;
 mod choices;
 pub mod detect;
 pub mod export;

@@ -7,6 +7,7 @@
 //! change. Every subcommand accepts a flag again and keeps the last value
 //! (`args_override_self`), as scripts that append an override expect.
 
+mod check;
 mod detect;
 mod detections_file;
 mod export;
@@ -128,6 +129,8 @@ enum Command {
     Planar(planar::PlanarArgs),
     Xytable(xytable::XytableArgs),
     Target(target::TargetArgs),
+    Check(check::CheckArgs),
+    Diff(check::DiffArgs),
     Completions(CompletionsArgs),
 }
 
@@ -171,6 +174,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Planar(a) => planar::run(a),
         Command::Xytable(a) => xytable::run(a),
         Command::Target(a) => target::run(a),
+        Command::Check(a) => check::run(a),
+        Command::Diff(a) => check::run_diff(a),
         Command::Completions(a) => completions(a.shell),
     }
 }
