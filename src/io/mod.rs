@@ -17,6 +17,7 @@ pub mod export_ros;
 pub mod export_stereo;
 pub mod export_transform;
 pub mod import_camera;
+mod import_camera_tools;
 pub mod kalibr_target;
 pub mod pairing;
 mod pose_candidates;
