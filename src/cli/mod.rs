@@ -7,6 +7,7 @@
 //! change. Every subcommand accepts a flag again and keeps the last value
 //! (`args_override_self`), as scripts that append an override expect.
 
+mod check;
 mod detect;
 mod detections_file;
 mod export;
@@ -130,6 +131,8 @@ enum Command {
     Plan(plan::PlanArgs),
     Xytable(xytable::XytableArgs),
     Target(target::TargetArgs),
+    Check(check::CheckArgs),
+    Diff(check::DiffArgs),
     Completions(CompletionsArgs),
 }
 
@@ -174,6 +177,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Plan(a) => plan::run(a),
         Command::Xytable(a) => xytable::run(a),
         Command::Target(a) => target::run(a),
+        Command::Check(a) => check::run(a),
+        Command::Diff(a) => check::run_diff(a),
         Command::Completions(a) => completions(a.shell),
     }
 }

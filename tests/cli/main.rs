@@ -9,6 +9,7 @@ mod support;
 mod cli_bad_images;
 mod cli_bad_inputs;
 mod cli_bad_inputs_scenes;
+mod cli_check;
 mod cli_detect;
 mod cli_export;
 mod cli_field;
