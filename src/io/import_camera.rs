@@ -1,7 +1,11 @@
 //! Reading cameras back: robocal JSON (a camera export or a calibration
-//! report), OpenCV FileStorage YAML and XML, and ROS `camera_info` YAML.
+//! report), OpenCV FileStorage YAML and XML, ROS `camera_info` YAML, a
+//! Kalibr camchain and an mrcal `.cameramodel` (the last two in
+//! [`super::import_camera_tools`]): every camera format `robocal export`
+//! writes but Halcon's, MATLAB's and the text matrix.
 //! The format is recognised from the content.
 
+use super::import_camera_tools::{from_kalibr, from_mrcal, is_kalibr, is_mrcal};
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
 
@@ -16,11 +20,18 @@ pub enum CameraSource {
     OpencvXml,
     /// ROS camera_info YAML.
     RosYaml,
+    /// A Kalibr camchain YAML (its first camera).
+    Kalibr,
+    /// An mrcal `.cameramodel`.
+    Mrcal,
 }
 
 /// Read a camera from text in any of the [`CameraSource`] formats.
 pub fn import_camera(text: &str) -> Result<(Camera, CameraSource)> {
     let trimmed = text.trim_start();
+    if is_mrcal(text) {
+        return from_mrcal(text).map(|c| (c, CameraSource::Mrcal));
+    }
     if trimmed.starts_with('{') {
         return from_json(text).map(|c| (c, CameraSource::Json));
     }
@@ -33,10 +44,13 @@ pub fn import_camera(text: &str) -> Result<(Camera, CameraSource)> {
     if text.contains("camera_matrix:") && text.contains("distortion_model:") {
         return from_yaml(text, true).map(|c| (c, CameraSource::RosYaml));
     }
+    if is_kalibr(text) {
+        return from_kalibr(text).map(|c| (c, CameraSource::Kalibr));
+    }
     Err(Error::parse(
         0,
         0,
-        "not a camera file: expected robocal JSON, OpenCV YAML/XML (camera_matrix, distortion_coefficients) or ROS camera_info YAML",
+        "not a camera file: expected robocal JSON, OpenCV YAML/XML (camera_matrix, distortion_coefficients), ROS camera_info YAML, a Kalibr camchain or an mrcal .cameramodel",
     ))
 }
 
