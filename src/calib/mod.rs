@@ -16,6 +16,9 @@
 //!   12 parameters, with the measurement noise from repeated observations.
 
 pub mod centre_models;
+pub mod check;
+#[cfg(test)]
+mod check_tests;
 mod closed_form;
 pub mod compare;
 pub mod dlt;
@@ -27,6 +30,7 @@ pub mod model_advice;
 pub mod multi;
 pub mod plausibility;
 pub mod pnp;
+pub mod projection_diff;
 mod refine;
 mod rejected;
 mod report;

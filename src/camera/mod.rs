@@ -20,6 +20,7 @@ mod examples;
 mod kannala_brandt;
 mod models;
 mod polynomial;
+mod tilt;
 mod undistort;
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 //! change. Every subcommand accepts a flag again and keeps the last value
 //! (`args_override_self`), as scripts that append an override expect.
 
+mod check;
 mod detect;
 mod detections_file;
 mod export;
@@ -19,6 +20,7 @@ mod intrinsics;
 mod laser;
 mod memory_budget;
 pub mod output;
+mod plan;
 mod planar;
 mod render;
 mod render_laser;
@@ -129,8 +131,11 @@ enum Command {
     Render(render::RenderArgs),
     Laser(laser::LaserArgs),
     Planar(planar::PlanarArgs),
+    Plan(plan::PlanArgs),
     Xytable(xytable::XytableArgs),
     Target(target::TargetArgs),
+    Check(check::CheckArgs),
+    Diff(check::DiffArgs),
     Completions(CompletionsArgs),
 }
 
@@ -173,8 +178,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Render(a) => render::run(a),
         Command::Laser(a) => laser::run(a),
         Command::Planar(a) => planar::run(a),
+        Command::Plan(a) => plan::run(a),
         Command::Xytable(a) => xytable::run(a),
         Command::Target(a) => target::run(a),
+        Command::Check(a) => check::run(a),
+        Command::Diff(a) => check::run_diff(a),
         Command::Completions(a) => completions(a.shell),
     }
 }
