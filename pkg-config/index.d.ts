@@ -296,6 +296,12 @@ export interface DistortionModels {
   kannala_brandt: { k1: number; k2: number; k3: number; k4: number };
   /** Enhanced unified camera model: alpha in [0, 1), beta > 0. */
   eucm: { alpha: number; beta: number };
+  /** Scheimpflug (tilted sensor): OpenCV's rational + thin prism then the sensor tilt tau_x tau_y in radians (CALIB_TILTED_MODEL, OpenCV's 14 coefficients). */
+  tilted: {
+    k1: number; k2: number; k3: number; k4: number; k5: number; k6: number;
+    p1: number; p2: number; s1: number; s2: number; s3: number; s4: number;
+    tau_x: number; tau_y: number;
+  };
 }
 
 /** A lens model name (`model` of the calibration inputs and reports). */
@@ -357,7 +363,7 @@ export interface Camera {
  * (and camera and rig reports said `crate_version`); `export_report` still
  * reads them, by their keys.
  */
-export type ReportKind = 'camera' | 'stereo' | 'rig' | 'handeye' | 'rig_handeye';
+export type ReportKind = 'camera' | 'stereo' | 'rig' | 'handeye' | 'rig_handeye' | 'check' | 'diff';
 
 // ---------------------------------------------------------------------------
 // Camera calibration (src/api/camera.rs, src/calib/report.rs, compare.rs)
@@ -865,6 +871,12 @@ export interface HandEyeInputBase {
    * ignored with image points, where `refine` applies).
    */
   refine_poses?: boolean;
+  /** The tool centre point in the flange frame (m): the report's `tcp_error`. */
+  tcp_m?: Vec3;
+  /** Hold the last N pose pairs out of the solve: the report's `holdout`. */
+  holdout?: number;
+  /** Points touched with the tool centre point (base frame, m) and seen at `image_px` from robot pose `view` (needs image points and the camera). */
+  touch?: { base_m: Vec3; image_px: [number, number]; view?: number }[];
 }
 
 /**
@@ -1093,7 +1105,59 @@ export interface HandEyeReportBase {
   refinement?: RefinementSummary;
   /** Present when the pose refinement ran (pose input; the primary transforms are then the refined ones). */
   pose_refinement?: PoseRefinementSummary;
+  /** The hand-eye error at the work point (the target centre on the camera's optical axis at the working distance); with the pose refinement. */
+  work_point_error?: WorkPointError;
+  /** The same at the tool centre point (`tcp_m` given). */
+  tcp_error?: WorkPointError;
+  /** Held-out poses (`holdout` given). */
+  holdout?: HoldoutReport;
+  /** Touch test (`touch` given). */
+  touch_test?: TouchReport;
   robocal_version: string;
+}
+
+/** The hand-eye error at one point (docs/handeye-field.md). */
+export interface WorkPointError {
+  /** `target centre` or `tool centre point`. */
+  point: string;
+  /** The point (m) in `frame`. */
+  point_m: Vec3;
+  /** `gripper` (eye-in-hand) or `base` (eye-to-hand). */
+  frame: 'gripper' | 'base';
+  point_camera_m: Vec3;
+  rms_mm: number;
+  /** sqrt(7.815 * largest eigenvalue of the point covariance): holds the 95 % ellipsoid. */
+  bound95_mm: number;
+  worst_direction_camera: Vec3;
+  rotation_share: number;
+  verdict: string;
+  shrink_by: string[];
+}
+
+/** One held-out pose: predicted against observed target position. */
+export interface HoldoutPose {
+  view: number;
+  translation_mm: number;
+  rotation_deg: number;
+}
+
+/** The report's `holdout`. */
+export interface HoldoutReport {
+  target_point_m: Vec3;
+  per_pose: HoldoutPose[];
+  rms_mm: number;
+  max_mm: number;
+  rotation_rms_deg: number;
+  in_sample_rms_mm: number;
+  expected_rms_mm: number;
+  verdict: string;
+}
+
+/** The report's `touch_test`. */
+export interface TouchReport {
+  points: { distance_mm: number; pixel_error_px: number; depth_m: number }[];
+  rms_mm: number;
+  max_mm: number;
 }
 
 /** Eye-in-hand report: the camera on the gripper, the target fixed in the base. */
@@ -1539,6 +1603,130 @@ export interface DemoIndex {
 }
 
 // ---------------------------------------------------------------------------
+// The check of a saved calibration and the projection difference
+// (src/api/check.rs, src/calib/check.rs, src/calib/projection_diff.rs; docs/check.md)
+
+/** The thresholds of the check's verdict (every key optional; defaults in docs/check.md). */
+export interface CheckThresholds {
+  /** Drifted when the worst projection shift exceeds this many projection std (default 3) ... */
+  shift_sigma?: number;
+  /** ... or this many px, whichever is larger (default 1). */
+  shift_floor_px?: number;
+  /** The projection-shift threshold itself, px (replaces the two above). */
+  shift_px?: number | null;
+  /** A parameter moved beyond this many of its std (default 3) ... */
+  param_sigma?: number;
+  /** ... and at least this, px (default 0.5). */
+  param_floor_px?: number;
+  /** Broken above this reprojection RMS of the saved model, px (default max(10 x saved RMS, 3 px)). */
+  broken_rms_px?: number | null;
+  /** With `camera_from_target`: moved beyond this translation, mm (default 2) ... */
+  pose_mm?: number;
+  /** ... or this rotation, degrees (default 0.2). */
+  pose_deg?: number;
+}
+
+/** The input JSON of `check_camera`. */
+export interface CheckRequest {
+  /** The saved calibration file's text: a robocal report or camera JSON, OpenCV YAML/XML or ROS camera_info. */
+  calibration: string;
+  /** Detections of the target in the new images (none reads broken). */
+  views?: CalibrationView[];
+  thresholds?: CheckThresholds;
+  /** Where the fixed camera saw the fixed target at calibration time. */
+  camera_from_target?: PoseInput | null;
+}
+
+/** The projection difference of two cameras (`calib::projection_diff::ProjectionDiff`), px. */
+export interface ProjectionDiff {
+  image_size_px: ImageSize;
+  /** Grid columns and rows. */
+  grid: [number, number];
+  x_px: number[];
+  y_px: number[];
+  /** Per grid row, per column: the shift, px (null where a model is not defined). */
+  map: (number | null)[][];
+  worst: number;
+  worst_at_px: [number, number];
+  median: number;
+  rms: number;
+  /** The fitted implied rotation b_from_a. */
+  b_from_a_quaternion_xyzw: [number, number, number, number];
+  implied_rotation_deg: number;
+  n_points: number;
+  n_fit: number;
+}
+
+/** The thresholds the verdict used. */
+export interface CheckUsedThresholds {
+  shift_px: number;
+  projection_std_px: number | null;
+  shift_sigma: number;
+  shift_floor_px: number;
+  param_sigma: number;
+  param_floor_px: number;
+  broken_rms_px: number;
+  pose_mm: number;
+  pose_deg: number;
+}
+
+/** One refitted parameter of the check. */
+export interface CheckParameter {
+  name: 'fx' | 'fy' | 'cx' | 'cy';
+  saved: number;
+  refit: number;
+  shift_px: number;
+  saved_std_px: number | null;
+  refit_std_px: number | null;
+  /** The shift in std (saved and refit std combined). */
+  shift_std: number | null;
+  moved: boolean;
+}
+
+/** The output JSON of `check_camera` (what `robocal check` writes). */
+export interface CheckReport {
+  kind: 'check';
+  robocal_version: string;
+  verdict: 'ok' | 'drifted' | 'broken';
+  reasons: string[];
+  image_size_px: ImageSize;
+  views: { name: string; n_points: number; rms_px: number | null; error: string | null }[];
+  reprojection_rms_px: number | null;
+  refit: { camera: Camera; rms_px: number; projection_std_px: number } | null;
+  parameters: CheckParameter[];
+  moved: string[];
+  projection_shift_px: ProjectionDiff | null;
+  pose_shift: { translation_mm: number; rotation_deg: number; moved: boolean } | null;
+  thresholds: CheckUsedThresholds;
+  warnings: string[];
+}
+
+/** The input JSON of `diff_cameras`. */
+export interface DiffRequest {
+  /** The first calibration file's text. */
+  a: string;
+  /** The second calibration file's text. */
+  b: string;
+  options?: {
+    /** Grid columns and rows (default [60, 40]). */
+    grid?: [number, number];
+    /** Pixels where data were: the rotation fit weighs each grid cell by the points in it. */
+    fit_px?: [number, number][];
+    /** Fit the rotation only within this distance of the image centre, px. */
+    focus_radius_px?: number | null;
+  };
+}
+
+/** The output JSON of `diff_cameras` (what `robocal diff` writes). */
+export interface DiffReport {
+  kind: 'diff';
+  robocal_version: string;
+  a: Camera;
+  b: Camera;
+  projection_shift_px: ProjectionDiff;
+}
+
+// ---------------------------------------------------------------------------
 // Function -> JSON map
 
 /**
@@ -1616,6 +1804,10 @@ export interface RobocalJson {
   rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
   /** `read_camera_file(text)` -> the camera of a robocal JSON (camera export or calibration report), OpenCV YAML/XML or ROS camera_info file, as `robocal rig --camera-file` reads it. */
   read_camera_file: [never, CameraFileReading];
+  /** `check_camera(request)` -> the check of a saved calibration against new views: ok, drifted or broken (docs/check.md). */
+  check_camera: [CheckRequest, CheckReport];
+  /** `diff_cameras(request)` -> the projection difference of two calibration files. */
+  diff_cameras: [DiffRequest, DiffReport];
 }
 
 /** What `read_camera_file` returns: the camera (what a rig input's `cameras[i].camera` takes to hold its intrinsics) and the format it was read as. */

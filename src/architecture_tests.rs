@@ -136,7 +136,18 @@ const RULES: &[Rule] = &[
         scope: Scope::Everywhere,
         why: "the synthetic scenes serve tests and the demo, never a host",
     },
+    Rule {
+        part: "api",
+        allowed: Allowed::Never(&["wasm"]),
+        scope: Scope::Everywhere,
+        why: "the request/report layer is called by the hosts, never the other way",
+    },
 ];
+
+/// Parts that may call the request/report layer `api`: the hosts (and
+/// `api` itself). Every other part sits below it and never reaches up
+/// (library code; tests may drive a solver through its request).
+const API_CALLERS: &[&str] = &["api", "wasm", "main", "cli"];
 
 /// Parts that may touch a host (files, clock, environment, threads,
 /// printing, the browser).
@@ -406,6 +417,12 @@ fn violations(src: &Path) -> Vec<String> {
                         ));
                     }
                 }
+                if module == "api" && !is_test && !API_CALLERS.contains(&part.as_str()) {
+                    found.push(format!(
+                        "{shown}:{}: {part} imports api (crate::api): only the hosts (wasm, cli) call the request/report layer",
+                        n + 1
+                    ));
+                }
             }
             if is_test || HOST_PARTS.contains(&part.as_str()) {
                 continue;
@@ -486,6 +503,8 @@ fn a_forbidden_import_is_named_with_its_file_line_and_rule() {
         ("io/read.rs", "pub fn f() { let _ = std::fs::read(\"x\"); }\n"),
         ("cli/mod.rs", "pub fn f() { let _ = std::fs::read(\"x\"); }\n"),
         ("detect/tests.rs", "use crate::synth::render;\n"),
+        ("io/csv.rs", "use crate::api::planar::HeightMatrix;\n#[cfg(test)]\nmod tests {\n    use crate::api::planar;\n}\n"),
+        ("wasm/x.rs", "use crate::api::planar::HeightMatrix;\n"),
     ];
     for (path, text) in files {
         let path = root.join(path);
@@ -502,6 +521,7 @@ fn a_forbidden_import_is_named_with_its_file_line_and_rule() {
             "src/calib/zhang.rs:1: calib imports detect (crate::detect): the solvers never see pixels: corner lists in, reports out",
             "src/camera/undistort.rs:2: camera imports image (crate::image): the camera is maths: it never imports image (pixels) nor anything above it",
             "src/handeye/repeat.rs:1: handeye imports synth (crate::synth): the solvers never depend on the synthetic scenes (the bootstrap draws from rng)",
+            "src/io/csv.rs:1: io imports api (crate::api): only the hosts (wasm, cli) call the request/report layer",
             "src/io/read.rs:1: io uses std::fs: only wasm.rs, wasm/, main.rs and cli/ touch a host",
         ]
     );

@@ -43,6 +43,7 @@ pub mod geometry;
 pub mod handeye;
 pub mod image;
 pub mod io;
+pub mod laser;
 pub mod optim;
 pub mod report_kind;
 pub mod rng;

@@ -22,16 +22,22 @@ pub enum ReportKind {
     /// A rig on a robot: the rig report with `handeye` (`robocal rig
     /// --setup`, `calibrate_rig_handeye`).
     RigHandeye,
+    /// A health check of a saved calibration (`robocal check`, `check_camera`).
+    Check,
+    /// The projection difference of two calibrations (`robocal diff`, `diff_cameras`).
+    Diff,
 }
 
 impl ReportKind {
     /// Every kind, in the order of the docs.
-    pub const ALL: [ReportKind; 5] = [
+    pub const ALL: [ReportKind; 7] = [
         ReportKind::Camera,
         ReportKind::Stereo,
         ReportKind::Rig,
         ReportKind::Handeye,
         ReportKind::RigHandeye,
+        ReportKind::Check,
+        ReportKind::Diff,
     ];
 
     /// The name written as `kind`.
@@ -42,6 +48,8 @@ impl ReportKind {
             ReportKind::Rig => "rig",
             ReportKind::Handeye => "handeye",
             ReportKind::RigHandeye => "rig_handeye",
+            ReportKind::Check => "check",
+            ReportKind::Diff => "diff",
         }
     }
 
@@ -112,7 +120,7 @@ mod tests {
             ReportKind::of_report(&serde_json::json!({"kind": "mono"}))
                 .unwrap_err()
                 .to_string(),
-            "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye)"
+            "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff)"
         );
     }
 }

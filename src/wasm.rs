@@ -1,5 +1,5 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
-//! and camera_file.rs, demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs,
+//! and camera_file.rs, check.rs, demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs,
 //! rig_handeye.rs and targets.rs beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
@@ -15,6 +15,7 @@
 //! JS side can show it ([`last_panic_message`]) instead of a dead worker.
 
 mod camera_file;
+mod check;
 mod demo;
 mod lens_models;
 mod live_capture;
@@ -22,12 +23,13 @@ mod rig_frames;
 mod rig_handeye;
 mod targets;
 pub use camera_file::read_camera_file;
+pub use check::{check_camera, diff_cameras};
 pub use demo::{render_demo, DemoData};
 pub use lens_models::lens_models;
 pub use live_capture::LiveCapture;
 pub use rig_frames::rig_frame_keys;
 pub use rig_handeye::calibrate_rig_handeye;
-use targets::{detect_options_from, target_from};
+use targets::target_from;
 pub use targets::{parse_target, read_kalibr_target, target_points, target_spec, target_svg};
 
 use crate::image::{decode, DecodeOptions, GrayImage};
@@ -266,10 +268,15 @@ pub fn detect_target(
     target_spec_or_json: &str,
     options_json: Option<String>,
 ) -> Result<String, JsError> {
-    let target = target_from(target_spec_or_json)?;
+    let request = crate::api::detect::DetectRequest {
+        other_boards: false,
+        ..crate::api::detect::DetectRequest::from_spec_or_json(target_spec_or_json)
+            .map_err(js_error)?
+    };
     let image = decode_gray(bytes, options_json)?;
-    let options = detect_options_from(target_spec_or_json);
-    let detection = crate::detect::detect(&image, &target, &options).map_err(js_error)?;
+    let detection = crate::api::detect::detect_target(&image, &request)
+        .detection
+        .map_err(js_error)?;
     serde_json::to_string(&detection).map_err(|e| JsError::new(&e.to_string()))
 }
 
@@ -284,10 +291,10 @@ pub fn detect_boards(
     target_spec_or_json: &str,
     options_json: Option<String>,
 ) -> Result<String, JsError> {
-    let target = target_from(target_spec_or_json)?;
+    let request = crate::api::detect::DetectRequest::from_spec_or_json(target_spec_or_json)
+        .map_err(js_error)?;
     let image = decode_gray(bytes, options_json)?;
-    let options = detect_options_from(target_spec_or_json);
-    let detections = crate::detect::detect_all(&image, &target, &options).map_err(js_error)?;
+    let detections = crate::api::detect::detect_boards(&image, &request).map_err(js_error)?;
     serde_json::to_string(&detections).map_err(|e| JsError::new(&e.to_string()))
 }
 
@@ -296,8 +303,18 @@ pub fn detect_boards(
 /// `transform` may be empty for the default transform.
 #[wasm_bindgen]
 pub fn export_report(report_json: &str, format: &str, transform: &str) -> Result<String, JsError> {
-    let transform = (!transform.is_empty()).then_some(transform);
-    crate::io::export::export(report_json, format, transform).map_err(js_error)
+    let files = crate::api::export::export(report_json, &export_request(format, transform))
+        .map_err(js_error)?;
+    Ok(crate::io::export::join_files(&files))
+}
+
+/// The export request of a format and a transform (`""`: the default).
+fn export_request(format: &str, transform: &str) -> crate::api::export::ExportRequest {
+    crate::api::export::ExportRequest {
+        format: format.to_string(),
+        transform: (!transform.is_empty()).then(|| transform.to_string()),
+        frames: Default::default(),
+    }
 }
 
 /// [`export_report`] as files, a JSON array of `{"name", "text"}`: several
@@ -312,23 +329,10 @@ pub fn export_report_files(
     transform: &str,
     frames_json: &str,
 ) -> Result<String, JsError> {
-    let frames: Vec<(String, String)> = if frames_json.trim().is_empty() {
-        Vec::new()
-    } else {
-        serde_json::from_str::<std::collections::BTreeMap<String, String>>(frames_json)
-            .map_err(|e| {
-                JsError::new(&format!(
-                    "frames: expected an object of frame names by role, e.g. {{\"rig\": \"camera_rig\"}}: {e}"
-                ))
-            })?
-            .into_iter()
-            .collect()
-    };
-    let options = crate::io::export::ExportOptions {
-        transform: (!transform.is_empty()).then_some(transform),
-        frames,
-    };
-    let files = crate::io::export::export_files(report_json, format, &options).map_err(js_error)?;
+    let request = export_request(format, transform)
+        .with_frames_json(frames_json)
+        .map_err(js_error)?;
+    let files = crate::api::export::export(report_json, &request).map_err(js_error)?;
     serde_json::to_string(&files).map_err(|e| JsError::new(&e.to_string()))
 }
 
@@ -402,11 +406,7 @@ pub fn planar_solve(json: &str) -> Result<String, JsError> {
 /// (each with `projection_matrix` 3x4 row-major), `verification`.
 #[wasm_bindgen]
 pub fn xytable_solve(json: &str) -> Result<String, JsError> {
-    json_call(
-        "xytable_solve",
-        json,
-        crate::workflows::xytable::solve_xytable,
-    )
+    json_call("xytable_solve", json, crate::api::xytable::xytable)
 }
 
 /// Camera-to-reference frame from known motions of one point (seed 000).
@@ -418,7 +418,7 @@ pub fn known_motion_solve(json: &str) -> Result<String, JsError> {
     json_call(
         "known_motion_solve",
         json,
-        crate::workflows::known_motion::solve_known_motion,
+        crate::api::xytable::known_motion,
     )
 }
 

@@ -14,6 +14,7 @@ import { HandEyeView } from './views/handeye.js';
 import { WorkflowsView } from './views/workflows.js';
 import { RigView } from './views/rig.js';
 import { ExportView } from './views/export.js';
+import { CheckView } from './views/check.js';
 import { ShareView, sharedFragment, decodeShare, sessionFile } from './views/share.js';
 
 const engine = new Engine();
@@ -187,6 +188,8 @@ async function startSteps(versionPromise) {
   const workflows = new WorkflowsView(store, engine);
   const rig = new RigView(store, engine, $('rig-panel'));
   new ExportView(store, engine);
+  // The check detects live frames in a worker of its own, as the capture does.
+  new CheckView(store, engine, () => new Engine());
   const version = await versionPromise;
   registerOffline(version);
   new ShareView(store, version, () => [...(camera.plots || []), ...(handeye.plots || [])], async (session) => {

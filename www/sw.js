@@ -32,6 +32,7 @@ const SHELL = [
   'views/capture-guide.js',
   'views/capture-poses.js',
   'views/capture-solve.js',
+  'views/check.js',
   'views/export.js',
   'views/handeye.js',
   'views/images.js',

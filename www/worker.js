@@ -153,6 +153,18 @@ handlers.cameraFile = async ({ text }) => {
   return JSON.parse(robocal.read_camera_file(text));
 };
 
+/** The check of a saved calibration against new views (check_camera, docs/check.md). */
+handlers.check = async ({ request }) => {
+  await ready;
+  return JSON.parse(robocal.check_camera(request));
+};
+
+/** The projection difference of two calibration files (diff_cameras). */
+handlers.diff = async ({ request }) => {
+  await ready;
+  return JSON.parse(robocal.diff_cameras(request));
+};
+
 handlers.rigFormats = async () => {
   await ready;
   return JSON.parse(robocal.rig_export_formats());

@@ -15,7 +15,8 @@
 //! `model` ([`LensModel`]) and `method` ([`MethodChoice`]) are read by serde
 //! as choices: an unknown name is an error naming the known ones.
 //! `model` is one of `brown` (default), `radial_k1_k2_k5`, `rational`,
-//! `division`, `kannala_brandt`, `eucm`, `none`; `method` one of `zhang`
+//! `division`, `kannala_brandt`, `eucm`, `none`, `tilted` (Scheimpflug);
+//! `method` one of `zhang`
 //! (default), `dlt` (non-coplanar points), `tsai` (planar), `ekf` (planar)
 //! or `all`. `image_size_px` may be left out when the views carry
 //! detections (which must then agree on it). `robust` means a Huber loss

@@ -197,7 +197,7 @@ fn bad_input_gives_clear_errors() {
     );
     assert_eq!(
         error(json!({"views": views, "image_size_px": [1280, 960], "model": "fisheye"})),
-        "model: unknown model 'fisheye' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none, splined)"
+        "model: unknown model 'fisheye' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none, tilted, splined)"
     );
     assert_eq!(
         error(json!({"views": views, "image_size_px": [1280, 960], "method": "magic"})),

@@ -14,7 +14,21 @@
 //!   rig --setup`);
 //! - [`poses`]: robot pose files (`read_robot_poses`, `read_robot_pose_files`);
 //! - [`planar`]: the planar workflow (`planar_fit`, `planar_solve`,
-//!   `robocal planar`).
+//!   `robocal planar`);
+//! - [`xytable`]: the XY-table and known-motion workflows (`xytable_solve`,
+//!   `known_motion_solve`, `robocal xytable`);
+//! - [`detect`]: which target to find and how (`detect_target`,
+//!   `detect_boards`, `robocal detect`, the images of `robocal intrinsics`);
+//! - [`export`]: a report in another format (`export_report`,
+//!   `export_report_files`, `robocal export`);
+//! - [`check`]: a saved calibration against new images, and the projection
+//!   difference of two calibrations (`check_camera`, `diff_cameras`,
+//!   `robocal check`, `robocal diff`);
+//! - [`plan`]: a pose plan for hand-eye (`robocal plan`); [`handeye_field`]:
+//!   the hand-eye's error at the work point, held-out poses and the touch
+//!   test (`robocal handeye --tcp/--holdout/--touch`);
+//! - [`laser`]: the laser plane of a laser-line sensor and its profiles as
+//!   points (`robocal laser plane`, `robocal laser points`).
 //!
 //! Every report says what it is in `kind` ([`crate::report_kind::ReportKind`])
 //! and which robocal wrote it in `robocal_version`; `robocal export` and
@@ -23,13 +37,22 @@
 pub mod camera;
 #[cfg(test)]
 pub(crate) mod camera_tests;
+pub mod check;
 mod choices;
+pub mod detect;
+pub mod export;
 pub mod handeye;
+pub mod handeye_field;
+#[cfg(test)]
+mod handeye_tests;
+pub mod laser;
+pub mod plan;
 pub mod planar;
 pub mod poses;
 pub mod rig;
 pub mod rig_handeye;
 pub mod stereo;
+pub mod xytable;
 
 pub use crate::report_kind::ReportKind;
 

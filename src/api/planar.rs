@@ -4,23 +4,13 @@
 
 use crate::error::Result;
 use crate::workflows::linear_fit::LinearFit;
+pub use crate::workflows::planar::HeightMatrix;
 use crate::workflows::planar::PlanarMatrix;
 use crate::workflows::planar_height::{ByParameter, HeightModel, MappedPoint};
 use crate::workflows::planar_solve::{
     solve_planar, HeightPoint, PlanarSolveOptions, PlanarSolveReport,
 };
 use serde::{Deserialize, Serialize};
-
-/// One per-height matrix, as in the article's Table 4. In JSON one flat
-/// object `{"height_mm", "a11", "a12", "tx", "a21", "a22", "ty"}`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct HeightMatrix {
-    /// Calibration height, mm.
-    pub height_mm: f64,
-    /// The matrix `robot_from_image` at that height.
-    #[serde(flatten)]
-    pub robot_from_image: PlanarMatrix,
-}
 
 /// A pixel to map at some height.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

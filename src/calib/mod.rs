@@ -17,6 +17,9 @@
 
 mod board_warp;
 pub mod centre_models;
+pub mod check;
+#[cfg(test)]
+mod check_tests;
 mod closed_form;
 pub mod compare;
 pub mod dlt;
@@ -28,6 +31,7 @@ pub mod model_advice;
 pub mod multi;
 pub mod plausibility;
 pub mod pnp;
+pub mod projection_diff;
 mod refine;
 mod rejected;
 mod report;

@@ -2,7 +2,9 @@
 //! ray in the camera frame to a distorted normalised image point `m`
 //! (pixel = K m).
 
-use super::{division, eucm, kannala_brandt, polynomial::col, polynomial::Poly, splined::Spline};
+use super::{
+    division, eucm, kannala_brandt, polynomial::col, polynomial::Poly, splined::Spline, tilt::Tilt,
+};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix2, Matrix2x3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -107,6 +109,40 @@ pub enum Distortion {
         /// Ellipsoid shape (1 = sphere, the unified model).
         beta: f64,
     },
+    /// A Scheimpflug camera: OpenCV's rational + thin-prism model followed
+    /// by the tilted sensor of `CALIB_TILTED_MODEL` (see `tilt.rs` for the
+    /// convention). Order `k1 k2 p1 p2 k3 k4 k5 k6 s1 s2 s3 s4 tau_x tau_y`,
+    /// OpenCV's 14 coefficients; the angles in radians.
+    Tilted {
+        /// Numerator r^2 coefficient.
+        k1: f64,
+        /// Numerator r^4 coefficient.
+        k2: f64,
+        /// Numerator r^6 coefficient.
+        k3: f64,
+        /// Denominator r^2 coefficient.
+        k4: f64,
+        /// Denominator r^4 coefficient.
+        k5: f64,
+        /// Denominator r^6 coefficient.
+        k6: f64,
+        /// First tangential coefficient.
+        p1: f64,
+        /// Second tangential coefficient.
+        p2: f64,
+        /// Thin prism: r^2 term added to x.
+        s1: f64,
+        /// Thin prism: r^4 term added to x.
+        s2: f64,
+        /// Thin prism: r^2 term added to y.
+        s3: f64,
+        /// Thin prism: r^4 term added to y.
+        s4: f64,
+        /// Sensor tilt about the x axis, radians (OpenCV tauX).
+        tau_x: f64,
+        /// Sensor tilt about the y axis, radians (OpenCV tauY).
+        tau_y: f64,
+    },
     /// Splined stereographic ([`super::splined`]): the stereographic
     /// projection plus a B-spline correction over a grid of control points;
     /// coefficients `dx0 dy0 dx1 ...`, their count set by the layout.
@@ -135,6 +171,7 @@ impl Distortion {
             Distortion::RadialK1K2K5 { .. } => "radial_k1_k2_k5",
             Distortion::KannalaBrandt { .. } => "kannala_brandt",
             Distortion::Eucm { .. } => "eucm",
+            Distortion::Tilted { .. } => "tilted",
             Distortion::Splined(_) => "splined",
         }
     }
@@ -151,6 +188,10 @@ impl Distortion {
             Distortion::RadialK1K2K5 { .. } => &["k1", "k2", "k5"],
             Distortion::KannalaBrandt { .. } => &["k1", "k2", "k3", "k4"],
             Distortion::Eucm { .. } => &["alpha", "beta"],
+            Distortion::Tilted { .. } => &[
+                "k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1", "s2", "s3", "s4", "tau_x",
+                "tau_y",
+            ],
             Distortion::Splined(s) => s.names(),
         }
     }
@@ -180,6 +221,22 @@ impl Distortion {
             Distortion::RadialK1K2K5 { k1, k2, k5 } => vec![k1, k2, k5],
             Distortion::KannalaBrandt { k1, k2, k3, k4 } => vec![k1, k2, k3, k4],
             Distortion::Eucm { alpha, beta } => vec![alpha, beta],
+            Distortion::Tilted {
+                k1,
+                k2,
+                k3,
+                k4,
+                k5,
+                k6,
+                p1,
+                p2,
+                s1,
+                s2,
+                s3,
+                s4,
+                tau_x,
+                tau_y,
+            } => vec![k1, k2, p1, p2, k3, k4, k5, k6, s1, s2, s3, s4, tau_x, tau_y],
         }
     }
 
@@ -246,6 +303,22 @@ impl Distortion {
                 alpha: c[0],
                 beta: c[1],
             },
+            Distortion::Tilted { .. } => Distortion::Tilted {
+                k1: c[0],
+                k2: c[1],
+                p1: c[2],
+                p2: c[3],
+                k3: c[4],
+                k4: c[5],
+                k5: c[6],
+                k6: c[7],
+                s1: c[8],
+                s2: c[9],
+                s3: c[10],
+                s4: c[11],
+                tau_x: c[12],
+                tau_y: c[13],
+            },
             Distortion::Splined(s) => Distortion::Splined(Spline {
                 control: c.to_vec(),
                 ..s.clone()
@@ -301,6 +374,29 @@ impl Distortion {
             Distortion::Division { kappa } => Family::Division(kappa),
             Distortion::KannalaBrandt { k1, k2, k3, k4 } => Family::KannalaBrandt([k1, k2, k3, k4]),
             Distortion::Eucm { alpha, beta } => Family::Eucm(alpha, beta),
+            Distortion::Tilted {
+                k1,
+                k2,
+                k3,
+                k4,
+                k5,
+                k6,
+                p1,
+                p2,
+                s1,
+                s2,
+                s3,
+                s4,
+                tau_x,
+                tau_y,
+            } => Family::Tilted(
+                Poly {
+                    k: [k1, k2, k3, k4, k5, k6],
+                    p: [p1, p2],
+                    s: [s1, s2, s3, s4],
+                },
+                Tilt::new(tau_x, tau_y),
+            ),
         }
     }
 
@@ -312,7 +408,7 @@ impl Distortion {
             Family::KannalaBrandt(k) => Ok(kannala_brandt::project(&k, p)?.0),
             Family::Eucm(alpha, beta) => Ok(eucm::project(alpha, beta, p)?.0),
             Family::Splined(s) => s.project_point(p),
-            Family::Pinhole | Family::Poly(..) | Family::Division(_) => {
+            Family::Pinhole | Family::Poly(..) | Family::Division(_) | Family::Tilted(..) => {
                 if !(p.z > 0.0) || !p.iter().all(|v| v.is_finite()) {
                     return Err(not_in_front(p));
                 }
@@ -332,6 +428,12 @@ impl Distortion {
                 Ok(poly.distort_value(n))
             }
             Family::Division(kappa) => Ok(division::distort(kappa, n)?.0),
+            Family::Tilted(poly, tilt) => {
+                if !poly.in_domain(n.norm_squared()) {
+                    return Err(self.beyond_fold(n));
+                }
+                tilt.apply_value(&poly.distort_value(n))
+            }
             Family::KannalaBrandt(_) | Family::Eucm(..) | Family::Splined(_) => {
                 self.project_point(&Vector3::new(n.x, n.y, 1.0))
             }
@@ -377,7 +479,7 @@ impl Distortion {
                     d_coeffs,
                 })
             }
-            Family::Pinhole | Family::Poly(..) | Family::Division(_) => {
+            Family::Pinhole | Family::Poly(..) | Family::Division(_) | Family::Tilted(..) => {
                 if !(p.z > 0.0) || !p.iter().all(|v| v.is_finite()) {
                     return Err(not_in_front(p));
                 }
@@ -413,6 +515,17 @@ impl Distortion {
                 let (m, d_n, d_k) = division::distort(kappa, n)?;
                 Ok((m, d_n, vec![d_k]))
             }
+            Family::Tilted(poly, tilt) => {
+                if !poly.in_domain(n.norm_squared()) {
+                    return Err(self.beyond_fold(n));
+                }
+                // The 12 polynomial columns are in OpenCV's order already.
+                let (d, d_n, d_poly) = poly.distort(n);
+                let (m, d_d, d_tau) = tilt.apply(&d)?;
+                let mut d_coeffs: Vec<Vector2<f64>> = d_poly.iter().map(|c| d_d * c).collect();
+                d_coeffs.extend(d_tau);
+                Ok((m, d_d * d_n, d_coeffs))
+            }
             Family::KannalaBrandt(_) | Family::Eucm(..) | Family::Splined(_) => {
                 let r = self.project_ray(&Vector3::new(n.x, n.y, 1.0))?;
                 // d m / d(x, y) at z = 1 is the first two columns.
@@ -439,6 +552,10 @@ impl Distortion {
             }
             Family::KannalaBrandt(k) => kannala_brandt::unproject(&k, m)?,
             Family::Eucm(alpha, beta) => eucm::unproject(alpha, beta, m)?,
+            Family::Tilted(poly, tilt) => {
+                let n = poly.undistort(&tilt.invert(m)?)?;
+                Vector3::new(n.x, n.y, 1.0)
+            }
             Family::Splined(s) => s.unproject(m)?,
         };
         let norm = ray.norm();
@@ -458,6 +575,7 @@ enum Family<'a> {
     Division(f64),
     KannalaBrandt([f64; 4]),
     Eucm(f64, f64),
+    Tilted(Poly, Tilt),
     Splined(&'a Spline),
 }
 

@@ -112,6 +112,30 @@ impl Camera {
         }
     }
 
+    /// A laser-profiler camera with a Scheimpflug sensor (tilted by about
+    /// 3 and -2 degrees) behind a lens with barrel distortion.
+    pub fn example_tilted() -> Camera {
+        Camera {
+            distortion: Distortion::Tilted {
+                k1: -0.21,
+                k2: 0.07,
+                k3: -0.008,
+                k4: 0.0,
+                k5: 0.0,
+                k6: 0.0,
+                p1: 0.0008,
+                p2: -0.0005,
+                s1: 0.0,
+                s2: 0.0,
+                s3: 0.0,
+                s4: 0.0,
+                tau_x: 0.052,
+                tau_y: -0.035,
+            },
+            ..Camera::example_pinhole()
+        }
+    }
+
     /// A wide-angle 1280x960 lens no parametric model fits: stereographic
     /// with a smooth bump field of a few pixels (12x8 cubic spline).
     pub fn example_splined() -> Camera {
@@ -142,6 +166,7 @@ impl Camera {
             Camera::example_radial_k1_k2_k5(),
             Camera::example_kannala_brandt(),
             Camera::example_eucm(),
+            Camera::example_tilted(),
             Camera::example_splined(),
         ]
     }

@@ -22,6 +22,7 @@ mod models;
 mod polynomial;
 mod spline_fit;
 pub mod splined;
+mod tilt;
 mod undistort;
 
 #[cfg(test)]

@@ -50,7 +50,7 @@ const ALL_CAMERA_FORMATS: &[&str] = &[
 ];
 
 /// How many lens models the table holds.
-const N_MODELS: usize = 8;
+const N_MODELS: usize = 9;
 
 /// The lens models, in the order of the menus (the default, `brown`, first).
 /// A static (not a const): the splined model's start owns a (empty) vector.
@@ -180,6 +180,37 @@ pub static LENS_MODELS: [LensModel; N_MODELS] = [
         coefficients: &[],
         start: Distortion::None,
         export_formats: ALL_CAMERA_FORMATS,
+        wide_angle: false,
+    },
+    LensModel {
+        name: "tilted",
+        aliases: &[
+            ("scheimpflug", "a Scheimpflug camera's tilted sensor"),
+            ("opencv14", "OpenCV's 14 coefficients"),
+        ],
+        label: "Scheimpflug (tilted sensor)",
+        description: "Scheimpflug / tilted sensor: OpenCV rational + thin prism + tilt tau_x tau_y (CALIB_TILTED_MODEL, laser profilers)",
+        coefficients: &[
+            "k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1", "s2", "s3", "s4", "tau_x",
+            "tau_y",
+        ],
+        start: Distortion::Tilted {
+            k1: 0.0,
+            k2: 0.0,
+            k3: 0.0,
+            k4: 0.0,
+            k5: 0.0,
+            k6: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+            s1: 0.0,
+            s2: 0.0,
+            s3: 0.0,
+            s4: 0.0,
+            tau_x: 0.0,
+            tau_y: 0.0,
+        },
+        export_formats: &["json", "opencv-yaml", "opencv-xml"],
         wide_angle: false,
     },
     // Its coefficients (`dx0 dy0 dx1 ...`, two per control point) come
@@ -335,7 +366,7 @@ mod tests {
     fn names_aliases_and_the_texts_made_from_the_table() {
         assert_eq!(
             model_list(),
-            "brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none, splined"
+            "brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none, tilted, splined"
         );
         assert_eq!(
             Distortion::named("brown5"),
@@ -354,9 +385,16 @@ mod tests {
             model_help("the camera"),
             "Lens model of the camera: brown (default: k1 k2 p1 p2 k3; also called brown5, \
              OpenCV's 5 coefficients), radial_k1_k2_k5, rational, division, kannala_brandt, \
-             eucm, none, splined (also called splined_stereographic, a stereographic projection \
+             eucm, none, tilted (also called scheimpflug, a Scheimpflug camera's tilted sensor; \
+             also called opencv14, OpenCV's 14 coefficients), \
+             splined (also called splined_stereographic, a stereographic projection \
              with a B-spline correction)"
         );
+        assert_eq!(
+            Distortion::named("scheimpflug"),
+            Distortion::named("tilted")
+        );
+        assert_eq!(Distortion::named("opencv14"), Distortion::named("tilted"));
         let kb = LensModel::named("kannala_brandt").map(|m| m.format_names().collect::<Vec<_>>());
         assert_eq!(
             kb,

@@ -255,3 +255,48 @@ fn undistortion_map_samples_where_the_distorted_camera_images_each_ray() {
         (map.map_x[i] as f64 - src.x).abs() < 1e-4 && (map.map_y[i] as f64 - src.y).abs() < 1e-4
     );
 }
+
+/// The tilted model is OpenCV's `CALIB_TILTED_MODEL`: pixels of
+/// `cv2.projectPoints` (opencv-python-headless 4.14.0.94) with 14
+/// coefficients, every term non-zero, printed by benches/tilted_opencv.py.
+#[wasm_bindgen_test(unsupported = test)]
+// The pixels as OpenCV printed them (17 significant digits).
+#[allow(clippy::excessive_precision)]
+fn the_tilted_model_projects_as_opencv() {
+    let camera = Camera {
+        distortion: Distortion::Tilted {
+            k1: -0.21,
+            k2: 0.07,
+            p1: 0.0008,
+            p2: -0.0005,
+            k3: -0.008,
+            k4: 0.02,
+            k5: -0.003,
+            k6: 0.001,
+            s1: 0.0011,
+            s2: -0.0002,
+            s3: 0.0006,
+            s4: 0.0001,
+            tau_x: 0.052,
+            tau_y: -0.035,
+        },
+        ..Camera::example_pinhole()
+    };
+    let opencv: [([f64; 3], [f64; 2]); 5] = [
+        ([0.0, 0.0, 1.0], [641.5, 478.25]),
+        ([0.3, -0.2, 1.0], [933.0176463966875, 284.13830096408731]),
+        ([-0.25, 0.35, 0.8], [344.18145257617556, 895.73635551702489]),
+        ([0.5, 0.4, 2.0], [890.706116860983, 678.71549696719876]),
+        ([-0.6, -0.45, 1.5], [272.90480244924731, 200.62004940675837]),
+    ];
+    for (p, want) in opencv {
+        let got = camera
+            .project(&Point3::new(p[0], p[1], p[2]))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let err = (got - Point2::new(want[0], want[1])).norm();
+        assert!(err < 1e-9, "{p:?}: {got} vs OpenCV {want:?} ({err} px)");
+        let back = camera.unproject(&got).unwrap_or_else(|e| panic!("{e}"));
+        let bearing = Vector3::new(p[0], p[1], p[2]).normalize();
+        assert!((back - bearing).norm() < 1e-10, "{p:?}: unprojection");
+    }
+}

@@ -6,7 +6,8 @@ use super::memory_budget::{MemoryBudget, DETECT_BYTES_PER_PIXEL, DETECT_MEMORY_B
 use super::{parse_target_print, CliError, ImageLimits};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use robocal::detect::{detect, detect_all, CentreModel, DetectOptions};
+use robocal::api::detect::{detect_target, has_other_boards, DetectRequest, Found};
+use robocal::detect::{CentreModel, DetectOptions};
 use robocal::image::DecodeOptions;
 use robocal::target::{Detection, Target};
 use serde_json::json;
@@ -116,10 +117,7 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
     };
     let files = &args.images;
     let decode = args.limits.decode_options();
-    let all_boards = matches!(
-        target,
-        Target::Charuco { .. } | Target::Aprilgrid { .. } | Target::ArucoGrid { .. }
-    );
+    let all_boards = has_other_boards(&target);
     let outcomes = run_with(files, &target, &options, &decode, args.threads, all_boards)?;
     let mut images = Vec::with_capacity(files.len());
     let mut found = 0;
@@ -314,22 +312,20 @@ fn one(
         exif_orientation,
     };
     let start = Instant::now();
-    let mut others = Vec::new();
-    if all_boards {
-        if let Ok(mut boards) = detect_all(&image, target, options) {
-            let own = target.to_spec();
-            if let Some(i) = boards.iter().position(|d| d.target.to_spec() == own) {
-                let d = boards.remove(i);
-                return found(Outcome::Found(d, start.elapsed().as_secs_f64()), boards);
-            }
-            others = boards;
-        }
-    }
-    let outcome = match detect(&image, target, options) {
+    let request = DetectRequest {
+        target: target.clone(),
+        options: options.clone(),
+        other_boards: all_boards,
+    };
+    let Found {
+        detection,
+        other_boards,
+    } = detect_target(&image, &request);
+    let outcome = match detection {
         Ok(d) => Outcome::Found(d, start.elapsed().as_secs_f64()),
         Err(e) => Outcome::Failed(e.kind().into(), e.to_string()),
     };
-    found(outcome, others)
+    found(outcome, other_boards)
 }
 
 #[cfg(test)]

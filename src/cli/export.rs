@@ -1,6 +1,7 @@
 //! `robocal export`: convert a report into any export format.
 
 use super::{read_text, write_output, CliError};
+use robocal::api::export::ExportRequest;
 
 #[derive(clap::Args)]
 #[command(
@@ -96,22 +97,18 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
         .format
         .as_deref()
         .ok_or_else(|| CliError::usage("export", "--format is required"))?;
-    let mut frames = Vec::with_capacity(args.frames.len());
-    for f in &args.frames {
-        let (role, name) = f.split_once('=').ok_or_else(|| {
-            CliError::usage(
-                "export",
-                format!("--frame takes ROLE=NAME (e.g. gripper=tool0), got '{f}'"),
-            )
-        })?;
-        frames.push((role.to_string(), name.to_string()));
+    let request = ExportRequest {
+        format: format.to_string(),
+        transform: args.transform.clone(),
+        frames: Default::default(),
     }
+    .with_frame_args(&args.frames)
+    .map_err(|e| match e {
+        robocal::Error::Invalid { message, .. } => CliError::usage("export", message),
+        other => other.into(),
+    })?;
     let text = read_text(report)?;
-    let options = robocal::io::export::ExportOptions {
-        transform: args.transform.as_deref(),
-        frames,
-    };
-    let files = robocal::io::export::export_files(&text, format, &options)?;
+    let files = robocal::api::export::export(&text, &request)?;
     match (files.as_slice(), args.output.as_deref()) {
         ([one], path) => write_output(path, &one.text),
         (_, None | Some("-")) => write_output(None, &robocal::io::export::join_files(&files)),

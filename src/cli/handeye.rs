@@ -6,7 +6,8 @@ use super::handeye_images::{
 };
 use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
-use robocal::api::handeye::{camera_from_json, solve_handeye, ImagePoints, DEFAULT_PIXEL_SIGMA_PX};
+use robocal::api::handeye::{camera_from_json, ImagePoints, DEFAULT_PIXEL_SIGMA_PX};
+use robocal::api::handeye_field::{solve_handeye_field, FieldRequest};
 use robocal::handeye::quality::intrinsics_move::std_from_json;
 use robocal::handeye::refine::over_pixels::RefineMode;
 use robocal::handeye::{HandEyeInput, HandEyeMethod, HandEyeOptions, Setup};
@@ -137,6 +138,19 @@ pub struct HandeyeArgs {
     /// another of these rules explains better is an error naming the rule
     #[arg(long, value_name = "RULE", default_value = "auto")]
     pair_by: String,
+    /// The tool centre point in the flange frame, X,Y,Z with a unit (mm, cm
+    /// or m), e.g. 0,0,150mm: the report's tcp_error gives the hand-eye
+    /// error there (docs/handeye-field.md)
+    #[arg(long, value_name = "X,Y,Z")]
+    tcp: Option<String>,
+    /// Hold the last N pose pairs out of the solve and report how well the
+    /// calibration predicts the target in them (the report's holdout)
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    holdout: usize,
+    /// Touch test: a JSON list of points touched with the tool centre point,
+    /// [{"base_m": [x, y, z], "image_px": [u, v], "view": i}] (needs --camera)
+    #[arg(long, value_name = "FILE")]
+    touch: Option<String>,
     /// Write the JSON report there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE")]
     output: Option<String>,
@@ -343,7 +357,19 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
         pixel_sigma_px: DEFAULT_PIXEL_SIGMA_PX,
         refine_poses: !args.no_refine,
     });
-    let mut report = solve_handeye(&input, &options, points.as_ref(), pre_warnings)
+    let touch = match args.touch.as_deref() {
+        Some(path) => serde_json::from_str(&read_text(path)?).map_err(|e| {
+            CliError::from(robocal::Error::parse(e.line(), e.column(), e.to_string())).in_file(path)
+        })?,
+        None => Vec::new(),
+    };
+    let field = FieldRequest {
+        tcp_m: args.tcp.as_deref().map(parse_tcp).transpose()?,
+        holdout: args.holdout,
+        touch,
+        camera: images.as_ref().map(|(_, c)| c.clone()),
+    };
+    let mut report = solve_handeye_field(&input, &options, points.as_ref(), pre_warnings, &field)
         .map_err(|e| with_dropped(e, &pairs))?;
     report.pairs = pairs;
     let json = serde_json::to_string_pretty(&report)
@@ -352,7 +378,60 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
+    for line in field_summary(&report) {
+        eprintln!("{line}");
+    }
     Ok(())
+}
+
+/// `--tcp X,Y,Z` with a unit (mm, cm or m) on the last number or on each.
+fn parse_tcp(text: &str) -> Result<[f64; 3], CliError> {
+    let bad = |why: &str| CliError::usage("handeye", format!("--tcp '{text}': {why}"));
+    let t = text.trim();
+    let (body, scale) = if let Some(b) = t.strip_suffix("mm") {
+        (b, 1e-3)
+    } else if let Some(b) = t.strip_suffix("cm") {
+        (b, 1e-2)
+    } else if let Some(b) = t.strip_suffix('m') {
+        (b, 1.0)
+    } else {
+        return Err(bad("needs a unit: mm, cm or m (e.g. 0,0,150mm)"));
+    };
+    let v: Vec<f64> = body
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad("expected three numbers X,Y,Z"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|a| a.is_finite()) => Ok([x * scale, y * scale, z * scale]),
+        _ => Err(bad("expected three numbers X,Y,Z")),
+    }
+}
+
+/// The report's field answers, one line each (standard error).
+fn field_summary(report: &robocal::handeye::report::HandEyeReport) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in [&report.work_point_error, &report.tcp_error]
+        .into_iter()
+        .flatten()
+    {
+        out.push(e.verdict.clone());
+        if let Some(first) = e.shrink_by.first() {
+            out.push(format!("  to shrink it: {first}"));
+        }
+    }
+    if let Some(h) = &report.holdout {
+        out.push(format!("holdout: {}", h.verdict));
+    }
+    if let Some(t) = &report.touch_test {
+        out.push(format!(
+            "touch test: {} points, RMS {:.2} mm, largest {:.2} mm",
+            t.points.len(),
+            t.rms_mm,
+            t.max_mm
+        ));
+    }
+    out
 }
 
 /// Too few pose pairs after images were dropped: the error lists them and

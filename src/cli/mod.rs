@@ -7,6 +7,7 @@
 //! change. Every subcommand accepts a flag again and keeps the last value
 //! (`args_override_self`), as scripts that append an override expect.
 
+mod check;
 mod detect;
 mod detections_file;
 mod export;
@@ -16,10 +17,13 @@ mod image_file;
 mod info;
 mod input;
 mod intrinsics;
+mod laser;
 mod memory_budget;
 pub mod output;
+mod plan;
 mod planar;
 mod render;
+mod render_laser;
 mod render_rig;
 mod render_video;
 mod rig;
@@ -125,9 +129,13 @@ enum Command {
     Rig(rig::RigArgs),
     Info(info::InfoArgs),
     Render(render::RenderArgs),
+    Laser(laser::LaserArgs),
     Planar(planar::PlanarArgs),
+    Plan(plan::PlanArgs),
     Xytable(xytable::XytableArgs),
     Target(target::TargetArgs),
+    Check(check::CheckArgs),
+    Diff(check::DiffArgs),
     Completions(CompletionsArgs),
 }
 
@@ -168,9 +176,13 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Rig(a) => rig::run(a),
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a),
+        Command::Laser(a) => laser::run(a),
         Command::Planar(a) => planar::run(a),
+        Command::Plan(a) => plan::run(a),
         Command::Xytable(a) => xytable::run(a),
         Command::Target(a) => target::run(a),
+        Command::Check(a) => check::run(a),
+        Command::Diff(a) => check::run_diff(a),
         Command::Completions(a) => completions(a.shell),
     }
 }

@@ -38,6 +38,14 @@ and read noise, JPEG and paper texture; each effect flag sets or overrides
 one of them. The truth stays the ideal projection (with --rolling-shutter,
 the sheared position where the point is imaged).
 
+--laser-plane nx,ny,nz,d renders each view twice: view_NNN.png with the
+laser off and view_NNN_laser.png with a laser stripe (the plane n . X = d
+in the camera frame met with the board: a Gaussian cross-profile of
+--laser-width px FWHM, speckle, clipping at 255; docs/laser.md); truth.json
+gains \"laser_plane\": {\"normal_camera\", \"distance_m\"} and per view
+\"stripe_image\", \"stripe_axis\" and \"stripe_px\" (the exact centre per
+column or row).
+
 --demo writes the web app's demo session instead: 12 chessboard images, the
 robot poses that go with them (DIR/poses.csv, Universal Robots format with an
 image column) and truth.json with gripper_from_camera and base_from_target.
@@ -68,6 +76,7 @@ frame's hold index or null while the board moves.",
   robocal render --out real --views 20 --effects realistic --noise 0
   robocal render --out coma --coma 1.5 --astigmatism 1 --gamma 2.2
   robocal render --out demo --demo
+  robocal render --out laser --views 4 --laser-plane 0,-0.98,0.196,0.098
   robocal render --out rig --rig --views 5 --side-frames 3
   robocal render --video board.y4m --size 1280x720 --target charuco:12x9:20mm:15mm:DICT_5X5_100",
     args_override_self = true
@@ -144,6 +153,8 @@ pub struct RenderArgs {
     board_warp_mm: Option<String>,
     #[command(flatten)]
     effects: EffectArgs,
+    #[command(flatten)]
+    laser: super::render_laser::LaserArgs,
 }
 
 /// Camera effects (robocal::synth::effects); each flag overrides the preset.
@@ -345,7 +356,15 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         ..render_options(&args)
     };
     let options = board_print(options, &target, print);
-    write_set(out, &camera, &target, args.views, args.seed, &options)
+    let laser = super::render_laser::laser_of(&args.laser, args.seed)?;
+    write_set(
+        out,
+        &camera,
+        &target,
+        (args.views, args.seed),
+        &options,
+        laser,
+    )
 }
 
 /// The print a spec's `:light-on-dark` asks for (a circle grid draws its
@@ -471,9 +490,9 @@ fn write_set(
     out: &Path,
     camera: &Camera,
     target: &Target,
-    views: usize,
-    seed: u64,
+    (views, seed): (usize, u64),
     options: &RenderOptions,
+    laser: Option<robocal::synth::laser::LaserStripe>,
 ) -> Result<(), CliError> {
     let (grid, pitch) = grid_of(target);
     let scene = Scene::calibration(seed, camera, grid, pitch, views, 0.0)?;
@@ -486,13 +505,35 @@ fn write_set(
         let rendered = render(camera, target, pose, &opts)?;
         let name = format!("view_{i:03}.png");
         write_png(&out.join(&name), &rendered.image)?;
-        truth_views.push(serde_json::json!({
+        let mut view = serde_json::json!({
             "image": name,
             "camera_from_target": transform_json(pose),
             "points": rendered.points,
-        }));
+        });
+        if let Some(laser) = &laser {
+            let on = RenderOptions {
+                laser: Some(laser.clone()),
+                seed: opts.seed ^ 0x1A5E,
+                ..opts.clone()
+            };
+            let stripe = render(camera, target, pose, &on)?;
+            let stripe_name = format!("view_{i:03}_laser.png");
+            write_png(&out.join(&stripe_name), &stripe.image)?;
+            view["stripe_image"] = serde_json::json!(stripe_name);
+            let truth = super::render_laser::stripe_truth_json(camera, pose, &laser.plane);
+            view["stripe_axis"] = truth["stripe_axis"].clone();
+            view["stripe_px"] = truth["stripe_px"].clone();
+        }
+        truth_views.push(view);
     }
     let mut truth = serde_json::json!({ "camera": camera, "target": target, "seed": seed, "views": truth_views });
+    if let Some(laser) = &laser {
+        truth["laser_plane"] = serde_json::json!({
+            "normal_camera": laser.plane.normal_camera,
+            "distance_m": laser.plane.distance_m,
+        });
+        truth["laser"] = serde_json::json!(laser);
+    }
     if options.board_warp_m != [0.0, 0.0] {
         truth["board_warp_mm"] = serde_json::json!(options.board_warp_m.map(|w| w * 1e3));
     }

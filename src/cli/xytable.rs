@@ -3,10 +3,9 @@
 //! known motions of one point (seed 000, Eq. 27-28).
 
 use super::{read_text, write_output, CliError};
+use robocal::api::xytable::{known_motion, xytable};
 use robocal::calib::dlt_kalman::KalmanMode;
 use robocal::io::workflow_csv::{parse_known_motion, parse_xytable_with};
-use robocal::workflows::known_motion::solve_known_motion;
-use robocal::workflows::xytable::solve_xytable;
 
 #[derive(clap::Args)]
 #[command(
@@ -100,7 +99,7 @@ pub fn run(args: XytableArgs) -> Result<(), CliError> {
         let mut request =
             parse_known_motion(&text).map_err(|e| CliError::Io(format!("{file}: {e}")))?;
         request.start_reference_mm = args.start_mm.as_deref().map(triple).transpose()?;
-        serde_json::to_string_pretty(&solve_known_motion(&request)?)
+        serde_json::to_string_pretty(&known_motion(&request)?)
     } else {
         if args.start_mm.is_some() {
             return Err(CliError::usage(
@@ -152,7 +151,7 @@ pub fn run(args: XytableArgs) -> Result<(), CliError> {
                 ))
             }
         };
-        serde_json::to_string_pretty(&solve_xytable(&request)?)
+        serde_json::to_string_pretty(&xytable(&request)?)
     }
     .map_err(|e| CliError::Io(format!("cannot encode the result as JSON: {e}")))?;
     write_output(args.output.as_deref(), &format!("{json}\n"))

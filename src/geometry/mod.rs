@@ -19,6 +19,8 @@
 //! - the one JSON shape of a pose, [`PoseJson`] (written by every report)
 //!   and [`PoseInput`] (what JSON inputs may give), in [`pose_serde`];
 //! - dual quaternions ([`DualQuaternion`]) for screw-motion solvers;
+//! - a [`Plane`] (unit normal, distance) and its change of frame with a
+//!   propagated covariance ([`PlaneEstimate`]);
 //! - [`nearest_rotation`] (SVD projection of a noisy 3x3),
 //!   [`rotation_angle_between`], and rotation averaging
 //!   ([`average_rotations_quaternion`], [`average_rotations_chordal`]).
@@ -27,6 +29,7 @@ mod average;
 mod dual_quaternion;
 mod euler;
 mod motions;
+mod plane;
 pub mod pose_serde;
 mod rotation;
 
@@ -36,6 +39,7 @@ pub use average::{average_rotations_chordal, average_rotations_quaternion};
 pub use dual_quaternion::DualQuaternion;
 pub use euler::{euler_from_rotation, rotation_from_euler, EulerKind, EulerOrder};
 pub use motions::motion_partners;
+pub use plane::{tangent_basis, Plane, PlaneEstimate};
 pub use rotation::{
     matrix4_from_pose, nearest_rotation, params_from_pose, pose_from_matrix4,
     pose_from_matrix4_with_tolerance, pose_from_params, quaternion_wxyz_from_rotation,

@@ -40,10 +40,12 @@
 //! trusted) and catches input mistakes; [`report`] is the JSON report.
 //! [`rig`] solves a whole camera rig's transform (`gripper_from_rig`,
 //! `base_from_rig`) from every camera's views together. The camera pose of
-//! one view from its points (PnP) is [`crate::calib::pnp`].
+//! one view from its points (PnP) is [`crate::calib::pnp`]. [`plan`] plans
+//! the robot poses of a calibration and predicts the error they reach.
 
 pub mod closed_form;
 pub mod math;
+pub mod plan;
 pub mod quality;
 pub mod refine;
 pub mod report;

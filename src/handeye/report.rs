@@ -7,6 +7,8 @@ use crate::geometry::PoseJson;
 use crate::handeye::closed_form::motion::MotionStats;
 use crate::handeye::quality::repeat::Repeatability;
 use crate::handeye::quality::residuals::{Errors, MotionResidual, ViewResidual};
+use crate::handeye::quality::verify::{HoldoutReport, TouchReport};
+use crate::handeye::quality::work_point::{camera_axis_point, work_point_error, WorkPointError};
 use crate::handeye::refine::over_pixels::RefinementSummary;
 use crate::handeye::refine::pose_summary::PoseRefinementSummary;
 use crate::handeye::solve::HandEyeResult;
@@ -125,6 +127,22 @@ pub struct HandEyeReport {
     /// estimated noise levels, outlier views.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub pose_refinement: Option<PoseRefinementSummary>,
+    /// The hand-eye error at the work point (the target centre where the
+    /// camera looks, [`crate::handeye::quality::work_point`]), when the pose
+    /// refinement gave a covariance.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub work_point_error: Option<WorkPointError>,
+    /// The same at the tool centre point, when one was given.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub tcp_error: Option<WorkPointError>,
+    /// Held-out poses: predicted against observed target pose
+    /// ([`crate::handeye::quality::verify`]), when some were held out.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub holdout: Option<HoldoutReport>,
+    /// Touch test: points touched with the tool centre point against the
+    /// camera's rays to them, when given.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub touch_test: Option<TouchReport>,
     /// robocal version that produced the report.
     pub robocal_version: String,
 }
@@ -218,7 +236,27 @@ impl HandEyeReport {
             pairs: Vec::new(),
             refinement: result.refinement.clone(),
             pose_refinement: result.pose_refinement.clone(),
+            work_point_error: default_work_point_error(result),
+            tcp_error: None,
+            holdout: None,
+            touch_test: None,
             robocal_version: crate::VERSION.to_string(),
         }
     }
+}
+
+/// The error at the default work point: on the camera's optical axis at the
+/// working distance (`pose_refinement.work_distance_m`, the median
+/// camera-target distance), from the refinement's covariance.
+fn default_work_point_error(result: &HandEyeResult) -> Option<WorkPointError> {
+    let summary = result.pose_refinement.as_ref()?;
+    let distance = summary.work_distance_m?;
+    let q = camera_axis_point(&result.x, distance);
+    work_point_error(
+        &summary.covariance,
+        result.setup,
+        &result.x,
+        &q,
+        "target centre",
+    )
 }

@@ -113,6 +113,16 @@ impl Report {
             ReportKind::Rig | ReportKind::RigHandeye => Report::Rig,
             ReportKind::Stereo => Report::Stereo,
             ReportKind::Camera | ReportKind::Handeye => Report::Other,
+            ReportKind::Check | ReportKind::Diff => {
+                return Err(Error::invalid(
+                    "kind",
+                    format!(
+                        "a '{}' report compares calibrations and holds no camera to export: \
+                         export the calibration itself",
+                        kind.name()
+                    ),
+                ))
+            }
         })
     }
 }

@@ -176,6 +176,8 @@ pub(super) fn opencv_distortion(c: &Camera) -> Result<(Vec<f64>, bool)> {
             let prism = v[8..].iter().any(|s| *s != 0.0);
             (if prism { v } else { v[..8].to_vec() }, false)
         }
+        // All 14, in OpenCV's order (CALIB_TILTED_MODEL).
+        Distortion::Tilted { .. } => (d.coefficients(), false),
         Distortion::KannalaBrandt { k1, k2, k3, k4 } => (vec![*k1, *k2, *k3, *k4], true),
         Distortion::Splined(_) => {
             return Err(unsupported(
@@ -190,6 +192,19 @@ pub(super) fn opencv_distortion(c: &Camera) -> Result<(Vec<f64>, bool)> {
             ))
         }
     })
+}
+
+/// The refusal of a model that `target` cannot hold, naming the formats of
+/// the lens-model table that can (for the models added with that list).
+pub(super) fn unsupported_listing(c: &Camera, target: &str) -> Error {
+    let model = c.distortion.model_name();
+    let formats = crate::camera::LensModel::named(model)
+        .map(|m| m.export_formats.join(", "))
+        .unwrap_or_default();
+    Error::invalid(
+        "format",
+        format!("the {model} lens model cannot be written for {target}: export it as {formats}"),
+    )
 }
 
 pub(super) fn unsupported(c: &Camera, target: &str) -> Error {
@@ -298,6 +313,12 @@ pub(super) fn ros_camera_info(
     info: &CameraExportInfo,
     rectified: Option<(&[f64], &[f64])>,
 ) -> Result<String> {
+    if let Distortion::Tilted { .. } = c.distortion {
+        return Err(unsupported_listing(
+            c,
+            "ROS camera_info (it has no tilted sensor)",
+        ));
+    }
     let (dist, fisheye) = opencv_distortion(c)?;
     let model = match (&c.distortion, fisheye) {
         (_, true) => "equidistant",

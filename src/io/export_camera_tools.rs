@@ -3,7 +3,9 @@
 //! 3x3 text matrix. The dispatch and the OpenCV/ROS/JSON writers are in
 //! [`super::export_camera`].
 
-use super::export_camera::{float, k_row_major, list, unsupported, CameraExportInfo};
+use super::export_camera::{
+    float, k_row_major, list, unsupported, unsupported_listing, CameraExportInfo,
+};
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
 
@@ -47,6 +49,7 @@ pub(super) fn kalibr_camera(c: &Camera, name: &str) -> Result<String> {
                 &format!("Kalibr (it takes {KALIBR_MODELS})"),
             ))
         }
+        Distortion::Tilted { .. } => return Err(unsupported_listing(c, "Kalibr")),
     };
     intrinsics.extend([c.fx, c.fy, c.cx, c.cy]);
     let mut out = format!(
@@ -101,6 +104,7 @@ pub(super) fn mrcal_model(c: &Camera, rt_cam_ref: Option<[f64; 6]>) -> Result<St
         | Distortion::Splined(_) => {
             return Err(unsupported(c, "mrcal (it has no equivalent model)"))
         }
+        Distortion::Tilted { .. } => return Err(unsupported_listing(c, "mrcal")),
     };
     let mut intrinsics = vec![c.fx, c.fy, c.cx, c.cy];
     intrinsics.extend(coeffs);
@@ -148,6 +152,12 @@ pub(super) fn halcon(c: &Camera, info: &CameraExportInfo) -> Result<String> {
         | Distortion::KannalaBrandt { .. }
         | Distortion::Eucm { .. }
         | Distortion::Splined(_) => return Err(unsupported(c, "Halcon area-scan parameters")),
+        Distortion::Tilted { .. } => {
+            return Err(unsupported_listing(
+                c,
+                "Halcon area-scan parameters (robocal writes no area_scan_tilt)",
+            ))
+        }
     };
     let mut values = vec![focus];
     values.extend(distortion);
@@ -177,6 +187,7 @@ pub(super) fn matlab(c: &Camera) -> Result<String> {
         | Distortion::KannalaBrandt { .. }
         | Distortion::Eucm { .. }
         | Distortion::Splined(_) => return Err(unsupported(c, "MATLAB cameraIntrinsics")),
+        Distortion::Tilted { .. } => return Err(unsupported_listing(c, "MATLAB cameraIntrinsics")),
     };
     Ok(format!(
         "% robocal {}: MATLAB conventions (1-based pixels: principal point = robocal's + 1)\n\

@@ -1,7 +1,11 @@
 //! Reading cameras back: robocal JSON (a camera export or a calibration
-//! report), OpenCV FileStorage YAML and XML, and ROS `camera_info` YAML.
+//! report), OpenCV FileStorage YAML and XML, ROS `camera_info` YAML, a
+//! Kalibr camchain and an mrcal `.cameramodel` (the last two in
+//! [`super::import_camera_tools`]): every camera format `robocal export`
+//! writes but Halcon's, MATLAB's and the text matrix.
 //! The format is recognised from the content.
 
+use super::import_camera_tools::{from_kalibr, from_mrcal, is_kalibr, is_mrcal};
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
 
@@ -16,11 +20,18 @@ pub enum CameraSource {
     OpencvXml,
     /// ROS camera_info YAML.
     RosYaml,
+    /// A Kalibr camchain YAML (its first camera).
+    Kalibr,
+    /// An mrcal `.cameramodel`.
+    Mrcal,
 }
 
 /// Read a camera from text in any of the [`CameraSource`] formats.
 pub fn import_camera(text: &str) -> Result<(Camera, CameraSource)> {
     let trimmed = text.trim_start();
+    if is_mrcal(text) {
+        return from_mrcal(text).map(|c| (c, CameraSource::Mrcal));
+    }
     if trimmed.starts_with('{') {
         return from_json(text).map(|c| (c, CameraSource::Json));
     }
@@ -33,10 +44,13 @@ pub fn import_camera(text: &str) -> Result<(Camera, CameraSource)> {
     if text.contains("camera_matrix:") && text.contains("distortion_model:") {
         return from_yaml(text, true).map(|c| (c, CameraSource::RosYaml));
     }
+    if is_kalibr(text) {
+        return from_kalibr(text).map(|c| (c, CameraSource::Kalibr));
+    }
     Err(Error::parse(
         0,
         0,
-        "not a camera file: expected robocal JSON, OpenCV YAML/XML (camera_matrix, distortion_coefficients) or ROS camera_info YAML",
+        "not a camera file: expected robocal JSON, OpenCV YAML/XML (camera_matrix, distortion_coefficients), ROS camera_info YAML, a Kalibr camchain or an mrcal .cameramodel",
     ))
 }
 
@@ -172,10 +186,28 @@ fn distortion_from_opencv(d: &[f64], fisheye: bool) -> Result<Distortion> {
             s3: g(10),
             s4: g(11),
         },
+        (14, false) => Distortion::Tilted {
+            k1: g(0),
+            k2: g(1),
+            p1: g(2),
+            p2: g(3),
+            k3: g(4),
+            k4: g(5),
+            k5: g(6),
+            k6: g(7),
+            s1: g(8),
+            s2: g(9),
+            s3: g(10),
+            s4: g(11),
+            tau_x: g(12),
+            tau_y: g(13),
+        },
         (n, _) => {
             return Err(Error::invalid(
                 "distortion_coefficients",
-                format!("{n} coefficients: robocal reads 4 (fisheye or k1 k2 p1 p2), 5, 8 or 12"),
+                format!(
+                    "{n} coefficients: robocal reads 4 (fisheye or k1 k2 p1 p2), 5, 8, 12 or 14 (tilted)"
+                ),
             ))
         }
     })

@@ -85,9 +85,13 @@ pub(crate) struct Reading {
     pub notes: Vec<String>,
 }
 
-/// Text or JSON to a table (JSON when the text starts with `[` or `{`).
+/// Text, KUKA KRL or JSON to a table (KRL when it holds a KRL pose
+/// aggregate, [`super::pose_krl`]; JSON when the text starts with `[` or `{`).
 pub(crate) fn table_from_input(text: &str) -> Result<Table> {
     let trimmed = text.trim_start_matches('\u{feff}').trim_start();
+    if let Some(krl) = super::pose_krl::table_from_krl(trimmed) {
+        return krl;
+    }
     if trimmed.starts_with('[') || trimmed.starts_with('{') {
         table_from_json(trimmed)
     } else {

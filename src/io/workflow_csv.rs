@@ -13,10 +13,10 @@
 //! order is free.
 
 use super::csv_table::CsvTable;
-use crate::api::planar::HeightMatrix;
 use crate::calib::dlt_kalman::KalmanMode;
 use crate::error::{Error, Result};
 use crate::workflows::known_motion::KnownMotionRequest;
+use crate::workflows::planar::HeightMatrix;
 use crate::workflows::planar::PlanarMatrix;
 use crate::workflows::planar_solve::HeightPoint;
 use crate::workflows::xytable::{StageObservation, XyTableRequest};

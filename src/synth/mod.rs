@@ -8,6 +8,8 @@ pub mod demo;
 pub mod effects;
 pub mod handeye;
 pub mod handeye_looking;
+pub mod laser;
+pub mod laser_scene;
 pub mod lens;
 pub mod render;
 pub mod rig;

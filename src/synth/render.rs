@@ -115,6 +115,9 @@ pub struct RenderOptions {
     /// Camera effects (gamma, lens PSF, motion, rolling shutter, Bayer,
     /// sensor noise, JPEG, paper texture); default: all off.
     pub effects: Effects,
+    /// A laser stripe drawn over the scene ([`crate::synth::laser`]);
+    /// default none.
+    pub laser: Option<crate::synth::laser::LaserStripe>,
     /// The board's flex, metres: mrcal's paraboloid (`calib::BoardWarp`)
     /// over the extent of the target's points, along the target's +z;
     /// default flat.
@@ -136,6 +139,7 @@ impl Default for RenderOptions {
             circle_diameter_ratio: 0.5,
             seed: 1,
             effects: Effects::default(),
+            laser: None,
             board_warp_m: [0.0, 0.0],
         }
     }
@@ -240,6 +244,18 @@ pub fn render(
     }
     if let Some(paper) = &fx.paper {
         apply_paper(&mut img, &corners, w as usize, paper);
+    }
+    if let Some(laser) = &options.laser {
+        let white = options.white.max(options.black).max(options.background);
+        crate::synth::laser::add_stripe(
+            &mut img,
+            &corners,
+            w as usize,
+            h as usize,
+            camera_from_target,
+            white,
+            laser,
+        );
     }
     let mut plane = crate::image::filter::Plane {
         w: w as usize,

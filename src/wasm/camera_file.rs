@@ -20,6 +20,8 @@ fn format_name(source: CameraSource) -> &'static str {
         CameraSource::OpencvYaml => "opencv-yaml",
         CameraSource::OpencvXml => "opencv-xml",
         CameraSource::RosYaml => "ros-yaml",
+        CameraSource::Kalibr => "kalibr",
+        CameraSource::Mrcal => "mrcal",
     }
 }
 

@@ -8,32 +8,12 @@ use wasm_bindgen::prelude::*;
 
 /// A target from a CLI spec (`chessboard:9x6:30mm`,
 /// `circles:4x11:20mm:asymmetric`, `dots:7x7:25mm`, `circle:10mm`,
-/// `squares:8x8:12.7mm:22.5778mm`) or a target JSON object, validated.
+/// `squares:8x8:12.7mm:22.5778mm`) or a target JSON object, validated
+/// ([`crate::api::detect::DetectRequest::from_spec_or_json`]).
 pub(super) fn target_from(spec_or_json: &str) -> Result<Target, JsError> {
-    if spec_or_json.trim_start().starts_with('{') {
-        serde_json::from_str::<Target>(spec_or_json)
-            .map_err(|e| JsError::new(&format!("target JSON: {e}")))?
-            .validated()
-            .map_err(js_error)
-    } else {
-        Target::parse_spec(spec_or_json).map_err(js_error)
-    }
-}
-
-/// The detection options of a target spec or JSON: the print a spec's
-/// `:dark-on-light` / `:light-on-dark` forces (a JSON forces none).
-pub(super) fn detect_options_from(spec_or_json: &str) -> crate::detect::DetectOptions {
-    let polarity = if spec_or_json.trim_start().starts_with('{') {
-        None
-    } else {
-        Target::parse_spec_print(spec_or_json)
-            .ok()
-            .and_then(|(_, print)| print)
-    };
-    crate::detect::DetectOptions {
-        polarity,
-        ..crate::detect::DetectOptions::default()
-    }
+    crate::api::detect::DetectRequest::from_spec_or_json(spec_or_json)
+        .map(|request| request.target)
+        .map_err(js_error)
 }
 
 /// The target of a CLI spec or target JSON, checked by the core: the target

@@ -76,6 +76,17 @@ pub struct PlanarMatrix {
     pub ty: f64,
 }
 
+/// One per-height matrix, as in the article's Table 4. In JSON one flat
+/// object `{"height_mm", "a11", "a12", "tx", "a21", "a22", "ty"}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HeightMatrix {
+    /// Calibration height, mm.
+    pub height_mm: f64,
+    /// The matrix `robot_from_image` at that height.
+    #[serde(flatten)]
+    pub robot_from_image: PlanarMatrix,
+}
+
 impl PlanarMatrix {
     /// Parameter names in the order of [`PlanarMatrix::to_array`].
     pub const NAMES: [&'static str; 6] = ["a11", "a12", "tx", "a21", "a22", "ty"];

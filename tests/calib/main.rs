@@ -11,6 +11,7 @@ mod calib_circles;
 mod calib_datasets;
 mod calib_ekf;
 mod calib_rig;
+mod calib_tilted;
 mod calib_zhang;
 mod calib_zhang1998;
 mod camera_opencv;

@@ -128,7 +128,7 @@ fn bad_arguments_say_what_to_change() {
         (&["intrinsics", "a.png"], 2, "robocal: intrinsics: --target is required with images, e.g. --target chessboard:9x6:30mm (see 'robocal intrinsics --help')\n"),
         (&["intrinsics", "--detections", d, "a.png"], 2, "robocal: intrinsics: give either IMAGES or --detections, not both (see 'robocal intrinsics --help')\n"),
         (&["intrinsics", "--detections", d, "--method", "magic"], 1, "robocal: method: unknown method 'magic' (expected one of zhang, dlt, tsai, ekf, or all)\n"),
-        (&["intrinsics", "--detections", d, "--model", "brown9"], 1, "robocal: model: unknown model 'brown9' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none, splined)\n"),
+        (&["intrinsics", "--detections", d, "--model", "brown9"], 1, "robocal: model: unknown model 'brown9' (expected one of brown, radial_k1_k2_k5, rational, division, kannala_brandt, eucm, none, tilted, splined)\n"),
         (&["intrinsics", "--detections", d, "--target", "chessboard:7x5:30mm"], 2, "robocal: intrinsics: --target does not match the target of the detection of 'view_000.png' (see 'robocal intrinsics --help')\n"),
     ];
     for (args, want_code, want_err) in cases {

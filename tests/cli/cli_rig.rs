@@ -305,6 +305,28 @@ fn rig_on_a_robot_gives_gripper_from_rig_and_checks_the_poses() {
         }
     }
     assert_eq!(held["cameras"], report["cameras"]);
+    // The poses as a folder of one ROS pose YAML per frame (named by the
+    // frame's number, as a teach pendant or a ROS logger writes them), given
+    // with the calibrated rig: the same gripper_from_rig as the table.
+    let folder = dir.join("poses");
+    std::fs::create_dir_all(&folder).expect("mkdir");
+    for (f, p) in &poses {
+        let (t, q) = (p.translation.vector, p.rotation.coords);
+        let text = format!(
+            "position: {{x: {}, y: {}, z: {}}}\norientation: {{x: {}, y: {}, z: {}, w: {}}}\n",
+            t.x, t.y, t.z, q.x, q.y, q.z, q.w
+        );
+        std::fs::write(folder.join(format!("pose_{f:03}.yaml")), text).expect("write");
+    }
+    let folder = folder.to_string_lossy().into_owned();
+    let mut args = args_of(&files, |_| true);
+    args.extend(["--rig", &out, "--setup", "eye-in-hand", "--poses", &folder]);
+    let (code, out_json, err) = robocal(&args);
+    assert_eq!(code, 0, "{err}");
+    let from_folder: Value = serde_json::from_str(&out_json).expect("json");
+    let got3 = pose(&from_folder["handeye"]["gripper_from_rig"]);
+    let d = (got3.translation.vector - got.translation.vector).norm();
+    assert!(d < 1e-9, "--poses FOLDER moved gripper_from_rig by {d} m");
     // Only two of its cameras: fine; a camera the rig does not have: named.
     let two: Vec<Vec<String>> = vec![files[0].clone(), files[1].clone()];
     let mut args = args_of(&two, |_| true);

@@ -180,6 +180,12 @@ const report = all.report;
   const yaml = output('read_camera_file', JSON.parse(robocal.read_camera_file(robocal.export_report(JSON.stringify(report), 'opencv-yaml', ''))), 'read_camera_file opencv-yaml');
   assert.equal(yaml.format, 'opencv-yaml');
   assert.throws(() => robocal.read_camera_file('hello'), { message: /not a camera file: expected robocal JSON, OpenCV YAML\/XML/ });
+  // The check (docs/check.md): the saved report against five of its own views reads ok.
+  const checked = call('check_camera', { calibration: JSON.stringify(report), views: views.slice(0, 5), thresholds: { param_sigma: 3 } });
+  assert.equal(checked.verdict, 'ok', checked.reasons.join('; '));
+  const yamlText = robocal.export_report(JSON.stringify(report), 'opencv-yaml', '');
+  const diff = call('diff_cameras', { a: JSON.stringify(report), b: yamlText, options: { grid: [30, 20] } });
+  assert.ok(diff.projection_shift_px.worst < 1e-3, `diff of a camera with its export: ${diff.projection_shift_px.worst}`);
 }
 
 const poses = JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', {}))));

@@ -47,6 +47,11 @@ const { report } = JSON.parse(robocal.calibrate_camera(JSON.stringify({ model: '
 assert.ok(Math.abs(report.camera_matrix[0][0] - 900) < 1.5, 'fx ' + report.camera_matrix[0][0]);
 assert.ok(Math.abs(report.camera_matrix[0][2] - 511.5) < 1.5, 'cx ' + report.camera_matrix[0][2]);
 assert.ok(report.rms_px < 0.2, 'rms ' + report.rms_px);
+// The check of the saved calibration against five of the views (docs/check.md): ok, with the shift map.
+const check = JSON.parse(robocal.check_camera(JSON.stringify({ calibration: JSON.stringify(report), views: views.slice(0, 5) })));
+assert.equal(check.verdict, 'ok', check.reasons.join('; '));
+assert.equal(check.projection_shift_px.map.length, 40);
+assert.ok(check.projection_shift_px.worst < check.thresholds.shift_px, 'worst ' + check.projection_shift_px.worst);
 const yaml = robocal.export_report(JSON.stringify(report), 'opencv-yaml', '');
 assert.ok(yaml.startsWith('%YAML:1.0'), yaml.slice(0, 40));
 assert.match(yaml, /camera_matrix: !!opencv-matrix/);

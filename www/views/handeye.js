@@ -155,6 +155,11 @@ export class HandEyeView {
       (pr.reprojection_rms_px != null ? ` Reprojection RMS ${num(pr.reprojection_rms_px, 4)} px` +
         (pr.closed_form_reprojection_rms_px != null ? ` (closed form ${num(pr.closed_form_reprojection_rms_px, 4)} px)` : '') +
         ` over ${(pr.per_view_reprojection_rms_px || []).length} views, each view's points projected through the refined transforms and its robot pose.` : '')) : null;
+    // The error where the robot works (report.work_point_error, tcp_error, holdout, touch_test).
+    const field = [r.work_point_error, r.tcp_error].filter(Boolean).map((w, i) => h('p', { class: 'hint', id: i === 0 ? 'handeye-work-point' : 'handeye-tcp' },
+      `${w.verdict}. To shrink it: ${w.shrink_by.join('; ')}.`));
+    if (r.holdout) field.push(h('p', { class: 'hint', id: 'handeye-holdout' }, `Held-out poses: ${r.holdout.verdict}.`));
+    if (r.touch_test) field.push(h('p', { class: 'hint', id: 'handeye-touch' }, `Touch test: ${r.touch_test.points.length} points, RMS ${num(r.touch_test.rms_mm, 3)} mm, largest ${num(r.touch_test.max_mm, 3)} mm.`));
     const motion = r.motion ? h('p', { class: 'hint' }, `${r.motion.motions} motions used (${r.motion.discarded_small_rotation} discarded for too little rotation); rotation angles ${num(r.motion.angle_min_deg, 1)}–${num(r.motion.angle_max_deg, 1)} deg (median ${num(r.motion.angle_median_deg, 1)}), axis spread ${num(r.motion.axis_spread_deg, 1)} deg.`) : null;
     // The table's quantity: closure per pose (its RMS and max are the table's).
     const names = r.pair_names || [];
@@ -175,7 +180,7 @@ export class HandEyeView {
     this.plots = plots;
     const leftOut = leftOutNote(r.left_out);
     fill(this.out, h('h3', {}, `Result (${r.method})`), leftOut, (r.warnings || []).map((w) => message('warning', w)),
-      measure, pose(camKey), pose(tgtKey), refinement, poseRefinement, errors, motion, h('h3', {}, 'Methods side by side'), methods,
+      measure, pose(camKey), pose(tgtKey), refinement, poseRefinement, field, errors, motion, h('h3', {}, 'Methods side by side'), methods,
       h('div', { class: 'plots' }, plots), h('h3', {}, '3-D view'), this.frames3d());
     this.draw3d(r, camKey, tgtKey, eyeInHand);
   }

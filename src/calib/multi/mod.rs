@@ -5,7 +5,9 @@
 //! in `rig_problem`, the report in [`rig_report`]). Both joint problems
 //! build their residual and Jacobian blocks with one helper,
 //! `block_problem`;
-//! `same_images` refuses one image set given for two cameras.
+//! `same_images` refuses one image set given for two cameras. Both check
+//! their extrinsics' std against leave-views-out refits (`rig_jackknife`,
+//! `stereo_jackknife`).
 
 mod block_problem;
 pub mod rig;
@@ -17,6 +19,7 @@ mod rig_problem;
 pub mod rig_report;
 mod same_images;
 pub mod stereo;
+mod stereo_jackknife;
 mod stereo_problem;
 pub mod stereo_rectify;
 #[cfg(test)]

@@ -114,18 +114,23 @@ pub(crate) fn leave_frames_out<'a>(
     if runs < MIN_GROUPS {
         return None;
     }
-    let n = runs as f64;
-    let std = deltas
-        .iter()
-        .map(|d| {
-            let mut out = [0.0; 6];
-            for (i, o) in out.iter_mut().enumerate() {
-                let mean = d.iter().map(|x| x[i]).sum::<f64>() / n;
-                let ss: f64 = d.iter().map(|x| (x[i] - mean).powi(2)).sum();
-                *o = ((n - 1.0) / n * ss).sqrt();
-            }
-            out
-        })
-        .collect();
+    let std = deltas.iter().map(|d| jackknife_std(d)).collect();
     Some(FrameSpread { std, runs })
+}
+
+/// The delete-a-group jackknife std of each of six components over the
+/// refits' deltas from the full solution: `sqrt((G - 1) / G * sum (x_g -
+/// mean)^2)` for `G` refits.
+pub(crate) fn jackknife_std(deltas: &[[f64; 6]]) -> [f64; 6] {
+    let n = deltas.len() as f64;
+    let mut out = [0.0; 6];
+    if deltas.is_empty() {
+        return out;
+    }
+    for (i, o) in out.iter_mut().enumerate() {
+        let mean = deltas.iter().map(|x| x[i]).sum::<f64>() / n;
+        let ss: f64 = deltas.iter().map(|x| (x[i] - mean).powi(2)).sum();
+        *o = ((n - 1.0) / n * ss).sqrt();
+    }
+    out
 }

@@ -7,6 +7,7 @@
 //! right_from_left jointly (the right camera sees the board at
 //! `right_from_left * left_from_target`).
 
+use super::stereo_jackknife::{leave_pairs_out, WARN_FACTOR};
 use crate::calib::model_advice::{advise, ModelAdvice};
 use crate::calib::multi::same_images::{refuse_identical_views, refuse_zero_baseline};
 use crate::calib::multi::stereo_problem::StereoProblem;
@@ -49,7 +50,9 @@ pub struct StereoCalibration {
     pub initial_right_from_left: PoseJson,
     /// Distance between the camera centres, metres.
     pub baseline_m: f64,
-    /// Standard deviations of right_from_left (`None` when singular).
+    /// Standard deviations of right_from_left (`None` when singular): the
+    /// joint fit's, widened axis by axis to the leave-pairs-out spread
+    /// where that is larger ([`super::stereo_jackknife`]).
     pub right_from_left_std: Option<TransformStd>,
     /// RMS reprojection error over every point of both cameras, px.
     pub rms_px: f64,
@@ -142,14 +145,11 @@ pub fn calibrate_stereo(
         global,
         blocks: left_poses.iter().map(block_from_pose).collect(),
     };
-    let result = solve(
-        &problem,
-        &start,
-        &LmOptions {
-            fixed_global,
-            ..lm_left
-        },
-    )?;
+    let lm = LmOptions {
+        fixed_global,
+        ..lm_left
+    };
+    let result = solve(&problem, &start, &lm)?;
     let g = &result.params.global;
     let (nl, nr) = (problem.n_left, problem.n_right);
     let rfl = problem.right_from_left(g);
@@ -178,9 +178,34 @@ pub fn calibrate_stereo(
     let blocks = problem.residuals_and_jacobian(&result.params, false)?;
     let squared: f64 = blocks.iter().map(|b| b.residuals.norm_squared()).sum();
     let o = problem.rfl_offset();
-    let right_from_left_std = result.std_global().map(|s| TransformStd {
-        rotation_rad: [s[o], s[o + 1], s[o + 2]],
-        translation_m: [s[o + 3], s[o + 4], s[o + 5]],
+    let mut warnings = warnings;
+    let right_from_left_std = result.std_global().map(|s| {
+        let mut std: [f64; 6] = std::array::from_fn(|i| s[o + i]);
+        // Checked against the spread of leave-pairs-out refits and widened
+        // to it axis by axis ([`super::stereo_jackknife`]).
+        if let Some((spread, runs)) = leave_pairs_out(&problem, &result, &lm) {
+            let mut worst: f64 = 1.0;
+            for (model, data) in std.iter_mut().zip(spread) {
+                if *model > 0.0 {
+                    worst = worst.max(data / *model);
+                    *model = model.max(data);
+                }
+            }
+            if worst > WARN_FACTOR {
+                warnings.push(format!(
+                    "right_from_left: leaving pairs out moves it {worst:.1}x more than the joint \
+                     fit's std says ({runs} refits): the pairs disagree beyond the pixel noise \
+                     (the two images of a pair not taken at one moment while the board moved, a \
+                     board that bends, a camera that moved between pairs); its std is widened to \
+                     that spread. Hold the board still for each pair or trigger the cameras \
+                     together"
+                ));
+            }
+        }
+        TransformStd {
+            rotation_rad: [std[0], std[1], std[2]],
+            translation_m: [std[3], std[4], std[5]],
+        }
     });
     let baseline_m = rfl.inverse().translation.vector.norm();
     refuse_zero_baseline(
@@ -194,7 +219,6 @@ pub fn calibrate_stereo(
         left: advise(left, left_size_px, options, &left_report),
         right: advise(right, right_size_px, options, &right_report),
     };
-    let mut warnings = warnings;
     for (side, a) in [("left", &advice.left), ("right", &advice.right)] {
         warnings.extend(a.warnings.iter().map(|w| format!("{side} camera: {w}")));
     }

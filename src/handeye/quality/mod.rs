@@ -4,7 +4,8 @@
 //! closure residuals and summary errors; [`repeat`]: leave-one-out and
 //! bootstrap), and whether its reported uncertainty can be trusted
 //! ([`trust`], [`intrinsics_move`] for a joint refinement that moved the
-//! intrinsics too far).
+//! intrinsics too far), and what the error is where the robot works
+//! ([`work_point`], [`verify`] against held-out poses and touched points).
 
 pub mod checks;
 pub mod gross;
@@ -13,3 +14,5 @@ pub mod pairing;
 pub mod repeat;
 pub mod residuals;
 pub mod trust;
+pub mod verify;
+pub mod work_point;

@@ -213,3 +213,112 @@ fn robot_correction_jacobian_matches_finite_differences() {
         }
     }
 }
+
+/// Seed 003's Table 1 (Zhang et al., "Simultaneous camera and hand-eye
+/// calibration for laser-vision robot welding", /work/shared/seeds/003_*.txt,
+/// section III): six control points, the end points of the laser line on
+/// two cubes in a 256x192 image, image x y (px) and world wx wy wz (mm) read
+/// from the ABB controller with the torch on each point.
+const SEED003_TABLE1: [([f64; 2], [f64; 3]); 6] = [
+    ([10.0, 116.0], [612.1, 236.2, 123.7]),
+    ([64.0, 116.0], [597.1, 236.7, 123.7]),
+    ([94.0, 116.0], [589.6, 237.1, 123.7]),
+    ([99.0, 116.0], [587.4, 237.6, 123.7]),
+    ([119.0, 116.0], [581.1, 237.9, 123.7]),
+    ([174.0, 116.0], [566.1, 238.2, 123.7]),
+];
+
+/// Table 1 through the seed-003 solver (`points_in_world`: world = robot
+/// base, one view, the robot pose T6 = identity since the paper does not
+/// print it, so `x` is the camera's pose in the base).
+///
+/// What the paper reports that the table can check: its intrinsics and
+/// hand-eye matrix (Eq. 9-10) are lost from the text, and its accuracy
+/// figure (0.12 mm mean over 20 seam points) uses points it does not list.
+/// What the table itself says, reproduced here: its image points lie on one
+/// row (y = 116) and its world points on one line (within 0.4 mm), so a
+/// central camera maps them by a 1-D projective map (3 numbers), and the six
+/// points fit such a map only to about 1.5 px RMS (the third point 2.7 px
+/// off, about 0.75 mm at the table's 0.28 mm per pixel). Six points give 12
+/// equations, not the paper's 18, for its 17 unknowns: Table 1 alone does
+/// not determine the intrinsics, so they are held here (f = 350 px, a
+/// nominal centre) and the solver finds the pose.
+#[wasm_bindgen_test(unsupported = test)]
+fn seed003_table1_control_points_through_the_world_point_solver() {
+    use nalgebra::{Matrix3, Point2, Point3, Rotation3};
+    let mm = 1e-3;
+    let world: Vec<Point3<f64>> = SEED003_TABLE1
+        .iter()
+        .map(|(_, w)| Point3::new(w[0] * mm, w[1] * mm, w[2] * mm))
+        .collect();
+    let image: Vec<Point2<f64>> = SEED003_TABLE1
+        .iter()
+        .map(|(p, _)| Point2::new(p[0], p[1]))
+        .collect();
+    // The world points lie on one line within 0.4 mm (0.35 mm at most).
+    let (a, b) = (world[0], world[5]);
+    let u = (b - a).normalize();
+    for p in &world {
+        let off = (p - a) - u * (p - a).dot(&u);
+        assert!(off.norm() < 0.4 * mm, "{} mm off the line", off.norm() / mm);
+    }
+    // Start: camera 100 mm above the line's middle, looking down (world -z),
+    // its x axis along the line (image x grows from point 1 to point 6).
+    let z = Vector3::new(0.0, 0.0, -1.0);
+    let x_axis = (u - z * u.dot(&z)).normalize();
+    let y_axis = z.cross(&x_axis);
+    let r = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[x_axis, y_axis, z]));
+    let middle = Point3::from((a.coords + b.coords) / 2.0);
+    let base_from_camera = Pose::from_parts(
+        Translation3::from(middle.coords - z * 0.1),
+        UnitQuaternion::from_rotation_matrix(&r),
+    );
+    let camera = Camera::pinhole(350.0, 350.0, 127.5, 95.5, 256, 192);
+    let views = vec![View {
+        name: "seed003_table1".into(),
+        object_m: world.clone(),
+        image_px: image.clone(),
+        point_ids: Vec::new(),
+    }];
+    let r = refine(
+        Setup::EyeInHand,
+        &[Pose::identity()],
+        &views,
+        &camera,
+        &base_from_camera,
+        &Pose::identity(),
+        &RefineOptions {
+            points_in_world: true,
+            ..Default::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let residuals: Vec<f64> = world
+        .iter()
+        .zip(&image)
+        .map(|(w, p)| {
+            let q = camera
+                .project(&(r.x.inverse() * w))
+                .unwrap_or_else(|e| panic!("{e}"));
+            (q - p).norm()
+        })
+        .collect();
+    eprintln!(
+        "seed 003 Table 1: rms {:.3} px, per point {residuals:.2?} px",
+        r.reprojection_rms_px
+    );
+    // The least-squares 1-D projective map of the six x coordinates (a
+    // separate fit, numpy, x = (a w + b) / (c w + 1) over wx) leaves
+    // 1.486 px RMS with the third and fifth points worst (2.67, 2.35 px):
+    // the solver lands there (measured 1.485 px).
+    assert!(
+        r.reprojection_rms_px > 1.45 && r.reprojection_rms_px < 1.52,
+        "{} px",
+        r.reprojection_rms_px
+    );
+    let worst = residuals
+        .iter()
+        .enumerate()
+        .fold((0, 0.0), |m, (i, e)| if *e > m.1 { (i, *e) } else { m });
+    assert_eq!(worst.0, 2, "the third point is the worst: {residuals:?}");
+}

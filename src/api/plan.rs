@@ -1,0 +1,110 @@
+//! The pose plan as JSON ([`crate::handeye::plan`]): the report `robocal
+//! plan` writes and the request of the wasm `plan_handeye_poses`.
+//!
+//! Request: `{"setup", "base_from_gripper": pose, "camera_from_target":
+//! pose, "camera": camera JSON, "board_m": [[x, y, z]...], "guess": pose
+//! (optional), "poses": 15, "max_tilt_deg": 40, "max_roll_deg": 60,
+//! "distance_m": [min, max], "flange_box_m": [[x0, y0, z0], [x1, y1, z1]],
+//! "margin_px": 20, "pixel_sigma_px": 0.3}` (poses as [`PoseInput`]).
+
+use crate::api::handeye::camera_from_json;
+use crate::error::{Error, Result};
+use crate::geometry::{PoseInput, PoseJson};
+use crate::handeye::plan::{plan, Plan, PlanInput, PlanLimits, PlanNoise};
+use crate::handeye::{Pose, Setup};
+use nalgebra::Point3;
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanRequest {
+    setup: Setup,
+    base_from_gripper: PoseInput,
+    camera_from_target: PoseInput,
+    camera: Value,
+    board_m: Vec<[f64; 3]>,
+    #[serde(default)]
+    guess: Option<PoseInput>,
+    #[serde(default)]
+    poses: Option<usize>,
+    #[serde(default)]
+    max_tilt_deg: Option<f64>,
+    #[serde(default)]
+    max_roll_deg: Option<f64>,
+    #[serde(default)]
+    distance_m: Option<[f64; 2]>,
+    #[serde(default)]
+    flange_box_m: Option<[[f64; 3]; 2]>,
+    #[serde(default)]
+    margin_px: Option<f64>,
+    #[serde(default)]
+    pixel_sigma_px: Option<f64>,
+}
+
+fn pose(p: &PoseInput, field: &str) -> Result<Pose> {
+    p.to_pose()
+        .map_err(|e| Error::invalid(field, e.to_string()))
+}
+
+/// The plan's JSON (the `robocal plan` output).
+pub fn plan_json_value(plan: &Plan) -> Value {
+    let poses: Vec<Value> = plan
+        .poses
+        .iter()
+        .map(|p| {
+            json!({
+                "base_from_gripper": PoseJson::from(&p.base_from_gripper),
+                "camera_from_target": PoseJson::from(&p.camera_from_target),
+                "tilt_deg": p.tilt_deg,
+                "distance_m": p.distance_m,
+                "roll_deg": p.roll_deg,
+            })
+        })
+        .collect();
+    json!({
+        "kind": "handeye-plan",
+        "poses": poses,
+        "predicted": plan.predicted,
+        "motion": plan.motion,
+        "travel_m": plan.travel_m,
+        "candidates": plan.candidates,
+        "notes": plan.notes,
+        "robocal_version": crate::VERSION,
+    })
+}
+
+/// Plan from a request JSON (module docs); returns the plan JSON.
+pub fn plan_json(request_json: &str) -> Result<String> {
+    let r: PlanRequest = serde_json::from_str(request_json)
+        .map_err(|e| Error::parse(e.line(), e.column(), e.to_string()))?;
+    let input = PlanInput {
+        setup: r.setup,
+        base_from_gripper: pose(&r.base_from_gripper, "base_from_gripper")?,
+        camera_from_target: pose(&r.camera_from_target, "camera_from_target")?,
+        camera: camera_from_json(&r.camera)?,
+        board_m: r.board_m.iter().map(|p| Point3::from(*p)).collect(),
+        guess: match &r.guess {
+            Some(g) => pose(g, "guess")?,
+            None => Pose::identity(),
+        },
+    };
+    let d = PlanLimits::default();
+    let limits = PlanLimits {
+        poses: r.poses.unwrap_or(d.poses),
+        max_tilt_deg: r.max_tilt_deg.unwrap_or(d.max_tilt_deg),
+        max_roll_deg: r.max_roll_deg.unwrap_or(d.max_roll_deg),
+        distance_m: r.distance_m.map(|v| (v[0], v[1])),
+        flange_box_m: r.flange_box_m.map(|b| (b[0], b[1])),
+        margin_px: r.margin_px.unwrap_or(d.margin_px),
+    };
+    let noise = PlanNoise {
+        pixel_sigma_px: r
+            .pixel_sigma_px
+            .unwrap_or(PlanNoise::default().pixel_sigma_px),
+        ..PlanNoise::default()
+    };
+    let planned = plan(&input, &limits, &noise)?;
+    crate::finite::check_finite("plan", &plan_json_value(&planned))?;
+    Ok(plan_json_value(&planned).to_string())
+}

@@ -1,0 +1,375 @@
+//! The laser plane from stripe observations on boards of known pose, by
+//! least squares, with its covariance, per-image residuals and warnings.
+//!
+//! Two error models:
+//! - [`PlaneResidual::ImagePx`] (the default): each stripe centre's
+//!   residual is the distance, along its scan direction in pixels, between
+//!   the measured centre and where the plane/board intersection line crosses
+//!   that column (row), to first order `(n . X - d) / (n . dX/dv)`, divided
+//!   by the extractor's std. The noise is in the image, so this is the
+//!   maximum-likelihood fit under Gaussian centre noise, and its covariance
+//!   is the one the noise implies: a far or grazing board, whose points move
+//!   by millimetres per pixel, weighs what its pixels are worth.
+//! - [`PlaneResidual::PointToPlane`]: the metric distance of each 3-D point
+//!   to the plane, unweighted: the classic total-least-squares plane, which
+//!   over-weights far and grazing boards.
+//!
+//! The plane's parameters are its normal (two tangent angles about the
+//! current normal) and its distance; the covariance is `s^2 (J^T J)^-1`
+//! at the solution with `s^2` the residual variance (chi^2 / (m - 3)),
+//! returned over `(nx, ny, nz, d)`. The board poses are taken as exact
+//! (a board's pose from its corners is far more precise than one stripe).
+
+use super::plane::{LaserPlane, StripeObservation};
+use crate::error::{Error, Result};
+use nalgebra::{Matrix3, Matrix4, Matrix4x3, SymmetricEigen, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// The residual the plane fit minimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PlaneResidual {
+    /// Pixels along the scan direction, weighted by each centre's std.
+    #[default]
+    ImagePx,
+    /// Metres from each point to the plane, unweighted.
+    PointToPlane,
+}
+
+impl PlaneResidual {
+    /// The name used by the CLI and JSON (`image_px`, `point_to_plane`).
+    pub fn name(self) -> &'static str {
+        match self {
+            PlaneResidual::ImagePx => "image_px",
+            PlaneResidual::PointToPlane => "point_to_plane",
+        }
+    }
+
+    /// From its name; an unknown name is an error naming the choices.
+    pub fn from_name(name: &str) -> Result<PlaneResidual> {
+        match name {
+            "image_px" | "image" => Ok(PlaneResidual::ImagePx),
+            "point_to_plane" | "point" => Ok(PlaneResidual::PointToPlane),
+            other => Err(Error::invalid(
+                "residual",
+                format!("unknown residual '{other}' (expected image_px or point_to_plane)"),
+            )),
+        }
+    }
+}
+
+/// Settings of [`fit_plane`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlaneFitOptions {
+    /// The error model (default: image-space).
+    pub residual: PlaneResidual,
+}
+
+/// The residuals of one image's stripe.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImageResidual {
+    /// The image's index.
+    pub image: usize,
+    /// Stripe centres used.
+    pub n_points: usize,
+    /// RMS residual along the scan, pixels (image-space model, unweighted).
+    pub rms_px: f64,
+    /// RMS point-to-plane distance, millimetres.
+    pub rms_mm: f64,
+}
+
+/// A fitted laser plane.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneFit {
+    /// The plane.
+    pub plane: LaserPlane,
+    /// Covariance of `(nx, ny, nz, d)` (d in metres), scaled by the
+    /// residual variance.
+    pub covariance: Matrix4<f64>,
+    /// Covariance of `(tilt_1, tilt_2, d)`: rotations of the normal about
+    /// two axes orthogonal to it (radians) and the distance (m).
+    pub tangent_covariance: Matrix3<f64>,
+    /// The residual variance `s^2` that scaled the covariance (1 when the
+    /// stds were exact).
+    pub variance_factor: f64,
+    /// RMS of the minimised residuals (image: in units of the std; point:
+    /// metres).
+    pub rms: f64,
+    /// Per image.
+    pub per_image: Vec<ImageResidual>,
+    /// Singular values of the centred point cloud (m, largest first).
+    pub singular_values_m: [f64; 3],
+    /// Weak geometry, in words.
+    pub warnings: Vec<String>,
+}
+
+/// Below this ratio of the second to the first singular value the points
+/// lie on one line and no plane is defined.
+const COLLINEAR_RATIO: f64 = 1e-6;
+/// Below this ratio the plane is weakly constrained: a warning.
+const WEAK_RATIO: f64 = 0.05;
+/// Stripe lines whose directions all agree within this are parallel, deg.
+const PARALLEL_DEG: f64 = 2.0;
+
+/// Fit the laser plane to stripe observations from at least two images.
+pub fn fit_plane(obs: &[StripeObservation], options: &PlaneFitOptions) -> Result<PlaneFit> {
+    let mut images: Vec<usize> = obs.iter().map(|o| o.image).collect();
+    images.sort_unstable();
+    images.dedup();
+    if images.len() < 2 {
+        return Err(Error::too_few(
+            "images with a stripe on the board",
+            2,
+            images.len(),
+        ));
+    }
+    if obs.len() < 3 {
+        return Err(Error::too_few("stripe points", 3, obs.len()));
+    }
+    if let Some(o) = obs.iter().find(|o| {
+        !(o.point_camera.coords.iter().all(|v| v.is_finite())
+            && o.std_px.is_finite()
+            && o.std_px > 0.0)
+    }) {
+        return Err(Error::invalid(
+            "stripe",
+            format!(
+                "a stripe point of image {} is not finite or has no std",
+                o.image + 1
+            ),
+        ));
+    }
+    let (start, singular) = total_least_squares(obs);
+    let (s0, s1) = (singular[0], singular[1]);
+    if !s1.is_finite() || s1 <= COLLINEAR_RATIO * s0 {
+        return Err(Error::degenerate(format!(
+            "the stripe points of all {} images lie on one line (singular values {:.3e}, {:.3e} m): \
+             the plane is not constrained; move or tilt the board so the stripe falls elsewhere",
+            images.len(),
+            s0,
+            s1
+        )));
+    }
+    let mut n = start.normal();
+    let mut d = start.distance_m;
+    let mut warnings = geometry_warnings(obs, &images, singular);
+    let mut jtj = Matrix3::zeros();
+    let mut chi2 = 0.0;
+    for _ in 0..30 {
+        let basis = tangent_basis(&n);
+        let (a, g, c) = normal_equations(obs, &n, d, &basis, options.residual);
+        jtj = a;
+        chi2 = c;
+        let Some(step) = a.cholesky().map(|ch| ch.solve(&(-g))) else {
+            return Err(Error::degenerate(
+                "the plane's normal equations are singular: the stripes do not constrain it",
+            ));
+        };
+        let rot = basis.0 * step[0] + basis.1 * step[1];
+        n = (n + rot).normalize();
+        d += step[2];
+        if step.norm() < 1e-14 {
+            break;
+        }
+    }
+    // The final linearisation, at the solution.
+    let basis = tangent_basis(&n);
+    let (a, _, c) = normal_equations(obs, &n, d, &basis, options.residual);
+    if a.cholesky().is_some() {
+        jtj = a;
+        chi2 = c;
+    }
+    let m = obs.len();
+    let variance_factor = if m > 3 { chi2 / (m - 3) as f64 } else { 1.0 };
+    let inv = jtj.try_inverse().ok_or_else(|| {
+        Error::degenerate(
+            "the plane's information matrix is singular: the stripes do not constrain it",
+        )
+    })?;
+    let tangent_covariance = inv * variance_factor;
+    let mut map = Matrix4x3::zeros();
+    for r in 0..3 {
+        map[(r, 0)] = basis.0[r];
+        map[(r, 1)] = basis.1[r];
+    }
+    map[(3, 2)] = 1.0;
+    let covariance = map * tangent_covariance * map.transpose();
+    // A sign flip of (n, d) leaves their joint covariance unchanged.
+    let plane = LaserPlane::new(n, d)?;
+    let per_image = images
+        .iter()
+        .map(|&i| image_residual(obs, i, &plane))
+        .collect();
+    let eig = SymmetricEigen::new(tangent_covariance);
+    if eig
+        .eigenvalues
+        .iter()
+        .any(|v| !(v.is_finite() && *v >= 0.0))
+    {
+        warnings.push("the plane's covariance is not positive: the fit is unreliable".into());
+    }
+    Ok(PlaneFit {
+        plane,
+        covariance,
+        tangent_covariance,
+        variance_factor,
+        rms: (chi2 / m as f64).sqrt(),
+        per_image,
+        singular_values_m: singular,
+        warnings,
+    })
+}
+
+/// Two unit vectors orthogonal to `n` and to each other.
+fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let a = n.cross(&helper).normalize();
+    let b = n.cross(&a);
+    (a, b)
+}
+
+/// `J^T J`, `J^T r` and `r^T r` over `(tilt_a, tilt_b, d)`.
+fn normal_equations(
+    obs: &[StripeObservation],
+    n: &Vector3<f64>,
+    d: f64,
+    basis: &(Vector3<f64>, Vector3<f64>),
+    model: PlaneResidual,
+) -> (Matrix3<f64>, Vector3<f64>, f64) {
+    let mut a = Matrix3::zeros();
+    let mut g = Vector3::zeros();
+    let mut chi2 = 0.0;
+    for o in obs {
+        let x = o.point_camera.coords;
+        let (r, dn, dd) = match model {
+            PlaneResidual::PointToPlane => (n.dot(&x) - d, x, -1.0),
+            PlaneResidual::ImagePx => {
+                let t = o.along_scan_m_per_px;
+                let nt = n.dot(&t);
+                if nt.abs() < 1e-15 {
+                    continue;
+                }
+                let e = n.dot(&x) - d;
+                let w = 1.0 / o.std_px;
+                (w * e / nt, w * (x * nt - t * e) / (nt * nt), -w / nt)
+            }
+        };
+        let j = Vector3::new(dn.dot(&basis.0), dn.dot(&basis.1), dd);
+        a += j * j.transpose();
+        g += j * r;
+        chi2 += r * r;
+    }
+    (a, g, chi2)
+}
+
+/// The point-to-plane total-least-squares plane and the singular values
+/// of the centred points.
+fn total_least_squares(obs: &[StripeObservation]) -> (LaserPlane, [f64; 3]) {
+    let m = obs.len() as f64;
+    let centre = obs
+        .iter()
+        .map(|o| o.point_camera.coords)
+        .sum::<Vector3<f64>>()
+        / m;
+    let mut scatter = Matrix3::zeros();
+    for o in obs {
+        let v = o.point_camera.coords - centre;
+        scatter += v * v.transpose();
+    }
+    let eig = SymmetricEigen::new(scatter);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
+    let sv = order.map(|i| eig.eigenvalues[i].max(0.0).sqrt());
+    let normal: Vector3<f64> = eig.eigenvectors.column(order[2]).into();
+    let plane = LaserPlane::new(normal, normal.dot(&centre)).unwrap_or(LaserPlane {
+        normal_camera: [0.0, 0.0, 1.0],
+        distance_m: 0.0,
+    });
+    (plane, sv)
+}
+
+/// Warnings on the geometry: points near one line, stripe lines parallel.
+fn geometry_warnings(obs: &[StripeObservation], images: &[usize], sv: [f64; 3]) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if sv[1] < WEAK_RATIO * sv[0] {
+        warnings.push(format!(
+            "the stripe points lie close to one line (singular values {:.2} and {:.2} mm): the \
+             plane's rotation about it is weakly constrained; place the board at other distances or tilts",
+            sv[0] * 1e3,
+            sv[1] * 1e3
+        ));
+    }
+    let directions: Vec<Vector3<f64>> = images
+        .iter()
+        .filter_map(|&i| {
+            let pts: Vec<Vector3<f64>> = obs
+                .iter()
+                .filter(|o| o.image == i)
+                .map(|o| o.point_camera.coords)
+                .collect();
+            line_direction(&pts)
+        })
+        .collect();
+    if directions.len() >= 2 {
+        let worst = directions
+            .iter()
+            .flat_map(|a| {
+                directions
+                    .iter()
+                    .map(move |b| a.dot(b).abs().min(1.0).acos())
+            })
+            .fold(0.0, f64::max)
+            .to_degrees();
+        if worst < PARALLEL_DEG {
+            warnings.push(format!(
+                "all {} stripe lines are parallel (within {:.2} deg): the plane's tilt about their \
+                 common direction rests on their separation alone; tilt the board about another axis \
+                 between poses",
+                directions.len(),
+                worst
+            ));
+        }
+    }
+    warnings
+}
+
+/// The principal direction of a set of points (None for fewer than 2).
+fn line_direction(pts: &[Vector3<f64>]) -> Option<Vector3<f64>> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let c = pts.iter().sum::<Vector3<f64>>() / pts.len() as f64;
+    let mut s = Matrix3::zeros();
+    for p in pts {
+        let v = p - c;
+        s += v * v.transpose();
+    }
+    let eig = SymmetricEigen::new(s);
+    let imax = eig.eigenvalues.imax();
+    Some(eig.eigenvectors.column(imax).into())
+}
+
+fn image_residual(obs: &[StripeObservation], image: usize, plane: &LaserPlane) -> ImageResidual {
+    let n = plane.normal();
+    let (mut sp, mut sm, mut k) = (0.0, 0.0, 0usize);
+    for o in obs.iter().filter(|o| o.image == image) {
+        let e = plane.signed_distance(&o.point_camera);
+        let nt = n.dot(&o.along_scan_m_per_px);
+        if nt.abs() > 1e-15 {
+            sp += (e / nt).powi(2);
+        }
+        sm += e * e;
+        k += 1;
+    }
+    let k1 = k.max(1) as f64;
+    ImageResidual {
+        image,
+        n_points: k,
+        rms_px: (sp / k1).sqrt(),
+        rms_mm: (sm / k1).sqrt() * 1e3,
+    }
+}

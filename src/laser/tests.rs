@@ -1,0 +1,247 @@
+//! Seeded laser scenes: the plane fit exact without noise and within its
+//! covariance with noise, its warnings and errors; the stripe extractors
+//! against the renderer's truth.
+
+use super::*;
+use crate::camera::Camera;
+use crate::rng::Rng;
+use crate::synth::laser::{stripe_truth, LaserStripe};
+use crate::synth::laser_scene::{example_plane, laser_board_poses, stripe_observations};
+use crate::synth::{board_pose, render, RenderOptions};
+use crate::target::Target;
+use nalgebra::Vector3;
+
+fn camera() -> Camera {
+    Camera::pinhole(800.0, 800.0, 320.0, 240.0, 640, 480)
+}
+
+const EXTENT: (f64, f64) = (0.2, 0.15);
+
+fn angle_deg(a: &LaserPlane, b: &LaserPlane) -> f64 {
+    a.normal()
+        .dot(&b.normal())
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees()
+}
+
+#[test]
+fn noise_free_fit_is_exact_with_both_residuals() {
+    let truth = example_plane();
+    let poses = laser_board_poses(3);
+    let obs =
+        stripe_observations(&camera(), &poses, &truth, EXTENT, 4, 0.0, &mut Rng::new(1)).unwrap();
+    assert!(obs.len() > 100, "{} observations", obs.len());
+    for residual in [PlaneResidual::ImagePx, PlaneResidual::PointToPlane] {
+        let fit = fit_plane(&obs, &PlaneFitOptions { residual }).unwrap();
+        assert!(
+            angle_deg(&fit.plane, &truth) < 1e-5,
+            "{residual:?}: {fit:?}"
+        );
+        assert!(
+            (fit.plane.distance_m - truth.distance_m).abs() < 1e-8,
+            "{fit:?}"
+        );
+        assert!(fit.warnings.is_empty(), "{:?}", fit.warnings);
+        assert_eq!(fit.per_image.len(), 3);
+    }
+}
+
+#[test]
+fn noisy_fit_lies_within_its_covariance() {
+    let truth = example_plane();
+    let poses = laser_board_poses(4);
+    let noise = 0.3;
+    let obs = stripe_observations(
+        &camera(),
+        &poses,
+        &truth,
+        EXTENT,
+        1,
+        noise,
+        &mut Rng::new(5),
+    )
+    .unwrap();
+    let fit = fit_plane(&obs, &PlaneFitOptions::default()).unwrap();
+    // The residual variance estimates the injected noise.
+    assert!(
+        (fit.variance_factor - 1.0).abs() < 0.1,
+        "{}",
+        fit.variance_factor
+    );
+    let e = Vector3::new(
+        fit.plane.normal_camera[0] - truth.normal_camera[0],
+        fit.plane.normal_camera[1] - truth.normal_camera[1],
+        fit.plane.normal_camera[2] - truth.normal_camera[2],
+    );
+    for k in 0..3 {
+        assert!(
+            e[k].abs() < 4.0 * fit.covariance[(k, k)].sqrt(),
+            "{k}: {e:?} {fit:?}"
+        );
+    }
+    let dd = fit.plane.distance_m - truth.distance_m;
+    assert!(dd.abs() < 4.0 * fit.covariance[(3, 3)].sqrt(), "{dd}");
+    assert!(angle_deg(&fit.plane, &truth) < 0.05);
+}
+
+#[test]
+fn parallel_stripes_warn_and_one_line_is_an_error() {
+    let truth = example_plane();
+    let cam = camera();
+    // The same board orientation at two depths: parallel stripe lines.
+    let r = nalgebra::UnitQuaternion::from_euler_angles(0.3, 0.0, 0.0);
+    let at =
+        |z: f64| crate::geometry::Pose::from_parts(nalgebra::Translation3::new(-0.1, -0.07, z), r);
+    let poses = [at(0.45), at(0.55)];
+    let obs = stripe_observations(&cam, &poses, &truth, EXTENT, 4, 0.0, &mut Rng::new(2)).unwrap();
+    let fit = fit_plane(&obs, &PlaneFitOptions::default()).unwrap();
+    assert!(
+        fit.warnings
+            .iter()
+            .any(|w| w.starts_with("all 2 stripe lines are parallel")),
+        "{:?}",
+        fit.warnings
+    );
+    // Two images of one line (the same pose twice): no plane.
+    let same = [at(0.5), at(0.5)];
+    let obs = stripe_observations(&cam, &same, &truth, EXTENT, 4, 0.0, &mut Rng::new(2)).unwrap();
+    let err = fit_plane(&obs, &PlaneFitOptions::default()).unwrap_err();
+    assert!(
+        err.to_string()
+            .starts_with("the stripe points of all 2 images lie on one line"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_input_errors_say_what_came() {
+    let truth = example_plane();
+    let poses = laser_board_poses(2);
+    let obs =
+        stripe_observations(&camera(), &poses, &truth, EXTENT, 4, 0.0, &mut Rng::new(1)).unwrap();
+    let one: Vec<_> = obs.iter().filter(|o| o.image == 0).cloned().collect();
+    let err = fit_plane(&one, &PlaneFitOptions::default()).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "requires at least 2 images with a stripe on the board, got 1"
+    );
+    assert_eq!(
+        LaserPlane::new(Vector3::zeros(), 0.1)
+            .unwrap_err()
+            .to_string(),
+        "laser_plane: needs a non-zero finite normal and a finite distance, got (0, 0, 0) and 0.1"
+    );
+    assert_eq!(
+        PlaneResidual::from_name("ray").unwrap_err().to_string(),
+        "residual: unknown residual 'ray' (expected image_px or point_to_plane)"
+    );
+    assert_eq!(
+        StripeMethod::from_name("peak").unwrap_err().to_string(),
+        "extractor: unknown extractor 'peak' (expected cog or ridge)"
+    );
+    let tiny = crate::image::GrayImage::new(4, 4, vec![0; 16]).unwrap();
+    assert_eq!(
+        extract_stripe(&tiny, None, &StripeOptions::default())
+            .unwrap_err()
+            .to_string(),
+        "stripe image: needs at least 8x8 pixels, got 4x4"
+    );
+}
+
+/// Mean and max |centre - truth| of a stripe, pixels, over the columns
+/// where both exist.
+fn centre_errors(stripe: &Stripe, truth: &[(usize, f64)]) -> (f64, f64, usize) {
+    let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0);
+    for p in &stripe.points {
+        let (idx, v) = match stripe.axis {
+            ScanAxis::Columns => (p.x_px as usize, p.y_px),
+            ScanAxis::Rows => (p.y_px as usize, p.x_px),
+        };
+        if let Some((_, t)) = truth.iter().find(|(i, _)| *i == idx) {
+            let e = (v - t).abs();
+            sum += e;
+            max = max.max(e);
+            n += 1;
+        }
+    }
+    (sum / n.max(1) as f64, max, n)
+}
+
+fn stripe_render(
+    width_px: f64,
+    ambient: f64,
+    noise: f64,
+) -> (
+    crate::image::GrayImage,
+    crate::image::GrayImage,
+    Vec<(usize, f64)>,
+) {
+    let cam = camera();
+    let target = Target::Chessboard {
+        cols: 9,
+        rows: 6,
+        square_m: 0.025,
+    };
+    let pose = board_pose(&target, (0.2, -0.15, 0.1), (0.0, 0.0, 0.5));
+    let mut laser = LaserStripe::new(example_plane());
+    laser.width_px = width_px;
+    laser.ambient = ambient;
+    let off_options = RenderOptions {
+        noise_sigma: noise,
+        seed: 3,
+        ..RenderOptions::default()
+    };
+    let on_options = RenderOptions {
+        laser: Some(laser),
+        seed: 4,
+        ..off_options.clone()
+    };
+    let off = render(&cam, &target, &pose, &off_options).unwrap().image;
+    let on = render(&cam, &target, &pose, &on_options).unwrap().image;
+    let truth = stripe_truth(&cam, &pose, &example_plane(), true);
+    (on, off, truth)
+}
+
+#[test]
+fn both_extractors_find_the_rendered_centre() {
+    let (on, off, truth) = stripe_render(5.0, 1.0, 2.0);
+    // Tolerances (px) with and without the laser-off image: the ridge
+    // detector's 2-D kernel spans the squares' edges under the stripe.
+    for (method, tol_off, tol_alone) in [
+        (StripeMethod::CentreOfGravity, 0.1, 0.15),
+        (StripeMethod::Ridge, 0.25, 0.3),
+    ] {
+        let options = StripeOptions {
+            method,
+            ..StripeOptions::default()
+        };
+        let with_off = extract_stripe(&on, Some(&off), &options).unwrap();
+        assert_eq!(with_off.axis, ScanAxis::Columns);
+        let (mean, _, n) = centre_errors(&with_off, &truth);
+        assert!(n > 550, "{method:?}: {n} centres");
+        assert!(
+            mean < tol_off,
+            "{method:?} with the laser-off image: mean error {mean} px"
+        );
+        // Dark image (a filtered camera), no laser-off image.
+        let (dark, _, truth) = stripe_render(5.0, 0.15, 2.0);
+        let alone = extract_stripe(&dark, None, &options).unwrap();
+        let (mean, _, n) = centre_errors(&alone, &truth);
+        let mut worst: Vec<(f64, f64, f64)> = alone
+            .points
+            .iter()
+            .filter_map(|p| {
+                let t = truth.iter().find(|(i, _)| *i == p.x_px as usize)?;
+                Some((p.x_px, p.y_px, t.1))
+            })
+            .collect();
+        worst.sort_by(|a, b| (b.1 - b.2).abs().total_cmp(&(a.1 - a.2).abs()));
+        worst.truncate(8);
+        assert!(
+            n > 550 && mean < tol_alone,
+            "{method:?} dark: {:?} {n} centres, mean error {mean} px, worst {worst:?}",
+            alone.axis
+        );
+    }
+}

@@ -1,0 +1,64 @@
+// Issue 39 on the page: the check step (10. Check). A saved calibration
+// file is loaded and checked against the live camera, Chromium's fake camera
+// playing rendered views of the board through that very camera: the verdict
+// shows (ok: the camera is the calibrated one), with the projection-shift
+// heat map and the refitted parameters. A second file gives the projection
+// difference of the two calibrations.
+import assert from 'node:assert/strict';
+import { mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { launch, shotsDir } from './harness.mjs';
+import { boardVideo, cameraJson } from './y4m.mjs';
+
+export const launchArgs = ['--use-fake-device-for-media-stream'];
+
+const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
+const file = (name, value) => ({ name, mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(value)) });
+
+export const tests = [
+  ['live check: a saved calibration against the fake camera shows a verdict, the shift map and the parameters', async (page, { url }) => {
+    const dir = mkdtempSync(join(tmpdir(), 'robocal-check-'));
+    let other = { close: async () => {} };
+    try {
+      // Six tilted views of the page's default board (chessboard 9x6, 30 mm), each held 10 frames.
+      const camera = cameraJson(640, 480);
+      const { path } = await boardVideo(page, dir, { spec: 'chessboard:9x6:30mm', camera, views: 6, hold: 10, seed: 7 });
+      other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
+      const p = await (await other.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
+      const errors = [];
+      p.on('pageerror', (e) => errors.push(e.message));
+      await p.context().grantPermissions(['camera'], { origin: url });
+      await p.goto(`${url}#check`);
+      await ready(p);
+      await p.locator('#step-check').waitFor({ state: 'visible', timeout: 10000 });
+      assert.equal(await p.isDisabled('#check-camera'), true, 'nothing to check before a calibration is loaded');
+      await p.setInputFiles('#check-file', file('camera.json', camera));
+      await p.waitForFunction(() => /^camera\.json \(json\): 640 × 480, fx 576\.0/.test(document.getElementById('check-file-info').textContent), null, { timeout: 10000 });
+      const t0 = Date.now();
+      await p.click('#check-camera');
+      await p.locator('#check-verdict').waitFor({ timeout: 90000 });
+      const seconds = (Date.now() - t0) / 1000;
+      const verdict = await p.getAttribute('#check-verdict', 'data-verdict');
+      const reasons = await p.$$eval('#check-reasons li', (els) => els.map((e) => e.textContent));
+      console.log(`     live check: ${verdict} in ${seconds.toFixed(1)} s ${reasons.join('; ')}`);
+      assert.ok(['ok', 'drifted', 'broken'].includes(verdict), verdict);
+      assert.equal(verdict, 'ok', `the calibrated camera itself: ${reasons.join('; ')}`);
+      assert.match(await p.textContent('#check-verdict'), /^OK: the camera agrees with its saved calibration\.$/);
+      assert.equal(await p.isVisible('#check-map'), true, 'the shift heat map');
+      assert.equal(await p.$$eval('#check-params tbody tr', (rows) => rows.length), 4);
+      assert.equal(await p.isHidden('#check-live'), true, 'the camera stops once the views are in');
+      await p.screenshot({ path: join(shotsDir, 'check-live-verdict.png'), fullPage: true });
+      // Another calibration (focal 2 % longer): the projection difference and its map.
+      const f = 0.9 * 640 * 1.02;
+      await p.setInputFiles('#check-other', file('longer.json', cameraJson(640, 480, { camera_matrix: [[f, 0, 319.5], [0, f, 239.5], [0, 0, 1]] })));
+      await p.locator('#check-diff').waitFor({ timeout: 10000 });
+      assert.match(await p.textContent('#check-diff'), /^camera\.json against longer\.json: projection shift worst \d+\.\d\d px at /);
+      assert.equal(await p.isVisible('#check-diff-map'), true);
+      assert.deepEqual(errors, []);
+    } finally {
+      await other.close();
+      rmSync(dir, { recursive: true, force: true });
+    }
+  }],
+];
