@@ -137,6 +137,18 @@ const RULES: &[Rule] = &[
         why: "the synthetic scenes serve tests and the demo, never a host",
     },
     Rule {
+        part: "laser",
+        allowed: Allowed::Never(&["calib", "handeye", "workflows", "io", "capture", "wasm"]),
+        scope: Scope::Everywhere,
+        why: "the laser stripe and plane are their own solver: pixels and points in, a plane out",
+    },
+    Rule {
+        part: "laser",
+        allowed: Allowed::Never(&["synth"]),
+        scope: Scope::Library,
+        why: "the laser solver never depends on the renderer (tests may render stripes)",
+    },
+    Rule {
         part: "api",
         allowed: Allowed::Never(&["wasm"]),
         scope: Scope::Everywhere,
