@@ -302,6 +302,11 @@ export interface DistortionModels {
     p1: number; p2: number; s1: number; s2: number; s3: number; s4: number;
     tau_x: number; tau_y: number;
   };
+  /** Splined stereographic (after mrcal): the stereographic projection plus a B-spline correction of degree `order` over `nx x ny` control points spanning `u_max` (stereographic units) each way; `control` = `[dx0, dy0, dx1, dy1, ...]`, `2 nx ny` values; `smoothness` the calibration's prior weight. */
+  splined: {
+    order: number; nx: number; ny: number; u_max: [number, number];
+    smoothness: number; control: number[];
+  };
 }
 
 /** A lens model name (`model` of the calibration inputs and reports). */
