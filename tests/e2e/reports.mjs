@@ -65,7 +65,11 @@ export const tests = [
     await page.keyboard.press('ArrowLeft');
     await page.keyboard.press('ArrowLeft');
     await page.waitForFunction(() => location.hash === '#target');
+    // End: the last step, the field check of a saved calibration (step 10).
     await page.keyboard.press('End');
+    await page.waitForFunction(() => location.hash === '#check');
+    assert.deepEqual(await visibleStep(page), ['step-check']);
+    await page.keyboard.press('ArrowLeft');
     await page.waitForFunction(() => location.hash === '#share');
     assert.deepEqual(await visibleStep(page), ['step-share']);
     await shot('share-by-keys');
@@ -197,7 +201,10 @@ export const tests = [
     const payload = JSON.parse(inflateRawSync(Buffer.from(link.split('#share=')[1], 'base64url')).toString('utf8'));
     const sizes = Object.fromEntries(['camera', 'handeye'].flatMap((k) => Object.entries(payload[k].result).map(([n, v]) => [`${k}.${n}`, JSON.stringify(v).length])));
     console.log(`     share link: ${link.length} characters (JSON ${JSON.stringify(payload).length} bytes)`);
-    assert.ok(link.length < 6000, `share link ${link.length} characters; JSON sizes ${JSON.stringify(sizes)}`);
+    // Under 6,500 characters: far inside what browsers and servers take in a
+    // URL (8 KB request lines), with the hand-eye's work-point error (its
+    // verdict and advice, ~680 bytes of JSON) since session 21.
+    assert.ok(link.length < 6500, `share link ${link.length} characters; JSON sizes ${JSON.stringify(sizes)}`);
     // What the link holds: the results, not the detections.
     assert.equal(payload.camera.result.views.length, 12);
     assert.equal(payload.camera.result.views[0].residuals_px, undefined);
