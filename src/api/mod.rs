@@ -37,6 +37,7 @@
 pub mod camera;
 #[cfg(test)]
 pub(crate) mod camera_tests;
+mod camera_views;
 pub mod check;
 mod choices;
 pub mod detect;

@@ -2,6 +2,7 @@
 //! examples and the web app's demo button. Deterministic for a given seed on
 //! every platform (native and wasm).
 
+mod albedo;
 mod bow;
 pub mod clutter;
 pub mod demo;
