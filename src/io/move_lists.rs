@@ -10,6 +10,7 @@
 //! configuration, and joint limits are the controller's to check.
 
 use super::pose_formats::{values_from_pose, AngleUnit, LengthUnit, PoseFormat};
+use super::RobotPose;
 use crate::error::{Error, Result};
 use crate::handeye::Pose;
 
@@ -129,6 +130,30 @@ pub fn format_move_list(poses: &[Pose], list: MoveList, name: &str) -> String {
         }
     }
     out
+}
+
+/// The text for the robot visiting `poses` (`base_from_gripper`, metres)
+/// in order, in the format named `name`: a program ([`MoveList`]: `ur-script`,
+/// `kuka-krl`, `abb-rapid`, named `robocal_plan`) or a pose table in any
+/// [`PoseFormat`] robocal reads (`ur`, `kuka`, `abb`, ..., in that format's
+/// default units, rows named `plan_01`, `plan_02`, ...). `None` when `name`
+/// is neither (what `robocal plan --export --format` writes).
+pub fn plan_export(poses: &[Pose], name: &str) -> Option<String> {
+    if let Ok(list) = name.parse::<MoveList>() {
+        return Some(format_move_list(poses, list, "robocal_plan"));
+    }
+    let format = PoseFormat::from_name(name)?;
+    let (length, angle) = format.default_units();
+    let rows: Vec<RobotPose> = poses
+        .iter()
+        .enumerate()
+        .map(|(i, p)| RobotPose {
+            name: Some(format!("plan_{:02}", i + 1)),
+            line: i + 1,
+            base_from_gripper: *p,
+        })
+        .collect();
+    Some(super::format_poses(&rows, format, length, angle))
 }
 
 #[cfg(test)]
