@@ -57,7 +57,7 @@ export class PlanView {
       h('label', {}, 'Current robot pose (base_from_gripper) ', h('input', { id: 'plan-robot-pose', size: 70, spellcheck: false })),
       h('label', {}, 'Read as ', h('select', { id: 'plan-pose-format' }, PRESETS.map(([v, t]) => h('option', { value: v, selected: v === 'xyz_quat_xyzw' }, v === 'xyz_quat_xyzw' ? `${t} (m)` : t)))),
       h('div', { class: 'row' },
-        field('plan-poses', 'Poses ', '12', { type: 'number', min: 3, max: 60, step: 1 }),
+        field('plan-count', 'Poses ', '12', { type: 'number', min: 3, max: 60, step: 1 }),
         field('plan-max-tilt', 'Max tilt (deg) ', '40', { type: 'number', min: 5, max: 80, step: 1 }),
         field('plan-distance-min', 'Distance from (mm) ', '', { type: 'number', min: 1, step: 1, placeholder: 'current −20 %' }),
         field('plan-distance-max', 'to (mm) ', '', { type: 'number', min: 1, step: 1, placeholder: 'current +20 %' })),
@@ -102,7 +102,7 @@ export class PlanView {
     const he = this.store.session.handeye.result;
     const guessKey = setup === 'eye-in-hand' ? 'gripper_from_camera' : 'gripper_from_target';
     const guess = he && he[guessKey] ? { translation_m: he[guessKey].translation_m, quaternion_xyzw: he[guessKey].quaternion_xyzw } : undefined;
-    const poses = Number($('plan-poses').value);
+    const poses = Number($('plan-count').value);
     const maxTilt = Number($('plan-max-tilt').value);
     if (!Number.isInteger(poses) || poses < 3) throw new Error('Poses: a whole number, at least 3');
     if (!(maxTilt > 0)) throw new Error('Max tilt: a positive number of degrees');
