@@ -27,7 +27,7 @@ export const MOVE_FORMATS = [
   ['xyz_quat_xyzw', 'Pose table: x y z qx qy qz qw (m)', 'robocal_plan_xyzw.csv'],
 ];
 
-const poseLine = (p) => [...p.translation_m, ...p.quaternion_xyzw].map((v) => num(v, 6)).join(',');
+const poseLine = (p) => [...p.translation_m, ...p.quaternion_xyzw].map((v) => String(Number(v.toFixed(9)))).join(',');
 
 export class PlanView {
   constructor(store, engine, robot) {
