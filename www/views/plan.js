@@ -147,7 +147,7 @@ export class PlanView {
     const motion = h('p', { class: 'hint' }, `Travel ${num(r.travel_m * 1000, 0)} mm from the current pose, ${r.candidates} candidates considered.`);
     this.formatSelect = h('select', { id: 'plan-format' }, MOVE_FORMATS.map(([v, t]) => h('option', { value: v }, t)));
     this.formatSelect.addEventListener('change', () => this.preview());
-    this.listOut = h('pre', { id: 'plan-move-list', class: 'export-preview' });
+    this.listOut = h('pre', { id: 'plan-move-list', class: 'export', tabindex: 0, 'aria-label': 'move list preview' });
     this.listStatus = h('p', { id: 'plan-move-status', class: 'hint' });
     const b = (id, label, text, f) => h('button', { type: 'button', id, 'aria-label': label, onclick: f }, text);
     fill(this.out, predicted, (r.notes || []).map((n) => message('info', n)), poses, motion,
