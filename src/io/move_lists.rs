@@ -189,4 +189,23 @@ mod tests {
             "format: unknown move list 'fanuc' (valid: ur-script, kuka-krl, abb-rapid)"
         );
     }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn plan_export_writes_programs_and_pose_tables() {
+        let p = Pose::from_parts(
+            Translation3::new(0.5, 0.1, 0.8),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+        );
+        let poses = [p, p, p];
+        let ur = plan_export(&poses, "ur-script").unwrap();
+        assert_eq!(ur.matches("movel(p[").count(), 3, "{ur}");
+        assert!(ur.contains("def robocal_plan():"), "{ur}");
+        let rapid = plan_export(&poses, "ABB-RAPID").unwrap();
+        assert_eq!(rapid.matches("MoveL [[").count(), 3, "{rapid}");
+        // A pose table in the format's default units (KUKA: mm, degrees).
+        let kuka = plan_export(&poses, "kuka").unwrap();
+        assert!(kuka.contains("plan_03"), "{kuka}");
+        assert!(kuka.contains("500"), "{kuka}");
+        assert!(plan_export(&poses, "lego").is_none());
+    }
 }
