@@ -1731,6 +1731,60 @@ export interface DiffReport {
   projection_shift_px: ProjectionDiff;
 }
 
+/** The input JSON of `plan_handeye_poses` (docs/pose-plan.md; `robocal plan`'s flags as keys). */
+export interface PlanRequest {
+  setup: 'eye-in-hand' | 'eye-to-hand';
+  /** The robot's current pose. */
+  base_from_gripper: PoseInput;
+  /** The camera's view of the target from the current pose (e.g. a calibration report view's, or PnP). */
+  camera_from_target: PoseInput;
+  /** The camera: its JSON, or a camera file's text (robocal JSON, OpenCV YAML/XML, ROS camera_info). */
+  camera: Camera | string;
+  /** The board points in the target frame, metres (e.g. from `target_points`, z = 0). */
+  board_m: Vec3[];
+  /** A rough gripper_from_camera (eye-in-hand) or gripper_from_target (eye-to-hand); default identity. */
+  guess?: PoseInput;
+  /** Number of poses (default 15). */
+  poses?: number;
+  /** Largest tilt of the board against the camera's view, degrees (default 40). */
+  max_tilt_deg?: number;
+  /** Largest roll about the optical axis from the current view, degrees (default 60). */
+  max_roll_deg?: number;
+  /** Working distance range, camera to board centre, metres (default the current distance -20 % .. +20 %). */
+  distance_m?: [number, number];
+  /** Box the flange stays in, base frame, metres: two opposite corners. */
+  flange_box_m?: [Vec3, Vec3];
+  /** Every board point at least this far inside the image, px (default 20). */
+  margin_px?: number;
+  /** Corner noise the prediction assumes, px (default 0.3). */
+  pixel_sigma_px?: number;
+}
+
+/** One planned pose, in visiting order from the current pose. */
+export interface PlanPose {
+  base_from_gripper: PoseReport;
+  /** The camera's predicted view of the target there. */
+  camera_from_target: PoseReport;
+  tilt_deg: number;
+  distance_m: number;
+  roll_deg: number;
+}
+
+/** The output JSON of `plan_handeye_poses` (what `robocal plan` writes). */
+export interface PlanReport {
+  kind: 'handeye-plan';
+  poses: PlanPose[];
+  /** The hand-eye error at the work point these poses reach. */
+  predicted: WorkPointError;
+  motion: MotionStats;
+  /** Flange travel along the tour from the current pose, metres. */
+  travel_m: number;
+  /** Candidates that passed the limits. */
+  candidates: number;
+  notes: string[];
+  robocal_version: string;
+}
+
 // ---------------------------------------------------------------------------
 // Function -> JSON map
 
@@ -1813,6 +1867,10 @@ export interface RobocalJson {
   check_camera: [CheckRequest, CheckReport];
   /** `diff_cameras(request)` -> the projection difference of two calibration files. */
   diff_cameras: [DiffRequest, DiffReport];
+  /** `plan_handeye_poses(request)` -> robot poses for a hand-eye calibration from one view of the target, with the predicted error at the work point (docs/pose-plan.md). */
+  plan_handeye_poses: [PlanRequest, PlanReport];
+  /** `plan_move_list(JSON.stringify(plan), format)` returns the text for the robot, not JSON: a program (`ur-script`, `kuka-krl`, `abb-rapid`) or a pose table in a pose format robocal reads (`ur`, `kuka`, `abb`, `fanuc`, `yaskawa`, `staubli`, `xyz_quat_xyzw`, ...), as `robocal plan --export --format` writes it. */
+  plan_move_list: [PlanReport, never];
 }
 
 /** What `read_camera_file` returns: the camera (what a rig input's `cameras[i].camera` takes to hold its intrinsics) and the format it was read as. */

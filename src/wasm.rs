@@ -1,5 +1,5 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
-//! and camera_file.rs, check.rs, demo.rs, lens_models.rs, live_capture.rs, rig_frames.rs,
+//! and camera_file.rs, check.rs, demo.rs, lens_models.rs, live_capture.rs, plan.rs, rig_frames.rs,
 //! rig_handeye.rs and targets.rs beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
@@ -19,6 +19,7 @@ mod check;
 mod demo;
 mod lens_models;
 mod live_capture;
+mod plan;
 mod rig_frames;
 mod rig_handeye;
 mod targets;
@@ -27,6 +28,7 @@ pub use check::{check_camera, diff_cameras};
 pub use demo::{render_demo, DemoData};
 pub use lens_models::lens_models;
 pub use live_capture::LiveCapture;
+pub use plan::{plan_handeye_poses, plan_move_list};
 pub use rig_frames::rig_frame_keys;
 pub use rig_handeye::calibrate_rig_handeye;
 use targets::target_from;

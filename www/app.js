@@ -11,6 +11,7 @@ import { CameraView } from './views/camera.js';
 import { loadLensModels } from './views/lens.js';
 import { RobotView } from './views/robot.js';
 import { HandEyeView } from './views/handeye.js';
+import { PlanView } from './views/plan.js';
 import { WorkflowsView } from './views/workflows.js';
 import { RigView } from './views/rig.js';
 import { ExportView } from './views/export.js';
@@ -185,6 +186,7 @@ async function startSteps(versionPromise) {
   const robot = new RobotView(store, engine);
   robotView = robot;
   const handeye = new HandEyeView(store, engine, robot);
+  const plan = new PlanView(store, engine, robot);
   const workflows = new WorkflowsView(store, engine);
   const rig = new RigView(store, engine, $('rig-panel'));
   new ExportView(store, engine);
@@ -215,6 +217,7 @@ async function startSteps(versionPromise) {
     camera.render();
     robot.render();
     handeye.render();
+    plan.render();
     workflows.render();
     rig.render();
     $('engine-status').textContent = readyText();

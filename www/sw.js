@@ -44,6 +44,7 @@ const SHELL = [
   'views/rig-robot.js',
   'views/rig-intrinsics.js',
   'views/lens.js',
+  'views/plan.js',
   'views/target.js',
   'views/workflows.js',
   'pkg/robocal.js',

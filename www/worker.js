@@ -159,6 +159,20 @@ handlers.check = async ({ request }) => {
   return JSON.parse(robocal.check_camera(request));
 };
 
+/** The hand-eye pose plan (plan_handeye_poses, docs/pose-plan.md); board_m from the session's target. */
+handlers.plan = async ({ request, target }) => {
+  await ready;
+  const r = JSON.parse(request);
+  r.board_m = JSON.parse(robocal.target_points(target)).map((p) => [p.x_m, p.y_m, 0]);
+  return JSON.parse(robocal.plan_handeye_poses(JSON.stringify(r)));
+};
+
+/** A plan's poses as a robot program or pose table (plan_move_list): the text. */
+handlers.planMoveList = async ({ report, format }) => {
+  await ready;
+  return robocal.plan_move_list(report, format);
+};
+
 /** The projection difference of two calibration files (diff_cameras). */
 handlers.diff = async ({ request }) => {
   await ready;

@@ -9,9 +9,8 @@ use robocal::api::handeye::camera_from_json;
 use robocal::api::plan::plan_json_value;
 use robocal::handeye::plan::{plan, PlanInput, PlanLimits, PlanNoise};
 use robocal::handeye::{Pose, Setup};
-use robocal::io::move_lists::{format_move_list, MoveList};
+use robocal::io::move_lists::plan_export;
 use robocal::io::pose_text::parse_pose_text;
-use robocal::io::{format_poses, PoseFormat, RobotPose};
 
 #[derive(clap::Args)]
 #[command(
@@ -254,31 +253,15 @@ pub fn run(args: PlanArgs) -> Result<(), CliError> {
             CliError::usage("plan", "--export needs --format NAME (e.g. ur, kuka-krl)")
         })?;
         let robot: Vec<Pose> = planned.poses.iter().map(|p| p.base_from_gripper).collect();
-        let text = match name.parse::<MoveList>() {
-            Ok(list) => format_move_list(&robot, list, "robocal_plan"),
-            Err(_) => {
-                let format = PoseFormat::from_name(name).ok_or_else(|| {
-                    CliError::usage(
-                        "plan",
-                        format!(
-                            "--format '{name}': not a pose format robocal reads nor a program \
-                             (ur-script, kuka-krl, abb-rapid)"
-                        ),
-                    )
-                })?;
-                let (l, a) = format.default_units();
-                let rows: Vec<RobotPose> = robot
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| RobotPose {
-                        name: Some(format!("plan_{:02}", i + 1)),
-                        line: i + 1,
-                        base_from_gripper: *p,
-                    })
-                    .collect();
-                format_poses(&rows, format, l, a)
-            }
-        };
+        let text = plan_export(&robot, name).ok_or_else(|| {
+            CliError::usage(
+                "plan",
+                format!(
+                    "--format '{name}': not a pose format robocal reads nor a program \
+                     (ur-script, kuka-krl, abb-rapid)"
+                ),
+            )
+        })?;
         super::write_output(Some(path), &text)?;
     }
     let json = serde_json::to_string_pretty(&plan_json_value(&planned))

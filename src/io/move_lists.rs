@@ -10,6 +10,7 @@
 //! configuration, and joint limits are the controller's to check.
 
 use super::pose_formats::{values_from_pose, AngleUnit, LengthUnit, PoseFormat};
+use super::RobotPose;
 use crate::error::{Error, Result};
 use crate::handeye::Pose;
 
@@ -131,6 +132,30 @@ pub fn format_move_list(poses: &[Pose], list: MoveList, name: &str) -> String {
     out
 }
 
+/// The text for the robot visiting `poses` (`base_from_gripper`, metres)
+/// in order, in the format named `name`: a program ([`MoveList`]: `ur-script`,
+/// `kuka-krl`, `abb-rapid`, named `robocal_plan`) or a pose table in any
+/// [`PoseFormat`] robocal reads (`ur`, `kuka`, `abb`, ..., in that format's
+/// default units, rows named `plan_01`, `plan_02`, ...). `None` when `name`
+/// is neither (what `robocal plan --export --format` writes).
+pub fn plan_export(poses: &[Pose], name: &str) -> Option<String> {
+    if let Ok(list) = name.parse::<MoveList>() {
+        return Some(format_move_list(poses, list, "robocal_plan"));
+    }
+    let format = PoseFormat::from_name(name)?;
+    let (length, angle) = format.default_units();
+    let rows: Vec<RobotPose> = poses
+        .iter()
+        .enumerate()
+        .map(|(i, p)| RobotPose {
+            name: Some(format!("plan_{:02}", i + 1)),
+            line: i + 1,
+            base_from_gripper: *p,
+        })
+        .collect();
+    Some(super::format_poses(&rows, format, length, angle))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -163,5 +188,24 @@ mod tests {
             "fanuc".parse::<MoveList>().unwrap_err().to_string(),
             "format: unknown move list 'fanuc' (valid: ur-script, kuka-krl, abb-rapid)"
         );
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn plan_export_writes_programs_and_pose_tables() {
+        let p = Pose::from_parts(
+            Translation3::new(0.5, 0.1, 0.8),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+        );
+        let poses = [p, p, p];
+        let ur = plan_export(&poses, "ur-script").unwrap();
+        assert_eq!(ur.matches("movel(p[").count(), 3, "{ur}");
+        assert!(ur.contains("def robocal_plan():"), "{ur}");
+        let rapid = plan_export(&poses, "ABB-RAPID").unwrap();
+        assert_eq!(rapid.matches("MoveL [[").count(), 3, "{rapid}");
+        // A pose table in the format's default units (KUKA: mm, degrees).
+        let kuka = plan_export(&poses, "kuka").unwrap();
+        assert!(kuka.contains("plan_03"), "{kuka}");
+        assert!(kuka.contains("500"), "{kuka}");
+        assert!(plan_export(&poses, "lego").is_none());
     }
 }

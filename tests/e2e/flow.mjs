@@ -1,6 +1,7 @@
 // The whole flow on the demo data: load, detect, solve the camera, read the
 // robot poses, solve the hand-eye, export every format, share a link that
-// opens read-only with the same numbers, and reload to find the session.
+// opens read-only with the same numbers, and reload to find the session;
+// then plan robot poses for hand-eye from one demo view (docs/pose-plan.md).
 // Ground truth is the demo scene's (src/synth/demo.rs): fx = fy = 900 px,
 // cx 511.5, cy 383.5, gripper_from_camera translation (30, -20, 100) mm.
 import assert from 'node:assert/strict';
@@ -95,5 +96,53 @@ export const tests = [
     await page.click('a[data-step=camera]');
     assert.equal(await cellValue(page, '#camera-params', 'fx'), fx);
     await shot('reloaded');
+  }],
+  ['plan robot poses for hand-eye on the demo', async (page, { url, shot }) => {
+    await page.goto(url);
+    await ready(page);
+    await page.click('#demo-button');
+    await page.waitForFunction(() => /12 with the target/.test(document.getElementById('image-summary').textContent), null, { timeout: 120000 });
+    await page.click('a[data-step=camera]');
+    await page.click('#solve-camera');
+    await page.locator('#camera-params').waitFor({ timeout: 60000 });
+    await page.click('a[data-step=robot]');
+    await page.locator('#pose-table').waitFor({ timeout: 20000 });
+    await page.click('a[data-step=handeye]');
+    // The rough hand-eye transform: the solved one.
+    await page.click('#solve-handeye');
+    await page.locator('#handeye-errors').waitFor({ timeout: 60000 });
+    // The current view: the first paired image, its robot pose prefilled as x,y,z,qx,qy,qz,qw (m).
+    await page.waitForFunction(() => document.getElementById('plan-view').options.length === 12, null, { timeout: 10000 });
+    const now = await page.inputValue('#plan-robot-pose');
+    assert.equal(now.split(',').length, 7, now);
+    const N = 9;
+    await page.fill('#plan-count', String(N));
+    await page.fill('#plan-max-tilt', '35');
+    await page.click('#plan-run');
+    await page.waitForFunction(() => document.querySelector('#plan-poses, #plan-results .msg-error'), null, { timeout: 120000 });
+    assert.equal(await page.$('#plan-results .msg-error'), null, await page.textContent('#plan-results'));
+    assert.equal(await page.$$eval('#plan-poses tbody tr', (rows) => rows.length), N);
+    const predicted = await page.textContent('#plan-predicted');
+    const bound = Number(/work point: (\S+) mm \(95 %\)/.exec(predicted)[1]);
+    assert.ok(bound > 0 && bound < 10, predicted);
+    // The 3-D view: the flange frames drawn (coloured pixels on the light background).
+    const drawn = await page.$eval('#plan-3d', (c) => {
+      const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - d[i + 1]) > 40 || Math.abs(d[i + 1] - d[i + 2]) > 40) n++;
+      return n;
+    });
+    assert.ok(drawn > 500, `coloured pixels in the 3-D view: ${drawn}`);
+    // The UR script: one movel per pose.
+    await page.waitForFunction(() => /^ur-script: \d+ bytes/.test(document.getElementById('plan-move-status').textContent), null, { timeout: 10000 });
+    const script = await page.textContent('#plan-move-list');
+    assert.equal(script.split('\n').filter((l) => l.trim().startsWith('movel(p[')).length, N, script.slice(0, 300));
+    // Another format: the KUKA KRL program, one LIN per pose.
+    await page.selectOption('#plan-format', 'kuka-krl');
+    await page.waitForFunction(() => /^kuka-krl: \d+ bytes/.test(document.getElementById('plan-move-status').textContent), null, { timeout: 10000 });
+    const krl = await page.textContent('#plan-move-list');
+    assert.equal(krl.split('\n').filter((l) => l.trim().startsWith('LIN ')).length, N, krl.slice(0, 300));
+    console.log(`     demo plan: ${N} poses, ${predicted}`);
+    await shot('plan');
   }],
 ];

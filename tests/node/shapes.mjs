@@ -191,6 +191,14 @@ const report = all.report;
 const poses = JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', {}))));
 output('read_robot_poses', poses);
 assert.ok(poses.parsed, 'the demo CSV has a header');
+// The hand-eye pose plan (docs/pose-plan.md): from the first view and its robot pose; its UR script.
+{
+  const boardM = JSON.parse(robocal.target_points(meta.target_spec)).map((p) => [p.x_m, p.y_m, 0]);
+  const plan = call('plan_handeye_poses', { setup: 'eye-in-hand', base_from_gripper: poses.parsed.poses[0].base_from_gripper, camera_from_target: report.views[0].camera_from_target, camera: report.camera, board_m: boardM, poses: 6, max_tilt_deg: 35 });
+  assert.equal(plan.poses.length, 6);
+  const script = robocal.plan_move_list(JSON.stringify(input('plan_move_list', plan)), 'ur-script');
+  assert.equal(script.split('\n').filter((l) => l.trim().startsWith('movel(')).length, 6);
+}
 output('read_robot_poses', JSON.parse(robocal.read_robot_poses(meta.poses_csv, JSON.stringify(input('read_robot_poses', { format: 'ur', length_unit: 'm', angle_unit: null, direction: 'base_from_gripper' })))), 'read_robot_poses ur');
 const bare = meta.poses_csv.trim().split('\n').slice(1).map((l) => l.split(',').slice(1).join(' ')).join('\n');
 const ambiguous = output('read_robot_poses', JSON.parse(robocal.read_robot_poses(bare, '')), 'read_robot_poses bare');

@@ -52,6 +52,18 @@ const check = JSON.parse(robocal.check_camera(JSON.stringify({ calibration: JSON
 assert.equal(check.verdict, 'ok', check.reasons.join('; '));
 assert.equal(check.projection_shift_px.map.length, 40);
 assert.ok(check.projection_shift_px.worst < check.thresholds.shift_px, 'worst ' + check.projection_shift_px.worst);
+// The hand-eye pose plan (docs/pose-plan.md) from the first demo view and its robot pose, and its UR script.
+const robotPoses = JSON.parse(robocal.read_robot_poses(meta.poses_csv, '')).parsed.poses;
+const boardM = JSON.parse(robocal.target_points(meta.target_spec)).map((p) => [p.x_m, p.y_m, 0]);
+const planRequest = { setup: 'eye-in-hand', base_from_gripper: robotPoses[0].base_from_gripper, camera_from_target: report.views[0].camera_from_target, camera: report.camera, board_m: boardM, poses: 8 };
+const plan = JSON.parse(robocal.plan_handeye_poses(JSON.stringify(planRequest)));
+assert.equal(plan.kind, 'handeye-plan');
+assert.equal(plan.poses.length, 8);
+assert.ok(plan.predicted.bound95_mm > 0, 'predicted ' + JSON.stringify(plan.predicted));
+const urScript = robocal.plan_move_list(JSON.stringify(plan), 'ur-script');
+assert.equal(urScript.split('movel(p[').length - 1, 8);
+assert.match(robocal.plan_move_list(JSON.stringify(plan), 'kuka'), /plan_08/);
+assert.throws(() => robocal.plan_move_list(JSON.stringify(plan), 'lego'), { message: /not a pose format robocal reads nor a program/ });
 const yaml = robocal.export_report(JSON.stringify(report), 'opencv-yaml', '');
 assert.ok(yaml.startsWith('%YAML:1.0'), yaml.slice(0, 40));
 assert.match(yaml, /camera_matrix: !!opencv-matrix/);
