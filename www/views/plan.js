@@ -54,7 +54,7 @@ export class PlanView {
     this.viewSelect.addEventListener('change', () => this.prefill());
     const form = h('form', { class: 'form', id: 'plan-form' },
       h('label', {}, 'Current view (image) ', this.viewSelect),
-      h('label', {}, 'Current robot pose (base_from_gripper) ', h('input', { id: 'plan-robot-pose', size: 70, spellcheck: false })),
+      h('label', {}, 'Current robot pose (base_from_gripper) ', h('input', { id: 'plan-robot-pose', spellcheck: false })),
       h('label', {}, 'Read as ', h('select', { id: 'plan-pose-format' }, PRESETS.map(([v, t]) => h('option', { value: v, selected: v === 'xyz_quat_xyzw' }, v === 'xyz_quat_xyzw' ? `${t} (m)` : t)))),
       h('div', { class: 'row' },
         field('plan-count', 'Poses ', '12', { type: 'number', min: 3, max: 60, step: 1 }),
