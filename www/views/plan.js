@@ -59,8 +59,9 @@ export class PlanView {
       h('div', { class: 'row' },
         field('plan-count', 'Poses ', '12', { type: 'number', min: 3, max: 60, step: 1 }),
         field('plan-max-tilt', 'Max tilt (deg) ', '40', { type: 'number', min: 5, max: 80, step: 1 }),
-        field('plan-distance-min', 'Distance from (mm) ', '', { type: 'number', min: 1, step: 1, placeholder: 'current −20 %' }),
-        field('plan-distance-max', 'to (mm) ', '', { type: 'number', min: 1, step: 1, placeholder: 'current +20 %' })),
+        field('plan-distance-min', 'Distance from (mm) ', '', { type: 'number', min: 1, step: 1 }),
+        field('plan-distance-max', 'to (mm) ', '', { type: 'number', min: 1, step: 1 })),
+      h('p', { class: 'hint' }, 'The distance range starts at the chosen view\'s camera-to-target distance, 20 % either way.'),
       h('p', { class: 'hint' }, 'The camera is the solved one (step 3), the target the session\'s; the rough hand-eye transform is the solved one (above) when there is one, identity otherwise. Joint limits, reachability and collisions are not modelled: check the poses in simulation before running them.'),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'plan-run' }, 'Plan poses')));
     form.addEventListener('submit', (e) => { e.preventDefault(); this.plan(); });
@@ -80,7 +81,17 @@ export class PlanView {
 
   prefill() {
     const v = this.views().find((x) => x.name === this.viewSelect.value);
-    if (v) $('plan-robot-pose').value = poseLine(v.pose);
+    if (!v) return;
+    $('plan-robot-pose').value = poseLine(v.pose);
+    // The working distance range: the chosen view's camera-to-target
+    // distance (to the target origin), 20 % either way; robocal plan without
+    // --distance measures to the board centre.
+    const t = v.camera_from_target && v.camera_from_target.translation_m;
+    if (t) {
+      const mm = Math.hypot(...t) * 1000;
+      $('plan-distance-min').value = String(Math.round(mm * 0.8));
+      $('plan-distance-max').value = String(Math.round(mm * 1.2));
+    }
   }
 
   /** The request of plan_handeye_poses (without board_m: the worker adds the target's points). */
