@@ -155,7 +155,7 @@ fn camera_from_k(k: &[f64], width: u32, height: u32, distortion: Distortion) -> 
 }
 
 /// OpenCV's distortion vector to a model (`fisheye` for cv::fisheye's 4).
-fn distortion_from_opencv(d: &[f64], fisheye: bool) -> Result<Distortion> {
+pub(super) fn distortion_from_opencv(d: &[f64], fisheye: bool) -> Result<Distortion> {
     let g = |i: usize| d.get(i).copied().unwrap_or(0.0);
     Ok(match (d.len(), fisheye) {
         (0, _) => Distortion::None,

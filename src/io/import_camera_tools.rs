@@ -254,32 +254,8 @@ pub(super) fn from_mrcal(text: &str) -> Result<Camera> {
             ),
         ));
     }
-    let c = &intrinsics[4..];
-    let g = |i: usize| c.get(i).copied().unwrap_or(0.0);
-    let distortion = match want {
-        0 => Distortion::None,
-        4 | 5 => Distortion::Brown {
-            k1: g(0),
-            k2: g(1),
-            p1: g(2),
-            p2: g(3),
-            k3: g(4),
-        },
-        _ => Distortion::Rational {
-            k1: g(0),
-            k2: g(1),
-            p1: g(2),
-            p2: g(3),
-            k3: g(4),
-            k4: g(5),
-            k5: g(6),
-            k6: g(7),
-            s1: g(8),
-            s2: g(9),
-            s3: g(10),
-            s4: g(11),
-        },
-    };
+    // mrcal's OPENCVn coefficients are OpenCV's, in OpenCV's order.
+    let distortion = super::import_camera::distortion_from_opencv(&intrinsics[4..], false)?;
     let camera = Camera {
         fx: intrinsics[0],
         fy: intrinsics[1],
