@@ -3,7 +3,7 @@
 //! at a 9x6 board (30 mm) at 0.5 m, 1280x960 at f = 1100 px, through the
 //! image path of `robocal handeye` (PnP with its covariance per view, the
 //! closed forms, the pose refinement, its leave-one-out repeatability and
-//! the checks of `handeye::quality::trust`).
+//! the checks of `handeye::quality::trust` and `handeye::quality::focal`).
 //!
 //! Each cell: eye-in-hand, pixel noise 0.2 px, robot noise 0.1 mm / 0.02 deg
 //! per axis, plus the misspecification named by the row. Columns: trials
@@ -11,16 +11,21 @@
 //! of its six components (rotation about x, y, z in the left frame and the
 //! translation x, y, z), trials that are not covered and carry no
 //! warning (silent wrong answers), trials whose std was widened to the
-//! leave-one-out spread, and trials warned that this spread is over 2x the
-//! model's.
+//! leave-one-out spread, trials warned that this spread is over 2x the
+//! model's, trials warned that the focal length disagrees with the robot's
+//! motion, and the coverage and silent share of the same trials without
+//! that focal check (the pose refinement alone, as before it).
 //!
 //! `cargo run --release --example handeye_coverage -- [TRIALS]` (default 100).
 
 use robocal::calib::pnp::camera_from_target_with_covariance;
 use robocal::calib::View;
 use robocal::camera::Camera;
-use robocal::handeye::solve::apply_pose_refinement_from_views;
-use robocal::handeye::{calibrate, HandEyeInput, HandEyeOptions, MotionPairs, Pose, Setup};
+use robocal::handeye::refine::over_poses::camera_noise_from_views;
+use robocal::handeye::solve::{apply_pose_refinement, apply_pose_refinement_from_views};
+use robocal::handeye::{
+    calibrate, HandEyeInput, HandEyeOptions, HandEyeResult, MotionPairs, Pose, Setup,
+};
 use robocal::synth::handeye_looking::{
     grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,
 };
@@ -38,9 +43,25 @@ struct Cell {
     focal_error: f64,
 }
 
-/// One trial: `(covered, covered by the model's std before widening,
-/// warned, widened, warned of a leave-one-out spread over 2x the model's)`.
-fn trial(cell: &Cell, seed: u64) -> Option<(bool, bool, bool, bool, bool)> {
+/// One trial's outcome.
+struct Outcome {
+    /// The truth within 3 reported std on every component.
+    covered: bool,
+    /// ... within 3 of the model's std (before any widening).
+    covered_before: bool,
+    /// Any warning.
+    warned: bool,
+    /// The std widened to the leave-one-out spread.
+    widened: bool,
+    /// Warned of a leave-one-out spread over 2x the model's.
+    spread_named: bool,
+    /// Warned that the focal length disagrees with the robot.
+    focal_named: bool,
+    /// Without the focal check: covered, and any warning.
+    without_focal_check: (bool, bool),
+}
+
+fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
     let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
     let config = LookingConfig {
         setup: Setup::EyeInHand,
@@ -81,30 +102,68 @@ fn trial(cell: &Cell, seed: u64) -> Option<(bool, bool, bool, bool, bool)> {
     };
     let mut result = calibrate(&input, &options).ok()?;
     let views: Vec<View> = pixels;
+    // The same pose refinement without the focal check (as before it).
+    let mut held = result.clone();
+    let (noise, _) = camera_noise_from_views(&input, &views, &used_camera);
+    apply_pose_refinement(&mut held, &input, noise, MotionPairs::All).ok()?;
     apply_pose_refinement_from_views(&mut result, &input, &views, &used_camera, MotionPairs::All)
         .ok()?;
-    let summary = result.pose_refinement.as_ref()?;
-    let std = &summary.camera_transform_std;
-    let dt = (result.x.translation.vector - scene.x_true.translation.vector) * 1e3;
-    let dr = (result.x.rotation * scene.x_true.rotation.inverse()).scaled_axis();
-    let within = |scale: f64| {
-        (0..3).all(|k| {
+    let covered = |r: &HandEyeResult, scale: f64| -> Option<bool> {
+        let std = &r.pose_refinement.as_ref()?.camera_transform_std;
+        let dt = (r.x.translation.vector - scene.x_true.translation.vector) * 1e3;
+        let dr = (r.x.rotation * scene.x_true.rotation.inverse()).scaled_axis();
+        Some((0..3).all(|k| {
             dt[k].abs() <= 3.0 * scale * std.translation_mm[k]
                 && dr[k].to_degrees().abs() <= 3.0 * scale * std.rotation_deg[k]
-        })
+        }))
     };
+    let within = |scale: f64| covered(&result, scale).unwrap_or(false);
+    if std::env::var("FOCAL_DEBUG").is_ok() {
+        // TEMP diagnostics
+        let fs = robocal::handeye::quality::focal::focal_scale(
+            Setup::EyeInHand,
+            &input.base_from_gripper,
+            &views,
+            &used_camera,
+            (&held.x, &held.y),
+        );
+        let freed = robocal::handeye::quality::focal::check_focal(
+            &held,
+            &input,
+            &views,
+            &used_camera,
+            MotionPairs::All,
+        );
+        let err = |x: &Pose| {
+            let dt = (x.translation.vector - scene.x_true.translation.vector) * 1e3;
+            dt.norm()
+        };
+        let std = &held
+            .pose_refinement
+            .as_ref()?
+            .camera_transform_std
+            .translation_mm;
+        eprintln!(
+            "DBG {} seed {seed} s {:?} held_err {:.3} held_std [{:.3} {:.3} {:.3}] freed_err {:?} covered {} held_covered {}",
+            cell.name,
+            fs.map(|f| (f.scale - 1.0, f.std, (f.scale - 1.0) / f.std)),
+            err(&held.x), std[0], std[1], std[2],
+            freed.as_ref().and_then(|f| f.freed.map(|(x, _)| err(&x))),
+            within(1.0), covered(&held, 1.0)?
+        );
+    }
+    let summary = result.pose_refinement.as_ref()?;
     let widened = summary.std_widened_by;
-    let spread_named = result
-        .warnings
-        .iter()
-        .any(|w| w.starts_with("uncertainty: the leave-one-out solutions spread"));
-    Some((
-        within(1.0),
-        within(1.0 / widened.unwrap_or(1.0)),
-        !result.warnings.is_empty(),
-        widened.is_some(),
-        spread_named,
-    ))
+    let named = |start: &str| result.warnings.iter().any(|w| w.starts_with(start));
+    Some(Outcome {
+        covered: within(1.0),
+        covered_before: within(1.0 / widened.unwrap_or(1.0)),
+        warned: !result.warnings.is_empty(),
+        widened: widened.is_some(),
+        spread_named: named("uncertainty: the leave-one-out solutions spread"),
+        focal_named: named("focal length:"),
+        without_focal_check: (covered(&held, 1.0)?, !held.warnings.is_empty()),
+    })
 }
 
 fn main() {
@@ -172,31 +231,40 @@ fn main() {
     ];
     println!(
         "| scene | trials | truth within 3 std (the model's std) | truth within 3 std (reported) \
-         | wrong without a warning | std widened | spread over 2x named |"
+         | wrong without a warning | std widened | spread over 2x named | focal length named \
+         | without the focal check: covered, wrong without a warning |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for cell in &cells {
         let (mut n, mut covered, mut before, mut silent, mut widened) = (0, 0, 0, 0, 0);
-        let mut named = 0;
+        let (mut named, mut focal, mut held_covered, mut held_silent) = (0, 0, 0, 0);
         for t in 0..trials {
-            if let Some((c, b, warned, w, over)) = trial(cell, 9000 + t) {
+            if let Some(o) = trial(cell, 9000 + t) {
                 n += 1;
-                covered += usize::from(c);
-                before += usize::from(b);
-                silent += usize::from(!c && !warned);
-                widened += usize::from(w);
-                named += usize::from(over);
+                covered += usize::from(o.covered);
+                before += usize::from(o.covered_before);
+                silent += usize::from(!o.covered && !o.warned);
+                widened += usize::from(o.widened);
+                named += usize::from(o.spread_named);
+                focal += usize::from(o.focal_named);
+                let (c, warned) = o.without_focal_check;
+                held_covered += usize::from(c);
+                held_silent += usize::from(!c && !warned);
             }
         }
         let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
         println!(
-            "| {} | {n} | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % |",
+            "| {} | {n} | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} %, \
+             {:.1} % |",
             cell.name,
             pct(before),
             pct(covered),
             pct(silent),
             pct(widened),
-            pct(named)
+            pct(named),
+            pct(focal),
+            pct(held_covered),
+            pct(held_silent)
         );
     }
 }

@@ -1074,6 +1074,18 @@ export interface PoseRefinementSummary {
   work_distance_m?: number;
   /** The std of a point at the working distance on the camera's optical axis, mm (root-sum-square over the axes): the hand-eye error where the camera looks. */
   work_point_std_mm?: number;
+  /** With image points: present when the camera's focal length disagrees with the robot's motion (fitted scale more than 3 of its jackknife std and 0.1 % from 1); the std then include the shift to the solution with the focal length freed. */
+  focal_check?: FocalCheck;
+}
+
+/** The focal length checked against the robot's motion (image path). */
+export interface FocalCheck {
+  /** The scale of fx and fy that fits the image points through the robot poses. */
+  scale: number;
+  /** Its jackknife std over the views. */
+  scale_std: number;
+  /** How far the solution with the focal length so scaled lies from the reported one: [mm, deg] of the camera transform; absent when that refit failed. */
+  freed_moves?: [number, number];
 }
 
 /** One robot pose and the image paired with it (`robocal handeye` with images only). */

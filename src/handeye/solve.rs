@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::handeye::closed_form::motion::{build_motions, motion_stats, MotionStats};
 use crate::handeye::closed_form::{axxb, axzb, scara};
 use crate::handeye::quality::checks;
+use crate::handeye::quality::focal::check_focal;
 use crate::handeye::quality::repeat::{repeatability, Repeatability};
 use crate::handeye::quality::residuals::{
     combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
@@ -412,7 +413,38 @@ pub fn apply_pose_refinement_from_views(
     let (camera_noise, warning) = camera_noise_from_views(input, views, camera);
     result.warnings.extend(warning);
     apply_pose_refinement(result, input, camera_noise, motion_pairs)?;
-    add_reprojection_rms(result, input, views, camera)
+    add_reprojection_rms(result, input, views, camera)?;
+    apply_focal_check(result, input, views, camera, motion_pairs);
+    Ok(())
+}
+
+/// The focal length checked against the robot's motion
+/// ([`crate::handeye::quality::focal::check_focal`]): when it disagrees,
+/// the shift to the freed solution joins the covariance (the std and the
+/// error at the working distance follow), the finding goes into
+/// `pose_refinement.focal_check` and its warning into the result.
+fn apply_focal_check(
+    result: &mut HandEyeResult,
+    input: &HandEyeInput,
+    views: &[View],
+    camera: &Camera,
+    motion_pairs: MotionPairs,
+) {
+    use crate::handeye::quality::trust::{add_shift_to_covariance, work_point_std_mm};
+    let Some(found) = check_focal(result, input, views, camera, motion_pairs) else {
+        return;
+    };
+    let rotation = result.x.rotation.to_rotation_matrix().into_inner();
+    if let Some(summary) = result.pose_refinement.as_mut() {
+        if let Some((dx, dy)) = &found.shift {
+            add_shift_to_covariance(summary, dx, dy);
+            if let Some(d) = summary.work_distance_m {
+                summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, d));
+            }
+        }
+        summary.focal_check = Some(found.check);
+    }
+    result.warnings.push(found.warning);
 }
 
 /// With image points and the pose refinement run: the reprojection RMS of

@@ -9,6 +9,7 @@ mod support;
 mod handeye;
 mod handeye_charuco;
 mod handeye_field;
+mod handeye_focal;
 mod handeye_grid_boards;
 mod handeye_image_path;
 mod handeye_repeatability;

@@ -54,6 +54,7 @@ impl RefineMode {
             robot_noise,
             pixel_sigma_px,
             points_in_world: false,
+            focal_scale: false,
         })
     }
 }

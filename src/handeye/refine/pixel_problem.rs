@@ -71,6 +71,10 @@ pub struct RefineOptions {
     pub pixel_sigma_px: f64,
     /// Object points are world coordinates (control points): `y` = identity, held.
     pub points_in_world: bool,
+    /// Free one common scale of fx and fy, every other intrinsic held (the
+    /// focal check of [`crate::handeye::quality::focal`]); the refined
+    /// camera is returned. Ignored when `intrinsics` frees them all.
+    pub focal_scale: bool,
 }
 
 impl Default for RefineOptions {
@@ -80,6 +84,7 @@ impl Default for RefineOptions {
             robot_noise: RobotNoise::Trusted,
             pixel_sigma_px: 0.5,
             points_in_world: false,
+            focal_scale: false,
         }
     }
 }
@@ -91,7 +96,7 @@ pub struct RefineResult {
     pub x: Pose,
     /// Refined target pose.
     pub y: Pose,
-    /// The camera (refined when requested).
+    /// The camera (refined, or its focal length scaled, when requested).
     pub camera: Camera,
     /// Reprojection RMS over all points (px).
     pub reprojection_rms_px: f64,
@@ -116,6 +121,8 @@ struct Problem<'a> {
     views: &'a [View],
     camera: &'a Camera,
     intrinsics: bool,
+    /// One common scale of fx and fy is `global[12]` (when not `intrinsics`).
+    focal_scale: bool,
     pixel_weight: f64,
     prior: Option<(f64, f64)>,
 }
@@ -124,6 +131,17 @@ impl Problem<'_> {
     fn camera_at(&self, g: &[f64]) -> Result<Camera> {
         if self.intrinsics {
             self.camera.with_params(&g[12..])
+        } else if self.focal_scale {
+            let s = g[12];
+            if !(s.is_finite() && s > 0.0) {
+                return Err(Error::invalid(
+                    "focal_scale",
+                    format!("must be positive and finite, got {s}"),
+                ));
+            }
+            let mut camera = self.camera.clone();
+            (camera.fx, camera.fy) = (s * self.camera.fx, s * self.camera.fy);
+            Ok(camera)
         } else {
             Ok(self.camera.clone())
         }
@@ -223,6 +241,13 @@ impl BlockProblem for Problem<'_> {
                     if self.intrinsics {
                         jg.view_mut((0, 12), (2, d_cam.ncols()))
                             .copy_from(&(d_cam * self.pixel_weight));
+                    } else if self.focal_scale {
+                        // fx = s fx0, fy = s fy0: d pixel / d s.
+                        let (fx0, fy0) = (self.camera.fx, self.camera.fy);
+                        for row in 0..2 {
+                            jg[(row, 12)] =
+                                (d_cam[(row, 0)] * fx0 + d_cam[(row, 1)] * fy0) * self.pixel_weight;
+                        }
                     }
                     block.jac_global = jg;
                     if self.prior.is_some() {
@@ -310,8 +335,11 @@ pub fn refine(
     };
     let mut global = params_from_pose(x0).to_vec();
     global.extend(params_from_pose(&y_start).to_vec());
+    let focal_scale = options.focal_scale && !options.intrinsics;
     if options.intrinsics {
         global.extend(camera.params());
+    } else if focal_scale {
+        global.push(1.0);
     }
     let mut fixed_global = vec![false; global.len()];
     if options.points_in_world {
@@ -350,6 +378,7 @@ pub fn refine(
             views,
             camera,
             intrinsics: options.intrinsics,
+            focal_scale,
             pixel_weight: 1.0 / options.pixel_sigma_px,
             prior,
         };

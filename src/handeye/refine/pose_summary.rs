@@ -2,6 +2,7 @@
 //! object, [`PoseRefinementSummary`]) and the per-axis standard deviations
 //! of a transform from its covariance.
 
+use crate::handeye::quality::focal::FocalCheck;
 use crate::handeye::refine::pose_noise::NoiseLevels;
 use crate::handeye::refine::pose_problem::Covariance12;
 use serde::{Deserialize, Serialize};
@@ -80,6 +81,12 @@ pub struct PoseRefinementSummary {
     /// the camera looks ([`crate::handeye::quality::trust::work_point_std_mm`]).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub work_point_std_mm: Option<f64>,
+    /// With image points: present when the camera's focal length disagrees
+    /// with the robot's motion beyond its std; the std then include the
+    /// shift to the solution with the focal length freed
+    /// ([`crate::handeye::quality::focal`]).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub focal_check: Option<FocalCheck>,
 }
 
 #[cfg(test)]
@@ -106,6 +113,7 @@ impl PoseRefinementSummary {
             std_widened_by: None,
             work_distance_m: None,
             work_point_std_mm: None,
+            focal_check: None,
         }
     }
 }

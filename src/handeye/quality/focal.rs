@@ -1,0 +1,236 @@
+//! Does the camera's focal length agree with the robot's motion?
+//!
+//! The image path takes each view's camera pose from PnP with the given
+//! intrinsics. A focal length 1 % off puts every target about 1 % too far
+//! along the optical axis and turns the poses of tilted views; the robot's
+//! metric motions disagree with that, and the hand-eye solve with the
+//! intrinsics held is biased while its covariance (built on those
+//! intrinsics) says it is exact. Because the robot gives metric scale, the
+//! focal length is observable in the joint problem over the pixels and the
+//! robot poses: the reprojection least squares of
+//! [`crate::handeye::refine::pixel_problem`] with one common scale `s` of fx
+//! and fy free (`focal_scale`), the robot poses as given.
+//!
+//! The check ([`check_focal`]): `s` and its jackknife std over the views
+//! (leave one out, or one of [`FOCAL_GROUPS`] groups out on larger sets),
+//! which measures the robot's noise and kinematic error as well as the
+//! pixels' (the point-wise covariance of that problem would take the robot
+//! as exact). When `|s - 1|` exceeds [`FOCAL_ALERT_STD`] of that std and
+//! [`FOCAL_MIN`], the camera poses are computed again by PnP with fx and fy
+//! scaled by `s` and the pose refinement runs on them: the freed solution.
+//! The orchestrator adds the shift between the held (reported) and the
+//! freed solutions to the covariance and gives the warning, which says how
+//! far the focal length is off and what to do.
+
+use crate::calib::pnp::camera_from_target_with_covariance;
+use crate::calib::View;
+use crate::camera::Camera;
+use crate::handeye::quality::residuals::pose_difference;
+use crate::handeye::quality::trust::{pose_shift, MIN_LOO_VIEWS};
+use crate::handeye::refine::over_poses::refine_over_poses;
+use crate::handeye::refine::pixel_problem::{refine, RefineOptions};
+use crate::handeye::refine::pose_noise::CameraNoise;
+use crate::handeye::solve::{HandEyeInput, HandEyeResult};
+use crate::handeye::{MotionPairs, Pose, Setup};
+use serde::{Deserialize, Serialize};
+
+/// The focal length is named as off when its fitted scale is more than
+/// this many of its jackknife std from 1 ...
+pub const FOCAL_ALERT_STD: f64 = 3.0;
+/// ... and more than this (relative) from 1: smaller differences move the
+/// hand-eye translation by well under its std at any working distance.
+pub const FOCAL_MIN: f64 = 1e-3;
+/// Most jackknife groups (each a refit without its views): larger sets
+/// leave out one group of every `n / FOCAL_GROUPS`-th view at a time.
+pub const FOCAL_GROUPS: usize = 30;
+
+/// The focal scale that fits the pixels through the robot poses: fx and fy
+/// times `scale` (about 1 when the intrinsics and the robot agree).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FocalScale {
+    /// The fitted scale of fx and fy.
+    pub scale: f64,
+    /// Its jackknife std over the views.
+    pub std: f64,
+}
+
+/// What [`check_focal`] found when the focal length disagrees with the
+/// robot: the report's `pose_refinement.focal_check` object.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FocalCheck {
+    /// The scale of fx and fy that fits the pixels through the robot poses.
+    pub scale: f64,
+    /// Its jackknife std over the views.
+    pub scale_std: f64,
+    /// How far the freed solution (camera poses from PnP with the scaled
+    /// focal length, pose refinement again) lies from the reported one:
+    /// (mm, degrees) of the camera transform; absent when that refit failed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub freed_moves: Option<[f64; 2]>,
+}
+
+/// The finding of [`check_focal`], for the orchestrator to write.
+#[derive(Debug, Clone)]
+pub struct FocalFinding {
+    /// The report's object.
+    pub check: FocalCheck,
+    /// The freed solution `(x, y)`, when its refit ran.
+    pub freed: Option<(Pose, Pose)>,
+    /// The shift from the reported to the freed camera and target
+    /// transforms (`[rotation (rad, left frame); translation (m)]` each).
+    pub shift: Option<([f64; 6], [f64; 6])>,
+    /// The warning.
+    pub warning: String,
+}
+
+/// The focal scale of the joint pixel problem and its jackknife std,
+/// started from `(x, y)`; `None` with fewer than [`MIN_LOO_VIEWS`] views or
+/// when the fits fail.
+pub fn focal_scale(
+    setup: Setup,
+    base_from_gripper: &[Pose],
+    views: &[View],
+    camera: &Camera,
+    (x, y): (&Pose, &Pose),
+) -> Option<FocalScale> {
+    let n = views.len();
+    if n < MIN_LOO_VIEWS || base_from_gripper.len() != n {
+        return None;
+    }
+    let options = RefineOptions {
+        focal_scale: true,
+        ..Default::default()
+    };
+    let full = refine(setup, base_from_gripper, views, camera, x, y, &options).ok()?;
+    let scale = full.camera.fx / camera.fx;
+    let groups = n.min(FOCAL_GROUPS);
+    let runs: Vec<f64> = (0..groups)
+        .filter_map(|g| {
+            let keep: Vec<usize> = (0..n).filter(|i| i % groups != g).collect();
+            let robots: Vec<Pose> = keep.iter().map(|&i| base_from_gripper[i]).collect();
+            let kept: Vec<View> = keep.iter().map(|&i| views[i].clone()).collect();
+            refine(
+                setup,
+                &robots,
+                &kept,
+                &full.camera,
+                &full.x,
+                &full.y,
+                &options,
+            )
+            .ok()
+            .map(|r| r.camera.fx / camera.fx)
+            .filter(|s| s.is_finite())
+        })
+        .collect();
+    if runs.len() + 1 < groups || runs.len() < 2 {
+        return None;
+    }
+    let m = runs.len() as f64;
+    let mean = runs.iter().sum::<f64>() / m;
+    let var = (m - 1.0) / m * runs.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
+    (scale.is_finite() && var.is_finite()).then(|| FocalScale {
+        scale,
+        std: var.sqrt(),
+    })
+}
+
+/// Check the focal length of `camera` against the robot's motion (module
+/// docs) for an image-path result whose pose refinement ran; `None` when
+/// it agrees or cannot be checked (too few views, parallel rotation axes).
+pub fn check_focal(
+    result: &HandEyeResult,
+    input: &HandEyeInput,
+    views: &[View],
+    camera: &Camera,
+    motion_pairs: MotionPairs,
+) -> Option<FocalFinding> {
+    if result.pose_refinement.is_none() || !result.unobservable_translation.is_empty() {
+        return None;
+    }
+    let fit = focal_scale(
+        input.setup,
+        &input.base_from_gripper,
+        views,
+        camera,
+        (&result.x, &result.y),
+    )?;
+    let off = fit.scale - 1.0;
+    if !(off.abs() > FOCAL_ALERT_STD * fit.std && off.abs() > FOCAL_MIN) {
+        return None;
+    }
+    let freed = freed_solution(result, input, views, camera, fit.scale, motion_pairs);
+    let moves = freed.map(|(x, _)| pose_difference(&result.x, &x));
+    let shift = freed.map(|(x, y)| (pose_shift(&result.x, &x), pose_shift(&result.y, &y)));
+    let key = input.setup.camera_key();
+    let what = match moves {
+        Some((mm, deg)) => format!(
+            "with the focal length scaled by {:.4} (fx {:.1} px, fy {:.1} px) {key} moves by \
+             {mm:.2} mm and {deg:.3} deg, which its std now includes",
+            fit.scale,
+            camera.fx * fit.scale,
+            camera.fy * fit.scale
+        ),
+        None => format!(
+            "the refit with the focal length scaled by {:.4} failed, so the std do not include \
+             its effect",
+            fit.scale
+        ),
+    };
+    let warning = format!(
+        "focal length: the camera's focal length disagrees with the robot's motion by {:.2} % \
+         ({:.1} std): fitted through the robot poses, the image points want fx and fy {} by \
+         that much; {what}. Recalibrate the camera's intrinsics (with the focus and zoom of \
+         these images), or check the target's square size and the robot's accuracy",
+        100.0 * off.abs(),
+        off.abs() / fit.std.max(f64::MIN_POSITIVE),
+        if off > 0.0 { "longer" } else { "shorter" },
+    );
+    Some(FocalFinding {
+        check: FocalCheck {
+            scale: fit.scale,
+            scale_std: fit.std,
+            freed_moves: moves.map(|(mm, deg)| [mm, deg]),
+        },
+        freed,
+        shift,
+        warning,
+    })
+}
+
+/// The pose refinement on camera poses from PnP with fx and fy scaled by
+/// `scale` (each view's covariance from the same fit), started from the
+/// result's solutions; `None` when a PnP or the refinement fails.
+fn freed_solution(
+    result: &HandEyeResult,
+    input: &HandEyeInput,
+    views: &[View],
+    camera: &Camera,
+    scale: f64,
+    motion_pairs: MotionPairs,
+) -> Option<(Pose, Pose)> {
+    let mut scaled = camera.clone();
+    (scaled.fx, scaled.fy) = (camera.fx * scale, camera.fy * scale);
+    let mut poses = Vec::with_capacity(views.len());
+    let mut covariances = Vec::with_capacity(views.len());
+    for v in views {
+        let (pose, _, cov) = camera_from_target_with_covariance(&scaled, v).ok()?;
+        poses.push(pose);
+        covariances.push(cov);
+    }
+    let freed_input = HandEyeInput {
+        setup: input.setup,
+        base_from_gripper: input.base_from_gripper.clone(),
+        camera_from_target: poses,
+    };
+    let found = refine_over_poses(
+        result,
+        &freed_input,
+        CameraNoise::PerView(covariances),
+        motion_pairs,
+        true,
+        None,
+    )
+    .ok()?;
+    found.refined.map(|r| (r.x, r.y))
+}
