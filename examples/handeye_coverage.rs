@@ -118,40 +118,6 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
         }))
     };
     let within = |scale: f64| covered(&result, scale).unwrap_or(false);
-    if std::env::var("FOCAL_DEBUG").is_ok() {
-        // TEMP diagnostics
-        let fs = robocal::handeye::quality::focal::focal_scale(
-            Setup::EyeInHand,
-            &input.base_from_gripper,
-            &views,
-            &used_camera,
-            (&held.x, &held.y),
-        );
-        let freed = robocal::handeye::quality::focal::check_focal(
-            &held,
-            &input,
-            &views,
-            &used_camera,
-            MotionPairs::All,
-        );
-        let err = |x: &Pose| {
-            let dt = (x.translation.vector - scene.x_true.translation.vector) * 1e3;
-            dt.norm()
-        };
-        let std = &held
-            .pose_refinement
-            .as_ref()?
-            .camera_transform_std
-            .translation_mm;
-        eprintln!(
-            "DBG {} seed {seed} s {:?} held_err {:.3} held_std [{:.3} {:.3} {:.3}] freed_err {:?} covered {} held_covered {}",
-            cell.name,
-            fs.map(|f| (f.scale - 1.0, f.std, (f.scale - 1.0) / f.std)),
-            err(&held.x), std[0], std[1], std[2],
-            freed.as_ref().and_then(|f| f.freed.map(|(x, _)| err(&x))),
-            within(1.0), covered(&held, 1.0)?
-        );
-    }
     let summary = result.pose_refinement.as_ref()?;
     let widened = summary.std_widened_by;
     let named = |start: &str| result.warnings.iter().any(|w| w.starts_with(start));
