@@ -280,6 +280,7 @@ pub fn refine_over_poses(
         std_widened_by: None,
         work_distance_m: None,
         work_point_std_mm: None,
+        work_point: None,
     };
     let mut repeatability = None;
     if let Some((samples, seed)) = resampling {
