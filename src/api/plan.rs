@@ -12,9 +12,9 @@
 //! `pixel_sigma_px` is not given; without either it assumes 0.3 px.
 
 use crate::api::handeye::camera_from_json;
+use crate::calib::View;
 use crate::error::{Error, Result};
 use crate::geometry::{PoseInput, PoseJson};
-use crate::calib::View;
 use crate::handeye::plan::{
     pixel_sigma_from_view, plan, PixelNoiseSource, Plan, PlanInput, PlanLimits, PlanNoise,
 };

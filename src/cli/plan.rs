@@ -178,42 +178,40 @@ pub fn run(args: PlanArgs) -> Result<(), CliError> {
         .ok_or_else(|| CliError::usage("plan", "--target SPEC is required"))?;
     let target = parse_target("plan", spec)?;
     let board_m = target.object_points().into_iter().map(|(_, p)| p).collect();
-    let (camera_from_target, measured_sigma) = match (
-        args.image.as_deref(),
-        args.camera_pose.as_deref(),
-    ) {
-        (Some(image), None) => {
-            let outcomes = detect_images(
-                &[image.to_string()],
-                &target,
-                &super::detect_options_of(Some(spec)),
-                &super::ImageLimits::default(),
-                Some(1),
-            )?;
-            match outcomes.into_iter().next() {
-                Some(Outcome::Found(detection, _)) => {
-                    let (object, pixels) = detection.correspondences();
-                    let view = robocal::calib::View::new("", object, pixels);
-                    let (pose, sigma) = pixel_sigma_from_view(&camera, &view)
-                        .map_err(|e| CliError::from(e).in_file(image))?;
-                    (pose, Some(sigma))
+    let (camera_from_target, measured_sigma) =
+        match (args.image.as_deref(), args.camera_pose.as_deref()) {
+            (Some(image), None) => {
+                let outcomes = detect_images(
+                    &[image.to_string()],
+                    &target,
+                    &super::detect_options_of(Some(spec)),
+                    &super::ImageLimits::default(),
+                    Some(1),
+                )?;
+                match outcomes.into_iter().next() {
+                    Some(Outcome::Found(detection, _)) => {
+                        let (object, pixels) = detection.correspondences();
+                        let view = robocal::calib::View::new("", object, pixels);
+                        let (pose, sigma) = pixel_sigma_from_view(&camera, &view)
+                            .map_err(|e| CliError::from(e).in_file(image))?;
+                        (pose, Some(sigma))
+                    }
+                    Some(Outcome::Failed(_, message)) => {
+                        return Err(CliError::Io(format!(
+                            "{image}: detection failed: {message}"
+                        )))
+                    }
+                    None => return Err(CliError::Io(format!("{image}: not read"))),
                 }
-                Some(Outcome::Failed(_, message)) => {
-                    return Err(CliError::Io(format!(
-                        "{image}: detection failed: {message}"
-                    )))
-                }
-                None => return Err(CliError::Io(format!("{image}: not read"))),
             }
-        }
-        (None, Some(path)) => (one_pose("--camera-pose", path)?, None),
-        _ => {
-            return Err(CliError::usage(
-                "plan",
-                "give the current view: --image FILE or --camera-pose FILE (one of them)",
-            ))
-        }
-    };
+            (None, Some(path)) => (one_pose("--camera-pose", path)?, None),
+            _ => {
+                return Err(CliError::usage(
+                    "plan",
+                    "give the current view: --image FILE or --camera-pose FILE (one of them)",
+                ))
+            }
+        };
     let guess = match args.guess.as_deref() {
         Some(path) => one_pose("--guess", path)?,
         None => Pose::identity(),

@@ -353,8 +353,11 @@ fn planned_poses_reach_the_predicted_error_and_beat_a_random_plan() {
 /// the rendered current view (its PnP residual).
 #[test]
 fn planned_poses_reach_the_predicted_error_on_rendered_images() {
-    let (trials, random) = (16, 6);
-    let run = crate::plan_trials::run((trials, random), 3, PlanNoise::default(), true).unwrap();
+    // 64 trials: the RMS of an error dominated by one or two directions
+    // then has a relative spread of about 7 % (1 / sqrt(2 x 64 x 1.5));
+    // 16 trials (12 %) read 1.32 on seed 3 where 40 read 1.20 and seed 4
+    // 1.06 (examples/plan_monte_carlo.rs).
+    let run = crate::plan_trials::run((64, 6), 11, PlanNoise::default(), true).unwrap();
     eprintln!(
         "rendered plan: assumed {:.3} px (detector {:.3} px), predicted RMS {:.4} mm, \
          achieved {:.4} mm over {} trials; {} random plans {:.4} mm",
