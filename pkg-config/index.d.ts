@@ -1070,9 +1070,9 @@ export interface PoseRefinementSummary {
   closed_form_reprojection_rms_px?: number;
   /** Present when the leave-one-out solutions spread wider than the noise model predicts: the factor the std (and the covariance's square root) were widened by. */
   std_widened_by?: number;
-  /** The working distance: the median camera-target distance, m. */
+  /** The working distance: the mean distance from the camera to the target's centre over the views, m (to the target origin with camera poses only). */
   work_distance_m?: number;
-  /** The std of a point at the working distance on the camera's optical axis, mm (root-sum-square over the axes): the hand-eye error where the camera looks. */
+  /** The std at the default work point (work_point_error.rms_mm), mm (root-sum-square over the axes): the hand-eye error where the camera looks. */
   work_point_std_mm?: number;
   /** With image points: present when the camera's focal length disagrees with the robot's motion (fitted scale more than 3 of its jackknife std and 0.1 % from 1); the std then include the shift to the solution with the focal length freed. */
   focal_check?: FocalCheck;
@@ -1122,7 +1122,7 @@ export interface HandEyeReportBase {
   refinement?: RefinementSummary;
   /** Present when the pose refinement ran (pose input; the primary transforms are then the refined ones). */
   pose_refinement?: PoseRefinementSummary;
-  /** The hand-eye error at the work point (the target centre on the camera's optical axis at the working distance); with the pose refinement. */
+  /** The hand-eye error at the work point (by default the target's centre where the views see it, at their mean distance; docs/handeye-field.md); with the pose refinement. */
   work_point_error?: WorkPointError;
   /** The same at the tool centre point (`tcp_m` given). */
   tcp_error?: WorkPointError;
@@ -1137,6 +1137,8 @@ export interface HandEyeReportBase {
 export interface WorkPointError {
   /** `target centre` or `tool centre point`. */
   point: string;
+  /** How the point was chosen: the default at the board points' centre (image input) or the target origin (camera poses only), or the tool centre point given. */
+  placement?: 'board-centre' | 'target-origin' | 'tool-centre-point';
   /** The point (m) in `frame`. */
   point_m: Vec3;
   /** `gripper` (eye-in-hand) or `base` (eye-to-hand). */
@@ -1768,8 +1770,10 @@ export interface PlanRequest {
   flange_box_m?: [Vec3, Vec3];
   /** Every board point at least this far inside the image, px (default 20). */
   margin_px?: number;
-  /** Corner noise the prediction assumes, px (default 0.3). */
+  /** Corner noise the prediction assumes, px per axis (default: measured on `view_px`, else 0.3). */
   pixel_sigma_px?: number;
+  /** The current view's detected pixels of the `board_m` points, same order: the corner noise is measured on them (their PnP residual) when `pixel_sigma_px` is not given. */
+  view_px?: [number, number][];
 }
 
 /** One planned pose, in visiting order from the current pose. */
@@ -1794,6 +1798,13 @@ export interface PlanReport {
   /** Candidates that passed the limits. */
   candidates: number;
   notes: string[];
+  /** The noise the prediction assumed; `pixel_sigma_from`: `default` (0.3 px), `given` or `measured-on-view`. */
+  noise: {
+    pixel_sigma_px: number;
+    pixel_sigma_from: 'default' | 'given' | 'measured-on-view';
+    robot_rotation_deg: number;
+    robot_translation_mm: number;
+  };
   robocal_version: string;
 }
 

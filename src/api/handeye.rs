@@ -42,6 +42,8 @@ use crate::handeye::quality::checks::{
     rank_pose_candidates, recommend_candidate, setup_advice, CandidateScore, SetupAdvice,
 };
 use crate::handeye::quality::intrinsics_move::{std_from_json, warn_intrinsic_move};
+use crate::handeye::quality::trust::place_work_point;
+use crate::handeye::quality::work_point::Placement;
 use crate::handeye::refine::over_pixels::RefineMode;
 use crate::handeye::report::HandEyeReport;
 use crate::handeye::solve::{
@@ -49,7 +51,7 @@ use crate::handeye::solve::{
 };
 use crate::handeye::{HandEyeMethod, Pose, Setup};
 use crate::target::Detection;
-use nalgebra::{Point2, Point3};
+use nalgebra::{Point2, Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// Default expected pixel noise of the refinement (px).
@@ -460,6 +462,30 @@ pub fn solve_handeye(
             )?;
         }
     }
+    if let (Some(points), Some(summary)) = (images, result.pose_refinement.as_mut()) {
+        // The board points are known: the default work point is their
+        // centre, not the target frame's origin.
+        if let Some(centre) = board_centre(points.views) {
+            place_work_point(
+                summary,
+                &result.x,
+                &input.camera_from_target,
+                &centre,
+                Placement::BoardCentre,
+            );
+        }
+    }
     result.warnings.splice(0..0, warnings_first);
     HandEyeReport::checked(&result)
+}
+
+/// The centre of the board points of every view (target frame; a point
+/// seen in several views counts as often), `None` without points.
+pub fn board_centre(views: &[View]) -> Option<Point3<f64>> {
+    let all: Vec<&Point3<f64>> = views.iter().flat_map(|v| &v.object_m).collect();
+    if all.is_empty() {
+        return None;
+    }
+    let sum = all.iter().fold(Vector3::zeros(), |a, p| a + p.coords);
+    Some(Point3::from(sum / all.len() as f64))
 }

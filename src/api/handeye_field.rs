@@ -10,11 +10,11 @@
 //! "image_px": [u, v], "view": i}]` (points touched with the tool centre
 //! point; needs the camera).
 
-use crate::api::handeye::{solve_handeye, ImagePoints};
+use crate::api::handeye::{board_centre, solve_handeye, ImagePoints};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::handeye::quality::verify::{holdout_report, touch_test, TouchPoint};
-use crate::handeye::quality::work_point::work_point_error;
+use crate::handeye::quality::work_point::{work_point_error, Placement};
 use crate::handeye::report::HandEyeReport;
 use crate::handeye::solve::{HandEyeInput, HandEyeOptions};
 use crate::handeye::{Chain, Pose, Setup};
@@ -80,15 +80,9 @@ fn transforms(report: &HandEyeReport) -> Result<(Pose, Pose)> {
 /// The centre of the board points of every view (target frame), or the
 /// target origin without image points.
 fn target_centre(images: Option<&ImagePoints>) -> Point3<f64> {
-    let Some(points) = images else {
-        return Point3::origin();
-    };
-    let all: Vec<&Point3<f64>> = points.views.iter().flat_map(|v| &v.object_m).collect();
-    if all.is_empty() {
-        return Point3::origin();
-    }
-    let sum = all.iter().fold(Vector3::zeros(), |a, p| a + p.coords);
-    Point3::from(sum / all.len() as f64)
+    images
+        .and_then(|p| board_centre(p.views))
+        .unwrap_or_else(Point3::origin)
 }
 
 /// [`solve_handeye`] with the [`FieldRequest`]: the last `holdout` pairs
@@ -137,7 +131,7 @@ pub fn solve_handeye_field(
                 input.setup,
                 &x,
                 &q,
-                "tool centre point",
+                Placement::ToolCentrePoint,
             );
         }
     }

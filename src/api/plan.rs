@@ -5,14 +5,21 @@
 //! pose, "camera": camera JSON, "board_m": [[x, y, z]...], "guess": pose
 //! (optional), "poses": 15, "max_tilt_deg": 40, "max_roll_deg": 60,
 //! "distance_m": [min, max], "flange_box_m": [[x0, y0, z0], [x1, y1, z1]],
-//! "margin_px": 20, "pixel_sigma_px": 0.3}` (poses as [`PoseInput`]).
+//! "margin_px": 20, "pixel_sigma_px": 0.3, "view_px": [[u, v]...]}` (poses
+//! as [`PoseInput`]). `view_px`, the current view's detected pixels of the
+//! `board_m` points in the same order, lets the plan measure the corner
+//! noise on it ([`crate::handeye::plan::pixel_sigma_from_view`]) when
+//! `pixel_sigma_px` is not given; without either it assumes 0.3 px.
 
 use crate::api::handeye::camera_from_json;
+use crate::calib::View;
 use crate::error::{Error, Result};
 use crate::geometry::{PoseInput, PoseJson};
-use crate::handeye::plan::{plan, Plan, PlanInput, PlanLimits, PlanNoise};
+use crate::handeye::plan::{
+    pixel_sigma_from_view, plan, PixelNoiseSource, Plan, PlanInput, PlanLimits, PlanNoise,
+};
 use crate::handeye::{Pose, Setup};
-use nalgebra::Point3;
+use nalgebra::{Point2, Point3};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
@@ -40,6 +47,8 @@ struct PlanRequest {
     margin_px: Option<f64>,
     #[serde(default)]
     pixel_sigma_px: Option<f64>,
+    #[serde(default)]
+    view_px: Option<Vec<[f64; 2]>>,
 }
 
 fn pose(p: &PoseInput, field: &str) -> Result<Pose> {
@@ -70,6 +79,12 @@ pub fn plan_json_value(plan: &Plan) -> Value {
         "travel_m": plan.travel_m,
         "candidates": plan.candidates,
         "notes": plan.notes,
+        "noise": {
+            "pixel_sigma_px": plan.noise.pixel_sigma_px,
+            "pixel_sigma_from": plan.noise.pixel_sigma_from,
+            "robot_rotation_deg": plan.noise.robot_rotation_deg,
+            "robot_translation_mm": plan.noise.robot_translation_mm,
+        },
         "robocal_version": crate::VERSION,
     })
 }
@@ -98,11 +113,43 @@ pub fn plan_json(request_json: &str) -> Result<String> {
         flange_box_m: r.flange_box_m.map(|b| (b[0], b[1])),
         margin_px: r.margin_px.unwrap_or(d.margin_px),
     };
-    let noise = PlanNoise {
-        pixel_sigma_px: r
-            .pixel_sigma_px
-            .unwrap_or(PlanNoise::default().pixel_sigma_px),
-        ..PlanNoise::default()
+    let noise = match (r.pixel_sigma_px, &r.view_px) {
+        (Some(sigma), _) if !(sigma > 0.0 && sigma.is_finite()) => {
+            return Err(Error::invalid(
+                "pixel_sigma_px",
+                format!("{sigma}: a positive number of pixels"),
+            ))
+        }
+        (Some(sigma), _) => PlanNoise {
+            pixel_sigma_px: sigma,
+            pixel_sigma_from: PixelNoiseSource::Given,
+            ..PlanNoise::default()
+        },
+        (None, Some(pixels)) => {
+            if pixels.len() != input.board_m.len() {
+                return Err(Error::invalid(
+                    "view_px",
+                    format!(
+                        "{} pixels for {} board points (one per point of board_m, same order)",
+                        pixels.len(),
+                        input.board_m.len()
+                    ),
+                ));
+            }
+            let view = View::new(
+                "",
+                input.board_m.clone(),
+                pixels.iter().map(|p| Point2::new(p[0], p[1])).collect(),
+            );
+            let (_, sigma) = pixel_sigma_from_view(&input.camera, &view)
+                .map_err(|e| Error::invalid("view_px", e.to_string()))?;
+            PlanNoise {
+                pixel_sigma_px: sigma,
+                pixel_sigma_from: PixelNoiseSource::MeasuredOnView,
+                ..PlanNoise::default()
+            }
+        }
+        (None, None) => PlanNoise::default(),
     };
     let planned = plan(&input, &limits, &noise)?;
     crate::finite::check_finite("plan", &plan_json_value(&planned))?;

@@ -7,7 +7,9 @@ use super::robot_poses::{read_pose_source, read_robot_poses};
 use super::{parse_target, CliError};
 use robocal::api::handeye::camera_from_json;
 use robocal::api::plan::plan_json_value;
-use robocal::handeye::plan::{plan, PlanInput, PlanLimits, PlanNoise};
+use robocal::handeye::plan::{
+    pixel_sigma_from_view, plan, PixelNoiseSource, PlanInput, PlanLimits, PlanNoise,
+};
 use robocal::handeye::{Pose, Setup};
 use robocal::io::move_lists::plan_export;
 use robocal::io::pose_text::parse_pose_text;
@@ -25,7 +27,8 @@ use robocal::io::pose_text::parse_pose_text;
     after_help = "Output JSON: poses [{base_from_gripper, camera_from_target, tilt_deg,
 distance_m, roll_deg}] in visiting order from the current pose, predicted
 (the hand-eye error at the work point these poses reach: bound95_mm, rms_mm,
-verdict, shrink_by), motion, travel_m, candidates, notes. Joint limits,
+verdict, shrink_by), motion, travel_m, candidates, notes, noise (the noise the
+prediction assumed: pixel_sigma_px and where it comes from). Joint limits,
 reachability and collisions are not modelled: check the poses in simulation.
 --export writes the poses for the robot: a pose table in any --pose-format
 robocal reads (ur, kuka, abb, fanuc, ...), or a program: ur-script, kuka-krl,
@@ -88,9 +91,10 @@ pub struct PlanArgs {
     /// Every board point at least this far inside the image (px)
     #[arg(long, value_name = "PX", default_value_t = 20.0)]
     margin: f64,
-    /// Corner noise the prediction assumes (px)
-    #[arg(long, value_name = "PX", default_value_t = 0.3)]
-    pixel_noise: f64,
+    /// Corner noise the prediction assumes (px per axis; default: measured
+    /// on --image, its PnP residual; 0.3 with --camera-pose)
+    #[arg(long, value_name = "PX")]
+    pixel_noise: Option<f64>,
     /// Write the poses for the robot there (with --format)
     #[arg(long, value_name = "FILE")]
     export: Option<String>,
@@ -174,39 +178,40 @@ pub fn run(args: PlanArgs) -> Result<(), CliError> {
         .ok_or_else(|| CliError::usage("plan", "--target SPEC is required"))?;
     let target = parse_target("plan", spec)?;
     let board_m = target.object_points().into_iter().map(|(_, p)| p).collect();
-    let camera_from_target = match (args.image.as_deref(), args.camera_pose.as_deref()) {
-        (Some(image), None) => {
-            let outcomes = detect_images(
-                &[image.to_string()],
-                &target,
-                &super::detect_options_of(Some(spec)),
-                &super::ImageLimits::default(),
-                Some(1),
-            )?;
-            match outcomes.into_iter().next() {
-                Some(Outcome::Found(detection, _)) => {
-                    let (object, pixels) = detection.correspondences();
-                    let view = robocal::calib::View::new("", object, pixels);
-                    robocal::calib::pnp::camera_from_target(&camera, &view)
-                        .map_err(|e| CliError::from(e).in_file(image))?
-                        .0
+    let (camera_from_target, measured_sigma) =
+        match (args.image.as_deref(), args.camera_pose.as_deref()) {
+            (Some(image), None) => {
+                let outcomes = detect_images(
+                    &[image.to_string()],
+                    &target,
+                    &super::detect_options_of(Some(spec)),
+                    &super::ImageLimits::default(),
+                    Some(1),
+                )?;
+                match outcomes.into_iter().next() {
+                    Some(Outcome::Found(detection, _)) => {
+                        let (object, pixels) = detection.correspondences();
+                        let view = robocal::calib::View::new("", object, pixels);
+                        let (pose, sigma) = pixel_sigma_from_view(&camera, &view)
+                            .map_err(|e| CliError::from(e).in_file(image))?;
+                        (pose, Some(sigma))
+                    }
+                    Some(Outcome::Failed(_, message)) => {
+                        return Err(CliError::Io(format!(
+                            "{image}: detection failed: {message}"
+                        )))
+                    }
+                    None => return Err(CliError::Io(format!("{image}: not read"))),
                 }
-                Some(Outcome::Failed(_, message)) => {
-                    return Err(CliError::Io(format!(
-                        "{image}: detection failed: {message}"
-                    )))
-                }
-                None => return Err(CliError::Io(format!("{image}: not read"))),
             }
-        }
-        (None, Some(path)) => one_pose("--camera-pose", path)?,
-        _ => {
-            return Err(CliError::usage(
-                "plan",
-                "give the current view: --image FILE or --camera-pose FILE (one of them)",
-            ))
-        }
-    };
+            (None, Some(path)) => (one_pose("--camera-pose", path)?, None),
+            _ => {
+                return Err(CliError::usage(
+                    "plan",
+                    "give the current view: --image FILE or --camera-pose FILE (one of them)",
+                ))
+            }
+        };
     let guess = match args.guess.as_deref() {
         Some(path) => one_pose("--guess", path)?,
         None => Pose::identity(),
@@ -243,9 +248,24 @@ pub fn run(args: PlanArgs) -> Result<(), CliError> {
         flange_box_m,
         margin_px: args.margin,
     };
-    let noise = PlanNoise {
-        pixel_sigma_px: args.pixel_noise,
-        ..PlanNoise::default()
+    let noise = match (args.pixel_noise, measured_sigma) {
+        (Some(sigma), _) if !(sigma > 0.0 && sigma.is_finite()) => {
+            return Err(CliError::usage(
+                "plan",
+                format!("--pixel-noise {sigma}: a positive number of pixels"),
+            ))
+        }
+        (Some(sigma), _) => PlanNoise {
+            pixel_sigma_px: sigma,
+            pixel_sigma_from: PixelNoiseSource::Given,
+            ..PlanNoise::default()
+        },
+        (None, Some(sigma)) => PlanNoise {
+            pixel_sigma_px: sigma,
+            pixel_sigma_from: PixelNoiseSource::MeasuredOnView,
+            ..PlanNoise::default()
+        },
+        (None, None) => PlanNoise::default(),
     };
     let planned = plan(&input, &limits, &noise)?;
     if let Some(path) = args.export.as_deref() {

@@ -8,11 +8,12 @@ use crate::handeye::closed_form::motion::MotionStats;
 use crate::handeye::quality::repeat::Repeatability;
 use crate::handeye::quality::residuals::{Errors, MotionResidual, ViewResidual};
 use crate::handeye::quality::verify::{HoldoutReport, TouchReport};
-use crate::handeye::quality::work_point::{camera_axis_point, work_point_error, WorkPointError};
+use crate::handeye::quality::work_point::{work_point_error, WorkPointError};
 use crate::handeye::refine::over_pixels::RefinementSummary;
 use crate::handeye::refine::pose_summary::PoseRefinementSummary;
 use crate::handeye::solve::HandEyeResult;
 use crate::handeye::{Pose, Setup};
+use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 
 /// One robot pose and the image paired with it.
@@ -127,9 +128,10 @@ pub struct HandEyeReport {
     /// estimated noise levels, outlier views.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub pose_refinement: Option<PoseRefinementSummary>,
-    /// The hand-eye error at the work point (the target centre where the
-    /// camera looks, [`crate::handeye::quality::work_point`]), when the pose
-    /// refinement gave a covariance.
+    /// The hand-eye error at the work point (by default the target's centre
+    /// where the views see it, at their mean distance,
+    /// [`crate::handeye::quality::work_point`]), when the pose refinement
+    /// gave a covariance.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub work_point_error: Option<WorkPointError>,
     /// The same at the tool centre point, when one was given.
@@ -245,18 +247,19 @@ impl HandEyeReport {
     }
 }
 
-/// The error at the default work point: on the camera's optical axis at the
-/// working distance (`pose_refinement.work_distance_m`, the median
-/// camera-target distance), from the refinement's covariance.
+/// The error at the default work point (the target's centre where the
+/// views see it, at their mean distance: `pose_refinement.work_distance_m`,
+/// [`crate::handeye::quality::work_point`]), from the refinement's
+/// covariance.
 fn default_work_point_error(result: &HandEyeResult) -> Option<WorkPointError> {
     let summary = result.pose_refinement.as_ref()?;
-    let distance = summary.work_distance_m?;
-    let q = camera_axis_point(&result.x, distance);
+    let point = summary.work_point?;
+    let q = result.x * Point3::from(point.camera_m);
     work_point_error(
         &summary.covariance,
         result.setup,
         &result.x,
-        &q,
-        "target centre",
+        &q.coords,
+        point.placement,
     )
 }

@@ -11,11 +11,11 @@ use wasm_bindgen::prelude::*;
 /// Plan robot poses for a hand-eye calibration from one view of the
 /// target: the JSON request and report of `robocal::api::plan::plan_json`
 /// (`{"setup", "base_from_gripper", "camera_from_target", "camera",
-/// "board_m", "poses": 15, "max_tilt_deg", "distance_m", ...}` ->
-/// `{"kind": "handeye-plan", "poses": [{"base_from_gripper",
+/// "board_m", "poses": 15, "max_tilt_deg", "distance_m", "view_px", ...}`
+/// -> `{"kind": "handeye-plan", "poses": [{"base_from_gripper",
 /// "camera_from_target", "tilt_deg", "distance_m", "roll_deg"}],
 /// "predicted": {"bound95_mm", "rms_mm", "verdict", ...}, "motion",
-/// "travel_m", "candidates", "notes"}`).
+/// "travel_m", "candidates", "notes", "noise"}`).
 #[wasm_bindgen]
 pub fn plan_handeye_poses(request_json: &str) -> Result<String, JsError> {
     crate::api::plan::plan_json(request_json).map_err(js_error)

@@ -151,13 +151,40 @@ fn plan_writes_poses_a_program_and_its_predicted_error() {
         assert_eq!(plan["kind"], "handeye-plan");
         assert_eq!(plan["poses"].as_array().unwrap().len(), 10);
         assert!(plan["predicted"]["bound95_mm"].as_f64().unwrap() > 0.0);
+        assert_eq!(plan["predicted"]["placement"], "board-centre");
         assert!(
             run.2
                 .contains("note: joint limits, reachability and collisions are not modelled"),
             "{}",
             run.2
         );
+        // A camera pose, no image: nothing to measure the noise on.
+        assert_eq!(plan["noise"]["pixel_sigma_from"], "default");
+        assert_eq!(plan["noise"]["pixel_sigma_px"], 0.3);
+        assert!(
+            run.2
+                .contains("note: the prediction assumes 0.30 px corner noise, not measured"),
+            "{}",
+            run.2
+        );
     }
+    let given = support::robocal_in(
+        &dir,
+        &[&base[..], &["--pixel-noise", "0.1", "-o", "plan.json"]].concat(),
+    );
+    assert_eq!(given.0, 0, "{}", given.2);
+    let plan = read_json(&dir.join("plan.json"));
+    assert_eq!(plan["noise"]["pixel_sigma_from"], "given");
+    assert_eq!(plan["noise"]["pixel_sigma_px"], 0.1);
+    let negative = support::robocal_in(&dir, &[&base[..], &["--pixel-noise", "0"]].concat());
+    assert_eq!(negative.0, 2, "{}", negative.2);
+    assert!(
+        negative
+            .2
+            .contains("--pixel-noise 0: a positive number of pixels"),
+        "{}",
+        negative.2
+    );
     let bad = support::robocal_in(&dir, &[&base[..], &["--distance", "0.4,0.6"]].concat());
     assert_eq!(bad.0, 2, "{}", bad.2);
     assert!(

@@ -345,3 +345,40 @@ fn planned_poses_reach_the_predicted_error_and_beat_a_random_plan() {
         "planned {achieved} mm vs random {random} mm"
     );
 }
+
+/// Issue 39, part 3, on rendered images (tests/handeye/plan_trials.rs): the
+/// planned poses, rendered, detected and solved through the api, reach the
+/// plan's predicted RMS error at the work point within 20 %, and random
+/// plans of the same size do worse. The plan's pixel noise is measured on
+/// the rendered current view (its PnP residual).
+#[test]
+fn planned_poses_reach_the_predicted_error_on_rendered_images() {
+    // 64 trials: the RMS of an error dominated by one or two directions
+    // then has a relative spread of about 7 % (1 / sqrt(2 x 64 x 1.5));
+    // 16 trials (12 %) read 1.32 on seed 3 where 40 read 1.20 and seed 4
+    // 1.06 (examples/plan_monte_carlo.rs).
+    let run = crate::plan_trials::run((64, 6), 11, PlanNoise::default(), true).unwrap();
+    eprintln!(
+        "rendered plan: assumed {:.3} px (detector {:.3} px), predicted RMS {:.4} mm, \
+         achieved {:.4} mm over {} trials; {} random plans {:.4} mm",
+        run.assumed_sigma_px,
+        run.corner_rms_px,
+        run.predicted_mm,
+        run.planned_mm,
+        run.trials,
+        run.random_trials,
+        run.random_mm
+    );
+    assert!(
+        (run.planned_mm / run.predicted_mm - 1.0).abs() <= 0.2,
+        "achieved {} mm vs predicted {} mm",
+        run.planned_mm,
+        run.predicted_mm
+    );
+    assert!(
+        run.planned_mm < run.random_mm,
+        "planned {} mm vs random {} mm",
+        run.planned_mm,
+        run.random_mm
+    );
+}

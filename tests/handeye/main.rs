@@ -15,3 +15,4 @@ mod handeye_image_path;
 mod handeye_repeatability;
 mod handeye_rig;
 mod handeye_rig_coverage;
+mod plan_trials;

@@ -22,7 +22,10 @@
 //!    `margin_px`, and the flange stays in the box (when given).
 //! 3. **Choice.** Greedy A-optimal design: each step adds the candidate that
 //!    most lowers the predicted position variance at the work point (the
-//!    board centre on the optical axis at the middle distance), from the
+//!    board centre, on every candidate's optical axis, at the middle of the
+//!    distance range; the plan's `predicted` is then given where the
+//!    report's default puts it: the board centre at the planned views' mean
+//!    distance, [`crate::handeye::quality::work_point`]), from the
 //!    Fisher information of the pose refinement
 //!    ([`crate::handeye::refine::pose_problem::fisher_information`]) with
 //!    each view's camera pose covariance predicted from the board points
@@ -36,18 +39,24 @@
 //! flange box is the only workspace limit; check the poses in the robot's
 //! own simulator before running them.
 
+pub mod noise;
 pub mod order;
+
+pub use noise::pixel_sigma_from_view;
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::handeye::closed_form::motion::{build_motions, motion_stats, MotionStats};
-use crate::handeye::quality::work_point::{camera_axis_point, work_point_error, WorkPointError};
+use crate::handeye::quality::work_point::{
+    camera_axis_point, target_centre_camera, work_point_error, Placement, WorkPointError,
+};
 use crate::handeye::refine::pose_noise::{CameraNoise, NoiseModel};
 use crate::handeye::refine::pose_problem::{fisher_information, Covariance12};
 use crate::handeye::refine::pose_residual::PoseMeasurement;
 use crate::handeye::refine::pose_shape::predicted_covariance;
 use crate::handeye::{Chain, MotionPairs, Pose, Setup};
 use nalgebra::{Matrix3, Point2, Point3, Rotation3, UnitQuaternion, Vector3};
+use serde::Serialize;
 
 /// Most poses a plan holds.
 pub const MAX_PLAN_POSES: usize = 200;
@@ -85,11 +94,27 @@ impl Default for PlanLimits {
     }
 }
 
+/// Where the plan's pixel noise comes from (the plan JSON's
+/// `noise.pixel_sigma_from`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PixelNoiseSource {
+    /// The default 0.3 px (nothing measured, nothing given).
+    Default,
+    /// Given by the user (`--pixel-noise`, `pixel_sigma_px`).
+    Given,
+    /// Measured on the current view's image points ([`pixel_sigma_from_view`]).
+    MeasuredOnView,
+}
+
 /// The noise the prediction assumes.
 #[derive(Debug, Clone, Copy)]
 pub struct PlanNoise {
-    /// Corner noise (px, default 0.3).
+    /// Corner noise per axis (px, default 0.3; measured on the current
+    /// view when its image points are known: [`pixel_sigma_from_view`]).
     pub pixel_sigma_px: f64,
+    /// Where `pixel_sigma_px` comes from.
+    pub pixel_sigma_from: PixelNoiseSource,
     /// Robot rotation noise per axis (degrees, default 0.02).
     pub robot_rotation_deg: f64,
     /// Robot translation noise per axis (mm, default 0.1).
@@ -100,6 +125,7 @@ impl Default for PlanNoise {
     fn default() -> Self {
         PlanNoise {
             pixel_sigma_px: 0.3,
+            pixel_sigma_from: PixelNoiseSource::Default,
             robot_rotation_deg: 0.02,
             robot_translation_mm: 0.1,
         }
@@ -156,6 +182,8 @@ pub struct Plan {
     pub candidates: usize,
     /// What the user should know.
     pub notes: Vec<String>,
+    /// The noise the prediction assumed.
+    pub noise: PlanNoise,
 }
 
 /// The transforms the views are mapped through: eye-in-hand
@@ -451,7 +479,13 @@ pub fn plan(input: &PlanInput, limits: &PlanLimits, noise: &PlanNoise) -> Result
         .try_inverse()
         .ok_or_else(|| Error::degenerate("the planned poses leave the hand-eye unobservable"))?;
     let cov_rows = rows(&covariance);
-    let predicted = work_point_error(&cov_rows, input.setup, &x, &q, "target centre")
+    // The report's default work point for these views: the board centre
+    // (on every planned view's optical axis) at their mean distance.
+    let planned_views: Vec<Pose> = poses.iter().map(|p| p.camera_from_target).collect();
+    let q = target_centre_camera(&planned_views, &centre)
+        .map(|q_camera| (x * Point3::from(q_camera)).coords)
+        .unwrap_or(q);
+    let predicted = work_point_error(&cov_rows, input.setup, &x, &q, Placement::BoardCentre)
         .ok_or_else(|| Error::degenerate("the predicted covariance is not finite"))?;
     let chain = Chain::new(
         input.setup,
@@ -470,6 +504,18 @@ pub fn plan(input: &PlanInput, limits: &PlanLimits, noise: &PlanNoise) -> Result
          robot's simulator before running them"
             .to_string(),
     ];
+    match noise.pixel_sigma_from {
+        PixelNoiseSource::Default => notes.push(format!(
+            "the prediction assumes {:.2} px corner noise, not measured: give the current view's \
+             image (its PnP residual gives the detector's noise) or the noise you know",
+            noise.pixel_sigma_px
+        )),
+        PixelNoiseSource::MeasuredOnView => notes.push(format!(
+            "corner noise {:.3} px per axis, measured on the current view (its PnP residual)",
+            noise.pixel_sigma_px
+        )),
+        PixelNoiseSource::Given => {}
+    }
     if motion.angle_max_deg < 30.0 {
         notes.push(format!(
             "the largest rotation between two planned poses is {:.0} deg (30 or more is \
@@ -485,6 +531,7 @@ pub fn plan(input: &PlanInput, limits: &PlanLimits, noise: &PlanNoise) -> Result
         travel_m,
         candidates: candidates.len(),
         notes,
+        noise: *noise,
     })
 }
 

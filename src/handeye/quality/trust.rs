@@ -20,21 +20,23 @@
 //!    median: a focal-length error then moves the camera along its optical
 //!    axis without leaving a residual).
 //!
-//! Finally the error that matters to a user: the std of a point at the
-//! working distance on the camera's optical axis (the median camera-target
-//! distance), from the (widened) covariance of the camera transform.
+//! Finally the error that matters to a user: the std at the default work
+//! point (the target's centre where the views see it, at their mean
+//! distance: [`crate::handeye::quality::work_point::target_centre_camera`]),
+//! from the (widened) covariance of the camera transform.
 
 use crate::handeye::closed_form::motion::MotionStats;
 use crate::handeye::quality::checks::consistency;
 use crate::handeye::quality::repeat::Repeatability;
 use crate::handeye::quality::residuals::pose_difference;
+use crate::handeye::quality::work_point::{target_centre_camera, DefaultWorkPoint, Placement};
 use crate::handeye::refine::pose_noise::NoiseModel;
 use crate::handeye::refine::pose_problem::{refine, PoseRefineOptions};
 use crate::handeye::refine::pose_residual::PoseMeasurement;
 use crate::handeye::refine::pose_summary::{transform_std, PoseRefinementSummary};
 use crate::handeye::solve::HandEyeInput;
 use crate::handeye::{Pose, Setup};
-use nalgebra::{Matrix3, SMatrix, Vector3};
+use nalgebra::{Matrix3, Point3, SMatrix, Vector3};
 
 /// The covariance is widened when the leave-one-out spread exceeds it by
 /// more than this factor ...
@@ -169,17 +171,17 @@ pub fn geometry_warnings(views: usize, motion: &MotionStats, distances_m: &[f64]
     out
 }
 
-/// The std (mm, root-sum-square over the axes) of a point at `distance_m`
-/// on the camera's optical axis, in the frame of the camera transform's
-/// left side, from the refinement's covariance; `x_rotation` is the camera
+/// The std (mm, root-sum-square over the axes) of a point `point_camera`
+/// (camera frame, m), in the frame of the camera transform's left side,
+/// from the refinement's covariance; `x_rotation` is the camera
 /// transform's rotation (`gripper_from_camera` or `base_from_camera`).
 /// Rotation errors are in the left frame: `d(point) = d(t) - [R p]x d(theta)`.
 pub fn work_point_std_mm(
     summary: &PoseRefinementSummary,
     x_rotation: &Matrix3<f64>,
-    distance_m: f64,
+    point_camera: &Vector3<f64>,
 ) -> f64 {
-    let p = x_rotation * Vector3::new(0.0, 0.0, distance_m);
+    let p = x_rotation * point_camera;
     let skew = Matrix3::new(0.0, -p.z, p.y, p.z, 0.0, -p.x, -p.y, p.x, 0.0);
     let mut j = SMatrix::<f64, 3, 6>::zeros();
     j.fixed_view_mut::<3, 3>(0, 0).copy_from(&(-skew));
@@ -319,7 +321,9 @@ pub(crate) fn check_translation_scale(
 
 /// The uncertainty checked against the data ([`crate::handeye::quality::trust`]): widened
 /// to the leave-one-out spread of `repeatability` when that is larger (the
-/// warning returned), and the error at the working distance.
+/// warning returned), and the error at the default work point (the target
+/// frame's origin here; [`place_work_point`] moves it to the board centre
+/// when the board points are known).
 pub(crate) fn check_uncertainty(
     summary: &mut PoseRefinementSummary,
     x: &Pose,
@@ -329,20 +333,39 @@ pub(crate) fn check_uncertainty(
     let n = input.camera_from_target.len();
     let rotation = x.rotation.to_rotation_matrix().into_inner();
     let warning = repeatability.and_then(|rep| widen_to_leave_one_out(summary, rep, &rotation, n));
-    let mut d: Vec<f64> = input
-        .camera_from_target
-        .iter()
-        .map(|p| p.translation.vector.norm())
-        .filter(|v| v.is_finite())
-        .collect();
-    if d.is_empty() {
-        return warning;
-    }
-    d.sort_by(f64::total_cmp);
-    let distance = d[d.len() / 2];
-    summary.work_distance_m = Some(distance);
-    summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, distance));
+    place_work_point(
+        summary,
+        x,
+        &input.camera_from_target,
+        &Point3::origin(),
+        Placement::TargetOrigin,
+    );
     warning
+}
+
+/// Place the summary's default work point at the target point `centre`
+/// (target frame) as the views `camera_from_target` see it
+/// ([`target_centre_camera`]): `work_distance_m` (its mean distance),
+/// `work_point_std_mm` (the error there) and the point itself, which the
+/// report's `work_point_error` is computed at. Left unchanged when no view
+/// places it.
+pub fn place_work_point(
+    summary: &mut PoseRefinementSummary,
+    x: &Pose,
+    camera_from_target: &[Pose],
+    centre: &Point3<f64>,
+    placement: Placement,
+) {
+    let Some(q) = target_centre_camera(camera_from_target, centre) else {
+        return;
+    };
+    let rotation = x.rotation.to_rotation_matrix().into_inner();
+    summary.work_distance_m = Some(q.norm());
+    summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, &q));
+    summary.work_point = Some(DefaultWorkPoint {
+        camera_m: [q.x, q.y, q.z],
+        placement,
+    });
 }
 
 /// The frame name of the camera transform, for messages.
@@ -408,10 +431,10 @@ mod tests {
             row[k] = 1e-6; // (1 mrad)^2 for rotations, (1 mm)^2 for translations
         }
         let summary = PoseRefinementSummary::for_tests(cov);
-        let s = work_point_std_mm(&summary, &Matrix3::identity(), 0.5);
+        let s = work_point_std_mm(&summary, &Matrix3::identity(), &Vector3::new(0.0, 0.0, 0.5));
         assert!((s - (3.0f64 + 0.5).sqrt()).abs() < 1e-9, "{s}");
         // At the transform's origin only the translation counts.
-        let s0 = work_point_std_mm(&summary, &Matrix3::identity(), 0.0);
+        let s0 = work_point_std_mm(&summary, &Matrix3::identity(), &Vector3::zeros());
         assert!((s0 - 3f64.sqrt()).abs() < 1e-9, "{s0}");
     }
 }

@@ -1,5 +1,19 @@
 //! The hand-eye error where it matters: at a work point, in millimetres.
 //!
+//! **The default work point** is the target's centre where the views see
+//! it ([`target_centre_camera`]): each view's `camera_from_target` places
+//! the centre `c` (target frame) at `c_i = camera_from_target_i * c` in the
+//! camera frame; the point is taken in the mean of their directions
+//! `c_i / |c_i|`, at their mean distance `mean |c_i|` (the mean working
+//! distance), then carried into `x`'s left frame by the solved `x`.
+//! Eye-in-hand the target is one fixed point of the base, and the gripper
+//! frame sees it where the camera does from an average pose; eye-to-hand it
+//! is fixed in the gripper and rides through the base frame, where the
+//! fixed camera sees it on average. With image points `c` is the centre of
+//! the board points ([`Placement::BoardCentre`]); with camera poses only
+//! the board is unknown and `c` is the target frame's origin
+//! ([`Placement::TargetOrigin`]).
+//!
 //! The pose refinement's covariance of the camera transform `x`
 //! (`gripper_from_camera` or `base_from_camera`; rotation errors `w` in
 //! `x`'s left frame, translation errors `v`, see
@@ -23,11 +37,46 @@
 
 use crate::handeye::math::skew;
 use crate::handeye::{Pose, Setup};
-use nalgebra::{Matrix3, SMatrix, SymmetricEigen, Vector3};
+use nalgebra::{Matrix3, Point3, SMatrix, SymmetricEigen, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// The 95 % quantile of chi-squared with 3 degrees of freedom.
 pub const CHI2_3_95: f64 = 7.814_727_903_251_178;
+
+/// How a work point was placed (the `placement` key).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Placement {
+    /// The default with image points: the centre of the board points,
+    /// where the views see it, at their mean distance (module docs).
+    BoardCentre,
+    /// The default with camera poses only (the board points unknown): the
+    /// target frame's origin, where the views see it, at their mean
+    /// distance.
+    TargetOrigin,
+    /// The tool centre point the user gave.
+    ToolCentrePoint,
+}
+
+impl Placement {
+    /// The point's name in the report (`point`, the verdict).
+    pub fn point_name(self) -> &'static str {
+        match self {
+            Placement::BoardCentre | Placement::TargetOrigin => "target centre",
+            Placement::ToolCentrePoint => "tool centre point",
+        }
+    }
+}
+
+/// Where the default work point is (kept with the pose refinement's summary
+/// until the report is written: [`crate::handeye::quality::trust::place_work_point`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DefaultWorkPoint {
+    /// The point in the camera frame (m).
+    pub camera_m: [f64; 3],
+    /// How it was placed.
+    pub placement: Placement,
+}
 
 /// The hand-eye error at one point (the report's `work_point_error` and
 /// `tcp_error`).
@@ -35,6 +84,11 @@ pub const CHI2_3_95: f64 = 7.814_727_903_251_178;
 pub struct WorkPointError {
     /// What the point is: `target centre` or `tool centre point`.
     pub point: String,
+    /// How it was placed: `board-centre` or `target-origin` (the default,
+    /// with or without image points), `tool-centre-point` (given).
+    /// Absent in reports written before it existed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub placement: Option<Placement>,
     /// The point (metres) in `frame`.
     pub point_m: [f64; 3],
     /// `gripper` (eye-in-hand) or `base` (eye-to-hand): the left frame of
@@ -74,10 +128,36 @@ fn point_jacobian(x: &Pose, q: &Vector3<f64>) -> SMatrix<f64, 3, 6> {
     j
 }
 
-/// The default work point: the point `distance_m` in front of the camera on
-/// its optical axis (where it looks at the target), in `x`'s left frame.
+/// The point `distance_m` in front of the camera on its optical axis, in
+/// `x`'s left frame (the plan's views look at the board centre along it).
 pub fn camera_axis_point(x: &Pose, distance_m: f64) -> Vector3<f64> {
-    (x * nalgebra::Point3::new(0.0, 0.0, distance_m)).coords
+    (x * Point3::new(0.0, 0.0, distance_m)).coords
+}
+
+/// The default work point in the camera frame (module docs): the target
+/// point `centre` (target frame) as the views see it, in the mean of its
+/// directions at its mean distance. `None` without a view that places it
+/// in front of the camera at a finite distance.
+pub fn target_centre_camera(
+    camera_from_target: &[Pose],
+    centre: &Point3<f64>,
+) -> Option<Vector3<f64>> {
+    let seen: Vec<Vector3<f64>> = camera_from_target
+        .iter()
+        .map(|c| (c * centre).coords)
+        .filter(|p| p.iter().all(|v| v.is_finite()) && p.norm() > 0.0)
+        .collect();
+    if seen.is_empty() {
+        return None;
+    }
+    let n = seen.len() as f64;
+    let distance = seen.iter().map(|p| p.norm()).sum::<f64>() / n;
+    let direction = seen
+        .iter()
+        .map(|p| p.normalize())
+        .sum::<Vector3<f64>>()
+        .try_normalize(1e-9)?;
+    Some(direction * distance)
 }
 
 fn camera_axis_name(axis_camera: &Vector3<f64>) -> Option<&'static str> {
@@ -116,8 +196,9 @@ pub fn work_point_error(
     setup: Setup,
     x: &Pose,
     q: &Vector3<f64>,
-    point: &str,
+    placement: Placement,
 ) -> Option<WorkPointError> {
+    let point = placement.point_name();
     if covariance.len() < 6 {
         return None;
     }
@@ -196,6 +277,7 @@ pub fn work_point_error(
     );
     Some(WorkPointError {
         point: point.to_string(),
+        placement: Some(placement),
         point_m: [q.x, q.y, q.z],
         frame: match setup {
             Setup::EyeInHand => "gripper",
@@ -233,7 +315,7 @@ mod tests {
             Setup::EyeInHand,
             &x,
             &Vector3::zeros(),
-            "p",
+            Placement::ToolCentrePoint,
         )
         .unwrap();
         assert!((e.bound95_mm - CHI2_3_95.sqrt()).abs() < 1e-9, "{e:?}");
@@ -250,7 +332,7 @@ mod tests {
         cov[0][0] = 1e-6;
         let x = Pose::identity();
         let q = camera_axis_point(&x, 0.5);
-        let e = work_point_error(&cov, Setup::EyeToHand, &x, &q, "target centre").unwrap();
+        let e = work_point_error(&cov, Setup::EyeToHand, &x, &q, Placement::TargetOrigin).unwrap();
         assert!(
             (e.bound95_mm - 0.5 * CHI2_3_95.sqrt()).abs() < 1e-9,
             "{e:?}"
@@ -266,5 +348,29 @@ mod tests {
             .verdict
             .contains("rotation about the camera's x axis (lever 500 mm)"));
         assert_eq!(e.point_camera_m, [0.0, 0.0, 0.5]);
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn the_default_point_is_the_target_centre_at_the_mean_distance() {
+        // Two views see the centre 0.4 m and 0.6 m away, 20 degrees to
+        // either side of the optical axis: the mean direction is the axis,
+        // the mean distance 0.5 m (the mean point would be 0.47 m away and
+        // off the axis).
+        let at = |x: f64, z: f64| {
+            Pose::from_parts(
+                nalgebra::Translation3::new(x, 0.0, z),
+                nalgebra::UnitQuaternion::identity(),
+            )
+        };
+        let (s, c) = 20f64.to_radians().sin_cos();
+        let views = [at(-0.4 * s, 0.4 * c), at(0.6 * s, 0.6 * c)];
+        let q = target_centre_camera(&views, &Point3::origin()).unwrap();
+        assert!((q - Vector3::new(0.0, 0.0, 0.5)).norm() < 1e-12, "{q:?}");
+        assert!(target_centre_camera(&[], &Point3::origin()).is_none());
+        // The centre is a target point: a board centre 0.1 m along x of
+        // the origin, seen straight ahead at 0.5 m.
+        let one = [at(-0.1, 0.5)];
+        let q = target_centre_camera(&one, &Point3::new(0.1, 0.0, 0.0)).unwrap();
+        assert!((q - Vector3::new(0.0, 0.0, 0.5)).norm() < 1e-12, "{q:?}");
     }
 }

@@ -281,6 +281,7 @@ pub fn refine_over_poses(
         work_distance_m: None,
         work_point_std_mm: None,
         focal_check: None,
+        work_point: None,
     };
     let mut repeatability = None;
     if let Some((samples, seed)) = resampling {

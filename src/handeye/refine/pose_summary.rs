@@ -3,6 +3,7 @@
 //! of a transform from its covariance.
 
 use crate::handeye::quality::focal::FocalCheck;
+use crate::handeye::quality::work_point::DefaultWorkPoint;
 use crate::handeye::refine::pose_noise::NoiseLevels;
 use crate::handeye::refine::pose_problem::Covariance12;
 use serde::{Deserialize, Serialize};
@@ -73,12 +74,16 @@ pub struct PoseRefinementSummary {
     /// widened by ([`crate::handeye::quality::trust`]); absent: not widened.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub std_widened_by: Option<f64>,
-    /// The working distance: the median camera-target distance (m).
+    /// The working distance: the mean distance from the camera to the
+    /// target's centre over the views (m; the target frame's origin with
+    /// camera poses only), the distance of the default work point
+    /// ([`crate::handeye::quality::work_point`]).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub work_distance_m: Option<f64>,
-    /// The std of a point at the working distance on the camera's optical
-    /// axis (mm, root-sum-square over the axes): the hand-eye error where
-    /// the camera looks ([`crate::handeye::quality::trust::work_point_std_mm`]).
+    /// The std at the default work point (mm, root-sum-square over the
+    /// axes; the report's `work_point_error.rms_mm`): the hand-eye error
+    /// where the camera looks at the target
+    /// ([`crate::handeye::quality::trust::work_point_std_mm`]).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub work_point_std_mm: Option<f64>,
     /// With image points: present when the camera's focal length disagrees
@@ -87,6 +92,10 @@ pub struct PoseRefinementSummary {
     /// ([`crate::handeye::quality::focal`]).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub focal_check: Option<FocalCheck>,
+    /// The default work point itself, for the report's `work_point_error`
+    /// (not written: that object holds it).
+    #[serde(skip)]
+    pub work_point: Option<DefaultWorkPoint>,
 }
 
 #[cfg(test)]
@@ -114,6 +123,7 @@ impl PoseRefinementSummary {
             work_distance_m: None,
             work_point_std_mm: None,
             focal_check: None,
+            work_point: None,
         }
     }
 }
