@@ -166,7 +166,10 @@ pub fn laser_plane_request(request_json: &str, images: Vec<GrayImage>) -> Result
     if let Some(names) = request.names.as_ref().filter(|n| n.len() != poses) {
         return Err(Error::invalid(
             "names",
-            format!("{} names for {poses} poses: give one name per pose", names.len()),
+            format!(
+                "{} names for {poses} poses: give one name per pose",
+                names.len()
+            ),
         ));
     }
     let mut views = Vec::with_capacity(poses);
@@ -178,7 +181,11 @@ pub fn laser_plane_request(request_json: &str, images: Vec<GrayImage>) -> Result
             Some(names) => names[k].clone(),
             None => format!("pose_{}", k + 1),
         };
-        views.push(LaserView { name, board, stripe });
+        views.push(LaserView {
+            name,
+            board,
+            stripe,
+        });
     }
     let settings = LaserPlaneSettings {
         residual,
@@ -200,7 +207,10 @@ pub fn laser_points_request(
     let (plane, _) = plane_from_json(&request.plane.to_string())?;
     let pose = |field: &str, p: &Option<PoseInput>| {
         p.as_ref()
-            .map(|p| p.to_pose().map_err(|e| Error::invalid(field, e.to_string())))
+            .map(|p| {
+                p.to_pose()
+                    .map_err(|e| Error::invalid(field, e.to_string()))
+            })
             .transpose()
     };
     let mount = pose("gripper_from_camera", &request.gripper_from_camera)?;
@@ -259,7 +269,8 @@ mod tests {
 
     #[test]
     fn plane_requests_say_what_is_wrong() {
-        let base = serde_json::json!({"camera": CAMERA, "target": "chessboard:9x6:30mm", "pairs": true});
+        let base =
+            serde_json::json!({"camera": CAMERA, "target": "chessboard:9x6:30mm", "pairs": true});
         assert_eq!(
             plane_error(base.clone(), 3),
             "images: pairs needs an even number of images (board, stripe, board, stripe, ...), got 3"
@@ -307,9 +318,10 @@ mod tests {
     fn stripe_settings_default_to_the_cli_defaults() {
         let o = StripeSettings::default().options().unwrap();
         assert_eq!(o, StripeOptions::default());
-        let ridge: StripeSettings =
-            serde_json::from_str(r#"{"extractor": "ridge", "axis": "rows", "min_contrast": 12, "max_width_px": 30}"#)
-                .unwrap();
+        let ridge: StripeSettings = serde_json::from_str(
+            r#"{"extractor": "ridge", "axis": "rows", "min_contrast": 12, "max_width_px": 30}"#,
+        )
+        .unwrap();
         let o = ridge.options().unwrap();
         assert_eq!(
             (o.method, o.axis, o.min_contrast, o.max_width_px),

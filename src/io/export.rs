@@ -10,9 +10,7 @@
 //! (docs/report-json.md, "Migration").
 
 use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
-use super::export_laser::{
-    export_plane_halcon, read_plane_report, HALCON_FORMAT, PLANE_FRAME,
-};
+use super::export_laser::{export_plane_halcon, read_plane_report, HALCON_FORMAT, PLANE_FRAME};
 use super::export_rig::{export_rig, is_rig_report, RigFormat};
 pub use super::export_rig::{join_files, ExportFile};
 use super::export_stereo::{export_stereo, is_stereo_report, not_a_stereo_format, StereoFormat};
@@ -214,7 +212,10 @@ fn export_laser_report(
     if let Some(t) = options.transform.filter(|t| *t != PLANE_FRAME) {
         return Err(Error::invalid(
             "transform",
-            format!("a laser plane report has one transform, {PLANE_FRAME}, not '{}'", shown(t)),
+            format!(
+                "a laser plane report has one transform, {PLANE_FRAME}, not '{}'",
+                shown(t)
+            ),
         ));
     }
     let (plane, covariance) = read_plane_report(report)?;

@@ -133,7 +133,11 @@ mod tests {
         }
         let files = export_files(&text, "halcon", &ExportOptions::default()).unwrap();
         assert_eq!(files[0].name, "laser_plane_halcon.txt");
-        assert!(files[0].text.contains("LightplanePose := ["), "{}", files[0].text);
+        assert!(
+            files[0].text.contains("LightplanePose := ["),
+            "{}",
+            files[0].text
+        );
         // Frame names by role, as for any transform.
         let renamed = export_files(
             &text,
@@ -144,8 +148,15 @@ mod tests {
             },
         )
         .unwrap();
-        assert!(renamed[0].text.contains("laser_sheet"), "{}", renamed[0].text);
-        assert_eq!(export(&text, "report", None).unwrap().trim_end(), crate::io::to_string_pretty(&value));
+        assert!(
+            renamed[0].text.contains("laser_sheet"),
+            "{}",
+            renamed[0].text
+        );
+        assert_eq!(
+            export(&text, "report", None).unwrap().trim_end(),
+            crate::io::to_string_pretty(&value)
+        );
     }
 
     #[test]

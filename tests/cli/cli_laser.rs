@@ -124,7 +124,10 @@ fn the_plane_and_the_points_of_rendered_scans_match_the_truth() {
         );
         assert!(image["rms_px"].as_f64().unwrap() < 0.5, "{image}");
     }
-    assert!(report["warnings"].as_array().unwrap().is_empty(), "{report}");
+    assert!(
+        report["warnings"].as_array().unwrap().is_empty(),
+        "{report}"
+    );
     assert!(plane["distance_std_mm"].as_f64().unwrap() > 0.0);
 
     // 2. The held-out pose's stripe as points: on the true plane and on the
@@ -165,23 +168,36 @@ fn the_plane_and_the_points_of_rendered_scans_match_the_truth() {
             worst_board_mm = worst_board_mm.max(z.abs() * 1e3);
             on_board += 1;
         }
-        let px = [p["pixel"][0].as_f64().unwrap(), p["pixel"][1].as_f64().unwrap()];
+        let px = [
+            p["pixel"][0].as_f64().unwrap(),
+            p["pixel"][1].as_f64().unwrap(),
+        ];
         if let Some(tp) = true_px.iter().find(|q| (q[0] - px[0]).abs() < 1e-9) {
             px_sum += (tp[1] - px[1]).abs();
             px_n += 1;
         }
     }
-    assert!(on_board > 200, "{on_board} points inside the board's corners");
+    assert!(
+        on_board > 200,
+        "{on_board} points inside the board's corners"
+    );
     assert!(px_n > 200, "{px_n} centres matched the truth's columns");
     let px_mean = px_sum / px_n as f64;
     assert!(px_mean < 0.2, "mean centre error {px_mean} px");
-    assert!(worst_plane_mm < 0.5, "a point {worst_plane_mm} mm off the true plane");
-    assert!(worst_board_mm < 0.5, "a point {worst_board_mm} mm off the board");
+    assert!(
+        worst_plane_mm < 0.5,
+        "a point {worst_plane_mm} mm off the true plane"
+    );
+    assert!(
+        worst_board_mm < 0.5,
+        "a point {worst_board_mm} mm off the board"
+    );
 
     // 3. The exports: `robocal export` reads the report by its kind and
     // writes what `robocal laser plane --format` writes.
     for format in ["halcon", "urdf", "ros2-static-tf"] {
-        let (code, exported, err) = robocal(&["export", &path(&dir, "plane.json"), "--format", format]);
+        let (code, exported, err) =
+            robocal(&["export", &path(&dir, "plane.json"), "--format", format]);
         assert_eq!(code, 0, "{format}: {err}");
         let mut direct = args.clone();
         direct.truncate(7);
@@ -189,7 +205,10 @@ fn the_plane_and_the_points_of_rendered_scans_match_the_truth() {
         direct.extend(args[9..].iter().copied());
         let (code, written, err) = robocal(&direct);
         assert_eq!(code, 0, "{format}: {err}");
-        assert_eq!(exported, written, "{format}: export and laser plane --format differ");
+        assert_eq!(
+            exported, written,
+            "{format}: export and laser plane --format differ"
+        );
     }
     let (_, halcon, _) = robocal(&["export", &path(&dir, "plane.json"), "--format", "halcon"]);
     assert!(halcon.contains("LightplanePose := ["), "{halcon}");
