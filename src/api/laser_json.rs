@@ -349,6 +349,9 @@ mod tests {
         let err = laser_points_request(&request.to_string(), flat, None)
             .unwrap_err()
             .to_string();
-        assert!(err.starts_with("gripper_from_camera: "), "{err}");
+        assert_eq!(
+            err,
+            "gripper_from_camera: pose: expected matrix_row_major (4 rows of 4 numbers) or translation_m and quaternion_xyzw, got translation_m alone"
+        );
     }
 }
