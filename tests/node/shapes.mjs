@@ -348,7 +348,7 @@ rejects('views and detections', { setup: 'eye-in-hand', base_from_gripper, views
 {
   const scene = laserScene(work);
   const plane = call('laser_plane', { ...scene.request, residual: 'image_px', stripe: { extractor: 'cog', axis: 'auto', min_contrast: 20, max_width_px: 24 } }, scene.images);
-  const [off, on] = scene.pairs[4];
+  const [off, on] = scene.pairs[scene.held];
   call('laser_points', { camera: scene.camera, plane, gripper_from_camera: { translation_m: [0, 0, 0.1], quaternion_xyzw: [0, 0, 0, 1] }, base_from_gripper: { translation_m: [0.5, 0, 0.3], quaternion_xyzw: [1, 0, 0, 0] } }, on, off);
   call('laser_points', { camera: scene.camera, plane: { laser_plane: { normal_camera: plane.laser_plane.normal_camera, distance_m: plane.laser_plane.distance_m } } }, on);
   output('laser_stripe', JSON.parse(robocal.laser_stripe(on, off, JSON.stringify(input('laser_stripe', { extractor: 'ridge' })))), 'laser_stripe ridge');
