@@ -53,7 +53,7 @@ assert.ok(Math.abs(mounted.points[0].flange_m[2] - mounted.points[0].camera_m[2]
 const halcon = robocal.export_report(JSON.stringify(report), 'halcon', '');
 assert.match(halcon, /^LightplanePose := \[/m);
 const urdf = robocal.export_report(JSON.stringify(report), 'urdf', '');
-assert.match(urdf, /camera_from_laser_plane/);
+assert.match(urdf, /<joint name="camera_to_laser_plane" type="fixed">\n  <parent link="camera"\/>\n  <child link="laser_plane"\/>/);
 const [file] = JSON.parse(robocal.export_report_files(JSON.stringify(report), 'halcon', '', ''));
 assert.deepEqual(file, { name: 'laser_plane_halcon.txt', text: halcon });
 assert.throws(() => robocal.export_report(JSON.stringify(points), 'halcon', ''), { message: "kind: a 'laser_points' report holds 3-D points: export it as 'report', or export its laser plane report" });
