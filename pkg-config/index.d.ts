@@ -1333,7 +1333,8 @@ export type ExportFormatListEntry =
 /** A transform key of a report, `parent_from_child` (the `transform` of `export_report`; `""` = the first present of gripper_from_camera, base_from_camera, right_from_left, base_from_target). */
 export type TransformName = `${string}_from_${string}`;
 /** What `export_report` reads: camera formats need a camera report; transform formats a report with the transform. An optional `frame_names` object (`{"gripper": "tool0", "camera": "camera_optical_frame"}`) names the frames of a transform's key in the output. */
-export type ExportableReport = CameraCalibration | HandEyeReport | StereoCalibration | RigCalibration;
+/** A laser plane report exports as `halcon` (HALCON-style sheet-of-light parameters), as its plane frame `camera_from_laser_plane` in a transform format, or as `report`; a laser points report only as `report`. */
+export type ExportableReport = CameraCalibration | HandEyeReport | StereoCalibration | RigCalibration | LaserPlaneReport | LaserPointsReport;
 
 // ---------------------------------------------------------------------------
 // Planar workflow (src/workflows/planar*.rs)
@@ -1809,6 +1810,152 @@ export interface PlanReport {
 }
 
 // ---------------------------------------------------------------------------
+// Laser-line sensors (src/api/laser.rs, src/api/laser_json.rs; docs/laser.md)
+
+/** The stripe extractor's settings (the flags of `robocal laser`); every key may be left out. */
+export interface LaserStripeSettings {
+  /** `cog` (centre of gravity, default) or `ridge` (Steger's ridge detector). */
+  extractor?: 'cog' | 'ridge' | 'centre_of_gravity' | 'steger';
+  /** `auto` (default), `columns` (a roughly horizontal stripe) or `rows`. */
+  axis?: 'auto' | 'columns' | 'rows';
+  /** Smallest peak contrast above the local background, grey levels (default 20). */
+  min_contrast?: number;
+  /** Widest stripe expected, pixels (default 24). */
+  max_width_px?: number;
+}
+
+/** The input JSON of `laser_plane` (the images go beside it: one per pose, or board then stripe per pose with `pairs`). */
+export interface LaserPlaneRequest {
+  /** The calibrated camera file's text: a robocal report or camera JSON, OpenCV YAML/XML or ROS camera_info. */
+  camera: string;
+  /** The board: a CLI spec or a target JSON object. */
+  target: Target | TargetSpec;
+  /** The images alternate board (laser off) and stripe (laser on). */
+  pairs?: boolean;
+  /** A name per pose (default `pose_1`, ...). */
+  names?: string[];
+  /** The fit's residual: `image_px` (default: pixels along the scan, weighted by each centre's std) or `point_to_plane` (metres). */
+  residual?: 'image_px' | 'point_to_plane';
+  stripe?: LaserStripeSettings;
+}
+
+/** The plane `normal_camera . X = distance_m` (camera frame, metres; the normal points away from the camera centre). */
+export interface LaserPlane {
+  normal_camera: Vec3;
+  distance_m: number;
+}
+
+/** The fitted plane and its uncertainty. */
+export interface LaserPlaneFit extends LaserPlane {
+  /** Covariance of (nx, ny, nz, distance_m), row by row (rank 3: the normal stays unit). */
+  covariance: [Vec4, Vec4, Vec4, Vec4];
+  /** The normal's angular std (RMS over its two tilt axes), degrees. */
+  normal_std_deg: number;
+  /** The distance's std, millimetres. */
+  distance_std_mm: number;
+}
+
+/** One pose of the laser plane fit. */
+export interface LaserImageReport {
+  name: string;
+  /** The board's pose from its corners (PnP with the calibrated camera). */
+  camera_from_target: PoseReport;
+  board_rms_px: number;
+  stripe_axis: 'columns' | 'rows';
+  /** Stripe centres found in the image. */
+  stripe_points: number;
+  /** Centres on the board, used by the fit. */
+  n_points: number;
+  /** Residual RMS along the scan, pixels. */
+  rms_px: number;
+  /** Point-to-plane RMS, millimetres. */
+  rms_mm: number;
+  /** Scan lines without a centre between found ones, `[first, last]`. */
+  gaps: [number, number][];
+}
+
+/** The output JSON of `laser_plane` (what `robocal laser plane` writes). */
+export interface LaserPlaneReport {
+  kind: 'laser_plane';
+  robocal_version: string;
+  laser_plane: LaserPlaneFit;
+  residual: 'image_px' | 'point_to_plane';
+  extractor: 'cog' | 'ridge';
+  /** The residual variance that scaled the covariance (near 1 when the centres' std are right). */
+  variance_factor: number;
+  images: LaserImageReport[];
+  /** Singular values of the stripe points' scatter, metres. */
+  singular_values_m: Vec3;
+  /** Weak geometry (stripes nearly parallel or on one line) and images that added nothing. */
+  warnings: string[];
+}
+
+/** The input JSON of `laser_points` (the stripe image, and the laser-off image when given, go beside it). */
+export interface LaserPointsRequest {
+  /** The calibrated camera file's text. */
+  camera: string;
+  /** A `laser_plane` report, `{laser_plane: {...}}` or the bare plane. */
+  plane: LaserPlaneReport | { laser_plane: LaserPlane } | LaserPlane;
+  /** The camera's mounting on the flange: adds `flange_m` to every point. */
+  gripper_from_camera?: PoseInput | null;
+  /** The flange's pose for this image (needs `gripper_from_camera`): adds `base_m`. */
+  base_from_gripper?: PoseInput | null;
+  stripe?: LaserStripeSettings;
+}
+
+/** One profile point: a stripe centre's ray met with the plane. */
+export interface LaserProfilePoint {
+  pixel: Vec2;
+  camera_m: Vec3;
+  flange_m?: Vec3;
+  base_m?: Vec3;
+}
+
+/** The output JSON of `laser_points` (what `robocal laser points` writes). */
+export interface LaserPointsReport {
+  kind: 'laser_points';
+  robocal_version: string;
+  laser_plane: LaserPlane;
+  stripe_axis: 'columns' | 'rows';
+  extractor: 'cog' | 'ridge';
+  points: LaserProfilePoint[];
+  /** Centres whose ray missed the plane. */
+  missed: number;
+  gaps: [number, number][];
+  /** The two ends of every continuous piece of the stripe, pixels. */
+  ends: Vec2[];
+}
+
+/** One stripe centre (`laser::StripePoint`). */
+export interface LaserStripePoint {
+  x_px: number;
+  y_px: number;
+  /** Full width at half the contrast, pixels. */
+  width_px: number;
+  /** Brightest grey level of the peak (after the laser-off subtraction). */
+  peak: number;
+  /** Peak above the local background, grey levels. */
+  contrast: number;
+  /** The centre's std along the scan, pixels. */
+  std_px: number;
+  /** A pixel of the window is at 255. */
+  saturated: boolean;
+}
+
+/** The output JSON of `laser_stripe`: one image's stripe (`laser::Stripe`). */
+export interface LaserStripe {
+  axis: 'columns' | 'rows';
+  method: 'centre_of_gravity' | 'ridge';
+  points: LaserStripePoint[];
+  gaps: [number, number][];
+  ends: Vec2[];
+  /** The image's noise estimate, grey levels. */
+  noise_grey: number;
+  /** The ridge detector's Gaussian sigma, pixels (ridge only). */
+  ridge_sigma_px?: number;
+}
+
+// ---------------------------------------------------------------------------
 // Function -> JSON map
 
 /**
@@ -1894,6 +2041,12 @@ export interface RobocalJson {
   plan_handeye_poses: [PlanRequest, PlanReport];
   /** `plan_move_list(JSON.stringify(plan), format)` returns the text for the robot, not JSON: a program (`ur-script`, `kuka-krl`, `abb-rapid`) or a pose table in a pose format robocal reads (`ur`, `kuka`, `abb`, `fanuc`, `yaskawa`, `staubli`, `xyz_quat_xyzw`, ...), as `robocal plan --export --format` writes it. */
   plan_move_list: [PlanReport, never];
+  /** `laser_plane(JSON.stringify(request), images, options?)` -> the laser plane in the camera frame from board images with the stripe (`images`: Uint8Array per image, one per pose or board then stripe per pose with `pairs`), as `robocal laser plane` (docs/laser.md). */
+  laser_plane: [LaserPlaneRequest, LaserPlaneReport];
+  /** `laser_points(JSON.stringify(request), stripeImage, offImage or undefined, options?)` -> the stripe as 3-D points (camera, flange, base), as `robocal laser points`. */
+  laser_points: [LaserPointsRequest, LaserPointsReport];
+  /** `laser_stripe(image, offImage or undefined, JSON.stringify(settings) or "", options?)` -> one image's stripe centres, gaps and ends. */
+  laser_stripe: [LaserStripeSettings, LaserStripe];
 }
 
 /** What `read_camera_file` returns: the camera (what a rig input's `cameras[i].camera` takes to hold its intrinsics) and the format it was read as. */

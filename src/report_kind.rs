@@ -26,11 +26,16 @@ pub enum ReportKind {
     Check,
     /// The projection difference of two calibrations (`robocal diff`, `diff_cameras`).
     Diff,
+    /// A laser-line sensor's plane in the camera frame (`robocal laser
+    /// plane`, `laser_plane`; docs/laser.md).
+    LaserPlane,
+    /// A stripe image as 3-D points (`robocal laser points`, `laser_points`).
+    LaserPoints,
 }
 
 impl ReportKind {
     /// Every kind, in the order of the docs.
-    pub const ALL: [ReportKind; 7] = [
+    pub const ALL: [ReportKind; 9] = [
         ReportKind::Camera,
         ReportKind::Stereo,
         ReportKind::Rig,
@@ -38,6 +43,8 @@ impl ReportKind {
         ReportKind::RigHandeye,
         ReportKind::Check,
         ReportKind::Diff,
+        ReportKind::LaserPlane,
+        ReportKind::LaserPoints,
     ];
 
     /// The name written as `kind`.
@@ -50,6 +57,8 @@ impl ReportKind {
             ReportKind::RigHandeye => "rig_handeye",
             ReportKind::Check => "check",
             ReportKind::Diff => "diff",
+            ReportKind::LaserPlane => "laser_plane",
+            ReportKind::LaserPoints => "laser_points",
         }
     }
 
@@ -120,7 +129,7 @@ mod tests {
             ReportKind::of_report(&serde_json::json!({"kind": "mono"}))
                 .unwrap_err()
                 .to_string(),
-            "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff)"
+            "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff, laser_plane, laser_points)"
         );
     }
 }

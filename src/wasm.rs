@@ -1,6 +1,6 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
-//! and camera_file.rs, check.rs, demo.rs, lens_models.rs, live_capture.rs, plan.rs, rig_frames.rs,
-//! rig_handeye.rs and targets.rs beside it).
+//! and camera_file.rs, check.rs, demo.rs, laser.rs, lens_models.rs, live_capture.rs, plan.rs,
+//! rig_frames.rs, rig_handeye.rs and targets.rs beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
 //! errors as `JsError` whose message is the library's error text. Pixels
@@ -17,6 +17,7 @@
 mod camera_file;
 mod check;
 mod demo;
+mod laser;
 mod lens_models;
 mod live_capture;
 mod plan;
@@ -26,6 +27,7 @@ mod targets;
 pub use camera_file::read_camera_file;
 pub use check::{check_camera, diff_cameras};
 pub use demo::{render_demo, DemoData};
+pub use laser::{laser_plane, laser_points, laser_stripe};
 pub use lens_models::lens_models;
 pub use live_capture::LiveCapture;
 pub use plan::{plan_handeye_poses, plan_move_list};

@@ -16,6 +16,7 @@ import { WorkflowsView } from './views/workflows.js';
 import { RigView } from './views/rig.js';
 import { ExportView } from './views/export.js';
 import { CheckView } from './views/check.js';
+import { LaserView } from './views/laser.js';
 import { ShareView, sharedFragment, decodeShare, sessionFile } from './views/share.js';
 
 const engine = new Engine();
@@ -192,6 +193,7 @@ async function startSteps(versionPromise) {
   new ExportView(store, engine);
   // The check detects live frames in a worker of its own, as the capture does.
   new CheckView(store, engine, () => new Engine());
+  const laser = new LaserView(store, engine);
   const version = await versionPromise;
   registerOffline(version);
   new ShareView(store, version, () => [...(camera.plots || []), ...(handeye.plots || [])], async (session) => {
@@ -220,6 +222,7 @@ async function startSteps(versionPromise) {
     plan.render();
     workflows.render();
     rig.render();
+    laser.render();
     $('engine-status').textContent = readyText();
   };
   const hasWork = () => store.session.images.length || store.session.robot.text || store.session.robot.files || store.session.camera.result || store.session.rig.cameras.some((c) => c.files.length);

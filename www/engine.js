@@ -14,6 +14,7 @@ const STEPS = {
   handeye: 'solving the hand-eye calibration', rig: 'solving the rig', rigFrames: 'grouping the rig images into frames', export: 'exporting', poses: 'reading the robot poses',
   demo: 'rendering the demo', target: 'checking the target', kalibrTarget: 'reading the Kalibr target file', conventions: 'ranking the pose conventions',
   workflow: 'solving the workflow', lensModels: 'listing the lens models', 'workflow-csv': 'reading the workflow file', frame: 'detecting the target in the live video', guide: 'updating the capture guide',
+  laserPlane: 'finding the laser plane', laserStripe: 'finding the laser stripe in',
 };
 
 export function stepText(op, args = {}) {

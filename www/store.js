@@ -16,6 +16,7 @@ export function defaultSession() {
     workflows: { planar: null, xytable: null },
     // model, radial, tangential, options: the lens choice (views/lens.js); cameras: { name, files: [{ id, name, detection, error, spec }] }
     rig: { model: 'brown', result: null, cameras: [] },
+    laser: { result: null }, // result: the laser step's `laser_plane` report (views/laser.js)
     stereo: null, // { result }: `robocal stereo`'s report, from a session saved before the rig step replaced the stereo step
   };
 }

@@ -36,6 +36,7 @@ const SHELL = [
   'views/export.js',
   'views/handeye.js',
   'views/images.js',
+  'views/laser.js',
   'views/robot.js',
   'views/report.js',
   'views/share.js',

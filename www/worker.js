@@ -73,6 +73,18 @@ const handlers = {
   },
 };
 
+/** The laser plane from board images with the stripe (laser_plane, docs/laser.md). */
+handlers.laserPlane = async ({ request, images, maxPixels }) => {
+  await ready;
+  return JSON.parse(robocal.laser_plane(request, images.map((b) => new Uint8Array(b)), imageOptions(maxPixels)));
+};
+
+/** One image's stripe centres, gaps and ends (laser_stripe), the laser-off image subtracted when given. */
+handlers.laserStripe = async ({ bytes, off, settings, maxPixels }) => {
+  await ready;
+  return JSON.parse(robocal.laser_stripe(new Uint8Array(bytes), off ? new Uint8Array(off) : undefined, settings || '', imageOptions(maxPixels)));
+};
+
 handlers.export = async ({ report, format, transform }) => {
   await ready;
   return robocal.export_report(report, format, transform || '');

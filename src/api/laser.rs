@@ -188,7 +188,7 @@ pub fn laser_plane(
     }
     warnings.extend(fit.warnings.iter().cloned());
     Ok(LaserPlaneReport {
-        kind: "laser_plane",
+        kind: crate::report_kind::ReportKind::LaserPlane.name(),
         robocal_version: crate::VERSION,
         laser_plane: plane_json(&fit),
         residual: settings.residual.name(),
@@ -293,7 +293,7 @@ pub fn laser_points(
         base_from_gripper,
     )?;
     Ok(LaserPointsReport {
-        kind: "laser_points",
+        kind: crate::report_kind::ReportKind::LaserPoints.name(),
         robocal_version: crate::VERSION,
         laser_plane: *plane,
         stripe_axis: stripe.axis,

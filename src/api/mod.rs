@@ -28,7 +28,8 @@
 //!   the hand-eye's error at the work point, held-out poses and the touch
 //!   test (`robocal handeye --tcp/--holdout/--touch`);
 //! - [`laser`]: the laser plane of a laser-line sensor and its profiles as
-//!   points (`robocal laser plane`, `robocal laser points`).
+//!   points (`robocal laser plane`, `robocal laser points`); [`laser_json`]
+//!   their JSON requests (`laser_plane`, `laser_points`, `laser_stripe`).
 //!
 //! Every report says what it is in `kind` ([`crate::report_kind::ReportKind`])
 //! and which robocal wrote it in `robocal_version`; `robocal export` and
@@ -47,6 +48,7 @@ pub mod handeye_field;
 #[cfg(test)]
 mod handeye_tests;
 pub mod laser;
+pub mod laser_json;
 pub mod plan;
 pub mod planar;
 pub mod poses;

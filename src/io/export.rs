@@ -10,6 +10,7 @@
 //! (docs/report-json.md, "Migration").
 
 use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
+use super::export_laser::{export_plane_halcon, read_plane_report, HALCON_FORMAT, PLANE_FRAME};
 use super::export_rig::{export_rig, is_rig_report, RigFormat};
 pub use super::export_rig::{join_files, ExportFile};
 use super::export_stereo::{export_stereo, is_stereo_report, not_a_stereo_format, StereoFormat};
@@ -83,6 +84,9 @@ pub fn export_with(report_json: &str, format: &str, options: &ExportOptions) -> 
                 None => export_value(report_json, &report, format, options),
             }
         }
+        Report::Laser(kind) if format != "report" => {
+            export_laser_report(&report, kind, format, options).map(|f| f.text)
+        }
         _ => export_value(report_json, &report, format, options),
     }
 }
@@ -98,6 +102,9 @@ enum Report {
     /// A camera or hand-eye report (or a plain camera JSON), written from
     /// its keys.
     Other,
+    /// A laser report (`laser_plane`: its plane as HALCON parameters or as
+    /// a frame; `laser_points`: only `report`).
+    Laser(ReportKind),
 }
 
 impl Report {
@@ -113,6 +120,7 @@ impl Report {
             ReportKind::Rig | ReportKind::RigHandeye => Report::Rig,
             ReportKind::Stereo => Report::Stereo,
             ReportKind::Camera | ReportKind::Handeye => Report::Other,
+            ReportKind::LaserPlane | ReportKind::LaserPoints => Report::Laser(kind),
             ReportKind::Check | ReportKind::Diff => {
                 return Err(Error::invalid(
                     "kind",
@@ -141,6 +149,9 @@ pub fn export_files(
             if let Some(files) = export_stereo_report(&report, format, options)? {
                 return Ok(files);
             }
+        }
+        Report::Laser(kind) if format != "report" => {
+            return export_laser_report(&report, kind, format, options).map(|f| vec![f])
         }
         _ => {}
     }
@@ -175,6 +186,65 @@ fn export_rig_report(
     let rig = RigCalibration::deserialize(report)
         .map_err(|e| Error::invalid("report", format!("not a readable rig report: {e}")))?;
     export_rig(&rig, format, &options.frames)
+}
+
+/// A laser plane report (`kind`: `laser_plane`) as the HALCON-style
+/// sheet-of-light parameter list (`halcon`) or its plane as the frame
+/// `camera_from_laser_plane` in a transform format (frames `camera` and
+/// `laser_plane`, renamed by `--frame` or the report's `frame_names`): the
+/// same text as `robocal laser plane --format`. A `laser_points` report is
+/// written only as `report`.
+fn export_laser_report(
+    report: &serde_json::Value,
+    kind: ReportKind,
+    format: &str,
+    options: &ExportOptions,
+) -> Result<ExportFile> {
+    if kind != ReportKind::LaserPlane {
+        return Err(Error::invalid(
+            "kind",
+            format!(
+                "a '{}' report holds 3-D points: export it as 'report', or export its laser plane report",
+                kind.name()
+            ),
+        ));
+    }
+    if let Some(t) = options.transform.filter(|t| *t != PLANE_FRAME) {
+        return Err(Error::invalid(
+            "transform",
+            format!(
+                "a laser plane report has one transform, {PLANE_FRAME}, not '{}'",
+                shown(t)
+            ),
+        ));
+    }
+    let (plane, covariance) = read_plane_report(report)?;
+    if format == HALCON_FORMAT {
+        return Ok(ExportFile {
+            name: "laser_plane_halcon.txt".into(),
+            text: export_plane_halcon(&plane, &covariance),
+        });
+    }
+    let transform = TransformFormat::from_name(format).map_err(|_| {
+        Error::invalid(
+            "format",
+            format!(
+                "a laser plane report is written as report, {HALCON_FORMAT} (HALCON-style sheet-of-light parameters) or a transform format of its plane frame {PLANE_FRAME} ({}), got '{}'",
+                TransformFormat::names().join(", "),
+                shown(format)
+            ),
+        )
+    })?;
+    let roles = FrameNames::from_transform_name(PLANE_FRAME)?;
+    let names = FrameNames {
+        parent: frame_name(report, &options.frames, &roles.parent)?,
+        child: frame_name(report, &options.frames, &roles.child)?,
+        key: roles.key,
+    };
+    Ok(ExportFile {
+        name: "export.txt".into(),
+        text: export_transform(&plane.camera_from_plane(), &names, transform),
+    })
 }
 
 /// A stereo report in a stereo format; `None` when `report` is not a

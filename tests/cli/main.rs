@@ -16,6 +16,7 @@ mod cli_field;
 mod cli_handeye;
 mod cli_handeye_pairing;
 mod cli_intrinsics;
+mod cli_laser;
 mod cli_output;
 mod cli_partial_views;
 mod cli_polarity;

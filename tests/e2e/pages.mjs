@@ -215,7 +215,7 @@ export const tests = [
       const step = await page.evaluate(() => document.activeElement?.dataset?.step || null);
       if (step) reached.add(step);
     }
-    assert.deepEqual([...reached].sort(), ['camera', 'check', 'export', 'handeye', 'images', 'robot', 'share', 'stereo', 'target', 'workflows']);
+    assert.deepEqual([...reached].sort(), ['camera', 'check', 'export', 'handeye', 'images', 'laser', 'robot', 'share', 'stereo', 'target', 'workflows']);
     await page.keyboard.press('Shift+Tab');
     await shot('keyboard');
   }],

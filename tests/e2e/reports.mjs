@@ -65,8 +65,12 @@ export const tests = [
     await page.keyboard.press('ArrowLeft');
     await page.keyboard.press('ArrowLeft');
     await page.waitForFunction(() => location.hash === '#target');
-    // End: the last step, the field check of a saved calibration (step 10).
+    // End: the last step, the laser-line sensor (step 11); before it the
+    // field check of a saved calibration (step 10).
     await page.keyboard.press('End');
+    await page.waitForFunction(() => location.hash === '#laser');
+    assert.deepEqual(await visibleStep(page), ['step-laser']);
+    await page.keyboard.press('ArrowLeft');
     await page.waitForFunction(() => location.hash === '#check');
     assert.deepEqual(await visibleStep(page), ['step-check']);
     await page.keyboard.press('ArrowLeft');

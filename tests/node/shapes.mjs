@@ -11,6 +11,7 @@ import { createRequire } from 'node:module';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { rigInput, rigOnRobot } from './rig_scene.mjs';
+import { laserScene } from './laser_scene.mjs';
 
 // Node has no ImageData; the previews need one (pkg-config/README.md).
 globalThis.ImageData = class ImageData { constructor(data, width, height) { Object.assign(this, { data, width, height }); } };
@@ -341,6 +342,20 @@ rejects('null for a number', { ...report, rms_px: null }, declared('CameraCalibr
 rejects('a string for a number', { ...meta.images[0], offset: '0' }, propertyType(mapped('render_demo', 1), 'images'));
 rejects('keys of the other setup', { ...eyeInHand, base_from_camera: eyeInHand.gripper_from_camera }, mapped('solve_handeye', 1));
 rejects('views and detections', { setup: 'eye-in-hand', base_from_gripper, views: viewsIn, detections }, mapped('solve_handeye', 0));
+
+// Laser-line sensors (docs/laser.md): the plane from the rendered scans of
+// laser_scene.mjs, a held-out pose's points and stripe, the plane's exports.
+{
+  const scene = laserScene(work);
+  const plane = call('laser_plane', { ...scene.request, residual: 'image_px', stripe: { extractor: 'cog', axis: 'auto', min_contrast: 20, max_width_px: 24 } }, scene.images);
+  const [off, on] = scene.pairs[scene.held];
+  call('laser_points', { camera: scene.camera, plane, gripper_from_camera: { translation_m: [0, 0, 0.1], quaternion_xyzw: [0, 0, 0, 1] }, base_from_gripper: { translation_m: [0.5, 0, 0.3], quaternion_xyzw: [1, 0, 0, 0] } }, on, off);
+  call('laser_points', { camera: scene.camera, plane: { laser_plane: { normal_camera: plane.laser_plane.normal_camera, distance_m: plane.laser_plane.distance_m } } }, on);
+  output('laser_stripe', JSON.parse(robocal.laser_stripe(on, off, JSON.stringify(input('laser_stripe', { extractor: 'ridge' })))), 'laser_stripe ridge');
+  output('laser_stripe', JSON.parse(robocal.laser_stripe(on, undefined, '')));
+  input('export_report', plane);
+  output('export_report_files', JSON.parse(robocal.export_report_files(JSON.stringify(input('export_report_files', plane)), 'urdf', '', '')), 'export_report_files laser plane');
+}
 
 // 4. Coverage: every function in the map is exercised both ways (where it
 // has JSON), and every function of the package is in the map.

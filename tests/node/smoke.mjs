@@ -171,6 +171,8 @@ process.stdout.write(execFileSync('node', [join(here, 'shapes.mjs'), work]).toSt
 process.stdout.write(execFileSync('node', [join(here, 'rig.mjs'), work]).toString());
 // The rig on a robot on rendered images of known truth (the CLI's renderer).
 process.stdout.write(execFileSync('node', [join(here, 'rig_robot.mjs'), work]).toString());
+// Laser-line sensors on rendered scans of a known plane (laser_scene.mjs).
+process.stdout.write(execFileSync('node', [join(here, 'laser.mjs'), work]).toString());
 // LiveCapture on the renderer's test video (320x240, 5 fps: a hold is 5 frames).
 execFileSync(join(root, 'target/release/robocal'), ['render', '--video', join(work, 'live.y4m'), '--size', '320x240', '--fps', '5', '--seed', '11'], { stdio: 'ignore' });
 process.stdout.write(execFileSync('node', [join(here, 'live.mjs'), work]).toString());

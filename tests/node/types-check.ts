@@ -10,6 +10,7 @@ import type {
   PlanarFitRequest, PlanarSolveRequest, PlanarSolveResponse, PoseFileOptions, PoseReading,
   PoseReport, RankedCandidates, RankPoseInput, StereoCalibration, StereoInput, Target,
   TargetOf, TargetSpec, WorkflowCsvKinds, XyTableReport, XyTableRequest,
+  LaserPlaneRequest, LaserPlaneReport, LaserStripeSettings,
 } from 'robocal';
 
 declare const png: Uint8Array;
@@ -233,6 +234,15 @@ const motionReport: KnownMotionReport = {
   reference_origin_given: false, residuals_mm: [[0, 0, 0]], rms_mm: 0, input: { ...motion, start_reference_mm: null },
 };
 
+// --- Laser-line sensors: the images go beside the request as Uint8Array[]
+const laserRequest: LaserPlaneRequest = { camera: '{}', target: 'chessboard:9x6:30mm', pairs: true, names: ['view_000'], residual: 'image_px', stripe: { extractor: 'ridge', axis: 'auto' } };
+const laserPlane: LaserPlaneReport = JSON.parse(robocal.laser_plane(JSON.stringify(laserRequest), [png, png]));
+const laserExportable: ExportableReport = laserPlane;
+const laserPoints: JsonInput<'laser_points'> = { camera: '{}', plane: laserPlane, gripper_from_camera: pose };
+const laserStripe: JsonOutput<'laser_stripe'> = JSON.parse(robocal.laser_stripe(png, undefined, ''));
+// @ts-expect-error: no such extractor
+const wrongExtractor: LaserStripeSettings = { extractor: 'sobel' };
+
 // --- The demo and the map
 const demo = robocal.render_demo(1);
 const index: DemoIndex = JSON.parse(demo.json);
@@ -250,4 +260,5 @@ export {
   wrongView, wrongMethod, wrongTermination, stereoInput, fx, wrongPoseFormat, ambiguous, bothImages, wrongSetup,
   wrongKeyForSetup, cameraPose, rank, ranked, formats, format, wrongExport, exportable, urdf, fitRequest, fit, wrongTransform,
   solvedPlanar, xyReport, noHistory, motionReport, spec2, firstPng, targetInput, handeyeAgain, noJson,
+  laserExportable, laserPoints, laserStripe, wrongExtractor,
 };

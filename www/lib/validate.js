@@ -168,6 +168,10 @@ export function checkSession(raw, path = 'session') {
     s.rig.robot.result = check.objectOrNull(s.rig.robot.result, `${path}.rig.robot.result`);
     s.rig.robot.parsed = check.objectOrNull(s.rig.robot.parsed, `${path}.rig.robot.parsed`);
   }
+  // The laser step (views/laser.js); absent in sessions saved before it.
+  s.laser = step('laser');
+  s.laser.result = check.objectOrNull(s.laser.result, `${path}.laser.result`);
+  if (s.laser.result) check.oneOf(s.laser.result.kind, `${path}.laser.result.kind`, ['laser_plane']);
   s.stereo = check.objectOrNull(raw.stereo, `${path}.stereo`);
   return s;
 }
