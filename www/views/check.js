@@ -8,6 +8,8 @@ import { $, h, fill, table, num, message, readTextFile } from '../lib/dom.js';
 import { cameraErrorText, openCamera, stopStream } from '../lib/camera.js';
 import { targetSpec } from './target.js';
 
+/** The file names a saved calibration may have: every camera format robocal exports (HALCON's .dat and .hdev.txt, MATLAB's .m, the text matrix's .txt). */
+const CAMERA_FILES = '.json,.yaml,.yml,.xml,.cameramodel,.dat,.txt,.m,text/*,application/json';
 /** Distinct views of the target taken from the camera before the check runs. */
 const LIVE_VIEWS = 5;
 /** A live view counts as new when its first point moved this far (px) from every kept one. */
@@ -34,15 +36,15 @@ export class CheckView {
   build() {
     const panel = $('check-panel');
     fill(panel,
-      h('p', {}, 'Has the camera changed since it was calibrated? Load its saved calibration (robocal JSON report, OpenCV YAML/XML or ROS camera_info), then show the target of step 1 to the camera, or add a few images of it. The check poses the images with the saved camera, refits the focal lengths and principal point with the lens model held, and compares the two over the image. Images never leave this machine.'),
+      h('p', {}, 'Has the camera changed since it was calibrated? Load its saved calibration (any camera format robocal exports: robocal JSON report, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON .dat or tuple, MATLAB, text matrix), then show the target of step 1 to the camera, or add a few images of it. The check poses the images with the saved camera, refits the focal lengths and principal point with the lens model held, and compares the two over the image. Images never leave this machine.'),
       h('div', { class: 'form' },
-        h('label', {}, 'Saved calibration ', h('input', { type: 'file', id: 'check-file', accept: '.json,.yaml,.yml,.xml,.txt' })),
+        h('label', {}, 'Saved calibration ', h('input', { type: 'file', id: 'check-file', accept: CAMERA_FILES })),
         h('p', { id: 'check-file-info', class: 'hint' }, 'No calibration loaded.'),
         h('div', {},
           h('button', { type: 'button', id: 'check-camera', disabled: true }, 'Check with the camera'), ' ',
           h('button', { type: 'button', id: 'check-stop', hidden: true }, 'Stop camera')),
         h('label', {}, 'or images of the target ', h('input', { type: 'file', id: 'check-images', multiple: true, accept: 'image/*', disabled: true })),
-        h('label', {}, 'Compare with another calibration ', h('input', { type: 'file', id: 'check-other', accept: '.json,.yaml,.yml,.xml,.txt', disabled: true }))),
+        h('label', {}, 'Compare with another calibration ', h('input', { type: 'file', id: 'check-other', accept: CAMERA_FILES, disabled: true }))),
       h('div', { id: 'check-live', hidden: true },
         h('div', { class: 'live-view' }, h('video', { id: 'check-video', muted: true, playsinline: true, 'aria-label': 'Live camera picture for the check' })),
         h('p', { class: 'live-status', id: 'check-live-status', role: 'status' }, 'Starting…')),
@@ -59,7 +61,7 @@ export class CheckView {
   async load(file) {
     if (!file) return;
     try {
-      const text = await readTextFile(file, 'a camera calibration (robocal JSON, OpenCV YAML/XML or ROS camera_info)');
+      const text = await readTextFile(file, 'a camera calibration (any camera format robocal exports)');
       const { camera, format } = await this.engine.call('cameraFile', { text });
       this.calibration = { text, name: file.name, camera };
       $('check-file-info').textContent = `${file.name} (${format}): ${camera.width} × ${camera.height}, fx ${num(camera.fx, 1)}, fy ${num(camera.fy, 1)}, cx ${num(camera.cx, 1)}, cy ${num(camera.cy, 1)}`;
@@ -182,7 +184,7 @@ export class CheckView {
   async diff(file) {
     if (!file || !this.calibration) return;
     try {
-      const b = await readTextFile(file, 'a camera calibration (robocal JSON, OpenCV YAML/XML or ROS camera_info)');
+      const b = await readTextFile(file, 'a camera calibration (any camera format robocal exports)');
       const report = await this.engine.call('diff', { request: JSON.stringify({ a: this.calibration.text, b }) });
       const d = report.projection_shift_px;
       this.say(h('p', { id: 'check-diff' }, `${this.calibration.name} against ${file.name}: projection shift worst ${num(d.worst, 2)} px at (${num(d.worst_at_px[0], 0)}, ${num(d.worst_at_px[1], 0)}), median ${num(d.median, 2)} px, RMS ${num(d.rms, 2)} px, implied rotation ${num(d.implied_rotation_deg, 3)} deg.`), this.heatMap(d, 'check-diff-map'));
