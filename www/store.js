@@ -17,6 +17,8 @@ export function defaultSession() {
     // model, radial, tangential, options: the lens choice (views/lens.js); cameras: { name, files: [{ id, name, detection, error, spec }] }
     rig: { model: 'brown', result: null, cameras: [] },
     stereo: null, // { result }: `robocal stereo`'s report, from a session saved before the rig step replaced the stereo step
+    plan: null, // { inputs: { view, fields: { id: value } }, request, result }: the pose plan (views/plan.js)
+    check: null, // { name, result }: the last check of a saved calibration (views/check.js)
   };
 }
 
