@@ -146,7 +146,12 @@ pub fn distortion_template(model: &str) -> Result<Distortion> {
     })
 }
 
-pub(super) fn camera_from_k(k: &[f64], width: u32, height: u32, distortion: Distortion) -> Result<Camera> {
+pub(super) fn camera_from_k(
+    k: &[f64],
+    width: u32,
+    height: u32,
+    distortion: Distortion,
+) -> Result<Camera> {
     if let Some(bad) = k.iter().find(|v| !v.is_finite()) {
         return Err(Error::invalid(
             "camera_matrix",

@@ -80,11 +80,15 @@ pub(super) fn from_halcon_tuple(text: &str) -> Result<Camera> {
     let (kind_from_call, body) = if let Some(at) = rest.find("gen_cam_par_") {
         let call = &rest[at + "gen_cam_par_".len()..];
         let open = call.find('(').ok_or_else(|| {
-            Error::parse(line_no, 0, "expected gen_cam_par_...(arguments, CameraParam)")
+            Error::parse(
+                line_no,
+                0,
+                "expected gen_cam_par_...(arguments, CameraParam)",
+            )
         })?;
-        let close = call.find(')').ok_or_else(|| {
-            Error::parse(line_no, 0, "the gen_cam_par_ call has no closing ')'")
-        })?;
+        let close = call
+            .find(')')
+            .ok_or_else(|| Error::parse(line_no, 0, "the gen_cam_par_ call has no closing ')'"))?;
         let kind = call[..open].trim().to_string();
         // The last argument is the output variable.
         let args = &call[open + 1..close];
@@ -210,10 +214,7 @@ pub(super) fn from_halcon_dat(text: &str) -> Result<Camera> {
             "ImageHeight",
         ]
     };
-    if !matches!(
-        kind.as_str(),
-        "area_scan_division" | "area_scan_polynomial"
-    ) {
+    if !matches!(kind.as_str(), "area_scan_division" | "area_scan_polynomial") {
         return camera_from(&HalconParams {
             kind,
             values: Vec::new(),
@@ -247,9 +248,9 @@ pub(super) fn from_halcon_dat(text: &str) -> Result<Camera> {
                 ),
             ));
         };
-        let number = value.parse::<f64>().map_err(|_| {
-            Error::parse(*line, 0, format!("{name} is '{value}', not a number"))
-        })?;
+        let number = value
+            .parse::<f64>()
+            .map_err(|_| Error::parse(*line, 0, format!("{name} is '{value}', not a number")))?;
         values.push(number);
     }
     camera_from(&HalconParams {
@@ -434,16 +435,13 @@ fn brown_from_undistorting(camera: &Camera, c: [f64; 5]) -> Result<Distortion> {
         normal += jx * jx.transpose() + jy * jy.transpose();
         rhs += jx * (d.0 - u.0) + jy * (d.1 - u.1);
     }
-    let k = normal
-        .cholesky()
-        .map(|ch| ch.solve(&rhs))
-        .ok_or_else(|| {
-            Error::parse(
-                0,
-                0,
-                "the polynomial's distortion could not be fitted (degenerate image size)",
-            )
-        })?;
+    let k = normal.cholesky().map(|ch| ch.solve(&rhs)).ok_or_else(|| {
+        Error::parse(
+            0,
+            0,
+            "the polynomial's distortion could not be fitted (degenerate image size)",
+        )
+    })?;
     let worst_px = pairs
         .iter()
         .map(|&(u, d)| {

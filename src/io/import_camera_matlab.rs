@@ -9,7 +9,8 @@ use crate::error::{Error, Result};
 
 /// Whether `text` looks like a MATLAB camera script.
 pub(super) fn is_matlab(text: &str) -> bool {
-    text.contains("cameraIntrinsics") || text.contains("cameraParameters")
+    text.contains("cameraIntrinsics")
+        || text.contains("cameraParameters")
         || assignment(text, "focalLength").is_some()
 }
 
@@ -187,7 +188,9 @@ pub(super) fn from_text(text: &str) -> Result<Camera> {
         return Err(Error::parse(
             line,
             0,
-            format!("expected '{TEXT_SIZE_COMMENT} WIDTH HEIGHT' (two whole numbers > 0), got '{size}'"),
+            format!(
+                "expected '{TEXT_SIZE_COMMENT} WIDTH HEIGHT' (two whole numbers > 0), got '{size}'"
+            ),
         ));
     };
     camera_from_k(&k, width, height, Distortion::None)

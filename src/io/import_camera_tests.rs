@@ -36,7 +36,11 @@ fn canonical(d: &Distortion) -> Distortion {
 /// Same camera: every number within 1e-9 relative, same size and model.
 fn assert_same(back: &Camera, camera: &Camera, what: &str) {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-300);
-    assert_eq!((back.width, back.height), (camera.width, camera.height), "{what}");
+    assert_eq!(
+        (back.width, back.height),
+        (camera.width, camera.height),
+        "{what}"
+    );
     let (a, b) = (canonical(&back.distortion), canonical(&camera.distortion));
     assert_eq!(a.model_name(), b.model_name(), "{what}");
     let numbers = |c: &Camera, d: &Distortion| {
@@ -162,10 +166,18 @@ fn halcon_dat_and_tuple_files_convert_units_and_signs() {
     let (c, seen) = import_camera(HALCON_DAT).unwrap();
     assert_eq!(seen, CameraSource::Halcon);
     let fx = 0.008 / 8.3e-6;
-    assert!((c.fx - fx).abs() < 1e-9 && (c.fy - fx).abs() < 1e-9, "{c:?}");
+    assert!(
+        (c.fx - fx).abs() < 1e-9 && (c.fy - fx).abs() < 1e-9,
+        "{c:?}"
+    );
     assert_eq!((c.cx, c.cy, c.width, c.height), (371.5, 243.25, 752, 480));
     // Barrel distortion keeps its sign: kappa = Kappa Focus^2.
-    assert_eq!(c.distortion, Distortion::Division { kappa: -2500.0 * 0.008 * 0.008 });
+    assert_eq!(
+        c.distortion,
+        Distortion::Division {
+            kappa: -2500.0 * 0.008 * 0.008
+        }
+    );
     // The same camera as an HDevelop tuple, as a pre-12 tuple without its
     // type and as a gen_cam_par call.
     for text in [
@@ -193,18 +205,32 @@ fn a_halcon_polynomial_becomes_the_brown_model_that_inverts_it() {
         panic!("{c:?}")
     };
     // Undistorting with +K1 is distorting with about -K1 f^2.
-    assert!(b1 < 0.0 && (b1 + k1 * focus * focus).abs() < 0.2 * k1 * focus * focus, "{b1}");
+    assert!(
+        b1 < 0.0 && (b1 + k1 * focus * focus).abs() < 0.2 * k1 * focus * focus,
+        "{b1}"
+    );
     let mut worst: f64 = 0.0;
-    for (col, row) in [(0.0, 0.0), (1279.0, 959.0), (200.0, 700.0), (640.0, 480.0), (1000.0, 100.0)] {
+    for (col, row) in [
+        (0.0, 0.0),
+        (1279.0, 959.0),
+        (200.0, 700.0),
+        (640.0, 480.0),
+        (1000.0, 100.0),
+    ] {
         // HALCON: distorted metric (u, v) -> undistorted.
         let (u, v) = ((col - 640.0) * sx, (row - 480.0) * sx);
         let r2 = u * u + v * v;
         let uu = u * (1.0 + k1 * r2) + p1 * (r2 + 2.0 * u * u) + 2.0 * p2 * u * v;
         let vv = v * (1.0 + k1 * r2) + 2.0 * p1 * u * v + p2 * (r2 + 2.0 * v * v);
-        let projected = c.project(&Point3::new(uu / focus, vv / focus, 1.0)).unwrap();
+        let projected = c
+            .project(&Point3::new(uu / focus, vv / focus, 1.0))
+            .unwrap();
         worst = worst.max((projected - Point2::new(col, row)).norm());
     }
-    assert!(worst < super::import_camera_halcon::POLYNOMIAL_FIT_MAX_PX, "{worst} px");
+    assert!(
+        worst < super::import_camera_halcon::POLYNOMIAL_FIT_MAX_PX,
+        "{worst} px"
+    );
 }
 
 #[test]
@@ -238,7 +264,12 @@ fn damaged_files_name_the_line_and_what_is_missing() {
         "line 2: camera parameter 2 is 'kappa', not a number"
     );
     // MATLAB: a missing line, a damaged one.
-    let m = export_camera(&Camera::example_brown(), &CameraExportInfo::default(), CameraFormat::Matlab).unwrap();
+    let m = export_camera(
+        &Camera::example_brown(),
+        &CameraExportInfo::default(),
+        CameraFormat::Matlab,
+    )
+    .unwrap();
     let lines: Vec<&str> = m.lines().collect();
     let without = |prefix: &str| {
         lines
@@ -256,10 +287,26 @@ fn damaged_files_name_the_line_and_what_is_missing() {
         "line 2: focalLength has 1 numbers, expected [fx, fy]"
     );
     // Text: no size, a lens model left out.
-    let k = export_camera(&Camera::example_pinhole(), &CameraExportInfo::default(), CameraFormat::Text).unwrap();
-    assert!(err(&k.lines().take(3).map(|l| format!("{l}\n")).collect::<String>())
-        .starts_with("a 3x3 camera matrix holds no image size: add the line '# image_size_px: WIDTH HEIGHT'"));
-    let k = export_camera(&Camera::example_brown(), &CameraExportInfo::default(), CameraFormat::Text).unwrap();
+    let k = export_camera(
+        &Camera::example_pinhole(),
+        &CameraExportInfo::default(),
+        CameraFormat::Text,
+    )
+    .unwrap();
+    assert!(err(&k
+        .lines()
+        .take(3)
+        .map(|l| format!("{l}\n"))
+        .collect::<String>())
+    .starts_with(
+        "a 3x3 camera matrix holds no image size: add the line '# image_size_px: WIDTH HEIGHT'"
+    ));
+    let k = export_camera(
+        &Camera::example_brown(),
+        &CameraExportInfo::default(),
+        CameraFormat::Text,
+    )
+    .unwrap();
     assert!(
         err(&k).starts_with("line 5: this camera matrix was written from a camera with the brown lens model, which the text format does not hold"),
         "{}",

@@ -274,7 +274,10 @@ fn diff_reads_halcon_matlab_and_text_files() {
         diff["projection_shift_px"]["worst"].as_f64().unwrap()
     };
     let brown = Camera::example_brown();
-    let json = write("brown.json", &export_camera(&brown, &info, CameraFormat::Json).unwrap());
+    let json = write(
+        "brown.json",
+        &export_camera(&brown, &info, CameraFormat::Json).unwrap(),
+    );
     for (name, format) in [
         ("brown.hdev.txt", CameraFormat::Halcon),
         ("brown.m", CameraFormat::Matlab),
@@ -284,8 +287,14 @@ fn diff_reads_halcon_matlab_and_text_files() {
         assert!(worst < 1e-6, "{name}: {worst} px");
     }
     let pinhole = Camera::example_pinhole();
-    let json = write("pinhole.json", &export_camera(&pinhole, &info, CameraFormat::Json).unwrap());
-    let text = write("K.txt", &export_camera(&pinhole, &info, CameraFormat::Text).unwrap());
+    let json = write(
+        "pinhole.json",
+        &export_camera(&pinhole, &info, CameraFormat::Json).unwrap(),
+    );
+    let text = write(
+        "K.txt",
+        &export_camera(&pinhole, &info, CameraFormat::Text).unwrap(),
+    );
     assert!(diff_worst(&json, &text) < 1e-6);
     // HALCON's write_cam_par: Focus 8 mm, Kappa -2500 1/m^2, 8.3 um pixels.
     let dat = "ParGroup: Camera: Parameter;\n\t\"Internal camera parameters\";\n\n\
@@ -306,7 +315,10 @@ fn diff_reads_halcon_matlab_and_text_files() {
         },
     };
     let dat_path = write("camera.dat", dat);
-    let same = write("same.json", &export_camera(&same, &info, CameraFormat::Json).unwrap());
+    let same = write(
+        "same.json",
+        &export_camera(&same, &info, CameraFormat::Json).unwrap(),
+    );
     assert!(diff_worst(&same, &dat_path) < 1e-6);
     let broken = write("broken.dat", &dat.replace("Cy:cy:\t243.25;\n", ""));
     let (code, _, err) = robocal(&["diff", &same, &broken]);

@@ -102,8 +102,8 @@ export class PlanView {
     if (!saved) return;
     try {
       for (const [id, value] of Object.entries(saved.inputs.fields)) if (FIELD_IDS.includes(id)) $(id).value = value;
-      const view = saved.inputs.view;
-      if (view && [...this.viewSelect.options].some((o) => o.value === view)) this.viewSelect.value = view;
+      this.savedView = saved.inputs.view;
+      if (this.savedView) this.renderViews();
       if (saved.result) this.restoreResult(saved);
     } catch (err) {
       fill(this.out, message('error', `The saved plan could not be shown (${err.message}): plan again.`));
@@ -127,8 +127,11 @@ export class PlanView {
 
   renderViews() {
     const views = this.views();
-    const old = this.viewSelect.value;
+    // A restored plan's view, once the paired images are there: chosen, its restored fields kept.
+    const restored = this.savedView && views.some((v) => v.name === this.savedView) ? this.savedView : null;
+    const old = restored || this.viewSelect.value;
     fill(this.viewSelect, views.map((v) => h('option', { value: v.name, selected: v.name === old }, v.name)));
+    if (restored) { this.savedView = null; return; }
     if (views.length && (!old || !views.some((v) => v.name === old))) this.prefill();
   }
 
