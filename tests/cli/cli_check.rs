@@ -325,8 +325,10 @@ fn diff_reads_halcon_matlab_and_text_files() {
     assert_eq!(code, 1);
     assert_eq!(
         err,
-        "robocal: b: the HALCON camera file (area_scan_division) has no Cy entry ('Cy:cy: \
-         <value>;'): the file is truncated or not from write_cam_par\n"
+        format!(
+            "robocal: '{broken}': the HALCON camera file (area_scan_division) has no Cy entry \
+             ('Cy:cy: <value>;'): the file is truncated or not from write_cam_par\n"
+        )
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
