@@ -451,7 +451,7 @@ fn brown_from_undistorting(camera: &Camera, c: [f64; 5]) -> Result<Distortion> {
             (ex * camera.fx).hypot(ey * camera.fy)
         })
         .fold(0.0, f64::max);
-    if !(worst_px <= POLYNOMIAL_FIT_MAX_PX) {
+    if worst_px.is_nan() || worst_px > POLYNOMIAL_FIT_MAX_PX {
         return Err(Error::parse(
             0,
             0,
