@@ -2031,7 +2031,7 @@ export interface RobocalJson {
   pair_images: [string[], ImagePairing];
   /** `rig_frame_keys(JSON.stringify(cameras), groupBy)` (groupBy `'number'` or `'last'` (the last number in the name), `'first'`, `'order'`, a pattern with one `(\\d+)` such as `'sync(\\d+)'`, or `''`: by number unless no name has one) -> each image's frame key, as `robocal rig --group-by` groups them. */
   rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
-  /** `read_camera_file(text)` -> the camera of a robocal JSON (camera export or calibration report), OpenCV YAML/XML or ROS camera_info file, as `robocal rig --camera-file` reads it. */
+  /** `read_camera_file(text)` -> the camera of any camera format robocal exports (robocal JSON camera export or calibration report, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON tuple or .dat, MATLAB script, text matrix), as `robocal rig --camera-file` reads it. */
   read_camera_file: [never, CameraFileReading];
   /** `check_camera(request)` -> the check of a saved calibration against new views: ok, drifted or broken (docs/check.md). */
   check_camera: [CheckRequest, CheckReport];
@@ -2052,7 +2052,7 @@ export interface RobocalJson {
 /** What `read_camera_file` returns: the camera (what a rig input's `cameras[i].camera` takes to hold its intrinsics) and the format it was read as. */
 export interface CameraFileReading {
   camera: Camera;
-  format: 'json' | 'opencv-yaml' | 'opencv-xml' | 'ros-yaml';
+  format: 'json' | 'opencv-yaml' | 'opencv-xml' | 'ros-yaml' | 'kalibr' | 'mrcal' | 'halcon' | 'matlab' | 'text';
 }
 
 /** One camera's image names, the input of `rig_frame_keys`. */

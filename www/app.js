@@ -24,9 +24,13 @@ let robotView = null;
 const store = new Store();
 const READONLY_STEPS = ['camera', 'handeye', 'export', 'share'];
 
+/** The steps of a shared page: the check too when the link holds one. */
+const readonlySteps = () => [...READONLY_STEPS, ...(store.session.check && store.session.check.result ? ['check'] : [])];
+
 function showStep(readonly) {
   const links = [...document.querySelectorAll('#step-list a')];
-  for (const a of links) a.parentElement.hidden = readonly && !READONLY_STEPS.includes(a.dataset.step);
+  const shown = readonlySteps();
+  for (const a of links) a.parentElement.hidden = readonly && !shown.includes(a.dataset.step);
   const allowed = links.filter((a) => !a.parentElement.hidden).map((a) => a.dataset.step);
   const wanted = location.hash.slice(1);
   // A new session opens on step 1 (the target); a session with images on step 2.
@@ -103,6 +107,8 @@ async function openShared(fragment) {
   store.session.target = payload.target || store.session.target;
   if (payload.camera) Object.assign(store.session.camera, payload.camera);
   if (payload.handeye) Object.assign(store.session.handeye, payload.handeye);
+  if (payload.plan) store.session.plan = { inputs: { view: null, fields: {} }, request: { setup: payload.plan.setup }, result: payload.plan.result };
+  if (payload.check) store.session.check = payload.check;
   store.persistent = false;
   document.body.classList.add('readonly');
   $('readonly-banner').hidden = false;
@@ -111,6 +117,8 @@ async function openShared(fragment) {
   await loadLensModels(engine);
   const camera = new CameraView(store, engine, images, { readonly: true });
   new HandEyeView(store, engine, { pairs: () => [] }, { readonly: true });
+  new PlanView(store, engine, { pairs: () => [] }, { readonly: true });
+  new CheckView(store, engine, () => new Engine(), { readonly: true });
   new ExportView(store, engine);
   new ShareView(store, version, () => camera.plots || []);
   showStep(true);

@@ -18,6 +18,8 @@ export function defaultSession() {
     rig: { model: 'brown', result: null, cameras: [] },
     laser: { result: null }, // result: the laser step's `laser_plane` report (views/laser.js)
     stereo: null, // { result }: `robocal stereo`'s report, from a session saved before the rig step replaced the stereo step
+    plan: null, // { inputs: { view, fields: { id: value } }, request, result }: the pose plan (views/plan.js)
+    check: null, // { name, result }: the last check of a saved calibration (views/check.js)
   };
 }
 

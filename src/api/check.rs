@@ -14,8 +14,9 @@
 //! ```
 //!
 //! `calibration` is any camera file robocal reads back
-//! ([`crate::io::import_camera`]: a robocal report or camera JSON, OpenCV
-//! YAML/XML, ROS camera_info); from a robocal report the check also takes
+//! ([`crate::io::import_camera`]: any camera format robocal exports, a
+//! robocal report or camera JSON, OpenCV YAML/XML, ROS camera_info, Kalibr,
+//! mrcal, HALCON, MATLAB, the text matrix); from a robocal report the check also takes
 //! the saved `std`, `projection_uncertainty.max_std_px` and `rms_px`, which
 //! set its thresholds. `thresholds` and `camera_from_target` (the pose of a
 //! fixed target seen by a fixed camera at calibration time) are optional.

@@ -4,12 +4,13 @@
 //! Request: `{"setup", "base_from_gripper": pose, "camera_from_target":
 //! pose, "camera": camera JSON, "board_m": [[x, y, z]...], "guess": pose
 //! (optional), "poses": 15, "max_tilt_deg": 40, "max_roll_deg": 60,
-//! "distance_m": [min, max], "flange_box_m": [[x0, y0, z0], [x1, y1, z1]],
-//! "margin_px": 20, "pixel_sigma_px": 0.3, "view_px": [[u, v]...]}` (poses
-//! as [`PoseInput`]). `view_px`, the current view's detected pixels of the
-//! `board_m` points in the same order, lets the plan measure the corner
-//! noise on it ([`crate::handeye::plan::pixel_sigma_from_view`]) when
-//! `pixel_sigma_px` is not given; without either it assumes 0.3 px.
+//! "distance_m": [min, max], "flange_box_m": [[x0, y0, z0], [x1, y1, z1]]
+//! (two opposite corners, base frame), "margin_px": 20, "pixel_sigma_px":
+//! 0.3, "view_px": [[u, v]...]}` (poses as [`PoseInput`]). `view_px`, the
+//! current view's detected pixels of the `board_m` points in the same order,
+//! lets the plan measure the corner noise on it
+//! ([`crate::handeye::plan::pixel_sigma_from_view`]) when `pixel_sigma_px`
+//! is not given; without either it assumes 0.3 px.
 
 use crate::api::handeye::camera_from_json;
 use crate::calib::View;
@@ -110,7 +111,13 @@ pub fn plan_json(request_json: &str) -> Result<String> {
         max_tilt_deg: r.max_tilt_deg.unwrap_or(d.max_tilt_deg),
         max_roll_deg: r.max_roll_deg.unwrap_or(d.max_roll_deg),
         distance_m: r.distance_m.map(|v| (v[0], v[1])),
-        flange_box_m: r.flange_box_m.map(|b| (b[0], b[1])),
+        // Two opposite corners, in any order (as `robocal plan --flange-box`).
+        flange_box_m: r.flange_box_m.map(|[a, b]| {
+            (
+                [a[0].min(b[0]), a[1].min(b[1]), a[2].min(b[2])],
+                [a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])],
+            )
+        }),
         margin_px: r.margin_px.unwrap_or(d.margin_px),
     };
     let noise = match (r.pixel_sigma_px, &r.view_px) {

@@ -31,8 +31,9 @@ The exit code is 0 for every verdict: the verdict is data.
 
 --camera reads any camera file robocal reads back: a robocal report or
 camera JSON (with its std and projection uncertainty, which set the
-thresholds), OpenCV YAML/XML, ROS camera_info (thresholds then from the
-refit's uncertainty and the floors only).",
+thresholds), OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON (.dat
+or tuple), MATLAB, the text matrix (thresholds then from the refit's
+uncertainty and the floors only).",
     after_help = "Examples:
   robocal check --camera camera.json --target chessboard:9x6:30mm new/*.png
   robocal check --camera camera.yaml --target chessboard:9x6:30mm new/*.png -o check.json
@@ -40,7 +41,8 @@ refit's uncertainty and the floors only).",
     args_override_self = true
 )]
 pub struct CheckArgs {
-    /// The saved calibration (robocal JSON, OpenCV YAML/XML, ROS camera_info)
+    /// The saved calibration: any camera format robocal exports (robocal JSON,
+    /// OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON, MATLAB, text)
     #[arg(long, value_name = "FILE")]
     camera: String,
     /// The target, as for 'robocal detect' (chessboard:9x6:30mm, ...)

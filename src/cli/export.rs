@@ -20,7 +20,7 @@ REPORT.json is the output of 'robocal intrinsics' (a camera),
   mrcal         mrcal .cameramodel
   halcon        Halcon camera parameter tuple (metric, nominal 5 um pixels)
   matlab        MATLAB cameraIntrinsics script (1-based principal point)
-  text          the 3x3 camera matrix
+  text          the 3x3 camera matrix, then '# image_size_px: W H' (read back by --camera)
   report        the report itself, pretty-printed
 
 Transform formats (of gripper_from_camera, base_from_camera, right_from_left

@@ -53,8 +53,9 @@ pub struct PlanArgs {
     /// Units of the pose file: mm or m, deg or rad, or both (mm,deg)
     #[arg(long, value_name = "UNITS")]
     pose_units: Option<String>,
-    /// The camera (robocal camera JSON or calibration report, OpenCV YAML/XML,
-    /// ROS camera_info)
+    /// The camera: any camera format robocal exports (robocal camera JSON or
+    /// calibration report, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal,
+    /// HALCON, MATLAB, text)
     #[arg(long, value_name = "FILE")]
     camera: Option<String>,
     /// The board, e.g. chessboard:9x6:30mm

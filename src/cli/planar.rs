@@ -60,8 +60,9 @@ pub struct PlanarArgs {
     /// then refit
     #[arg(long, value_name = "SIGMA", allow_negative_numbers = true)]
     reject: Option<f64>,
-    /// solve: a calibrated camera (robocal JSON, OpenCV YAML/XML or ROS
-    /// camera_info); the image points are undistorted with it first
+    /// solve: a calibrated camera (any camera format robocal exports: robocal
+    /// JSON, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON, MATLAB,
+    /// text); the image points are undistorted with it first
     #[arg(long, value_name = "FILE")]
     camera: Option<String>,
     /// solve: plate length |AB| and width |BC| for the pixel density

@@ -31,8 +31,9 @@ one (\\d+), matched in the name without folders, such as 'sync(\\d+)'
 hold any subset of the board's points (marker boards partly out of view).
 
 Each camera is calibrated alone (Zhang), or its intrinsics are given and held
-with --camera-file NAME=FILE (a robocal camera JSON or report, OpenCV YAML/XML,
-ROS camera_info). The cameras are chained along a spanning tree of the pairs
+with --camera-file NAME=FILE (any camera format robocal exports: a robocal
+camera JSON or report, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON,
+MATLAB, text). The cameras are chained along a spanning tree of the pairs
 that saw the board together most often (rotations averaged over the shared
 frames), then one bundle adjustment refines every intrinsic, every
 camera_from_rig and every frame's board pose. When no frame links two groups of

@@ -207,9 +207,27 @@ intrinsics = cameraIntrinsics(focalLength, principalPoint, imageSize, ...\n    '
     ))
 }
 
+/// The 3x3 camera matrix, then the image size as a comment (what reads it
+/// back needs it; `numpy.loadtxt` skips it) and, for a camera with a lens
+/// model, a comment saying the model was left out (the reader refuses it).
 pub(super) fn text3x3(c: &Camera) -> String {
     let k = k_row_major(c);
-    k.chunks(3)
+    let mut out: String = k
+        .chunks(3)
         .map(|row| row.iter().map(|v| float(*v)).collect::<Vec<_>>().join(" ") + "\n")
-        .collect()
+        .collect();
+    out += &format!(
+        "{} {} {}\n",
+        super::import_camera_matlab::TEXT_SIZE_COMMENT,
+        c.width,
+        c.height
+    );
+    if c.distortion != Distortion::None {
+        out += &format!(
+            "{} {} (not written: this file holds the camera matrix only)\n",
+            super::import_camera_matlab::TEXT_MODEL_COMMENT,
+            c.distortion.model_name()
+        );
+    }
+    out
 }

@@ -1,10 +1,17 @@
 //! Reading cameras back: robocal JSON (a camera export or a calibration
 //! report), OpenCV FileStorage YAML and XML, ROS `camera_info` YAML, a
 //! Kalibr camchain and an mrcal `.cameramodel` (the last two in
-//! [`super::import_camera_tools`]): every camera format `robocal export`
-//! writes but Halcon's, MATLAB's and the text matrix.
-//! The format is recognised from the content.
+//! [`super::import_camera_tools`]), HALCON camera parameters (an HDevelop
+//! tuple or a `write_cam_par` `.dat` file, [`super::import_camera_halcon`]),
+//! robocal's MATLAB script and its text matrix
+//! ([`super::import_camera_matlab`]): every camera format `robocal export`
+//! writes. The format is recognised from the content, in the order of
+//! [`NOT_A_CAMERA`]'s list.
 
+use super::import_camera_halcon::{
+    from_halcon_dat, from_halcon_tuple, is_halcon_dat, is_halcon_tuple,
+};
+use super::import_camera_matlab::{from_matlab, from_text, is_matlab, is_text_matrix};
 use super::import_camera_tools::{from_kalibr, from_mrcal, is_kalibr, is_mrcal};
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
@@ -24,7 +31,18 @@ pub enum CameraSource {
     Kalibr,
     /// An mrcal `.cameramodel`.
     Mrcal,
+    /// HALCON camera parameters: an HDevelop tuple (robocal's `halcon`
+    /// export) or HALCON's `write_cam_par` `.dat` file.
+    Halcon,
+    /// robocal's MATLAB script (`cameraIntrinsics`).
+    Matlab,
+    /// robocal's text camera matrix (with its image-size comment).
+    Text,
 }
+
+/// The error of a text that is no camera file: the formats, in the order
+/// they are recognised.
+pub const NOT_A_CAMERA: &str = "not a camera file: expected robocal JSON, OpenCV YAML/XML (camera_matrix, distortion_coefficients), ROS camera_info YAML, a Kalibr camchain, an mrcal .cameramodel, HALCON camera parameters (a .dat file or a CameraParam tuple), robocal's MATLAB script or a 3x3 camera matrix";
 
 /// Read a camera from text in any of the [`CameraSource`] formats.
 pub fn import_camera(text: &str) -> Result<(Camera, CameraSource)> {
@@ -47,11 +65,19 @@ pub fn import_camera(text: &str) -> Result<(Camera, CameraSource)> {
     if is_kalibr(text) {
         return from_kalibr(text).map(|c| (c, CameraSource::Kalibr));
     }
-    Err(Error::parse(
-        0,
-        0,
-        "not a camera file: expected robocal JSON, OpenCV YAML/XML (camera_matrix, distortion_coefficients), ROS camera_info YAML, a Kalibr camchain or an mrcal .cameramodel",
-    ))
+    if is_halcon_dat(text) {
+        return from_halcon_dat(text).map(|c| (c, CameraSource::Halcon));
+    }
+    if is_halcon_tuple(text) {
+        return from_halcon_tuple(text).map(|c| (c, CameraSource::Halcon));
+    }
+    if is_matlab(text) {
+        return from_matlab(text).map(|c| (c, CameraSource::Matlab));
+    }
+    if is_text_matrix(text) {
+        return from_text(text).map(|c| (c, CameraSource::Text));
+    }
+    Err(Error::parse(0, 0, NOT_A_CAMERA))
 }
 
 fn from_json(text: &str) -> Result<Camera> {
@@ -120,7 +146,12 @@ pub fn distortion_template(model: &str) -> Result<Distortion> {
     })
 }
 
-fn camera_from_k(k: &[f64], width: u32, height: u32, distortion: Distortion) -> Result<Camera> {
+pub(super) fn camera_from_k(
+    k: &[f64],
+    width: u32,
+    height: u32,
+    distortion: Distortion,
+) -> Result<Camera> {
     if let Some(bad) = k.iter().find(|v| !v.is_finite()) {
         return Err(Error::invalid(
             "camera_matrix",

@@ -18,6 +18,8 @@ pub mod export_ros;
 pub mod export_stereo;
 pub mod export_transform;
 pub mod import_camera;
+pub mod import_camera_halcon;
+pub mod import_camera_matlab;
 mod import_camera_tools;
 pub mod kalibr_target;
 pub mod move_lists;
@@ -39,6 +41,8 @@ pub mod workflow_csv;
 mod export_rig_tests;
 #[cfg(test)]
 mod export_tests;
+#[cfg(test)]
+mod import_camera_tests;
 #[cfg(test)]
 mod pose_tests;
 

@@ -22,14 +22,19 @@ fn format_name(source: CameraSource) -> &'static str {
         CameraSource::RosYaml => "ros-yaml",
         CameraSource::Kalibr => "kalibr",
         CameraSource::Mrcal => "mrcal",
+        CameraSource::Halcon => "halcon",
+        CameraSource::Matlab => "matlab",
+        CameraSource::Text => "text",
     }
 }
 
-/// Read a camera file's text: robocal JSON (a camera export or a
-/// calibration report), OpenCV FileStorage YAML or XML, or a ROS
-/// `camera_info` YAML, recognised from the content as `robocal rig
+/// Read a camera file's text: any camera format robocal exports (robocal
+/// JSON or a calibration report, OpenCV FileStorage YAML or XML, ROS
+/// `camera_info` YAML, Kalibr, mrcal, HALCON's tuple or `.dat`, MATLAB,
+/// the text matrix), recognised from the content as `robocal rig
 /// --camera-file` reads it. Out: `{"camera": {...}, "format": "json" |
-/// "opencv-yaml" | "opencv-xml" | "ros-yaml"}`; `camera` is what a rig
+/// "opencv-yaml" | "opencv-xml" | "ros-yaml" | "kalibr" | "mrcal" |
+/// "halcon" | "matlab" | "text"}`; `camera` is what a rig
 /// input's `cameras[i].camera` takes to hold that camera's intrinsics.
 #[wasm_bindgen]
 pub fn read_camera_file(text: &str) -> Result<String, JsError> {

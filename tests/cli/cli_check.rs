@@ -252,3 +252,83 @@ fn bad_input_gets_a_message_that_names_it() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `diff` (and so `check --camera`) reads every camera format robocal
+/// exports, HALCON's own `.dat` too: each against the JSON it came from
+/// shifts nothing; a damaged file names its line.
+#[test]
+fn diff_reads_halcon_matlab_and_text_files() {
+    use robocal::camera::{Camera, Distortion};
+    use robocal::io::export_camera::{export_camera, CameraExportInfo, CameraFormat};
+    let dir = temp_dir("cli", "check-formats");
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let info = CameraExportInfo::default();
+    let diff_worst = |a: &str, b: &str| {
+        let (code, out, err) = robocal(&["diff", a, b, "--grid", "30x20"]);
+        assert_eq!(code, 0, "{a} {b}: {err}");
+        let diff: Value = serde_json::from_str(&out).unwrap();
+        diff["projection_shift_px"]["worst"].as_f64().unwrap()
+    };
+    let brown = Camera::example_brown();
+    let json = write(
+        "brown.json",
+        &export_camera(&brown, &info, CameraFormat::Json).unwrap(),
+    );
+    for (name, format) in [
+        ("brown.hdev.txt", CameraFormat::Halcon),
+        ("brown.m", CameraFormat::Matlab),
+    ] {
+        let other = write(name, &export_camera(&brown, &info, format).unwrap());
+        let worst = diff_worst(&json, &other);
+        assert!(worst < 1e-6, "{name}: {worst} px");
+    }
+    let pinhole = Camera::example_pinhole();
+    let json = write(
+        "pinhole.json",
+        &export_camera(&pinhole, &info, CameraFormat::Json).unwrap(),
+    );
+    let text = write(
+        "K.txt",
+        &export_camera(&pinhole, &info, CameraFormat::Text).unwrap(),
+    );
+    assert!(diff_worst(&json, &text) < 1e-6);
+    // HALCON's write_cam_par: Focus 8 mm, Kappa -2500 1/m^2, 8.3 um pixels.
+    let dat = "ParGroup: Camera: Parameter;\n\t\"Internal camera parameters\";\n\n\
+        Focus:foc:\t0.008;\n\tDOUBLE:0.0:;\n\tKappa:kappa:\t-2500;\n\
+        Sx:sx:\t8.3e-06;\nSy:sy:\t8.3e-06;\nCx:cx:\t371.5;\nCy:cy:\t243.25;\n\
+        ImageWidth:imgw:\t752;\nImageHeight:imgh:\t480;\n";
+    let f = 0.008 / 8.3e-6;
+    let same = Camera {
+        fx: f,
+        fy: f,
+        cx: 371.5,
+        cy: 243.25,
+        skew: 0.0,
+        width: 752,
+        height: 480,
+        distortion: Distortion::Division {
+            kappa: -2500.0 * 0.008 * 0.008,
+        },
+    };
+    let dat_path = write("camera.dat", dat);
+    let same = write(
+        "same.json",
+        &export_camera(&same, &info, CameraFormat::Json).unwrap(),
+    );
+    assert!(diff_worst(&same, &dat_path) < 1e-6);
+    let broken = write("broken.dat", &dat.replace("Cy:cy:\t243.25;\n", ""));
+    let (code, _, err) = robocal(&["diff", &same, &broken]);
+    assert_eq!(code, 1);
+    assert_eq!(
+        err,
+        format!(
+            "robocal: '{broken}': the HALCON camera file (area_scan_division) has no Cy entry \
+             ('Cy:cy: <value>;'): the file is truncated or not from write_cam_par\n"
+        )
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

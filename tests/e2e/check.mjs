@@ -16,7 +16,38 @@ export const launchArgs = ['--use-fake-device-for-media-stream'];
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 const file = (name, value) => ({ name, mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(value)) });
 
+/** A text file for the file input. */
+const textFile = (name, text) => ({ name, mimeType: 'text/plain', buffer: Buffer.from(text) });
+
 export const tests = [
+  ['every camera format robocal exports loads as the saved calibration: HALCON .dat and tuple, MATLAB, text; a damaged file names what is missing', async (page, { url }) => {
+    await page.goto(`${url}#check`);
+    await ready(page);
+    await page.locator('#step-check').waitFor({ state: 'visible', timeout: 10000 });
+    // The pickers take the files' extensions (.dat, .hdev.txt, .m, .txt, .cameramodel).
+    const accept = await page.getAttribute('#check-file', 'accept');
+    for (const ext of ['.dat', '.txt', '.m', '.cameramodel', '.json', '.yaml', '.xml']) assert.ok(accept.split(',').includes(ext), `${ext} in ${accept}`);
+    const info = async (f) => {
+      await page.$eval('#check-file-info', (el) => { el.textContent = ''; });
+      await page.setInputFiles('#check-file', f);
+      await page.waitForFunction(() => document.getElementById('check-file-info').textContent !== '', null, { timeout: 10000 });
+      return page.textContent('#check-file-info');
+    };
+    // HALCON's write_cam_par: Focus 8 mm over 8.3 um pixels, fx = 963.9 px.
+    const dat = 'ParGroup: Camera: Parameter;\n\t"Internal camera parameters";\n\nFocus:foc:\t0.008;\n\tDOUBLE:0.0:;\n\t"Focal length of the lens [meter]";\n\n'
+      + 'Kappa:kappa:\t-2500;\nSx:sx:\t8.3e-06;\nSy:sy:\t8.3e-06;\nCx:cx:\t371.5;\nCy:cy:\t243.25;\nImageWidth:imgw:\t752;\nImageHeight:imgh:\t480;\n';
+    assert.equal(await info(textFile('camera.dat', dat)), 'camera.dat (halcon): 752 × 480, fx 963.9, fy 963.9, cx 371.5, cy 243.3');
+    assert.equal(await info(textFile('camera.hdev.txt', "CameraParam := ['area_scan_division', 0.008, -2500, 8.3e-06, 8.3e-06, 371.5, 243.25, 752, 480]\n")),
+      'camera.hdev.txt (halcon): 752 × 480, fx 963.9, fy 963.9, cx 371.5, cy 243.3');
+    const m = 'focalLength = [900.0, 901.0];\nprincipalPoint = [321.5, 241.5];\nimageSize = [480, 640];\nradialDistortion = [-0.1, 0.02];\ntangentialDistortion = [0.0, 0.0];\nskew = 0.0;\n';
+    assert.equal(await info(textFile('camera.m', m)), 'camera.m (matlab): 640 × 480, fx 900.0, fy 901.0, cx 320.5, cy 240.5');
+    assert.equal(await info(textFile('K.txt', '900 0 319.5\n0 900 239.5\n0 0 1\n# image_size_px: 640 480\n')), 'K.txt (text): 640 × 480, fx 900.0, fy 900.0, cx 319.5, cy 239.5');
+    await page.setInputFiles('#check-file', textFile('broken.dat', dat.replace('Sx:sx:\t8.3e-06;\n', '')));
+    await page.locator('#check-result .msg-error').waitFor({ timeout: 10000 });
+    assert.equal(await page.textContent('#check-result .msg-error'),
+      "broken.dat: the HALCON camera file (area_scan_division) has no Sx entry ('Sx:sx: <value>;'): the file is truncated or not from write_cam_par");
+    assert.equal(await page.textContent('#check-file-info'), 'No calibration loaded.');
+  }],
   ['live check: a saved calibration against the fake camera shows a verdict, the shift map and the parameters', async (page, { url }) => {
     const dir = mkdtempSync(join(tmpdir(), 'robocal-check-'));
     let other = { close: async () => {} };

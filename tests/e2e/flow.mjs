@@ -1,10 +1,20 @@
 // The whole flow on the demo data: load, detect, solve the camera, read the
 // robot poses, solve the hand-eye, export every format, share a link that
 // opens read-only with the same numbers, and reload to find the session;
-// then plan robot poses for hand-eye from one demo view (docs/pose-plan.md).
+// then plan robot poses for hand-eye from one demo view (docs/pose-plan.md):
+// the plan back after a reload, in a share link, and a flange box no pose
+// fits refused in the CLI's words.
 // Ground truth is the demo scene's (src/synth/demo.rs): fx = fy = 900 px,
 // cx 511.5, cy 383.5, gripper_from_camera translation (30, -20, 100) mm.
 import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { mkdtempSync, writeFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { inflateRawSync } from 'node:zlib';
+import { root } from './harness.mjs';
+
+const CLI = join(root, 'target/release/robocal');
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 const cellValue = async (page, table, name) => Number(await page.$eval(`${table} tbody`, (tb, n) => {
@@ -144,5 +154,61 @@ export const tests = [
     assert.equal(krl.split('\n').filter((l) => l.trim().startsWith('LIN ')).length, N, krl.slice(0, 300));
     console.log(`     demo plan: ${N} poses, ${predicted}`);
     await shot('plan');
+    // The plan is kept in the session: after a reload its inputs and its poses are back.
+    const rows = () => page.$$eval('#plan-poses tbody tr', (trs) => trs.map((r) => r.textContent));
+    const planned = await rows();
+    await page.waitForTimeout(500); // the session is saved 300 ms after a change
+    await page.reload();
+    await ready(page);
+    await page.click('a[data-step=handeye]');
+    await page.locator('#plan-poses').waitFor({ timeout: 60000 });
+    assert.deepEqual(await rows(), planned);
+    assert.equal(await page.textContent('#plan-predicted'), predicted);
+    assert.equal(await page.inputValue('#plan-count'), String(N));
+    assert.equal(await page.inputValue('#plan-max-tilt'), '35');
+    await page.waitForFunction(() => document.getElementById('plan-view').options.length === 12, null, { timeout: 20000 });
+    assert.equal(await page.inputValue('#plan-robot-pose'), now);
+    await page.waitForFunction(() => /^ur-script: \d+ bytes/.test(document.getElementById('plan-move-status').textContent), null, { timeout: 10000 });
+    await shot('plan-reloaded');
+    // A share link carries the plan, inside the link budget (tests/e2e/reports.mjs);
+    // the shared page shows it read-only.
+    await page.click('a[data-step=share]');
+    await page.click('#make-share');
+    await page.waitForFunction(() => document.getElementById('share-link').value.includes('#share='), null, { timeout: 10000 });
+    const link = await page.inputValue('#share-link');
+    const payload = JSON.parse(inflateRawSync(Buffer.from(link.split('#share=')[1], 'base64url')).toString('utf8'));
+    assert.equal(payload.plan.result.poses.length, N);
+    assert.ok(link.length < 6500, `share link with the plan: ${link.length} characters`);
+    console.log(`     share link with the plan: ${link.length} characters`);
+    const shared = await (await browser.newContext()).newPage();
+    await shared.goto(link);
+    await shared.locator('#readonly-banner:not([hidden])').waitFor({ timeout: 20000 });
+    await shared.click('a[data-step=handeye]');
+    await shared.locator('#plan-poses').waitFor({ timeout: 20000 });
+    assert.equal(await shared.$$eval('#plan-poses tbody tr', (trs) => trs.length), N);
+    assert.equal(await shared.textContent('#plan-predicted'), predicted);
+    await shared.context().close();
+    // A flange box that no candidate pose fits: the core's words, the same as the CLI's.
+    await page.click('a[data-step=handeye]');
+    for (const [k, v] of Object.entries({ x0: 5000, y0: 5000, z0: 5000, x1: 5001, y1: 5001, z1: 5001 })) await page.fill(`#plan-box-${k}`, String(v));
+    await page.click('#plan-run');
+    await page.locator('#plan-results .msg-error').waitFor({ timeout: 120000 });
+    const refused = await page.textContent('#plan-results .msg-error');
+    const dir = mkdtempSync(join(tmpdir(), 'robocal-plan-'));
+    try {
+      const file = (name, text) => { writeFileSync(join(dir, name), text); return join(dir, name); };
+      const camera = file('camera.json', JSON.stringify({ model: 'none', image_size_px: [1024, 768], camera_matrix: [[900, 0, 511.5], [0, 900, 383.5], [0, 0, 1]], distortion: {} }));
+      const view = file('view.txt', '1,0,0,-0.12,0,1,0,-0.075,0,0,1,0.6,0,0,0,1\n');
+      const robot = file('now.csv', 'x,y,z,qx,qy,qz,qw\n0.4,0,0.5,1,0,0,0\n');
+      const cli = spawnSync(CLI, ['plan', '--setup', 'eye-in-hand', '--robot-pose', robot, '--pose-format', 'xyz_quat_xyzw', '--pose-units', 'm', '--camera', camera,
+        '--target', 'chessboard:9x6:30mm', '--camera-pose', view, '--poses', String(N), '--flange-box', '5000,5000,5000,5001,5001,5001mm'], { encoding: 'utf8' });
+      assert.equal(cli.status, 1, cli.stderr);
+      assert.equal(refused, cli.stderr.trim().replace(/^robocal: /, ''));
+      assert.match(refused, /^only 0 candidate poses keep the whole target in view within the limits, 9 wanted: /);
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+    // That refusal is saved too: the last plan's inputs, without a result.
+    await shot('plan-box-refused');
   }],
 ];

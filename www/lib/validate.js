@@ -87,6 +87,102 @@ export function checkHandeyeResult(r, path) {
   return r;
 }
 
+/** A list of `n` finite numbers. */
+function numbers(v, path, n) {
+  check.list(v, path);
+  if (v.length !== n) throw new Error(`${path} must have ${n} numbers, got ${v.length}`);
+  v.forEach((x, i) => check.number(x, `${path}[${i}]`));
+}
+
+/** A pose as the plan holds it: translation_m and quaternion_xyzw, or a 4 x 4 matrix_row_major. */
+function checkPose(p, path) {
+  check.object(p, path);
+  if (p.matrix_row_major !== undefined) {
+    check.list(p.matrix_row_major, `${path}.matrix_row_major`);
+    const flat = p.matrix_row_major.flat();
+    if (flat.length !== 16) throw new Error(`${path}.matrix_row_major must hold 16 numbers, got ${flat.length}`);
+    flat.forEach((x, i) => check.number(x, `${path}.matrix_row_major[${i}]`));
+  }
+  if (p.translation_m !== undefined || p.matrix_row_major === undefined) {
+    numbers(p.translation_m, `${path}.translation_m`, 3);
+    numbers(p.quaternion_xyzw, `${path}.quaternion_xyzw`, 4);
+  }
+  return p;
+}
+
+/** The pose plan's report (views/plan.js shows it): its poses and the predicted error. */
+export function checkPlanResult(r, path) {
+  if (r === null || r === undefined) return null;
+  check.object(r, path);
+  check.object(r.predicted, `${path}.predicted`);
+  for (const key of ['bound95_mm', 'rms_mm']) check.number(r.predicted[key], `${path}.predicted.${key}`);
+  check.string(r.predicted.verdict, `${path}.predicted.verdict`);
+  check.list(r.poses, `${path}.poses`).forEach((pose, i) => {
+    const p = `${path}.poses[${i}]`;
+    check.object(pose, p);
+    checkPose(pose.base_from_gripper, `${p}.base_from_gripper`);
+    if (pose.camera_from_target !== undefined) checkPose(pose.camera_from_target, `${p}.camera_from_target`);
+    for (const key of ['tilt_deg', 'distance_m', 'roll_deg']) check.number(pose[key], `${p}.${key}`);
+  });
+  for (const key of ['travel_m', 'candidates']) check.number(r[key], `${path}.${key}`);
+  if (r.notes !== undefined) check.list(r.notes, `${path}.notes`).forEach((n, i) => check.string(n, `${path}.notes[${i}]`));
+  return r;
+}
+
+/** The plan step's saved part: its inputs (field values), the request it sent and its report. */
+function checkPlan(plan, path) {
+  if (plan === null || plan === undefined) return null;
+  check.object(plan, path);
+  check.object(plan.inputs, `${path}.inputs`);
+  plan.inputs.view = check.stringOrNull(plan.inputs.view, `${path}.inputs.view`);
+  check.object(plan.inputs.fields, `${path}.inputs.fields`);
+  for (const [k, v] of Object.entries(plan.inputs.fields)) check.string(v, `${path}.inputs.fields.${k}`);
+  plan.request = check.objectOrNull(plan.request, `${path}.request`);
+  if (plan.request) {
+    check.oneOf(plan.request.setup, `${path}.request.setup`, ['eye-in-hand', 'eye-to-hand']);
+    checkPose(plan.request.base_from_gripper, `${path}.request.base_from_gripper`);
+    checkPose(plan.request.camera_from_target, `${path}.request.camera_from_target`);
+    check.object(plan.request.camera, `${path}.request.camera`);
+    if (plan.request.guess !== undefined) checkPose(plan.request.guess, `${path}.request.guess`);
+  }
+  plan.result = checkPlanResult(plan.result, `${path}.result`);
+  if (plan.result && !plan.request) throw new Error(`${path}.request must be an object when ${path}.result is, got null`);
+  return plan;
+}
+
+/** The check step's report (views/check.js shows it). */
+export function checkCheckResult(r, path) {
+  if (r === null || r === undefined) return null;
+  check.object(r, path);
+  check.oneOf(r.verdict, `${path}.verdict`, ['ok', 'drifted', 'broken']);
+  check.list(r.reasons, `${path}.reasons`).forEach((x, i) => check.string(x, `${path}.reasons[${i}]`));
+  check.list(r.parameters, `${path}.parameters`).forEach((p, i) => {
+    check.object(p, `${path}.parameters[${i}]`);
+    check.string(p.name, `${path}.parameters[${i}].name`);
+  });
+  check.list(r.warnings, `${path}.warnings`);
+  r.projection_shift_px = check.objectOrNull(r.projection_shift_px, `${path}.projection_shift_px`);
+  if (r.projection_shift_px) {
+    for (const key of ['worst', 'median']) check.number(r.projection_shift_px[key], `${path}.projection_shift_px.${key}`);
+    if (r.projection_shift_px.map !== undefined) {
+      check.list(r.projection_shift_px.map, `${path}.projection_shift_px.map`);
+      numbers(r.projection_shift_px.grid, `${path}.projection_shift_px.grid`, 2);
+      numbers(r.projection_shift_px.image_size_px, `${path}.projection_shift_px.image_size_px`, 2);
+    }
+  }
+  check.object(r.thresholds, `${path}.thresholds`);
+  return r;
+}
+
+/** The check step's saved part: the calibration file's name and the report. */
+function checkCheck(c, path) {
+  if (c === null || c === undefined) return null;
+  check.object(c, path);
+  check.string(c.name, `${path}.name`);
+  c.result = checkCheckResult(c.result, `${path}.result`);
+  return c;
+}
+
 /** One image of the session's list. */
 function checkImage(img, path) {
   check.object(img, path);
@@ -173,6 +269,9 @@ export function checkSession(raw, path = 'session') {
   s.laser.result = check.objectOrNull(s.laser.result, `${path}.laser.result`);
   if (s.laser.result) check.oneOf(s.laser.result.kind, `${path}.laser.result.kind`, ['laser_plane']);
   s.stereo = check.objectOrNull(raw.stereo, `${path}.stereo`);
+  // The pose plan (views/plan.js) and the check (views/check.js); absent in sessions saved before them.
+  s.plan = checkPlan(raw.plan, `${path}.plan`);
+  s.check = checkCheck(raw.check, `${path}.check`);
   return s;
 }
 
@@ -188,5 +287,11 @@ export function checkSharePayload(p) {
     if (p.handeye.setup !== undefined) check.oneOf(p.handeye.setup, 'handeye.setup', ['eye-in-hand', 'eye-to-hand']);
     checkHandeyeResult(p.handeye.result, 'handeye.result');
   }
+  if (p.plan !== undefined && p.plan !== null) {
+    check.object(p.plan, 'plan');
+    if (p.plan.setup !== undefined) check.oneOf(p.plan.setup, 'plan.setup', ['eye-in-hand', 'eye-to-hand']);
+    checkPlanResult(p.plan.result, 'plan.result');
+  }
+  if (p.check !== undefined && p.check !== null) checkCheck(p.check, 'check');
   return p;
 }

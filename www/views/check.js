@@ -3,11 +3,16 @@
 // or dropped images of step 1's target: the core's check (check_camera,
 // docs/check.md) gives ok / drifted / broken, the projection shift map and
 // the parameters that moved. A second calibration file gives the
-// projection difference of the two (diff_cameras). Images stay here.
+// projection difference of the two (diff_cameras). Images stay here. The
+// last check's report is kept in the session (session.check: shown again
+// after a reload, carried by a session file and a share link, whose
+// read-only page shows it without the shift map).
 import { $, h, fill, table, num, message, readTextFile } from '../lib/dom.js';
 import { cameraErrorText, openCamera, stopStream } from '../lib/camera.js';
 import { targetSpec } from './target.js';
 
+/** The file names a saved calibration may have: every camera format robocal exports (HALCON's .dat and .hdev.txt, MATLAB's .m, the text matrix's .txt). */
+const CAMERA_FILES = '.json,.yaml,.yml,.xml,.cameramodel,.dat,.txt,.m,text/*,application/json';
 /** Distinct views of the target taken from the camera before the check runs. */
 const LIVE_VIEWS = 5;
 /** A live view counts as new when its first point moved this far (px) from every kept one. */
@@ -20,8 +25,9 @@ const VERDICT_WORDS = {
 
 export class CheckView {
   /** `makeEngine()` gives the live detection's own worker. */
-  constructor(store, engine, makeEngine) {
+  constructor(store, engine, makeEngine, { readonly = false } = {}) {
     this.store = store;
+    this.readonly = readonly;
     this.engine = engine;
     this.makeEngine = makeEngine;
     this.calibration = null; // { text, name, camera }
@@ -33,16 +39,21 @@ export class CheckView {
 
   build() {
     const panel = $('check-panel');
+    if (this.readonly) {
+      fill(panel, h('div', { id: 'check-result', 'aria-live': 'polite' }));
+      this.showSaved();
+      return;
+    }
     fill(panel,
-      h('p', {}, 'Has the camera changed since it was calibrated? Load its saved calibration (robocal JSON report, OpenCV YAML/XML or ROS camera_info), then show the target of step 1 to the camera, or add a few images of it. The check poses the images with the saved camera, refits the focal lengths and principal point with the lens model held, and compares the two over the image. Images never leave this machine.'),
+      h('p', {}, 'Has the camera changed since it was calibrated? Load its saved calibration (any camera format robocal exports: robocal JSON report, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON .dat or tuple, MATLAB, text matrix), then show the target of step 1 to the camera, or add a few images of it. The check poses the images with the saved camera, refits the focal lengths and principal point with the lens model held, and compares the two over the image. Images never leave this machine.'),
       h('div', { class: 'form' },
-        h('label', {}, 'Saved calibration ', h('input', { type: 'file', id: 'check-file', accept: '.json,.yaml,.yml,.xml,.txt' })),
+        h('label', {}, 'Saved calibration ', h('input', { type: 'file', id: 'check-file', accept: CAMERA_FILES })),
         h('p', { id: 'check-file-info', class: 'hint' }, 'No calibration loaded.'),
         h('div', {},
           h('button', { type: 'button', id: 'check-camera', disabled: true }, 'Check with the camera'), ' ',
           h('button', { type: 'button', id: 'check-stop', hidden: true }, 'Stop camera')),
         h('label', {}, 'or images of the target ', h('input', { type: 'file', id: 'check-images', multiple: true, accept: 'image/*', disabled: true })),
-        h('label', {}, 'Compare with another calibration ', h('input', { type: 'file', id: 'check-other', accept: '.json,.yaml,.yml,.xml,.txt', disabled: true }))),
+        h('label', {}, 'Compare with another calibration ', h('input', { type: 'file', id: 'check-other', accept: CAMERA_FILES, disabled: true }))),
       h('div', { id: 'check-live', hidden: true },
         h('div', { class: 'live-view' }, h('video', { id: 'check-video', muted: true, playsinline: true, 'aria-label': 'Live camera picture for the check' })),
         h('p', { class: 'live-status', id: 'check-live-status', role: 'status' }, 'Starting…')),
@@ -52,6 +63,21 @@ export class CheckView {
     $('check-stop').addEventListener('click', () => this.stopCamera());
     $('check-images').addEventListener('change', (e) => this.checkImages([...e.target.files]));
     $('check-other').addEventListener('change', (e) => this.diff(e.target.files[0]));
+    this.showSaved();
+  }
+
+  /** The session's last check (session.check), as it was shown. */
+  showSaved() {
+    const saved = this.store.session.check;
+    if (!saved || !saved.result) {
+      if (this.readonly) this.say(message('info', 'This link holds no check.'));
+      return;
+    }
+    try {
+      this.show(saved.result, [], `The last check, of ${saved.name}:`);
+    } catch (err) {
+      this.say(message('error', `The saved check could not be shown (${err.message}): check again.`));
+    }
   }
 
   say(...nodes) { fill($('check-result'), ...nodes); }
@@ -59,7 +85,7 @@ export class CheckView {
   async load(file) {
     if (!file) return;
     try {
-      const text = await readTextFile(file, 'a camera calibration (robocal JSON, OpenCV YAML/XML or ROS camera_info)');
+      const text = await readTextFile(file, 'a camera calibration (any camera format robocal exports)');
       const { camera, format } = await this.engine.call('cameraFile', { text });
       this.calibration = { text, name: file.name, camera };
       $('check-file-info').textContent = `${file.name} (${format}): ${camera.width} × ${camera.height}, fx ${num(camera.fx, 1)}, fy ${num(camera.fy, 1)}, cx ${num(camera.cx, 1)}, cy ${num(camera.cy, 1)}`;
@@ -159,21 +185,23 @@ export class CheckView {
     try {
       const report = await this.engine.call('check', { request });
       this.report = report;
+      this.store.session.check = { name: this.calibration.name, result: report };
+      this.store.changed('check-result');
       this.show(report, missed);
     } catch (err) {
       this.say(message('error', `The check could not run: ${err.message}`));
     }
   }
 
-  show(report, missed) {
+  show(report, missed, heading = null) {
     const verdict = h('p', { id: 'check-verdict', class: `verdict verdict-${report.verdict}`, dataset: { verdict: report.verdict } }, VERDICT_WORDS[report.verdict]);
     const shift = report.projection_shift_px;
     const rows = report.parameters.map((p) => [p.name, num(p.saved, 2), num(p.refit, 2), num(p.shift_px, 2), p.shift_std === null ? '—' : num(p.shift_std, 1), p.moved ? 'moved' : '']);
     const t = report.thresholds;
-    this.say(verdict,
+    this.say(heading ? h('p', { id: 'check-saved' }, heading) : null, verdict,
       report.reasons.length ? h('ul', { id: 'check-reasons' }, report.reasons.map((r) => h('li', {}, r))) : null,
       shift ? h('p', {}, `Projection shift (implied rotation compensated): worst ${num(shift.worst, 2)} px, median ${num(shift.median, 2)} px; threshold ${num(t.shift_px, 2)} px. Reprojection RMS of the saved camera on these views: ${num(report.reprojection_rms_px, 3)} px (broken above ${num(t.broken_rms_px, 2)} px).`) : null,
-      shift ? this.heatMap(shift, 'check-map') : null,
+      shift && shift.map ? this.heatMap(shift, 'check-map') : null,
       rows.length ? table(['parameter', 'saved px', 'now px', 'shift px', 'shift in std', ''], rows, { id: 'check-params' }) : null,
       report.warnings.map((w) => message('warning', w)),
       missed.map((m) => message('warning', `${m}; skipped`)));
@@ -182,7 +210,7 @@ export class CheckView {
   async diff(file) {
     if (!file || !this.calibration) return;
     try {
-      const b = await readTextFile(file, 'a camera calibration (robocal JSON, OpenCV YAML/XML or ROS camera_info)');
+      const b = await readTextFile(file, 'a camera calibration (any camera format robocal exports)');
       const report = await this.engine.call('diff', { request: JSON.stringify({ a: this.calibration.text, b }) });
       const d = report.projection_shift_px;
       this.say(h('p', { id: 'check-diff' }, `${this.calibration.name} against ${file.name}: projection shift worst ${num(d.worst, 2)} px at (${num(d.worst_at_px[0], 0)}, ${num(d.worst_at_px[1], 0)}), median ${num(d.median, 2)} px, RMS ${num(d.rms, 2)} px, implied rotation ${num(d.implied_rotation_deg, 3)} deg.`), this.heatMap(d, 'check-diff-map'));

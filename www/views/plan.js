@@ -6,7 +6,12 @@
 // the rough hand-eye transform is the solved one when there is one. Shows
 // the predicted error at the work point, the poses, a 3-D view of the
 // flange frames and camera frustums, and the program or pose table for the
-// robot in the chosen format.
+// robot in the chosen format. The inputs, the request and the plan are
+// kept in the session (session.plan): a reload or a session file shows the
+// plan again. The limits of `robocal plan` (tilt, roll, distance, the
+// flange box, the image margin) go to the core as given: its words, the
+// CLI's, come back for values it refuses. A shared page shows the plan
+// read-only.
 import { $, h, fill, table, num, message, download } from '../lib/dom.js';
 import { FrameView } from '../lib/view3d.js';
 import { mul, fromPose, IDENTITY } from '../lib/mat4.js';
@@ -27,16 +32,22 @@ export const MOVE_FORMATS = [
   ['xyz_quat_xyzw', 'Pose table: x y z qx qy qz qw (m)', 'robocal_plan_xyzw.csv'],
 ];
 
+/** The inputs kept in session.plan.inputs.fields: every field of the form but the view. */
+const FIELD_IDS = ['plan-robot-pose', 'plan-pose-format', 'plan-count', 'plan-max-tilt', 'plan-max-roll', 'plan-distance-min', 'plan-distance-max', 'plan-margin',
+  'plan-box-x0', 'plan-box-y0', 'plan-box-z0', 'plan-box-x1', 'plan-box-y1', 'plan-box-z1'];
+const BOX_IDS = FIELD_IDS.filter((id) => id.startsWith('plan-box-'));
+
 const poseLine = (p) => [...p.translation_m, ...p.quaternion_xyzw].map((v) => String(Number(v.toFixed(9)))).join(',');
 
 export class PlanView {
-  constructor(store, engine, robot) {
+  constructor(store, engine, robot, { readonly = false } = {}) {
     this.store = store;
     this.engine = engine;
     this.robot = robot;
+    this.readonly = readonly;
     this.report = null;
     this.render();
-    store.onChange((what) => { if (/camera-result|handeye-result|robot|detections|included|all/.test(what)) this.renderViews(); });
+    if (!readonly) store.onChange((what) => { if (/camera-result|handeye-result|robot|detections|included|all/.test(what)) this.renderViews(); });
   }
 
   /** Paired images with a camera pose from the camera solve: the possible current views. */
@@ -49,6 +60,16 @@ export class PlanView {
   }
 
   render() {
+    this.out = h('div', { id: 'plan-results', 'aria-live': 'polite' });
+    this.canvas3d = h('canvas', { width: 900, height: 620, id: 'plan-3d', role: 'img', 'aria-label': '3-D view of the planned flange frames and camera frustums' });
+    this.view3d = new FrameView(this.canvas3d);
+    this.report = null;
+    if (this.readonly) {
+      const saved = this.store.session.plan;
+      fill($('plan-panel'), saved && saved.result ? [h('h3', {}, 'Planned robot poses'), this.out] : null);
+      if (saved && saved.result) this.restoreResult(saved);
+      return;
+    }
     const field = (id, label, value, attrs = {}) => h('label', {}, label, h('input', { id, value, ...attrs }));
     this.viewSelect = h('select', { id: 'plan-view' });
     this.viewSelect.addEventListener('change', () => this.prefill());
@@ -62,20 +83,55 @@ export class PlanView {
         field('plan-distance-min', 'Distance from (mm) ', '', { type: 'number', min: 1, step: 1 }),
         field('plan-distance-max', 'to (mm) ', '', { type: 'number', min: 1, step: 1 })),
       h('p', { class: 'hint' }, 'The distance range starts at the chosen view\'s camera-to-target distance, 20 % either way.'),
+      h('div', { class: 'row' },
+        field('plan-max-roll', 'Max roll about the optical axis (deg) ', '60', { type: 'number', step: 'any' }),
+        field('plan-margin', 'Image margin (px) ', '20', { type: 'number', step: 'any' })),
+      h('fieldset', { id: 'plan-box' }, h('legend', {}, 'Flange box (base frame, mm, two opposite corners; empty: no box)'),
+        h('div', { class: 'row' }, ['x0', 'y0', 'z0', 'x1', 'y1', 'z1'].map((k) => field(`plan-box-${k}`, `${k} `, '', { type: 'number', step: 'any', size: 7 })))),
       h('p', { class: 'hint' }, 'The camera is the solved one (step 3), the target the session\'s; the rough hand-eye transform is the solved one (above) when there is one, identity otherwise. Joint limits, reachability and collisions are not modelled: check the poses in simulation before running them.'),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'plan-run' }, 'Plan poses')));
     form.addEventListener('submit', (e) => { e.preventDefault(); this.plan(); });
-    this.out = h('div', { id: 'plan-results', 'aria-live': 'polite' });
-    this.canvas3d = h('canvas', { width: 900, height: 620, id: 'plan-3d', role: 'img', 'aria-label': '3-D view of the planned flange frames and camera frustums' });
-    this.view3d = new FrameView(this.canvas3d);
     fill($('plan-panel'), h('h3', {}, 'Plan robot poses'), h('p', { class: 'hint' }, 'Poses for the robot to visit for a hand-eye calibration, from one view of the target and the robot pose there (as robocal plan).'), form, this.out);
     this.renderViews();
+    this.restore();
+  }
+
+  /** The inputs and the plan of session.plan, back in the form and the results. */
+  restore() {
+    const saved = this.store.session.plan;
+    if (!saved) return;
+    try {
+      for (const [id, value] of Object.entries(saved.inputs.fields)) if (FIELD_IDS.includes(id)) $(id).value = value;
+      this.savedView = saved.inputs.view;
+      if (this.savedView) this.renderViews();
+      if (saved.result) this.restoreResult(saved);
+    } catch (err) {
+      fill(this.out, message('error', `The saved plan could not be shown (${err.message}): plan again.`));
+    }
+  }
+
+  restoreResult(saved) {
+    try {
+      this.report = saved.result;
+      this.show(saved.result, saved.request);
+    } catch (err) {
+      this.report = null;
+      fill(this.out, message('error', `The saved plan could not be shown (${err.message}): plan again.`));
+    }
+  }
+
+  /** The form's values, as session.plan.inputs keeps them. */
+  inputs() {
+    return { view: this.viewSelect.value || null, fields: Object.fromEntries(FIELD_IDS.map((id) => [id, $(id).value])) };
   }
 
   renderViews() {
     const views = this.views();
-    const old = this.viewSelect.value;
+    // A restored plan's view, once the paired images are there: chosen, its restored fields kept.
+    const restored = this.savedView && views.some((v) => v.name === this.savedView) ? this.savedView : null;
+    const old = restored || this.viewSelect.value;
     fill(this.viewSelect, views.map((v) => h('option', { value: v.name, selected: v.name === old }, v.name)));
+    if (restored) { this.savedView = null; return; }
     if (views.length && (!old || !views.some((v) => v.name === old))) this.prefill();
   }
 
@@ -117,6 +173,13 @@ export class PlanView {
     const maxTilt = Number($('plan-max-tilt').value);
     if (!Number.isInteger(poses) || poses < 3) throw new Error('Poses: a whole number, at least 3');
     if (!(maxTilt > 0)) throw new Error('Max tilt: a positive number of degrees');
+    // Roll, margin and the flange box go to the core as given: it says what it refuses.
+    const optional = (id) => ($(id).value.trim() === '' ? undefined : Number($(id).value));
+    const maxRoll = optional('plan-max-roll');
+    const margin = optional('plan-margin');
+    const box = BOX_IDS.map(optional);
+    const given = box.filter((v) => v !== undefined).length;
+    if (given && given < 6) throw new Error('Flange box: give all six corner coordinates (mm), or none');
     const [d0, d1] = ['plan-distance-min', 'plan-distance-max'].map((id) => $(id).value.trim());
     let distance;
     if (d0 || d1) {
@@ -133,6 +196,9 @@ export class PlanView {
       poses,
       max_tilt_deg: maxTilt,
       ...(distance ? { distance_m: distance } : {}),
+      ...(maxRoll !== undefined ? { max_roll_deg: maxRoll } : {}),
+      ...(margin !== undefined ? { margin_px: margin } : {}),
+      ...(given ? { flange_box_m: [box.slice(0, 3).map((v) => v / 1000), box.slice(3).map((v) => v / 1000)] } : {}),
     };
   }
 
@@ -140,10 +206,16 @@ export class PlanView {
     let request;
     try { request = await this.request(); } catch (err) { fill(this.out, message('error', err.message)); return; }
     fill(this.out, message('info', `Planning ${request.poses} poses…`));
+    const inputs = this.inputs();
     try {
       this.report = await this.engine.call('plan', { request: JSON.stringify(request), target: JSON.stringify(this.store.session.target) });
+      this.store.session.plan = { inputs, request, result: this.report };
+      this.store.changed('plan-result');
       this.show(this.report, request);
     } catch (err) {
+      this.report = null;
+      this.store.session.plan = { inputs, request: null, result: null };
+      this.store.changed('plan-result');
       fill(this.out, message('error', err.message));
     }
   }
@@ -161,9 +233,11 @@ export class PlanView {
     this.listOut = h('pre', { id: 'plan-move-list', class: 'export', tabindex: 0, 'aria-label': 'move list preview' });
     this.listStatus = h('p', { id: 'plan-move-status', class: 'hint' });
     const b = (id, label, text, f) => h('button', { type: 'button', id, 'aria-label': label, onclick: f }, text);
+    // A shared link's plan holds no camera poses: no 3-D view then.
+    const in3d = request && r.poses.every((p) => p.camera_from_target);
     fill(this.out, predicted, (r.notes || []).map((n) => message('info', n)), poses, motion,
-      h('h3', {}, '3-D view'),
-      h('div', { class: 'frames-3d' },
+      in3d ? h('h3', {}, '3-D view') : null,
+      !in3d ? null : h('div', { class: 'frames-3d' },
         h('div', { class: 'row' }, b('plan-zoom-in', 'zoom in', '+', () => this.view3d.zoomBy(1.25)),
           b('plan-zoom-out', 'zoom out', '−', () => this.view3d.zoomBy(0.8)), b('plan-reset', 'reset the view', 'Reset view', () => this.view3d.reset())),
         this.canvas3d),
@@ -171,7 +245,7 @@ export class PlanView {
       h('div', { class: 'row' }, h('label', {}, 'Format ', this.formatSelect),
         h('button', { type: 'button', id: 'plan-download', onclick: () => this.save() }, 'Download')),
       this.listStatus, this.listOut);
-    this.draw3d(r, request);
+    if (in3d) this.draw3d(r, request);
     this.preview();
   }
 

@@ -31,7 +31,7 @@ export function intrinsicsControl(c, k, engine, changed) {
   const choice = c.intrinsics || 'solve';
   const select = h('select', { id: `rig-intrinsics-${k}`, 'aria-label': `camera ${k + 1} intrinsics` },
     CHOICES.map(([v, t]) => h('option', { value: v, selected: v === choice }, t)));
-  const file = h('input', { type: 'file', id: `rig-camera-file-${k}`, 'aria-label': `camera ${k + 1} camera file`, accept: '.json,.yaml,.yml,.xml,text/*,application/json', hidden: choice !== 'file' });
+  const file = h('input', { type: 'file', id: `rig-camera-file-${k}`, 'aria-label': `camera ${k + 1} camera file`, accept: '.json,.yaml,.yml,.xml,.cameramodel,.dat,.m,.txt,text/*,application/json', hidden: choice !== 'file' });
   const status = h('span', { class: 'hint', id: `rig-held-${k}` }, statusText(c));
   select.addEventListener('change', () => {
     c.intrinsics = select.value;

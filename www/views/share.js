@@ -98,7 +98,17 @@ export function sharePayload(session, version) {
     camera: cam ? { result: compactResult(cam), comparison: session.camera.comparison, model: session.camera.model, method: session.camera.method } : null,
     handeye: he ? { result: compactResult(he), setup: session.handeye.setup, frameNames: session.handeye.frameNames } : null,
     workflows: compactResult(session.workflows),
+    // The pose plan without its camera poses (no 3-D view on the shared
+    // page) and the last check without its shift map: a few hundred bytes each.
+    plan: session.plan && session.plan.result ? { result: compactResult(session.plan.result), setup: session.plan.request && session.plan.request.setup } : null,
+    check: session.check && session.check.result ? { name: session.check.name, result: compactCheck(session.check.result) } : null,
   };
+}
+
+/** A check report for a link: the verdict, reasons, parameters and shift statistics, not the map. */
+function compactCheck(report) {
+  const { map, ...shift } = report.projection_shift_px || {};
+  return compactResult({ ...report, projection_shift_px: report.projection_shift_px ? shift : null, refit: undefined });
 }
 
 /** The session file: everything but the image bytes (target, detections, poses, options, results). */
@@ -135,14 +145,14 @@ export class ShareView {
   render() {
     const s = this.store.session;
     const sessionTools = this.loadSession ? this.sessionSection() : null;
-    if (!s.camera.result && !s.handeye.result) {
-      fill($('share-panel'), message('info', 'Solve a camera or a hand-eye calibration first: the link and the report hold their results.'), sessionTools);
+    if (!s.camera.result && !s.handeye.result && !(s.plan && s.plan.result) && !(s.check && s.check.result)) {
+      fill($('share-panel'), message('info', 'Solve a camera or a hand-eye calibration, plan robot poses or check a saved calibration first: the link and the report hold their results.'), sessionTools);
       return;
     }
     this.link = h('input', { type: 'text', readonly: true, id: 'share-link', 'aria-label': 'share link', class: 'wide' });
     this.status = h('p', { class: 'hint', 'aria-live': 'polite', id: 'share-status' });
     fill($('share-panel'),
-      h('p', {}, 'The link holds the results (camera, transforms, errors; not the images or the detections) compressed in its fragment (after #), which browsers never send to a server. Whoever opens it sees a read-only results page.'),
+      h('p', {}, 'The link holds the results (camera, transforms, errors, the pose plan, the last check; not the images or the detections) compressed in its fragment (after #), which browsers never send to a server. Whoever opens it sees a read-only results page.'),
       h('div', { class: 'row' },
         h('button', { type: 'button', class: 'primary', id: 'make-share', onclick: () => this.makeLink() }, 'Create share link'),
         h('button', { type: 'button', id: 'copy-share', onclick: () => this.copy() }, 'Copy link'),
