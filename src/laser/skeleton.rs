@@ -106,8 +106,11 @@ pub fn end_points(image: &GrayImage, threshold: u8, min_len: usize) -> Result<Ve
             {
                 s += 0.25;
             }
-            // The last set pixel's outer half: the edge is half a pixel on.
-            let reach = s + 0.5;
+            // `s` is the last sample inside the last set pixel, about a
+            // quarter pixel past its centre: where, on average, a cut lies
+            // whose pixel is set from a quarter's coverage on (a saturated
+            // core four times the threshold).
+            let reach = s;
             out.push(EndPoint {
                 pixel: [x, y],
                 refined_px: [x as f64 + dir[0] * reach, y as f64 + dir[1] * reach],
