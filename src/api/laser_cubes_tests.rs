@@ -177,6 +177,10 @@ fn seed003_cube_end_points_are_the_control_points_and_give_the_hand_eye() {
 /// pinhole intrinsics and the hand-eye transform (11 numbers) has rank 8:
 /// three directions change nothing. With the principal point and the
 /// aspect held (one focal length) the rank is full.
+/// One parameter's perturbation: a step `h` to the camera parameters and
+/// the hand-eye perturbation it gives.
+type Column = Box<dyn Fn(f64) -> (Vec<f64>, Vec<f64>)>;
+
 #[test]
 fn seed003_control_points_leave_the_intrinsics_undetermined() {
     let (camera, plane) = sensor();
@@ -207,7 +211,7 @@ fn seed003_control_points_leave_the_intrinsics_undetermined() {
             .collect()
     };
     let k0 = camera.params();
-    let jacobian = |columns: &[Box<dyn Fn(f64) -> (Vec<f64>, Vec<f64>)>]| -> DMatrix<f64> {
+    let jacobian = |columns: &[Column]| -> DMatrix<f64> {
         let rows = points.len() * 2;
         let mut j = DMatrix::zeros(rows, columns.len());
         for (c, f) in columns.iter().enumerate() {
@@ -229,7 +233,7 @@ fn seed003_control_points_leave_the_intrinsics_undetermined() {
         }
         j
     };
-    let intrinsic = |i: usize| -> Box<dyn Fn(f64) -> (Vec<f64>, Vec<f64>)> {
+    let intrinsic = |i: usize| -> Column {
         let k0 = k0.clone();
         Box::new(move |h| {
             let mut k = k0.clone();
@@ -237,7 +241,7 @@ fn seed003_control_points_leave_the_intrinsics_undetermined() {
             (k, vec![0.0; 6])
         })
     };
-    let focal = || -> Box<dyn Fn(f64) -> (Vec<f64>, Vec<f64>)> {
+    let focal = || -> Column {
         let k0 = k0.clone();
         Box::new(move |h| {
             let mut k = k0.clone();
@@ -246,7 +250,7 @@ fn seed003_control_points_leave_the_intrinsics_undetermined() {
             (k, vec![0.0; 6])
         })
     };
-    let pose = |i: usize| -> Box<dyn Fn(f64) -> (Vec<f64>, Vec<f64>)> {
+    let pose = |i: usize| -> Column {
         let k0 = k0.clone();
         Box::new(move |h| {
             let mut d = vec![0.0; 6];
@@ -254,9 +258,9 @@ fn seed003_control_points_leave_the_intrinsics_undetermined() {
             (k0.clone(), d)
         })
     };
-    let mut full: Vec<Box<dyn Fn(f64) -> (Vec<f64>, Vec<f64>)>> = (0..5).map(intrinsic).collect();
+    let mut full: Vec<Column> = (0..5).map(intrinsic).collect();
     full.extend((0..6).map(pose));
-    let mut one_focal: Vec<Box<dyn Fn(f64) -> (Vec<f64>, Vec<f64>)>> = vec![focal()];
+    let mut one_focal: Vec<Column> = vec![focal()];
     one_focal.extend((0..6).map(pose));
     let sv = |j: DMatrix<f64>| {
         let mut s: Vec<f64> = j.singular_values().iter().copied().collect();
