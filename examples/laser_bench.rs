@@ -117,12 +117,13 @@ fn monte_carlo(camera: &Camera, trials: usize) -> Result<(), robocal::Error> {
         for _ in 0..trials {
             let obs = stripe_observations(camera, &poses, &truth, (0.2, 0.15), 4, noise, &mut rng)?;
             let fit = fit_plane(&obs, &PlaneFitOptions::default())?;
-            // The bound: (J^T J)^-1 with the injected std (not rescaled).
-            let c = fit.covariance / fit.variance_factor;
-            let n = fit.plane.normal();
+            // The bound: the reported covariance (the residuals' sandwich,
+            // for independent centres (J^T J)^-1 with the injected std).
+            let c = fit.estimate.normal_distance_covariance();
+            let n = fit.estimate.plane.normal.into_inner();
             let a = n.cross(&Vector3::x()).normalize();
             let b = n.cross(&a);
-            let e = n - truth.normal();
+            let e = n - truth.normal.into_inner();
             let e2 = Vector2::new(e.dot(&a), e.dot(&b));
             let cnn = c.fixed_view::<3, 3>(0, 0).into_owned();
             let c2 = Matrix2::new(
@@ -139,7 +140,7 @@ fn monte_carlo(camera: &Camera, trials: usize) -> Result<(), robocal::Error> {
                     cover_n += 1;
                 }
             }
-            let ed = fit.plane.distance_m - truth.distance_m;
+            let ed = fit.estimate.plane.distance_m - truth.distance_m;
             se_d += ed * ed;
             sb_d += c[(3, 3)];
             if ed.abs() <= 3.0 * c[(3, 3)].sqrt() {

@@ -6,7 +6,8 @@
 //! detected, its pose found by PnP with the calibrated camera, the stripe
 //! extracted (the laser-off image subtracted when given), its centres on
 //! the board kept (inside the detected corners' hull) and met with the
-//! board plane; the plane is fitted to those points ([`crate::laser::fit`]).
+//! board plane; the plane is fitted to those points ([`crate::laser::fit`]),
+//! its covariance including the board poses' (from their corners' scatter).
 //! [`laser_points`]: a stripe image and a plane to points in the camera
 //! frame (and flange and base frames given the mounting and robot pose).
 
@@ -17,10 +18,11 @@ use crate::error::{Error, Result};
 use crate::geometry::{Pose, PoseJson};
 use crate::image::GrayImage;
 use crate::laser::fit::ImageResidual;
+use crate::laser::joint::{refine_with_intrinsics, JointImage};
 use crate::laser::points::{profile_points, ProfilePoint};
 use crate::laser::{
-    extract_stripe, fit_plane, LaserPlane, PlaneFitOptions, PlaneResidual, ScanAxis,
-    StripeObservation, StripeOptions,
+    extract_stripe, fit_plane_with_boards, plane_in_camera, BoardPose, LaserPlane, PlaneFitOptions,
+    PlaneResidual, ScanAxis, StripeObservation, StripeOptions,
 };
 use crate::target::Target;
 use nalgebra::Point2;
@@ -99,7 +101,8 @@ pub struct LaserPlaneReport {
     pub residual: &'static str,
     /// The stripe extractor (`cog` or `ridge`).
     pub extractor: &'static str,
-    /// The residual variance that scaled the covariance.
+    /// The residual variance `chi^2 / (m - 3)` (near 1 when the extractor's
+    /// stds are right; the covariance comes from the residuals themselves).
     pub variance_factor: f64,
     /// Per image.
     pub images: Vec<LaserImageReport>,
@@ -116,6 +119,77 @@ pub fn laser_plane(
     views: &[LaserView],
     settings: &LaserPlaneSettings,
 ) -> Result<LaserPlaneReport> {
+    let measured = measure(camera, target, views, settings)?;
+    fit_measured(camera, measured, settings)
+}
+
+/// [`laser_plane`] with the camera refined jointly with the plane
+/// ([`crate::laser::joint`]: the corners of every board and the stripe
+/// centres in one least squares; at least 3 board poses). The report is
+/// the plane fitted with the refined camera and board poses; the refined
+/// camera is returned beside it.
+pub fn laser_plane_refining_camera(
+    camera: &Camera,
+    target: &Target,
+    views: &[LaserView],
+    settings: &LaserPlaneSettings,
+) -> Result<(LaserPlaneReport, Camera)> {
+    let measured = measure(camera, target, views, settings)?;
+    let first = fit_measured(camera, measured.clone(), settings)?;
+    let start = plane_in_camera(
+        nalgebra::Vector3::from(first.laser_plane.normal_camera),
+        first.laser_plane.distance_m,
+    )?;
+    // The stripe stds scaled so their residuals have unit variance, as the
+    // corners' are by their own scatter.
+    let scale = first.variance_factor.max(1e-12).sqrt();
+    let images: Vec<JointImage> = measured
+        .iter()
+        .map(|m| JointImage {
+            object_m: m.view.object_m.clone(),
+            image_px: m.view.image_px.clone(),
+            corner_std_px: m.corner_variance.sqrt().max(1e-3),
+            camera_from_target: m.pose,
+            stripe: m.centres.iter().map(|(p, s)| (*p, s * scale)).collect(),
+            scan_along_y: m.along_y,
+        })
+        .collect();
+    let joint = refine_with_intrinsics(camera, &images, &start)?;
+    let mut again = Vec::with_capacity(measured.len());
+    for (m, pose) in measured.into_iter().zip(&joint.camera_from_target) {
+        again.push(remeasure(&joint.camera, m, pose)?);
+    }
+    let mut report = fit_measured(&joint.camera, again, settings)?;
+    report.warnings.push(format!(
+        "the camera was refined with the plane: corner RMS {:.3} px (was {:.3} px)",
+        joint.corner_rms_px.0, joint.corner_rms_px.1
+    ));
+    Ok((report, joint.camera))
+}
+
+/// One board pose as measured: the board's corners and pose, the stripe
+/// centres on it.
+#[derive(Clone)]
+struct Measured {
+    view: View,
+    pose: crate::geometry::Pose,
+    rms: f64,
+    /// The corners' variance per coordinate, px^2.
+    corner_variance: f64,
+    /// The pose's covariance per unit corner variance.
+    unit_covariance: nalgebra::Matrix6<f64>,
+    /// Centres on the board: pixel and std along the scan.
+    centres: Vec<(Point2<f64>, f64)>,
+    along_y: bool,
+    report: LaserImageReport,
+}
+
+fn measure(
+    camera: &Camera,
+    target: &Target,
+    views: &[LaserView],
+    settings: &LaserPlaneSettings,
+) -> Result<Vec<Measured>> {
     if views.len() < 2 {
         return Err(Error::too_few(
             "board poses (images or pairs)",
@@ -123,14 +197,16 @@ pub fn laser_plane(
             views.len(),
         ));
     }
-    let mut observations = Vec::new();
-    let mut images = Vec::new();
-    let mut warnings = Vec::new();
-    for (index, v) in views.iter().enumerate() {
+    let mut out = Vec::with_capacity(views.len());
+    for v in views {
         let detection = detect(&v.board, target, &settings.detect)
             .map_err(|e| Error::invalid(&v.name, format!("board not found: {e}")))?;
         let view = View::from_detection(v.name.clone(), &detection);
-        let (pose, rms) = pnp::camera_from_target(camera, &view)?;
+        let (pose, rms, unit_covariance) = pnp::camera_from_target_with_covariance(camera, &view)?;
+        // The corners' variance per coordinate: rms^2 = sum |r|^2 / n over
+        // 2 n coordinates less the pose's 6 parameters.
+        let n = view.image_px.len() as f64;
+        let corner_variance = rms * rms * n / (2.0 * n - 6.0).max(1.0);
         let (on, off) = match &v.stripe {
             Some(s) => (s, Some(&v.board)),
             None => (&v.board, None),
@@ -138,14 +214,72 @@ pub fn laser_plane(
         let stripe = extract_stripe(on, off, &settings.stripe)
             .map_err(|e| Error::invalid(&v.name, e.to_string()))?;
         let hull = convex_hull(&view.image_px);
-        let along_y = stripe.axis == ScanAxis::Columns;
+        let centres: Vec<(Point2<f64>, f64)> = stripe
+            .points
+            .iter()
+            .map(|p| (Point2::new(p.x_px, p.y_px), p.std_px))
+            .filter(|(px, _)| inside(&hull, px))
+            .collect();
+        out.push(Measured {
+            report: LaserImageReport {
+                name: v.name.clone(),
+                camera_from_target: PoseJson::from(&pose),
+                board_rms_px: rms,
+                stripe_axis: stripe.axis,
+                stripe_points: stripe.points.len(),
+                n_points: 0,
+                rms_px: 0.0,
+                rms_mm: 0.0,
+                gaps: stripe.gaps.clone(),
+            },
+            view,
+            pose,
+            rms,
+            corner_variance,
+            unit_covariance,
+            centres,
+            along_y: stripe.axis == ScanAxis::Columns,
+        });
+    }
+    Ok(out)
+}
+
+/// A measured board pose with a refined camera and pose: the pose's
+/// covariance and corner scatter recomputed, the centres kept.
+fn remeasure(camera: &Camera, mut m: Measured, pose: &crate::geometry::Pose) -> Result<Measured> {
+    let (_, _, unit_covariance) = pnp::camera_from_target_with_covariance(camera, &m.view)?;
+    let n = m.view.image_px.len();
+    let mut sum = 0.0;
+    for (p, q) in m.view.object_m.iter().zip(&m.view.image_px) {
+        sum += (camera.project(&(pose * p))? - q).norm_squared();
+    }
+    m.rms = (sum / n.max(1) as f64).sqrt();
+    m.corner_variance = sum / (2.0 * n as f64 - 6.0).max(1.0);
+    m.unit_covariance = unit_covariance;
+    m.pose = *pose;
+    m.report.camera_from_target = PoseJson::from(pose);
+    m.report.board_rms_px = m.rms;
+    Ok(m)
+}
+
+fn fit_measured(
+    camera: &Camera,
+    measured: Vec<Measured>,
+    settings: &LaserPlaneSettings,
+) -> Result<LaserPlaneReport> {
+    let mut observations = Vec::new();
+    let mut boards = Vec::new();
+    let mut images = Vec::new();
+    let mut warnings = Vec::new();
+    for (index, m) in measured.into_iter().enumerate() {
+        boards.push(BoardPose {
+            image: index,
+            camera_from_target: m.pose,
+            covariance: m.unit_covariance * m.corner_variance,
+        });
         let mut used = 0;
-        for p in &stripe.points {
-            let px = Point2::new(p.x_px, p.y_px);
-            if !inside(&hull, &px) {
-                continue;
-            }
-            if let Ok(o) = StripeObservation::new(camera, &pose, &px, along_y, p.std_px, index) {
+        for (px, std) in &m.centres {
+            if let Ok(o) = StripeObservation::new(camera, &m.pose, px, m.along_y, *std, index) {
                 observations.push(o);
                 used += 1;
             }
@@ -153,23 +287,16 @@ pub fn laser_plane(
         if used < 2 {
             warnings.push(format!(
                 "{}: {} stripe centres on the board, the image adds nothing",
-                v.name, used
+                m.report.name, used
             ));
         }
-        images.push(LaserImageReport {
-            name: v.name.clone(),
-            camera_from_target: PoseJson::from(&pose),
-            board_rms_px: rms,
-            stripe_axis: stripe.axis,
-            stripe_points: stripe.points.len(),
-            n_points: used,
-            rms_px: 0.0,
-            rms_mm: 0.0,
-            gaps: stripe.gaps.clone(),
-        });
+        let mut report = m.report;
+        report.n_points = used;
+        images.push(report);
     }
-    let fit = fit_plane(
+    let fit = fit_plane_with_boards(
         &observations,
+        &boards,
         &PlaneFitOptions {
             residual: settings.residual,
         },
@@ -202,11 +329,12 @@ pub fn laser_plane(
 
 /// The report's plane from a fit.
 pub fn plane_json(fit: &crate::laser::PlaneFit) -> LaserPlaneJson {
-    let c = fit.covariance;
-    let t = fit.tangent_covariance;
+    let c = fit.estimate.normal_distance_covariance();
+    let t = fit.estimate.covariance;
+    let n = fit.estimate.plane.normal;
     LaserPlaneJson {
-        normal_camera: fit.plane.normal_camera,
-        distance_m: fit.plane.distance_m,
+        normal_camera: [n.x, n.y, n.z],
+        distance_m: fit.estimate.plane.distance_m,
         covariance: std::array::from_fn(|r| std::array::from_fn(|k| c[(r, k)])),
         normal_std_deg: ((t[(0, 0)] + t[(1, 1)]).max(0.0) / 2.0).sqrt().to_degrees(),
         distance_std_mm: t[(2, 2)].max(0.0).sqrt() * 1e3,
@@ -230,7 +358,7 @@ pub fn plane_from_json(text: &str) -> Result<(LaserPlane, nalgebra::Matrix4<f64>
             "expected {\"laser_plane\": {\"normal_camera\": [nx, ny, nz], \"distance_m\": d}}",
         ));
     };
-    let plane = LaserPlane::new(nalgebra::Vector3::new(n[0], n[1], n[2]), d)?;
+    let plane = plane_in_camera(nalgebra::Vector3::new(n[0], n[1], n[2]), d)?;
     let mut cov = nalgebra::Matrix4::zeros();
     if let Some(rows) = p.get("covariance").and_then(|c| c.as_array()) {
         for (r, row) in rows.iter().take(4).enumerate() {
@@ -249,7 +377,8 @@ pub struct LaserPointsReport {
     pub kind: &'static str,
     /// The robocal that wrote it.
     pub robocal_version: &'static str,
-    /// The plane used.
+    /// The plane used (`{"normal_camera", "distance_m"}`).
+    #[serde(serialize_with = "crate::laser::plane::serialize_camera_plane")]
     pub laser_plane: LaserPlane,
     /// Columns or rows.
     pub stripe_axis: ScanAxis,
@@ -346,3 +475,11 @@ fn inside(hull: &[Point2<f64>], q: &Point2<f64>) -> bool {
         (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x) >= 0.0
     })
 }
+
+#[cfg(test)]
+#[path = "laser_cubes_tests.rs"]
+mod cube_tests;
+
+#[cfg(test)]
+#[path = "laser_joint_tests.rs"]
+mod joint_tests;

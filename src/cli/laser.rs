@@ -3,7 +3,8 @@
 
 use super::{read_text, CliError, ImageLimits};
 use robocal::api::laser::{
-    laser_plane, laser_points, plane_from_json, LaserPlaneSettings, LaserView,
+    laser_plane, laser_plane_refining_camera, laser_points, plane_from_json, LaserPlaneSettings,
+    LaserView,
 };
 use robocal::camera::Camera;
 use robocal::geometry::{Pose, PoseJson};
@@ -26,7 +27,9 @@ row) on the board and met with the board's plane; the plane is fitted to
 those points at two or more poses. The JSON report holds
 laser_plane.normal_camera (unit vector), laser_plane.distance_m and
 laser_plane.covariance (4x4 over nx, ny, nz, d), per-image residuals and
-warnings when the poses do not constrain the plane.
+warnings when the poses do not constrain the plane. --refine-intrinsics
+refines the camera with the plane (the boards' corners and the stripe in one
+least squares) and adds refined_camera.
 
 points: the stripe of one image met with the plane: 3-D points in the camera
 frame (and the flange and base frames with --gripper-from-camera and
@@ -85,6 +88,11 @@ struct PlaneArgs {
     /// centre's std) or point_to_plane (metres)
     #[arg(long, value_name = "NAME", default_value = "image_px")]
     residual: String,
+    /// Refine the camera (every intrinsic) jointly with the plane and the
+    /// board poses from the boards' corners and the stripe (3 or more
+    /// poses); the JSON report gains refined_camera
+    #[arg(long)]
+    refine_intrinsics: bool,
     /// Output: json (the report), halcon (a sheet-of-light parameter list)
     /// or a transform format of the plane frame (urdf, ros2, ros1, matrix, ...)
     #[arg(long, value_name = "FORMAT", default_value = "json")]
@@ -218,7 +226,12 @@ fn run_plane(a: PlaneArgs) -> Result<(), CliError> {
         stripe: stripe_options(&a.stripe)?,
         detect: super::detect_options_of(Some(&a.target)),
     };
-    let report = laser_plane(&camera, &target, &views, &settings)?;
+    let (report, refined) = if a.refine_intrinsics {
+        let (report, camera) = laser_plane_refining_camera(&camera, &target, &views, &settings)?;
+        (report, Some(camera))
+    } else {
+        (laser_plane(&camera, &target, &views, &settings)?, None)
+    };
     for w in &report.warnings {
         eprintln!("robocal laser plane: warning: {w}");
     }
@@ -227,7 +240,26 @@ fn run_plane(a: PlaneArgs) -> Result<(), CliError> {
     let text = match (format, transform) {
         ("halcon", _) => export_plane_halcon(&plane, &cov),
         (_, Some(t)) => export_plane_frame(&plane, t)?,
-        _ => serde_json::to_string_pretty(&report).map_err(|e| CliError::Io(e.to_string()))? + "\n",
+        _ => match &refined {
+            // The report's own key order, refined_camera after it.
+            Some(c) => {
+                #[derive(serde::Serialize)]
+                struct WithCamera<'a> {
+                    #[serde(flatten)]
+                    report: &'a robocal::api::laser::LaserPlaneReport,
+                    refined_camera: &'a Camera,
+                }
+                let both = WithCamera {
+                    report: &report,
+                    refined_camera: c,
+                };
+                serde_json::to_string_pretty(&both).map_err(|e| CliError::Io(e.to_string()))? + "\n"
+            }
+            None => {
+                serde_json::to_string_pretty(&report).map_err(|e| CliError::Io(e.to_string()))?
+                    + "\n"
+            }
+        },
     };
     super::write_output(a.output.as_deref(), &text)
 }

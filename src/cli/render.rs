@@ -528,8 +528,9 @@ fn write_set(
     }
     let mut truth = serde_json::json!({ "camera": camera, "target": target, "seed": seed, "views": truth_views });
     if let Some(laser) = &laser {
+        let n = laser.plane.normal;
         truth["laser_plane"] = serde_json::json!({
-            "normal_camera": laser.plane.normal_camera,
+            "normal_camera": [n.x, n.y, n.z],
             "distance_m": laser.plane.distance_m,
         });
         truth["laser"] = serde_json::json!(laser);

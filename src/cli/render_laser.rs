@@ -3,7 +3,7 @@
 //! (`view_000_laser.png`), the true plane and stripe in truth.json.
 
 use super::CliError;
-use robocal::laser::LaserPlane;
+use robocal::laser::{plane_in_camera, LaserPlane};
 use robocal::synth::laser::{stripe_truth, LaserStripe};
 use robocal::synth::Projection;
 
@@ -73,7 +73,7 @@ pub fn laser_of(a: &LaserArgs, seed: u64) -> Result<Option<LaserStripe>, CliErro
             format!("--laser-plane must be four numbers nx,ny,nz,d, got '{text}'"),
         ));
     };
-    let plane = LaserPlane::new(nalgebra::Vector3::new(nx, ny, nz), d)
+    let plane = plane_in_camera(nalgebra::Vector3::new(nx, ny, nz), d)
         .map_err(|e| CliError::usage("render", e.to_string()))?;
     for (flag, value) in [
         ("--laser-width", a.laser_width),

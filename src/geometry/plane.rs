@@ -12,7 +12,10 @@
 //! hand-eye transform perturbs it.
 
 use crate::error::{Error, Result};
-use nalgebra::{Isometry3, Matrix2x3, Matrix3, Matrix3x6, Matrix6, Unit, Vector3};
+use nalgebra::{
+    Isometry3, Matrix2x3, Matrix3, Matrix3x6, Matrix4, Matrix4x3, Matrix6, Point3, Rotation3,
+    Translation3, Unit, UnitQuaternion, Vector3,
+};
 
 /// The plane `normal . p = distance_m` in some frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,13 +59,19 @@ fn tangent_rows(normal: &Unit<Vector3<f64>>) -> Matrix2x3<f64> {
 impl Plane {
     /// The plane of `normal` (any length but 0) at `distance_m`.
     pub fn new(normal: Vector3<f64>, distance_m: f64) -> Result<Plane> {
+        Plane::checked("plane", normal, distance_m)
+    }
+
+    /// [`Plane::new`] with the error naming `field` (a laser plane's
+    /// `laser_plane`, say).
+    pub fn checked(field: &str, normal: Vector3<f64>, distance_m: f64) -> Result<Plane> {
         let norm = normal.norm();
         let usable = norm > 1e-12 && norm.is_finite() && distance_m.is_finite();
         if !usable {
             return Err(Error::invalid(
-                "plane",
+                field,
                 format!(
-                    "needs a finite non-zero normal and a finite distance, got ({}, {}, {}) and {distance_m} m",
+                    "needs a non-zero finite normal and a finite distance, got ({}, {}, {}) and {distance_m}",
                     normal.x, normal.y, normal.z
                 ),
             ));
@@ -71,6 +80,50 @@ impl Plane {
             normal: Unit::new_normalize(normal),
             distance_m,
         })
+    }
+
+    /// The same plane with the normal's sign chosen so that `distance_m >=
+    /// 0`: the normal points away from the frame's origin.
+    pub fn facing_away(self) -> Plane {
+        if self.distance_m < 0.0 {
+            Plane {
+                normal: -self.normal,
+                distance_m: -self.distance_m,
+            }
+        } else {
+            self
+        }
+    }
+
+    /// Where the ray `lambda * ray` from the frame's origin meets the plane
+    /// for some `lambda > 0`; `None` when it runs parallel or meets it behind.
+    pub fn intersect_ray(&self, ray: &Vector3<f64>) -> Option<Point3<f64>> {
+        let den = self.normal.dot(ray);
+        if den.abs() < 1e-12 {
+            return None;
+        }
+        let lambda = self.distance_m / den;
+        (lambda > 0.0 && lambda.is_finite()).then(|| Point3::from(ray * lambda))
+    }
+
+    /// The plane as a frame in this plane's frame (`a_from_plane` for a
+    /// plane in frame `a`): z along the normal, the origin the plane's
+    /// point nearest frame a's origin, x frame a's x axis projected into
+    /// the plane (its y axis when x is nearly along the normal).
+    pub fn a_from_plane(&self) -> Isometry3<f64> {
+        let z = self.normal.into_inner();
+        let seed = if z.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
+        let x = (seed - z * z.dot(&seed)).normalize();
+        let y = z.cross(&x);
+        let r = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[x, y, z]));
+        Isometry3::from_parts(
+            Translation3::from(z * self.distance_m),
+            UnitQuaternion::from_rotation_matrix(&r),
+        )
     }
 
     /// The same plane in frame `a`, from the plane in frame `b` and
@@ -90,6 +143,20 @@ impl Plane {
 }
 
 impl PlaneEstimate {
+    /// The covariance of `(nx, ny, nz, distance_m)` (rank 3: the normal
+    /// stays unit): turning the normal by `a e1 + b e2` moves it by `-a e2
+    /// + b e1` to first order.
+    pub fn normal_distance_covariance(&self) -> Matrix4<f64> {
+        let (e1, e2) = tangent_basis(&self.plane.normal);
+        let mut map = Matrix4x3::zeros();
+        for r in 0..3 {
+            map[(r, 0)] = -e2[r];
+            map[(r, 1)] = e1[r];
+        }
+        map[(3, 2)] = 1.0;
+        map * self.covariance * map.transpose()
+    }
+
     /// The plane in frame `a` with its covariance, from the plane in frame
     /// `b`, `a_from_b` and, when known, the 6x6 covariance of `a_from_b`
     /// (independent of the plane's). For the laser plane on the robot:

@@ -49,7 +49,7 @@ pub fn read_plane_report(report: &serde_json::Value) -> Result<(LaserPlane, Matr
 /// The plane in a transform format, as the frame `camera_from_laser_plane`.
 pub fn export_plane_frame(plane: &LaserPlane, format: TransformFormat) -> Result<String> {
     let names = FrameNames::from_transform_name("camera_from_laser_plane")?;
-    Ok(export_transform(&plane.camera_from_plane(), &names, format))
+    Ok(export_transform(&plane.a_from_plane(), &names, format))
 }
 
 /// A HALCON-style parameter list: the light plane's pose in the camera
@@ -58,14 +58,14 @@ pub fn export_plane_frame(plane: &LaserPlane, format: TransformFormat) -> Result
 /// Rz(gamma)), its z = 0 plane the light plane, plus the plane's normal,
 /// distance and their standard deviations.
 pub fn export_plane_halcon(plane: &LaserPlane, covariance: &Matrix4<f64>) -> String {
-    let pose = plane.camera_from_plane();
+    let pose = plane.a_from_plane();
     let r = pose.rotation.to_rotation_matrix();
     let m = r.matrix();
     let beta = m[(0, 2)].clamp(-1.0, 1.0).asin();
     let alpha = (-m[(1, 2)]).atan2(m[(2, 2)]);
     let gamma = (-m[(0, 1)]).atan2(m[(0, 0)]);
     let t = pose.translation.vector;
-    let n = plane.normal_camera;
+    let n = plane.normal;
     let std = |i: usize| covariance[(i, i)].max(0.0).sqrt();
     format!(
         "* robocal laser plane, HALCON-style sheet-of-light parameters\n\

@@ -7,22 +7,24 @@
 //!   the measured centre and where the plane/board intersection line crosses
 //!   that column (row), to first order `(n . X - d) / (n . dX/dv)`, divided
 //!   by the extractor's std. The noise is in the image, so this is the
-//!   maximum-likelihood fit under Gaussian centre noise, and its covariance
-//!   is the one the noise implies: a far or grazing board, whose points move
-//!   by millimetres per pixel, weighs what its pixels are worth.
+//!   maximum-likelihood fit under Gaussian centre noise: a far or grazing
+//!   board, whose points move by millimetres per pixel, weighs what its
+//!   pixels are worth.
 //! - [`PlaneResidual::PointToPlane`]: the metric distance of each 3-D point
 //!   to the plane, unweighted: the classic total-least-squares plane, which
 //!   over-weights far and grazing boards.
 //!
-//! The plane's parameters are its normal (two tangent angles about the
-//! current normal) and its distance; the covariance is `s^2 (J^T J)^-1`
-//! at the solution with `s^2` the residual variance (chi^2 / (m - 3)),
-//! returned over `(nx, ny, nz, d)`. The board poses are taken as exact
-//! (a board's pose from its corners is far more precise than one stripe).
+//! The plane's parameters are its normal (a rotation vector `a e1 + b e2`
+//! about [`tangent_basis`]'s axes) and its distance: the fit is a
+//! [`PlaneEstimate`], its covariance over `(a, b, d)`
+//! ([`super::covariance`]: the residuals' own scatter, correlations along
+//! the stripe included, plus the board poses' uncertainty when given).
 
-use super::plane::{LaserPlane, StripeObservation};
+use super::covariance::{plane_covariance, BoardPose};
+use super::plane::{plane_in_camera, LaserPlane, StripeObservation};
 use crate::error::{Error, Result};
-use nalgebra::{Matrix3, Matrix4, Matrix4x3, SymmetricEigen, Vector3};
+use crate::geometry::{tangent_basis, Plane, PlaneEstimate};
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// The residual the plane fit minimises.
@@ -81,16 +83,12 @@ pub struct ImageResidual {
 /// A fitted laser plane.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlaneFit {
-    /// The plane.
-    pub plane: LaserPlane,
-    /// Covariance of `(nx, ny, nz, d)` (d in metres), scaled by the
-    /// residual variance.
-    pub covariance: Matrix4<f64>,
-    /// Covariance of `(tilt_1, tilt_2, d)`: rotations of the normal about
-    /// two axes orthogonal to it (radians) and the distance (m).
-    pub tangent_covariance: Matrix3<f64>,
-    /// The residual variance `s^2` that scaled the covariance (1 when the
-    /// stds were exact).
+    /// The plane (camera frame, distance >= 0) and the covariance of its
+    /// `(a, b, d)` ([`crate::geometry::plane`]'s convention); the 4x4 over
+    /// `(nx, ny, nz, d)` is [`PlaneEstimate::normal_distance_covariance`].
+    pub estimate: PlaneEstimate,
+    /// The residual variance `chi^2 / (m - 3)` (1 when the centres' stds
+    /// are right).
     pub variance_factor: f64,
     /// RMS of the minimised residuals (image: in units of the std; point:
     /// metres).
@@ -111,8 +109,19 @@ const WEAK_RATIO: f64 = 0.05;
 /// Stripe lines whose directions all agree within this are parallel, deg.
 const PARALLEL_DEG: f64 = 2.0;
 
-/// Fit the laser plane to stripe observations from at least two images.
+/// Fit the laser plane to stripe observations from at least two images,
+/// the board poses taken as exact.
 pub fn fit_plane(obs: &[StripeObservation], options: &PlaneFitOptions) -> Result<PlaneFit> {
+    fit_plane_with_boards(obs, &[], options)
+}
+
+/// [`fit_plane`] with the board poses' uncertainty added to the plane's
+/// covariance (`boards`: the poses and covariances of the images).
+pub fn fit_plane_with_boards(
+    obs: &[StripeObservation],
+    boards: &[BoardPose],
+    options: &PlaneFitOptions,
+) -> Result<PlaneFit> {
     let mut images: Vec<usize> = obs.iter().map(|o| o.image).collect();
     images.sort_unstable();
     images.dedup();
@@ -150,57 +159,36 @@ pub fn fit_plane(obs: &[StripeObservation], options: &PlaneFitOptions) -> Result
             s1
         )));
     }
-    let mut n = start.normal();
+    let mut n = start.normal.into_inner();
     let mut d = start.distance_m;
     let mut warnings = geometry_warnings(obs, &images, singular);
-    let mut jtj = Matrix3::zeros();
-    let mut chi2 = 0.0;
     for _ in 0..30 {
-        let basis = tangent_basis(&n);
-        let (a, g, c) = normal_equations(obs, &n, d, &basis, options.residual);
-        jtj = a;
-        chi2 = c;
+        let basis = tangent_basis(&nalgebra::Unit::new_normalize(n));
+        let (a, g) = normal_equations(obs, &n, d, &basis, options.residual);
         let Some(step) = a.cholesky().map(|ch| ch.solve(&(-g))) else {
             return Err(Error::degenerate(
                 "the plane's normal equations are singular: the stripes do not constrain it",
             ));
         };
-        let rot = basis.0 * step[0] + basis.1 * step[1];
-        n = (n + rot).normalize();
+        // n <- exp(a e1 + b e2) n = n - a e2 + b e1 to first order.
+        n = (n - basis.1 * step[0] + basis.0 * step[1]).normalize();
         d += step[2];
         if step.norm() < 1e-14 {
             break;
         }
     }
-    // The final linearisation, at the solution.
-    let basis = tangent_basis(&n);
-    let (a, _, c) = normal_equations(obs, &n, d, &basis, options.residual);
-    if a.cholesky().is_some() {
-        jtj = a;
-        chi2 = c;
-    }
+    // The final linearisation, at the solution (the normal facing away).
+    let plane = plane_in_camera(n, d)?;
+    let rows = residual_rows(obs, &plane, options.residual);
+    let chi2: f64 = rows.iter().map(|r| r.residual * r.residual).sum();
     let m = obs.len();
     let variance_factor = if m > 3 { chi2 / (m - 3) as f64 } else { 1.0 };
-    let inv = jtj.try_inverse().ok_or_else(|| {
-        Error::degenerate(
-            "the plane's information matrix is singular: the stripes do not constrain it",
-        )
-    })?;
-    let tangent_covariance = inv * variance_factor;
-    let mut map = Matrix4x3::zeros();
-    for r in 0..3 {
-        map[(r, 0)] = basis.0[r];
-        map[(r, 1)] = basis.1[r];
-    }
-    map[(3, 2)] = 1.0;
-    let covariance = map * tangent_covariance * map.transpose();
-    // A sign flip of (n, d) leaves their joint covariance unchanged.
-    let plane = LaserPlane::new(n, d)?;
+    let covariance = plane_covariance(obs, &rows, boards)?;
     let per_image = images
         .iter()
         .map(|&i| image_residual(obs, i, &plane))
         .collect();
-    let eig = SymmetricEigen::new(tangent_covariance);
+    let eig = SymmetricEigen::new(covariance);
     if eig
         .eigenvalues
         .iter()
@@ -209,9 +197,7 @@ pub fn fit_plane(obs: &[StripeObservation], options: &PlaneFitOptions) -> Result
         warnings.push("the plane's covariance is not positive: the fit is unreliable".into());
     }
     Ok(PlaneFit {
-        plane,
-        covariance,
-        tangent_covariance,
+        estimate: PlaneEstimate { plane, covariance },
         variance_factor,
         rms: (chi2 / m as f64).sqrt(),
         per_image,
@@ -220,50 +206,87 @@ pub fn fit_plane(obs: &[StripeObservation], options: &PlaneFitOptions) -> Result
     })
 }
 
-/// Two unit vectors orthogonal to `n` and to each other.
-fn tangent_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    let helper = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let a = n.cross(&helper).normalize();
-    let b = n.cross(&a);
-    (a, b)
+/// One observation's residual, its Jacobian over the plane's `(a, b, d)`
+/// and over the observation's point (camera frame, per metre).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ResidualRow {
+    pub residual: f64,
+    pub jacobian: Vector3<f64>,
+    pub d_point: Vector3<f64>,
 }
 
-/// `J^T J`, `J^T r` and `r^T r` over `(tilt_a, tilt_b, d)`.
+/// The rows of every observation at `plane`, in order (zeros where the
+/// plane runs along the scan direction).
+pub(crate) fn residual_rows(
+    obs: &[StripeObservation],
+    plane: &LaserPlane,
+    model: PlaneResidual,
+) -> Vec<ResidualRow> {
+    let n = plane.normal.into_inner();
+    let basis = tangent_basis(&plane.normal);
+    obs.iter()
+        .map(|o| {
+            residual_row(o, &n, plane.distance_m, &basis, model).unwrap_or(ResidualRow {
+                residual: 0.0,
+                jacobian: Vector3::zeros(),
+                d_point: Vector3::zeros(),
+            })
+        })
+        .collect()
+}
+
+fn residual_row(
+    o: &StripeObservation,
+    n: &Vector3<f64>,
+    d: f64,
+    basis: &(Vector3<f64>, Vector3<f64>),
+    model: PlaneResidual,
+) -> Option<ResidualRow> {
+    let x = o.point_camera.coords;
+    let (r, dn, dd, dx) = match model {
+        PlaneResidual::PointToPlane => (n.dot(&x) - d, x, -1.0, *n),
+        PlaneResidual::ImagePx => {
+            let t = o.along_scan_m_per_px;
+            let nt = n.dot(&t);
+            if nt.abs() < 1e-15 {
+                return None;
+            }
+            let e = n.dot(&x) - d;
+            let w = 1.0 / o.std_px;
+            (
+                w * e / nt,
+                w * (x * nt - t * e) / (nt * nt),
+                -w / nt,
+                n * (w / nt),
+            )
+        }
+    };
+    // The normal turned by a e1 + b e2 moves by -a e2 + b e1.
+    Some(ResidualRow {
+        residual: r,
+        jacobian: Vector3::new(-dn.dot(&basis.1), dn.dot(&basis.0), dd),
+        d_point: dx,
+    })
+}
+
+/// `J^T J` and `J^T r` over `(a, b, d)`.
 fn normal_equations(
     obs: &[StripeObservation],
     n: &Vector3<f64>,
     d: f64,
     basis: &(Vector3<f64>, Vector3<f64>),
     model: PlaneResidual,
-) -> (Matrix3<f64>, Vector3<f64>, f64) {
+) -> (Matrix3<f64>, Vector3<f64>) {
     let mut a = Matrix3::zeros();
     let mut g = Vector3::zeros();
-    let mut chi2 = 0.0;
-    for o in obs {
-        let x = o.point_camera.coords;
-        let (r, dn, dd) = match model {
-            PlaneResidual::PointToPlane => (n.dot(&x) - d, x, -1.0),
-            PlaneResidual::ImagePx => {
-                let t = o.along_scan_m_per_px;
-                let nt = n.dot(&t);
-                if nt.abs() < 1e-15 {
-                    continue;
-                }
-                let e = n.dot(&x) - d;
-                let w = 1.0 / o.std_px;
-                (w * e / nt, w * (x * nt - t * e) / (nt * nt), -w / nt)
-            }
-        };
-        let j = Vector3::new(dn.dot(&basis.0), dn.dot(&basis.1), dd);
-        a += j * j.transpose();
-        g += j * r;
-        chi2 += r * r;
+    for row in obs
+        .iter()
+        .filter_map(|o| residual_row(o, n, d, basis, model))
+    {
+        a += row.jacobian * row.jacobian.transpose();
+        g += row.jacobian * row.residual;
     }
-    (a, g, chi2)
+    (a, g)
 }
 
 /// The point-to-plane total-least-squares plane and the singular values
@@ -285,8 +308,8 @@ fn total_least_squares(obs: &[StripeObservation]) -> (LaserPlane, [f64; 3]) {
     order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
     let sv = order.map(|i| eig.eigenvalues[i].max(0.0).sqrt());
     let normal: Vector3<f64> = eig.eigenvectors.column(order[2]).into();
-    let plane = LaserPlane::new(normal, normal.dot(&centre)).unwrap_or(LaserPlane {
-        normal_camera: [0.0, 0.0, 1.0],
+    let plane = plane_in_camera(normal, normal.dot(&centre)).unwrap_or(Plane {
+        normal: Vector3::z_axis(),
         distance_m: 0.0,
     });
     (plane, sv)
@@ -354,10 +377,10 @@ fn line_direction(pts: &[Vector3<f64>]) -> Option<Vector3<f64>> {
 }
 
 fn image_residual(obs: &[StripeObservation], image: usize, plane: &LaserPlane) -> ImageResidual {
-    let n = plane.normal();
+    let n = plane.normal;
     let (mut sp, mut sm, mut k) = (0.0, 0.0, 0usize);
     for o in obs.iter().filter(|o| o.image == image) {
-        let e = plane.signed_distance(&o.point_camera);
+        let e = plane.signed_distance_m(&o.point_camera.coords);
         let nt = n.dot(&o.along_scan_m_per_px);
         if nt.abs() > 1e-15 {
             sp += (e / nt).powi(2);

@@ -6,72 +6,54 @@
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::geometry::Pose;
+use crate::geometry::{Plane, Pose};
 use nalgebra::{Point2, Point3, Vector3};
-use serde::{Deserialize, Serialize};
+use serde::{Serialize, Serializer};
 
-/// The laser's plane of light in the camera frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LaserPlane {
-    /// Unit normal, camera frame (pointing away from the camera centre).
-    pub normal_camera: [f64; 3],
-    /// Distance of the camera centre to the plane, metres (>= 0).
-    pub distance_m: f64,
+/// The laser's plane of light: a [`Plane`] in the camera frame, its normal
+/// pointing away from the camera centre (`distance_m >= 0`). Its estimate
+/// with covariance is a [`crate::geometry::PlaneEstimate`].
+pub type LaserPlane = Plane;
+
+/// The laser plane `normal . X = distance_m` (camera frame) with `normal`
+/// normalised (the distance scaled with it) and the sign chosen so the
+/// distance is >= 0; fails for a zero or non-finite normal.
+pub fn plane_in_camera(normal: Vector3<f64>, distance_m: f64) -> Result<LaserPlane> {
+    let norm = normal.norm();
+    let scale = if norm > 1e-12 && norm.is_finite() {
+        norm
+    } else {
+        1.0
+    };
+    Plane::checked("laser_plane", normal, distance_m / scale).map(Plane::facing_away)
 }
 
-impl LaserPlane {
-    /// The plane `n . X = d` with `n` normalised and the sign chosen so the
-    /// distance is >= 0; fails for a zero or non-finite normal.
-    pub fn new(normal: Vector3<f64>, distance_m: f64) -> Result<LaserPlane> {
-        let norm = normal.norm();
-        if !(norm.is_finite() && norm > 1e-12 && distance_m.is_finite()) {
-            return Err(Error::invalid(
-                "laser_plane",
-                format!(
-                    "needs a non-zero finite normal and a finite distance, got ({}, {}, {}) and {}",
-                    normal.x, normal.y, normal.z, distance_m
-                ),
-            ));
-        }
-        let (n, d) = (normal / norm, distance_m / norm);
-        let (n, d) = if d < 0.0 { (-n, -d) } else { (n, d) };
-        Ok(LaserPlane {
-            normal_camera: [n.x, n.y, n.z],
-            distance_m: d,
-        })
+/// The JSON of a laser plane: `{"normal_camera": [nx, ny, nz],
+/// "distance_m": d}` (for `#[serde(serialize_with)]`).
+pub fn serialize_camera_plane<S: Serializer>(
+    plane: &LaserPlane,
+    serializer: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    #[derive(Serialize)]
+    struct Json {
+        normal_camera: [f64; 3],
+        distance_m: f64,
     }
-
-    /// The unit normal as a vector.
-    pub fn normal(&self) -> Vector3<f64> {
-        Vector3::from(self.normal_camera)
+    let n = plane.normal;
+    Json {
+        normal_camera: [n.x, n.y, n.z],
+        distance_m: plane.distance_m,
     }
-
-    /// Signed distance of a camera-frame point to the plane, metres.
-    pub fn signed_distance(&self, p: &Point3<f64>) -> f64 {
-        self.normal().dot(&p.coords) - self.distance_m
-    }
-
-    /// Where the ray along `ray` (camera frame, through the centre) meets
-    /// the plane; `None` when it runs parallel or meets it behind.
-    pub fn intersect_ray(&self, ray: &Vector3<f64>) -> Option<Point3<f64>> {
-        ray_plane(ray, &self.normal(), self.distance_m)
-    }
-}
-
-/// `lambda * ray` on the plane `n . X = d`, for lambda > 0.
-pub(crate) fn ray_plane(ray: &Vector3<f64>, n: &Vector3<f64>, d: f64) -> Option<Point3<f64>> {
-    let den = n.dot(ray);
-    if den.abs() < 1e-12 {
-        return None;
-    }
-    let lambda = d / den;
-    (lambda > 0.0 && lambda.is_finite()).then(|| Point3::from(ray * lambda))
+    .serialize(serializer)
 }
 
 /// The board plane `m . X = e` of a pose `camera_from_target` (target z = 0).
-pub(crate) fn board_plane(camera_from_target: &Pose) -> (Vector3<f64>, f64) {
-    let m = camera_from_target.rotation * Vector3::z();
-    (m, m.dot(&camera_from_target.translation.vector))
+pub(crate) fn board_plane(camera_from_target: &Pose) -> Plane {
+    let m = camera_from_target.rotation * Vector3::z_axis();
+    Plane {
+        normal: m,
+        distance_m: m.dot(&camera_from_target.translation.vector),
+    }
 }
 
 /// One stripe centre on a board of known pose: the point where its pixel's
@@ -101,10 +83,10 @@ impl StripeObservation {
         std_px: f64,
         image: usize,
     ) -> Result<StripeObservation> {
-        let (m, e) = board_plane(camera_from_target);
+        let board = board_plane(camera_from_target);
         let on_board = |px: &Point2<f64>| -> Result<Point3<f64>> {
             let ray = camera.unproject(px)?;
-            ray_plane(&ray, &m, e).ok_or_else(|| {
+            board.intersect_ray(&ray).ok_or_else(|| {
                 Error::degenerate(format!(
                     "the ray of pixel ({:.2}, {:.2}) does not meet the board of image {}",
                     px.x,
@@ -134,27 +116,5 @@ impl StripeObservation {
             std_px,
             image,
         })
-    }
-}
-
-impl LaserPlane {
-    /// `camera_from_plane`: the plane as a frame, z along the normal, the
-    /// origin the plane's point closest to the camera centre, x the camera's
-    /// x axis projected into the plane (its y axis when x is nearly normal).
-    pub fn camera_from_plane(&self) -> Pose {
-        let z = self.normal();
-        let seed = if z.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
-        };
-        let x = (seed - z * z.dot(&seed)).normalize();
-        let y = z.cross(&x);
-        let r =
-            nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::from_columns(&[x, y, z]));
-        Pose::from_parts(
-            nalgebra::Translation3::from(z * self.distance_m),
-            nalgebra::UnitQuaternion::from_rotation_matrix(&r),
-        )
     }
 }

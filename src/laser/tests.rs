@@ -18,8 +18,8 @@ fn camera() -> Camera {
 const EXTENT: (f64, f64) = (0.2, 0.15);
 
 fn angle_deg(a: &LaserPlane, b: &LaserPlane) -> f64 {
-    a.normal()
-        .dot(&b.normal())
+    a.normal
+        .dot(&b.normal.into_inner())
         .clamp(-1.0, 1.0)
         .acos()
         .to_degrees()
@@ -35,11 +35,11 @@ fn noise_free_fit_is_exact_with_both_residuals() {
     for residual in [PlaneResidual::ImagePx, PlaneResidual::PointToPlane] {
         let fit = fit_plane(&obs, &PlaneFitOptions { residual }).unwrap();
         assert!(
-            angle_deg(&fit.plane, &truth) < 1e-5,
+            angle_deg(&fit.estimate.plane, &truth) < 1e-5,
             "{residual:?}: {fit:?}"
         );
         assert!(
-            (fit.plane.distance_m - truth.distance_m).abs() < 1e-8,
+            (fit.estimate.plane.distance_m - truth.distance_m).abs() < 1e-8,
             "{fit:?}"
         );
         assert!(fit.warnings.is_empty(), "{:?}", fit.warnings);
@@ -69,20 +69,17 @@ fn noisy_fit_lies_within_its_covariance() {
         "{}",
         fit.variance_factor
     );
-    let e = Vector3::new(
-        fit.plane.normal_camera[0] - truth.normal_camera[0],
-        fit.plane.normal_camera[1] - truth.normal_camera[1],
-        fit.plane.normal_camera[2] - truth.normal_camera[2],
-    );
+    let e: Vector3<f64> = fit.estimate.plane.normal.into_inner() - truth.normal.into_inner();
+    let covariance = fit.estimate.normal_distance_covariance();
     for k in 0..3 {
         assert!(
-            e[k].abs() < 4.0 * fit.covariance[(k, k)].sqrt(),
+            e[k].abs() < 4.0 * covariance[(k, k)].sqrt(),
             "{k}: {e:?} {fit:?}"
         );
     }
-    let dd = fit.plane.distance_m - truth.distance_m;
-    assert!(dd.abs() < 4.0 * fit.covariance[(3, 3)].sqrt(), "{dd}");
-    assert!(angle_deg(&fit.plane, &truth) < 0.05);
+    let dd = fit.estimate.plane.distance_m - truth.distance_m;
+    assert!(dd.abs() < 4.0 * covariance[(3, 3)].sqrt(), "{dd}");
+    assert!(angle_deg(&fit.estimate.plane, &truth) < 0.05);
 }
 
 #[test]
@@ -127,7 +124,7 @@ fn bad_input_errors_say_what_came() {
         "requires at least 2 images with a stripe on the board, got 1"
     );
     assert_eq!(
-        LaserPlane::new(Vector3::zeros(), 0.1)
+        plane_in_camera(Vector3::zeros(), 0.1)
             .unwrap_err()
             .to_string(),
         "laser_plane: needs a non-zero finite normal and a finite distance, got (0, 0, 0) and 0.1"

@@ -27,6 +27,7 @@ use super::Projection;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LaserStripe {
     /// The plane of light in the camera frame.
+    #[serde(serialize_with = "crate::laser::plane::serialize_camera_plane")]
     pub plane: LaserPlane,
     /// Grey level of the stripe's peak on white print, before gain (default
     /// 400: a white square saturates).
@@ -72,7 +73,7 @@ pub(crate) fn add_stripe(
     white: f64,
     laser: &LaserStripe,
 ) {
-    let n = laser.plane.normal();
+    let n = laser.plane.normal.into_inner();
     let d = laser.plane.distance_m;
     let cw = w + 1;
     // Signed distance to the laser plane at every pixel corner.
@@ -192,7 +193,7 @@ pub fn stripe_truth(
     plane: &LaserPlane,
     along_columns: bool,
 ) -> Vec<(usize, f64)> {
-    let n = plane.normal();
+    let n = plane.normal.into_inner();
     let m = camera_from_target.rotation * Vector3::z();
     let e = m.dot(&camera_from_target.translation.vector);
     let u = n.cross(&m);

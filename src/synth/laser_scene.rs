@@ -15,7 +15,7 @@ use nalgebra::{Point2, Vector3};
 /// camera (-y), fanned along x, aimed at the optical axis 0.5 m away.
 pub fn example_plane() -> LaserPlane {
     LaserPlane {
-        normal_camera: Vector3::new(0.0, -0.5, 0.1).normalize().into(),
+        normal: nalgebra::Unit::new_normalize(Vector3::new(0.0, -0.5, 0.1)),
         distance_m: 0.1 * 0.5 / 0.26f64.sqrt(),
     }
 }

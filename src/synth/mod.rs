@@ -10,6 +10,7 @@ pub mod effects;
 pub mod handeye;
 pub mod handeye_looking;
 pub mod laser;
+pub mod laser_cubes;
 pub mod laser_scene;
 pub mod lens;
 pub mod render;
