@@ -438,8 +438,9 @@ fn apply_focal_check(
     if let Some(summary) = result.pose_refinement.as_mut() {
         if let Some((dx, dy)) = &found.shift {
             add_shift_to_covariance(summary, dx, dy);
-            if let Some(d) = summary.work_distance_m {
-                summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, d));
+            if let Some(point) = summary.work_point.as_ref().map(|w| w.camera_m) {
+                let q = nalgebra::Vector3::from(point);
+                summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, &q));
             }
         }
         summary.focal_check = Some(found.check);

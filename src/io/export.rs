@@ -243,7 +243,7 @@ fn export_laser_report(
     };
     Ok(ExportFile {
         name: "export.txt".into(),
-        text: export_transform(&plane.camera_from_plane(), &names, transform),
+        text: export_transform(&plane.a_from_plane(), &names, transform),
     })
 }
 
