@@ -242,3 +242,35 @@ fn both_extractors_find_the_rendered_centre() {
         );
     }
 }
+
+#[test]
+fn the_laser_plane_keeps_its_json_keys_and_its_4x4_covariance() {
+    // The plane serialises as {"normal_camera", "distance_m"} wherever a
+    // report or the renderer's truth carries it.
+    let stripe = LaserStripe::new(example_plane());
+    let json = serde_json::to_value(&stripe).unwrap();
+    let n = example_plane().normal;
+    assert_eq!(
+        json["plane"],
+        serde_json::json!({"normal_camera": [n.x, n.y, n.z], "distance_m": example_plane().distance_m})
+    );
+    // The 4x4 over (nx, ny, nz, d) is rank 3 with the normal in its null
+    // space, and the fit's covariance is symmetric positive definite.
+    let obs = stripe_observations(
+        &camera(),
+        &laser_board_poses(3),
+        &example_plane(),
+        EXTENT,
+        4,
+        0.3,
+        &mut Rng::new(9),
+    )
+    .unwrap();
+    let fit = fit_plane(&obs, &PlaneFitOptions::default()).unwrap();
+    let c4 = fit.estimate.normal_distance_covariance();
+    let m = fit.estimate.plane.normal;
+    let along = nalgebra::Vector4::new(m.x, m.y, m.z, 0.0);
+    assert!((c4 * along).norm() < 1e-12 * c4.norm(), "{c4}");
+    let eig = nalgebra::SymmetricEigen::new(fit.estimate.covariance);
+    assert!(eig.eigenvalues.iter().all(|v| *v > 0.0), "{eig:?}");
+}
