@@ -134,6 +134,11 @@ pub struct CameraCalibration {
     /// absent for the other models.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spline_support: Option<super::SplineSupport>,
+    /// With the cross-validation option: the projection difference of two
+    /// halves of the views for this model and the others, beside its
+    /// predicted uncertainty; absent without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cross_validation: Option<super::cross_validation::CrossValidation>,
     /// Distorted minus undistorted pixel positions on a grid over the image.
     #[serde(default)]
     pub distortion_field: DistortionField,
@@ -267,6 +272,7 @@ pub(crate) fn build_report(
         camera,
         board_warp: None,
         spline_support: None,
+        cross_validation: None,
         rejected,
         start: None,
         starts: Vec::new(),
