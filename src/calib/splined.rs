@@ -12,6 +12,7 @@ use super::zhang::{calibrate_usable, CalibrationOptions};
 use super::{CameraCalibration, View};
 use crate::camera::{splined::stereographic, Camera, Distortion, Spline};
 use crate::error::Result;
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Image cells per side (x, y) of [`SplineSupport::image_coverage`].
@@ -146,6 +147,26 @@ fn valid_mask(cells: &[bool]) -> Vec<String> {
         .chunks(COVERAGE_GRID.0)
         .map(|row| row.iter().map(|v| if *v { '#' } else { '.' }).collect())
         .collect()
+}
+
+/// The map `M` (3 x parameters) from a parameter change to the camera
+/// rotation that best explains its projection change over the grid (least
+/// squares over every grid pixel with Jacobians: `(sum R^T R)^-1 sum R^T J`,
+/// `J` d pixel / d params, `R` d pixel / d rotation); `None` when the
+/// rotation is not determined (fewer than two grid pixels).
+pub(crate) fn implied_rotation(
+    jacobians: &[Vec<Option<(DMatrix<f64>, DMatrix<f64>)>>],
+) -> Option<DMatrix<f64>> {
+    let cells: Vec<&(DMatrix<f64>, DMatrix<f64>)> = jacobians.iter().flatten().flatten().collect();
+    let n = cells.first()?.0.ncols();
+    let mut rtr = DMatrix::<f64>::zeros(3, 3);
+    let mut rtj = DMatrix::<f64>::zeros(3, n);
+    for (j, r) in &cells {
+        rtr += r.transpose() * r;
+        rtj += r.transpose() * j;
+    }
+    let inverse = rtr.try_inverse()?;
+    Some(inverse * rtj)
 }
 
 /// Share of the image in the valid region below which a splined fit draws

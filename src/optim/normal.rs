@@ -124,35 +124,35 @@ impl Normal {
         let active: Vec<usize> = (0..ng)
             .filter(|&c| jg_t.row(c).iter().any(|v| *v != 0.0))
             .collect();
-        let sparse = active.len() * 4 < ng * 3;
-        let jg = if sparse {
-            DMatrix::from_fn(active.len(), rows, |i, k| jg_t[(active[i], k)])
-        } else {
-            jg_t
-        };
-        let at = |i: usize| if sparse { active[i] } else { i };
-        if ng > 0 {
+        if ng > 0 && active.len() * 4 < ng * 3 {
+            let jg = DMatrix::from_fn(active.len(), rows, |i, k| jg_t[(active[i], k)]);
             let u = &jg * jg.transpose();
             let g = &jg * &r;
-            for i in 0..u.nrows() {
-                for j in 0..u.ncols() {
-                    self.u[(at(i), at(j))] += u[(i, j)];
+            for (i, &ai) in active.iter().enumerate() {
+                for (j, &aj) in active.iter().enumerate() {
+                    self.u[(ai, aj)] += u[(i, j)];
                 }
-                self.g_global[at(i)] += g[i];
+                self.g_global[ai] += g[i];
+            }
+            if let Some(b) = block {
+                let w = &jg * jb_t.transpose();
+                for (i, &ai) in active.iter().enumerate() {
+                    for j in 0..nb {
+                        self.w[b][(ai, j)] += w[(i, j)];
+                    }
+                }
+            }
+        } else if ng > 0 {
+            self.u.gemm(1.0, &jg_t, &jg_t.transpose(), 1.0);
+            self.g_global.gemv(1.0, &jg_t, &r, 1.0);
+            if let Some(b) = block {
+                self.w[b].gemm(1.0, &jg_t, &jb_t.transpose(), 1.0);
             }
         }
         if let Some(b) = block {
             let jb = jb_t.transpose();
             self.v[b].gemm(1.0, &jb_t, &jb, 1.0);
             self.g_blocks[b].gemv(1.0, &jb_t, &r, 1.0);
-            if ng > 0 {
-                let w = &jg * &jb;
-                for i in 0..w.nrows() {
-                    for j in 0..w.ncols() {
-                        self.w[b][(at(i), j)] += w[(i, j)];
-                    }
-                }
-            }
         }
     }
 

@@ -495,6 +495,7 @@ fn cross_validation_tells_a_fisheye_s_brown_halves_apart_and_names_kannala_brand
     assert_eq!(row("brown")["chosen"], json!(true));
     assert_eq!(row("brown")["agree"], json!(false));
     assert_eq!(row("kannala_brandt")["agree"], json!(true));
+    let recommended = cv["recommended"].as_str().expect("recommended");
     for key in [
         "diff_median_px",
         "diff_worst_px",
@@ -504,9 +505,17 @@ fn cross_validation_tells_a_fisheye_s_brown_halves_apart_and_names_kannala_brand
     ] {
         assert!(row("kannala_brandt")[key].is_number(), "{key}");
     }
-    assert_eq!(cv["recommended"], json!("kannala_brandt"));
+    // A fisheye model (EUCM follows this lens too), named in the warning.
     assert!(
-        stderr.contains("robocal intrinsics: warning: cross-validation: the two halves of the views calibrated with brown differ by "),
+        ["kannala_brandt", "eucm"].contains(&recommended),
+        "{recommended}"
+    );
+    assert!(
+        stderr.contains("robocal intrinsics: warning: cross-validation: "),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains(&format!("(CLI: --model {recommended})")),
         "{stderr}"
     );
     // Without the flag, no key.
