@@ -353,49 +353,4 @@ export const tests = [
       && /RMS 0\.0\d+ px/.test(document.querySelector('#camera-results h3')?.textContent || ''), null, { timeout: 90000 });
     assert.match(await page.textContent('#camera-results h3'), /RMS 0\.0\d+ px over \d+ views$/);
   }],
-  ['the splined model with its knots, its valid region and uncertainty map; cross-validation of the lens models on a fisheye', async (page, { url, shot }) => {
-    await page.goto(url);
-    await ready(page);
-    // A fisheye lens (Kannala-Brandt, fx 420 over 1280x960), 16 rendered views.
-    const dir = mkdtempSync(join(tmpdir(), 'robocal-fisheye-cv-'));
-    const camera = join(dir, 'fisheye.json');
-    writeFileSync(camera, JSON.stringify({ image_size_px: [1280, 960], camera_matrix: [[420, 0, 639], [0, 419.5, 481], [0, 0, 1]],
-      model: 'kannala_brandt', distortion: { k1: 0.045, k2: -0.012, k3: 0.0021, k4: -0.0004 } }));
-    let fisheye;
-    try { fisheye = render(['--views', '16', '--camera', camera]); } finally { rmSync(dir, { recursive: true, force: true }); }
-    await page.click('a[data-step=images]');
-    await page.setInputFiles('#file-input', fisheye.images);
-    await settled(page, 16);
-    await page.click('a[data-step=camera]');
-    // Brown-Conrady, cross-validated: its halves disagree, Kannala-Brandt's agree.
-    assert.equal(await page.isVisible('#camera-spline-terms'), false);
-    await page.check('#camera-cross-validate');
-    await solveCamera(page);
-    await page.locator('#camera-cross-validation-table').waitFor({ timeout: 10000 });
-    // Brown-Conrady's halves disagree (or one half does not calibrate).
-    assert.match(await cell(page, '#camera-cross-validation-table', 'brown (chosen)', 4), /^(disagree|not fitted)/);
-    assert.equal(await cell(page, '#camera-cross-validation-table', 'kannala_brandt', 4), 'agree');
-    assert.ok(await page.isVisible('#plot-cross-validation'));
-    // A fisheye model is recommended (EUCM follows this lens too).
-    const [, recommended] = /(kannala_brandt|eucm) recommended$/.exec(await page.textContent('#camera-cross-validation-summary')) || [];
-    assert.ok(recommended, await page.textContent('#camera-cross-validation-summary'));
-    const advice = await page.$$eval('#camera-results .msg-warning', (els) => els.map((e) => e.textContent));
-    assert.ok(advice.some((w) => w.startsWith('cross-validation: ') && w.includes(`(CLI: --model ${recommended})`)), advice.join('\n'));
-    await shot('cross-validation');
-    // The splined model: its knot and order fields, then its valid region
-    // and projection-uncertainty map.
-    await page.uncheck('#camera-cross-validate');
-    await page.selectOption('#camera-model', 'splined');
-    assert.ok(await page.isVisible('#camera-spline-terms'));
-    await page.fill('#camera-spline-terms input[name=spline_nx]', '10');
-    await page.fill('#camera-spline-terms input[name=spline_ny]', '8');
-    await page.dispatchEvent('#camera-form', 'change');
-    await solveCamera(page);
-    assert.equal(await page.$('#camera-cross-validation'), null);
-    assert.match(await page.textContent('#camera-valid-region'), /^Splined lens: \d+ of 80 control points have data; the valid region \(image cells holding points\) is \d+ % of the image/);
-    assert.ok(await page.isVisible('#plot-uncertainty'));
-    assert.equal(await cell(page, '#camera-params', 'dx79', 0), 'dx79');
-    assert.equal(await cell(page, '#camera-params', 'dx80', 0), null);
-    await shot('splined');
-  }],
 ];
