@@ -336,7 +336,7 @@ pub fn projection_uncertainty(
     let x_px: Vec<f64> = (0..cols).map(|i| at(i, cols, camera.width)).collect();
     let y_px: Vec<f64> = (0..rows).map(|i| at(i, rows, camera.height)).collect();
     // d pixel / d params and d pixel / d (camera rotation) at each grid pixel.
-    let jacobians_at = |x: f64, y: f64| -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+    let jacobians_at = |x: f64, y: f64| -> Option<super::splined::PixelJacobians> {
         if c.nrows() == 0 {
             return None;
         }
@@ -347,7 +347,7 @@ pub fn projection_uncertainty(
         let d_rot = d_point * (-p.cross_matrix());
         Some((j, DMatrix::from_column_slice(2, 3, d_rot.as_slice())))
     };
-    let jacobians: Vec<Vec<Option<(DMatrix<f64>, DMatrix<f64>)>>> = y_px
+    let jacobians: Vec<Vec<Option<super::splined::PixelJacobians>>> = y_px
         .iter()
         .map(|&y| x_px.iter().map(|&x| jacobians_at(x, y)).collect())
         .collect();

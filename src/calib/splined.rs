@@ -149,14 +149,16 @@ fn valid_mask(cells: &[bool]) -> Vec<String> {
         .collect()
 }
 
+/// At one pixel: d pixel / d params (2 x parameters) and d pixel / d
+/// camera rotation (2 x 3).
+pub(crate) type PixelJacobians = (DMatrix<f64>, DMatrix<f64>);
+
 /// The map `M` (3 x parameters) from a parameter change to the camera
 /// rotation that best explains its projection change over the grid (least
 /// squares over every grid pixel with Jacobians: `(sum R^T R)^-1 sum R^T J`,
 /// `J` d pixel / d params, `R` d pixel / d rotation); `None` when the
 /// rotation is not determined (fewer than two grid pixels).
-pub(crate) fn implied_rotation(
-    jacobians: &[Vec<Option<(DMatrix<f64>, DMatrix<f64>)>>],
-) -> Option<DMatrix<f64>> {
+pub(crate) fn implied_rotation(jacobians: &[Vec<Option<PixelJacobians>>]) -> Option<DMatrix<f64>> {
     let cells: Vec<&(DMatrix<f64>, DMatrix<f64>)> = jacobians.iter().flatten().flatten().collect();
     let n = cells.first()?.0.ncols();
     let mut rtr = DMatrix::<f64>::zeros(3, 3);

@@ -228,7 +228,7 @@ pub(crate) fn predicted_std(report: &CameraCalibration, grid: &[Point2<f64>]) ->
             Some((j, DMatrix::from_column_slice(2, 3, d_rot.as_slice())))
         })
         .collect();
-    let implied = crate::calib::splined::implied_rotation(&[jacobians.clone()]);
+    let implied = crate::calib::splined::implied_rotation(std::slice::from_ref(&jacobians));
     jacobians
         .iter()
         .map(|cell| {
