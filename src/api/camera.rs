@@ -121,6 +121,11 @@ pub struct JsonOptions {
     /// The splined model's degree, 2 or 3 (default 3).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spline_order: Option<usize>,
+    /// Calibrate two halves of the views with this model and the others and
+    /// report their projection difference beside its predicted uncertainty
+    /// (report key `cross_validation`, see docs/lens-models.md).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub cross_validate: bool,
 }
 
 impl Default for JsonOptions {
@@ -135,6 +140,7 @@ impl Default for JsonOptions {
             board_warp: false,
             spline_knots: None,
             spline_order: None,
+            cross_validate: false,
         }
     }
 }
@@ -287,6 +293,12 @@ pub fn calibrate_input(input: &CalibrationInput) -> Result<CalibrationOutput> {
     let mut report = calibrate_with(method, &views, size, &options)?;
     let advice = crate::calib::model_advice::advise_model(&views, size, &options, &report);
     report.warnings.extend(advice);
+    if input.options.cross_validate {
+        use crate::calib::cross_validation::{cross_validate, cross_validation_warning};
+        let cv = cross_validate(&views, size, &options, &report)?;
+        report.warnings.extend(cross_validation_warning(&cv));
+        report.cross_validation = Some(cv);
+    }
     report
         .warnings
         .extend(left_out.iter().map(LeftOut::warning));

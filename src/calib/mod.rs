@@ -22,6 +22,7 @@ pub mod check;
 mod check_tests;
 mod closed_form;
 pub mod compare;
+pub mod cross_validation;
 pub mod dlt;
 pub mod dlt_kalman;
 pub mod ekf;

@@ -134,6 +134,11 @@ pub struct CameraCalibration {
     /// absent for the other models.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spline_support: Option<super::SplineSupport>,
+    /// With the cross-validation option: the projection difference of two
+    /// halves of the views for this model and the others, beside its
+    /// predicted uncertainty; absent without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cross_validation: Option<super::cross_validation::CrossValidation>,
     /// Distorted minus undistorted pixel positions on a grid over the image.
     #[serde(default)]
     pub distortion_field: DistortionField,
@@ -267,6 +272,7 @@ pub(crate) fn build_report(
         camera,
         board_warp: None,
         spline_support: None,
+        cross_validation: None,
         rejected,
         start: None,
         starts: Vec::new(),
@@ -329,20 +335,47 @@ pub fn projection_uncertainty(
     let at = |i: usize, n: usize, size: u32| i as f64 * (size as f64 - 1.0) / (n - 1) as f64;
     let x_px: Vec<f64> = (0..cols).map(|i| at(i, cols, camera.width)).collect();
     let y_px: Vec<f64> = (0..rows).map(|i| at(i, rows, camera.height)).collect();
-    let std_at = |x: f64, y: f64| -> Option<f64> {
+    // d pixel / d params and d pixel / d (camera rotation) at each grid pixel.
+    let jacobians_at = |x: f64, y: f64| -> Option<super::splined::PixelJacobians> {
         if c.nrows() == 0 {
             return None;
         }
         let ray = camera.unproject(&Point2::new(x, y)).ok()?;
-        let (_, _, j) = camera
-            .project_with_jacobians(&Point3::from(ray * depth))
-            .ok()?;
-        let s = &j * c * j.transpose();
-        Some(s.symmetric_eigenvalues().max().max(0.0).sqrt())
+        let p = ray * depth;
+        let (_, d_point, j) = camera.project_with_jacobians(&Point3::from(p)).ok()?;
+        // Left perturbation of the point by a small rotation w: dp = -[p]x w.
+        let d_rot = d_point * (-p.cross_matrix());
+        Some((j, DMatrix::from_column_slice(2, 3, d_rot.as_slice())))
     };
-    let std_px: Vec<Vec<Option<f64>>> = y_px
+    let jacobians: Vec<Vec<Option<super::splined::PixelJacobians>>> = y_px
         .iter()
-        .map(|&y| x_px.iter().map(|&x| std_at(x, y)).collect())
+        .map(|&y| x_px.iter().map(|&x| jacobians_at(x, y)).collect())
+        .collect();
+    // A splined lens absorbs a small rotation of the camera frame (every
+    // pose turned, the correction shifted): its parameters' covariance
+    // holds that nearly free direction, which moves no projection of the
+    // scene. As mrcal's uncertainty (and the projection diff) does, the
+    // part of a parameter change a rotation explains over the grid is
+    // taken out before it counts.
+    let implied = match camera.distortion {
+        crate::camera::Distortion::Splined(_) => super::splined::implied_rotation(&jacobians),
+        _ => None,
+    };
+    let std_px: Vec<Vec<Option<f64>>> = jacobians
+        .iter()
+        .map(|row| {
+            row.iter()
+                .map(|cell| {
+                    let (j, r) = cell.as_ref()?;
+                    let j = match &implied {
+                        Some(m) => j - r * m,
+                        None => j.clone(),
+                    };
+                    let s = &j * c * j.transpose();
+                    Some(s.symmetric_eigenvalues().max().max(0.0).sqrt())
+                })
+                .collect()
+        })
         .collect();
     let max_std_px = std_px
         .iter()

@@ -12,6 +12,7 @@ use super::zhang::{calibrate_usable, CalibrationOptions};
 use super::{CameraCalibration, View};
 use crate::camera::{splined::stereographic, Camera, Distortion, Spline};
 use crate::error::Result;
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Image cells per side (x, y) of [`SplineSupport::image_coverage`].
@@ -31,6 +32,39 @@ pub struct SplineSupport {
     /// One string per row of control points (top first): `#` where data
     /// constrain the control point, `.` where only the smoothness prior does.
     pub mask: Vec<String>,
+    /// The valid region over the image: one string per row of the 16x12
+    /// grid of image cells (top first), `#` where a used point falls in the
+    /// cell, `.` where none does (there the model is the smoothness prior's
+    /// extrapolation of the cells around).
+    /// Empty in reports written before the key existed.
+    #[serde(default)]
+    pub image_mask: Vec<String>,
+}
+
+impl SplineSupport {
+    /// Whether pixel `(x, y)` of an image of `size` lies in the valid
+    /// region ([`SplineSupport::image_mask`]); false without a mask.
+    pub fn is_valid_px(&self, x: f64, y: f64, size: (u32, u32)) -> bool {
+        let Some((cx, cy)) = coverage_cell(x, y, size) else {
+            return false;
+        };
+        self.image_mask
+            .get(cy)
+            .and_then(|row| row.as_bytes().get(cx))
+            .is_some_and(|c| *c == b'#')
+    }
+}
+
+/// The cell of [`COVERAGE_GRID`] holding pixel `(x, y)`, if inside.
+pub(crate) fn coverage_cell(x: f64, y: f64, size: (u32, u32)) -> Option<(usize, usize)> {
+    let (w, h) = (size.0.max(1) as f64, size.1.max(1) as f64);
+    let cx = ((x + 0.5) / w * COVERAGE_GRID.0 as f64).floor();
+    let cy = ((y + 0.5) / h * COVERAGE_GRID.1 as f64).floor();
+    let inside = cx >= 0.0
+        && cy >= 0.0
+        && (cx as usize) < COVERAGE_GRID.0
+        && (cy as usize) < COVERAGE_GRID.1;
+    inside.then_some((cx as usize, cy as usize))
 }
 
 /// [`super::calibrate`] for a splined model without a given camera: the
@@ -71,16 +105,11 @@ pub(crate) fn spline_support(problem: &CalibProblem, camera: &Camera) -> Option<
     };
     let mut seen = vec![false; s.nx * s.ny];
     let mut cells = vec![false; COVERAGE_GRID.0 * COVERAGE_GRID.1];
-    let (w, h) = (camera.width.max(1) as f64, camera.height.max(1) as f64);
+    let size = (camera.width, camera.height);
     for (view, used) in problem.views.iter().zip(problem.used) {
         for (px, _) in view.image_px.iter().zip(used).filter(|(_, u)| **u) {
-            let cx = ((px.x + 0.5) / w * COVERAGE_GRID.0 as f64).floor();
-            let cy = ((px.y + 0.5) / h * COVERAGE_GRID.1 as f64).floor();
-            if cx >= 0.0 && cy >= 0.0 {
-                let (cx, cy) = (cx as usize, cy as usize);
-                if cx < COVERAGE_GRID.0 && cy < COVERAGE_GRID.1 {
-                    cells[cy * COVERAGE_GRID.0 + cx] = true;
-                }
+            if let Some((cx, cy)) = coverage_cell(px.x, px.y, size) {
+                cells[cy * COVERAGE_GRID.0 + cx] = true;
             }
             let Ok(ray) = camera.unproject(px) else {
                 continue;
@@ -108,19 +137,77 @@ pub(crate) fn spline_support(problem: &CalibProblem, camera: &Camera) -> Option<
         fraction: supported as f64 / seen.len().max(1) as f64,
         image_coverage: cells.iter().filter(|v| **v).count() as f64 / cells.len() as f64,
         mask,
+        image_mask: valid_mask(&cells),
     })
 }
 
-/// The warning of a spline with knots no data constrain.
-pub(crate) fn support_warning(support: &SplineSupport) -> Option<String> {
+/// The rows of [`SplineSupport::image_mask`] from the cells holding a point.
+fn valid_mask(cells: &[bool]) -> Vec<String> {
+    cells
+        .chunks(COVERAGE_GRID.0)
+        .map(|row| row.iter().map(|v| if *v { '#' } else { '.' }).collect())
+        .collect()
+}
+
+/// At one pixel: d pixel / d params (2 x parameters) and d pixel / d
+/// camera rotation (2 x 3).
+pub(crate) type PixelJacobians = (DMatrix<f64>, DMatrix<f64>);
+
+/// The map `M` (3 x parameters) from a parameter change to the camera
+/// rotation that best explains its projection change over the grid (least
+/// squares over every grid pixel with Jacobians: `(sum R^T R)^-1 sum R^T J`,
+/// `J` d pixel / d params, `R` d pixel / d rotation); `None` when the
+/// rotation is not determined (fewer than two grid pixels).
+pub(crate) fn implied_rotation(jacobians: &[Vec<Option<PixelJacobians>>]) -> Option<DMatrix<f64>> {
+    let cells: Vec<&(DMatrix<f64>, DMatrix<f64>)> = jacobians.iter().flatten().flatten().collect();
+    let n = cells.first()?.0.ncols();
+    let mut rtr = DMatrix::<f64>::zeros(3, 3);
+    let mut rtj = DMatrix::<f64>::zeros(3, n);
+    for (j, r) in &cells {
+        rtr += r.transpose() * r;
+        rtj += r.transpose() * j;
+    }
+    let inverse = rtr.try_inverse()?;
+    Some(inverse * rtj)
+}
+
+/// Share of the image in the valid region below which a splined fit draws
+/// a warning even when every control point has data.
+pub const VALID_REGION_ALERT: f64 = 0.9;
+/// RMS residual (px) of a splined fit above which it draws a warning: far
+/// above detection noise, a spline that still leaves it does not follow
+/// the lens (too few knots) or fits wrong detections.
+pub const SPLINED_RMS_ALERT_PX: f64 = 0.5;
+
+/// The warnings of a splined fit: control points no data constrain (and
+/// the share of the image in the valid region), and a residual far above
+/// detection noise.
+pub(crate) fn spline_warnings(support: &SplineSupport, rms_px: f64) -> Vec<String> {
+    let mut out = Vec::new();
     let total = support.knots[0] * support.knots[1];
-    (support.supported < total).then(|| {
-        format!(
+    if support.supported < total {
+        out.push(format!(
             "{} of the spline's {total} control points have no data in their support (the \
-             points cover {:.0} % of the image): there the lens model is the smoothness \
-             prior's extrapolation, trust it only where the projection uncertainty is small",
+             points cover {:.0} % of the image, the report's spline_support.image_mask): \
+             there the lens model is the smoothness prior's extrapolation, trust it only \
+             where the projection uncertainty is small",
             total - support.supported,
             100.0 * support.image_coverage
-        )
-    })
+        ));
+    } else if support.image_coverage < VALID_REGION_ALERT {
+        out.push(format!(
+            "the points cover {:.0} % of the image: outside the valid region (the report's \
+             spline_support.image_mask) the splined model is the prior's extrapolation",
+            100.0 * support.image_coverage
+        ));
+    }
+    if rms_px > SPLINED_RMS_ALERT_PX {
+        out.push(format!(
+            "the splined fit leaves rms {rms_px:.3} px, far above detection noise (below \
+             {SPLINED_RMS_ALERT_PX} px expected): the {}x{} knots may be too coarse for this \
+             lens (raise --spline-knots) or some detections are wrong",
+            support.knots[0], support.knots[1]
+        ));
+    }
+    out
 }

@@ -291,12 +291,9 @@ fn finish(
             .and_then(super::board_warp::warp_warning),
     );
     report.spline_support = super::splined::spline_support(problem, &report.camera);
-    checks.extend(
-        report
-            .spline_support
-            .as_ref()
-            .and_then(super::splined::support_warning),
-    );
+    if let Some(support) = &report.spline_support {
+        checks.extend(super::splined::spline_warnings(support, report.rms_px));
+    }
     checks.append(&mut report.warnings);
     report.warnings = checks;
     report.start = Some(start);

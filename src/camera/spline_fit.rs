@@ -22,7 +22,8 @@ impl Camera {
     /// this camera's image) with this camera's fx fy cx cy skew, whose
     /// projection matches this one's: the control values are the linear
     /// least-squares fit to this camera's `m - u` on a grid of pixels.
-    /// Fails when this camera cannot unproject the image's border.
+    /// The field covers the rays of the border pixels this camera can
+    /// unproject; fails when it can unproject none.
     pub fn splined_like(&self, spline: &Spline) -> Result<Camera> {
         let mut spline = Spline {
             control: vec![0.0; 2 * spline.nx * spline.ny],
@@ -44,18 +45,23 @@ impl Camera {
                 Point2::new(0.0, t * h),
                 Point2::new(w, t * h),
             ] {
-                let u = u_of(px).ok_or_else(|| {
-                    Error::invalid(
-                        "camera",
-                        format!(
-                            "pixel ({:.1}, {:.1}) does not unproject: no spline field to cover",
-                            px.x, px.y
-                        ),
-                    )
-                })?;
+                // A border pixel the camera cannot unproject (a fitted
+                // fisheye polynomial that folds beyond its data, in the
+                // image corners) is left out: the field covers the rays
+                // the camera has.
+                let Some(u) = u_of(px) else { continue };
                 u_max[0] = u_max[0].max(u.x.abs());
                 u_max[1] = u_max[1].max(u.y.abs());
             }
+        }
+        if !(u_max[0] > 0.0 && u_max[1] > 0.0) {
+            return Err(Error::invalid(
+                "camera",
+                format!(
+                    "no pixel of the {}x{} image's border unprojects: no spline field to cover",
+                    self.width, self.height
+                ),
+            ));
         }
         spline.u_max = u_max.map(|u| u * FIELD_MARGIN);
         spline.check()?;

@@ -22,6 +22,10 @@ REPORT.json is the output of 'robocal intrinsics' (a camera),
   matlab        MATLAB cameraIntrinsics script (1-based principal point)
   text          the 3x3 camera matrix, then '# image_size_px: W H' (read back by --camera)
   report        the report itself, pretty-printed
+  remap         a dense undistortion map for cv2.remap, any lens model (splined
+                included): OpenCV FileStorage YAML with mapx, mapy (rows =
+                height, cols = width) onto the distortion-free camera_matrix
+                (about 20 MB at 1280x960)
 
 Transform formats (of gripper_from_camera, base_from_camera, right_from_left
 or base_from_target, the first present; choose with --transform):

@@ -82,6 +82,13 @@ pub struct IntrinsicsArgs {
     /// With --model splined: the B-spline's degree, 2 or 3 (default 3)
     #[arg(long, value_name = "N")]
     spline_order: Option<usize>,
+    /// Calibrate two halves of the views (even and odd) with this model and
+    /// the others (brown, rational, kannala_brandt, eucm) and report their
+    /// projection difference beside its predicted uncertainty (report key
+    /// cross_validation); a warning names a model whose halves agree when
+    /// the chosen one's do not
+    #[arg(long)]
+    cross_validate: bool,
     /// Images detected in parallel (default: all cores)
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
@@ -174,6 +181,7 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
             board_warp: args.board_warp,
             spline_knots: args.spline_knots.as_deref().map(parse_knots).transpose()?,
             spline_order: args.spline_order,
+            cross_validate: args.cross_validate,
         },
         views,
         image_size_px: None,

@@ -30,6 +30,11 @@ pub const DEFAULT_TRANSFORMS: [&str; 4] = [
     "base_from_target",
 ];
 
+/// The dense undistortion map for `cv2.remap` of any camera
+/// ([`super::export_remap`]): not in [`format_names`] (the page's menus),
+/// a map of a whole image is tens of megabytes.
+pub const REMAP_FORMAT: &str = "remap";
+
 /// What [`export`] can write: every camera format, `report` (the report
 /// itself, pretty-printed) and every transform format.
 pub fn format_names() -> Vec<String> {
@@ -159,6 +164,7 @@ pub fn export_files(
     let extension = match CameraFormat::from_name(format) {
         Ok(f) => f.extension(),
         Err(_) if format == "report" => "json",
+        Err(_) if format == REMAP_FORMAT => "yaml",
         Err(_) => "txt",
     };
     Ok(vec![ExportFile {
@@ -272,6 +278,10 @@ fn export_value(
     let transform = options.transform;
     if format == "report" {
         return Ok(super::to_string_pretty(report) + "\n");
+    }
+    if format == REMAP_FORMAT {
+        let (camera, _) = import_camera(report_json)?;
+        return super::export_remap::remap_yaml(&camera);
     }
     if let Ok(camera_format) = CameraFormat::from_name(format) {
         let (camera, _) = import_camera(report_json).map_err(|e| match e {

@@ -83,25 +83,31 @@ pub(super) fn mrcal_model(c: &Camera, rt_cam_ref: Option<[f64; 6]>) -> Result<St
         ));
     }
     let (lensmodel, coeffs) = match &c.distortion {
-        Distortion::None => ("LENSMODEL_PINHOLE", vec![]),
-        Distortion::Brown { k1, k2, k3, p1, p2 } => {
-            ("LENSMODEL_OPENCV5", vec![*k1, *k2, *p1, *p2, *k3])
-        }
-        Distortion::RadialK1K2K5 { k1, k2, k5 } => {
-            ("LENSMODEL_OPENCV5", vec![*k1, *k2, 0.0, 0.0, *k5])
-        }
+        Distortion::None => ("LENSMODEL_PINHOLE".to_string(), vec![]),
+        Distortion::Brown { k1, k2, k3, p1, p2 } => (
+            "LENSMODEL_OPENCV5".to_string(),
+            vec![*k1, *k2, *p1, *p2, *k3],
+        ),
+        Distortion::RadialK1K2K5 { k1, k2, k5 } => (
+            "LENSMODEL_OPENCV5".to_string(),
+            vec![*k1, *k2, 0.0, 0.0, *k5],
+        ),
         Distortion::Rational { .. } => {
             let v = c.distortion.coefficients();
             if v[8..].iter().any(|s| *s != 0.0) {
-                ("LENSMODEL_OPENCV12", v)
+                ("LENSMODEL_OPENCV12".to_string(), v)
             } else {
-                ("LENSMODEL_OPENCV8", v[..8].to_vec())
+                ("LENSMODEL_OPENCV8".to_string(), v[..8].to_vec())
             }
         }
+        // Written only when its knots sit on mrcal's grid (see the module).
+        Distortion::Splined(s) => (
+            super::export_mrcal_splined::mrcal_splined_name(s)?,
+            s.control.clone(),
+        ),
         Distortion::KannalaBrandt { .. }
         | Distortion::Division { .. }
-        | Distortion::Eucm { .. }
-        | Distortion::Splined(_) => {
+        | Distortion::Eucm { .. } => {
             return Err(unsupported(c, "mrcal (it has no equivalent model)"))
         }
         Distortion::Tilted { .. } => return Err(unsupported_listing(c, "mrcal")),

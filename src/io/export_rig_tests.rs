@@ -54,6 +54,7 @@ fn calibration_of(camera: Camera, rms_px: f64) -> CameraCalibration {
         },
         board_warp: None,
         spline_support: None,
+        cross_validation: None,
         projection_uncertainty: ProjectionUncertainty {
             reference_depth_m: 1.0,
             x_px: Vec::new(),

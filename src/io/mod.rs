@@ -13,6 +13,8 @@ pub mod export;
 pub mod export_camera;
 mod export_camera_tools;
 pub mod export_laser;
+mod export_mrcal_splined;
+pub mod export_remap;
 pub mod export_rig;
 pub mod export_ros;
 pub mod export_stereo;

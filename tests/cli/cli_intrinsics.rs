@@ -442,3 +442,132 @@ fn the_model_help_lists_every_model_of_the_table() {
         }
     }
 }
+
+/// A detections file of `truth` seen in `n_views` views of a 10x8 board at
+/// `noise_px` (seed 11, the scene of the library's cross-validation test).
+fn scene_detections(
+    dir: &std::path::Path,
+    truth: &Camera,
+    n_views: usize,
+    noise_px: f64,
+) -> PathBuf {
+    let scene = Scene::calibration(11, truth, (10, 8), 0.03, n_views, noise_px).expect("scene");
+    let target = json!({"kind": "chessboard", "cols": 10, "rows": 8, "square_m": 0.03});
+    let images: Vec<Value> = scene
+        .views
+        .iter()
+        .map(|v| {
+            let points: Vec<Value> = v
+                .object_m
+                .iter()
+                .zip(&v.image_px)
+                .map(|(o, p)| {
+                    let id = (o.y / 0.03).round() as usize * 10 + (o.x / 0.03).round() as usize;
+                    json!({"id": id, "x_px": p.x, "y_px": p.y})
+                })
+                .collect();
+            json!({"file": format!("{}.png", v.name), "detect_ms": 1.0, "detection": {
+                "image_size_px": [truth.width, truth.height], "target": target, "points": points}})
+        })
+        .collect();
+    let path = dir.join("detections.json");
+    let doc = json!({"robocal_version": "0.1.0", "target": target, "images": images});
+    std::fs::write(&path, doc.to_string()).expect("write");
+    path
+}
+
+#[test]
+fn cross_validation_tells_a_fisheye_s_brown_halves_apart_and_names_kannala_brandt() {
+    let dir = temp_dir("intrinsics", "cross-validate");
+    let d = scene_detections(&dir, &Camera::example_kannala_brandt(), 24, 0.1);
+    let (code, stdout, stderr) = robocal(&[
+        "intrinsics",
+        "--detections",
+        d.to_str().expect("path"),
+        "--cross-validate",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let report: Value = serde_json::from_str(&stdout).expect("report");
+    let cv = &report["cross_validation"];
+    assert_eq!(cv["views"], json!([12, 12]));
+    let rows = cv["models"].as_array().expect("models");
+    let row = |m: &str| rows.iter().find(|r| r["model"] == m).expect("row");
+    assert_eq!(row("brown")["chosen"], json!(true));
+    assert_eq!(row("brown")["agree"], json!(false));
+    assert_eq!(row("kannala_brandt")["agree"], json!(true));
+    let recommended = cv["recommended"].as_str().expect("recommended");
+    for key in [
+        "diff_median_px",
+        "diff_worst_px",
+        "predicted_median_px",
+        "ratio_median",
+        "grid_points",
+    ] {
+        assert!(row("kannala_brandt")[key].is_number(), "{key}");
+    }
+    // A fisheye model (EUCM follows this lens too), named in the warning.
+    assert!(
+        ["kannala_brandt", "eucm"].contains(&recommended),
+        "{recommended}"
+    );
+    assert!(
+        stderr.contains("robocal intrinsics: warning: cross-validation: "),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains(&format!("(CLI: --model {recommended})")),
+        "{stderr}"
+    );
+    // Without the flag, no key.
+    let (_, stdout, _) = robocal(&["intrinsics", "--detections", d.to_str().expect("path")]);
+    let plain: Value = serde_json::from_str(&stdout).expect("report");
+    assert!(plain.get("cross_validation").is_none());
+}
+
+#[test]
+fn the_remap_export_holds_a_map_per_pixel_for_cv2_remap() {
+    let dir = temp_dir("intrinsics", "remap");
+    let camera = dir.join("camera.json");
+    std::fs::write(
+        &camera,
+        r#"{"image_size_px": [64, 48], "camera_matrix": [[60, 0, 31.5], [0, 60, 23.5], [0, 0, 1]],
+            "model": "brown", "distortion": {"k1": -0.2, "k2": 0.05, "k3": 0, "p1": 0, "p2": 0}}"#,
+    )
+    .expect("write");
+    let (code, stdout, stderr) = robocal(&[
+        "export",
+        camera.to_str().expect("path"),
+        "--format",
+        "remap",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.starts_with(
+            "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n"
+        ),
+        "{}",
+        &stdout[..200]
+    );
+    assert!(
+        stdout.contains("mapx: !!opencv-matrix\n   rows: 48\n   cols: 64\n   dt: f\n   data: [ ")
+    );
+    assert!(
+        stdout.contains("mapy: !!opencv-matrix\n   rows: 48\n   cols: 64\n   dt: f\n   data: [ ")
+    );
+    // One value per pixel; barrel distortion pulls the output's corner
+    // pixel inwards in the source image.
+    let values = |name: &str| -> Vec<f64> {
+        let start = stdout
+            .find(&format!("{name}: !!opencv-matrix"))
+            .expect("matrix");
+        let rest = &stdout[start..];
+        let (open, close) = (rest.find('[').expect("["), rest.find(']').expect("]"));
+        rest[open + 1..close]
+            .split(',')
+            .map(|v| v.trim().parse().expect("number"))
+            .collect()
+    };
+    let (mapx, mapy) = (values("mapx"), values("mapy"));
+    assert_eq!((mapx.len(), mapy.len()), (64 * 48, 64 * 48));
+    assert!(mapx[0] > 0.5 && mapy[0] > 0.5, "{} {}", mapx[0], mapy[0]);
+}

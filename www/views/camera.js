@@ -44,9 +44,9 @@ export class CameraView {
       items.map(([v, label]) => h('option', { value: v, selected: v === value }, label)));
     const lens = lensFields(st, 'camera');
     const form = h('form', { class: 'form', id: 'camera-form' },
-      lens.model, lens.brown,
+      lens.model, lens.brown, lens.spline,
       h('label', {}, 'Method', select('method', METHODS, st.method)),
-      lens.options,
+      lens.options, lens.cross,
       h('p', { class: 'hint', id: 'camera-input-summary' }),
       h('div', { class: 'row' }, h('button', { type: 'submit', class: 'primary', id: 'solve-camera' }, 'Solve camera')));
     form.addEventListener('change', () => this.readForm(form));
@@ -152,7 +152,11 @@ export class CameraView {
       warnings,
       r.rejected ? this.rejectedNote(r) : null,
       h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat, picked)),
+      r.spline_support ? h('p', { class: 'hint', id: 'camera-valid-region' },
+        `Splined lens: ${r.spline_support.supported} of ${r.spline_support.knots[0] * r.spline_support.knots[1]} control points have data; `
+        + `the valid region (image cells holding points) is ${num(100 * r.spline_support.image_coverage, 0)} % of the image, and outside it the model is extrapolated: trust it where the uncertainty map is low.`) : null,
       h('div', { class: 'plots' }, vec, unc, dist),
+      r.cross_validation ? this.crossValidationSection(r.cross_validation, [w, hgt]) : null,
       this.undistortSection(r),
       comparison ? this.comparisonTable(comparison, comparisonNote) : null,
       r.correlation && r.correlation.matrix ? this.correlationNote(r.correlation) : null);
@@ -238,6 +242,29 @@ export class CameraView {
     } finally {
       button.disabled = false;
     }
+  }
+
+  /**
+   * The cross-validation (report key cross_validation): each model's two
+   * halves, their median difference against its predicted uncertainty, and
+   * the chosen model's difference map (grey where the halves have no data).
+   */
+  crossValidationSection(cv, [w, hgt]) {
+    const chosen = cv.models[0];
+    const canvas = h('canvas', { id: 'plot-cross-validation', width: 460, height: 340, role: 'img', 'aria-label': 'cross-validation difference map' });
+    const map = chosen && chosen.diff_map_px && chosen.diff_map_px.length ? heatmap(canvas, {
+      cols: cv.x_px.length, rows: cv.y_px.length, width_px: w, height_px: hgt,
+      values: chosen.diff_map_px.flat().map((v) => (v === null ? NaN : v)),
+    }, { title: `Two halves of the views with ${chosen.model}: projection difference` }) : null;
+    const rows = cv.models.map((m) => [m.model + (m.chosen ? ' (chosen)' : ''),
+      m.error ? '-' : num(m.diff_median_px, 3), m.error ? '-' : num(m.predicted_median_px, 3),
+      m.error ? '-' : num(m.ratio_median, 1), m.error ? `not fitted: ${m.error}` : (m.agree ? 'agree' : 'disagree')]);
+    return h('section', { id: 'camera-cross-validation', 'aria-labelledby': 'cross-validation-title' },
+      h('h3', { id: 'cross-validation-title' }, `Cross-validation: ${cv.views[0]} and ${cv.views[1]} views`),
+      h('p', { class: 'hint' }, 'Each half of the views is calibrated alone; halves that differ by about their predicted uncertainty mean the model fits the lens, many times more mean it does not.'),
+      table(['model', 'median difference (px)', 'predicted (px)', 'ratio', 'halves'], rows, { id: 'camera-cross-validation-table' }),
+      h('p', { id: 'camera-cross-validation-summary' }, cv.summary),
+      map ? h('div', { class: 'plots' }, map) : null);
   }
 
   /** The `method: "all"` rows, and the core's note on methods it left out (said once). */

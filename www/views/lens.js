@@ -23,6 +23,9 @@ export async function loadLensModels(engine) {
 }
 /** Brown-Conrady as users know it: 2 or 3 radial coefficients, tangential on or off (held at 0 otherwise). */
 const RADIAL = [['3', '3 radial (k1 k2 k3: OpenCV default)'], ['2', '2 radial (k1 k2, k3 held at 0: MATLAB, Bouguet, Kalibr default)']];
+/** The splined model's degrees and the bounds of its control points per axis (camera::splined::MAX_KNOTS). */
+const SPLINE_ORDERS = [['3', 'cubic (order 3, default)'], ['2', 'quadratic (order 2)']];
+const KNOTS = { min: 4, max: 40, nx: 12, ny: 8 };
 const OPTIONS = [
   ['fix_principal_point', 'Fix the principal point at the image centre'],
   ['fix_aspect_ratio', 'Fix the aspect ratio (fy / fx) at its closed-form value'],
@@ -48,8 +51,21 @@ export function lensFields(st, prefix) {
     brown: h('div', { class: 'row', id: `${prefix}-brown-terms`, hidden: st.model !== 'brown' },
       h('label', {}, 'Radial terms ', select('radial', RADIAL, st.radial || '3')),
       h('label', { class: 'check' }, h('input', { type: 'checkbox', name: 'tangential', checked: st.tangential !== false }), ' Tangential p1 p2')),
+    spline: h('div', { class: 'row', id: `${prefix}-spline-terms`, hidden: st.model !== 'splined' },
+      knotInput('spline_nx', 'Control points across x', (st.spline || {}).nx ?? KNOTS.nx),
+      knotInput('spline_ny', 'across y', (st.spline || {}).ny ?? KNOTS.ny),
+      h('label', {}, 'Spline ', select('spline_order', SPLINE_ORDERS, String((st.spline || {}).order ?? 3))),
+      h('p', { class: 'hint' }, 'Defaults 12 x 8, cubic; more control points follow finer lens structure and need more views that cover the image (40 or more).')),
+    cross: h('label', { class: 'check' },
+      h('input', { type: 'checkbox', name: 'cross_validate', id: `${prefix}-cross-validate`, checked: !!st.crossValidate }),
+      ' Cross-validate: calibrate two halves of the views with each lens model and compare them with their predicted uncertainty (about ten times the solve time)'),
     options: h('fieldset', {}, h('legend', {}, 'Options'), opts),
   };
+}
+
+/** A number field of control points along one axis. */
+function knotInput(name, label, value) {
+  return h('label', {}, `${label} `, h('input', { type: 'number', name, min: KNOTS.min, max: KNOTS.max, step: 1, value, size: 3 }));
 }
 
 /** The controls of `lensFields` in `form` into `st`. */
@@ -58,6 +74,15 @@ export function readLens(st, form) {
   st.radial = form.elements.radial.value;
   st.tangential = form.elements.tangential.checked;
   form.elements.radial.closest('.row').hidden = st.model !== 'brown';
+  if (form.elements.spline_nx) {
+    form.elements.spline_nx.closest('.row').hidden = st.model !== 'splined';
+    st.spline = {
+      nx: Number(form.elements.spline_nx.value) || KNOTS.nx,
+      ny: Number(form.elements.spline_ny.value) || KNOTS.ny,
+      order: Number(form.elements.spline_order.value) || 3,
+    };
+  }
+  if (form.elements.cross_validate) st.crossValidate = form.elements.cross_validate.checked;
   st.options = st.options || {};
   for (const [key] of OPTIONS) st.options[key] = form.elements[key].checked;
 }
@@ -68,6 +93,9 @@ export function jsonOptions(st) {
   const fixed = [];
   if (st.model === 'brown' && st.radial === '2') fixed.push('k3');
   if (st.model === 'brown' && st.tangential === false) fixed.push('p1', 'p2');
-  const out = square ? { ...rest, aspect_ratio: 1 } : rest;
+  let out = square ? { ...rest, aspect_ratio: 1 } : rest;
+  // The core checks the bounds and says which one a value breaks.
+  if (st.model === 'splined' && st.spline) out = { ...out, spline_knots: [st.spline.nx, st.spline.ny], spline_order: st.spline.order };
+  if (st.crossValidate) out = { ...out, cross_validate: true };
   return fixed.length ? { ...out, fixed_coefficients: fixed } : out;
 }

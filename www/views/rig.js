@@ -60,7 +60,7 @@ export class RigView {
   render() {
     const st = this.state;
     const lens = lensFields(st, 'rig');
-    const form = h('form', { class: 'form', id: 'rig-lens' }, lens.model, lens.brown, lens.options);
+    const form = h('form', { class: 'form', id: 'rig-lens' }, lens.model, lens.brown, lens.spline, lens.options);
     form.addEventListener('change', () => { readLens(st, form); this.store.changed('rig'); });
     form.addEventListener('submit', (e) => e.preventDefault());
     this.camerasOut = h('div', { id: 'rig-cameras', class: 'form' });
