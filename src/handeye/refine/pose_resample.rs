@@ -34,8 +34,7 @@ use crate::handeye::refine::pose_problem::{
     in_basis, translation_basis, whitening, PoseRefineOptions, HUBER_SCALE,
 };
 use crate::handeye::refine::pose_residual::{linearise, perturb, PoseMeasurement};
-use crate::handeye::solve::HandEyeOptions;
-use crate::handeye::{Chain, MotionPairs, Pose, Setup};
+use crate::handeye::{Chain, HandEyeOptions, MotionPairs, Pose, Setup};
 use crate::optim::Loss;
 use nalgebra::{Matrix3, Matrix6, SMatrix, SVector, Vector3, Vector6};
 
@@ -269,7 +268,7 @@ mod tests {
             let b: Vec<Pose> = views.iter().map(|v| v.base_from_gripper).collect();
             let c: Vec<Pose> = views.iter().map(|v| v.camera_from_target).collect();
             let chain = Chain::new(setup, &b, &c).unwrap();
-            let (x0, y0, _) = crate::handeye::solve::solve_method(
+            let (x0, y0, _) = crate::handeye::closed_form::solve_method(
                 crate::handeye::HandEyeMethod::Shah,
                 &chain,
                 MotionPairs::All,
