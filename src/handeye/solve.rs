@@ -85,7 +85,9 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
     }
     // 3. Every requested method; a failing one is reported, not fatal.
     let mut methods = Vec::new();
-    let mut best: Option<(f64, usize, Pose, Pose, Vec<Vector3<f64>>)> = None;
+    // (score, index, x, y, unobservable directions) of the best so far.
+    type Best = (f64, usize, Pose, Pose, Vec<Vector3<f64>>);
+    let mut best: Option<Best> = None;
     for (i, &method) in options.methods.iter().enumerate() {
         let outcome = solve_with_motions(method, &chain, &set.kept).map(|(x, y, u)| {
             let e = errors(&view_residuals(&chain, &x, &y));

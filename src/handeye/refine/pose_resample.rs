@@ -308,14 +308,14 @@ mod tests {
             // The spread of X over the runs (root-sum-square of the
             // deviations; leave-one-out with the jackknife scale).
             let n = views.len() as f64;
-            let spread =
-                |rows: &[((f64, f64), (f64, f64), (f64, f64))], pick: usize, scale: f64| {
-                    let ss = rows.iter().fold((0.0, 0.0), |a, r| {
-                        let d = [r.0, r.1, r.2][pick];
-                        (a.0 + d.0 * d.0, a.1 + d.1 * d.1)
-                    });
-                    ((scale * ss.0).sqrt(), (scale * ss.1).sqrt())
-                };
+            type Differences = ((f64, f64), (f64, f64), (f64, f64));
+            let spread = |rows: &[Differences], pick: usize, scale: f64| {
+                let ss = rows.iter().fold((0.0, 0.0), |a, r| {
+                    let d = [r.0, r.1, r.2][pick];
+                    (a.0 + d.0 * d.0, a.1 + d.1 * d.1)
+                });
+                ((scale * ss.0).sqrt(), (scale * ss.1).sqrt())
+            };
             let (loo, boot) = rows.split_at(views.len());
             let b = boot.len() as f64;
             let parts = [
