@@ -13,6 +13,8 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
+mod cycle_tests;
+
 /// Where a rule applies.
 #[derive(Clone, Copy, PartialEq)]
 enum Scope {

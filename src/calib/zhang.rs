@@ -482,6 +482,9 @@ pub(crate) fn lm_options(initial: &Camera, options: &CalibrationOptions) -> Resu
     })
 }
 
+/// The points kept (per view, per point) and the outliers left out.
+type Classified = (Vec<Vec<bool>>, Vec<Vec<Outlier>>);
+
 /// The points within k robust sigmas (sigma from the median residual of
 /// the currently used points), and an [`Outlier`] record for each point the
 /// current mask leaves out.
@@ -490,7 +493,7 @@ fn classify(
     params: &BlockParams,
     used: &[Vec<bool>],
     k: f64,
-) -> Result<(Vec<Vec<bool>>, Vec<Vec<Outlier>>)> {
+) -> Result<Classified> {
     let blocks = crate::optim::BlockProblem::residuals_and_jacobian(every, params, false)?;
     let norms: Vec<f64> = blocks.iter().map(|b| b.residuals.norm()).collect();
     let mut used_norms: Vec<f64> = norms

@@ -9,6 +9,10 @@ use crate::error::{Error, Result};
 use nalgebra::{Matrix2, Matrix2x3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+/// A distorted point with its Jacobian with respect to the undistorted one
+/// and its derivative along each coefficient.
+type DistortedWithJacobians = (Vector2<f64>, Matrix2<f64>, Vec<Vector2<f64>>);
+
 /// A lens model and its coefficients. All act on normalised coordinates
 /// (`X/Z`, `Y/Z`) or, for the wide-angle models, on the ray itself; the
 /// coefficient order of [`Distortion::coefficients`] is the order of
@@ -501,7 +505,7 @@ impl Distortion {
     pub(crate) fn distort_with_jacobians(
         &self,
         n: &Vector2<f64>,
-    ) -> Result<(Vector2<f64>, Matrix2<f64>, Vec<Vector2<f64>>)> {
+    ) -> Result<DistortedWithJacobians> {
         match self.family() {
             Family::Pinhole => Ok((*n, Matrix2::identity(), vec![])),
             Family::Poly(poly, cols) => {

@@ -34,7 +34,7 @@ pub(crate) fn project(
     alpha: f64,
     beta: f64,
     p: &Vector3<f64>,
-) -> Result<(Vector2<f64>, Matrix2x3<f64>, [Vector2<f64>; 2])> {
+) -> Result<super::ProjectionWithJacobians<2>> {
     check_params(alpha, beta)?;
     let (x, y, z) = (p.x, p.y, p.z);
     let r2 = x * x + y * y;

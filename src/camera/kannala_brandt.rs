@@ -35,10 +35,7 @@ fn monotonic_up_to(k: &[f64; 4], theta: f64) -> bool {
 
 /// Distorted normalised point, Jacobian with respect to the 3-D point and
 /// with respect to k1..k4.
-pub(crate) fn project(
-    k: &[f64; 4],
-    p: &Vector3<f64>,
-) -> Result<(Vector2<f64>, Matrix2x3<f64>, [Vector2<f64>; 4])> {
+pub(crate) fn project(k: &[f64; 4], p: &Vector3<f64>) -> Result<super::ProjectionWithJacobians<4>> {
     let (x, y, z) = (p.x, p.y, p.z);
     let rho = (x * x + y * y).sqrt();
     let norm2 = rho * rho + z * z;

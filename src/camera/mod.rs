@@ -37,6 +37,15 @@ use crate::error::{Error, Result};
 use nalgebra::{DMatrix, Matrix2, Matrix2x3, Matrix3, Point2, Point3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+/// A projection with its Jacobians: the normalised point, its Jacobian with
+/// respect to the 3-D point, and its derivative along each of the model's
+/// `N` coefficients.
+pub(crate) type ProjectionWithJacobians<const N: usize> = (
+    nalgebra::Vector2<f64>,
+    nalgebra::Matrix2x3<f64>,
+    [nalgebra::Vector2<f64>; N],
+);
+
 /// Number of pinhole parameters before the distortion coefficients in
 /// [`Camera::params`]: fx, fy, cx, cy, skew.
 pub const N_PINHOLE_PARAMS: usize = 5;

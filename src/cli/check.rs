@@ -256,11 +256,7 @@ fn parse_grid(text: &str) -> Result<[usize; 2], CliError> {
             format!("--grid '{text}': give columns x rows, e.g. 60x40"),
         )
     };
-    let (c, r) = text.split_once(['x', 'X']).ok_or_else(bad)?;
-    Ok([
-        c.trim().parse().map_err(|_| bad())?,
-        r.trim().parse().map_err(|_| bad())?,
-    ])
+    super::values::by_pair(text, true).ok_or_else(bad)
 }
 
 fn write_json<T: serde::Serialize>(path: Option<&str>, value: &T) -> Result<(), CliError> {

@@ -385,28 +385,17 @@ pub fn run(args: HandeyeArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `--tcp X,Y,Z` with a unit (mm, cm or m) on the last number or on each.
+/// `--tcp X,Y,Z` with a unit (mm, cm or m) on the last number, in metres.
 fn parse_tcp(text: &str) -> Result<[f64; 3], CliError> {
-    let bad = |why: &str| CliError::usage("handeye", format!("--tcp '{text}': {why}"));
-    let t = text.trim();
-    let (body, scale) = if let Some(b) = t.strip_suffix("mm") {
-        (b, 1e-3)
-    } else if let Some(b) = t.strip_suffix("cm") {
-        (b, 1e-2)
-    } else if let Some(b) = t.strip_suffix('m') {
-        (b, 1.0)
-    } else {
-        return Err(bad("needs a unit: mm, cm or m (e.g. 0,0,150mm)"));
+    let flag = super::values::LengthsFlag {
+        command: "handeye",
+        flag: "--tcp",
+        count: 3,
+        expected: "expected three numbers X,Y,Z",
+        unit_example: " (e.g. 0,0,150mm)",
     };
-    let v: Vec<f64> = body
-        .split(',')
-        .map(|s| s.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| bad("expected three numbers X,Y,Z"))?;
-    match v.as_slice() {
-        [x, y, z] if v.iter().all(|a| a.is_finite()) => Ok([x * scale, y * scale, z * scale]),
-        _ => Err(bad("expected three numbers X,Y,Z")),
-    }
+    let v = super::values::lengths_m(&flag, text)?;
+    Ok([v[0], v[1], v[2]])
 }
 
 /// The report's field answers, one line each (standard error).

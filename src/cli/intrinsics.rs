@@ -115,11 +115,7 @@ fn parse_knots(text: &str) -> Result<[usize; 2], CliError> {
             format!("--spline-knots takes NXxNY, e.g. 12x8, got '{text}'"),
         )
     };
-    let (x, y) = text.split_once(['x', 'X']).ok_or_else(bad)?;
-    Ok([
-        x.trim().parse().map_err(|_| bad())?,
-        y.trim().parse().map_err(|_| bad())?,
-    ])
+    super::values::by_pair(text, true).ok_or_else(bad)
 }
 
 pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {

@@ -33,6 +33,7 @@ mod robot_poses;
 mod serve;
 mod stereo;
 mod target;
+mod values;
 mod xytable;
 
 pub use input::{read_pose_text, read_text};

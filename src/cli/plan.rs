@@ -111,26 +111,15 @@ pub struct PlanArgs {
 
 /// Numbers separated by commas with one unit (mm, cm or m) at the end.
 fn lengths(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, CliError> {
-    let bad = |why: &str| CliError::usage("plan", format!("{flag} '{text}': {why}"));
-    let t = text.trim();
-    let (body, scale) = if let Some(b) = t.strip_suffix("mm") {
-        (b, 1e-3)
-    } else if let Some(b) = t.strip_suffix("cm") {
-        (b, 1e-2)
-    } else if let Some(b) = t.strip_suffix('m') {
-        (b, 1.0)
-    } else {
-        return Err(bad("needs a unit: mm, cm or m"));
+    let expected = format!("expected {count} numbers");
+    let flag = super::values::LengthsFlag {
+        command: "plan",
+        flag,
+        count,
+        expected: &expected,
+        unit_example: "",
     };
-    let v: Vec<f64> = body
-        .split(',')
-        .map(|s| s.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| bad(&format!("expected {count} numbers")))?;
-    if v.len() != count || v.iter().any(|a| !a.is_finite()) {
-        return Err(bad(&format!("expected {count} numbers")));
-    }
-    Ok(v.iter().map(|a| a * scale).collect())
+    super::values::lengths_m(&flag, text)
 }
 
 fn one_pose(flag: &str, path: &str) -> Result<Pose, CliError> {

@@ -35,8 +35,7 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), CliError> {
             format!("--size expects WIDTHxHEIGHT with even sides up to 3840x2160 (e.g. 640x480 or 1280x720), got '{text}'"),
         )
     };
-    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    let [w, h]: [u32; 2] = super::values::by_pair(text, false).ok_or_else(bad)?;
     if w < 64 || h < 48 || w > 3840 || h > 2160 || w % 2 != 0 || h % 2 != 0 {
         return Err(bad());
     }

@@ -35,7 +35,10 @@
 //! the [`closed_form`] solvers, picks the primary solution, then the
 //! refinements of [`refine`] (over the poses by default, over the pixels of
 //! the image path), and it alone writes the [`HandEyeResult`]: the refiners
-//! return what they found. [`quality`] measures the result (closure
+//! return what they found. What a calibration takes is [`input`], what it
+//! produces [`result`]: the stages read them without importing the
+//! orchestrator (no import cycle among the files, checked by
+//! src/architecture_tests.rs). [`quality`] measures the result (closure
 //! residuals, repeatability, whether the reported uncertainty can be
 //! trusted) and catches input mistakes; [`report`] is the JSON report.
 //! [`rig`] solves a whole camera rig's transform (`gripper_from_rig`,
@@ -44,11 +47,13 @@
 //! the robot poses of a calibration and predicts the error they reach.
 
 pub mod closed_form;
+pub mod input;
 pub mod math;
 pub mod plan;
 pub mod quality;
 pub mod refine;
 pub mod report;
+pub mod result;
 pub mod rig;
 pub mod solve;
 
@@ -59,6 +64,10 @@ pub mod solve;
 /// have 10 to a few hundred poses.
 pub const MAX_POSES: usize = 1000;
 
+/// Fewest pose pairs hand-eye calibration accepts (the gross-error check
+/// of [`quality::gross`] needs one more).
+pub const MIN_POSES: usize = 3;
+
 #[cfg(test)]
 mod solver_tests;
 
@@ -66,7 +75,9 @@ use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 pub use closed_form::motion::{Motion, MotionPairs};
-pub use solve::{calibrate, HandEyeInput, HandEyeOptions, HandEyeResult};
+pub use input::{HandEyeInput, HandEyeOptions};
+pub use result::{HandEyeResult, MethodResult};
+pub use solve::calibrate;
 
 pub use crate::geometry::Pose;
 

@@ -9,10 +9,9 @@ use crate::handeye::quality::repeat::Repeatability;
 use crate::handeye::quality::residuals::{Errors, MotionResidual, ViewResidual};
 use crate::handeye::quality::verify::{HoldoutReport, TouchReport};
 use crate::handeye::quality::work_point::{work_point_error, WorkPointError};
-use crate::handeye::refine::over_pixels::RefinementSummary;
+use crate::handeye::refine::pixel_summary::RefinementSummary;
 use crate::handeye::refine::pose_summary::PoseRefinementSummary;
-use crate::handeye::solve::HandEyeResult;
-use crate::handeye::{Pose, Setup};
+use crate::handeye::{HandEyeResult, Pose, Setup};
 use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 

@@ -6,14 +6,14 @@
 use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::handeye::closed_form::motion::{build_motions, motion_stats, MotionStats};
-use crate::handeye::closed_form::{axxb, axzb, scara};
+use crate::handeye::closed_form::motion::{build_motions, motion_stats};
+use crate::handeye::closed_form::{estimate_target, scara, solve_with_motions};
 use crate::handeye::quality::checks;
 use crate::handeye::quality::focal::check_focal;
-use crate::handeye::quality::repeat::{repeatability, Repeatability};
+use crate::handeye::quality::repeat::repeatability;
 use crate::handeye::quality::residuals::{
-    combined_score_mm, errors, estimate_target, lever_arm_m, motion_residuals, pose_difference,
-    view_residuals, Errors, MotionResidual, ViewResidual,
+    combined_score_mm, errors, lever_arm_m, motion_residuals, pose_difference, view_residuals,
+    Errors,
 };
 use crate::handeye::refine::over_pixels::{
     refine_over_pixels, reprojection_rms_per_view_px, RefineMode,
@@ -22,145 +22,18 @@ use crate::handeye::refine::over_poses::{
     camera_noise_from_views, refine_over_poses, PoseFindings,
 };
 use crate::handeye::refine::pose_noise::CameraNoise;
-use crate::handeye::{Chain, HandEyeMethod, Motion, MotionPairs, Pose, Setup};
+use crate::handeye::{Chain, HandEyeMethod, Motion, MotionPairs, Pose};
 use nalgebra::Vector3;
 
-/// Default number of bootstrap resamples.
-pub const DEFAULT_BOOTSTRAP_SAMPLES: usize = 100;
-
-/// What to solve: the setup and the paired poses (metres).
-#[derive(Debug, Clone)]
-pub struct HandEyeInput {
-    /// Camera on the gripper or fixed in the world.
-    pub setup: Setup,
-    /// Robot poses, one per view.
-    pub base_from_gripper: Vec<Pose>,
-    /// Target poses seen by the camera, one per view, paired with the robot poses.
-    pub camera_from_target: Vec<Pose>,
-}
-
-/// Tunables, with defaults from [`HandEyeOptions::default`].
-#[derive(Debug, Clone)]
-pub struct HandEyeOptions {
-    /// Methods to run (default: all eight).
-    pub methods: Vec<HandEyeMethod>,
-    /// Which view pairs become AX = XB motions (default: all pairs).
-    pub motion_pairs: MotionPairs,
-    /// Input mistakes (units, inverted poses, shifted pairing) are errors
-    /// when true (default), warnings when false.
-    pub strict_checks: bool,
-    /// Bootstrap resamples for repeatability (default
-    /// [`DEFAULT_BOOTSTRAP_SAMPLES`]; 0 disables leave-one-out and bootstrap).
-    pub bootstrap_samples: usize,
-    /// Seed of the bootstrap resampling.
-    pub seed: u64,
-    /// Refine the closed forms by the maximum-likelihood pose refinement
-    /// ([`crate::handeye::refine::over_poses`]; default true). The image path turns it off
-    /// and refines over image points instead.
-    pub refine_poses: bool,
-}
-
-impl Default for HandEyeOptions {
-    fn default() -> Self {
-        HandEyeOptions {
-            methods: HandEyeMethod::ALL.to_vec(),
-            motion_pairs: MotionPairs::All,
-            strict_checks: true,
-            bootstrap_samples: DEFAULT_BOOTSTRAP_SAMPLES,
-            seed: 1,
-            refine_poses: true,
-        }
-    }
-}
-
-/// One solver's outcome.
-#[derive(Debug, Clone)]
-pub struct MethodResult {
-    /// The solver.
-    pub method: HandEyeMethod,
-    /// `(x, y, errors)` or why the solver failed.
-    pub outcome: std::result::Result<(Pose, Pose, Errors), Error>,
-    /// Distance of `x` from the primary solution: (mm, degrees).
-    pub disagreement: Option<(f64, f64)>,
-    /// Robust cost of this solution under the pose refinement's noise
-    /// model, when the pose refinement ran.
-    pub pose_cost: Option<f64>,
-}
-
-/// Everything a calibration produces (serialise with
-/// [`crate::handeye::report::HandEyeReport::new`]).
-#[derive(Debug, Clone)]
-pub struct HandEyeResult {
-    /// The setup solved.
-    pub setup: Setup,
-    /// Name of the solution reported as primary (a method name, or `scara`).
-    pub method: String,
-    /// `gripper_from_camera` (eye-in-hand) or `base_from_camera` (eye-to-hand).
-    pub x: Pose,
-    /// `base_from_target` (eye-in-hand) or `gripper_from_target` (eye-to-hand).
-    pub y: Pose,
-    /// Summary errors of the primary solution.
-    pub errors: Errors,
-    /// Per-view residuals of the primary solution.
-    pub per_view: Vec<ViewResidual>,
-    /// Per-motion residuals of the primary solution.
-    pub per_motion: Vec<MotionResidual>,
-    /// Motion diversity.
-    pub motion: MotionStats,
-    /// Every requested solver.
-    pub methods: Vec<MethodResult>,
-    /// Unit directions (frame of `x`'s left side) along which the translation
-    /// of `x` is unobservable.
-    pub unobservable_translation: Vec<Vector3<f64>>,
-    /// Leave-one-out and bootstrap, when requested.
-    pub repeatability: Option<Repeatability>,
-    /// Everything the user should know.
-    pub warnings: Vec<String>,
-    /// The image-based refinement, when run
-    /// ([`crate::handeye::refine::over_pixels::apply_refinement`]).
-    pub refinement: Option<crate::handeye::refine::over_pixels::RefinementSummary>,
-    /// The pose refinement, when run ([`crate::handeye::refine::over_poses`]).
-    pub pose_refinement: Option<crate::handeye::refine::pose_summary::PoseRefinementSummary>,
-}
-
-/// Solve one method on a chain; returns `(x, y, unobservable directions)`.
-pub fn solve_method(
-    method: HandEyeMethod,
-    chain: &Chain,
-    pairs: MotionPairs,
-) -> Result<(Pose, Pose, Vec<Vector3<f64>>)> {
-    if method.is_axzb() {
-        return solve_with_motions(method, chain, &[]);
-    }
-    solve_with_motions(method, chain, &build_motions(chain, pairs).kept)
-}
-
-/// [`solve_method`] with the chain's motions built once by the caller
-/// (unused by the AX = ZB methods): at 1,000 poses each build is half a
-/// million motions.
-fn solve_with_motions(
-    method: HandEyeMethod,
-    chain: &Chain,
-    motions: &[Motion],
-) -> Result<(Pose, Pose, Vec<Vector3<f64>>)> {
-    if method.is_axzb() {
-        let (x, y) = axzb::solve(method, chain)?;
-        return Ok((x, y, Vec::new()));
-    }
-    let (x, unobservable) = axxb::solve(method, motions)?;
-    let y = estimate_target(chain, &x)?;
-    Ok((x, y, unobservable))
-}
+// The paths `handeye::solve::{HandEyeInput, ...}` of before the split stay.
+pub use crate::handeye::input::{HandEyeInput, HandEyeOptions, DEFAULT_BOOTSTRAP_SAMPLES};
+pub use crate::handeye::result::{HandEyeResult, MethodResult};
 
 /// Calibrate: check the input, run every requested method, pick the one
 /// with the smallest combined closure residual as primary, report.
 pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandEyeResult> {
     // 1. Input checks and mistakes, before any solving.
-    let chain = Chain::new(
-        input.setup,
-        &input.base_from_gripper,
-        &input.camera_from_target,
-    )?;
+    let chain = input.chain()?;
     let mut warnings = checks::check_input(input, options)?;
     let set = build_motions(&chain, options.motion_pairs);
     let motion = motion_stats(&set);
@@ -213,7 +86,9 @@ pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandE
     }
     // 3. Every requested method; a failing one is reported, not fatal.
     let mut methods = Vec::new();
-    let mut best: Option<(f64, usize, Pose, Pose, Vec<Vector3<f64>>)> = None;
+    // (score, index, x, y, unobservable directions) of the best so far.
+    type Best = (f64, usize, Pose, Pose, Vec<Vector3<f64>>);
+    let mut best: Option<Best> = None;
     for (i, &method) in options.methods.iter().enumerate() {
         let outcome = solve_with_motions(method, &chain, &set.kept).map(|(x, y, u)| {
             let e = errors(&view_residuals(&chain, &x, &y));
@@ -307,11 +182,7 @@ fn with_pose_refinement(
         // The refinement did not run: the closed form's repeatability.
         if result.pose_refinement.is_none() && resampling.is_some() {
             if let Ok(method) = result.method.parse::<HandEyeMethod>() {
-                let chain = Chain::new(
-                    input.setup,
-                    &input.base_from_gripper,
-                    &input.camera_from_target,
-                )?;
+                let chain = input.chain()?;
                 result.repeatability =
                     Some(repeatability(&chain, method, options, &result.x, &result.y));
             }
@@ -368,11 +239,7 @@ pub fn apply_refinement(
     let Some(refined) = found.refined else {
         return Ok(());
     };
-    let chain = Chain::new(
-        input.setup,
-        &input.base_from_gripper,
-        &input.camera_from_target,
-    )?;
+    let chain = input.chain()?;
     let method = format!("refined from {}", refined.summary.started_from);
     make_primary(
         result,
@@ -463,11 +330,7 @@ fn add_reprojection_rms(
     let Some(summary) = result.pose_refinement.as_mut() else {
         return Ok(());
     };
-    let chain = Chain::new(
-        input.setup,
-        &input.base_from_gripper,
-        &input.camera_from_target,
-    )?;
+    let chain = input.chain()?;
     let closed_form = result
         .methods
         .iter()
@@ -536,11 +399,7 @@ fn write_pose_findings(
     let Some(refined) = found.refined else {
         return Ok(());
     };
-    let chain = Chain::new(
-        input.setup,
-        &input.base_from_gripper,
-        &input.camera_from_target,
-    )?;
+    let chain = input.chain()?;
     let built;
     let motions = match motions {
         Some(kept) => kept,

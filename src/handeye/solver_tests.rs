@@ -1,8 +1,9 @@
 //! Solver accuracy on seeded synthetic scenes and the exact degeneracy and
 //! mistake messages.
 
+use crate::handeye::closed_form::solve_method;
 use crate::handeye::quality::residuals::pose_difference;
-use crate::handeye::solve::{calibrate, solve_method, HandEyeInput, HandEyeOptions};
+use crate::handeye::{calibrate, HandEyeInput, HandEyeOptions};
 use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
 use crate::synth::handeye::{handeye_scene, HandEyeScene, HandEyeSceneConfig};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};

@@ -3,7 +3,7 @@
 //! Conventions converted here (see the crate's conventions): OpenCV, ROS,
 //! Kalibr and mrcal share ours (pixel centres at integer coordinates, so the
 //! principal point is written as is); MATLAB is 1-based (principal point
-//! + 1) and stores the transposed camera matrix; Halcon's camera parameters
+//! plus 1) and stores the transposed camera matrix; Halcon's camera parameters
 //! are metric (focal length and pixel size in metres, distortion scaled by
 //! powers of the focal length) with the principal point in pixels.
 

@@ -27,10 +27,14 @@ pub(super) fn kalibr_camera(c: &Camera, name: &str) -> Result<String> {
     }
     let (camera_model, mut intrinsics, distortion_model, coeffs) = match c.distortion {
         Distortion::None => ("pinhole", vec![], "none", vec![]),
-        Distortion::Brown { k1, k2, k3, p1, p2 } if k3 == 0.0 => {
-            ("pinhole", vec![], "radtan", vec![k1, k2, p1, p2])
-        }
-        Distortion::RadialK1K2K5 { k1, k2, k5 } if k5 == 0.0 => {
+        Distortion::Brown {
+            k1,
+            k2,
+            k3: 0.0,
+            p1,
+            p2,
+        } => ("pinhole", vec![], "radtan", vec![k1, k2, p1, p2]),
+        Distortion::RadialK1K2K5 { k1, k2, k5: 0.0 } => {
             ("pinhole", vec![], "radtan", vec![k1, k2, 0.0, 0.0])
         }
         Distortion::KannalaBrandt { k1, k2, k3, k4 } => {

@@ -241,8 +241,8 @@ pub fn export_transform(pose: &Pose, names: &FrameNames, format: TransformFormat
             "# {label} (ROS 1): x y z (m) qx qy qz qw parent child\nrosrun tf2_ros static_transform_publisher {}\n",
             ros1_args(pose, names)
         ),
-        TransformFormat::Ros1Launch => ros1_launch(&label, &ros1_args(pose, names), names),
-        TransformFormat::Ros2Launch => ros2_launch(&label, &ros2_args(pose, names), names),
+        TransformFormat::Ros1Launch => ros1_launch(label, &ros1_args(pose, names), names),
+        TransformFormat::Ros2Launch => ros2_launch(label, &ros2_args(pose, names), names),
         TransformFormat::UrPose => {
             let r = rotvec_from_rotation(&pose.rotation);
             let v = fixed(&[xyz[0], xyz[1], xyz[2], r.x, r.y, r.z], 6);

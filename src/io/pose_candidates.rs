@@ -174,7 +174,7 @@ fn rank(table: &Table, readings: &[Reading], options: &PoseFileOptions) -> Resul
         }
     }
     if out.is_empty() {
-        return Err(first_error.unwrap_or_else(|| no_poses()));
+        return Err(first_error.unwrap_or_else(no_poses));
     }
     // Equal penalties: the order of PoseFormat::all() (vendor presets first).
     let all = PoseFormat::all();

@@ -249,13 +249,13 @@ pub fn pair_poses(
         ));
     }
     let mut twice = Vec::new();
-    for k in 0..images.len() {
+    for (k, image) in images.iter().enumerate() {
         let rows: Vec<String> = (0..image_of_pose.len())
             .filter(|&i| image_of_pose[i] == k)
             .map(|i| row(i).to_string())
             .collect();
         if rows.len() > 1 {
-            twice.push(format!("rows {} all name '{}'", rows.join(", "), images[k]));
+            twice.push(format!("rows {} all name '{}'", rows.join(", "), image));
         }
     }
     if !twice.is_empty() {

@@ -565,8 +565,9 @@ fn header_units_and_names_say_the_convention() {
     )
     .unwrap();
     assert!(
-        (small.poses[0].base_from_gripper.rotation.angle() - 1.5707963267948966f64.to_radians())
-            .abs()
+        (small.poses[0].base_from_gripper.rotation.angle()
+            - std::f64::consts::FRAC_PI_2.to_radians())
+        .abs()
             < 1e-12
     );
 }

@@ -107,8 +107,7 @@ impl Albedo {
                 square_m,
             } => {
                 let (i, j) = ((x / square_m).floor() as i64, (y / square_m).floor() as i64);
-                let on_squares =
-                    i >= -1 && j >= -1 && i <= *cols as i64 - 1 && j <= *rows as i64 - 1;
+                let on_squares = i >= -1 && j >= -1 && i < *cols as i64 && j < *rows as i64;
                 if on_squares && (i + j).rem_euclid(2) == 0 {
                     self.black
                 } else {

@@ -133,7 +133,7 @@ fn bad_input_is_refused_clearly() {
     );
     // More positions than the bound: refused before any solving.
     let mut req = request(&mut || 0.0);
-    let one = req.observations[0].clone();
+    let one = req.observations[0];
     req.observations = vec![one; MAX_POSITIONS + 1];
     assert_eq!(
         solve_xytable(&req).unwrap_err().to_string(),

@@ -8,10 +8,10 @@ use support::{dataset, robocal, temp_dir};
 use robocal::synth::Scene;
 use robocal::Camera;
 use serde_json::{json, Value};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A `robocal detect` output for a noise-free scene, plus one failed image.
-fn detections_file(dir: &PathBuf) -> (PathBuf, Camera) {
+fn detections_file(dir: &Path) -> (PathBuf, Camera) {
     let truth = Camera::example_brown();
     let scene = Scene::calibration(11, &truth, (9, 6), 0.03, 6, 0.0).expect("scene");
     let mut images: Vec<Value> = scene

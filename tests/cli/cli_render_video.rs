@@ -94,12 +94,9 @@ fn a_chessboard_video_plays_the_truth_frame_by_frame() {
         let first = hold["first_frame"].as_u64().unwrap() as usize;
         let last = hold["last_frame"].as_u64().unwrap() as usize;
         assert_eq!(last, first + 1);
-        for i in first..=last {
-            assert_eq!(truth_frames[i]["hold"].as_u64(), Some(k as u64));
-            assert_eq!(
-                truth_frames[i]["camera_from_target"],
-                hold["camera_from_target"]
-            );
+        for frame in &truth_frames[first..=last] {
+            assert_eq!(frame["hold"].as_u64(), Some(k as u64));
+            assert_eq!(frame["camera_from_target"], hold["camera_from_target"]);
         }
         assert!(truth_frames[last + 1..]
             .first()

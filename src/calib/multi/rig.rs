@@ -207,7 +207,7 @@ pub fn calibrate_rig(
         &names,
     );
     if let (Some(c), Some(spread)) = (covariance_global.as_mut(), &spread) {
-        for k in 0..cameras.len() {
+        for (k, name) in names.iter().enumerate() {
             let Some(o) = problem.pose_offset(k) else {
                 continue;
             };
@@ -231,7 +231,7 @@ pub fn calibrate_rig(
                      moved, a board that bends, a camera that moved between frames); its std \
                      is widened to that spread. Hold the board still for each frame or trigger \
                      the cameras together",
-                    names[k], spread.runs
+                    name, spread.runs
                 ));
             }
         }

@@ -21,7 +21,7 @@ use super::rig_graph::{co_observation_counts, spanning_tree};
 use super::rig_problem::{RigProblem, Sighting};
 use crate::calib::refine::CalibProblem;
 use crate::geometry::{rotvec_from_rotation, Pose};
-use crate::optim::{solve, BlockParams, LmOptions, LmResult};
+use crate::optim::{solve, BlockParams, BlockProblem, LmOptions, LmResult};
 
 /// Most groups of frames left out (one refit each).
 pub const MAX_GROUPS: usize = 20;
@@ -64,7 +64,7 @@ pub(crate) fn leave_frames_out<'a>(
     let mut deltas: Vec<Vec<[f64; 6]>> = vec![Vec::new(); n_cameras];
     let mut runs = 0;
     for g in 0..groups {
-        let keep: Vec<usize> = (0..n_frames).filter(|f| f % groups != g).collect();
+        let keep = kept_without_group(n_frames, groups, g);
         let frames: Vec<Vec<Sighting>> = keep.iter().map(|&f| problem.frames[f].clone()).collect();
         // The refit must still tie every camera to the rig.
         let mut frames_of = vec![Vec::new(); n_cameras];
@@ -88,27 +88,13 @@ pub(crate) fn leave_frames_out<'a>(
             rig_camera: problem.rig_camera,
             frames,
         };
-        let start = BlockParams {
-            global: full.params.global.clone(),
-            blocks: keep
-                .iter()
-                .map(|&f| full.params.blocks[f].clone())
-                .collect(),
-        };
-        let options = LmOptions {
-            max_iterations: ITERATIONS,
-            fixed_blocks: Vec::new(),
-            ..lm.clone()
-        };
-        let Ok(refit) = solve(&sub, &start, &options) else {
+        let Some(refit) = refit_from_full(&sub, full, &keep, lm) else {
             continue;
         };
         runs += 1;
         for (k, d) in deltas.iter_mut().enumerate() {
             let pose = sub.camera_from_rig(&refit.params.global, k);
-            let r = rotvec_from_rotation(&(pose.rotation * full_poses[k].rotation.inverse()));
-            let t = pose.translation.vector - full_poses[k].translation.vector;
-            d.push([r.x, r.y, r.z, t.x, t.y, t.z]);
+            d.push(pose_delta(&pose, &full_poses[k]));
         }
     }
     if runs < MIN_GROUPS {
@@ -116,6 +102,44 @@ pub(crate) fn leave_frames_out<'a>(
     }
     let std = deltas.iter().map(|d| jackknife_std(d)).collect();
     Some(FrameSpread { std, runs })
+}
+
+/// The indices of `n` items kept when group `g` of `groups` (every
+/// `groups`-th item from `g`) is left out.
+pub(crate) fn kept_without_group(n: usize, groups: usize, g: usize) -> Vec<usize> {
+    (0..n).filter(|i| i % groups != g).collect()
+}
+
+/// `sub`, the problem over the items `keep`, refit from the full
+/// solution's global parameters and the blocks of `keep`, for at most
+/// [`ITERATIONS`] steps; `None` when the solver fails.
+pub(crate) fn refit_from_full(
+    sub: &dyn BlockProblem,
+    full: &LmResult,
+    keep: &[usize],
+    lm: &LmOptions,
+) -> Option<LmResult> {
+    let start = BlockParams {
+        global: full.params.global.clone(),
+        blocks: keep
+            .iter()
+            .map(|&i| full.params.blocks[i].clone())
+            .collect(),
+    };
+    let options = LmOptions {
+        max_iterations: ITERATIONS,
+        fixed_blocks: Vec::new(),
+        ..lm.clone()
+    };
+    solve(sub, &start, &options).ok()
+}
+
+/// How far `pose` is from `full`: `[rotation (left perturbation) rad x3,
+/// translation m x3]`.
+pub(crate) fn pose_delta(pose: &Pose, full: &Pose) -> [f64; 6] {
+    let r = rotvec_from_rotation(&(pose.rotation * full.rotation.inverse()));
+    let t = pose.translation.vector - full.translation.vector;
+    [r.x, r.y, r.z, t.x, t.y, t.z]
 }
 
 /// The delete-a-group jackknife std of each of six components over the

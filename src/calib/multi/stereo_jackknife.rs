@@ -9,16 +9,17 @@
 //!
 //! The pairs are left out group by group (every `groups`-th pair, at most
 //! [`MAX_GROUPS`] groups, at least [`MIN_GROUPS`]), each refit from the
-//! full solution for at most [`ITERATIONS`] steps; the jackknife variance
+//! full solution for at most [`ITERATIONS`](super::rig_jackknife::ITERATIONS) steps; the jackknife variance
 //! of right_from_left over the refits widens the reported std axis by
 //! axis where it is larger, and a factor beyond [`WARN_FACTOR`] is said.
 
-use super::rig_jackknife::{jackknife_std, ITERATIONS, MAX_GROUPS, MIN_GROUPS};
+use super::rig_jackknife::{
+    jackknife_std, kept_without_group, pose_delta, refit_from_full, MAX_GROUPS, MIN_GROUPS,
+};
 use super::stereo_problem::StereoProblem;
 use crate::calib::refine::CalibProblem;
 use crate::calib::View;
-use crate::geometry::rotvec_from_rotation;
-use crate::optim::{solve, BlockParams, LmOptions, LmResult};
+use crate::optim::{LmOptions, LmResult};
 
 pub(crate) use super::rig_jackknife::WARN_FACTOR;
 
@@ -38,7 +39,7 @@ pub(crate) fn leave_pairs_out(
     let full_rfl = problem.right_from_left(&full.params.global);
     let mut deltas = Vec::with_capacity(groups);
     for g in 0..groups {
-        let keep: Vec<usize> = (0..n_pairs).filter(|i| i % groups != g).collect();
+        let keep = kept_without_group(n_pairs, groups, g);
         let pick_views =
             |views: &[View]| -> Vec<View> { keep.iter().map(|&i| views[i].clone()).collect() };
         let pick_used = |used: &[Vec<bool>]| -> Vec<Vec<bool>> {
@@ -63,25 +64,11 @@ pub(crate) fn leave_pairs_out(
             n_left: problem.n_left,
             n_right: problem.n_right,
         };
-        let start = BlockParams {
-            global: full.params.global.clone(),
-            blocks: keep
-                .iter()
-                .map(|&i| full.params.blocks[i].clone())
-                .collect(),
-        };
-        let options = LmOptions {
-            max_iterations: ITERATIONS,
-            fixed_blocks: Vec::new(),
-            ..lm.clone()
-        };
-        let Ok(refit) = solve(&sub, &start, &options) else {
+        let Some(refit) = refit_from_full(&sub, full, &keep, lm) else {
             continue;
         };
         let rfl = sub.right_from_left(&refit.params.global);
-        let r = rotvec_from_rotation(&(rfl.rotation * full_rfl.rotation.inverse()));
-        let t = rfl.translation.vector - full_rfl.translation.vector;
-        deltas.push([r.x, r.y, r.z, t.x, t.y, t.z]);
+        deltas.push(pose_delta(&rfl, &full_rfl));
     }
     (deltas.len() >= MIN_GROUPS).then(|| (jackknife_std(&deltas), deltas.len()))
 }

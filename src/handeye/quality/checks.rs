@@ -8,13 +8,14 @@ use crate::error::{Error, Result};
 use crate::handeye::closed_form::axxb;
 use crate::handeye::closed_form::motion::build_motions;
 use crate::handeye::quality::residuals::{motion_residuals, motion_rms};
-use crate::handeye::solve::{HandEyeInput, HandEyeOptions};
-use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, Setup, MIN_MOTION_ROTATION_DEG};
+use crate::handeye::{
+    Chain, HandEyeInput, HandEyeMethod, HandEyeOptions, MotionPairs, Pose, Setup,
+    MIN_MOTION_ROTATION_DEG,
+};
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, SMatrix, Vector3, Vector4};
 use serde::{Deserialize, Serialize};
 
-/// Fewest pose pairs hand-eye calibration accepts.
-pub const MIN_POSES: usize = 3;
+pub use crate::handeye::MIN_POSES;
 /// Robot motions that translate less than this (m) count as "not moving".
 const MIN_TRANSLATION_M: f64 = 1e-3;
 /// An alternative reading of the input must fit this many times better than

@@ -4,10 +4,9 @@
 //! down-weight it and report a transform far off.
 
 use crate::error::{Error, Result};
-use crate::handeye::quality::checks::MIN_POSES;
+use crate::handeye::closed_form::solve_method;
 use crate::handeye::quality::residuals::{lever_arm_m, view_residuals, ViewResidual};
-use crate::handeye::solve::solve_method;
-use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose};
+use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, MIN_POSES};
 
 /// A pose pair is a gross error when, with it left out, its residual (the
 /// displacement at the target, mm) is this many times the median of the

@@ -9,7 +9,7 @@
 //! [`INTRINSIC_MOVE_ALERT_STD`] of them is named, with what it suggests.
 
 use crate::camera::Camera;
-use crate::handeye::solve::HandEyeResult;
+use crate::handeye::HandEyeResult;
 use std::collections::BTreeMap;
 
 /// A move of an intrinsic by more than this many of its calibrated standard

@@ -3,9 +3,9 @@
 //! summary errors and the standard deviation of every output parameter.
 
 use crate::error::Result;
+use crate::handeye::closed_form::solve_method;
 use crate::handeye::quality::residuals::{errors, pose_difference, view_residuals, Errors};
-use crate::handeye::solve::{solve_method, HandEyeOptions};
-use crate::handeye::{Chain, HandEyeMethod, Pose};
+use crate::handeye::{Chain, HandEyeMethod, HandEyeOptions, Pose};
 use crate::rng::Rng;
 use serde::{Deserialize, Serialize};
 

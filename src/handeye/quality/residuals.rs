@@ -2,8 +2,6 @@
 //! errors (seed 004's translation/rotation RMS and max), and the distance
 //! between two solutions.
 
-use crate::error::Result;
-use crate::handeye::math::mean_pose;
 use crate::handeye::{Chain, Motion, Pose};
 use serde::{Deserialize, Serialize};
 
@@ -57,15 +55,6 @@ pub fn pose_difference(a: &Pose, b: &Pose) -> (f64, f64) {
         (a.translation.vector - b.translation.vector).norm() * 1e3,
         d.rotation.angle().to_degrees(),
     )
-}
-
-/// The target pose `y` that best fits `x`: the mean of the per-view
-/// `robot[i] * x * camera[i]` (chordal rotation mean, mean translation).
-pub fn estimate_target(chain: &Chain, x: &Pose) -> Result<Pose> {
-    let implied: Vec<Pose> = (0..chain.len())
-        .map(|i| chain.implied_target(i, x))
-        .collect();
-    mean_pose(&implied)
 }
 
 /// Per-view closure residuals of a solution.

@@ -34,8 +34,7 @@ use crate::handeye::refine::pose_noise::NoiseModel;
 use crate::handeye::refine::pose_problem::{refine, PoseRefineOptions};
 use crate::handeye::refine::pose_residual::PoseMeasurement;
 use crate::handeye::refine::pose_summary::{transform_std, PoseRefinementSummary};
-use crate::handeye::solve::HandEyeInput;
-use crate::handeye::{Pose, Setup};
+use crate::handeye::{HandEyeInput, Pose, Setup};
 use nalgebra::{Matrix3, Point3, SMatrix, Vector3};
 
 /// The covariance is widened when the leave-one-out spread exceeds it by

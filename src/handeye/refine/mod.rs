@@ -19,6 +19,7 @@ pub mod noise_choice;
 pub mod over_pixels;
 pub mod over_poses;
 pub mod pixel_problem;
+pub mod pixel_summary;
 pub mod pose_noise;
 pub mod pose_problem;
 pub mod pose_resample;

@@ -5,13 +5,40 @@
 //! [`crate::handeye::refine::pose_shape`] (Akaike's criterion between them).
 
 use crate::error::Result;
-use crate::handeye::refine::over_poses::{board_pivot, pivot_levers};
 use crate::handeye::refine::pose_noise::{CameraNoise, NoiseModel, MIN_POSES_FOR_NOISE_ESTIMATE};
 use crate::handeye::refine::pose_problem::{estimate_noise, negative_log_likelihood};
 use crate::handeye::refine::pose_residual::PoseMeasurement;
 use crate::handeye::refine::pose_shape::{predicted_covariances, NominalTarget};
 use crate::handeye::{Pose, Setup};
 use nalgebra::Vector3;
+
+/// Where the camera looks on the target: the mean intersection of the
+/// optical axes with the target plane z = 0 (target frame), the pivot of
+/// the diagonal camera noise model ([`NoiseModel::pivot_levers`]). `None`
+/// when an axis is nearly parallel to the plane or the mean is not finite
+/// (then the target origin is the pivot).
+pub fn board_pivot(views: &[PoseMeasurement]) -> Option<Vector3<f64>> {
+    let mut sum = Vector3::zeros();
+    for m in views {
+        let target_from_camera = m.camera_from_target.inverse();
+        let origin = target_from_camera.translation.vector;
+        let axis = target_from_camera.rotation * Vector3::z();
+        if axis.z.abs() < 0.1 {
+            return None;
+        }
+        sum += origin - axis * (origin.z / axis.z);
+    }
+    let p = sum / views.len().max(1) as f64;
+    p.iter().all(|v| v.is_finite()).then_some(p)
+}
+
+/// `R_c p` per view for a pivot `p` (target frame).
+pub fn pivot_levers(views: &[PoseMeasurement], pivot: &Vector3<f64>) -> Vec<Vector3<f64>> {
+    views
+        .iter()
+        .map(|m| m.camera_from_target.rotation * pivot)
+        .collect()
+}
 
 /// A camera noise model with its levels fitted, and how it is reported.
 #[derive(Debug, Clone)]

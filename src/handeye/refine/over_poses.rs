@@ -17,6 +17,7 @@ use crate::calib::pnp::camera_from_target_with_covariance;
 use crate::calib::View;
 use crate::camera::Camera;
 use crate::error::Result;
+use crate::handeye::closed_form::solve_method;
 use crate::handeye::quality::repeat::{repeatability, Repeatability};
 use crate::handeye::quality::trust::{check_translation_scale, check_uncertainty};
 use crate::handeye::refine::noise_choice::choose_noise_model;
@@ -28,10 +29,9 @@ use crate::handeye::refine::pose_shape::NominalTarget;
 use crate::handeye::refine::pose_summary::{
     transform_std, NominalTargetReport, PoseRefinementSummary,
 };
-use crate::handeye::solve::{solve_method, HandEyeInput, HandEyeOptions, HandEyeResult};
-use crate::handeye::HandEyeMethod;
-use crate::handeye::{Chain, MotionPairs, Pose};
-use nalgebra::Vector3;
+use crate::handeye::{
+    Chain, HandEyeInput, HandEyeMethod, HandEyeOptions, HandEyeResult, MotionPairs, Pose,
+};
 
 /// The measurements of an input, in order.
 pub fn measurements(input: &HandEyeInput) -> Vec<PoseMeasurement> {
@@ -47,34 +47,6 @@ pub fn paired(base_from_gripper: &[Pose], camera_from_target: &[Pose]) -> Vec<Po
             base_from_gripper: *b,
             camera_from_target: *c,
         })
-        .collect()
-}
-
-/// Where the camera looks on the target: the mean intersection of the
-/// optical axes with the target plane z = 0 (target frame), the pivot of
-/// the diagonal camera noise model ([`NoiseModel::pivot_levers`]). `None`
-/// when an axis is nearly parallel to the plane or the mean is not finite
-/// (then the target origin is the pivot).
-pub fn board_pivot(views: &[PoseMeasurement]) -> Option<Vector3<f64>> {
-    let mut sum = Vector3::zeros();
-    for m in views {
-        let target_from_camera = m.camera_from_target.inverse();
-        let origin = target_from_camera.translation.vector;
-        let axis = target_from_camera.rotation * Vector3::z();
-        if axis.z.abs() < 0.1 {
-            return None;
-        }
-        sum += origin - axis * (origin.z / axis.z);
-    }
-    let p = sum / views.len().max(1) as f64;
-    p.iter().all(|v| v.is_finite()).then_some(p)
-}
-
-/// `R_c p` per view for a pivot `p` (target frame).
-pub fn pivot_levers(views: &[PoseMeasurement], pivot: &Vector3<f64>) -> Vec<Vector3<f64>> {
-    views
-        .iter()
-        .map(|m| m.camera_from_target.rotation * pivot)
         .collect()
 }
 

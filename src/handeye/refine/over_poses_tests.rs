@@ -186,11 +186,10 @@ fn an_outlier_pose_is_flagged_and_does_not_pull_the_estimate() {
     let mut input = noisy_input(&scene, &mut rng);
     // View 7's robot pose is 3 mm and 0.5 deg off (a wrong pose pairing
     // would be worse): about 30 sigma.
-    input.base_from_gripper[7] = input.base_from_gripper[7]
-        * Pose::from_parts(
-            Translation3::new(0.003, 0.0, 0.0),
-            UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.5f64.to_radians(), 0.0)),
-        );
+    input.base_from_gripper[7] *= Pose::from_parts(
+        Translation3::new(0.003, 0.0, 0.0),
+        UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.5f64.to_radians(), 0.0)),
+    );
     let result = calibrate(&input, &options()).unwrap();
     let s = result.pose_refinement.as_ref().unwrap();
     // View 7 is flagged far above the threshold; a good view may sit just

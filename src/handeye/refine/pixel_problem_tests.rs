@@ -3,9 +3,9 @@
 
 use crate::calib::View;
 use crate::camera::Camera;
+use crate::handeye::closed_form::solve_method;
 use crate::handeye::quality::residuals::pose_difference;
 use crate::handeye::refine::pixel_problem::{refine, RefineOptions, RobotNoise};
-use crate::handeye::solve::solve_method;
 use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, Setup};
 use crate::rng::Rng;
 use crate::synth::handeye::{project_grid, HandEyeScene};

@@ -34,8 +34,7 @@ use crate::handeye::refine::pose_problem::{
     in_basis, translation_basis, whitening, PoseRefineOptions, HUBER_SCALE,
 };
 use crate::handeye::refine::pose_residual::{linearise, perturb, PoseMeasurement};
-use crate::handeye::solve::HandEyeOptions;
-use crate::handeye::{Chain, MotionPairs, Pose, Setup};
+use crate::handeye::{Chain, HandEyeOptions, MotionPairs, Pose, Setup};
 use crate::optim::Loss;
 use nalgebra::{Matrix3, Matrix6, SMatrix, SVector, Vector3, Vector6};
 
@@ -269,7 +268,7 @@ mod tests {
             let b: Vec<Pose> = views.iter().map(|v| v.base_from_gripper).collect();
             let c: Vec<Pose> = views.iter().map(|v| v.camera_from_target).collect();
             let chain = Chain::new(setup, &b, &c).unwrap();
-            let (x0, y0, _) = crate::handeye::solve::solve_method(
+            let (x0, y0, _) = crate::handeye::closed_form::solve_method(
                 crate::handeye::HandEyeMethod::Shah,
                 &chain,
                 MotionPairs::All,
@@ -309,14 +308,14 @@ mod tests {
             // The spread of X over the runs (root-sum-square of the
             // deviations; leave-one-out with the jackknife scale).
             let n = views.len() as f64;
-            let spread =
-                |rows: &[((f64, f64), (f64, f64), (f64, f64))], pick: usize, scale: f64| {
-                    let ss = rows.iter().fold((0.0, 0.0), |a, r| {
-                        let d = [r.0, r.1, r.2][pick];
-                        (a.0 + d.0 * d.0, a.1 + d.1 * d.1)
-                    });
-                    ((scale * ss.0).sqrt(), (scale * ss.1).sqrt())
-                };
+            type Differences = ((f64, f64), (f64, f64), (f64, f64));
+            let spread = |rows: &[Differences], pick: usize, scale: f64| {
+                let ss = rows.iter().fold((0.0, 0.0), |a, r| {
+                    let d = [r.0, r.1, r.2][pick];
+                    (a.0 + d.0 * d.0, a.1 + d.1 * d.1)
+                });
+                ((scale * ss.0).sqrt(), (scale * ss.1).sqrt())
+            };
             let (loo, boot) = rows.split_at(views.len());
             let b = boot.len() as f64;
             let parts = [
