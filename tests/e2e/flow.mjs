@@ -107,7 +107,7 @@ export const tests = [
     assert.equal(await cellValue(page, '#camera-params', 'fx'), fx);
     await shot('reloaded');
   }],
-  ['plan robot poses for hand-eye on the demo', async (page, { url, shot }) => {
+  ['plan robot poses for hand-eye on the demo', async (page, { url, shot, browser }) => {
     await page.goto(url);
     await ready(page);
     await page.click('#demo-button');

@@ -116,7 +116,7 @@ function compactPlan(plan) {
   return {
     predicted: { bound95_mm: p.bound95_mm, rms_mm: p.rms_mm, verdict: p.verdict },
     poses: plan.poses.map((x) => ({
-      base_from_gripper: { translation_m: x.base_from_gripper.translation_m.map(round), quaternion_xyzw: x.base_from_gripper.quaternion_xyzw.map(round) },
+      base_from_gripper: { translation_m: x.base_from_gripper.translation_m.map((v) => round(v)), quaternion_xyzw: x.base_from_gripper.quaternion_xyzw.map((v) => round(v)) },
       tilt_deg: round(x.tilt_deg, PLAN_TABLE_DIGITS), distance_m: round(x.distance_m, PLAN_TABLE_DIGITS), roll_deg: round(x.roll_deg, PLAN_TABLE_DIGITS),
     })),
     travel_m: round(plan.travel_m),
