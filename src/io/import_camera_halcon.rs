@@ -12,8 +12,8 @@
 //! image plane in the undistorting direction:
 //! - division: `undistorted = distorted / (1 + Kappa r^2)`, robocal's
 //!   division model with `kappa = Kappa Focus^2` (exact);
-//! - polynomial: `u~ = u (1 + K1 r^2 + K2 r^4 + K3 r^6) + P1 (r^2 + 2 u^2)
-//!   + 2 P2 u v` (and `v~` alike, `P1`/`P2` swapped), also undistorting. No
+//! - polynomial: `u~ = u (1 + K1 r^2 + K2 r^4 + K3 r^6) +
+//!   P1 (r^2 + 2 u^2) + 2 P2 u v` (and `v~` alike, `P1`/`P2` swapped), also undistorting. No
 //!   robocal model runs that way, so a HALCON polynomial becomes the
 //!   Brown-Conrady model fitted to it over the image (linear least squares,
 //!   refused when the fit is off by more than [`POLYNOMIAL_FIT_MAX_PX`]).

@@ -107,7 +107,7 @@ export const tests = [
     assert.equal(await cellValue(page, '#camera-params', 'fx'), fx);
     await shot('reloaded');
   }],
-  ['plan robot poses for hand-eye on the demo', async (page, { url, shot }) => {
+  ['plan robot poses for hand-eye on the demo', async (page, { url, shot, browser }) => {
     await page.goto(url);
     await ready(page);
     await page.click('#demo-button');
@@ -178,7 +178,9 @@ export const tests = [
     const link = await page.inputValue('#share-link');
     const payload = JSON.parse(inflateRawSync(Buffer.from(link.split('#share=')[1], 'base64url')).toString('utf8'));
     assert.equal(payload.plan.result.poses.length, N);
-    assert.ok(link.length < 6500, `share link with the plan: ${link.length} characters`);
+    // The link without a plan keeps its 6,500 characters (tests/e2e/reports.mjs);
+    // the plan's poses add about 600, still far inside an 8 KB request line.
+    assert.ok(link.length < 7000, `share link with the plan: ${link.length} characters`);
     console.log(`     share link with the plan: ${link.length} characters`);
     const shared = await (await browser.newContext()).newPage();
     await shared.goto(link);

@@ -100,8 +100,27 @@ export function sharePayload(session, version) {
     workflows: compactResult(session.workflows),
     // The pose plan without its camera poses (no 3-D view on the shared
     // page) and the last check without its shift map: a few hundred bytes each.
-    plan: session.plan && session.plan.result ? { result: compactResult(session.plan.result), setup: session.plan.request && session.plan.request.setup } : null,
+    plan: session.plan && session.plan.result ? { result: compactPlan(session.plan.result), setup: session.plan.request && session.plan.request.setup } : null,
     check: session.check && session.check.result ? { name: session.check.name, result: compactCheck(session.check.result) } : null,
+  };
+}
+
+/** Significant digits of a shared plan's poses (10 µm on a metre; the table shows 0.01 mm) and of its angles and distances. */
+const PLAN_DIGITS = 5;
+const PLAN_TABLE_DIGITS = 4;
+
+/** A plan for a link: the predicted error, each pose's flange pose, tilt, distance and roll, the travel; not the camera poses, the motion statistics or the notes. */
+function compactPlan(plan) {
+  const round = (v, digits = PLAN_DIGITS) => Number(v.toPrecision(digits));
+  const p = plan.predicted;
+  return {
+    predicted: { bound95_mm: p.bound95_mm, rms_mm: p.rms_mm, verdict: p.verdict },
+    poses: plan.poses.map((x) => ({
+      base_from_gripper: { translation_m: x.base_from_gripper.translation_m.map((v) => round(v)), quaternion_xyzw: x.base_from_gripper.quaternion_xyzw.map((v) => round(v)) },
+      tilt_deg: round(x.tilt_deg, PLAN_TABLE_DIGITS), distance_m: round(x.distance_m, PLAN_TABLE_DIGITS), roll_deg: round(x.roll_deg, PLAN_TABLE_DIGITS),
+    })),
+    travel_m: round(plan.travel_m),
+    candidates: plan.candidates,
   };
 }
 
