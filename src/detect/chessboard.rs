@@ -17,8 +17,8 @@
 //!    90 degrees: use a board with `cols + rows` odd (e.g. 9x6) for
 //!    multi-view work.
 
-use super::lattice::{self, Cells, PointIndex};
 use super::edge_corner::{refine_by_edges, EdgeRoom};
+use super::lattice::{self, Cells, PointIndex};
 use super::refine::refine_saddle;
 use super::saddle::{self, Candidate};
 use super::DetectOptions;

@@ -58,7 +58,11 @@ fn radial_errors(optics: Option<Optics>) -> Vec<(f64, f64)> {
             ..RenderOptions::default()
         };
         let r = render(&cam, &target, &board_pose(&target, rpy, at), &o).unwrap();
-        assert_eq!(r.points.len(), target.point_count(), "view {k}: board in view");
+        assert_eq!(
+            r.points.len(),
+            target.point_count(),
+            "view {k}: board in view"
+        );
         let det = detect(&r.image, &target, &DetectOptions::default())
             .unwrap_or_else(|e| panic!("view {k}: {e}"));
         assert_eq!(det.points.len(), r.points.len(), "view {k}: every corner");
@@ -86,9 +90,11 @@ fn ring(errors: &[(f64, f64)], lo: f64, hi: f64) -> (f64, usize) {
     (sel.iter().sum::<f64>() / sel.len().max(1) as f64, sel.len())
 }
 
-/// Bounds on the mean radial error per ring, pixels (measured: see the test).
+/// Bounds on the mean radial error per ring, pixels: issue 42's goal
+/// (0.02 px) outside, half of it inside. Measured: inner -0.0014 px (125
+/// corners), middle -0.0034 (190), outer -0.0069 (35).
 const INNER_TOLERANCE_PX: f64 = 0.01;
-const OUTER_TOLERANCE_PX: f64 = 0.03;
+const OUTER_TOLERANCE_PX: f64 = 0.02;
 
 #[test]
 fn corners_under_edge_blur_have_no_radial_bias() {
@@ -106,7 +112,16 @@ fn corners_under_edge_blur_have_no_radial_bias() {
         "edge blur: mean radial error inner {inner:+.4} px ({n_inner}), middle \
          {middle:+.4} ({n_middle}), outer {outer:+.4} ({n_outer})"
     );
-    assert!(n_inner >= 20 && n_outer >= 20, "{n_inner} / {n_outer} corners");
-    assert!(inner.abs() < INNER_TOLERANCE_PX, "inner ring: {inner:+.4} px");
-    assert!(outer.abs() < OUTER_TOLERANCE_PX, "outer ring: {outer:+.4} px");
+    assert!(
+        n_inner >= 20 && n_outer >= 20,
+        "{n_inner} / {n_outer} corners"
+    );
+    assert!(
+        inner.abs() < INNER_TOLERANCE_PX,
+        "inner ring: {inner:+.4} px"
+    );
+    assert!(
+        outer.abs() < OUTER_TOLERANCE_PX,
+        "outer ring: {outer:+.4} px"
+    );
 }
