@@ -464,9 +464,10 @@ mod tests {
             let (n1, n2) = (Vector2::new(-0.3, 1.0), Vector2::new(1.0, 0.2));
             let hessian = n1 * n2.transpose() + n2 * n1.transpose();
             let start = Point2::new(x0 + 0.3, y0 - 0.2);
+            // Arms and profiles stay inside the 64 px image.
             let room = EdgeRoom {
-                step_px: 40.0,
-                depth_px: 20.0,
+                step_px: 24.0,
+                depth_px: 12.0,
             };
             let p = refine_by_edges(&img, start, &hessian, room).expect("a corner");
             let err = ((p.x - x0).powi(2) + (p.y - y0).powi(2)).sqrt();
