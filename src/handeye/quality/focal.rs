@@ -30,9 +30,9 @@ use crate::handeye::quality::trust::{pose_shift, MIN_LOO_VIEWS};
 use crate::handeye::refine::over_poses::refine_over_poses;
 use crate::handeye::refine::pixel_problem::{refine, RefineOptions};
 use crate::handeye::refine::pose_noise::CameraNoise;
-use crate::handeye::solve::{HandEyeInput, HandEyeResult};
+use crate::handeye::refine::pose_summary::FocalCheck;
+use crate::handeye::{HandEyeInput, HandEyeResult};
 use crate::handeye::{MotionPairs, Pose, Setup};
-use serde::{Deserialize, Serialize};
 
 /// The focal length is named as off when its fitted scale is more than
 /// this many of its jackknife std from 1 ...
@@ -52,21 +52,6 @@ pub struct FocalScale {
     pub scale: f64,
     /// Its jackknife std over the views.
     pub std: f64,
-}
-
-/// What [`check_focal`] found when the focal length disagrees with the
-/// robot: the report's `pose_refinement.focal_check` object.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FocalCheck {
-    /// The scale of fx and fy that fits the pixels through the robot poses.
-    pub scale: f64,
-    /// Its jackknife std over the views.
-    pub scale_std: f64,
-    /// How far the freed solution (camera poses from PnP with the scaled
-    /// focal length, pose refinement again) lies from the reported one:
-    /// (mm, degrees) of the camera transform; absent when that refit failed.
-    #[serde(skip_serializing_if = "Option::is_none", default)]
-    pub freed_moves: Option<[f64; 2]>,
 }
 
 /// The finding of [`check_focal`], for the orchestrator to write.

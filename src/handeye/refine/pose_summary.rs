@@ -2,7 +2,6 @@
 //! object, [`PoseRefinementSummary`]) and the per-axis standard deviations
 //! of a transform from its covariance.
 
-use crate::handeye::quality::focal::FocalCheck;
 use crate::handeye::quality::work_point::DefaultWorkPoint;
 use crate::handeye::refine::pose_noise::NoiseLevels;
 use crate::handeye::refine::pose_problem::Covariance12;
@@ -15,6 +14,21 @@ pub struct TransformStd {
     pub rotation_deg: [f64; 3],
     /// Std of `translation_m`'s x, y, z (mm).
     pub translation_mm: [f64; 3],
+}
+
+/// What [`crate::handeye::quality::focal::check_focal`] found when the focal length disagrees with the
+/// robot: the report's `pose_refinement.focal_check` object.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FocalCheck {
+    /// The scale of fx and fy that fits the pixels through the robot poses.
+    pub scale: f64,
+    /// Its jackknife std over the views.
+    pub scale_std: f64,
+    /// How far the freed solution (camera poses from PnP with the scaled
+    /// focal length, pose refinement again) lies from the reported one:
+    /// (mm, degrees) of the camera transform; absent when that refit failed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub freed_moves: Option<[f64; 2]>,
 }
 
 /// What the pose refinement did (the report's `pose_refinement` object).
