@@ -28,10 +28,10 @@ pub enum Distortion {
     /// The ideal pinhole camera.
     None,
     /// Brown-Conrady: radial k1 k2 k3 and tangential (decentering) p1 p2.
-    /// OpenCV's 5-coefficient model (order `k1 k2 p1 p2 k3`) and Halcon's
-    /// "polynomial" model (Halcon's K1..K3, P1, P2 scale with the focal
-    /// length in metres: `k1 = K1 f^2`, `k2 = K2 f^4`, `k3 = K3 f^6`,
-    /// `p1 = P2 f`, `p2 = P1 f`, with Halcon's (row, column) order).
+    /// OpenCV's 5-coefficient model (order `k1 k2 p1 p2 k3`). HALCON's
+    /// "polynomial" model has the same terms but maps distorted to
+    /// undistorted points, so its coefficients are fitted, not copied
+    /// (`crate::io`'s HALCON reader and export).
     Brown {
         /// r^2 radial coefficient.
         k1: f64,

@@ -6,6 +6,7 @@
 use super::export_camera::{
     float, k_row_major, list, unsupported, unsupported_listing, CameraExportInfo,
 };
+use super::import_camera_halcon::{undistorting_polynomial, FITTED_MARK, HALCON_EXPORT_MAX_PX};
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
 
@@ -141,23 +142,43 @@ pub(super) fn halcon(c: &Camera, info: &CameraExportInfo) -> Result<String> {
     let focus = c.fx * sx;
     let sy = focus / c.fy;
     let f2 = focus * focus;
+    // HALCON's polynomial maps distorted to undistorted image-plane points,
+    // Brown's the other way: the coefficients are fitted, not copied.
+    let mut fit_note = String::new();
     let (kind, distortion) = match c.distortion {
         Distortion::None => ("area_scan_division", vec![0.0]),
         Distortion::Division { kappa } => ("area_scan_division", vec![kappa / f2]),
-        Distortion::Brown { k1, k2, k3, p1, p2 } => (
-            "area_scan_polynomial",
-            vec![
-                k1 / f2,
-                k2 / (f2 * f2),
-                k3 / (f2 * f2 * f2),
-                p2 / focus,
-                p1 / focus,
-            ],
-        ),
-        Distortion::RadialK1K2K5 { k1, k2, k5 } => (
-            "area_scan_polynomial",
-            vec![k1 / f2, k2 / (f2 * f2), k5 / (f2 * f2 * f2), 0.0, 0.0],
-        ),
+        Distortion::Brown { .. } | Distortion::RadialK1K2K5 { .. } => {
+            let ([a1, a2, a3, q1, q2], worst_px) = undistorting_polynomial(c)?;
+            if !(worst_px <= HALCON_EXPORT_MAX_PX) {
+                return Err(Error::invalid(
+                    "format",
+                    format!(
+                        "HALCON's area_scan_polynomial maps distorted to undistorted points; the \
+                         nearest one to this {} model is off by {worst_px:.3} px in this image, \
+                         more than {HALCON_EXPORT_MAX_PX} px: calibrate with --model division \
+                         for HALCON, or export another format",
+                        c.distortion.model_name()
+                    ),
+                ));
+            }
+            fit_note = format!(
+                "* area_scan_polynomial {FITTED_MARK} image-plane points (HALCON's convention): \
+                 fitted to robocal's {} model over the image, worst {} px.\n",
+                c.distortion.model_name(),
+                float((worst_px * 1e4).ceil() / 1e4)
+            );
+            (
+                "area_scan_polynomial",
+                vec![
+                    a1 / f2,
+                    a2 / (f2 * f2),
+                    a3 / (f2 * f2 * f2),
+                    q1 / focus,
+                    q2 / focus,
+                ],
+            )
+        }
         Distortion::Rational { .. }
         | Distortion::KannalaBrandt { .. }
         | Distortion::Eucm { .. }
@@ -178,7 +199,7 @@ pub(super) fn halcon(c: &Camera, info: &CameraExportInfo) -> Result<String> {
         "Focus [m], K1, K2, K3, P1, P2, Sx [m], Sy [m], Cx [px], Cy [px], ImageWidth, ImageHeight"
     };
     Ok(format!(
-        "* robocal {}: Halcon camera parameters ({names}).\n* Sx is a nominal pixel size of {} m: only Focus/Sx is calibrated.\nCameraParam := ['{kind}', {}, {}, {}]\n",
+        "* robocal {}: Halcon camera parameters ({names}).\n* Sx is a nominal pixel size of {} m: only Focus/Sx is calibrated.\n{fit_note}CameraParam := ['{kind}', {}, {}, {}]\n",
         crate::VERSION,
         float(sx),
         list(&values),

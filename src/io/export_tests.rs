@@ -120,14 +120,18 @@ fn matlab_is_one_based_and_halcon_is_metric() {
     assert!(m.contains("principalPoint = [320.75, 242.125];"), "{m}");
     assert!(m.contains("imageSize = [480, 640];"), "{m}");
     let h = export_camera(&c, &CameraExportInfo::default(), CameraFormat::Halcon).unwrap();
-    // Focus = fx * 5 µm; K1 = k1 / Focus^2.
+    // Focus = fx * 5 µm; HALCON's K1 undistorts: about -k1 / Focus^2.
     let focus = 812.3456789 * 5e-6;
+    let start = format!("['area_scan_polynomial', {}, ", float(focus));
+    let at = h.find(&start).unwrap_or_else(|| panic!("{h}")) + start.len();
+    let big_k1: f64 = h[at..].split(',').next().unwrap().trim().parse().unwrap();
+    let first_order = 0.2286 / (focus * focus);
     assert!(
-        h.contains(&format!(
-            "['area_scan_polynomial', {}, {}, ",
-            float(focus),
-            float(-0.2286 / (focus * focus))
-        )),
+        (big_k1 - first_order).abs() < 0.3 * first_order,
+        "K1 {big_k1} vs {first_order}\n{h}"
+    );
+    assert!(
+        h.contains("maps distorted to undistorted image-plane points"),
         "{h}"
     );
 }
@@ -410,6 +414,16 @@ fn the_lens_model_table_names_the_formats_the_writers_accept() {
                 values[k] = 0.0;
                 camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
             }
+            if entry_fits(entry.copied()) {
+                // HALCON's polynomial fits a milder lens within its bound.
+                let values: Vec<f64> = camera
+                    .distortion
+                    .coefficients()
+                    .iter()
+                    .map(|c| c * 0.1)
+                    .collect();
+                camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
+            }
             let written = export_camera(&camera, &CameraExportInfo::default(), format).is_ok();
             assert_eq!(
                 written,
@@ -466,4 +480,12 @@ fn the_tilted_model_goes_to_opencv_with_14_coefficients_and_back() {
             "{format:?}: {err}"
         );
     }
+}
+
+/// A table entry whose format holds the model only where a fit is close
+/// enough (HALCON's undistorting polynomial).
+fn entry_fits<'a>(entry: impl Into<Option<&'a str>>) -> bool {
+    entry
+        .into()
+        .is_some_and(|e| e.ends_with("fitted within 0.25 px)"))
 }

@@ -17,17 +17,20 @@
 //!   robocal model runs that way, so a HALCON polynomial becomes the
 //!   Brown-Conrady model fitted to it over the image (linear least squares,
 //!   refused when the fit is off by more than [`POLYNOMIAL_FIT_MAX_PX`]).
-//!   robocal's own `halcon` export (its first comment line says so) writes
+//!   robocal's `halcon` export writes the undistorting polynomial fitted to
+//!   the camera's Brown model ([`undistorting_polynomial`], its header says
+//!   so) and reads it back like HALCON's own. Exports of robocal 0.1 before
+//!   that (a first comment line from robocal without the fit's words) held
 //!   Brown's coefficients scaled by powers of Focus (`K1 = k1 / Focus^2`,
-//!   `P1 = p2 / Focus`, `P2 = p1 / Focus`, see [`crate::camera::Distortion`])
-//!   and is read back with that exact mapping.
+//!   `P1 = p2 / Focus`, `P2 = p1 / Focus`): wrong for HALCON, and read back
+//!   with that exact mapping so that robocal's own camera comes back.
 //!
 //! Tilted, telecentric, hypercentric and line-scan cameras have no robocal
 //! model: an error names the type.
 
 use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{Point2, SMatrix, SVector};
 
 /// How far (pixels, anywhere in the image) the Brown-Conrady model fitted
 /// to a HALCON polynomial may be from it.
@@ -60,7 +63,7 @@ struct HalconParams {
 
 /// A camera from an HDevelop tuple or `gen_cam_par_area_scan_*` call.
 pub(super) fn from_halcon_tuple(text: &str) -> Result<Camera> {
-    let by_robocal = text.trim_start().starts_with("* robocal");
+    let by_robocal = is_old_robocal_export(text);
     // The first line holding the tuple (or the call), with its number.
     let Some((n, _)) = text.lines().enumerate().find(|(_, l)| {
         let l = l.trim_start();
@@ -470,4 +473,82 @@ fn brown_from_undistorting(camera: &Camera, c: [f64; 5]) -> Result<Distortion> {
         p1: k[3],
         p2: k[4],
     })
+}
+
+/// Whether a robocal `halcon` export holds Brown's own coefficients (the
+/// exports before HALCON's direction was honoured, read back with that
+/// mapping) rather than a fitted undistorting polynomial (whose header
+/// says [`FITTED_MARK`]).
+fn is_old_robocal_export(text: &str) -> bool {
+    text.trim_start().starts_with("* robocal") && !text.contains(FITTED_MARK)
+}
+
+/// How far (pixels, anywhere in the image) the undistorting polynomial
+/// robocal's `halcon` export writes may be from the camera's own model;
+/// beyond it the export is refused (the lens-model table says so).
+pub const HALCON_EXPORT_MAX_PX: f64 = 0.25;
+
+/// The words of the export's header that mark a fitted undistorting
+/// polynomial.
+pub(super) const FITTED_MARK: &str = "maps distorted to undistorted";
+
+/// HALCON's undistorting polynomial nearest (least squares over a grid of
+/// image points) to `camera`'s distorting model, in normalised units
+/// `[K1 f^2, K2 f^4, K3 f^6, P1 f, P2 f]`, with its worst error over the
+/// grid (pixels). What `robocal export --format halcon` writes for the
+/// Brown-Conrady and k1 k2 k5 models: HALCON maps distorted to undistorted
+/// points, robocal the other way, so no coefficient carries over as it is.
+pub(super) fn undistorting_polynomial(camera: &Camera) -> Result<([f64; 5], f64)> {
+    // Pairs (distorted, undistorted) in normalised coordinates.
+    let mut pairs = Vec::with_capacity(FIT_GRID * FIT_GRID);
+    for i in 0..FIT_GRID {
+        for j in 0..FIT_GRID {
+            let col = (camera.width as f64 - 1.0) * i as f64 / (FIT_GRID - 1) as f64;
+            let row = (camera.height as f64 - 1.0) * j as f64 / (FIT_GRID - 1) as f64;
+            let d = Point2::new((col - camera.cx) / camera.fx, (row - camera.cy) / camera.fy);
+            let u = camera.undistort_normalized(&d).map_err(|e| {
+                Error::invalid(
+                    "format",
+                    format!(
+                        "HALCON's polynomial could not be fitted: pixel ({col:.0}, {row:.0}) does \
+                         not undistort ({e})"
+                    ),
+                )
+            })?;
+            pairs.push((d, u));
+        }
+    }
+    // HALCON's undistorted - distorted is linear in (K1 f^2, ..., P2 f).
+    let rows = |d: &Point2<f64>| {
+        let (x, y) = (d.x, d.y);
+        let r2 = x * x + y * y;
+        let (r4, r6) = (r2 * r2, r2 * r2 * r2);
+        (
+            SVector::<f64, 5>::from([x * r2, x * r4, x * r6, r2 + 2.0 * x * x, 2.0 * x * y]),
+            SVector::<f64, 5>::from([y * r2, y * r4, y * r6, 2.0 * x * y, r2 + 2.0 * y * y]),
+        )
+    };
+    let mut normal = SMatrix::<f64, 5, 5>::zeros();
+    let mut rhs = SVector::<f64, 5>::zeros();
+    for (d, u) in &pairs {
+        let (jx, jy) = rows(d);
+        normal += jx * jx.transpose() + jy * jy.transpose();
+        rhs += jx * (u.x - d.x) + jy * (u.y - d.y);
+    }
+    let c = normal.cholesky().map(|ch| ch.solve(&rhs)).ok_or_else(|| {
+        Error::invalid(
+            "format",
+            "HALCON's polynomial could not be fitted (degenerate image size)",
+        )
+    })?;
+    let worst_px = pairs
+        .iter()
+        .map(|(d, u)| {
+            let (jx, jy) = rows(d);
+            let ex = d.x + jx.dot(&c) - u.x;
+            let ey = d.y + jy.dot(&c) - u.y;
+            (ex * camera.fx).hypot(ey * camera.fy)
+        })
+        .fold(0.0, f64::max);
+    Ok(([c[0], c[1], c[2], c[3], c[4]], worst_px))
 }

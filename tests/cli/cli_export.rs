@@ -27,9 +27,15 @@ fn export_writes_the_golden_bytes_to_stdout_and_files() {
         target.to_str().unwrap(),
     ]);
     assert_eq!((code, out.as_str()), (0, ""));
+    // The matrix, then its image size and the lens model it leaves out as
+    // comments (the golden file).
+    let written = std::fs::read_to_string(&target).unwrap();
+    assert!(written.starts_with(
+        "1000.5 0.0 640.25\n0.0 1001.75 479.5\n0.0 0.0 1.0\n# image_size_px: 1280 960\n"
+    ));
     assert_eq!(
-        std::fs::read_to_string(&target).unwrap(),
-        "1000.5 0.0 640.25\n0.0 1001.75 479.5\n0.0 0.0 1.0\n"
+        written,
+        std::fs::read_to_string(format!("{FIXTURES}/camera.K.txt")).unwrap()
     );
 }
 
