@@ -16,11 +16,6 @@ distance r from the principal point over the half-diagonal: centre r < 0.3,
 middle 0.3-0.6, outer r >= 0.6. bias = mean radial error; spread = RMS
 distance.
 
---board charuco (issue 42): the same rows on a ChArUco board,
-charuco:9x7:30mm:18mm:DICT_4X4_50 (8x6 inner corners, markers 0.6 of the
-square: a white margin of 6-7 px around each marker at these scales),
-robocal against OpenCV's CharucoDetector (its corners by id).
-
 --calib S: calibrations (brown, 5 coefficients) from 20 realistic views per
 seed, seeds 1..S: robocal intrinsics on robocal's corners, OpenCV
 calibrateCamera on its cornerSubPix corners; fx error against the truth
@@ -29,9 +24,6 @@ calibrateCamera on its cornerSubPix corners; fx error against the truth
 Usage (crate root; runs in benches/.venv, see benches/opencv_venv.py):
   cargo build --release --bin robocal
   python3 benches/corner_study.py [--views 200] [--rows all|name,...] [--calib 5]
-      [--board chessboard|charuco] [--robocal PATH] [--reuse-renders]
-
-Uses this python's cv2 when it is 4.14, else benches/.venv's.
 """
 import json
 import os
@@ -40,29 +32,12 @@ import sys
 
 from opencv_venv import ensure_venv
 
-
-def settle_opencv():
-    """This python's cv2 when it is 4.14, else benches/.venv's."""
-    try:
-        import cv2
-
-        if cv2.__version__.startswith("4.14"):
-            return
-    except ImportError:
-        pass
-    ensure_venv()
-
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 OUT = os.path.join(HERE, "out", "corner_study")
 ROBOCAL = os.path.join(ROOT, "target", "release", "robocal")
 TARGET = "chessboard:9x6:30mm"
 PATTERN = (9, 6)
-# --reuse-renders: keep a row's images when they were made with the same
-# arguments (comparing two robocal builds on the same renders).
-REUSE = False
-CHARUCO = "charuco:9x7:30mm:18mm:DICT_4X4_50"
 # A 640x480 camera with barrel distortion (the demo camera's coefficients).
 CAMERA = {"fx": 600.0, "fy": 600.0, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480,
           "distortion": {"k1": -0.18, "k2": 0.05, "p1": 0.0005, "p2": -0.0003, "k3": 0.0}}
@@ -73,7 +48,6 @@ ROWS = [
     ("ideal", []),
     ("gamma 2.2", ["--gamma", "2.2"]),
     ("lens blur", ["--defocus", "0.8", "--field-curvature", "1", "--astigmatism", "1.5", "--coma", "1.5"]),
-    ("edge blur", ["--defocus", "0.5", "--field-curvature", "1.5", "--astigmatism", "2", "--coma", "2"]),
     ("defocus + curvature", ["--defocus", "0.8", "--field-curvature", "1"]),
     ("coma 1.5", ["--coma", "1.5"]),
     ("astigmatism 1.5", ["--astigmatism", "1.5"]),
@@ -90,24 +64,18 @@ def run(cmd):
     subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
-def render(folder, views, seed, flags, target=TARGET):
+def render(folder, views, seed, flags):
     os.makedirs(folder, exist_ok=True)
     cam = os.path.join(OUT, "camera.json")
-    stamp = os.path.join(folder, "render-args.json")
-    args = [views, seed, target, flags]
-    if REUSE and os.path.exists(stamp) and json.load(open(stamp)) == args:
-        truth = json.load(open(os.path.join(folder, "truth.json")))
-        return truth, [os.path.join(folder, v["image"]) for v in truth["views"]]
     run([ROBOCAL, "render", "--out", folder, "--camera", cam, "--views", str(views), "--seed", str(seed),
-         "--target", target, "--noise", "1", *flags])
-    json.dump(args, open(stamp, "w"))
+         "--noise", "1", *flags])
     truth = json.load(open(os.path.join(folder, "truth.json")))
     files = [os.path.join(folder, v["image"]) for v in truth["views"]]
     return truth, files
 
 
-def robocal_points(files, det_path, target=TARGET):
-    run([ROBOCAL, "detect", "--target", target, "-o", det_path, *files])
+def robocal_points(files, det_path):
+    run([ROBOCAL, "detect", "--target", TARGET, "-o", det_path, *files])
     out = []
     for im in json.load(open(det_path))["images"]:
         d = im.get("detection")
@@ -129,22 +97,6 @@ def opencv_detectors():
         return c.reshape(-1, 2) if ok else None
 
     return {"cornerSubPix": classic, "findChessboardCornersSB": sb}
-
-
-def opencv_charuco():
-    """OpenCV's CharucoDetector on CHARUCO: {id: (x, y)} or None."""
-    import cv2
-
-    board = cv2.aruco.CharucoBoard((9, 7), 0.030, 0.018, cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50))
-    det = cv2.aruco.CharucoDetector(board)
-
-    def run_one(g):
-        corners, ids, _, _ = det.detectBoard(g)
-        if ids is None:
-            return None
-        return {int(i): (float(c[0][0]), float(c[0][1])) for i, c in zip(ids.ravel(), corners)}
-
-    return {"CharucoDetector": run_one}
 
 
 def match(found, truth_pts):
@@ -189,29 +141,25 @@ def summary(rows):
     return out
 
 
-def study(views, names, board):
+def study(views, names):
     import cv2
 
-    target = CHARUCO if board == "charuco" else TARGET
-    print(f"corner study: {views} views per row, 640x480, {target}, OpenCV {cv2.__version__}")
+    print(f"corner study: {views} views per row, 640x480, {TARGET}, OpenCV {cv2.__version__}")
     print("bias = mean radial error px (+ outward), rms = RMS distance px; regions by r / half-diagonal\n")
     print(f"| effect | detector | found | bias all | bias centre | bias middle | bias outer | rms all | rms centre | rms outer |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    detectors = opencv_charuco() if board == "charuco" else opencv_detectors()
+    detectors = opencv_detectors()
     for name, flags in ROWS:
         if names != "all" and name not in names:
             continue
-        folder = os.path.join(OUT, board, name.replace(" ", "_").replace("%", "pc"))
-        truth, files = render(folder, views, 42, flags, target)
-        per = {"robocal": robocal_points(files, os.path.join(folder, "robocal.json"), target)}
+        folder = os.path.join(OUT, name.replace(" ", "_").replace("%", "pc"))
+        truth, files = render(folder, views, 42, flags)
+        per = {"robocal": robocal_points(files, os.path.join(folder, "robocal.json"))}
         for dname, fn in detectors.items():
             per[dname] = []
             for f, v in zip(files, truth["views"]):
                 c = fn(cv2.imread(f, cv2.IMREAD_GRAYSCALE))
-                if board == "charuco":
-                    per[dname].append(c)
-                else:
-                    per[dname].append(match(c, v["points"]) if c is not None else None)
+                per[dname].append(match(c, v["points"]) if c is not None else None)
         for dname, found in per.items():
             rows, n = [], 0
             for fpts, v in zip(found, truth["views"]):
@@ -261,13 +209,8 @@ def calibrations(seeds):
 
 
 def main():
-    global ROBOCAL, REUSE
-    REUSE = "--reuse-renders" in sys.argv
-    settle_opencv()
+    ensure_venv()
     args = sys.argv[1:]
-    if "--robocal" in args:
-        ROBOCAL = os.path.abspath(args[args.index("--robocal") + 1])
-    board = args[args.index("--board") + 1] if "--board" in args else "chessboard"
     views = int(args[args.index("--views") + 1]) if "--views" in args else 200
     names = args[args.index("--rows") + 1].split(",") if "--rows" in args else "all"
     calib = int(args[args.index("--calib") + 1]) if "--calib" in args else 0
@@ -275,7 +218,7 @@ def main():
     with open(os.path.join(OUT, "camera.json"), "w") as f:
         json.dump(CAMERA_FILE, f)
     if names != ["none"]:
-        study(views, names, board)
+        study(views, names)
     if calib:
         calibrations(calib)
 

@@ -17,7 +17,6 @@
 //!    90 degrees: use a board with `cols + rows` odd (e.g. 9x6) for
 //!    multi-view work.
 
-use super::edge_corner::{refine_by_edges, EdgeRoom};
 use super::lattice::{self, Cells, PointIndex};
 use super::refine::refine_saddle;
 use super::saddle::{self, Candidate};
@@ -420,18 +419,10 @@ fn refine_all(
                 ),
             });
         };
-        // The saddle is the corner only under a point-symmetric blur; the
-        // edges' centroids are it under any (edge_corner.rs). A chessboard's
-        // squares are clear to their next edge.
-        let room = EdgeRoom {
-            step_px: local,
-            depth_px: local,
-        };
-        let pos = refine_by_edges(img, fit.pos, &fit.hessian, room).unwrap_or(fit.pos);
         out.push(DetectedPoint {
             id,
-            x_px: pos.x,
-            y_px: pos.y,
+            x_px: fit.pos.x,
+            y_px: fit.pos.y,
             covariance_px2: None,
         });
     }

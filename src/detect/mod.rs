@@ -6,10 +6,7 @@
 //!   [`DetectOptions::max_working_side_px`] (then up to two finer levels if that
 //!   fails), grid growth from seeds with local perspective prediction and
 //!   alternating corner polarity, and a saddle-point surface fit at full
-//!   resolution for every corner, moved to where the centroids of its two
-//!   edges' blur meet (`edge_corner.rs`: unbiased under a lens blur that is
-//!   not point-symmetric; ChArUco corners too, where the white margin
-//!   around the markers leaves room).
+//!   resolution for every corner.
 //! - **Circle grids and dot plates**: dark (or, for light-on-dark grids,
 //!   light) blobs from a locally adaptive threshold, grown into a lattice,
 //!   ordered by the same rules as chessboards (right-handed, then id 0
@@ -106,7 +103,6 @@ mod blobs;
 mod centres;
 pub(crate) mod chessboard;
 mod circles;
-mod edge_corner;
 mod ellipse;
 mod lattice;
 pub mod markers;

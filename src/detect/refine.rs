@@ -44,8 +44,6 @@ const BASIS: [(usize, usize); 6] = [(2, 0), (1, 1), (0, 2), (1, 0), (0, 1), (0, 
 #[derive(Debug, Clone)]
 pub(crate) struct SaddleFit {
     pub pos: Point2<f64>,
-    /// The fitted surface's Hessian (its zero lines are the edges).
-    pub hessian: Matrix2<f64>,
 }
 
 /// Raw pixels around a start point, f32, with the smoothing's sigma and
@@ -109,7 +107,6 @@ pub(crate) fn refine_saddle(img: &GrayImage, start: Point2<f64>, window: f64) ->
         if step.norm() < STEP_TOLERANCE_PX {
             return Some(SaddleFit {
                 pos: Point2::from(c + origin),
-                hessian: h,
             });
         }
     }
@@ -117,7 +114,6 @@ pub(crate) fn refine_saddle(img: &GrayImage, start: Point2<f64>, window: f64) ->
     let (h, _) = fit_quadratic(&patch, c, w, sigma_w2)?;
     (h.determinant() < 0.0).then(|| SaddleFit {
         pos: Point2::from(c + origin),
-        hessian: h,
     })
 }
 

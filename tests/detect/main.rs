@@ -8,7 +8,6 @@ mod support;
 
 mod detect_circles;
 mod detect_datasets;
-mod detect_edge_blur;
 mod detect_grid_boards;
 mod detect_markers;
 mod detect_markers_datasets;

@@ -28,7 +28,6 @@
 //!
 //!    Any subset of points may come out (partial views, occlusion).
 
-mod corner_fit;
 mod decode;
 mod edges;
 mod grid_corners;
@@ -36,13 +35,12 @@ pub(crate) mod homography;
 mod quads;
 mod runs;
 
-use super::edge_corner::EdgeRoom;
+use super::refine::refine_saddle;
 use super::DetectOptions;
 use crate::error::{Error, Result};
 use crate::image::GrayImage;
 use crate::target::marker_board::{self, MarkerLayout};
 use crate::target::{DetectedPoint, Detection, Dictionary, Target};
-use corner_fit::{refine, EDGE_CLEARANCE_PX, MIN_WINDOW_PX};
 use decode::Marker;
 use homography::Homography;
 use nalgebra::Point2;
@@ -61,6 +59,14 @@ pub const DISAGREE_FRACTION: f64 = 0.5;
 pub const NEIGHBOURHOOD_MARKERS: f64 = 3.0;
 /// Floor of the disagreement tolerance, pixels.
 pub const MIN_DISAGREE_PX: f64 = 1.5;
+/// Largest saddle-fit half-window, pixels (the chessboard detector's).
+const MAX_WINDOW_PX: f64 = 6.0;
+/// Smallest saddle-fit half-window, pixels.
+const MIN_WINDOW_PX: f64 = 2.5;
+/// A corner is refined only when it is this many half-windows (plus one
+/// pixel) inside the image: the fit's reach (1.5 half-windows) and its
+/// smoothing.
+const BORDER_WINDOWS: f64 = 2.0;
 
 /// Decoding tunables.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -353,6 +359,28 @@ fn consistent_markers(layout: &MarkerLayout, mine: &mut Vec<(usize, &Marker)>) {
     }
 }
 
+/// The saddle fit of a seed with half-window `window`, or `None`.
+fn refine(image: &GrayImage, seed: Point2<f64>, window: f64) -> Option<Point2<f64>> {
+    let window = window.clamp(MIN_WINDOW_PX, MAX_WINDOW_PX);
+    // The fit reads 1.5 half-windows around the corner plus its smoothing:
+    // where that reaches past the image edge it sees replicated border
+    // pixels and the corner comes out biased (2.6 px on a partial-view
+    // render, once outside the image). Such a corner is left out, as one
+    // beyond the edge is.
+    let margin = BORDER_WINDOWS * window + 1.0;
+    let inside = |p: Point2<f64>| {
+        p.x >= margin
+            && p.y >= margin
+            && p.x <= image.width as f64 - 1.0 - margin
+            && p.y <= image.height as f64 - 1.0 - margin
+    };
+    if !inside(seed) {
+        return None;
+    }
+    let fit = refine_saddle(image, seed, window)?;
+    ((fit.pos - seed).norm() <= 0.5 * window + 1.0 && inside(fit.pos)).then_some(fit.pos)
+}
+
 fn charuco_corners(
     image: &GrayImage,
     board: &Target,
@@ -419,12 +447,7 @@ fn charuco_corners(
             // The fit's weights reach 1.5 windows: stay within the white
             // margin plus the marker's black border.
             let border_px = marker_m / (layout.dictionary.marker_bits() + 2) as f64 * px_per_m;
-            // The edges' profiles stay in the white margin (edge_corner.rs).
-            let room = EdgeRoom {
-                step_px: square_m * px_per_m,
-                depth_px: margin_px - EDGE_CLEARANCE_PX,
-            };
-            if let Some(p) = refine(image, seed, (margin_px + border_px) / 2.0, Some(room)) {
+            if let Some(p) = refine(image, seed, (margin_px + border_px) / 2.0) {
                 out.push(DetectedPoint {
                     id: i + j * (squares_x - 1),
                     x_px: p.x,
@@ -465,7 +488,7 @@ fn aprilgrid_corners(
         let border_px = layout.border_bits as f64 * side / n as f64;
         let window = 0.5 * gap_px.min(border_px);
         for (id, seed) in ids.into_iter().zip(m.corners) {
-            if let Some(p) = refine(image, seed, window, None) {
+            if let Some(p) = refine(image, seed, window) {
                 out.push(DetectedPoint {
                     id,
                     x_px: p.x,
