@@ -484,7 +484,7 @@ fn the_tilted_model_goes_to_opencv_with_14_coefficients_and_back() {
 
 /// A table entry whose format holds the model only where a fit is close
 /// enough: HALCON's undistorting polynomial, fitted to Brown's (the export
-/// refuses a lens it cannot fit within 0.25 px, as the example's strong
+/// refuses a lens it cannot fit within 0.5 px, as the example's strong
 /// one).
 fn entry_fits<'a>(entry: impl Into<Option<&'a str>>) -> bool {
     entry.into().is_some_and(|e| e == "halcon")

@@ -486,7 +486,7 @@ fn is_old_robocal_export(text: &str) -> bool {
 /// How far (pixels, anywhere in the image) the undistorting polynomial
 /// robocal's `halcon` export writes may be from the camera's own model;
 /// beyond it the export is refused (the lens-model table says so).
-pub const HALCON_EXPORT_MAX_PX: f64 = 0.25;
+pub const HALCON_EXPORT_MAX_PX: f64 = 0.5;
 
 /// The words of the export's header that mark a fitted undistorting
 /// polynomial.

@@ -1,7 +1,7 @@
 //! Reading back every camera format robocal writes: a table of every
 //! format x every lens model it holds (export then import is the same
 //! camera to 1e-9 relative; HALCON's polynomial, fitted both ways, to
-//! 0.3 px), HALCON's own files, and the errors of damaged files.
+//! 0.55 px), HALCON's own files, and the errors of damaged files.
 
 use super::export_camera::{export_camera, CameraExportInfo, CameraFormat};
 use super::import_camera::{import_camera, CameraSource, NOT_A_CAMERA};
@@ -396,7 +396,7 @@ fn an_old_robocal_halcon_export_reads_back_exactly() {
 
 /// A table entry whose format holds the model only where a fit is close
 /// enough: HALCON's undistorting polynomial, fitted to Brown's (the export
-/// refuses a lens it cannot fit within 0.25 px, as the example's strong
+/// refuses a lens it cannot fit within 0.5 px, as the example's strong
 /// one).
 fn entry_fits<'a>(entry: impl Into<Option<&'a str>>) -> bool {
     entry.into().is_some_and(|e| e == "halcon")

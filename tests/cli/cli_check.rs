@@ -284,7 +284,7 @@ fn diff_reads_halcon_matlab_and_text_files() {
     );
     let worst = diff_worst(&json, &other);
     assert!(worst < 1e-6, "brown.m: {worst} px");
-    // HALCON's polynomial undistorts: the export fits it (within 0.25 px),
+    // HALCON's polynomial undistorts: the export fits it (within 0.5 px),
     // the reader fits Brown back (within 0.05 px); a milder lens, as the
     // lens-model table says.
     let mild = Camera {
@@ -310,7 +310,7 @@ fn diff_reads_halcon_matlab_and_text_files() {
         &export_camera(&mild, &info, CameraFormat::Halcon).unwrap(),
     );
     let worst = diff_worst(&mild_json, &other);
-    assert!(worst < 0.3, "mild.hdev.txt: {worst} px");
+    assert!(worst < 0.55, "mild.hdev.txt: {worst} px");
     let err = export_camera(&brown, &info, CameraFormat::Halcon)
         .unwrap_err()
         .to_string();
