@@ -338,23 +338,7 @@ fn crate_modules(line: &str) -> Vec<String> {
             continue;
         }
         if let Some(group) = after.strip_prefix('{') {
-            let mut depth = 0;
-            let mut item = String::new();
-            let mut items = Vec::new();
-            for ch in group.chars() {
-                match ch {
-                    '{' => depth += 1,
-                    '}' if depth == 0 => break,
-                    '}' => depth -= 1,
-                    ',' if depth == 0 => {
-                        items.push(std::mem::take(&mut item));
-                        continue;
-                    }
-                    _ => {}
-                }
-                item.push(ch);
-            }
-            items.push(item);
+            let items = split_braced_items(group);
             found.extend(items.iter().map(|s| leading_ident(s.trim())));
         } else {
             found.push(leading_ident(after));
@@ -539,4 +523,25 @@ fn a_forbidden_import_is_named_with_its_file_line_and_rule() {
             "src/io/read.rs:1: io uses std::fs: only wasm.rs, wasm/, main.rs and cli/ touch a host",
         ]
     );
+}
+
+/// The comma-separated items of a `use` group's inside (after its `{`), up
+/// to its closing `}`: nested groups stay whole.
+fn split_braced_items(group: &str) -> Vec<String> {
+    let (mut items, mut depth, mut item) = (Vec::new(), 0, String::new());
+    for ch in group.chars() {
+        match ch {
+            '{' => depth += 1,
+            '}' if depth == 0 => break,
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                items.push(std::mem::take(&mut item));
+                continue;
+            }
+            _ => {}
+        }
+        item.push(ch);
+    }
+    items.push(item);
+    items
 }

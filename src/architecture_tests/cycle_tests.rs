@@ -62,21 +62,7 @@ fn expand_compact(tree: &str) -> Vec<Vec<String>> {
     let inner = tree[open + 1..]
         .strip_suffix('}')
         .unwrap_or(&tree[open + 1..]);
-    let (mut items, mut depth, mut item) = (Vec::new(), 0, String::new());
-    for ch in inner.chars() {
-        match ch {
-            '{' => depth += 1,
-            '}' => depth -= 1,
-            ',' if depth == 0 => {
-                items.push(std::mem::take(&mut item));
-                continue;
-            }
-            _ => {}
-        }
-        item.push(ch);
-    }
-    items.push(item);
-    items
+    super::split_braced_items(inner)
         .iter()
         .filter(|i| !i.is_empty())
         .flat_map(|i| expand_compact(&format!("{prefix}{i}")))

@@ -414,16 +414,7 @@ fn the_lens_model_table_names_the_formats_the_writers_accept() {
                 values[k] = 0.0;
                 camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
             }
-            if entry_fits(entry.copied()) {
-                // HALCON's polynomial fits a milder lens within its bound.
-                let values: Vec<f64> = camera
-                    .distortion
-                    .coefficients()
-                    .iter()
-                    .map(|c| c * 0.1)
-                    .collect();
-                camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
-            }
+            super::import_camera_tests::milder_for_halcon(entry.copied(), &mut camera);
             let written = export_camera(&camera, &CameraExportInfo::default(), format).is_ok();
             assert_eq!(
                 written,
@@ -480,12 +471,4 @@ fn the_tilted_model_goes_to_opencv_with_14_coefficients_and_back() {
             "{format:?}: {err}"
         );
     }
-}
-
-/// A table entry whose format holds the model only where a fit is close
-/// enough: HALCON's undistorting polynomial, fitted to Brown's (the export
-/// refuses a lens it cannot fit within 0.5 px, as the example's strong
-/// one).
-fn entry_fits<'a>(entry: impl Into<Option<&'a str>>) -> bool {
-    entry.into().is_some_and(|e| e == "halcon")
 }

@@ -134,16 +134,7 @@ fn every_format_reads_back_every_lens_model_it_holds() {
                 values[k] = 0.0;
                 camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
             }
-            if entry_fits(entry) {
-                // HALCON's polynomial fits a milder lens within its bound.
-                let values: Vec<f64> = camera
-                    .distortion
-                    .coefficients()
-                    .iter()
-                    .map(|c| c * 0.1)
-                    .collect();
-                camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
-            }
+            milder_for_halcon(Some(entry), &mut camera);
             let text = export_camera(&camera, &CameraExportInfo::default(), format)
                 .unwrap_or_else(|e| panic!("{model} to {name}: {e}"));
             let (back, seen) =
@@ -394,10 +385,18 @@ fn an_old_robocal_halcon_export_reads_back_exactly() {
     }
 }
 
-/// A table entry whose format holds the model only where a fit is close
-/// enough: HALCON's undistorting polynomial, fitted to Brown's (the export
-/// refuses a lens it cannot fit within 0.5 px, as the example's strong
-/// one).
-fn entry_fits<'a>(entry: impl Into<Option<&'a str>>) -> bool {
-    entry.into().is_some_and(|e| e == "halcon")
+/// HALCON's entry in the lens-model table holds Brown's model only where
+/// its undistorting polynomial fits (the export refuses a lens it cannot
+/// fit within 0.5 px, as the example's strong one): for `halcon` the
+/// camera's lens is made ten times milder.
+pub(super) fn milder_for_halcon(entry: Option<&str>, camera: &mut Camera) {
+    if entry == Some("halcon") {
+        let values: Vec<f64> = camera
+            .distortion
+            .coefficients()
+            .iter()
+            .map(|c| c * 0.1)
+            .collect();
+        camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
+    }
 }
