@@ -116,7 +116,9 @@ async function openShared(fragment) {
   const images = { setResiduals() {} };
   await loadLensModels(engine);
   const camera = new CameraView(store, engine, images, { readonly: true });
-  new HandEyeView(store, engine, { pairs: () => [] }, { readonly: true });
+  // The robot poses the link carries: the hand-eye step's 3-D view draws them.
+  const robotPoses = (payload.handeye && payload.handeye.robotPoses) || [];
+  new HandEyeView(store, engine, { pairs: () => robotPoses.map((pose) => ({ image: true, pose: { base_from_gripper: pose } })) }, { readonly: true });
   new PlanView(store, engine, { pairs: () => [] }, { readonly: true });
   new CheckView(store, engine, () => new Engine(), { readonly: true });
   new ExportView(store, engine);
@@ -211,7 +213,7 @@ async function startSteps(versionPromise) {
     await store.save();
     location.hash = session.camera && session.camera.result ? 'camera' : 'images';
     location.reload();
-  });
+  }, () => handeye.robotPoses3d());
   restoring.hidden = true;
   store.onChange((what) => { if (/detections|included|images|all/.test(what)) camera.summarise(); });
   const readyText = () => `Calibration engine ready (robocal ${version}).`;

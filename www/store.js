@@ -4,6 +4,8 @@
 import { checkSession } from './lib/validate.js';
 const DB_NAME = 'robocal';
 const DB_VERSION = 1;
+/** The longest a change waits to be saved (ms). */
+const SAVE_MS = 300;
 
 export function defaultSession() {
   return {
@@ -20,6 +22,7 @@ export function defaultSession() {
     stereo: null, // { result }: `robocal stereo`'s report, from a session saved before the rig step replaced the stereo step
     plan: null, // { inputs: { view, fields: { id: value } }, request, result }: the pose plan (views/plan.js)
     check: null, // { name, result }: the last check of a saved calibration (views/check.js)
+    captureCount: 0, // the last capture_NNN.png number given (views/capture.js): names never repeat
   };
 }
 
@@ -119,10 +122,15 @@ export class Store {
 
   onChange(fn) { this.listeners.add(fn); }
 
+  /**
+   * Tell the views, and save within SAVE_MS of the first unsaved change (a
+   * stream of changes, e.g. thumbnails decoding one by one, never holds the
+   * save off: a reload then finds the session as it was a moment before).
+   */
   changed(what) {
     for (const fn of this.listeners) fn(what);
-    clearTimeout(this.saveTimer);
-    this.saveTimer = setTimeout(() => this.save(), 300);
+    if (this.saveTimer) return;
+    this.saveTimer = setTimeout(() => { this.saveTimer = null; this.save(); }, SAVE_MS);
   }
 
   async save() {
@@ -140,13 +148,19 @@ export class Store {
     }
   }
 
+  /**
+   * Add an image: its bytes are stored first, then the session listing it
+   * is saved at once, so a reload at any moment (e.g. during detection)
+   * finds every image added before it.
+   */
   async addImage(img, bytes) {
-    this.session.images.push(img);
     this.bytes.set(img.id, bytes);
     if (this.db && this.persistent) {
       try { await tx(this.db, 'blobs', 'readwrite', (s) => s.put(bytes, img.id)); } catch (e) { console.warn(e); }
     }
+    this.session.images.push(img);
     this.changed('images');
+    await this.save();
   }
 
   /** Keep bytes that are not a step-2 image (the rig step's). */

@@ -23,6 +23,7 @@ const SHELL = [
   'lib/frames.js',
   'lib/mat4.js',
   'lib/plot.js',
+  'lib/reports.js',
   'lib/rig3d.js',
   'lib/validate.js',
   'lib/view3d.js',

@@ -98,3 +98,47 @@ export function trapFocus(dialog) {
     else if (opener) { const o = opener; opener = null; if (o.isConnected) o.focus(); }
   }).observe(dialog, { attributes: true, attributeFilter: ['open'] });
 }
+
+/**
+ * The files of a drop (files, and the files inside dropped folders, walked
+ * to any depth), in natural name order. A file inside a folder is kept when
+ * `keep(name)`; a file dropped itself always is (its reader says what is
+ * wrong with it).
+ */
+export async function droppedFiles(dt, keep = () => true) {
+  const entries = [...dt.items].map((i) => (i.webkitGetAsEntry ? i.webkitGetAsEntry() : null)).filter(Boolean);
+  if (!entries.length) return [...dt.files];
+  const out = [];
+  const walk = async (entry) => {
+    if (entry.isFile) {
+      const file = await new Promise((res, rej) => entry.file(res, rej));
+      if (keep(file.name) || !entry.fullPath.includes('/', 1)) out.push(file);
+    } else if (entry.isDirectory) {
+      const reader = entry.createReader();
+      let batch;
+      do {
+        batch = await new Promise((res, rej) => reader.readEntries(res, rej));
+        for (const e of batch) await walk(e);
+      } while (batch.length);
+    }
+  };
+  for (const e of entries) await walk(e);
+  return out.sort((a, b) => a.name.localeCompare(b.name, undefined, { numeric: true }));
+}
+
+/**
+ * Files dropped on `zone` go to `take(files)`: the zone is outlined while
+ * files are dragged over it. `keep(name)` chooses the files inside folders.
+ */
+export function dropTarget(zone, take, keep) {
+  const files = (e) => e.dataTransfer && [...e.dataTransfer.types].includes('Files');
+  zone.addEventListener('dragover', (e) => { if (!files(e)) return; e.preventDefault(); zone.classList.add('over'); });
+  zone.addEventListener('dragleave', (e) => { if (!zone.contains(e.relatedTarget)) zone.classList.remove('over'); });
+  zone.addEventListener('drop', async (e) => {
+    if (!files(e)) return;
+    e.preventDefault();
+    zone.classList.remove('over');
+    const dropped = await droppedFiles(e.dataTransfer, keep);
+    if (dropped.length) take(dropped);
+  });
+}

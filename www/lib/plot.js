@@ -64,6 +64,7 @@ function extent(values, pad = 0.05) {
 
 /** points: [{x, y, group}] ; symmetric: centre the axes on 0 with equal scale. */
 export function scatter(canvas, points, { xlabel, ylabel, title, symmetric = false } = {}) {
+  canvas.dataset.count = String(points.length); // what is drawn, for scripts and tests
   let [xmin, xmax] = extent(points.map((p) => p.x));
   let [ymin, ymax] = extent(points.map((p) => p.y));
   if (symmetric) {
@@ -171,6 +172,7 @@ export function lines(canvas, series, { xlabel, ylabel, title } = {}) {
 
 /** vectors over an image frame of size [w, h] (y down): [{x, y, dx, dy}] scaled by gain. */
 export function vectors(canvas, items, [w, h], { gain = 20, title } = {}) {
+  canvas.dataset.count = String(items.length);
   const { ctx, X, Y } = frame(canvas, { xmin: 0, xmax: w, ymin: 0, ymax: h, xlabel: `x (px); vectors ×${gain}`, ylabel: 'y (px)', title, equal: true, yDown: true });
   ctx.strokeStyle = '#d62728'; ctx.lineWidth = 1;
   for (const v of items) {

@@ -218,6 +218,8 @@ export function checkSession(raw, path = 'session') {
     ids.add(img.id);
   });
 
+  if (!Number.isInteger(s.captureCount) || s.captureCount < 0) fail(`${path}.captureCount`, 'a whole number >= 0', s.captureCount);
+
   s.camera = step('camera');
   check.string(s.camera.model, `${path}.camera.model`);
   check.string(s.camera.method, `${path}.camera.method`);
@@ -281,11 +283,25 @@ export function checkSharePayload(p) {
   if (p.camera !== undefined && p.camera !== null) {
     check.object(p.camera, 'camera');
     checkCameraResult(p.camera.result, 'camera.result');
+    // The residuals' sample (share.js): points drawn by the residual plots.
+    ((p.camera.result && p.camera.result.views) || []).forEach((v, i) => {
+      if (v.residuals_px === undefined) return;
+      check.list(v.residuals_px, `camera.result.views[${i}].residuals_px`).forEach((r, j) => {
+        check.object(r, `camera.result.views[${i}].residuals_px[${j}]`);
+        for (const key of ['x', 'y', 'dx', 'dy']) check.number(r[key], `camera.result.views[${i}].residuals_px[${j}].${key}`);
+      });
+    });
+    if (p.camera.residualsSampled !== undefined) {
+      check.object(p.camera.residualsSampled, 'camera.residualsSampled');
+      for (const key of ['kept', 'total']) check.number(p.camera.residualsSampled[key], `camera.residualsSampled.${key}`);
+    }
   }
   if (p.handeye !== undefined && p.handeye !== null) {
     check.object(p.handeye, 'handeye');
     if (p.handeye.setup !== undefined) check.oneOf(p.handeye.setup, 'handeye.setup', ['eye-in-hand', 'eye-to-hand']);
     checkHandeyeResult(p.handeye.result, 'handeye.result');
+    // The robot poses of the 3-D view (share.js).
+    if (p.handeye.robotPoses !== undefined) check.list(p.handeye.robotPoses, 'handeye.robotPoses').forEach((pose, i) => checkPose(pose, `handeye.robotPoses[${i}]`));
   }
   if (p.plan !== undefined && p.plan !== null) {
     check.object(p.plan, 'plan');

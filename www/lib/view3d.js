@@ -59,6 +59,7 @@ export class FrameView {
    * camera frustums, board outlines).
    */
   set(frames, links = [], shapes = []) {
+    this.canvas.dataset.frames = String(frames.length); // what is drawn, for scripts and tests
     this.shapes = shapes;
     this.frames = frames.map((f) => ({ name: f.name, ...mat(f.matrix_row_major), size: f.size }));
     this.links = links;

@@ -21,6 +21,14 @@ function putPixels(canvas, p) {
   canvas.getContext('2d').putImageData(p.image, 0, 0); // the core's ImageData
 }
 
+/** On a shared page: how many of the residuals the link carried (a sample), or that it carried none. */
+function residualNote(sampled) {
+  const text = sampled && sampled.kept
+    ? `The residual plots show a sample of ${sampled.kept} of the ${sampled.total} points (a share link carries a sample; the session file holds them all).`
+    : 'This link carries no residuals: the residual plots are empty (the session file holds them).';
+  return h('p', { class: 'hint', id: 'camera-residual-sample' }, text);
+}
+
 export class CameraView {
   constructor(store, engine, images, { readonly = false } = {}) {
     this.store = store;
@@ -152,6 +160,7 @@ export class CameraView {
       warnings,
       r.rejected ? this.rejectedNote(r) : null,
       h('div', { class: 'two-col' }, params, h('div', { class: 'plots' }, viewBars, scat, picked)),
+      this.readonly ? residualNote(this.state.residualsSampled) : null,
       r.spline_support ? h('p', { class: 'hint', id: 'camera-valid-region' },
         `Splined lens: ${r.spline_support.supported} of ${r.spline_support.knots[0] * r.spline_support.knots[1]} control points have data; `
         + `the valid region (image cells holding points) is ${num(100 * r.spline_support.image_coverage, 0)} % of the image, and outside it the model is extrapolated: trust it where the uncertainty map is low.`) : null,

@@ -307,9 +307,18 @@ export class CaptureView {
     return blob.arrayBuffer();
   }
 
+  /**
+   * The next capture's name, taken at once (before any await): two captures
+   * in flight never share a number. The session counts every number given
+   * (kept in IndexedDB), so a name never comes back after a reload or after
+   * its frame was removed.
+   */
   nextCaptureName() {
+    const s = this.store.session;
     const used = this.images.images.map((i) => CAPTURE_NAME.exec(i.name)).filter(Boolean).map((m) => Number(m[1]));
-    return `capture_${String((used.length ? Math.max(...used) : 0) + 1).padStart(3, '0')}.png`;
+    const n = Math.max(s.captureCount || 0, ...used) + 1;
+    s.captureCount = n;
+    return `capture_${String(n).padStart(3, '0')}.png`;
   }
 
   /**
@@ -321,8 +330,6 @@ export class CaptureView {
    */
   async capture(extra = {}, guideIndex = null) {
     if (!this.stream || !$('camera-video').videoWidth) return null;
-    const name = this.nextCaptureName();
-    if (guideIndex !== null) this.guide.named(guideIndex, name);
     // A typed robot pose must read before the frame is taken: a capture
     // without its pose would shift the pairing of every later one.
     const line = this.poses.line;
@@ -336,6 +343,9 @@ export class CaptureView {
       }
     }
     this.say('');
+    // Named once the pose reads (a refused line takes no number).
+    const name = this.nextCaptureName();
+    if (guideIndex !== null) this.guide.named(guideIndex, name);
     try {
       const bytes = await this.grabPng();
       // The frame's card appears at once; detection of the PNG follows.

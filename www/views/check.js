@@ -10,6 +10,7 @@
 import { $, h, fill, table, num, message, readTextFile } from '../lib/dom.js';
 import { cameraErrorText, openCamera, stopStream } from '../lib/camera.js';
 import { targetSpec } from './target.js';
+import { readCameraFile, cameraOfReport } from '../lib/reports.js';
 
 /** The file names a saved calibration may have: every camera format robocal exports (HALCON's .dat and .hdev.txt, MATLAB's .m, the text matrix's .txt). */
 const CAMERA_FILES = '.json,.yaml,.yml,.xml,.cameramodel,.dat,.txt,.m,text/*,application/json';
@@ -85,8 +86,9 @@ export class CheckView {
   async load(file) {
     if (!file) return;
     try {
-      const text = await readTextFile(file, 'a camera calibration (any camera format robocal exports)');
-      const { camera, format } = await this.engine.call('cameraFile', { text });
+      const read = await readTextFile(file, 'a camera calibration (any camera format robocal exports)');
+      // A report is read by its kind (a rig's or a stereo pair's first camera; a check report is refused).
+      const { camera, format, text } = await readCameraFile(this.engine, read);
       this.calibration = { text, name: file.name, camera };
       $('check-file-info').textContent = `${file.name} (${format}): ${camera.width} × ${camera.height}, fx ${num(camera.fx, 1)}, fy ${num(camera.fy, 1)}, cx ${num(camera.cx, 1)}, cy ${num(camera.cy, 1)}`;
       for (const id of ['check-camera', 'check-images', 'check-other']) $(id).disabled = false;
@@ -210,7 +212,7 @@ export class CheckView {
   async diff(file) {
     if (!file || !this.calibration) return;
     try {
-      const b = await readTextFile(file, 'a camera calibration (any camera format robocal exports)');
+      const b = cameraOfReport(await readTextFile(file, 'a camera calibration (any camera format robocal exports)')).text;
       const report = await this.engine.call('diff', { request: JSON.stringify({ a: this.calibration.text, b }) });
       const d = report.projection_shift_px;
       this.say(h('p', { id: 'check-diff' }, `${this.calibration.name} against ${file.name}: projection shift worst ${num(d.worst, 2)} px at (${num(d.worst_at_px[0], 0)}, ${num(d.worst_at_px[1], 0)}), median ${num(d.median, 2)} px, RMS ${num(d.rms, 2)} px, implied rotation ${num(d.implied_rotation_deg, 3)} deg.`), this.heatMap(d, 'check-diff-map'));

@@ -194,8 +194,13 @@ export class HandEyeView {
       this.canvas3d);
   }
 
+  /** The robot poses (base_from_gripper) the 3-D view draws: the first 8 paired with an image. */
+  robotPoses3d() {
+    return this.robot.pairs().filter((p) => p.image).slice(0, 8).map((p) => p.pose.base_from_gripper);
+  }
+
   draw3d(r, camKey, tgtKey, eyeInHand) {
-    const robot = this.robot.pairs().filter((p) => p.image).slice(0, 8).map((p) => fromPose(p.pose.base_from_gripper));
+    const robot = this.robotPoses3d().map(fromPose);
     const frames = [{ name: 'base', matrix_row_major: IDENTITY }];
     const links = [];
     robot.forEach((g, i) => {

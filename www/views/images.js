@@ -1,7 +1,7 @@
 // Step 2: images. Load (files or a folder), decode and detect in the worker
 // with progress and cancel, thumbnails with the detected points, an
 // inspector with zoom and residuals, include/exclude, and a coverage map.
-import { $, h, fill, trapFocus } from '../lib/dom.js';
+import { $, h, fill, trapFocus, droppedFiles } from '../lib/dom.js';
 import { targetSpec } from './target.js';
 import { MARKER_BOARDS, pointCount, otherBoard, notTheTarget, otherBoardsText, fillBoardButtons, drawOtherBoards } from './boards.js';
 
@@ -85,7 +85,7 @@ export class ImagesView {
     zone.addEventListener('drop', async (e) => {
       e.preventDefault();
       zone.classList.remove('over');
-      this.addFiles(await filesFromDrop(e.dataTransfer));
+      this.addFiles(await droppedFiles(e.dataTransfer, (name) => IMAGE_EXT.test(name)));
     });
     // The file fields are hidden (no invisible tab stops): two buttons open them.
     $('choose-files').addEventListener('click', () => $('file-input').click());
@@ -108,7 +108,11 @@ export class ImagesView {
     $('inspector-zoom').addEventListener('input', () => this.drawInspector());
   }
 
-  /** Rebuild cards from the session (after a reload or a demo load). */
+  /**
+   * Rebuild cards from the session (after a reload or a demo load). Images
+   * a reload caught before their detection are detected now (not awaited:
+   * the other steps need not wait for it).
+   */
   async restore() {
     await this.boardInfo();
     fill($('cards'));
@@ -119,6 +123,8 @@ export class ImagesView {
       this.renderCard(img);
     }
     this.refresh();
+    const undetected = this.images.filter((i) => i.status === 'decoded' && !i.detection);
+    if (undetected.length) this.resumed = this.detectAll(undetected);
   }
 
   async addFiles(files) {
@@ -499,25 +505,4 @@ function drawCoverage(canvas, imgs) {
   });
   ctx.strokeStyle = '#888';
   ctx.strokeRect(0, 0, w * s, hgt * s);
-}
-
-async function filesFromDrop(dt) {
-  const entries = [...dt.items].map((i) => (i.webkitGetAsEntry ? i.webkitGetAsEntry() : null)).filter(Boolean);
-  if (!entries.length) return [...dt.files];
-  const out = [];
-  const walk = async (entry) => {
-    if (entry.isFile) {
-      const file = await new Promise((res, rej) => entry.file(res, rej));
-      if (IMAGE_EXT.test(file.name) || !entry.fullPath.includes('/', 1)) out.push(file);
-    } else if (entry.isDirectory) {
-      const reader = entry.createReader();
-      let batch;
-      do {
-        batch = await new Promise((res, rej) => reader.readEntries(res, rej));
-        for (const e of batch) await walk(e);
-      } while (batch.length);
-    }
-  };
-  for (const e of entries) await walk(e);
-  return out.sort((a, b) => a.name.localeCompare(b.name, undefined, { numeric: true }));
 }

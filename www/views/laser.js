@@ -10,6 +10,7 @@
 // the session.
 import { $, h, fill, table, num, message, download, readTextFile } from '../lib/dom.js';
 import { targetSpec } from './target.js';
+import { readCameraFile } from '../lib/reports.js';
 
 /** [format, label, file name]: the formats a laser plane report is written in. */
 const EXPORTS = [
@@ -102,8 +103,8 @@ export class LaserView {
   async loadCamera(file) {
     if (!file) return;
     try {
-      const text = await readTextFile(file, CAMERA_FILES);
-      const { camera, format } = await this.engine.call('cameraFile', { text });
+      // A report is read by its kind (a rig's or a stereo pair's first camera).
+      const { camera, format, text } = await readCameraFile(this.engine, await readTextFile(file, CAMERA_FILES));
       this.cameraFile = { text, name: `${file.name} (${format}, ${camera.width} × ${camera.height})` };
       fill($('laser-status'));
     } catch (err) {

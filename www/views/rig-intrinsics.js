@@ -7,6 +7,7 @@
 // goes into the rig input as `cameras[i].camera`: the joint fit keeps it
 // exactly.
 import { h, message, num, readTextFile, download } from '../lib/dom.js';
+import { readCameraFile } from '../lib/reports.js';
 
 export const CHOICES = [
   ['solve', 'solve with the rig'],
@@ -45,7 +46,8 @@ export function intrinsicsControl(c, k, engine, changed) {
     if (!f) return;
     try {
       const text = await readTextFile(f, 'a camera: robocal JSON, OpenCV YAML/XML or ROS camera_info');
-      const read = await engine.call('cameraFile', { text });
+      // A rig report gives the camera of this name (a stereo report its left or right).
+      const read = await readCameraFile(engine, text, c.name);
       c.cameraFile = { name: f.name, format: read.format, camera: read.camera };
       status.textContent = statusText(c);
       status.classList.remove('msg-error');

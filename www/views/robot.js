@@ -3,7 +3,7 @@
 // file stem); see how they were read (format, units, direction: editable,
 // with vendor presets), the parsed poses, and which pose goes with which
 // image.
-import { $, h, fill, table, num, message, readTextFile } from '../lib/dom.js';
+import { $, h, fill, table, num, message, readTextFile, dropTarget } from '../lib/dom.js';
 
 export const PRESETS = [
   ['auto', 'Detect from the file'],
@@ -21,6 +21,9 @@ export const PRESETS = [
   ...['extrinsic', 'intrinsic'].flatMap((kind) => ['xyz', 'xzy', 'yxz', 'yzx', 'zxy', 'zyx', 'xyx', 'xzx', 'yxy', 'yzy', 'zxz', 'zyz']
     .map((order) => [`xyz_euler_${kind}_${order}`, `Euler x y z + ${order} ${kind === 'extrinsic' ? 'about fixed axes' : 'about moving axes'}`])),
 ];
+
+/** The files of a dropped folder read as poses. */
+const POSE_FILE = /\.(csv|tsv|txt|json|dat|ya?ml)$/i;
 
 /** What the page reads as one pose per file when loaded alone. */
 const ONE_POSE_FILE = /\.(ya?ml)$/i;
@@ -92,6 +95,8 @@ export class RobotView {
     this.engine = engine;
     this.render();
     store.onChange((what) => { if (/detections|included|images|all/.test(what)) this.renderPairing(); });
+    // Pose files (or a folder of them) dropped anywhere on the step: read as if chosen together.
+    dropTarget($('step-robot'), (files) => this.load(files), (name) => POSE_FILE.test(name));
   }
 
   get state() { return this.store.session.robot; }
@@ -108,11 +113,11 @@ export class RobotView {
       if (!chosen.length) return;
       input.value = '';
       await this.load(chosen);
-      fileName.textContent = `loaded: ${st.fileName}`;
     });
     const form = h('div', { class: 'form', id: 'pose-form' },
       h('div', { class: 'row file-row' }, h('span', {}, 'Pose file'),
-        h('button', { type: 'button', id: 'pose-choose', 'aria-describedby': 'pose-file-name', onclick: () => input.click() }, 'Choose pose file(s)…'), fileName, input),
+        h('button', { type: 'button', id: 'pose-choose', 'aria-describedby': 'pose-file-name', onclick: () => input.click() }, 'Choose pose file(s)…'), fileName, input,
+        h('span', { class: 'hint' }, 'or drop pose files (or a folder of them) on this step')),
       h('p', { class: 'hint', id: 'pose-forms' }, FORMS_HINT),
       sel('pose-format', PRESETS, st.format, 'Format '),
       sel('pose-length', [['auto', 'from the file or preset'], ['mm', 'millimetres'], ['m', 'metres']], st.lengthUnit, 'Lengths '),
@@ -136,6 +141,7 @@ export class RobotView {
   async load(chosen) {
     Object.assign(this.state, await loadPoseFiles(this.engine, chosen, this.options()));
     this.store.changed('robot');
+    $('pose-file-name').textContent = `loaded: ${this.state.fileName}`;
     this.show();
   }
 

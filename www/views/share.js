@@ -57,8 +57,14 @@ export function sharedFragment() {
   return location.hash.startsWith(PREFIX) ? location.hash.slice(PREFIX.length) : null;
 }
 
-/** Keys of a result that grow with the number of views or points, and the pose refinement's 12 x 12 covariance (the per-axis std stay): left out of a link. */
-const BULKY = new Set(['residuals_px', 'per_motion', 'distortion_field', 'camera_from_target', 'detections', 'per_view_reprojection_rms_px', 'covariance']);
+/**
+ * Keys of a result that grow with the number of views or points, and the
+ * pose refinement's 12 x 12 covariance (the per-axis std stay): left out of
+ * a link. The per-view reprojection RMS of the hand-eye refinements stay (a
+ * number a view: the shared page says over how many views); the residuals
+ * come as a sample (residualSample).
+ */
+const BULKY = new Set(['residuals_px', 'per_motion', 'distortion_field', 'camera_from_target', 'detections', 'covariance']);
 
 /** Keys of a result kept with every digit. */
 const EXACT = new Set(['camera', 'camera_matrix', 'distortion', 'rms_px', 'std']);
@@ -89,14 +95,55 @@ export function compactResult(value, depth = 0) {
   return out;
 }
 
-export function sharePayload(session, version) {
+/**
+ * At most `budget` of the camera's residuals, spread over every view (every
+ * k-th point), positions to 0.1 px and residuals to 1e-4 px: the shared
+ * page's residual plots. Puts them on `result.views[i].residuals_px` and
+ * returns `{ kept, total }` (null when none were kept).
+ */
+function residualSample(cam, result, budget) {
+  const views = Array.isArray(cam.views) ? cam.views : [];
+  const total = views.reduce((n, v) => n + (Array.isArray(v.residuals_px) ? v.residuals_px.length : 0), 0);
+  if (!budget || !total || !Array.isArray(result.views)) return null;
+  const every = Math.ceil(total / budget);
+  const tenth = (v) => Math.round(v * 10) / 10;
+  let i = 0;
+  let kept = 0;
+  views.forEach((v, vi) => {
+    const sample = [];
+    for (const r of v.residuals_px || []) {
+      if (i++ % every === 0) sample.push({ x: tenth(r.x), y: tenth(r.y), dx: Number(r.dx.toFixed(4)), dy: Number(r.dy.toFixed(4)) });
+    }
+    if (result.views[vi]) result.views[vi].residuals_px = sample;
+    kept += sample.length;
+  });
+  return { kept, total };
+}
+
+/** Significant digits of the robot poses a link carries for the 3-D view. */
+const POSE_DIGITS = 5;
+
+/**
+ * What a link (and the HTML report's JSON) holds. `residuals`: how many of
+ * the camera's residuals to carry (a sample; 0: none); `robotPoses`: the
+ * base_from_gripper poses of the hand-eye step's 3-D view.
+ */
+export function sharePayload(session, version, { residuals = 0, robotPoses = [] } = {}) {
   const cam = session.camera.result;
   const he = session.handeye.result;
+  let camera = null;
+  if (cam) {
+    const result = compactResult(cam);
+    const sampled = residualSample(cam, result, residuals);
+    camera = { result, comparison: session.camera.comparison, model: session.camera.model, method: session.camera.method, ...(sampled ? { residualsSampled: sampled } : {}) };
+  }
+  const round = (v) => Number(v.toPrecision(POSE_DIGITS));
+  const poses = (robotPoses || []).map((p) => ({ translation_m: p.translation_m.map(round), quaternion_xyzw: p.quaternion_xyzw.map(round) }));
   return {
     kind: 'robocal-share', schema: 1, robocal_version: version,
     target: session.target,
-    camera: cam ? { result: compactResult(cam), comparison: session.camera.comparison, model: session.camera.model, method: session.camera.method } : null,
-    handeye: he ? { result: compactResult(he), setup: session.handeye.setup, frameNames: session.handeye.frameNames } : null,
+    camera,
+    handeye: he ? { result: compactResult(he), setup: session.handeye.setup, frameNames: session.handeye.frameNames, ...(poses.length ? { robotPoses: poses } : {}) } : null,
     workflows: compactResult(session.workflows),
     // The pose plan without its camera poses (no 3-D view on the shared
     // page) and the last check without its shift map: a few hundred bytes each.
@@ -150,13 +197,23 @@ export function readSessionFile(text) {
   }
 }
 
+/** Residual samples tried, largest first, until the link fits in LINK_CHARS. */
+const RESIDUAL_BUDGETS = [240, 120, 60, 0];
+/** The longest link made with a residual sample (characters; browsers and servers take 8 KB request lines). */
+const LINK_CHARS = 6000;
+
 export class ShareView {
-  /** `loadSession(session)` replaces this tab's session (absent on a shared, read-only page). */
-  constructor(store, version, plotsProvider, loadSession = null) {
+  /**
+   * `loadSession(session)` replaces this tab's session (absent on a shared,
+   * read-only page); `robotPoses()` the robot poses of the hand-eye step's
+   * 3-D view, carried by the link.
+   */
+  constructor(store, version, plotsProvider, loadSession = null, robotPoses = () => []) {
     this.store = store;
     this.version = version;
     this.plotsProvider = plotsProvider;
     this.loadSession = loadSession;
+    this.robotPoses = robotPoses;
     this.render();
     store.onChange((what) => { if (/result|all|shared/.test(what)) this.render(); });
   }
@@ -206,8 +263,14 @@ export class ShareView {
   }
 
   async makeLink() {
-    const data = await encodeShare(sharePayload(this.store.session, this.version));
-    this.link.value = `${location.origin}${location.pathname}${PREFIX}${data}`;
+    const base = `${location.origin}${location.pathname}${PREFIX}`;
+    const robotPoses = this.store.session.handeye.result ? this.robotPoses() : [];
+    let data = '';
+    for (const residuals of RESIDUAL_BUDGETS) {
+      data = await encodeShare(sharePayload(this.store.session, this.version, { residuals, robotPoses }));
+      if (base.length + data.length <= LINK_CHARS) break;
+    }
+    this.link.value = `${base}${data}`;
     this.status.textContent = `Link ready: ${this.link.value.length} characters.`;
     return this.link.value;
   }
