@@ -374,3 +374,34 @@ export const tests = [
     }
   }],
 ];
+
+tests.push(
+  ['capture names never repeat: two captures at once, after removing the last frame, after a reload', async (page, { url, shot }) => {
+    await open(page, url);
+    await page.click('#camera-start');
+    await live(page);
+    // Two captures in flight at once (a click while the first frame is still being encoded).
+    await page.evaluate(() => { const b = document.getElementById('capture-frame'); b.click(); b.click(); });
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 2, null, { timeout: 30000 });
+    assert.deepEqual((await cards(page)).map((c) => c.name), ['capture_001.png', 'capture_002.png']);
+    // The last frame removed: its number is not given again.
+    await page.click('button[aria-label="remove capture_002.png"]');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 1, null, { timeout: 10000 });
+    await page.click('#capture-frame');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 2, null, { timeout: 30000 });
+    assert.deepEqual((await cards(page)).map((c) => c.name), ['capture_001.png', 'capture_003.png']);
+    // Removed again, then a reload: the session remembers the numbers given.
+    await page.click('button[aria-label="remove capture_003.png"]');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 1, null, { timeout: 10000 });
+    await page.waitForTimeout(500); // the store saves within 300 ms of a change
+    await page.reload();
+    await ready(page);
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 1, null, { timeout: 30000 });
+    await page.click('#camera-start');
+    await live(page);
+    await page.click('#capture-frame');
+    await page.waitForFunction(() => document.querySelectorAll('.card').length === 2, null, { timeout: 30000 });
+    assert.deepEqual((await cards(page)).map((c) => c.name), ['capture_001.png', 'capture_004.png']);
+    await shot('unique-names');
+  }],
+);

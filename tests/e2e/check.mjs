@@ -93,3 +93,44 @@ export const tests = [
     }
   }],
 ];
+
+tests.push(
+  ['a report loaded as the saved calibration is read by its kind: a rig\'s or a stereo pair\'s camera, old reports without kind, a report without a camera named', async (page, { url }) => {
+    await page.goto(`${url}#check`);
+    await ready(page);
+    await page.locator('#step-check').waitFor({ state: 'visible', timeout: 10000 });
+    const info = async (f) => {
+      await page.$eval('#check-file-info', (el) => { el.textContent = ''; });
+      await page.$eval('#check-result', (el) => { el.textContent = ''; });
+      await page.setInputFiles('#check-file', f);
+      await page.waitForFunction(() => document.getElementById('check-file-info').textContent !== '', null, { timeout: 10000 });
+      return page.textContent('#check-file-info');
+    };
+    const error = async () => page.textContent('#check-result .msg-error');
+    // Camera reports as robocal writes them: kind and robocal_version (a camera JSON export has neither).
+    const a = { kind: 'camera', robocal_version: '0.1.0', ...cameraJson(640, 480) };
+    const b = { kind: 'camera', robocal_version: '0.1.0', ...cameraJson(800, 600) };
+    assert.equal(await info(file('camera.json', a)), 'camera.json (json): 640 × 480, fx 576.0, fy 576.0, cx 319.5, cy 239.5');
+    const { kind, ...old } = a;
+    assert.equal(await info(file('old-camera.json', { ...old, crate_version: '0.0.9' })), 'old-camera.json (json): 640 × 480, fx 576.0, fy 576.0, cx 319.5, cy 239.5');
+    // A rig report: its first camera (the rig step takes the camera of its own name).
+    const pose = { translation_m: [0, 0, 0], quaternion_xyzw: [0, 0, 0, 1] };
+    const rig = { kind: 'rig', robocal_version: '0.1.0', cameras: [{ name: 'top', calibration: b, camera_from_rig: pose }, { name: 'side', calibration: a, camera_from_rig: pose }], co_observation: [] };
+    assert.equal(await info(file('rig.json', rig)), 'rig.json (json: camera top (the first of 2) of a rig report): 800 × 600, fx 720.0, fy 720.0, cx 399.5, cy 299.5');
+    // The same rig written before kind: recognised by its keys, as robocal export does.
+    const { kind: k2, ...oldRig } = rig;
+    assert.equal(await info(file('old-rig.json', oldRig)), 'old-rig.json (json: camera top (the first of 2) of a rig report): 800 × 600, fx 720.0, fy 720.0, cx 399.5, cy 299.5');
+    const stereo = { left: b, right: a, right_from_left: pose };
+    assert.equal(await info(file('stereo.json', stereo)), 'stereo.json (json: the left camera of a stereo report): 800 × 600, fx 720.0, fy 720.0, cx 399.5, cy 299.5');
+    assert.equal(await info(file('stereo-kind.json', { kind: 'stereo', ...stereo })), 'stereo-kind.json (json: the left camera of a stereo report): 800 × 600, fx 720.0, fy 720.0, cx 399.5, cy 299.5');
+    // A check report holds no camera; an unknown kind names the kinds.
+    assert.equal(await info(file('check.json', { kind: 'check', verdict: 'ok' })), 'No calibration loaded.');
+    assert.equal(await error(), "check.json: a 'check' report compares a calibration with the camera and holds no camera: load the calibration itself");
+    assert.equal(await info(file('mono.json', { ...a, kind: 'mono' })), 'No calibration loaded.');
+    assert.equal(await error(),
+      "mono.json: kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff, laser_plane, laser_points)");
+    // After a refusal a report loads again, and the check is ready for it.
+    assert.equal(await info(file('rig.json', rig)), 'rig.json (json: camera top (the first of 2) of a rig report): 800 × 600, fx 720.0, fy 720.0, cx 399.5, cy 299.5');
+    assert.equal(await page.isEnabled('#check-images'), true);
+  }],
+);

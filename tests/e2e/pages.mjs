@@ -4,7 +4,7 @@
 // convention the file's layout does not reveal.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { root } from './harness.mjs';
@@ -220,3 +220,107 @@ export const tests = [
     await shot('keyboard');
   }],
 ];
+
+/** The demo session as `robocal render --demo` writes it: its images ([{name, mimeType, buffer}]) and poses.csv's text. */
+function renderedDemo() {
+  const dir = mkdtempSync(join(tmpdir(), 'robocal-demo-'));
+  try {
+    execFileSync(join(root, 'target/release/robocal'), ['render', '--out', dir, '--demo'], { stdio: 'ignore' });
+    const images = readdirSync(dir).filter((n) => n.endsWith('.png')).sort()
+      .map((name) => ({ name, mimeType: 'image/png', buffer: readFileSync(join(dir, name)) }));
+    return { images, poses: readFileSync(join(dir, 'poses.csv'), 'utf8') };
+  } finally {
+    rmSync(dir, { recursive: true, force: true });
+  }
+}
+
+/** Rotation vector (rad) -> quaternion [x, y, z, w]. */
+function quaternionOf([x, y, z]) {
+  const angle = Math.hypot(x, y, z);
+  const s = angle < 1e-12 ? 0.5 : Math.sin(angle / 2) / angle;
+  return [x * s, y * s, z * s, Math.cos(angle / 2)];
+}
+
+/** Drop `files` ([{name, text}]) on the element `selector` as a user's drag and drop would: dragover, then drop. Returns whether the zone was outlined during the drag. */
+const dropFiles = (page, selector, files) => page.evaluate(([selector, files]) => {
+  const dt = new DataTransfer();
+  for (const f of files) dt.items.add(new File([f.text], f.name, { type: 'text/plain' }));
+  const el = document.querySelector(selector);
+  el.dispatchEvent(new DragEvent('dragover', { dataTransfer: dt, bubbles: true, cancelable: true }));
+  const outlined = document.getElementById('step-robot').classList.contains('over');
+  el.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));
+  return outlined;
+}, [selector, files]);
+
+tests.push(
+  ['a reload during detection loses no image, and detection resumes for the images not yet detected', async (page, { url, shot }) => {
+    const { images } = renderedDemo();
+    // Two copies of the demo's 12 images: detection takes a few seconds.
+    const files = [...images, ...images.map((f) => ({ ...f, name: f.name.replace('demo_', 'again_') }))];
+    const n = files.length;
+    await page.goto(`${url}#images`);
+    await ready(page);
+    // After the reload, before the page starts: what this browser's storage held.
+    await page.addInitScript(() => {
+      const req = indexedDB.open('robocal');
+      req.onsuccess = () => {
+        const db = req.result;
+        const get = db.transaction('session').objectStore('session').get('current');
+        get.onsuccess = () => {
+          const images = (get.result && get.result.images) || [];
+          window.__saved = { images: images.length, detected: images.filter((i) => i.detection).length };
+          db.close();
+        };
+      };
+    });
+    await page.setInputFiles('#file-input', files);
+    // The first image detected: reload at once, the others still to do.
+    await page.waitForFunction(() => /\b[1-9]\d* with the target/.test(document.getElementById('image-summary').textContent), null, { timeout: 120000 });
+    await page.reload();
+    await ready(page);
+    await page.waitForFunction(() => window.__saved, null, { timeout: 10000 });
+    const saved = await page.evaluate(() => window.__saved);
+    assert.equal(saved.images, n, 'every image added before the reload was kept');
+    assert.ok(saved.detected < n, `the reload came during detection (${saved.detected} of ${n} detected)`);
+    // Detection goes on for the rest, without a click.
+    await page.waitForFunction((n) => document.getElementById('image-summary').textContent === `${n} files, ${n} decoded, ${n} with the target`
+      && document.getElementById('progress-row').hidden, n, { timeout: 180000 });
+    const metas = await page.$$eval('.card .meta', (ms) => ms.map((m) => m.textContent));
+    assert.equal(metas.length, n);
+    for (const m of metas) assert.match(m, /54 points/);
+    await shot('resumed');
+  }],
+  ['pose files dropped on the robot step are read as if chosen: several one-pose files at once, one pose table', async (page, { url, shot }) => {
+    const { poses } = renderedDemo();
+    const [head, ...rows] = poses.trim().split('\n').map((l) => l.split(','));
+    const col = (name) => head.indexOf(name);
+    // One ROS pose YAML per image, named by the image's stem.
+    const yaml = rows.map((r) => {
+      const v = (k) => Number(r[col(k)]);
+      const [qx, qy, qz, qw] = quaternionOf([v('rx'), v('ry'), v('rz')]);
+      return { name: r[col('image')].replace('.png', '.yaml'), text: `position: {x: ${v('x')}, y: ${v('y')}, z: ${v('z')}}\norientation: {x: ${qx}, y: ${qy}, z: ${qz}, w: ${qw}}\n` };
+    });
+    await page.goto(`${url}#robot`);
+    await ready(page);
+    await page.locator('#pose-form').waitFor({ timeout: 10000 });
+    const read = () => page.$$eval('#pose-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent).join(' ')));
+    // The file picker first: what a drop must give.
+    await page.setInputFiles('#pose-input', yaml.map((f) => ({ name: f.name, mimeType: 'text/plain', buffer: Buffer.from(f.text) })));
+    await page.locator('#pose-table').waitFor({ timeout: 20000 });
+    const chosen = { how: await page.textContent('#pose-format-used'), rows: await read() };
+    assert.match(chosen.how, /^12 pose files: 12 poses read as /);
+    assert.equal(chosen.rows.length, 12);
+    // A pose table dropped on the step's text.
+    assert.equal(await dropFiles(page, '#robot-title', [{ name: 'poses.csv', text: poses }]), true, 'the step is outlined while files are dragged over it');
+    await page.waitForFunction(() => /^poses\.csv: 12 poses read as /.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    assert.equal(await page.textContent('#pose-file-name'), 'loaded: poses.csv');
+    assert.equal(await page.$eval('#step-robot', (s) => s.classList.contains('over')), false);
+    // The one-pose files dropped together: the same reading as chosen with the picker.
+    await dropFiles(page, '#pose-form', yaml);
+    await page.waitForFunction(() => /^12 pose files: /.test(document.getElementById('pose-format-used')?.textContent || ''), null, { timeout: 20000 });
+    assert.equal(await page.textContent('#pose-format-used'), chosen.how);
+    assert.deepEqual(await read(), chosen.rows);
+    assert.equal(await page.textContent('#pose-file-name'), 'loaded: 12 pose files');
+    await shot('dropped');
+  }],
+);

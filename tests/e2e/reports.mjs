@@ -282,3 +282,48 @@ export const tests = [
     await shot('shared');
   }],
 ];
+
+tests.push(
+  ['the shared page shows what the link holds: residual plots from a sample, the hand-eye refinement over its views, the 3-D view of the robot poses', async (page, { url, shot, browser }) => {
+    await demoSolved(page, url);
+    const refinement = await page.textContent('#handeye-pose-refinement');
+    assert.match(refinement, / over 12 views, /);
+    const frames = await page.getAttribute('#frames-3d', 'data-frames');
+    await page.click('a[data-step=share]');
+    await page.click('#make-share');
+    await page.waitForFunction(() => document.getElementById('share-link').value.includes('#share='));
+    const link = await page.inputValue('#share-link');
+    console.log(`     share link with the residual sample: ${link.length} characters`);
+    assert.ok(link.length <= 6000, `share link ${link.length} characters`);
+    const payload = JSON.parse(inflateRawSync(Buffer.from(link.split('#share=')[1], 'base64url')).toString('utf8'));
+    const { kept, total } = payload.camera.residualsSampled;
+    assert.equal(total, 12 * 54);
+    assert.ok(kept >= 60 && kept <= 240, `${kept} residuals in the link`);
+    assert.equal(payload.camera.result.views.reduce((n, v) => n + v.residuals_px.length, 0), kept);
+    assert.equal(payload.handeye.robotPoses.length, 8);
+    const shared = await (await browser.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
+    const errors = [];
+    shared.on('pageerror', (e) => errors.push(e.message));
+    await shared.goto(link);
+    await shared.locator('#readonly-banner:not([hidden])').waitFor({ timeout: 20000 });
+    await shared.locator('#camera-params').waitFor({ timeout: 20000 });
+    // The residual plots draw the sample, and say it is one.
+    assert.match(await shared.textContent('#camera-results h3'), / over 12 views$/);
+    assert.equal(await shared.getAttribute('#plot-residuals', 'data-count'), String(kept));
+    assert.equal(await shared.getAttribute('#plot-vectors', 'data-count'), String(kept));
+    assert.equal(await shared.textContent('#camera-residual-sample'),
+      `The residual plots show a sample of ${kept} of the ${total} points (a share link carries a sample; the session file holds them all).`);
+    await shared.screenshot({ path: join(shotsDir, 'reports-shared-camera.png'), fullPage: true });
+    // The hand-eye: its refinement over as many views as on the page, the 3-D view with the robot poses.
+    await shared.click('a[data-step=handeye]');
+    await shared.locator('#handeye-pose-refinement').waitFor({ timeout: 20000 });
+    assert.equal(await shared.textContent('#handeye-pose-refinement'), refinement);
+    assert.equal(await shared.getAttribute('#frames-3d', 'data-frames'), frames);
+    assert.equal(frames, String(1 + 8 + 2), 'base, 8 grippers, camera and target');
+    await shared.locator('#frames-3d').scrollIntoViewIfNeeded();
+    await shared.screenshot({ path: join(shotsDir, 'reports-shared-3d.png'), fullPage: true });
+    assert.deepEqual(errors, []);
+    await shared.context().close();
+    await shot('shared-link');
+  }],
+);
