@@ -17,7 +17,7 @@ import { RigView } from './views/rig.js';
 import { ExportView } from './views/export.js';
 import { CheckView } from './views/check.js';
 import { LaserView } from './views/laser.js';
-import { ShareView, sharedFragment, decodeShare, sessionFile } from './views/share.js';
+import { ShareView, sharedFragment, decodeShare, sessionFile, restoreResiduals } from './views/share.js';
 
 const engine = new Engine();
 let robotView = null;
@@ -105,7 +105,12 @@ async function openShared(fragment) {
   }
   store.session = defaultSession();
   store.session.target = payload.target || store.session.target;
-  if (payload.camera) Object.assign(store.session.camera, payload.camera);
+  if (payload.camera) {
+    const { residualSample, ...camera } = payload.camera;
+    Object.assign(store.session.camera, camera);
+    // The link's sample of the residuals: drawn by the camera step's residual plots.
+    if (residualSample && camera.result) store.session.camera.residualsSampled = restoreResiduals(camera.result, residualSample);
+  }
   if (payload.handeye) Object.assign(store.session.handeye, payload.handeye);
   if (payload.plan) store.session.plan = { inputs: { view: null, fields: {} }, request: { setup: payload.plan.setup }, result: payload.plan.result };
   if (payload.check) store.session.check = payload.check;
@@ -122,7 +127,7 @@ async function openShared(fragment) {
   new PlanView(store, engine, { pairs: () => [] }, { readonly: true });
   new CheckView(store, engine, () => new Engine(), { readonly: true });
   new ExportView(store, engine);
-  new ShareView(store, version, () => camera.plots || []);
+  new ShareView(store, version, () => camera.plots || [], null, () => robotPoses);
   showStep(true);
   stepKeys();
   onHashChange(true, fragment);

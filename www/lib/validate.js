@@ -283,17 +283,14 @@ export function checkSharePayload(p) {
   if (p.camera !== undefined && p.camera !== null) {
     check.object(p.camera, 'camera');
     checkCameraResult(p.camera.result, 'camera.result');
-    // The residuals' sample (share.js): points drawn by the residual plots.
-    ((p.camera.result && p.camera.result.views) || []).forEach((v, i) => {
-      if (v.residuals_px === undefined) return;
-      check.list(v.residuals_px, `camera.result.views[${i}].residuals_px`).forEach((r, j) => {
-        check.object(r, `camera.result.views[${i}].residuals_px[${j}]`);
-        for (const key of ['x', 'y', 'dx', 'dy']) check.number(r[key], `camera.result.views[${i}].residuals_px[${j}].${key}`);
+    // The residuals' sample (share.js): x, y, dx, dy of each view's points, drawn by the residual plots.
+    if (p.camera.residualSample !== undefined) {
+      const sample = check.object(p.camera.residualSample, 'camera.residualSample');
+      check.number(sample.total, 'camera.residualSample.total');
+      check.list(sample.views, 'camera.residualSample.views').forEach((flat, i) => {
+        check.list(flat, `camera.residualSample.views[${i}]`).forEach((x, j) => check.number(x, `camera.residualSample.views[${i}][${j}]`));
+        if (flat.length % 4) throw new Error(`camera.residualSample.views[${i}] must hold 4 numbers a point (x, y, dx, dy), got ${flat.length}`);
       });
-    });
-    if (p.camera.residualsSampled !== undefined) {
-      check.object(p.camera.residualsSampled, 'camera.residualsSampled');
-      for (const key of ['kept', 'total']) check.number(p.camera.residualsSampled[key], `camera.residualsSampled.${key}`);
     }
   }
   if (p.handeye !== undefined && p.handeye !== null) {

@@ -98,26 +98,37 @@ export function compactResult(value, depth = 0) {
 /**
  * At most `budget` of the camera's residuals, spread over every view (every
  * k-th point), positions to 0.1 px and residuals to 1e-4 px: the shared
- * page's residual plots. Puts them on `result.views[i].residuals_px` and
- * returns `{ kept, total }` (null when none were kept).
+ * page's residual plots. `{ total, views }`, `views[i]` the flat
+ * [x, y, dx, dy, ...] of the result's view i; null when none are kept.
  */
-function residualSample(cam, result, budget) {
+function residualSample(cam, budget) {
   const views = Array.isArray(cam.views) ? cam.views : [];
   const total = views.reduce((n, v) => n + (Array.isArray(v.residuals_px) ? v.residuals_px.length : 0), 0);
-  if (!budget || !total || !Array.isArray(result.views)) return null;
+  if (!budget || !total) return null;
   const every = Math.ceil(total / budget);
   const tenth = (v) => Math.round(v * 10) / 10;
   let i = 0;
+  return {
+    total,
+    views: views.map((v) => (v.residuals_px || []).filter(() => i++ % every === 0)
+      .flatMap((r) => [tenth(r.x), tenth(r.y), Number(r.dx.toFixed(4)), Number(r.dy.toFixed(4))])),
+  };
+}
+
+/**
+ * A link's residual sample put back on the camera result's views (as
+ * `residuals_px`, what the residual plots draw); `{ kept, total }`.
+ */
+export function restoreResiduals(result, sample) {
   let kept = 0;
-  views.forEach((v, vi) => {
-    const sample = [];
-    for (const r of v.residuals_px || []) {
-      if (i++ % every === 0) sample.push({ x: tenth(r.x), y: tenth(r.y), dx: Number(r.dx.toFixed(4)), dy: Number(r.dy.toFixed(4)) });
-    }
-    if (result.views[vi]) result.views[vi].residuals_px = sample;
-    kept += sample.length;
+  sample.views.forEach((flat, vi) => {
+    const view = result.views && result.views[vi];
+    if (!view) return;
+    view.residuals_px = [];
+    for (let k = 0; k + 3 < flat.length; k += 4) view.residuals_px.push({ x: flat[k], y: flat[k + 1], dx: flat[k + 2], dy: flat[k + 3] });
+    kept += view.residuals_px.length;
   });
-  return { kept, total };
+  return { kept, total: sample.total };
 }
 
 /** Significant digits of the robot poses a link carries for the 3-D view. */
@@ -133,9 +144,8 @@ export function sharePayload(session, version, { residuals = 0, robotPoses = [] 
   const he = session.handeye.result;
   let camera = null;
   if (cam) {
-    const result = compactResult(cam);
-    const sampled = residualSample(cam, result, residuals);
-    camera = { result, comparison: session.camera.comparison, model: session.camera.model, method: session.camera.method, ...(sampled ? { residualsSampled: sampled } : {}) };
+    const sample = residualSample(cam, residuals);
+    camera = { result: compactResult(cam), comparison: session.camera.comparison, model: session.camera.model, method: session.camera.method, ...(sample ? { residualSample: sample } : {}) };
   }
   const round = (v) => Number(v.toPrecision(POSE_DIGITS));
   const poses = (robotPoses || []).map((p) => ({ translation_m: p.translation_m.map(round), quaternion_xyzw: p.quaternion_xyzw.map(round) }));
