@@ -298,7 +298,7 @@ tests.push(
     const yaml = rows.map((r) => {
       const v = (k) => Number(r[col(k)]);
       const [qx, qy, qz, qw] = quaternionOf([v('rx'), v('ry'), v('rz')]);
-      return { name: r[col('image')].replace('.png', '.yaml'), text: `position: {x: ${v('x')}, y: ${v('y')}, z: ${v('z')}}\norientation: {x: ${qx}, y: ${qy}, z: ${qz}, w: ${qw}}\n` };
+      return { name: r[col('name')].replace('.png', '.yaml'), text: `position: {x: ${v('x')}, y: ${v('y')}, z: ${v('z')}}\norientation: {x: ${qx}, y: ${qy}, z: ${qz}, w: ${qw}}\n` };
     });
     await page.goto(`${url}#robot`);
     await ready(page);
