@@ -109,7 +109,12 @@ async function openShared(fragment) {
     const { residualSample, ...camera } = payload.camera;
     Object.assign(store.session.camera, camera);
     // The link's sample of the residuals: drawn by the camera step's residual plots.
-    if (residualSample && camera.result) store.session.camera.residualsSampled = restoreResiduals(camera.result, residualSample);
+    // A damaged sample is left out (the page says the link carries no residuals).
+    try {
+      if (residualSample && camera.result) store.session.camera.residualsSampled = restoreResiduals(camera.result, residualSample);
+    } catch (err) {
+      console.warn(err);
+    }
   }
   if (payload.handeye) Object.assign(store.session.handeye, payload.handeye);
   if (payload.plan) store.session.plan = { inputs: { view: null, fields: {} }, request: { setup: payload.plan.setup }, result: payload.plan.result };

@@ -283,14 +283,15 @@ export function checkSharePayload(p) {
   if (p.camera !== undefined && p.camera !== null) {
     check.object(p.camera, 'camera');
     checkCameraResult(p.camera.result, 'camera.result');
-    // The residuals' sample (share.js): x, y, dx, dy of each view's points, drawn by the residual plots.
+    // The residuals' sample (share.js): packed points, drawn by the residual plots.
     if (p.camera.residualSample !== undefined) {
       const sample = check.object(p.camera.residualSample, 'camera.residualSample');
-      check.number(sample.total, 'camera.residualSample.total');
-      check.list(sample.views, 'camera.residualSample.views').forEach((flat, i) => {
-        check.list(flat, `camera.residualSample.views[${i}]`).forEach((x, j) => check.number(x, `camera.residualSample.views[${i}][${j}]`));
-        if (flat.length % 4) throw new Error(`camera.residualSample.views[${i}] must hold 4 numbers a point (x, y, dx, dy), got ${flat.length}`);
+      for (const key of ['total', 'step_px']) check.number(sample[key], `camera.residualSample.${key}`);
+      check.list(sample.counts, 'camera.residualSample.counts').forEach((n, i) => {
+        if (!Number.isInteger(n) || n < 0) fail(`camera.residualSample.counts[${i}]`, 'a whole number >= 0', n);
       });
+      check.string(sample.data, 'camera.residualSample.data');
+      if (!/^[A-Za-z0-9+/]*={0,2}$/.test(sample.data)) fail('camera.residualSample.data', 'base64 text', sample.data);
     }
   }
   if (p.handeye !== undefined && p.handeye !== null) {

@@ -73,15 +73,22 @@ const EXACT = new Set(['camera', 'camera_matrix', 'distortion', 'rms_px', 'std']
 const LINK_DIGITS = 7;
 
 /**
+ * Keys drawn, never read as numbers, on the shared page, and their
+ * significant digits: the projection uncertainty map (colours) and the
+ * correlation matrix (|r| > 0.95 named to 3 decimals).
+ */
+const COARSE = new Map([['projection_uncertainty', 3], ['correlation', 5]]);
+
+/**
  * A result without its per-point and per-motion data (a few KB): what a
  * link carries. Arrays of per-run samples (repeatability) go too, and the
  * matrix of a transform nested below the top level (the methods' rows keep
  * translation and quaternion); the per-view rows keep their name, RMS and
- * point counts. Numbers keep LINK_DIGITS significant digits.
+ * point counts. Numbers keep LINK_DIGITS significant digits (COARSE's keys fewer).
  */
-export function compactResult(value, depth = 0) {
-  if (typeof value === 'number') return Number.isFinite(value) ? Number(value.toPrecision(LINK_DIGITS)) : value;
-  if (Array.isArray(value)) return value.map((v) => compactResult(v, depth + 1));
+export function compactResult(value, depth = 0, digits = LINK_DIGITS) {
+  if (typeof value === 'number') return Number.isFinite(value) ? Number(value.toPrecision(digits)) : value;
+  if (Array.isArray(value)) return value.map((v) => compactResult(v, depth + 1, digits));
   if (!value || typeof value !== 'object') return value;
   const out = {};
   const pose = 'translation_m' in value && 'quaternion_xyzw' in value;
@@ -90,43 +97,61 @@ export function compactResult(value, depth = 0) {
     // The results themselves (camera, its matrix and coefficients, the
     // transforms) keep every digit: the shared page shows and exports them.
     const exact = depth === 0 && (EXACT.has(k) || (v && typeof v === 'object' && 'translation_m' in v));
-    out[k] = exact ? v : compactResult(v, depth + 1);
+    out[k] = exact ? v : compactResult(v, depth + 1, Math.min(digits, COARSE.get(k) || digits));
   }
   return out;
 }
 
 /**
  * At most `budget` of the camera's residuals, spread over every view (every
- * k-th point), positions to 0.1 px and residuals to 1e-4 px: the shared
- * page's residual plots. `{ total, views }`, `views[i]` the flat
- * [x, y, dx, dy, ...] of the result's view i; null when none are kept.
+ * k-th point): the shared page's residual plots. Packed as 6 bytes a point
+ * (x and y in whole pixels, unsigned 16-bit; dx and dy signed 8-bit in
+ * steps of `step_px`, 1/127 of the largest residual kept), base64:
+ * `{ total, step_px, counts, data }`, `counts[i]` the points of the
+ * result's view i; null when none are kept.
  */
 function residualSample(cam, budget) {
   const views = Array.isArray(cam.views) ? cam.views : [];
   const total = views.reduce((n, v) => n + (Array.isArray(v.residuals_px) ? v.residuals_px.length : 0), 0);
   if (!budget || !total) return null;
   const every = Math.ceil(total / budget);
-  const tenth = (v) => Math.round(v * 10) / 10;
   let i = 0;
-  return {
-    total,
-    views: views.map((v) => (v.residuals_px || []).filter(() => i++ % every === 0)
-      .flatMap((r) => [tenth(r.x), tenth(r.y), Number(r.dx.toFixed(4)), Number(r.dy.toFixed(4))])),
-  };
+  const kept = views.map((v) => (Array.isArray(v.residuals_px) ? v.residuals_px : []).filter(() => i++ % every === 0));
+  const points = kept.flat();
+  const largest = Math.max(...points.map((r) => Math.max(Math.abs(r.dx), Math.abs(r.dy))), 1e-9);
+  const step = Number((largest / 127).toPrecision(4)) || 1e-9;
+  const bytes = new Uint8Array(points.length * 6);
+  const data = new DataView(bytes.buffer);
+  const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, Math.round(v)));
+  points.forEach((r, k) => {
+    data.setUint16(6 * k, clamp(r.x, 0, 65535), true);
+    data.setUint16(6 * k + 2, clamp(r.y, 0, 65535), true);
+    data.setInt8(6 * k + 4, clamp(r.dx / step, -127, 127));
+    data.setInt8(6 * k + 5, clamp(r.dy / step, -127, 127));
+  });
+  let text = '';
+  for (const b of bytes) text += String.fromCharCode(b);
+  return { total, step_px: step, counts: kept.map((k) => k.length), data: btoa(text) };
 }
 
 /**
  * A link's residual sample put back on the camera result's views (as
- * `residuals_px`, what the residual plots draw); `{ kept, total }`.
+ * `residuals_px`, what the residual plots draw); `{ kept, total }`. Throws
+ * when the sample does not hold its counts' points.
  */
 export function restoreResiduals(result, sample) {
-  let kept = 0;
-  sample.views.forEach((flat, vi) => {
+  const bytes = Uint8Array.from(atob(sample.data), (c) => c.charCodeAt(0));
+  const kept = sample.counts.reduce((a, b) => a + b, 0);
+  if (bytes.length !== 6 * kept) throw new Error(`the residual sample holds ${bytes.length} bytes, not the ${6 * kept} of its ${kept} points`);
+  const data = new DataView(bytes.buffer);
+  let k = 0;
+  sample.counts.forEach((n, vi) => {
     const view = result.views && result.views[vi];
-    if (!view) return;
-    view.residuals_px = [];
-    for (let k = 0; k + 3 < flat.length; k += 4) view.residuals_px.push({ x: flat[k], y: flat[k + 1], dx: flat[k + 2], dy: flat[k + 3] });
-    kept += view.residuals_px.length;
+    const points = [];
+    for (let j = 0; j < n; j++, k++) {
+      points.push({ x: data.getUint16(6 * k, true), y: data.getUint16(6 * k + 2, true), dx: data.getInt8(6 * k + 4) * sample.step_px, dy: data.getInt8(6 * k + 5) * sample.step_px });
+    }
+    if (view) view.residuals_px = points;
   });
   return { kept, total: sample.total };
 }
@@ -208,9 +233,9 @@ export function readSessionFile(text) {
 }
 
 /** Residual samples tried, largest first, until the link fits in LINK_CHARS. */
-const RESIDUAL_BUDGETS = [240, 120, 60, 0];
+const RESIDUAL_BUDGETS = [240, 180, 120, 90, 60, 40, 0];
 /** The longest link made with a residual sample (characters; browsers and servers take 8 KB request lines). */
-const LINK_CHARS = 6000;
+const LINK_CHARS = 6400;
 
 export class ShareView {
   /**
