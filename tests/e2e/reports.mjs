@@ -301,7 +301,7 @@ tests.push(
     assert.equal(sample.counts.length, 12);
     const kept = sample.counts.reduce((n, c) => n + c, 0);
     const total = sample.total;
-    assert.equal(Buffer.from(sample.data, 'base64').length, 6 * kept);
+    assert.equal(Buffer.from(sample.data, 'base64').length, 4 * kept);
     assert.ok(kept >= 30 && kept <= 240, `${kept} residuals in the link`);
     assert.equal(payload.handeye.robotPoses.length, 8);
     const shared = await (await browser.newContext({ viewport: { width: 1280, height: 900 } })).newPage();

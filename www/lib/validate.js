@@ -287,6 +287,7 @@ export function checkSharePayload(p) {
     if (p.camera.residualSample !== undefined) {
       const sample = check.object(p.camera.residualSample, 'camera.residualSample');
       for (const key of ['total', 'step_px']) check.number(sample[key], `camera.residualSample.${key}`);
+      numbers(sample.image_size_px, 'camera.residualSample.image_size_px', 2);
       check.list(sample.counts, 'camera.residualSample.counts').forEach((n, i) => {
         if (!Number.isInteger(n) || n < 0) fail(`camera.residualSample.counts[${i}]`, 'a whole number >= 0', n);
       });

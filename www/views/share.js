@@ -104,34 +104,30 @@ export function compactResult(value, depth = 0, digits = LINK_DIGITS) {
 
 /**
  * At most `budget` of the camera's residuals, spread over every view (every
- * k-th point): the shared page's residual plots. Packed as 6 bytes a point
- * (x and y in whole pixels, unsigned 16-bit; dx and dy signed 8-bit in
- * steps of `step_px`, 1/127 of the largest residual kept), base64:
- * `{ total, step_px, counts, data }`, `counts[i]` the points of the
- * result's view i; null when none are kept.
+ * k-th point): the shared page's residual plots. Packed as 4 bytes a point,
+ * base64: x and y in 256ths of the image's width and height, dx and dy
+ * signed in steps of `step_px` (1/127 of the largest residual kept):
+ * `{ total, image_size_px, step_px, counts, data }`, `counts[i]` the
+ * points of the result's view i; null when none are kept.
  */
 function residualSample(cam, budget) {
   const views = Array.isArray(cam.views) ? cam.views : [];
   const total = views.reduce((n, v) => n + (Array.isArray(v.residuals_px) ? v.residuals_px.length : 0), 0);
-  if (!budget || !total) return null;
+  const size = cam.image_size_px;
+  if (!budget || !total || !Array.isArray(size)) return null;
   const every = Math.ceil(total / budget);
   let i = 0;
   const kept = views.map((v) => (Array.isArray(v.residuals_px) ? v.residuals_px : []).filter(() => i++ % every === 0));
   const points = kept.flat();
   const largest = Math.max(...points.map((r) => Math.max(Math.abs(r.dx), Math.abs(r.dy))), 1e-9);
-  const step = Number((largest / 127).toPrecision(4)) || 1e-9;
-  const bytes = new Uint8Array(points.length * 6);
-  const data = new DataView(bytes.buffer);
+  const step = Number((largest / 127).toPrecision(4));
   const clamp = (v, lo, hi) => Math.min(hi, Math.max(lo, Math.round(v)));
-  points.forEach((r, k) => {
-    data.setUint16(6 * k, clamp(r.x, 0, 65535), true);
-    data.setUint16(6 * k + 2, clamp(r.y, 0, 65535), true);
-    data.setInt8(6 * k + 4, clamp(r.dx / step, -127, 127));
-    data.setInt8(6 * k + 5, clamp(r.dy / step, -127, 127));
-  });
   let text = '';
-  for (const b of bytes) text += String.fromCharCode(b);
-  return { total, step_px: step, counts: kept.map((k) => k.length), data: btoa(text) };
+  for (const r of points) {
+    const q = [clamp((r.x / size[0]) * 256 - 0.5, 0, 255), clamp((r.y / size[1]) * 256 - 0.5, 0, 255), clamp(r.dx / step, -127, 127) & 255, clamp(r.dy / step, -127, 127) & 255];
+    text += String.fromCharCode(...q);
+  }
+  return { total, image_size_px: size, step_px: step, counts: kept.map((k) => k.length), data: btoa(text) };
 }
 
 /**
@@ -142,31 +138,52 @@ function residualSample(cam, budget) {
 export function restoreResiduals(result, sample) {
   const bytes = Uint8Array.from(atob(sample.data), (c) => c.charCodeAt(0));
   const kept = sample.counts.reduce((a, b) => a + b, 0);
-  if (bytes.length !== 6 * kept) throw new Error(`the residual sample holds ${bytes.length} bytes, not the ${6 * kept} of its ${kept} points`);
-  const data = new DataView(bytes.buffer);
+  if (bytes.length !== 4 * kept) throw new Error(`the residual sample holds ${bytes.length} bytes, not the ${4 * kept} of its ${kept} points`);
+  const [w, hgt] = sample.image_size_px;
+  const signed = (b) => (b > 127 ? b - 256 : b);
   let k = 0;
   sample.counts.forEach((n, vi) => {
-    const view = result.views && result.views[vi];
     const points = [];
-    for (let j = 0; j < n; j++, k++) {
-      points.push({ x: data.getUint16(6 * k, true), y: data.getUint16(6 * k + 2, true), dx: data.getInt8(6 * k + 4) * sample.step_px, dy: data.getInt8(6 * k + 5) * sample.step_px });
+    for (let j = 0; j < n; j++, k += 4) {
+      points.push({ x: ((bytes[k] + 0.5) * w) / 256, y: ((bytes[k + 1] + 0.5) * hgt) / 256, dx: signed(bytes[k + 2]) * sample.step_px, dy: signed(bytes[k + 3]) * sample.step_px });
     }
-    if (view) view.residuals_px = points;
+    if (result.views && result.views[vi]) result.views[vi].residuals_px = points;
   });
   return { kept, total: sample.total };
 }
 
+/**
+ * The hand-eye methods' rows as the shared page's table shows them: each
+ * camera transform's translation (no rotation, no target transform).
+ */
+function compactMethods(rows) {
+  const shown = ['gripper_from_camera', 'base_from_camera'];
+  const hidden = ['base_from_target', 'gripper_from_target'];
+  return rows.map((row) => {
+    if (!row || typeof row !== 'object') return row;
+    const out = {};
+    for (const [k, v] of Object.entries(row)) {
+      if (hidden.includes(k)) continue;
+      out[k] = shown.includes(k) && v && Array.isArray(v.translation_m) ? { translation_m: v.translation_m } : v;
+    }
+    return out;
+  });
+}
+
 /** Significant digits of the robot poses a link carries for the 3-D view. */
-const POSE_DIGITS = 5;
+const POSE_DIGITS = 4;
 
 /**
  * What a link (and the HTML report's JSON) holds. `residuals`: how many of
  * the camera's residuals to carry (a sample; 0: none); `robotPoses`: the
- * base_from_gripper poses of the hand-eye step's 3-D view.
+ * base_from_gripper poses of the hand-eye step's 3-D view; `link`: the
+ * hand-eye methods' rows as the shared page shows them.
  */
-export function sharePayload(session, version, { residuals = 0, robotPoses = [] } = {}) {
+export function sharePayload(session, version, { residuals = 0, robotPoses = [], link = false } = {}) {
   const cam = session.camera.result;
-  const he = session.handeye.result;
+  const he0 = session.handeye.result;
+  // A link's methods rows as its table shows them (the HTML report's JSON keeps them whole).
+  const he = he0 && link && Array.isArray(he0.methods) ? { ...he0, methods: compactMethods(he0.methods) } : he0;
   let camera = null;
   if (cam) {
     const sample = residualSample(cam, residuals);
@@ -302,7 +319,7 @@ export class ShareView {
     const robotPoses = this.store.session.handeye.result ? this.robotPoses() : [];
     let data = '';
     for (const residuals of RESIDUAL_BUDGETS) {
-      data = await encodeShare(sharePayload(this.store.session, this.version, { residuals, robotPoses }));
+      data = await encodeShare(sharePayload(this.store.session, this.version, { residuals, robotPoses, link: true }));
       if (base.length + data.length <= LINK_CHARS) break;
     }
     this.link.value = `${base}${data}`;
