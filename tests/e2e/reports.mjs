@@ -303,6 +303,7 @@ tests.push(
     const total = sample.total;
     assert.equal(Buffer.from(sample.data, 'base64').length, 4 * kept);
     assert.ok(kept >= 30 && kept <= 240, `${kept} residuals in the link`);
+    console.log(`     residuals in the link: ${kept} of ${total}`);
     assert.equal(payload.handeye.robotPoses.length, 8);
     const shared = await (await browser.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
     const errors = [];
