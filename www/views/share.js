@@ -280,7 +280,7 @@ export class ShareView {
     this.link = h('input', { type: 'text', readonly: true, id: 'share-link', 'aria-label': 'share link', class: 'wide' });
     this.status = h('p', { class: 'hint', 'aria-live': 'polite', id: 'share-status' });
     fill($('share-panel'),
-      h('p', {}, 'The link holds the results (camera, transforms, errors, the pose plan, the last check; not the images or the detections) compressed in its fragment (after #), which browsers never send to a server. Whoever opens it sees a read-only results page.'),
+      h('p', {}, 'The link holds the results (camera, transforms, errors, a sample of the residuals, the robot poses of the 3-D view, the pose plan, the last check; not the images or the detections) compressed in its fragment (after #), which browsers never send to a server. Whoever opens it sees a read-only results page.'),
       h('div', { class: 'row' },
         h('button', { type: 'button', class: 'primary', id: 'make-share', onclick: () => this.makeLink() }, 'Create share link'),
         h('button', { type: 'button', id: 'copy-share', onclick: () => this.copy() }, 'Copy link'),
