@@ -132,5 +132,11 @@ tests.push(
     // After a refusal a report loads again, and the check is ready for it.
     assert.equal(await info(file('rig.json', rig)), 'rig.json (json: camera top (the first of 2) of a rig report): 800 × 600, fx 720.0, fy 720.0, cx 399.5, cy 299.5');
     assert.equal(await page.isEnabled('#check-images'), true);
+    // A report given as a session file: named by its kind, and where it loads.
+    await page.evaluate(() => { location.hash = 'share'; });
+    await page.setInputFiles('#session-input', file('rig.json', rig));
+    await page.waitForFunction(() => document.getElementById('session-status').textContent !== '', null, { timeout: 10000 });
+    assert.equal(await page.textContent('#session-status'),
+      "rig.json: this file is a robocal 'rig' report, not a session file: a report loads where the page takes a camera file (the check step, a rig camera's intrinsics, the laser step)");
   }],
 );

@@ -5,6 +5,7 @@
 import { $, h, fill, download, message } from '../lib/dom.js';
 import { reportHtml } from './report.js';
 import { checkSession, checkSharePayload } from '../lib/validate.js';
+import { REPORT_KINDS } from '../lib/reports.js';
 
 const PREFIX = '#share=';
 
@@ -238,6 +239,10 @@ export function sessionFile(session, version) {
 export function readSessionFile(text) {
   let doc;
   try { doc = JSON.parse(text); } catch (e) { throw new Error('this file is not a robocal session file (it is not JSON)'); }
+  // A calibration report (its kind, docs/report-json.md) is no session: say where it loads.
+  if (doc && typeof doc.kind === 'string' && REPORT_KINDS.includes(doc.kind)) {
+    throw new Error(`this file is a robocal '${doc.kind}' report, not a session file: a report loads where the page takes a camera file (the check step, a rig camera's intrinsics, the laser step)`);
+  }
   if (!doc || doc.kind !== 'robocal-session' || doc.schema !== 1 || !doc.session || typeof doc.session !== 'object') {
     throw new Error('this file is not a robocal session file (save one with "Download session file")');
   }
