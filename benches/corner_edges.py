@@ -134,8 +134,7 @@ def main():
     if a.render:
         truth = json.load(open(os.path.join(a.render, "truth.json")))
         images = [os.path.join(a.render, v["image"]) for v in truth["views"]]
-        k = truth["camera"]["camera_matrix"] if "camera_matrix" in truth["camera"] else None
-        pp = np.array([k[0][2], k[1][2]]) if k else np.array([float(v) for v in a.pp.split(",")])
+        pp = np.array([truth["camera"]["cx"], truth["camera"]["cy"]])
         truth = {v["image"]: np.array([[p["x_px"], p["y_px"]] for p in v["points"]]) for v in truth["views"]}
     else:
         images = sorted(glob.glob(a.images))

@@ -100,8 +100,7 @@ def main():
         else:
             t = json.load(open(os.path.join(s, "truth.json")))
             images = [os.path.join(s, v["image"]) for v in t["views"]]
-            k = t["camera"]["camera_matrix"]
-            pp = np.array([k[0][2], k[1][2]])
+            pp = np.array([t["camera"]["cx"], t["camera"]["cy"]])
             truth = {v["image"]: np.array([[p["x_px"], p["y_px"]] for p in v["points"]]) for v in t["views"]}
         sets, names, size = corner_sets(images, maxima)
         ids = [list(range(COLS * ROWS))] * len(names)
