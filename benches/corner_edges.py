@@ -29,17 +29,38 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from real_sets import cv2, dataset_dir  # noqa: E402  (settles the venv)
 import numpy as np  # noqa: E402
-from scipy.ndimage import map_coordinates, spline_filter  # noqa: E402
 
 COLS, ROWS = 9, 6
 
 
+def sample(img, x, y):
+    """Cubic-convolution (Keys, a = -0.5) interpolation of img at float
+    coordinates x, y (pixel centres at integers, edges replicated)."""
+    x, y = np.asarray(x, np.float64), np.asarray(y, np.float64)
+    ix, iy = np.floor(x).astype(int), np.floor(y).astype(int)
+
+    def weights(f):
+        t = np.stack([1 + f, f, 1 - f, 2 - f])
+        a = -0.5
+        near = (a + 2) * t ** 3 - (a + 3) * t ** 2 + 1
+        far = a * t ** 3 - 5 * a * t ** 2 + 8 * a * t - 4 * a
+        return np.where(t <= 1, near, far)
+
+    wx, wy = weights(x - ix), weights(y - iy)
+    h, w = img.shape
+    out = np.zeros_like(x)
+    for j in range(4):
+        yy = np.clip(iy + j - 1, 0, h - 1)
+        for i in range(4):
+            out += wy[j] * wx[i] * img[yy, np.clip(ix + i - 1, 0, w - 1)]
+    return out
+
+
 def edge_point(img, p, n, reach=7.0):
-    """Gradient centroid of the profile through p along unit normal n
-    (img: cubic-spline coefficients, scipy's spline_filter)."""
+    """Gradient centroid of the profile through p along unit normal n."""
     s = np.arange(-reach, reach + 1e-9, 0.25)
     xy = p[None, :] + s[:, None] * n[None, :]
-    v = map_coordinates(img, [xy[:, 1], xy[:, 0]], order=3, mode="nearest", prefilter=False)
+    v = sample(img, xy[:, 0], xy[:, 1])
     # The signed derivative, no threshold: a threshold or |d| would clip
     # the PSF's asymmetric tail or pull the centroid to the profile's middle.
     d = np.diff(v)
@@ -155,7 +176,7 @@ def main():
         sets = {f"cornerSubPix {2 * h + 1}x{2 * h + 1}": cv2.cornerSubPix(gray, c.copy(), (h, h), (-1, -1), crit)
                 .reshape(-1, 2).astype(np.float64) for h in (3, 5, 7)}
         g = sets["cornerSubPix 15x15"].reshape(ROWS, COLS, 2)
-        img = spline_filter(gray.astype(np.float64), order=3, mode="nearest")
+        img = gray.astype(np.float64)
         inner = [(i, j) for j in range(ROWS) for i in range(COLS)] if a.all_corners else \
             [(i, j) for j in range(1, ROWS - 1) for i in range(1, COLS - 1)]
         edge = np.array([edge_corner(img, g, i, j) for i, j in inner])

@@ -24,25 +24,23 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from corner_edges import calibrate  # noqa: E402
+from corner_edges import calibrate, sample  # noqa: E402
 from real_sets import cv2, dataset_dir  # noqa: E402  (settles the venv)
 import numpy as np  # noqa: E402
-from scipy.ndimage import map_coordinates, spline_filter  # noqa: E402
 
 COLS, ROWS = 9, 6
 PP = {"left": (341.586, 234.259), "right": (326.472, 249.333)}  # Bouguet's example 5
 
 
-def saddle(coef, c, w):
-    """The saddle fit at half-window w from c (coef: spline coefficients
-    of the smoothed image)."""
+def saddle(smooth, c, w):
+    """The saddle fit at half-window w from c on the smoothed image."""
     n = int(np.floor(1.5 * w))
     t = np.arange(-n, n + 1.0)
     u, v = (a.ravel() for a in np.meshgrid(t, t))
     sw = np.sqrt(np.exp(-(u * u + v * v) / (2 * (0.5 * w) ** 2)))
     a = np.c_[u * u, u * v, v * v, u, v, np.ones_like(u)] * sw[:, None]
     for _ in range(10):
-        z = map_coordinates(coef, [c[1] + v, c[0] + u], order=3, mode="nearest", prefilter=False)
+        z = sample(smooth, c[0] + u, c[1] + v)
         p = np.linalg.lstsq(a, z * sw, rcond=None)[0]
         step = -np.linalg.solve(np.array([[2 * p[0], p[1]], [p[1], 2 * p[2]]]), p[3:5])
         c = c + step
@@ -70,8 +68,7 @@ def corner_sets(images, maxima):
         for mx in maxima:
             w = min(max(np.median(steps) / 6.0, 2.5), mx)
             smooth = cv2.GaussianBlur(gray.astype(np.float64), (0, 0), max(w / 3.5, 1.0))
-            coef = spline_filter(smooth, order=3, mode="nearest")
-            out[mx].append(np.array([saddle(coef, q.copy(), w) for q in ref]))
+            out[mx].append(np.array([saddle(smooth, q.copy(), w) for q in ref]))
     return out, names, size
 
 
