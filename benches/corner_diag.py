@@ -7,8 +7,16 @@ square size; the offsets are projected on the direction away from the
 board's corner centroid ("outward", what moves the focal length) and on the
 two local grid directions.
 
+--split: which part of the difference moves the calibration. Calibrations
+(`robocal intrinsics --detections`, k1 k2 p1 p2, k3 held, all views'
+corners with OpenCV's order as ids) from cornerSubPix 15x15's corners,
+from robocal's, and from cornerSubPix's plus one part of the difference:
+its per-image affine part (a least-squares affine map of each view's
+corners: the board looking larger, shifted or sheared), its global radial
+part about --pp (s1 r + s3 r^3) and the rest (per corner, not affine).
+
 Usage (crate root): python3 benches/corner_diag.py --robocal target/debug/robocal
-  [--images 'DIR/left*.jpg'] [--cols 9 --rows 6] [--per-image]
+  [--images 'DIR/left*.jpg'] [--cols 9 --rows 6] [--per-image] [--split --pp 341.586,234.259]
 """
 import argparse
 import glob
@@ -35,6 +43,32 @@ def cv_corners(gray, cols, rows, half):
     return c.reshape(-1, 2).astype(np.float64), out
 
 
+def split(robocal, pairs, size, pp, cols, rows):
+    import corner_edges
+
+    corner_edges.COLS, corner_edges.ROWS = cols, rows
+    ids = [list(range(cols * rows))] * len(pairs)
+    cv = [c for c, _ in pairs]
+    affine = []
+    for c, r in pairs:
+        x = np.c_[c - c.mean(0), np.ones(len(c))]
+        affine.append(c + x @ np.linalg.lstsq(x, r - c, rcond=None)[0])
+    p = np.vstack(cv) - pp
+    d = np.vstack([r for _, r in pairs]) - np.vstack(cv)
+    r2 = (p ** 2).sum(1) / 1e4
+    x = np.r_[np.c_[p[:, 0], p[:, 0] * r2], np.c_[p[:, 1], p[:, 1] * r2]]
+    s1, s3 = np.linalg.lstsq(x, np.r_[d[:, 0], d[:, 1]], rcond=None)[0]
+    radial = [c + (c - pp) * (s1 + s3 * ((c - pp) ** 2).sum(1)[:, None] / 1e4) for c in cv]
+    print(f"split: radial part of robocal - cornerSubPix 15x15 about {pp}: s1 {s1:.2e}, s3 {s3:.2e} per 1e4 px^2")
+    for label, views in [("cornerSubPix 15x15", cv), ("robocal", [r for _, r in pairs]),
+                         ("cornerSubPix + per-image affine part", affine),
+                         ("cornerSubPix + global radial part", radial),
+                         ("cornerSubPix + the rest (not affine)", [r - (a_ - c) for (c, r), a_ in zip(pairs, affine)])]:
+        q = corner_edges.calibrate(robocal, views, ids, size)
+        print(f"  {label:38s} fx {q['fx']:.3f} (std {q['sfx']:.3f}) fy {q['fy']:.3f} cx {q['cx']:.3f} cy {q['cy']:.3f}, "
+              f"rms {q['rms']:.4f} px")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--robocal", default=os.path.join(os.path.dirname(HERE), "target", "debug", "robocal"))
@@ -44,6 +78,8 @@ def main():
     ap.add_argument("--rows", type=int, default=6)
     ap.add_argument("--per-image", action="store_true")
     ap.add_argument("--dump", help="write every corner's offsets to this .npy")
+    ap.add_argument("--split", action="store_true", help="calibrate from the parts of the difference (above)")
+    ap.add_argument("--pp", default="341.586,234.259", help="principal point for --split's radial part")
     a = ap.parse_args()
     images = sorted(glob.glob(a.images))
     if not images:
@@ -54,7 +90,7 @@ def main():
                         "-o", out, *images], check=True, capture_output=True)
         det = json.load(open(out))
     by_name = {os.path.basename(e["file"]): e.get("detection") for e in det["images"]}
-    rows_out = []
+    rows_out, pairs, size = [], [], None
     for path in images:
         gray = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
         coarse, sub = cv_corners(gray, a.cols, a.rows, [7, 5])
@@ -66,6 +102,8 @@ def main():
         rc_all = np.array([[p["x_px"], p["y_px"]] for p in dd["points"]])
         ref = sub[7]
         rc = np.array([rc_all[np.argmin(((rc_all - q) ** 2).sum(1))] for q in ref])
+        pairs.append((ref, rc))
+        size = gray.shape[::-1]
         sbm = None
         if ok:
             sb = sb.reshape(-1, 2).astype(np.float64)
@@ -121,6 +159,8 @@ def main():
         summ([r for r in rows_out if lo <= r["step"] < hi], f"square {lo}-{hi} px")
     for lo, hi in [(0, 100), (100, 200), (200, 300), (300, 800)]:
         summ([r for r in rows_out if lo <= r["r"] < hi], f"radius {lo}-{hi} px")
+    if a.split:
+        split(a.robocal, pairs, size, np.array([float(v) for v in a.pp.split(",")]), a.cols, a.rows)
     if a.per_image:
         by = collections.defaultdict(list)
         for r in rows_out:
