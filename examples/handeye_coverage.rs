@@ -130,7 +130,9 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
         let dt = (result.x.translation.vector - scene.x_true.translation.vector) * 1e3;
         let dr = (result.x.rotation * scene.x_true.rotation.inverse()).scaled_axis();
         (0..3)
-            .map(|k| dt[k].abs() / std.translation_mm[k] + dr[k].to_degrees().abs() / std.rotation_deg[k])
+            .map(|k| {
+                dt[k].abs() / std.translation_mm[k] + dr[k].to_degrees().abs() / std.rotation_deg[k]
+            })
             .sum::<f64>()
             / 6.0
     };

@@ -148,12 +148,12 @@ mod tests {
     #[test]
     fn the_t_tail_matches_closed_forms() {
         // nu = 1 (Cauchy): P(|T| > t) = 1 - 2 atan(t) / pi.
-        for t in [0.5, 1.0, 3.0, 10.0] {
+        for t in [0.5f64, 1.0, 3.0, 10.0] {
             let exact = 1.0 - 2.0 * f64::atan(t) / std::f64::consts::PI;
             assert!((two_sided_tail(t, 1.0) - exact).abs() < 1e-12, "t = {t}");
         }
         // nu = 2: P(|T| > t) = 1 - t / sqrt(2 + t^2).
-        for t in [0.5, 2.0, 7.0] {
+        for t in [0.5f64, 2.0, 7.0] {
             let exact = 1.0 - t / (2.0 + t * t).sqrt();
             assert!((two_sided_tail(t, 2.0) - exact).abs() < 1e-12, "t = {t}");
         }

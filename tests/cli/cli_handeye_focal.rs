@@ -105,7 +105,11 @@ fn truth_within_3_std(report: &Value) -> Result<(), String> {
             return Err(format!("t[{k}] {t_mm} mm, std {}", s("translation_mm", k)));
         }
         if angle_deg[k].abs() > 3.0 * s("rotation_deg", k) {
-            return Err(format!("r[{k}] {} deg, std {}", angle_deg[k], s("rotation_deg", k)));
+            return Err(format!(
+                "r[{k}] {} deg, std {}",
+                angle_deg[k],
+                s("rotation_deg", k)
+            ));
         }
     }
     Ok(())
@@ -130,8 +134,14 @@ fn rwhe_focal_check_is_quiet_at_the_right_focal_length_and_covers_a_wrong_one() 
     let short = rwhe_report(&dir, &tmp, 1078.88);
     let named = warnings(&short, "focal length:");
     assert_eq!(named.len(), 1, "{:?}", short["warnings"]);
-    assert!(named[0].contains("(fx 1080.0 px, fy 1080.0 px)"), "{}", named[0]);
-    let scale = short["pose_refinement"]["focal_check"]["scale"].as_f64().unwrap();
+    assert!(
+        named[0].contains("(fx 1080.0 px, fy 1080.0 px)"),
+        "{}",
+        named[0]
+    );
+    let scale = short["pose_refinement"]["focal_check"]["scale"]
+        .as_f64()
+        .unwrap();
     assert!((scale - 1080.0 / 1078.88).abs() < 2e-4, "{scale}");
     truth_within_3_std(&short).unwrap();
     // 0.05 % short: the answer moves 2.5 mm along the optical axis, several
