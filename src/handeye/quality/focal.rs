@@ -181,15 +181,17 @@ pub fn check_focal(
             fit.scale
         ),
     };
-    let warning = (off.abs() > FOCAL_MIN || beyond_std).then(|| format!(
-        "focal length: the camera's focal length disagrees with the robot's motion by {:.2} % \
+    let warning = (off.abs() > FOCAL_MIN || beyond_std).then(|| {
+        format!(
+            "focal length: the camera's focal length disagrees with the robot's motion by {:.2} % \
          ({:.1} std): fitted through the robot poses, the image points want fx and fy {} by \
          that much; {what}. Recalibrate the camera's intrinsics (with the focus and zoom of \
          these images), or check the target's square size and the robot's accuracy",
-        100.0 * off.abs(),
-        off.abs() / fit.std.max(f64::MIN_POSITIVE),
-        if off > 0.0 { "longer" } else { "shorter" },
-    ));
+            100.0 * off.abs(),
+            off.abs() / fit.std.max(f64::MIN_POSITIVE),
+            if off > 0.0 { "longer" } else { "shorter" },
+        )
+    });
     Some(FocalFinding {
         check: FocalCheck {
             scale: fit.scale,
@@ -258,7 +260,14 @@ mod tests {
             rotation_deg: [0.01, 0.02, 0.03],
             translation_mm: [0.5, 0.5, 1.0],
         };
-        let within = [0.009f64.to_radians(), 0.0, -0.02f64.to_radians(), 4e-4, -4e-4, 9e-4];
+        let within = [
+            0.009f64.to_radians(),
+            0.0,
+            -0.02f64.to_radians(),
+            4e-4,
+            -4e-4,
+            9e-4,
+        ];
         assert!(!shift_beyond_std(&within, &std));
         // 1.1 mm along z against a 1 mm std (RWHE's fx 0.05 % short: 2.5 mm
         // against 0.76 mm).

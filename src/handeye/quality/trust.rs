@@ -22,8 +22,8 @@
 //!    few degrees of freedom is itself uncertain: the error over it
 //!    follows Student's t, whose 3-std interval covers 98.9 % with 12 (4
 //!    poses) instead of 99.73 %. The covariance is scaled by the square
-//!    of [`coverage_factor`] of those degrees of freedom (1.26 at 4 poses,
-//!    1.12 at 6) before the leave-one-out comparison, which cannot run
+//!    of [`coverage_factor`] of those degrees of freedom (1.25 at 4 poses,
+//!    1.11 at 6) before the leave-one-out comparison, which cannot run
 //!    below [`MIN_LOO_VIEWS`] poses; the "only n poses" warning stays.
 //! 2. **Weak geometry, named**: fewer than [`FEW_POSES`] poses, a largest
 //!    robot rotation under [`SMALL_ROTATION_DEG`], and the target at one
