@@ -1,25 +1,113 @@
-//! Does a rig's reported std cover the truth when the frames were not
-//! taken at one moment? Seeded Monte Carlo over `synth::rig` scenes (four
-//! cameras, 0.3 px noise) with a per-view timing error of free-running
-//! cameras and a hand-held board (issue 35's rig row).
+//! Does a rig's (or a stereo pair's) reported std cover the truth when the
+//! frames were not taken at one moment? Seeded Monte Carlo over
+//! `synth::rig` scenes (four cameras, 0.3 px noise) with a per-view timing
+//! error of free-running cameras and a hand-held board (issue 35's rig
+//! row).
 //!
-//! `cargo run --release --example rig_coverage -- [TRIALS]` prints one row
-//! per timing error: the share of trials whose every camera_from_rig
-//! component (3 rotation, 3 translation, cameras 1-3) lies within 3
-//! reported std, the share warned, the share refused, and the share wrong
-//! (some component outside 3 std; beyond 4 std) without a warning that the frames
-//! disagree (the grouping check, the intrinsics drift or the leave-frames-out
-//! spread).
+//! `cargo run --release --example rig_coverage -- [TRIALS] [rig|stereo]
+//! [MS,MS,...]` prints one row per timing error (default 0, 1, 5, 15 ms):
+//! the share of trials whose every camera_from_rig component (3 rotation,
+//! 3 translation, cameras 1-3; for `stereo`, right_from_left of cam0 and
+//! cam1 over the frames both see, 12 pairs) lies within 3 reported std
+//! with its 95 % (Wilson) interval, the share warned, the share refused,
+//! the share wrong (some component outside 3 std; beyond 4 std) without a
+//! warning that the frames disagree (the grouping check, the intrinsics
+//! drift or the leave-frames-out spread), the mean over trials and
+//! components of |error| / std (about 0.8 for a right std) and the worst.
 
 use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::CalibrationOptions;
 use robocal::geometry::{rotvec_from_rotation, Pose};
-use robocal::synth::rig::{rig_scene, RigSceneConfig};
+use robocal::synth::rig::{rig_scene, RigScene, RigSceneConfig};
 
 fn errors(got: &Pose, truth: &Pose) -> [f64; 6] {
     let r = rotvec_from_rotation(&(got.rotation * truth.rotation.inverse()));
     let t = got.translation.vector - truth.translation.vector;
     [r.x, r.y, r.z, t.x, t.y, t.z]
+}
+
+/// One solved trial: its |error| / std per component, and whether a
+/// warning named frames that disagree.
+struct Trial {
+    ratios: Vec<f64>,
+    warned: bool,
+}
+
+/// The warnings that speak to frames not taken at one moment: the grouping
+/// check's, the intrinsics drift and the leave-frames-out spread (the
+/// scene's other warnings, e.g. partial views, say nothing about it).
+fn names_timing(w: &str) -> bool {
+    w.contains("disagree on how the board moved")
+        || w.contains("moved its intrinsics beyond")
+        || w.contains("leaving frames out moves")
+        || w.contains("leaving pairs out moves")
+}
+
+fn rig_trial(scene: &RigScene) -> Option<Trial> {
+    let cameras: Vec<RigCameraViews> = (0..scene.names.len())
+        .map(|k| RigCameraViews {
+            name: scene.names[k].clone(),
+            image_size_px: (scene.cameras[k].width, scene.cameras[k].height),
+            views: scene.views[k].clone(),
+            camera: None,
+        })
+        .collect();
+    let options = RigOptions {
+        calibration: CalibrationOptions::default(),
+        rig_frame: None,
+        target: "chessboard:11x8:60mm".into(),
+        grouping: "number".into(),
+    };
+    let rig = calibrate_rig(&cameras, &scene.frame_keys, &options).ok()?;
+    let mut ratios = Vec::new();
+    for (k, camera) in rig.cameras.iter().enumerate().skip(1) {
+        let (Some(got), Some(s)) = (
+            camera.camera_from_rig.to_pose().ok(),
+            camera.camera_from_rig_std.as_ref(),
+        ) else {
+            ratios.push(f64::INFINITY);
+            continue;
+        };
+        let e = errors(&got, &scene.camera_from_rig[k]);
+        let std = [s.rotation_rad, s.translation_m].concat();
+        ratios.extend(e.iter().zip(&std).map(|(err, sd)| err.abs() / sd));
+    }
+    let warned = rig.warnings.iter().any(|w| names_timing(w));
+    Some(Trial { ratios, warned })
+}
+
+/// cam0 (left) and cam1 (right) over the frames both see.
+fn stereo_trial(scene: &RigScene) -> Option<Trial> {
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    for (f, v) in &scene.views[0] {
+        if let Some((_, r)) = scene.views[1].iter().find(|(g, _)| g == f) {
+            left.push(v.clone());
+            right.push(r.clone());
+        }
+    }
+    let size = |k: usize| (scene.cameras[k].width, scene.cameras[k].height);
+    let options = CalibrationOptions::default();
+    let pair = calibrate_stereo(&left, &right, size(0), size(1), &options).ok()?;
+    let got = pair.right_from_left.to_pose().ok()?;
+    let s = pair.right_from_left_std.as_ref()?;
+    // cam0 is the rig frame: right_from_left is cam1's camera_from_rig.
+    let e = errors(&got, &scene.camera_from_rig[1]);
+    let std = [s.rotation_rad, s.translation_m].concat();
+    let ratios = e.iter().zip(&std).map(|(err, sd)| err.abs() / sd).collect();
+    let warned = pair.warnings.iter().any(|w| names_timing(w));
+    Some(Trial { ratios, warned })
+}
+
+/// The 95 % Wilson score interval of a share `k` of `n`.
+fn wilson(k: usize, n: usize) -> (f64, f64) {
+    if n == 0 {
+        return (0.0, 1.0);
+    }
+    let (n, p, z) = (n as f64, k as f64 / n as f64, 1.96f64);
+    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+    let half = z / (1.0 + z * z / n) * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
+    (centre - half, centre + half)
 }
 
 #[derive(Default)]
@@ -30,88 +118,66 @@ struct Row {
     refused: usize,
     silent_wrong: usize,
     silent_beyond_4: usize,
+    ratio_sum: f64,
+    ratio_count: usize,
     worst_ratio: f64,
 }
 
 fn main() {
-    let trials: u64 = std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(100);
-    println!("| timing error (std per view) | trials | covered (3 std) | warned | refused | outside 3 std, no warning | beyond 4 std, no warning | worst error / std |");
-    println!("|---|---|---|---|---|---|---|---|");
-    for timing_ms in [0.0, 1.0, 5.0, 15.0] {
+    let mut args = std::env::args().skip(1);
+    let trials: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(100);
+    let stereo = args.next().is_some_and(|a| a == "stereo");
+    let timings: Vec<f64> = args
+        .next()
+        .map(|a| a.split(',').filter_map(|v| v.parse().ok()).collect())
+        .unwrap_or_else(|| vec![0.0, 1.0, 5.0, 15.0]);
+    println!("| timing error (std per view) | trials | covered (3 std) | its 95 % interval | warned | refused | outside 3 std, no warning | beyond 4 std, no warning | mean abs(error) / std | worst error / std |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for timing_ms in timings {
         let mut row = Row::default();
         for seed in 0..trials {
             let config = RigSceneConfig {
                 noise_px: 0.3,
                 timing_ms,
+                pair_frames: if stereo { 12 } else { 8 },
                 ..RigSceneConfig::default()
             };
             let scene = rig_scene(&config, 7000 + seed);
-            let cameras: Vec<RigCameraViews> = (0..scene.names.len())
-                .map(|k| RigCameraViews {
-                    name: scene.names[k].clone(),
-                    image_size_px: (scene.cameras[k].width, scene.cameras[k].height),
-                    views: scene.views[k].clone(),
-                    camera: None,
-                })
-                .collect();
-            let options = RigOptions {
-                calibration: CalibrationOptions::default(),
-                rig_frame: None,
-                target: "chessboard:11x8:60mm".into(),
-                grouping: "number".into(),
-            };
             row.trials += 1;
-            let rig = match calibrate_rig(&cameras, &scene.frame_keys, &options) {
-                Ok(rig) => rig,
-                Err(_) => {
-                    row.refused += 1;
-                    continue;
-                }
+            let trial = if stereo {
+                stereo_trial(&scene)
+            } else {
+                rig_trial(&scene)
             };
-            let mut covered = true;
-            let mut beyond_4 = false;
-            for (k, camera) in rig.cameras.iter().enumerate().skip(1) {
-                let (Some(got), Some(s)) = (
-                    camera.camera_from_rig.to_pose().ok(),
-                    camera.camera_from_rig_std.as_ref(),
-                ) else {
-                    covered = false;
-                    continue;
-                };
-                let e = errors(&got, &scene.camera_from_rig[k]);
-                let std = [s.rotation_rad, s.translation_m].concat();
-                for (err, sd) in e.iter().zip(&std) {
-                    let ratio = err.abs() / sd;
-                    row.worst_ratio = row.worst_ratio.max(ratio);
-                    covered &= ratio <= 3.0;
-                    beyond_4 |= ratio > 4.0;
-                }
+            let Some(trial) = trial else {
+                row.refused += 1;
+                continue;
+            };
+            let covered = trial.ratios.iter().all(|r| *r <= 3.0);
+            let beyond_4 = trial.ratios.iter().any(|r| *r > 4.0);
+            for r in &trial.ratios {
+                row.worst_ratio = row.worst_ratio.max(*r);
+                row.ratio_sum += r;
+                row.ratio_count += 1;
             }
-            // The warnings that speak to frames not taken at one moment:
-            // the grouping check's and the intrinsics drift (the scene's
-            // other warnings, e.g. partial views, say nothing about it).
-            let warned = rig.warnings.iter().any(|w| {
-                w.contains("disagree on how the board moved")
-                    || w.contains("moved its intrinsics beyond")
-                    || w.contains("leaving frames out moves")
-            });
             row.covered += usize::from(covered);
-            row.warned += usize::from(warned);
-            row.silent_wrong += usize::from(!covered && !warned);
-            row.silent_beyond_4 += usize::from(beyond_4 && !warned);
+            row.warned += usize::from(trial.warned);
+            row.silent_wrong += usize::from(!covered && !trial.warned);
+            row.silent_beyond_4 += usize::from(beyond_4 && !trial.warned);
         }
         let pct = |n: usize| 100.0 * n as f64 / row.trials as f64;
+        let (low, high) = wilson(row.covered, row.trials);
         println!(
-            "| {timing_ms} ms | {} | {:.0} % | {:.0} % | {:.0} % | {:.0} % | {:.0} % | {:.1} |",
+            "| {timing_ms} ms | {} | {:.1} % | {:.1}-{:.1} % | {:.0} % | {:.0} % | {:.1} % | {:.1} % | {:.2} | {:.1} |",
             row.trials,
             pct(row.covered),
+            100.0 * low,
+            100.0 * high,
             pct(row.warned),
             pct(row.refused),
             pct(row.silent_wrong),
             pct(row.silent_beyond_4),
+            row.ratio_sum / row.ratio_count.max(1) as f64,
             row.worst_ratio
         );
     }

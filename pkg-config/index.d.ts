@@ -1068,7 +1068,7 @@ export interface PoseRefinementSummary {
   per_view_reprojection_rms_px?: number[];
   /** With image points: reprojection RMS of the closed form it started from, px. */
   closed_form_reprojection_rms_px?: number;
-  /** Present when the leave-one-out solutions spread wider than the noise model predicts: the factor the std (and the covariance's square root) were widened by. */
+  /** Present when the leave-one-out solutions spread wider than the noise model predicts, or the noise scale rests on fewer than 8 poses (the Student-t factor of its degrees of freedom): the factor the std (and the covariance's square root) were widened by, the product of both. */
   std_widened_by?: number;
   /** The working distance: the mean distance from the camera to the target's centre over the views, m (to the target origin with camera poses only). */
   work_distance_m?: number;

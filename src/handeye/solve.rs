@@ -312,7 +312,7 @@ fn apply_focal_check(
         }
         summary.focal_check = Some(found.check);
     }
-    result.warnings.push(found.warning);
+    result.warnings.extend(found.warning);
 }
 
 /// With image points and the pose refinement run: the reprojection RMS of

@@ -12,6 +12,7 @@
 //! [`BlockProblem::retract`].
 
 pub mod dense;
+pub mod student_t;
 mod loss;
 mod normal;
 

@@ -14,6 +14,7 @@ mod cli_detect;
 mod cli_export;
 mod cli_field;
 mod cli_handeye;
+mod cli_handeye_focal;
 mod cli_handeye_pairing;
 mod cli_intrinsics;
 mod cli_laser;

@@ -214,14 +214,13 @@ pub fn calibrate_rig(
             let mut worst: f64 = 1.0;
             for i in 0..6 {
                 let model = c[(o + i, o + i)].max(0.0).sqrt();
-                let factor = if model > 0.0 {
-                    (spread.std[k][i] / model).max(1.0)
-                } else {
-                    1.0
-                };
-                c.row_mut(o + i).scale_mut(factor);
-                c.column_mut(o + i).scale_mut(factor);
-                worst = worst.max(factor);
+                if model > 0.0 {
+                    // Widened to the t-scaled spread, warned on the plain one.
+                    let factor = (spread.covering[k][i] / model).max(1.0);
+                    c.row_mut(o + i).scale_mut(factor);
+                    c.column_mut(o + i).scale_mut(factor);
+                    worst = worst.max(spread.std[k][i] / model);
+                }
             }
             if worst > WARN_FACTOR {
                 warnings.push(format!(

@@ -183,12 +183,14 @@ pub fn calibrate_stereo(
         let mut std: [f64; 6] = std::array::from_fn(|i| s[o + i]);
         // Checked against the spread of leave-pairs-out refits and widened
         // to it axis by axis ([`super::stereo_jackknife`]).
-        if let Some((spread, runs)) = leave_pairs_out(&problem, &result, &lm) {
+        if let Some(spread) = leave_pairs_out(&problem, &result, &lm) {
+            let runs = spread.runs;
             let mut worst: f64 = 1.0;
-            for (model, data) in std.iter_mut().zip(spread) {
+            for ((model, data), covering) in std.iter_mut().zip(spread.std).zip(spread.covering) {
                 if *model > 0.0 {
+                    // Warned on the plain spread, widened to the t-scaled one.
                     worst = worst.max(data / *model);
-                    *model = model.max(data);
+                    *model = model.max(covering);
                 }
             }
             if worst > WARN_FACTOR {

@@ -10,11 +10,14 @@
 //! The pairs are left out group by group (every `groups`-th pair, at most
 //! [`MAX_GROUPS`] groups, at least [`MIN_GROUPS`]), each refit from the
 //! full solution for at most [`ITERATIONS`](super::rig_jackknife::ITERATIONS) steps; the jackknife variance
-//! of right_from_left over the refits widens the reported std axis by
-//! axis where it is larger, and a factor beyond [`WARN_FACTOR`] is said.
+//! of right_from_left over the refits, times the Student-t factor of its
+//! `G - 1` degrees of freedom ([`super::rig_jackknife`]'s docs), widens
+//! the reported std axis by axis where it is larger, and a plain spread
+//! beyond [`WARN_FACTOR`] times the model's is said.
 
 use super::rig_jackknife::{
-    jackknife_std, kept_without_group, pose_delta, refit_from_full, MAX_GROUPS, MIN_GROUPS,
+    covering_std, jackknife_std, kept_without_group, pose_delta, refit_from_full, MAX_GROUPS,
+    MIN_GROUPS,
 };
 use super::stereo_problem::StereoProblem;
 use crate::calib::refine::CalibProblem;
@@ -23,14 +26,25 @@ use crate::optim::{LmOptions, LmResult};
 
 pub(crate) use super::rig_jackknife::WARN_FACTOR;
 
-/// The leave-pairs-out std of right_from_left, `[rotation (left
-/// perturbation) rad x3, translation m x3]`, and the refits it rests on;
-/// `None` with fewer than [`MIN_GROUPS`] pairs or refits.
+/// The leave-pairs-out spread of right_from_left.
+pub(crate) struct PairSpread {
+    /// The jackknife std, `[rotation (left perturbation) rad x3,
+    /// translation m x3]`.
+    pub std: [f64; 6],
+    /// The same times the t factor of its `runs - 1` degrees of freedom:
+    /// what the reported std is widened to.
+    pub covering: [f64; 6],
+    /// Refits it rests on.
+    pub runs: usize,
+}
+
+/// The leave-pairs-out spread of right_from_left; `None` with fewer than
+/// [`MIN_GROUPS`] pairs or refits.
 pub(crate) fn leave_pairs_out(
     problem: &StereoProblem,
     full: &LmResult,
     lm: &LmOptions,
-) -> Option<([f64; 6], usize)> {
+) -> Option<PairSpread> {
     let n_pairs = problem.left.views.len();
     let groups = n_pairs.min(MAX_GROUPS);
     if groups < MIN_GROUPS {
@@ -70,5 +84,13 @@ pub(crate) fn leave_pairs_out(
         let rfl = sub.right_from_left(&refit.params.global);
         deltas.push(pose_delta(&rfl, &full_rfl));
     }
-    (deltas.len() >= MIN_GROUPS).then(|| (jackknife_std(&deltas), deltas.len()))
+    let runs = deltas.len();
+    (runs >= MIN_GROUPS).then(|| {
+        let std = jackknife_std(&deltas);
+        PairSpread {
+            std,
+            covering: covering_std(&std, runs),
+            runs,
+        }
+    })
 }

@@ -14,6 +14,17 @@
 //!    covariance's by more than [`WIDEN_RATIO`], the covariance is scaled
 //!    by the square of the larger ratio (the std by the ratio) and a warning
 //!    says so.
+//!    Few poses ([`widen_for_few_poses`]): below
+//!    [`crate::handeye::refine::pose_noise::MIN_POSES_FOR_NOISE_ESTIMATE`]
+//!    poses the noise levels are the documented defaults times one scale
+//!    fitted to the residuals, `6 n - 12` degrees of freedom for `n` inlier
+//!    poses (six residuals a pose, twelve unknowns). A std resting on so
+//!    few degrees of freedom is itself uncertain: the error over it
+//!    follows Student's t, whose 3-std interval covers 98.9 % with 12 (4
+//!    poses) instead of 99.73 %. The covariance is scaled by the square
+//!    of [`coverage_factor`] of those degrees of freedom (1.25 at 4 poses,
+//!    1.11 at 6) before the leave-one-out comparison, which cannot run
+//!    below [`MIN_LOO_VIEWS`] poses; the "only n poses" warning stays.
 //! 2. **Weak geometry, named**: fewer than [`FEW_POSES`] poses, a largest
 //!    robot rotation under [`SMALL_ROTATION_DEG`], and the target at one
 //!    distance in every view (spread under [`ONE_DISTANCE_SPREAD`] of the
@@ -35,6 +46,7 @@ use crate::handeye::refine::pose_problem::{refine, PoseRefineOptions};
 use crate::handeye::refine::pose_residual::PoseMeasurement;
 use crate::handeye::refine::pose_summary::{transform_std, PoseRefinementSummary};
 use crate::handeye::{HandEyeInput, Pose, Setup};
+use crate::optim::student_t::coverage_factor;
 use nalgebra::{Matrix3, Point3, SMatrix, Vector3};
 
 /// The covariance is widened when the leave-one-out spread exceeds it by
@@ -99,17 +111,7 @@ pub fn widen_to_leave_one_out(
     if !ratio.is_finite() || ratio <= WIDEN_RATIO {
         return None;
     }
-    let scale = ratio * ratio;
-    let mut cov = SMatrix::<f64, 12, 12>::zeros();
-    for (r, row) in summary.covariance.iter_mut().enumerate() {
-        for (c, v) in row.iter_mut().enumerate() {
-            *v *= scale;
-            cov[(r, c)] = *v;
-        }
-    }
-    summary.camera_transform_std = transform_std(&cov, 0);
-    summary.target_transform_std = transform_std(&cov, 6);
-    summary.std_widened_by = Some(ratio);
+    scale_covariance(summary, ratio);
     if ratio <= WARN_RATIO {
         return None;
     }
@@ -125,6 +127,44 @@ pub fn widen_to_leave_one_out(
         rss(loo_r),
         rss(&model_r)
     ))
+}
+
+/// Scale the covariance by `factor^2` (the std by `factor`), recompute the
+/// std and record the factor in `std_widened_by` (times any earlier one).
+fn scale_covariance(summary: &mut PoseRefinementSummary, factor: f64) {
+    let scale = factor * factor;
+    let mut cov = SMatrix::<f64, 12, 12>::zeros();
+    for (r, row) in summary.covariance.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            *v *= scale;
+            cov[(r, c)] = *v;
+        }
+    }
+    summary.camera_transform_std = transform_std(&cov, 0);
+    summary.target_transform_std = transform_std(&cov, 6);
+    summary.std_widened_by = Some(summary.std_widened_by.unwrap_or(1.0) * factor);
+}
+
+/// Widen the covariance for the few degrees of freedom its noise scale
+/// rests on (module docs): with the noise levels scaled by one common
+/// factor (fewer than 8 inlier poses), the std times [`coverage_factor`]
+/// of `6 n - 12` for `n` inlier poses. Returns the factor (none when the
+/// levels were estimated per component or nothing is left to fit them).
+pub fn widen_for_few_poses(summary: &mut PoseRefinementSummary) -> Option<f64> {
+    if summary.noise_estimated_per_component {
+        return None;
+    }
+    let inliers = summary
+        .whitened_residual_norms
+        .len()
+        .saturating_sub(summary.outlier_views.len());
+    let dof = 6.0 * inliers as f64 - 12.0;
+    let factor = coverage_factor(dof);
+    if dof <= 0.0 || factor <= 1.0 {
+        return None;
+    }
+    scale_covariance(summary, factor);
+    Some(factor)
 }
 
 /// Warnings that name weak geometry (module docs): `views` poses used,
@@ -331,6 +371,7 @@ pub(crate) fn check_uncertainty(
 ) -> Option<String> {
     let n = input.camera_from_target.len();
     let rotation = x.rotation.to_rotation_matrix().into_inner();
+    widen_for_few_poses(summary);
     let warning = repeatability.and_then(|rep| widen_to_leave_one_out(summary, rep, &rotation, n));
     place_work_point(
         summary,

@@ -84,8 +84,10 @@ pub struct PoseRefinementSummary {
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub closed_form_reprojection_rms_px: Option<f64>,
     /// When the leave-one-out solutions spread wider than the noise model
-    /// predicts: the factor the std (and the covariance's square root) was
-    /// widened by ([`crate::handeye::quality::trust`]); absent: not widened.
+    /// predicts, or the noise scale rests on few poses (the Student-t
+    /// factor of its degrees of freedom): the factor the std (and the
+    /// covariance's square root) was widened by, the product of both
+    /// ([`crate::handeye::quality::trust`]); absent: not widened.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub std_widened_by: Option<f64>,
     /// The working distance: the mean distance from the camera to the
