@@ -28,12 +28,16 @@ mod render_rig;
 mod render_video;
 mod rig;
 mod rig_handeye;
+mod rig_video;
 mod rig_summary;
 mod robot_poses;
 mod serve;
 mod stereo;
 mod target;
 mod values;
+mod video;
+mod video_frames;
+mod video_inputs;
 mod xytable;
 
 pub use input::{read_pose_text, read_text};
