@@ -78,6 +78,7 @@ pub fn expand(
         })
         .transpose()?;
     let budget = flags.budget("rig")?;
+    let config = flags.config("rig")?;
     let pool = pool(threads)?;
     // 1. Every video camera's frames and their sync keys.
     let mut scans = Vec::new();
@@ -97,7 +98,7 @@ pub fn expand(
             None => None,
         };
         let times = frames.map(|f| f.time_s.as_slice());
-        let found = scan(video, target, options, budget, times, &pool)?;
+        let found = scan(video, target, options, budget, &config, times, &pool)?;
         eprintln!("robocal rig: camera {}: {}", names[k], found.summary());
         let key = |index: usize| match frames {
             Some(f) => f.sync_index.get(index).map_or(index as u64, |s| *s),

@@ -30,6 +30,18 @@ pub struct VideoFlags {
     /// adding coverage
     #[arg(long, value_name = "N")]
     max_frames: Option<usize>,
+    /// Video inputs: the still rule's largest board motion between frames,
+    /// px (default 1.5, the live capture's), or 'any' to keep moving boards
+    /// (a recording of a board in motion at a low frame rate; the sharp rule
+    /// still leaves out blurred frames)
+    #[arg(long, value_name = "PX|any")]
+    still_px: Option<String>,
+    /// Video inputs: which frames the capture's rules keep: capture (found,
+    /// still, sharp and adding coverage, default) or sharp (found, still and
+    /// sharp: the coverage rule off, for a rig whose cameras need the frames
+    /// they share more than each camera's own coverage)
+    #[arg(long, value_name = "RULE", value_parser = ["capture", "sharp"])]
+    video_keep: Option<String>,
 }
 
 /// The bounds of `--every` and `--max-frames`.
@@ -41,15 +53,47 @@ pub const DEFAULT_MAX_FRAMES: usize = 60;
 const FALLBACK_FPS: f64 = 30.0;
 
 impl VideoFlags {
-    /// `(every, max_frames)`, checked.
-    pub fn budget(&self, command: &str) -> Result<(usize, usize), CliError> {
+    /// The capture thresholds these flags ask for.
+    pub fn config(&self, command: &str) -> Result<CaptureConfig, CliError> {
+        let mut config = CaptureConfig::default();
+        match self.still_px.as_deref() {
+            None => {}
+            Some("any") => config.still_max_px = f64::INFINITY,
+            Some(text) => match text.parse::<f64>() {
+                Ok(px) if px.is_finite() && px > 0.0 => config.still_max_px = px,
+                _ => {
+                    return Err(CliError::usage(
+                        command,
+                        format!("--still-px takes a number of pixels > 0 or 'any', got '{text}'"),
+                    ))
+                }
+            },
+        }
+        Ok(config)
+    }
+
+    /// `(every, max_frames, coverage rule on)`, checked.
+    pub fn budget(&self, command: &str) -> Result<Budget, CliError> {
         super::check_optional_bounds(command, "--every", self.every, EVERY)?;
         super::check_optional_bounds(command, "--max-frames", self.max_frames, MAX_FRAMES)?;
-        Ok((
-            self.every.unwrap_or(1),
-            self.max_frames.unwrap_or(DEFAULT_MAX_FRAMES),
-        ))
+        Ok(Budget {
+            every: self.every.unwrap_or(1),
+            max_frames: self.max_frames.unwrap_or(DEFAULT_MAX_FRAMES),
+            coverage: self.video_keep.as_deref() != Some("sharp"),
+        })
     }
+}
+
+/// Which frames of a video are looked at and kept.
+#[derive(Clone, Copy, Debug)]
+pub struct Budget {
+    /// Every Nth frame is looked at.
+    pub every: usize,
+    /// Reading stops once this many are kept.
+    pub max_frames: usize,
+    /// The capture's coverage rule on (off: a frame that passed found,
+    /// still and sharp is kept whatever it adds).
+    pub coverage: bool,
 }
 
 /// One frame looked at.
@@ -76,6 +120,8 @@ pub struct VideoScan {
     pub frames_read: usize,
     /// The frames looked at, in video order.
     pub frames: Vec<VideoFrame>,
+    /// The coverage rule was on.
+    pub coverage: bool,
 }
 
 impl VideoScan {
@@ -101,7 +147,7 @@ impl VideoScan {
             .map(|(m, n)| format!("{n} {m}"))
             .collect();
         format!(
-            "{}: {} frames read ({} {}x{}), {} looked at, board in {found}, {} kept (still, sharp, adding coverage){}",
+            "{}: {} frames read ({} {}x{}), {} looked at, board in {found}, {} kept ({}){}",
             self.path,
             self.frames_read,
             self.info.codec,
@@ -109,6 +155,11 @@ impl VideoScan {
             self.info.height,
             self.frames.len(),
             self.kept().count(),
+            if self.coverage {
+                "still, sharp, adding coverage"
+            } else {
+                "still and sharp"
+            },
             if left.is_empty() {
                 String::new()
             } else {
@@ -150,17 +201,23 @@ pub fn scan(
     path: &str,
     target: &Target,
     options: &DetectOptions,
-    (every, max_frames): (usize, usize),
+    budget: Budget,
+    config: &CaptureConfig,
     times_s: Option<&[f64]>,
     pool: &rayon::ThreadPool,
 ) -> Result<VideoScan, CliError> {
+    let Budget {
+        every,
+        max_frames,
+        coverage,
+    } = budget;
     let mut reader = FrameReader::open(path)?;
     let info = reader.info().clone();
     let mut session = CaptureSession::new(
         target.clone(),
         info.width,
         info.height,
-        CaptureConfig::default(),
+        config.clone(),
     )
     .map_err(|e| CliError::Io(format!("'{path}': {e}")))?;
     let fps = if info.fps > 0.0 { info.fps } else { FALLBACK_FPS };
@@ -204,7 +261,8 @@ pub fn scan(
             } else {
                 Reason::NotFound
             };
-            let keep = report == Reason::Kept;
+            let passed = matches!(report, Reason::NothingNew | Reason::GoodEnough);
+            let keep = report == Reason::Kept || (!coverage && passed);
             kept += usize::from(keep);
             frames.push(VideoFrame {
                 index: *index,
@@ -230,5 +288,6 @@ pub fn scan(
         info,
         frames_read: read,
         frames,
+        coverage,
     })
 }

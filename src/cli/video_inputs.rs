@@ -47,13 +47,14 @@ pub fn expand(
         return Ok(inputs);
     }
     let budget = flags.budget(command)?;
+    let config = flags.config(command)?;
     let pool = pool(threads)?;
     for file in files {
         if !is_video(file) {
             inputs.names.push(file.clone());
             continue;
         }
-        let video = scan(file, target, options, budget, None, &pool)?;
+        let video = scan(file, target, options, budget, &config, None, &pool)?;
         eprintln!("robocal {command}: {}", video.summary());
         for frame in video.frames.into_iter().filter(|f| f.kept) {
             if let Ok(d) = frame.detection {
