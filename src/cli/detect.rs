@@ -314,6 +314,9 @@ fn one(
         CliError::Robocal(e) => Processed::failed(e.kind(), e.to_string()),
         other => Processed::failed("io", other.to_string()),
     };
+    if super::video::is_video(file) {
+        return Processed::failed("io", super::video::not_read_here(file));
+    }
     let opened = match open_image(file, decode) {
         Ok(f) => f,
         Err(e) => return cli_failed(e),

@@ -57,6 +57,15 @@ fn not_installed(path: &str, program: &str) -> CliError {
     ))
 }
 
+/// The failure of a video given to a command that takes images only.
+pub fn not_read_here(path: &str) -> String {
+    format!(
+        "'{path}' is a video: this command takes images; detect, intrinsics and rig read videos \
+         (docs/video.md; two cameras' videos make a rig: robocal rig --camera left left.mp4 \
+         --camera right right.mp4), or extract frames: ffmpeg -i '{path}' frame_%04d.png"
+    )
+}
+
 /// Spawn `program` with `args`, its missing executable named as such.
 fn spawn(path: &str, program: &str, args: &[&str], stdout: Stdio) -> Result<Child, CliError> {
     Command::new(program)
