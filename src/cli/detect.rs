@@ -134,8 +134,15 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
         .filter(|f| inputs.frame(f).is_none())
         .cloned()
         .collect();
-    let mut detected =
-        run_with(&images_only, &target, &options, &decode, args.threads, all_boards)?.into_iter();
+    let mut detected = run_with(
+        &images_only,
+        &target,
+        &options,
+        &decode,
+        args.threads,
+        all_boards,
+    )?
+    .into_iter();
     let outcomes: Vec<Processed> = files
         .iter()
         .filter_map(|f| match inputs.frame(f) {

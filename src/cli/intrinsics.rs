@@ -281,8 +281,7 @@ fn views_from_images(
     video: &super::video_frames::VideoFlags,
     threads: Option<usize>,
 ) -> Result<Vec<JsonView>, CliError> {
-    let inputs =
-        super::video_inputs::expand("intrinsics", files, target, options, video, threads)?;
+    let inputs = super::video_inputs::expand("intrinsics", files, target, options, video, threads)?;
     let outcomes = inputs.detect(target, options, &limits.decode_options(), threads)?;
     let mut views = vec![];
     for (file, outcome) in inputs.names.iter().zip(outcomes) {

@@ -311,7 +311,9 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
     let all: Vec<String> = cameras.iter().flat_map(|c| c.images.clone()).collect();
     let decode = args.limits.decode_options();
     let mut outcomes = match &videos {
-        Some(v) => v.inputs(&all).detect(&target, &options, &decode, args.threads)?,
+        Some(v) => v
+            .inputs(&all)
+            .detect(&target, &options, &decode, args.threads)?,
         None => run_all(&all, &target, &options, &decode, args.threads)?,
     }
     .into_iter();

@@ -94,7 +94,10 @@ pub fn expand(
             )));
         };
         let frames = match &stamps {
-            Some(s) => Some(s.camera(cam_id(&names[k], video, s)?).map_err(CliError::from)?),
+            Some(s) => Some(
+                s.camera(cam_id(&names[k], video, s)?)
+                    .map_err(CliError::from)?,
+            ),
             None => None,
         };
         let times = frames.map(|f| f.time_s.as_slice());

@@ -24,11 +24,8 @@ pub const VIDEO_EXTENSIONS: [&str; 6] = ["mp4", "m4v", "mov", "avi", "mkv", "web
 /// Whether `path` names a video by its extension.
 pub fn is_video(path: &str) -> bool {
     let base = path.rsplit(['/', '\\']).next().unwrap_or(path);
-    base.rsplit_once('.').is_some_and(|(_, ext)| {
-        VIDEO_EXTENSIONS
-            .iter()
-            .any(|v| v.eq_ignore_ascii_case(ext))
-    })
+    base.rsplit_once('.')
+        .is_some_and(|(_, ext)| VIDEO_EXTENSIONS.iter().any(|v| v.eq_ignore_ascii_case(ext)))
 }
 
 /// The name of frame `index` of `path` in reports: `cam_0.mp4#frame0123`.
@@ -106,9 +103,7 @@ fn rate(text: &str) -> f64 {
 /// The size, codec and frame rate of `path`'s first video stream.
 pub fn probe(path: &str) -> Result<VideoInfo, CliError> {
     if !std::path::Path::new(path).is_file() {
-        return Err(CliError::Io(format!(
-            "cannot read '{path}': no such file"
-        )));
+        return Err(CliError::Io(format!("cannot read '{path}': no such file")));
     }
     let args = [
         "-v",
@@ -233,7 +228,11 @@ impl FrameReader {
         if filled < len {
             self.done = true;
             let status = self.child.wait();
-            let stderr = self.stderr.take().and_then(|h| h.join().ok()).unwrap_or_default();
+            let stderr = self
+                .stderr
+                .take()
+                .and_then(|h| h.join().ok())
+                .unwrap_or_default();
             let failed = !status.as_ref().is_ok_and(|s| s.success());
             if failed || filled > 0 || self.next == 0 {
                 let why = match (filled, tail(&stderr)) {
@@ -278,7 +277,14 @@ mod tests {
 
     #[test]
     fn videos_are_known_by_their_extension() {
-        for p in ["cam_0.mp4", "a/b.MOV", "x.webm", "c:\\v\\y.Mkv", "z.avi", "q.m4v"] {
+        for p in [
+            "cam_0.mp4",
+            "a/b.MOV",
+            "x.webm",
+            "c:\\v\\y.Mkv",
+            "z.avi",
+            "q.m4v",
+        ] {
             assert!(is_video(p), "{p}");
         }
         for p in ["cam_0.png", "mp4", "a.mp4/b.jpg", "noext", "x.mp4.png"] {

@@ -133,19 +133,12 @@ impl VideoScan {
     /// One line for standard error: frames read, found, kept and why the
     /// others were left out.
     pub fn summary(&self) -> String {
-        let found = self
-            .frames
-            .iter()
-            .filter(|f| f.detection.is_ok())
-            .count();
+        let found = self.frames.iter().filter(|f| f.detection.is_ok()).count();
         let mut reasons: BTreeMap<&'static str, usize> = BTreeMap::new();
         for f in self.frames.iter().filter(|f| !f.kept) {
             *reasons.entry(f.reason.message()).or_default() += 1;
         }
-        let left: Vec<String> = reasons
-            .iter()
-            .map(|(m, n)| format!("{n} {m}"))
-            .collect();
+        let left: Vec<String> = reasons.iter().map(|(m, n)| format!("{n} {m}")).collect();
         format!(
             "{}: {} frames read ({} {}x{}), {} looked at, board in {found}, {} kept ({}){}",
             self.path,
@@ -213,14 +206,13 @@ pub fn scan(
     } = budget;
     let mut reader = FrameReader::open(path)?;
     let info = reader.info().clone();
-    let mut session = CaptureSession::new(
-        target.clone(),
-        info.width,
-        info.height,
-        config.clone(),
-    )
-    .map_err(|e| CliError::Io(format!("'{path}': {e}")))?;
-    let fps = if info.fps > 0.0 { info.fps } else { FALLBACK_FPS };
+    let mut session = CaptureSession::new(target.clone(), info.width, info.height, config.clone())
+        .map_err(|e| CliError::Io(format!("'{path}': {e}")))?;
+    let fps = if info.fps > 0.0 {
+        info.fps
+    } else {
+        FALLBACK_FPS
+    };
     let batch_len = pool.current_num_threads().max(1) * 2;
     let mut frames = Vec::new();
     let mut read = 0;

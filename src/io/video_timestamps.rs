@@ -88,7 +88,11 @@ pub fn parse_video_timestamps(text: &str) -> Result<VideoTimestamps> {
             other => other,
         })?;
     if table.is_empty() {
-        return Err(Error::parse(0, 0, "the timestamps file has a header but no rows"));
+        return Err(Error::parse(
+            0,
+            0,
+            "the timestamps file has a header but no rows",
+        ));
     }
     // Per camera: frame_index -> (sync_index, time, line).
     let mut rows: BTreeMap<u64, BTreeMap<u64, (u64, f64, usize)>> = BTreeMap::new();
@@ -154,7 +158,10 @@ mod tests {
         assert_eq!(c1.sync_index, vec![26, 27]);
         assert_eq!(c1.frames(), 2);
         let missing = t.camera(3).unwrap_err().to_string();
-        assert!(missing.contains("cam_id 3") && missing.contains("0, 1"), "{missing}");
+        assert!(
+            missing.contains("cam_id 3") && missing.contains("0, 1"),
+            "{missing}"
+        );
     }
 
     #[test]
@@ -166,8 +173,13 @@ mod tests {
 
     #[test]
     fn errors_name_the_line_and_the_expected_format() {
-        let e = parse_video_timestamps("sync,cam\n1,2\n").unwrap_err().to_string();
-        assert!(e.contains("sync_index,cam_id,frame_index,frame_time"), "{e}");
+        let e = parse_video_timestamps("sync,cam\n1,2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("sync_index,cam_id,frame_index,frame_time"),
+            "{e}"
+        );
         let e = parse_video_timestamps("sync_index,cam_id,frame_index,frame_time\n")
             .unwrap_err()
             .to_string();
