@@ -104,7 +104,8 @@ pub struct IntrinsicsArgs {
     /// Write the report there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE")]
     output: Option<String>,
-    /// The images (instead of --detections)
+    /// The images (instead of --detections); videos (.mp4 .mov .webm ...,
+    /// read through ffmpeg) give their frames kept by the live capture's rules
     #[arg(value_name = "IMAGES")]
     images: Vec<String>,
 }
