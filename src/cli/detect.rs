@@ -75,7 +75,10 @@ pub struct DetectArgs {
     circle_centres: Option<String>,
     #[command(flatten)]
     limits: ImageLimits,
-    /// The images
+    #[command(flatten)]
+    video: super::video_frames::VideoFlags,
+    /// The images (and videos: their frames chosen by the live capture's
+    /// rules, named FILE#frameNNNN)
     #[arg(value_name = "IMAGES")]
     images: Vec<String>,
 }
@@ -115,10 +118,42 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
             .unwrap_or_default(),
         polarity: print,
     };
-    let files = &args.images;
+    let inputs = super::video_inputs::expand(
+        "detect",
+        &args.images,
+        &target,
+        &options,
+        &args.video,
+        args.threads,
+    )?;
+    let files = &inputs.names;
     let decode = args.limits.decode_options();
     let all_boards = has_other_boards(&target);
-    let outcomes = run_with(files, &target, &options, &decode, args.threads, all_boards)?;
+    let images_only: Vec<String> = files
+        .iter()
+        .filter(|f| inputs.frame(f).is_none())
+        .cloned()
+        .collect();
+    let mut detected = run_with(
+        &images_only,
+        &target,
+        &options,
+        &decode,
+        args.threads,
+        all_boards,
+    )?
+    .into_iter();
+    let outcomes: Vec<Processed> = files
+        .iter()
+        .filter_map(|f| match inputs.frame(f) {
+            Some(d) => Some(Processed {
+                outcome: Outcome::Found(d.clone(), 0.0),
+                others: Vec::new(),
+                exif_orientation: None,
+            }),
+            None => detected.next(),
+        })
+        .collect();
     let mut images = Vec::with_capacity(files.len());
     let mut found = 0;
     for (
@@ -286,6 +321,9 @@ fn one(
         CliError::Robocal(e) => Processed::failed(e.kind(), e.to_string()),
         other => Processed::failed("io", other.to_string()),
     };
+    if super::video::is_video(file) {
+        return Processed::failed("io", super::video::not_read_here(file));
+    }
     let opened = match open_image(file, decode) {
         Ok(f) => f,
         Err(e) => return cli_failed(e),

@@ -1,7 +1,7 @@
 //! `robocal intrinsics`: calibrate a camera from images or from the
 //! detections `robocal detect` wrote.
 
-use super::detect::{run_all, Outcome};
+use super::detect::Outcome;
 use super::detections_file::read_detections;
 use super::{write_output, CliError};
 use robocal::api::camera::{
@@ -94,6 +94,8 @@ pub struct IntrinsicsArgs {
     threads: Option<usize>,
     #[command(flatten)]
     limits: super::ImageLimits,
+    #[command(flatten)]
+    video: super::video_frames::VideoFlags,
     /// Benchmarking: solve N times and print the median solve time (detections
     /// in, report out; no file or detection time) on standard error (1: no
     /// timing line)
@@ -102,7 +104,8 @@ pub struct IntrinsicsArgs {
     /// Write the report there (default: standard output)
     #[arg(short = 'o', long, value_name = "FILE")]
     output: Option<String>,
-    /// The images (instead of --detections)
+    /// The images (instead of --detections); videos (.mp4 .mov .webm ...,
+    /// read through ffmpeg) give their frames kept by the live capture's rules
     #[arg(value_name = "IMAGES")]
     images: Vec<String>,
 }
@@ -154,6 +157,7 @@ pub fn run(args: IntrinsicsArgs) -> Result<(), CliError> {
                 &target,
                 &super::detect_options_of(args.target.as_deref()),
                 &args.limits,
+                &args.video,
                 args.threads,
             )?
         }
@@ -275,11 +279,13 @@ fn views_from_images(
     target: &Target,
     options: &DetectOptions,
     limits: &super::ImageLimits,
+    video: &super::video_frames::VideoFlags,
     threads: Option<usize>,
 ) -> Result<Vec<JsonView>, CliError> {
-    let outcomes = run_all(files, target, options, &limits.decode_options(), threads)?;
+    let inputs = super::video_inputs::expand("intrinsics", files, target, options, video, threads)?;
+    let outcomes = inputs.detect(target, options, &limits.decode_options(), threads)?;
     let mut views = vec![];
-    for (file, outcome) in files.iter().zip(outcomes) {
+    for (file, outcome) in inputs.names.iter().zip(outcomes) {
         match outcome {
             Outcome::Found(detection, _) => views.push(JsonView {
                 name: file.clone(),

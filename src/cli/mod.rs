@@ -29,11 +29,15 @@ mod render_video;
 mod rig;
 mod rig_handeye;
 mod rig_summary;
+mod rig_video;
 mod robot_poses;
 mod serve;
 mod stereo;
 mod target;
 mod values;
+mod video;
+mod video_frames;
+mod video_inputs;
 mod xytable;
 
 pub use input::{read_pose_text, read_text};

@@ -119,6 +119,13 @@ pub struct RigArgs {
     #[command(flatten)]
     limits: super::ImageLimits,
     #[command(flatten)]
+    video: super::video_frames::VideoFlags,
+    /// Cameras given as videos (--camera cam0 cam_0.mp4): caliscope's
+    /// timestamps.csv (sync_index,cam_id,frame_index,frame_time) matching
+    /// their frames by sync_index (default: by frame index)
+    #[arg(long, value_name = "FILE", overrides_with = "timestamps")]
+    timestamps: Option<String>,
+    #[command(flatten)]
     handeye: super::rig_handeye::RigHandEyeFlags,
     /// A calibrated rig (the report of 'robocal rig -o rig.json'): its
     /// intrinsics and camera_from_rig are held and only the hand-eye is
@@ -284,24 +291,31 @@ pub fn run(args: RigArgs) -> Result<(), CliError> {
         }
         None => (0..cameras.len()).collect(),
     };
-    // 2. Frame keys, then detection in every image at once.
+    // 2. Videos into their chosen frames, frame keys, then detection in
+    // every image at once.
+    let options = super::detect_options_of(Some(&target_spec));
+    let videos = video_cameras(&mut cameras, &target, &options, &args)?;
     let mut keys_per_camera = Vec::with_capacity(cameras.len());
     for c in &cameras {
         let names: Vec<&str> = c.images.iter().map(String::as_str).collect();
-        keys_per_camera.push(frame_keys(&names, &grouping, &c.name).map_err(|e| usage(plain(e)))?);
+        keys_per_camera.push(match &videos {
+            Some(v) if c.images.iter().all(|i| v.key(i).is_some()) => {
+                c.images.iter().filter_map(|i| v.key(i)).collect()
+            }
+            _ => frame_keys(&names, &grouping, &c.name).map_err(|e| usage(plain(e)))?,
+        });
     }
     let mut keys: Vec<String> = keys_per_camera.iter().flatten().cloned().collect();
     sort_frame_keys(&mut keys);
     keys.dedup();
     let all: Vec<String> = cameras.iter().flat_map(|c| c.images.clone()).collect();
     let decode = args.limits.decode_options();
-    let mut outcomes = run_all(
-        &all,
-        &target,
-        &super::detect_options_of(Some(&target_spec)),
-        &decode,
-        args.threads,
-    )?
+    let mut outcomes = match &videos {
+        Some(v) => v
+            .inputs(&all)
+            .detect(&target, &options, &decode, args.threads)?,
+        None => run_all(&all, &target, &options, &decode, args.threads)?,
+    }
     .into_iter();
     let mut request_cameras = Vec::with_capacity(cameras.len());
     for ((c, camera_keys), held) in cameras.iter().zip(&keys_per_camera).zip(held) {
@@ -475,6 +489,31 @@ fn rig_cameras(
 ) -> Result<Vec<usize>, CliError> {
     let names: Vec<&str> = cameras.iter().map(|c| c.name.as_str()).collect();
     rig_cameras_named(rig, &names, "--camera").map_err(|e| usage(format!("'{path}': {}", plain(e))))
+}
+
+/// The cameras given as videos replaced by their chosen frames
+/// ([`super::rig_video`]).
+fn video_cameras(
+    cameras: &mut [CameraArg],
+    target: &Target,
+    options: &robocal::detect::DetectOptions,
+    args: &RigArgs,
+) -> Result<Option<super::rig_video::RigVideos>, CliError> {
+    let names: Vec<String> = cameras.iter().map(|c| c.name.clone()).collect();
+    let mut lists: Vec<Vec<String>> = cameras.iter().map(|c| c.images.clone()).collect();
+    let videos = super::rig_video::expand(
+        &names,
+        &mut lists,
+        target,
+        options,
+        &args.video,
+        args.timestamps.as_deref(),
+        args.threads,
+    )?;
+    for (c, list) in cameras.iter_mut().zip(lists) {
+        c.images = list;
+    }
+    Ok(videos)
 }
 
 fn cameras_of_flags(flags: &[Vec<String>]) -> Vec<CameraArg> {

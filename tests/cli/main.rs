@@ -25,4 +25,5 @@ mod cli_render;
 mod cli_render_video;
 mod cli_rig;
 mod cli_stereo;
+mod cli_video;
 mod cli_workflows;
