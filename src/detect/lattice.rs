@@ -333,35 +333,47 @@ pub(crate) fn complete_maps(cells: &Cells, board: &[(i32, i32)], diagonal: bool)
     out
 }
 
+/// The lattice-to-board matrices `complete_maps` tries: the 8 turns and
+/// reflections of the axes, or for `diagonal` lattices (asymmetric grids,
+/// whose points are the board cells with `i + j` even) every basis of that
+/// lattice with steps of at most two cells along each axis: the diagonals
+/// `(1, 1)`, `(1, -1)` and also a row or column step `(2, 0)`, `(0, 2)`
+/// beside a diagonal (the nearest neighbours of a grid tilted beyond about
+/// 55 degrees, where a row step is foreshortened below a diagonal one).
 fn candidate_matrices(diagonal: bool) -> Vec<[[i32; 2]; 2]> {
+    if !diagonal {
+        let mut out = Vec::new();
+        for swap in [false, true] {
+            for sa in [1, -1] {
+                for sb in [1, -1] {
+                    out.push(if swap {
+                        [[0, sa], [sb, 0]]
+                    } else {
+                        [[sa, 0], [0, sb]]
+                    });
+                }
+            }
+        }
+        return out;
+    }
+    // Columns (a step, b step) in board cells: each on the lattice (even
+    // coordinate sum), together a basis of it (determinant +-2).
     let mut out = Vec::new();
-    for swap in [false, true] {
-        for sa in [1, -1] {
-            for sb in [1, -1] {
-                let m = if swap {
-                    [[0, sa], [sb, 0]]
-                } else {
-                    [[sa, 0], [0, sb]]
-                };
-                out.push(if diagonal {
-                    // Lattice steps (1,0) and (0,1) become board (1,1), (1,-1).
-                    let d = [[1, 1], [1, -1]];
-                    [
-                        [
-                            m[0][0] * d[0][0] + m[0][1] * d[1][0],
-                            m[0][0] * d[0][1] + m[0][1] * d[1][1],
-                        ],
-                        [
-                            m[1][0] * d[0][0] + m[1][1] * d[1][0],
-                            m[1][0] * d[0][1] + m[1][1] * d[1][1],
-                        ],
-                    ]
-                } else {
-                    m
-                });
+    for a in -2..=2i32 {
+        for b in -2..=2i32 {
+            for c in -2..=2i32 {
+                for d in -2..=2i32 {
+                    let on_lattice = (a + c) % 2 == 0 && (b + d) % 2 == 0;
+                    if on_lattice && (a * d - b * c).abs() == 2 {
+                        out.push([[a, b], [c, d]]);
+                    }
+                }
             }
         }
     }
+    // The diagonal bases first (the usual case; the order only matters for
+    // the cost of the search).
+    out.sort_by_key(|m| m.iter().flatten().map(|v| v.abs()).sum::<i32>());
     out
 }
 
