@@ -463,4 +463,36 @@ mod tests {
         // The generated order is right-handed with id 0 nearest the top-left.
         assert_eq!(order, (0..15).collect::<Vec<_>>());
     }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn orders_an_asymmetric_grid_grown_along_a_row_and_a_diagonal() {
+        // A 4x5 asymmetric grid (board cells (2 i + j % 2, j)) squeezed
+        // to 0.4 along x, as a strong tilt does: a row step (2, 0) is then
+        // 0.8 units, shorter than a diagonal (1.08), and the lattice grows
+        // along a row and a diagonal. Issue 36: every circle was in the
+        // lattice but no map took that basis ("found 20 of 20").
+        let board: Vec<(i32, i32)> = (0..5)
+            .flat_map(|j| (0..4).map(move |i| (2 * i + j % 2, j)))
+            .collect();
+        let pts: Vec<Point2<f64>> = board
+            .iter()
+            .map(|&(x, y)| Point2::new(50.0 + 8.0 * x as f64, 40.0 + 20.0 * y as f64))
+            .collect();
+        let index = PointIndex::new(&pts, 16.0);
+        // Seed 5 is board (3, 1): its row neighbour 6 is (5, 1), its
+        // diagonal neighbour 9 is (4, 2).
+        let cells = grow(
+            &index,
+            5,
+            pts[6] - pts[5],
+            pts[9] - pts[5],
+            100,
+            &|_, _, _| true,
+        );
+        assert_eq!(cells.len(), 20);
+        let maps = complete_maps(&cells, &board, true);
+        assert!(!maps.is_empty());
+        let order = choose_order(&pts, &cells, &maps, &board, 4, &|_| false).unwrap();
+        assert_eq!(order, (0..20).collect::<Vec<_>>());
+    }
 }
