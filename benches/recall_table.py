@@ -21,7 +21,8 @@ claims (robocal: by id; OpenCV: the nearest truth point, since its marker
 corner order and numbering differ from Kalibr's); any other point is
 "wrong". Error: mean / max distance of the found points.
 
-Usage (crate root): python3 benches/recall_table.py [--views N] [--skip-render]
+Usage (crate root): python3 benches/recall_table.py [--views N] [--skip-render] [--out DIR]
+(renders in DIR, default benches/out/recall)
 """
 import json
 import os
@@ -150,10 +151,11 @@ def main():
     import cv2
 
     views = arg("--views", 6)
+    out = sys.argv[sys.argv.index("--out") + 1] if "--out" in sys.argv else OUT
     if "--skip-render" not in sys.argv:
-        subprocess.check_call(["cargo", "run", "--example", "recall_table", "--", OUT, "--views", str(views)],
+        subprocess.check_call(["cargo", "run", "--example", "recall_table", "--", out, "--views", str(views)],
                               cwd=ROOT)
-    sets = json.load(open(os.path.join(OUT, "recall.json")))
+    sets = json.load(open(os.path.join(out, "recall.json")))
     cv2.setNumThreads(1)
     print(f"OpenCV {cv2.__version__}; found = within {FOUND_PX} px of its truth point; cells: found/in view "
           f"(recall), mean / max px of the found points, wrong points")

@@ -81,9 +81,9 @@ fn main() {
             };
             // Circle grids carry the print in their spec; the others are
             // rendered inverted and detected without a print option.
-            let (render_spec, detect_spec, options) = match (print, inverted_spec) {
-                (Polarity::LightOnDark, s) if !s.is_empty() => (s, s, RenderOptions::default()),
-                _ => (spec, spec, RenderOptions::default().printed(print)),
+            let (render_spec, detect_spec, render_print) = match (print, inverted_spec) {
+                (Polarity::LightOnDark, s) if !s.is_empty() => (s, s, Polarity::DarkOnLight),
+                _ => (spec, spec, print),
             };
             let target = Target::parse_spec(render_spec).expect("spec");
             let det_target = Target::parse_spec(detect_spec).expect("spec");
@@ -106,13 +106,15 @@ fn main() {
                         rng.range(-0.6, 0.6),
                     );
                     let at = (rng.range(-0.05, 0.05) * z, rng.range(-0.04, 0.04) * z, z);
+                    // The print last: it swaps the black and white set here.
                     let o = RenderOptions {
                         seed: 300 + k as u64,
                         blur_sigma_px: blur,
                         black,
                         white,
-                        ..options.clone()
-                    };
+                        ..RenderOptions::default()
+                    }
+                    .printed(render_print);
                     let r =
                         render(&cam, &target, &board_pose(&target, rpy, at), &o).expect("render");
                     let file = format!("{out}/{set}/{k:03}.png");
