@@ -26,8 +26,10 @@ fn webcam() -> Pinhole {
     }
 }
 
-/// Poses: (roll, pitch, yaw), board centre (metres).
-const VIEWS: [((f64, f64, f64), (f64, f64, f64)); 6] = [
+/// A pose: (roll, pitch, yaw) radians, board centre (metres).
+type View = ((f64, f64, f64), (f64, f64, f64));
+
+const VIEWS: [View; 6] = [
     ((0.1, -0.2, 0.05), (0.0, 0.0, 1.0)),
     ((0.45, 0.3, -0.3), (0.12, -0.05, 1.1)),
     ((-0.35, 0.5, 0.6), (-0.15, 0.08, 1.2)),
