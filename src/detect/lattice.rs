@@ -333,35 +333,47 @@ pub(crate) fn complete_maps(cells: &Cells, board: &[(i32, i32)], diagonal: bool)
     out
 }
 
+/// The lattice-to-board matrices `complete_maps` tries: the 8 turns and
+/// reflections of the axes, or for `diagonal` lattices (asymmetric grids,
+/// whose points are the board cells with `i + j` even) every basis of that
+/// lattice with steps of at most two cells along each axis: the diagonals
+/// `(1, 1)`, `(1, -1)` and also a row or column step `(2, 0)`, `(0, 2)`
+/// beside a diagonal (the nearest neighbours of a grid tilted beyond about
+/// 55 degrees, where a row step is foreshortened below a diagonal one).
 fn candidate_matrices(diagonal: bool) -> Vec<[[i32; 2]; 2]> {
+    if !diagonal {
+        let mut out = Vec::new();
+        for swap in [false, true] {
+            for sa in [1, -1] {
+                for sb in [1, -1] {
+                    out.push(if swap {
+                        [[0, sa], [sb, 0]]
+                    } else {
+                        [[sa, 0], [0, sb]]
+                    });
+                }
+            }
+        }
+        return out;
+    }
+    // Columns (a step, b step) in board cells: each on the lattice (even
+    // coordinate sum), together a basis of it (determinant +-2).
     let mut out = Vec::new();
-    for swap in [false, true] {
-        for sa in [1, -1] {
-            for sb in [1, -1] {
-                let m = if swap {
-                    [[0, sa], [sb, 0]]
-                } else {
-                    [[sa, 0], [0, sb]]
-                };
-                out.push(if diagonal {
-                    // Lattice steps (1,0) and (0,1) become board (1,1), (1,-1).
-                    let d = [[1, 1], [1, -1]];
-                    [
-                        [
-                            m[0][0] * d[0][0] + m[0][1] * d[1][0],
-                            m[0][0] * d[0][1] + m[0][1] * d[1][1],
-                        ],
-                        [
-                            m[1][0] * d[0][0] + m[1][1] * d[1][0],
-                            m[1][0] * d[0][1] + m[1][1] * d[1][1],
-                        ],
-                    ]
-                } else {
-                    m
-                });
+    for a in -2..=2i32 {
+        for b in -2..=2i32 {
+            for c in -2..=2i32 {
+                for d in -2..=2i32 {
+                    let on_lattice = (a + c) % 2 == 0 && (b + d) % 2 == 0;
+                    if on_lattice && (a * d - b * c).abs() == 2 {
+                        out.push([[a, b], [c, d]]);
+                    }
+                }
             }
         }
     }
+    // The diagonal bases first (the usual case; the order only matters for
+    // the cost of the search).
+    out.sort_by_key(|m| m.iter().flatten().map(|v| v.abs()).sum::<i32>());
     out
 }
 
@@ -450,5 +462,37 @@ mod tests {
         let order = choose_order(&pts, &cells, &maps, &board, 5, &|_| false).unwrap();
         // The generated order is right-handed with id 0 nearest the top-left.
         assert_eq!(order, (0..15).collect::<Vec<_>>());
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn orders_an_asymmetric_grid_grown_along_a_row_and_a_diagonal() {
+        // A 4x5 asymmetric grid (board cells (2 i + j % 2, j)) squeezed
+        // to 0.4 along x, as a strong tilt does: a row step (2, 0) is then
+        // 0.8 units, shorter than a diagonal (1.08), and the lattice grows
+        // along a row and a diagonal. Issue 36: every circle was in the
+        // lattice but no map took that basis ("found 20 of 20").
+        let board: Vec<(i32, i32)> = (0..5)
+            .flat_map(|j| (0..4).map(move |i| (2 * i + j % 2, j)))
+            .collect();
+        let pts: Vec<Point2<f64>> = board
+            .iter()
+            .map(|&(x, y)| Point2::new(50.0 + 8.0 * x as f64, 40.0 + 20.0 * y as f64))
+            .collect();
+        let index = PointIndex::new(&pts, 16.0);
+        // Seed 5 is board (3, 1): its row neighbour 6 is (5, 1), its
+        // diagonal neighbour 9 is (4, 2).
+        let cells = grow(
+            &index,
+            5,
+            pts[6] - pts[5],
+            pts[9] - pts[5],
+            100,
+            &|_, _, _| true,
+        );
+        assert_eq!(cells.len(), 20);
+        let maps = complete_maps(&cells, &board, true);
+        assert!(!maps.is_empty());
+        let order = choose_order(&pts, &cells, &maps, &board, 4, &|_| false).unwrap();
+        assert_eq!(order, (0..20).collect::<Vec<_>>());
     }
 }

@@ -7,8 +7,10 @@
 mod support;
 
 mod detect_circles;
+mod detect_circles_asym;
 mod detect_datasets;
 mod detect_grid_boards;
+mod detect_marker_recall;
 mod detect_markers;
 mod detect_markers_datasets;
 mod detect_polarity;

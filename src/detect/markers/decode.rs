@@ -19,6 +19,13 @@ const MIN_CONTRAST: f64 = 20.0;
 /// maxErroneousBitsInBorderRate is 0.35; stricter here, the border is what
 /// rejects false markers).
 const MAX_BORDER_ERROR_RATE: f64 = 0.1;
+/// [`MIN_CONTRAST`] for a read where the board predicts a marker: the
+/// place and the id are known, so a faint marker (blur, low contrast,
+/// small) is read too.
+const EXPECTED_MIN_CONTRAST: f64 = 8.0;
+/// [`MAX_BORDER_ERROR_RATE`] for a read where the board predicts a marker
+/// (OpenCV's maxErroneousBitsInBorderRate).
+const EXPECTED_MAX_BORDER_ERROR_RATE: f64 = 0.35;
 
 /// A decoded marker in the image.
 #[derive(Debug, Clone)]
@@ -41,25 +48,70 @@ pub(crate) fn read_marker(
     border: usize,
     max_bit_errors: u32,
 ) -> Option<Marker> {
-    let bits = dictionary.marker_bits();
-    let n = bits + 2 * border;
+    let n = dictionary.marker_bits() + 2 * border;
+    let cells = sample_cells(img, &quad.corners, n)?;
+    let code = classify(&cells, n, border, MIN_CONTRAST, MAX_BORDER_ERROR_RATE)?;
+    // 4. Decode; the marker's own top-left is sampled corner `rotation`.
+    let d = dictionary.decode(code, max_bit_errors)?;
+    let corners = [0, 1, 2, 3].map(|j| quad.corners[(d.rotation + j) % 4]);
+    Some(Marker {
+        id: d.id,
+        corners,
+        bit_errors: d.bit_errors,
+    })
+}
+
+/// Whether the cells inside `corners` (the marker's own corner order,
+/// rotation 0) read as `dictionary`'s marker `id` with at most
+/// `max_bit_errors` wrong bits, under the looser contrast and border
+/// limits of a read at a place the board predicts (`recover.rs`): the
+/// bit errors, or `None`. A read that is another marker of the dictionary
+/// exactly is refused.
+pub(crate) fn read_expected(
+    img: &GrayImage,
+    corners: &[Point2<f64>; 4],
+    dictionary: Dictionary,
+    border: usize,
+    id: usize,
+    max_bit_errors: u32,
+) -> Option<u32> {
+    let n = dictionary.marker_bits() + 2 * border;
+    let cells = sample_cells(img, corners, n)?;
+    let code = classify(
+        &cells,
+        n,
+        border,
+        EXPECTED_MIN_CONTRAST,
+        EXPECTED_MAX_BORDER_ERROR_RATE,
+    )?;
+    let errors = (code ^ dictionary.code(id)?).count_ones();
+    if errors > max_bit_errors {
+        return None;
+    }
+    match dictionary.decode(code, 0) {
+        Some(d) if d.id != id || d.rotation != 0 => None,
+        _ => Some(errors),
+    }
+}
+
+/// Mean grey level of each of the `n` x `n` cells of the quad `corners`
+/// (row-major, rectified by the quad's homography), `None` when a sample
+/// falls outside the image.
+fn sample_cells(img: &GrayImage, corners: &[Point2<f64>; 4], n: usize) -> Option<Vec<f64>> {
     let unit = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
     let pairs: Vec<_> = unit
         .iter()
-        .zip(&quad.corners)
+        .zip(corners)
         .map(|(&(u, v), c)| (Point2::new(u, v), *c))
         .collect();
     let h = Homography::fit(&pairs)?;
-    // 1. Cell means.
+    let off = |s: usize| 0.5 + SAMPLE_SPREAD * ((s as f64 + 0.5) / SAMPLES_PER_CELL as f64 - 0.5);
     let mut cells = vec![0.0; n * n];
     for row in 0..n {
         for col in 0..n {
             let mut sum = 0.0;
             for sy in 0..SAMPLES_PER_CELL {
                 for sx in 0..SAMPLES_PER_CELL {
-                    let off = |s: usize| {
-                        0.5 + SAMPLE_SPREAD * ((s as f64 + 0.5) / SAMPLES_PER_CELL as f64 - 0.5)
-                    };
                     let u = (col as f64 + off(sx)) / n as f64;
                     let v = (row as f64 + off(sy)) / n as f64;
                     let p = h.map(&Point2::new(u, v))?;
@@ -69,17 +121,29 @@ pub(crate) fn read_marker(
             cells[row * n + col] = sum / (SAMPLES_PER_CELL * SAMPLES_PER_CELL) as f64;
         }
     }
-    // 2. Threshold and contrast.
-    let t = otsu(&cells)?;
+    Some(cells)
+}
+
+/// The inner cells' bits (light = 1, row-major) of sampled `cells`, split
+/// by Otsu's threshold, when the light and dark means differ by at least
+/// `min_contrast` and at most `max_border_rate` of the border cells read
+/// light.
+fn classify(
+    cells: &[f64],
+    n: usize,
+    border: usize,
+    min_contrast: f64,
+    max_border_rate: f64,
+) -> Option<u64> {
+    let t = otsu(cells)?;
     let (dark, light): (Vec<f64>, Vec<f64>) = cells.iter().copied().partition(|&v| v < t);
     if dark.is_empty() || light.is_empty() {
         return None;
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    if mean(&light) - mean(&dark) < MIN_CONTRAST {
+    if mean(&light) - mean(&dark) < min_contrast {
         return None;
     }
-    // 3. Border.
     let is_border =
         |r: usize, c: usize| r < border || c < border || r >= n - border || c >= n - border;
     let mut border_cells = 0;
@@ -96,17 +160,10 @@ pub(crate) fn read_marker(
             }
         }
     }
-    if border_light as f64 > MAX_BORDER_ERROR_RATE * border_cells as f64 {
+    if border_light as f64 > max_border_rate * border_cells as f64 {
         return None;
     }
-    // 4. Decode; the marker's own top-left is sampled corner `rotation`.
-    let d = dictionary.decode(code, max_bit_errors)?;
-    let corners = [0, 1, 2, 3].map(|j| quad.corners[(d.rotation + j) % 4]);
-    Some(Marker {
-        id: d.id,
-        corners,
-        bit_errors: d.bit_errors,
-    })
+    Some(code)
 }
 
 fn bilinear(img: &GrayImage, x: f64, y: f64) -> Option<f64> {

@@ -11,14 +11,19 @@
 //!    consecutive ids (a second board printed with the next ids). Within a
 //!    board, markers that the homography of their neighbours places more
 //!    than [`OUTLIER_FRACTION`] of their side away are dropped (a
-//!    duplicate id, a false decode, the other ChArUco layout).
+//!    duplicate id, a false decode, the other ChArUco layout). The
+//!    board's markers the search missed are then looked for where the
+//!    found ones place them and read as the id expected there
+//!    ([`recover`], OpenCV's `refineDetectedMarkers`).
 //! 3. Points, measured, never interpolated: each is seeded from the
 //!    markers around it and refined as a saddle point of the image with the
 //!    chessboard detector's sub-pixel fit (`refine.rs`).
 //!    - ChArUco: every inner chessboard corner next to at least one
 //!      detected marker, seeded from each neighbouring marker's own
 //!      homography; a corner whose two neighbouring markers predict it more
-//!      than [`DISAGREE_FRACTION`] of the marker margin apart is dropped.
+//!      than [`DISAGREE_FRACTION`] of the marker margin (or
+//!      [`DISAGREE_SIDE_FRACTION`] of the marker side) apart is dropped;
+//!      the fit starts from the homography of all of them together.
 //!    - AprilGrid: the four corners of every tag (each is an X-junction with
 //!      Kalibr's corner squares), seeded at the tag's quad corners.
 //!    - ArUco grid: the four corners of every marker, plain L-corners of a
@@ -33,7 +38,9 @@ mod edges;
 mod grid_corners;
 pub(crate) mod homography;
 mod quads;
+mod recover;
 mod runs;
+mod tag_corners;
 
 use super::refine::refine_saddle;
 use super::DetectOptions;
@@ -46,6 +53,7 @@ use homography::Homography;
 use nalgebra::Point2;
 pub(crate) use quads::{decimates, Resolutions};
 use std::collections::HashMap;
+use tag_corners::{aprilgrid_corners, aruco_grid_corners};
 
 /// A marker is an outlier of its board when the board's homography puts
 /// one of its corners further than this fraction of its side away.
@@ -59,6 +67,12 @@ pub const DISAGREE_FRACTION: f64 = 0.5;
 pub const NEIGHBOURHOOD_MARKERS: f64 = 3.0;
 /// Floor of the disagreement tolerance, pixels.
 pub const MIN_DISAGREE_PX: f64 = 1.5;
+/// Floor of the disagreement tolerance as a fraction of the markers' side:
+/// a small marker's own homography extrapolates its side's noise to the
+/// corner (3-5 px apart on caliscope's 20 px markers, whose joint seed the
+/// saddle fit then finds within a pixel); a wrong marker is off by more
+/// ([`OUTLIER_FRACTION`] of its side, checked before).
+pub const DISAGREE_SIDE_FRACTION: f64 = 0.3;
 /// Largest saddle-fit half-window, pixels (the chessboard detector's).
 const MAX_WINDOW_PX: f64 = 6.0;
 /// Smallest saddle-fit half-window, pixels.
@@ -278,10 +292,12 @@ fn board_markers<'m>(layout: &MarkerLayout, markers: &'m [Marker]) -> Vec<(usize
 /// markers is consistent.
 fn assemble(image: &GrayImage, board: &Target, markers: &[Marker]) -> Option<Detection> {
     let layout = marker_board::layout(board)?;
-    let mine = board_markers(&layout, markers);
+    let mut mine = board_markers(&layout, markers);
     if mine.is_empty() {
         return None;
     }
+    let recovered = recover::recover_missing(image, &layout, &mine);
+    mine.extend(recovered.iter().map(|(k, m)| (*k, m)));
     let points = match board {
         Target::Charuco { .. } => charuco_corners(image, board, &layout, &mine),
         Target::Aprilgrid { .. } => aprilgrid_corners(image, board, &layout, &mine),
@@ -414,7 +430,9 @@ fn charuco_corners(
             let corner = Point2::new((i + 1) as f64 * square_m, (j + 1) as f64 * square_m);
             let around = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)];
             let mut predictions = Vec::new();
+            let mut all_pairs = Vec::new();
             let mut px_per_m = 0.0;
+            let mut side_px = 0.0;
             for sq in around {
                 let Some(&(k, m)) = detected.get(&sq) else {
                     continue;
@@ -427,23 +445,28 @@ fn charuco_corners(
                 if let Some(p) = Homography::fit(&pairs).and_then(|h| h.map(&corner)) {
                     predictions.push(p);
                     px_per_m += mean_side(&m.corners) / marker_m;
+                    side_px += mean_side(&m.corners);
+                    all_pairs.extend(pairs);
                 }
             }
             if predictions.is_empty() {
                 continue;
             }
             px_per_m /= predictions.len() as f64;
+            side_px /= predictions.len() as f64;
             let margin_px = margin_m * px_per_m;
-            let tol = (DISAGREE_FRACTION * margin_px).max(MIN_DISAGREE_PX);
+            let tol = (DISAGREE_FRACTION * margin_px)
+                .max(MIN_DISAGREE_PX)
+                .max(DISAGREE_SIDE_FRACTION * side_px);
             if predictions.len() == 2 && (predictions[0] - predictions[1]).norm() > tol {
                 continue;
             }
-            let seed = Point2::from(
-                predictions
-                    .iter()
-                    .fold(nalgebra::Vector2::zeros(), |s, p| s + p.coords)
-                    / predictions.len() as f64,
-            );
+            // Seeded from both markers' corners at once: the corner lies
+            // between them, where their joint homography interpolates
+            // (each marker's own extrapolates past its side).
+            let Some(seed) = Homography::fit(&all_pairs).and_then(|h| h.map(&corner)) else {
+                continue;
+            };
             // The fit's weights reach 1.5 windows: stay within the white
             // margin plus the marker's black border.
             let border_px = marker_m / (layout.dictionary.marker_bits() + 2) as f64 * px_per_m;
@@ -457,84 +480,6 @@ fn charuco_corners(
             }
         }
     }
-    out
-}
-
-fn aprilgrid_corners(
-    image: &GrayImage,
-    board: &Target,
-    layout: &MarkerLayout,
-    mine: &[(usize, &Marker)],
-) -> Vec<DetectedPoint> {
-    let Target::Aprilgrid {
-        tag_cols,
-        spacing_ratio,
-        ..
-    } = board
-    else {
-        return Vec::new();
-    };
-    let corner_cols = 2 * tag_cols;
-    let n = layout.dictionary.marker_bits() + 2 * layout.border_bits;
-    let mut out = Vec::new();
-    for &(k, m) in mine {
-        // The tag's OpenCV corners are printed bottom-right, bottom-left,
-        // top-left, top-right: Kalibr's base + 1, base, base + 2 cols,
-        // base + 2 cols + 1.
-        let base = (k / tag_cols) * corner_cols * 2 + (k % tag_cols) * 2;
-        let ids = [base + 1, base, base + corner_cols, base + corner_cols + 1];
-        let side = mean_side(&m.corners);
-        let gap_px = spacing_ratio * side;
-        let border_px = layout.border_bits as f64 * side / n as f64;
-        let window = 0.5 * gap_px.min(border_px);
-        for (id, seed) in ids.into_iter().zip(m.corners) {
-            if let Some(p) = refine(image, seed, window) {
-                out.push(DetectedPoint {
-                    id,
-                    x_px: p.x,
-                    y_px: p.y,
-                    covariance_px2: None,
-                });
-            }
-        }
-    }
-    out.sort_by_key(|p| p.id);
-    out
-}
-
-/// An ArUco grid's points: every consistent marker's four corners
-/// ([`grid_corners`]), point `4 k + c` for corner `c` of the board's marker
-/// `k` ([`marker_board`]), in id order. Corners within [`MIN_WINDOW_PX`] of
-/// the image border are left out (their edge fits reach past it).
-fn aruco_grid_corners(
-    image: &GrayImage,
-    layout: &MarkerLayout,
-    mine: &[(usize, &Marker)],
-) -> Vec<DetectedPoint> {
-    let cells = layout.dictionary.marker_bits() + 2 * layout.border_bits;
-    let margin = MIN_WINDOW_PX;
-    let inside = |p: &Point2<f64>| {
-        p.x >= margin
-            && p.y >= margin
-            && p.x <= image.width as f64 - 1.0 - margin
-            && p.y <= image.height as f64 - 1.0 - margin
-    };
-    let mut out: Vec<DetectedPoint> = mine
-        .iter()
-        .flat_map(|&(k, m)| {
-            grid_corners::refine_corners(image, m.corners, cells)
-                .into_iter()
-                .enumerate()
-                .filter(|(_, p)| inside(p))
-                .map(move |(c, p)| DetectedPoint {
-                    id: 4 * k + c,
-                    x_px: p.x,
-                    y_px: p.y,
-                    covariance_px2: None,
-                })
-        })
-        .collect();
-    out.sort_by_key(|p| p.id);
     out
 }
 
