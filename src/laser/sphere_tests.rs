@@ -35,7 +35,8 @@ fn emitter(plane: &LaserPlane) -> Point3<f64> {
 /// Start values off the truth: the plane turned 1 deg and 2 mm off, the
 /// mounting turned 2 deg and 5 mm off.
 fn starts(plane: &LaserPlane, mount: &Pose) -> (LaserPlane, Pose) {
-    let turn = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.6, 0.8, 0.0) * 1f64.to_radians());
+    let turn =
+        nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.6, 0.8, 0.0) * 1f64.to_radians());
     let start_plane = LaserPlane {
         normal: turn * plane.normal,
         distance_m: plane.distance_m + 0.002,
@@ -55,7 +56,11 @@ fn errors(
     let p = &c.plane_camera.plane;
     let diff = mount.inverse() * c.gripper_from_camera;
     [
-        p.normal.dot(&plane.normal).clamp(-1.0, 1.0).acos().to_degrees(),
+        p.normal
+            .dot(&plane.normal)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees(),
         (p.distance_m - plane.distance_m).abs() * 1e3,
         diff.rotation.angle().to_degrees(),
         diff.translation.vector.norm() * 1e3,
@@ -64,7 +69,12 @@ fn errors(
 }
 
 /// Exact stripe centres: the plane/sphere circle, lit and seen, projected.
-fn exact_scans(poses: &[Pose], mount: &Pose, plane: &LaserPlane, scene: &SphereScene) -> Vec<SphereScan> {
+fn exact_scans(
+    poses: &[Pose],
+    mount: &Pose,
+    plane: &LaserPlane,
+    scene: &SphereScene,
+) -> Vec<SphereScan> {
     let cam = camera();
     let n = plane.normal.into_inner();
     let e = emitter(plane);
@@ -83,7 +93,9 @@ fn exact_scans(poses: &[Pose], mount: &Pose, plane: &LaserPlane, scene: &SphereS
                     let p = q + (u * a.cos() + v * a.sin()) * rho;
                     let seen = (-p).dot(&(p - c)) > 0.0;
                     let lit = (e.coords - p).dot(&(p - c)) > 0.0;
-                    (seen && lit).then(|| cam.project(&Point3::from(p)).ok()).flatten()
+                    (seen && lit)
+                        .then(|| cam.project(&Point3::from(p)).ok())
+                        .flatten()
                 })
                 .collect();
             SphereScan {
@@ -99,9 +111,20 @@ fn exact_profiles_give_the_exact_sensor() {
     let (plane, mount, scene) = (example_plane(), example_mounting(), example_sphere());
     let poses = sphere_scan_poses(6, &scene, &mount, &plane);
     let scans = exact_scans(&poses, &mount, &plane, &scene);
-    assert!(scans.iter().all(|s| s.pixels.len() > 30), "{:?}", scans.iter().map(|s| s.pixels.len()).collect::<Vec<_>>());
+    assert!(
+        scans.iter().all(|s| s.pixels.len() > 30),
+        "{:?}",
+        scans.iter().map(|s| s.pixels.len()).collect::<Vec<_>>()
+    );
     let (start_plane, start_mount) = starts(&plane, &mount);
-    let c = calibrate_on_sphere(&camera(), &scans, scene.radius_m, &start_plane, &start_mount).unwrap();
+    let c = calibrate_on_sphere(
+        &camera(),
+        &scans,
+        scene.radius_m,
+        &start_plane,
+        &start_mount,
+    )
+    .unwrap();
     let e = errors(&c, &plane, &mount, &scene);
     assert!(e.iter().all(|v| *v < 1e-4), "{e:?}");
     assert!(c.rms_m < 1e-8, "{}", c.rms_m);
@@ -133,12 +156,24 @@ fn rendered_scans_give_the_sensor_within_bounds() {
             seed: 11 + k as u64,
             ..SphereRenderOptions::default()
         };
-        let image = render_sphere(&cam, &(b * mount), &plane, &emitter(&plane), &scene, &options).unwrap();
+        let image = render_sphere(
+            &cam,
+            &(b * mount),
+            &plane,
+            &emitter(&plane),
+            &scene,
+            &options,
+        )
+        .unwrap();
         let stripe = extract_stripe(&image, None, &StripeOptions::default()).unwrap();
         // Each centre against the true stripe: its ray meets the true plane
         // at a point this far from the sphere.
         let c = ((b * mount).inverse() * scene.centre_base).coords;
-        let pixels: Vec<Point2<f64>> = stripe.points.iter().map(|p| Point2::new(p.x_px, p.y_px)).collect();
+        let pixels: Vec<Point2<f64>> = stripe
+            .points
+            .iter()
+            .map(|p| Point2::new(p.x_px, p.y_px))
+            .collect();
         for px in &pixels {
             let x = plane.intersect_ray(&cam.unproject(px).unwrap()).unwrap();
             centre_err.0 += ((x.coords - c).norm() - scene.radius_m).abs();
@@ -149,11 +184,18 @@ fn rendered_scans_give_the_sensor_within_bounds() {
             pixels,
         });
     }
-    assert!(scans.iter().all(|s| s.pixels.len() > 30), "{:?}", scans.iter().map(|s| s.pixels.len()).collect::<Vec<_>>());
+    assert!(
+        scans.iter().all(|s| s.pixels.len() > 30),
+        "{:?}",
+        scans.iter().map(|s| s.pixels.len()).collect::<Vec<_>>()
+    );
     let (start_plane, start_mount) = starts(&plane, &mount);
     let c = calibrate_on_sphere(&cam, &scans, scene.radius_m, &start_plane, &start_mount).unwrap();
     let e = errors(&c, &plane, &mount, &scene);
-    let std_normal_deg = (0.5 * (c.plane_camera.covariance[(0, 0)] + c.plane_camera.covariance[(1, 1)])).sqrt().to_degrees();
+    let std_normal_deg = (0.5
+        * (c.plane_camera.covariance[(0, 0)] + c.plane_camera.covariance[(1, 1)]))
+        .sqrt()
+        .to_degrees();
     let std_d_mm = c.plane_camera.covariance[(2, 2)].sqrt() * 1e3;
     eprintln!(
         "sphere scans: errors {e:?}, std normal {std_normal_deg} deg, distance {std_d_mm} mm, rms {} mm, {} points, mean true-plane miss {} mm",
@@ -161,5 +203,8 @@ fn rendered_scans_give_the_sensor_within_bounds() {
         c.n_points,
         centre_err.0 / centre_err.1 as f64 * 1e3
     );
-    assert!(e[0] < 0.2 && e[1] < 0.5 && e[2] < 0.3 && e[3] < 1.0 && e[4] < 1.0, "{e:?}");
+    assert!(
+        e[0] < 0.2 && e[1] < 0.5 && e[2] < 0.3 && e[3] < 1.0 && e[4] < 1.0,
+        "{e:?}"
+    );
 }

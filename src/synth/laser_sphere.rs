@@ -92,11 +92,9 @@ pub fn sphere_scan_poses(
             let a = f * 2.4;
             let tilt = 0.25 + 0.15 * (f * 0.9).sin();
             let yaw = 1.05 * (f * 1.7).sin();
-            let turn = UnitQuaternion::from_scaled_axis(Vector3::new(
-                tilt * a.cos(),
-                tilt * a.sin(),
-                0.0,
-            )) * UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.0, yaw));
+            let turn =
+                UnitQuaternion::from_scaled_axis(Vector3::new(tilt * a.cos(), tilt * a.sin(), 0.0))
+                    * UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.0, yaw));
             let r = down * turn;
             // The centre in the camera frame: on the plane's side given
             // by the height, x and depth varied.
@@ -134,8 +132,10 @@ pub fn render_sphere(
     // The sphere's image: its centre's projection and a generous radius.
     let centre_px = camera.project(&c)?;
     let reach = 1.6 * camera.fx.max(camera.fy) * r / (c.z - r).max(1e-3) + 4.0;
-    let x_range = (centre_px.x - reach).max(0.0) as usize..((centre_px.x + reach).max(0.0) as usize + 1).min(w);
-    let y_range = (centre_px.y - reach).max(0.0) as usize..((centre_px.y + reach).max(0.0) as usize + 1).min(h);
+    let x_range = (centre_px.x - reach).max(0.0) as usize
+        ..((centre_px.x + reach).max(0.0) as usize + 1).min(w);
+    let y_range = (centre_px.y - reach).max(0.0) as usize
+        ..((centre_px.y + reach).max(0.0) as usize + 1).min(h);
     let mut rng = Rng::new(options.seed);
     let mut pixels = Vec::with_capacity(w * h);
     for y in 0..h {
