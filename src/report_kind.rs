@@ -31,11 +31,14 @@ pub enum ReportKind {
     LaserPlane,
     /// A stripe image as 3-D points (`robocal laser points`, `laser_points`).
     LaserPoints,
+    /// A laser-line sensor on the robot from scans of a sphere: the plane,
+    /// the camera's mounting (`robocal laser sphere`, `laser_sphere`).
+    LaserSphere,
 }
 
 impl ReportKind {
     /// Every kind, in the order of the docs.
-    pub const ALL: [ReportKind; 9] = [
+    pub const ALL: [ReportKind; 10] = [
         ReportKind::Camera,
         ReportKind::Stereo,
         ReportKind::Rig,
@@ -45,6 +48,7 @@ impl ReportKind {
         ReportKind::Diff,
         ReportKind::LaserPlane,
         ReportKind::LaserPoints,
+        ReportKind::LaserSphere,
     ];
 
     /// The name written as `kind`.
@@ -59,6 +63,7 @@ impl ReportKind {
             ReportKind::Diff => "diff",
             ReportKind::LaserPlane => "laser_plane",
             ReportKind::LaserPoints => "laser_points",
+            ReportKind::LaserSphere => "laser_sphere",
         }
     }
 
@@ -129,7 +134,7 @@ mod tests {
             ReportKind::of_report(&serde_json::json!({"kind": "mono"}))
                 .unwrap_err()
                 .to_string(),
-            "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff, laser_plane, laser_points)"
+            "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff, laser_plane, laser_points, laser_sphere)"
         );
     }
 }

@@ -329,12 +329,17 @@ fn fit_measured(
 
 /// The report's plane from a fit.
 pub fn plane_json(fit: &crate::laser::PlaneFit) -> LaserPlaneJson {
-    let c = fit.estimate.normal_distance_covariance();
-    let t = fit.estimate.covariance;
-    let n = fit.estimate.plane.normal;
+    estimate_json(&fit.estimate)
+}
+
+/// The report's plane from an estimate (camera frame).
+pub fn estimate_json(estimate: &crate::geometry::PlaneEstimate) -> LaserPlaneJson {
+    let c = estimate.normal_distance_covariance();
+    let t = estimate.covariance;
+    let n = estimate.plane.normal;
     LaserPlaneJson {
         normal_camera: [n.x, n.y, n.z],
-        distance_m: fit.estimate.plane.distance_m,
+        distance_m: estimate.plane.distance_m,
         covariance: std::array::from_fn(|r| std::array::from_fn(|k| c[(r, k)])),
         normal_std_deg: ((t[(0, 0)] + t[(1, 1)]).max(0.0) / 2.0).sqrt().to_degrees(),
         distance_std_mm: t[(2, 2)].max(0.0).sqrt() * 1e3,

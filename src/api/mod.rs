@@ -49,6 +49,7 @@ pub mod handeye_field;
 mod handeye_tests;
 pub mod laser;
 pub mod laser_json;
+pub mod laser_sphere;
 pub mod plan;
 pub mod planar;
 pub mod poses;

@@ -20,6 +20,8 @@ use robocal::laser::{PlaneResidual, ScanAxis, StripeMethod, StripeOptions};
 
   robocal laser plane --camera FILE --target SPEC [--pairs] IMAGES... [-o FILE]
   robocal laser points --camera FILE --plane FILE [--off FILE] IMAGE [-o FILE]
+  robocal laser sphere --camera FILE --plane FILE --gripper-from-camera FILE --radius-mm R
+      --base-from-gripper POSE... IMAGES... [-o FILE]
 
 plane: per board pose, the board is detected and its pose found with the
 calibrated camera, the stripe's centre is extracted in every column (or
@@ -33,7 +35,14 @@ least squares) and adds refined_camera.
 
 points: the stripe of one image met with the plane: 3-D points in the camera
 frame (and the flange and base frames with --gripper-from-camera and
---base-from-gripper).",
+--base-from-gripper).
+
+sphere: the sensor on the robot from laser images of a sphere of known
+radius at several robot poses (one --base-from-gripper per image): the
+laser plane, the camera's mounting gripper_from_camera and the sphere's
+centre refined together from start values (a plane and a mounting within a
+few mm and degrees), with their covariance; the plane also in the flange
+frame.",
     after_help = "Examples:
   robocal render --out scans --views 4 --laser-plane 0,-0.98,0.196,0.098
   robocal laser plane --camera camera.json --target chessboard:9x6:30mm --pairs \\
@@ -52,11 +61,13 @@ enum LaserCommand {
     Plane(PlaneArgs),
     /// A stripe image to 3-D points with a known laser plane
     Points(PointsArgs),
+    /// The plane and the camera on the robot's flange from scans of a sphere
+    Sphere(super::laser_sphere::SphereArgs),
 }
 
-/// Stripe extraction flags shared by both subcommands.
+/// Stripe extraction flags shared by the subcommands.
 #[derive(clap::Args)]
-struct StripeArgs {
+pub(super) struct StripeArgs {
     /// Stripe extractor: cog (centre of gravity over a thresholded window)
     /// or ridge (Steger's ridge detector)
     #[arg(long, value_name = "NAME", default_value = "cog")]
@@ -143,10 +154,11 @@ pub fn run(args: LaserArgs) -> Result<(), CliError> {
     match args.command {
         LaserCommand::Plane(a) => run_plane(a),
         LaserCommand::Points(a) => run_points(a),
+        LaserCommand::Sphere(a) => super::laser_sphere::run_sphere(a),
     }
 }
 
-fn stripe_options(a: &StripeArgs) -> Result<StripeOptions, CliError> {
+pub(super) fn stripe_options(a: &StripeArgs) -> Result<StripeOptions, CliError> {
     let method = StripeMethod::from_name(&a.extractor)
         .map_err(|e| CliError::usage("laser", e.to_string()))?;
     let axis = match a.axis.as_str() {
@@ -169,13 +181,13 @@ fn stripe_options(a: &StripeArgs) -> Result<StripeOptions, CliError> {
     })
 }
 
-fn read_camera(path: &str) -> Result<Camera, CliError> {
+pub(super) fn read_camera(path: &str) -> Result<Camera, CliError> {
     Ok(robocal::io::import_camera::import_camera(&read_text(path)?)
         .map_err(|e| CliError::from(e).in_file(path))?
         .0)
 }
 
-fn read_gray(path: &str, limits: &ImageLimits) -> Result<GrayImage, CliError> {
+pub(super) fn read_gray(path: &str, limits: &ImageLimits) -> Result<GrayImage, CliError> {
     let bytes = super::image_file::read_image(path, &limits.decode_options())?;
     robocal::image::decode_gray(&bytes).map_err(|e| CliError::from(e).in_file(path))
 }
@@ -265,7 +277,7 @@ fn run_plane(a: PlaneArgs) -> Result<(), CliError> {
 }
 
 /// A pose from a JSON file: a pose object, or the value of `key` in it.
-fn read_pose(path: &str, key: &str) -> Result<Pose, CliError> {
+pub(super) fn read_pose(path: &str, key: &str) -> Result<Pose, CliError> {
     let value: serde_json::Value = serde_json::from_str(&read_text(path)?)
         .map_err(|e| CliError::Io(format!("'{path}': {e}")))?;
     let found = value

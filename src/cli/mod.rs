@@ -18,6 +18,7 @@ mod info;
 mod input;
 mod intrinsics;
 mod laser;
+mod laser_sphere;
 mod memory_budget;
 pub mod output;
 mod plan;

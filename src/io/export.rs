@@ -107,8 +107,9 @@ enum Report {
     /// A camera or hand-eye report (or a plain camera JSON), written from
     /// its keys.
     Other,
-    /// A laser report (`laser_plane`: its plane as HALCON parameters or as
-    /// a frame; `laser_points`: only `report`).
+    /// A laser report (`laser_plane`, `laser_sphere`: its camera-frame
+    /// plane as HALCON parameters or as a frame; `laser_points`: only
+    /// `report`).
     Laser(ReportKind),
 }
 
@@ -125,7 +126,9 @@ impl Report {
             ReportKind::Rig | ReportKind::RigHandeye => Report::Rig,
             ReportKind::Stereo => Report::Stereo,
             ReportKind::Camera | ReportKind::Handeye => Report::Other,
-            ReportKind::LaserPlane | ReportKind::LaserPoints => Report::Laser(kind),
+            ReportKind::LaserPlane | ReportKind::LaserPoints | ReportKind::LaserSphere => {
+                Report::Laser(kind)
+            }
             ReportKind::Check | ReportKind::Diff => {
                 return Err(Error::invalid(
                     "kind",
@@ -206,7 +209,7 @@ fn export_laser_report(
     format: &str,
     options: &ExportOptions,
 ) -> Result<ExportFile> {
-    if kind != ReportKind::LaserPlane {
+    if kind == ReportKind::LaserPoints {
         return Err(Error::invalid(
             "kind",
             format!(

@@ -457,7 +457,7 @@ fn the_one_entry_detects_a_rig_report_and_joins_multi_file_formats() {
         export_with(&unknown, "kalibr", &options)
             .unwrap_err()
             .to_string(),
-        "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff, laser_plane, laser_points)"
+        "kind: unknown report kind 'mono' (expected one of camera, stereo, rig, handeye, rig_handeye, check, diff, laser_plane, laser_points, laser_sphere)"
     );
     let broken = json.replacen("\"rig_frame\"", "\"rig_frame_x\"", 1);
     assert_eq!(

@@ -14,7 +14,9 @@
 //!   correlated scatter and the board poses' uncertainty;
 //! - [`points`]: a stripe's centres to 3-D points (camera, flange or base);
 //! - [`skeleton`]: seed 003's control points: the laser image binarised,
-//!   thinned, and the end points of its lines.
+//!   thinned, and the end points of its lines;
+//! - [`sphere`]: the sensor on the robot (plane and camera in the flange
+//!   frame) from scans of a sphere of known radius.
 //!
 //! Pure maths on pixels and numbers: no files, no clock.
 
@@ -25,6 +27,7 @@ pub mod plane;
 pub mod points;
 pub mod ridge;
 pub mod skeleton;
+pub mod sphere;
 pub mod stripe;
 
 pub use covariance::BoardPose;
@@ -32,5 +35,7 @@ pub use fit::{fit_plane, fit_plane_with_boards, PlaneFit, PlaneFitOptions, Plane
 pub use plane::{plane_in_camera, LaserPlane, StripeObservation};
 pub use stripe::{extract_stripe, ScanAxis, Stripe, StripeMethod, StripeOptions, StripePoint};
 
+#[cfg(test)]
+mod sphere_tests;
 #[cfg(test)]
 mod tests;

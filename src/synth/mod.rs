@@ -12,6 +12,7 @@ pub mod handeye_looking;
 pub mod laser;
 pub mod laser_cubes;
 pub mod laser_scene;
+pub mod laser_sphere;
 pub mod lens;
 pub mod render;
 pub mod rig;
