@@ -214,7 +214,8 @@ impl BlockProblem for CalibProblem<'_> {
                 let residuals =
                     DVector::from_column_slice(&[pixel.x - observed.x, pixel.y - observed.y]);
                 let jac_block = if jacobians {
-                    // Left perturbation R <- exp(d) R: d(R x)/dd = -[R x]_x.
+                    // Left perturbation R <- exp(d) R: d(R x)/dd = -[R x]_x;
+                    // of the whole pose (splined): d(R x + t)/dd = -[R x + t]_x.
                     let d_rot = if self.whole_pose_steps() {
                         d_point * (-skew(&p.coords))
                     } else {
