@@ -5,22 +5,26 @@
 // `calibrate_camera` and the default 12x8 cubic spline (its Kannala-Brandt
 // pre-fit included).
 // Usage (crate root, after `make pkg`):
-//   node benches/wasm_splined.mjs [--repeat N] [--knots NXxNY] [PKG_JS]
+//   node benches/wasm_splined.mjs [--repeat N] [--knots NXxNY] [--dump FILE] [PKG_JS]
 // PKG_JS defaults to pkg/node/robocal.js. Prints each solve's time and the median.
+// --dump FILE writes the input JSON and exits (the native timing reads it:
+// `cargo run --release --example splined_time -- FILE`).
 import { createRequire } from 'node:module';
+import { writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { performance } from 'node:perf_hooks';
 
 const args = process.argv.slice(2);
 let repeat = 3;
 let knots = null;
+let dump = null;
 while (args[0]?.startsWith('--')) {
   const [flag, value] = args.splice(0, 2);
   if (flag === '--repeat') repeat = Number(value);
   else if (flag === '--knots') knots = value.split('x').map(Number);
+  else if (flag === '--dump') dump = value;
   else throw new Error(`unknown flag ${flag}`);
 }
-const robocal = createRequire(import.meta.url)(resolve(args[0] ?? 'pkg/node/robocal.js'));
 
 // A seeded generator (xorshift) and Gaussian noise (Box-Muller).
 let state = 0x9e3779b9;
@@ -72,6 +76,11 @@ while (views.length < 40) {
 }
 const options = knots ? { spline_knots: knots } : {};
 const input = JSON.stringify({ model: 'splined', options, views, image_size_px: [W, H] });
+if (dump) {
+  writeFileSync(dump, input);
+  process.exit(0);
+}
+const robocal = createRequire(import.meta.url)(resolve(args[0] ?? 'pkg/node/robocal.js'));
 const times = [];
 let report;
 for (let i = 0; i < repeat; i++) {

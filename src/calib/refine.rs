@@ -122,6 +122,12 @@ impl CalibProblem<'_> {
         }
     }
 
+    /// Whether a pose step turns the whole pose (`[R | t] <- exp(d) [R | t]`,
+    /// then `t += dt`) rather than its rotation alone: for a splined lens.
+    fn whole_pose_steps(&self) -> bool {
+        matches!(self.template.distortion, Distortion::Splined(_))
+    }
+
     /// The smoothness prior of a splined lens: per second difference of
     /// neighbouring control values, `weight * f * (c0 - 2 c1 + c2)` for
     /// the x and the y correction (pixels; f the mean focal length of the
@@ -208,8 +214,13 @@ impl BlockProblem for CalibProblem<'_> {
                 let residuals =
                     DVector::from_column_slice(&[pixel.x - observed.x, pixel.y - observed.y]);
                 let jac_block = if jacobians {
-                    // Left perturbation R <- exp(d) R: d(R x)/dd = -[R x]_x.
-                    let d_rot = d_point * (-skew(&rotated));
+                    // Left perturbation R <- exp(d) R: d(R x)/dd = -[R x]_x;
+                    // of the whole pose (splined): d(R x + t)/dd = -[R x + t]_x.
+                    let d_rot = if self.whole_pose_steps() {
+                        d_point * (-skew(&p.coords))
+                    } else {
+                        d_point * (-skew(&rotated))
+                    };
                     let mut j = DMatrix::zeros(2, 6);
                     j.view_mut((0, 0), (2, 3)).copy_from(&d_rot);
                     j.view_mut((0, 3), (2, 3)).copy_from(&d_point);
@@ -252,6 +263,7 @@ impl BlockProblem for CalibProblem<'_> {
             .zip(&step.global)
             .map(|(x, d)| x + d)
             .collect();
+        let whole = self.whole_pose_steps();
         let blocks = params
             .blocks
             .iter()
@@ -260,7 +272,11 @@ impl BlockProblem for CalibProblem<'_> {
                 let rotation = rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2]))
                     * rotation_from_rotvec(&Vector3::new(b[0], b[1], b[2]));
                 let r = rotvec_from_rotation(&rotation);
-                vec![r.x, r.y, r.z, b[3] + d[3], b[4] + d[4], b[5] + d[5]]
+                let mut t = Vector3::new(b[3], b[4], b[5]);
+                if whole {
+                    t = rotation_from_rotvec(&Vector3::new(d[0], d[1], d[2])) * t;
+                }
+                vec![r.x, r.y, r.z, t.x + d[3], t.y + d[4], t.z + d[5]]
             })
             .collect();
         BlockParams { global, blocks }

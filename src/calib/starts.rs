@@ -55,6 +55,37 @@ pub(crate) struct BestStart {
     pub outcomes: Vec<StartOutcome>,
 }
 
+/// The start of a splined lens: the parametric fit it reproduces
+/// ([`super::splined`]).
+pub(crate) const PARAMETRIC_FIT: &str = "parametric_fit";
+
+/// A splined fit from the parametric fit, with the base projection (fx fy
+/// cx cy) held at that fit's: no other start is tried. The others are
+/// pinhole closed forms and focal lengths the held base projection cannot
+/// take, and a fold of the spline where it only extrapolates (the image
+/// corners beyond the data) is no wrong minimum; the valid region says
+/// where the model holds. A fit still moving at the iteration limit gets
+/// one more budget, as the best of the other starts does.
+fn splined_start(
+    problem: &CalibProblem,
+    first_name: &str,
+    lm: &LmOptions,
+    result: LmResult,
+) -> Result<BestStart> {
+    let result = if converged(&result) {
+        result
+    } else {
+        let more = solve(problem, &result.params, lm)?;
+        let iterations = result.iterations + more.iterations;
+        LmResult { iterations, ..more }
+    };
+    Ok(BestStart {
+        result,
+        start: first_name.to_string(),
+        outcomes: Vec::new(),
+    })
+}
+
 /// Whether a fit converged: it stopped for any reason but the iteration
 /// limit (a stop for lack of decrease is a minimum to machine precision).
 pub(crate) fn converged(result: &LmResult) -> bool {
@@ -73,6 +104,9 @@ pub(crate) fn best_start(
     options: &CalibrationOptions,
 ) -> Result<BestStart> {
     let result = solve(problem, first, lm)?;
+    if first_name == PARAMETRIC_FIT {
+        return splined_start(problem, first_name, lm, result);
+    }
     let camera = problem.camera(&result.params.global)?;
     let mut suspect = !converged(&result) || implausible(&camera);
     if !suspect && first_name == "given" {

@@ -138,6 +138,18 @@ pub(crate) fn calibrate_usable(
     if let (Distortion::Splined(spline), None) = (&options.model, &options.initial_camera) {
         return super::splined::calibrate_splined(views, image_size_px, options, spline);
     }
+    calibrate_from(views, image_size_px, options, None)
+}
+
+/// [`calibrate_usable`] with the poses (one `[rotation vector,
+/// translation]` block per view) to start from; `None` (or a count that
+/// does not match the views): the poses of the homographies.
+pub(crate) fn calibrate_from(
+    views: &[View],
+    image_size_px: (u32, u32),
+    options: &CalibrationOptions,
+    start_poses: Option<Vec<Vec<f64>>>,
+) -> Result<CameraCalibration> {
     let warp = match options.board_warp {
         false => None,
         true => Some(BoardExtent::of(views).ok_or_else(|| {
@@ -158,10 +170,13 @@ pub(crate) fn calibrate_usable(
     let initial = initial_camera(&homographies, image_size_px, options)?;
     // 3. Poses from the homographies.
     let k = initial.camera_matrix();
-    let poses = homographies
-        .iter()
-        .map(|h| pose_from_homography(&k, h).map(|p| block_from_pose(&p)))
-        .collect::<Result<Vec<_>>>()?;
+    let poses = match start_poses {
+        Some(p) if p.len() == views.len() => p,
+        _ => homographies
+            .iter()
+            .map(|h| pose_from_homography(&k, h).map(|p| block_from_pose(&p)))
+            .collect::<Result<Vec<_>>>()?,
+    };
     // 4. Bundle adjustment from the best start, with outlier rounds.
     let all_used: Vec<Vec<bool>> = views.iter().map(|v| vec![true; v.object_m.len()]).collect();
     let mut used = all_used.clone();
@@ -177,7 +192,7 @@ pub(crate) fn calibrate_usable(
     };
     let aspect = held_aspect(&initial, options);
     let first_name = match (&options.initial_camera, &options.model) {
-        (Some(_), Distortion::Splined(_)) => "parametric_fit",
+        (Some(_), Distortion::Splined(_)) => super::starts::PARAMETRIC_FIT,
         (Some(_), _) => "given",
         (None, _) => "closed_form",
     };
