@@ -22,11 +22,6 @@ const MIN_DIAGONAL: f64 = 1e-9;
 /// the others to 12 digits.
 const RANK_TOLERANCE: f64 = 1e-12;
 
-/// Most global parameters for [`Normal::add_run_direct`]; beyond (a
-/// splined lens's control values) the rows are stacked for the matrix
-/// products over the touched columns.
-const DIRECT_MAX_GLOBAL: usize = 40;
-
 /// J^T J and J^T r, accumulated per block, with robust weights applied.
 #[derive(Clone, Debug)]
 pub(crate) struct Normal {
@@ -93,10 +88,6 @@ impl Normal {
     /// Add the rows of residual blocks that all touch `block`.
     fn add_run(&mut self, run: &[ResidualBlock], block: Option<usize>, loss: &Loss) {
         let ng = self.u.nrows();
-        if ng <= DIRECT_MAX_GLOBAL {
-            self.add_run_direct(run, block, loss);
-            return;
-        }
         let nb = block.map_or(0, |b| self.v[b].nrows());
         let rows: usize = run.iter().map(|rb| rb.residuals.len()).sum();
         // Transposed stacks (parameters x rows): column k is one residual.
@@ -162,83 +153,6 @@ impl Normal {
             let jb = jb_t.transpose();
             self.v[b].gemm(1.0, &jb_t, &jb, 1.0);
             self.g_blocks[b].gemv(1.0, &jb_t, &r, 1.0);
-        }
-    }
-
-    /// [`Normal::add_run`] for a few global parameters: each row's products
-    /// summed straight into the upper triangles of local sums, without
-    /// stacking the run's rows (for the 2-row blocks of a calibration, the
-    /// stacking and the general matrix product's packing cost more than
-    /// the products).
-    fn add_run_direct(&mut self, run: &[ResidualBlock], block: Option<usize>, loss: &Loss) {
-        let ng = self.u.nrows();
-        let nb = block.map_or(0, |b| self.v[b].nrows());
-        let mut u = vec![0.0; ng * ng];
-        let mut w = vec![0.0; ng * nb];
-        let mut v = vec![0.0; nb * nb];
-        let mut g = vec![0.0; ng];
-        let mut gb = vec![0.0; nb];
-        let mut jg = vec![0.0; ng];
-        let mut jb = vec![0.0; nb];
-        for rb in run {
-            // IRLS: scale J and r by sqrt(rho'), as in add_run.
-            let (_, d_rho) = loss.evaluate(rb.residuals.norm_squared());
-            let wt = d_rho.max(0.0).sqrt();
-            let global = rb.jac_global.ncols() == ng && ng > 0;
-            let has_block = rb.jac_block.ncols() == nb && nb > 0;
-            for i in 0..rb.residuals.len() {
-                let r = wt * rb.residuals[i];
-                for (c, j) in jg.iter_mut().enumerate() {
-                    *j = if global { wt * rb.jac_global[(i, c)] } else { 0.0 };
-                }
-                for (c, j) in jb.iter_mut().enumerate() {
-                    *j = if has_block { wt * rb.jac_block[(i, c)] } else { 0.0 };
-                }
-                for (a, &ja) in jg.iter().enumerate() {
-                    let row = &mut u[a * ng..(a + 1) * ng];
-                    for (ub, &jb_) in row[a..].iter_mut().zip(&jg[a..]) {
-                        *ub += ja * jb_;
-                    }
-                    g[a] += ja * r;
-                    for (wb, &jb_) in w[a * nb..(a + 1) * nb].iter_mut().zip(&jb) {
-                        *wb += ja * jb_;
-                    }
-                }
-                for (a, &ja) in jb.iter().enumerate() {
-                    let row = &mut v[a * nb..(a + 1) * nb];
-                    for (vb, &jb_) in row[a..].iter_mut().zip(&jb[a..]) {
-                        *vb += ja * jb_;
-                    }
-                    gb[a] += ja * r;
-                }
-            }
-        }
-        for a in 0..ng {
-            for b in a..ng {
-                let x = u[a * ng + b];
-                self.u[(a, b)] += x;
-                if b != a {
-                    self.u[(b, a)] += x;
-                }
-            }
-            self.g_global[a] += g[a];
-        }
-        if let Some(b) = block {
-            for a in 0..ng {
-                for j in 0..nb {
-                    self.w[b][(a, j)] += w[a * nb + j];
-                }
-            }
-            for a in 0..nb {
-                for c in a..nb {
-                    let x = v[a * nb + c];
-                    self.v[b][(a, c)] += x;
-                    if c != a {
-                        self.v[b][(c, a)] += x;
-                    }
-                }
-                self.g_blocks[b][a] += gb[a];
-            }
         }
     }
 
