@@ -34,7 +34,11 @@
 //!
 //! The alternatives are fitted with the user's options except held
 //! coefficients (whose names belong to the chosen model); a model that fails
-//! to solve is left out.
+//! to solve is left out. For the warnings alone ([`advise_model`], the
+//! `intrinsics` report) a fit that is fine first screens each alternative
+//! ([`super::model_advice_screen`]) and refits only those the screen cannot
+//! rule out: the comparison's figures are not shown there, and every model
+//! a warning names is still refitted in full.
 
 use super::compare::{calibrate_with, Method};
 use super::model_advice_screen::{screened_rms, SCREEN_MARGIN};
