@@ -63,7 +63,12 @@ pub(crate) fn screened_rms(
     let blocks = report
         .views
         .iter()
-        .map(|v| v.camera_from_target.to_pose().ok().map(|p| block_from_pose(&p)))
+        .map(|v| {
+            v.camera_from_target
+                .to_pose()
+                .ok()
+                .map(|p| block_from_pose(&p))
+        })
         .collect::<Option<Vec<_>>>()?;
     let used: Vec<Vec<bool>> = views.iter().map(|v| vec![true; v.object_m.len()]).collect();
     let problem = CalibProblem {

@@ -265,7 +265,13 @@ fn the_screen_never_leaves_out_a_model_that_fits_as_well() {
         Camera::example_eucm(),
         Camera::example_rational(),
     ];
-    let models = ["brown", "division", "radial_k1_k2_k5", "kannala_brandt", "eucm"];
+    let models = [
+        "brown",
+        "division",
+        "radial_k1_k2_k5",
+        "kannala_brandt",
+        "eucm",
+    ];
     let mut failed = Vec::new();
     for truth in &truths {
         let scene = Scene::calibration(7, truth, (9, 6), 0.03, 10, 0.1).expect("scene");
