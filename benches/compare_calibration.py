@@ -7,7 +7,9 @@ detections JSON; both solvers then read those very points:
   - opencv-left-9x6: the 13 OpenCV sample images left01..left14.jpg
     (640x480, chessboard 9x6, 30 mm squares), from ../shared/datasets;
   - render-N: `robocal render --views N --seed S` (1024x768, barrel
-    distortion, grey-level noise 2), detected by robocal.
+    distortion, grey-level noise 2), detected by robocal: 12, 20 and 40
+    views of the 9x6 chessboard, and render-charuco-20: 20 views of a
+    ChArUco 12x9 (11x8 inner corners, `charuco:12x9:30mm:22mm:DICT_5X5_100`).
 For each set and model: OpenCV `cv2.calibrateCamera` (single-threaded,
 `cv2.setNumThreads(1)`, default termination criteria except for the row
 "rational converged" (run to its minimum); float32 points, as it requires, and
@@ -72,6 +74,9 @@ MODELS = {
 CONVERGED_ITERATIONS = 1000
 CRITERIA = {"rational converged": CONVERGED_ITERATIONS}
 QUICK_MODELS = ["brown5", "brown5 fx=fy"]
+CHESSBOARD = "chessboard:9x6:30mm"
+# 11 x 8 inner corners (88 points a view), 1024x768 renders as the chessboard's.
+CHARUCO = "charuco:12x9:30mm:22mm:DICT_5X5_100"
 
 
 def run(cmd):
@@ -99,6 +104,11 @@ def board_points(target):
     id = row * cols + col at (col, row) * square, z = 0)."""
     import numpy as np
 
+    if target.get("kind") == "charuco":
+        # Inner corners, id = row * (squares_x - 1) + col at ((col + 1), (row + 1)) * square.
+        cols, rows, sq = target["squares_x"] - 1, target["squares_y"] - 1, target["square_m"]
+        return np.array([[(i + 1) * sq, (j + 1) * sq, 0.0] for j in range(rows) for i in range(cols)],
+                        np.float64)
     cols, rows, sq = target["cols"], target["rows"], target["square_m"]
     return np.array([[i * sq, j * sq, 0.0] for j in range(rows) for i in range(cols)], np.float64)
 
@@ -252,13 +262,15 @@ def main():
             rows += compare("opencv-left-9x6 (robocal detections)", robocal, path, models, args.repeat)
         else:
             print("\n(opencv-left-right-9x6 not found: skipped)")
-        sets = [(12, 1)] if args.quick else [(12, 1), (40, 7)]
-        for views, seed in sets:
-            out = os.path.join(tmp, f"render{views}")
-            run([robocal, "render", "--out", out, "--views", str(views), "--seed", str(seed)])
+        sets = [(12, 1, CHESSBOARD)] if args.quick else [(12, 1, CHESSBOARD), (20, 3, CHESSBOARD),
+                                                           (20, 5, CHARUCO), (40, 7, CHESSBOARD)]
+        for views, seed, target in sets:
+            kind = "charuco-" if target == CHARUCO else ""
+            out = os.path.join(tmp, f"render{kind}{views}")
+            run([robocal, "render", "--out", out, "--views", str(views), "--seed", str(seed), "--target", target])
             images = sorted(glob.glob(os.path.join(out, "view_*.png")))
-            path = detect(robocal, "chessboard:9x6:30mm", images, os.path.join(tmp, f"render{views}.json"))
-            rows += compare(f"render-{views} (seed {seed}, robocal detections)", robocal, path, models,
+            path = detect(robocal, target, images, os.path.join(tmp, f"render{kind}{views}.json"))
+            rows += compare(f"render-{kind}{views} (seed {seed}, robocal detections)", robocal, path, models,
                             args.repeat)
     print("\ndiff px = rms robocal - rms opencv; max |d|/std = largest |robocal - opencv| over "
           "fx fy cx cy and the model's coefficients, in robocal's reported std (param: which); "

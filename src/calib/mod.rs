@@ -29,6 +29,7 @@ pub mod ekf;
 mod evaluate;
 mod homography;
 pub mod model_advice;
+mod model_advice_screen;
 pub mod multi;
 pub mod plausibility;
 pub mod pnp;

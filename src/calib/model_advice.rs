@@ -34,9 +34,14 @@
 //!
 //! The alternatives are fitted with the user's options except held
 //! coefficients (whose names belong to the chosen model); a model that fails
-//! to solve is left out.
+//! to solve is left out. For the warnings alone ([`advise_model`], the
+//! `intrinsics` report) a fit that is fine first screens each alternative
+//! ([`super::model_advice_screen`]) and refits only those the screen cannot
+//! rule out: the comparison's figures are not shown there, and every model
+//! a warning names is still refitted in full.
 
 use super::compare::{calibrate_with, Method};
+use super::model_advice_screen::{screened_rms, SCREEN_MARGIN};
 use super::report::CameraCalibration;
 use super::zhang::CalibrationOptions;
 use super::View;
@@ -183,7 +188,16 @@ pub fn advise_model(
     options: &CalibrationOptions,
     report: &CameraCalibration,
 ) -> Vec<String> {
-    advise(views, image_size_px, options, report).warnings
+    advise_with(views, image_size_px, options, report, Screen::Yes).warnings
+}
+
+/// Whether the advice may leave out, without a refit, a model the screen
+/// ([`super::model_advice_screen`]) finds far from the decision: only when
+/// the comparison's figures are not shown (the warnings alone).
+#[derive(Clone, Copy, PartialEq)]
+enum Screen {
+    Yes,
+    No,
 }
 
 /// Of the fits within [`SAME_FIT_RATIO`] of the lowest RMS among `fits`,
@@ -217,6 +231,17 @@ pub fn advise(
     image_size_px: (u32, u32),
     options: &CalibrationOptions,
     report: &CameraCalibration,
+) -> ModelAdvice {
+    advise_with(views, image_size_px, options, report, Screen::No)
+}
+
+/// [`advise`], with the screen or without.
+fn advise_with(
+    views: &[View],
+    image_size_px: (u32, u32),
+    options: &CalibrationOptions,
+    report: &CameraCalibration,
+    screen: Screen,
 ) -> ModelAdvice {
     let chosen = report.model.as_str();
     // Coefficients held at 0 are not fitted: they count for nothing.
@@ -256,6 +281,15 @@ pub fn advise(
             fixed_coefficients: Vec::new(),
             ..options.clone()
         };
+        // A fine fit acts only on models that fit as well (step 2): one the
+        // screen finds far worse changes nothing and is not refitted.
+        if screen == Screen::Yes && !far_off {
+            let limit = SAME_FIT_RATIO * report.rms_px + SAME_FIT_PX;
+            if screened_rms(views, &alternative, report).is_some_and(|r| r > SCREEN_MARGIN * limit)
+            {
+                continue;
+            }
+        }
         if let Ok(r) = calibrate_with(Method::Zhang, views, image_size_px, &alternative) {
             if r.rms_px.is_finite() {
                 fits.push(ModelFit {

@@ -249,3 +249,74 @@ fn of_models_that_fit_alike_the_one_more_formats_hold_is_picked() {
     );
     assert_eq!(pick(&[]), None);
 }
+
+#[test]
+fn the_screen_never_leaves_out_a_model_that_fits_as_well() {
+    // Every truth of the examples fitted with every model, 10 views at 0.1
+    // px: for each alternative the screen's prediction against its full
+    // refit. A model whose refit is within the advice's limit must never be
+    // screened out; the prediction must not be far below the refit either
+    // (it would then keep refits for nothing).
+    let truths = [
+        Camera::example_brown(),
+        Camera::example_division(),
+        Camera::example_radial_k1_k2_k5(),
+        Camera::example_kannala_brandt(),
+        Camera::example_eucm(),
+        Camera::example_rational(),
+    ];
+    let models = [
+        "brown",
+        "division",
+        "radial_k1_k2_k5",
+        "kannala_brandt",
+        "eucm",
+    ];
+    let mut failed = Vec::new();
+    for truth in &truths {
+        let scene = Scene::calibration(7, truth, (9, 6), 0.03, 10, 0.1).expect("scene");
+        let views: Vec<View> = scene
+            .views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| View {
+                name: format!("v{i}"),
+                ..v.clone()
+            })
+            .collect();
+        let size = (truth.width, truth.height);
+        for chosen in models {
+            let options = CalibrationOptions {
+                model: Distortion::named(chosen).unwrap(),
+                ..CalibrationOptions::default()
+            };
+            let Ok(report) = calibrate_with(Method::Zhang, &views, size, &options) else {
+                continue;
+            };
+            let limit = SAME_FIT_RATIO * report.rms_px + SAME_FIT_PX;
+            for other in models.iter().filter(|m| **m != chosen) {
+                let alternative = CalibrationOptions {
+                    model: Distortion::named(other).unwrap(),
+                    ..options.clone()
+                };
+                let full = calibrate_with(Method::Zhang, &views, size, &alternative)
+                    .map(|r| r.rms_px)
+                    .unwrap_or(f64::INFINITY);
+                let screened = screened_rms(&views, &alternative, &report);
+                eprintln!(
+                    "{} via {chosen} ({:.4} px): {other} full {full:.4}, screen {screened:.4?}",
+                    truth.distortion.model_name(),
+                    report.rms_px
+                );
+                let Some(s) = screened else { continue };
+                if full <= limit && s > SCREEN_MARGIN * limit {
+                    failed.push(format!(
+                        "{} via {chosen}: {other} fits at {full} but the screen says {s}",
+                        truth.distortion.model_name()
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}
