@@ -12,9 +12,9 @@
 //! [`BlockProblem::retract`].
 
 pub mod dense;
-pub mod student_t;
 mod loss;
 mod normal;
+pub mod student_t;
 
 #[cfg(test)]
 mod tests;
