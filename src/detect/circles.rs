@@ -328,6 +328,9 @@ fn point(id: usize, centre: Point2<f64>, fit: &super::ellipse::EllipseFit) -> De
     }
 }
 
+/// Whether a seed blob's size fits the grid steps found around it.
+pub(crate) type SeedFits<'a> = dyn Fn(&Blob, Vector2<f64>, Vector2<f64>) -> bool + 'a;
+
 /// What the blob-lattice search of [`search_grid`] needs to know of a grid
 /// kind (circle grids and dot plates, square grids).
 pub(crate) struct GridSearch<'a> {
@@ -343,7 +346,7 @@ pub(crate) struct GridSearch<'a> {
     /// (clutter of the same kind beside the board may join it).
     pub trim: bool,
     /// Whether a seed blob's size fits the grid steps found around it.
-    pub seed_fits: &'a dyn Fn(&Blob, Vector2<f64>, Vector2<f64>) -> bool,
+    pub seed_fits: &'a SeedFits<'a>,
 }
 
 /// Grows a lattice from each of the first seeds among `blobs` (neighbours

@@ -122,6 +122,10 @@ pub(crate) struct Prediction {
     pub step_b: Vector2<f64>,
 }
 
+/// Whether the point at an index may take a lattice cell, given the cell's
+/// predicted position.
+pub(crate) type Accept<'a> = dyn Fn(usize, (i32, i32), &Prediction) -> bool + 'a;
+
 /// Grow from `seed` with initial steps `step_a`, `step_b`. `accept(point,
 /// cell, prediction)` vets a point for a cell. Stops at `max_cells`.
 pub(crate) fn grow(
@@ -130,7 +134,7 @@ pub(crate) fn grow(
     step_a: Vector2<f64>,
     step_b: Vector2<f64>,
     max_cells: usize,
-    accept: &dyn Fn(usize, (i32, i32), &Prediction) -> bool,
+    accept: &Accept,
 ) -> Cells {
     let pts = index.points;
     let mut cells = Cells::default();
@@ -202,10 +206,7 @@ pub(crate) fn predict(
     let mut sb: Option<Vector2<f64>> = None;
     for (da, db) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
         if let Some(p1) = get(a - da, b - db) {
-            let step = match get(a - 2 * da, b - 2 * db) {
-                Some(p2) => Some(p1 - p2),
-                None => None,
-            };
+            let step = get(a - 2 * da, b - 2 * db).map(|p2| p1 - p2);
             if let Some(s) = step {
                 sum += p1 + s;
                 n += 1.0;

@@ -20,10 +20,13 @@ use robocal::detect::{detect, CentreModel, DetectOptions};
 use robocal::synth::{board_pose, render, RenderOptions};
 use robocal::target::{DetectedPoint, Detection, Target};
 
+/// Roll, pitch, yaw (radians) and the board centre (m, camera frame).
+type ViewPose = ((f64, f64, f64), (f64, f64, f64));
+
 /// Views: roll, pitch, yaw (radians) and the board centre (m, camera frame).
 /// The first is tilted by 49 degrees, the others by 30-40 degrees and off
 /// the image centre, where distortion bends the board most.
-const VIEWS: [((f64, f64, f64), (f64, f64, f64)); 3] = [
+const VIEWS: [ViewPose; 3] = [
     ((0.63, -0.63, 0.2), (0.0, 0.0, 0.5)),
     ((-0.35, 0.5, -0.4), (0.08, -0.05, 0.45)),
     ((0.55, 0.25, 0.9), (-0.09, 0.06, 0.5)),

@@ -54,7 +54,7 @@ fn caliscope_inverted_charuco_frames_are_found_without_an_option() {
     };
     // Measured (module docs): frames with a board, corners.
     let measured = [(16, 181), (26, 130), (15, 139), (14, 93)];
-    for camera in 0..4 {
+    for (camera, &(frames, points)) in measured.iter().enumerate() {
         let video = videos.join(format!("cam_{camera}.mp4"));
         let Some(files) = extract(&video, &dir, camera) else {
             eprintln!(
@@ -97,7 +97,6 @@ fn caliscope_inverted_charuco_frames_are_found_without_an_option() {
             "camera {camera}: {found} of {} frames found, {full} with all 12 corners, {corners} corners",
             files.len()
         );
-        let (frames, points) = measured[camera];
         assert!(
             found + 1 >= frames && corners as f64 >= 0.95 * points as f64,
             "camera {camera}: {found} frames with {corners} corners, measured {frames} frames with {points} corners"

@@ -124,8 +124,9 @@ pub(super) fn erode(m: &Runs) -> Runs {
     let mut runs = Vec::new();
     let mut row_start = vec![0; m.height + 1];
     let (mut shrunk, mut above) = (Vec::new(), Vec::new());
-    for y in 1..m.height.saturating_sub(1) {
-        row_start[y] = runs.len();
+    let inner = m.height.saturating_sub(2);
+    for (y, start) in row_start.iter_mut().enumerate().skip(1).take(inner) {
+        *start = runs.len();
         shrunk.clear();
         shrunk.extend(m.row(y).iter().filter_map(|r| {
             (r.x1 >= r.x0 + 3).then_some(Run {
@@ -195,12 +196,12 @@ pub(super) fn regions(m: &Runs, min_extent: u32) -> Vec<Region> {
     let mut slot = vec![u32::MAX; n];
     let mut root_of = vec![0u32; n];
     let mut y = 0;
-    for i in 0..n {
+    for (i, root_slot) in root_of.iter_mut().enumerate() {
         while m.row_start[y + 1] <= i {
             y += 1;
         }
         let root = find(&mut parent, i as u32) as usize;
-        root_of[i] = root as u32;
+        *root_slot = root as u32;
         if slot[root] == u32::MAX {
             slot[root] = stats.len() as u32;
             stats.push(Stats::new());

@@ -354,7 +354,7 @@ pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
     // The scale is only meaningful when the rotations fit as given.
     if found.is_empty() {
         let s = given.robot_translation_scale;
-        if s.is_finite() && s > 0.0 && (s > SCALE_TOLERANCE || s < 1.0 / SCALE_TOLERANCE) {
+        if s.is_finite() && s > 0.0 && !(1.0 / SCALE_TOLERANCE..=SCALE_TOLERANCE).contains(&s) {
             let hint = if (s.log10() + 3.0).abs() < 0.15 {
                 "the robot poses look like millimetres while the camera poses are metres: convert the \
                  robot translations to metres (divide by 1000) or choose a pose format with mm units"
