@@ -45,6 +45,7 @@ const SHELL = [
   'views/rig-stereo.js',
   'views/rig-robot.js',
   'views/rig-intrinsics.js',
+  'views/rig-video.js',
   'views/lens.js',
   'views/plan.js',
   'views/target.js',

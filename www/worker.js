@@ -142,6 +142,12 @@ handlers.undistort = async ({ bytes, camera, maxSide, maxPixels }) => {
   return { image: robocal.undistort_preview(new Uint8Array(bytes), camera, maxSide, imageOptions(maxPixels)) };
 };
 
+/** caliscope's timestamps.csv per camera in video frame order (io::video_timestamps). */
+handlers.videoTimestamps = async ({ text }) => {
+  await ready;
+  return JSON.parse(robocal.video_timestamps(text));
+};
+
 /** Rig frames by file name: the rule of `robocal rig` (io::pairing). */
 handlers.rigFrames = async ({ cameras, groupBy }) => {
   await ready;
