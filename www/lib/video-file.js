@@ -93,6 +93,25 @@ async function mp4Video(file) {
 }
 
 /**
+ * A Matroska/WebM track's DefaultDuration (element 0x23E383, nanoseconds
+ * per frame) near its CodecID at `near`, in seconds, or null.
+ */
+function defaultDuration(bytes, near) {
+  for (let i = Math.max(0, near - 400); i + 4 < Math.min(bytes.length, near + 400); i++) {
+    if (bytes[i] !== 0x23 || bytes[i + 1] !== 0xe3 || bytes[i + 2] !== 0x83) continue;
+    const first = bytes[i + 3];
+    const len = Math.clz32(first) - 23; // the size's own length (1 for 0x8N)
+    if (len < 1 || len > 8) return null;
+    let size = first & (0xff >> len);
+    for (let k = 1; k < len; k++) size = size * 256 + bytes[i + 3 + k];
+    let ns = 0;
+    for (let k = 0; k < size; k++) ns = ns * 256 + bytes[i + 3 + len + k];
+    return size >= 1 && size <= 8 && ns > 0 ? ns / 1e9 : null;
+  }
+  return null;
+}
+
+/**
  * The codec of a video file as its container names it (`mp4v`, `avc1`,
  * `V_VP9`, an AVI's fourcc, ...) with what it is, and the frame duration
  * in seconds when the container says (MP4/MOV), else null.
@@ -107,7 +126,10 @@ export async function videoCodec(file) {
   } else if (head[0] === 0x1a && head[1] === 0x45 && head[2] === 0xdf && head[3] === 0xa3) {
     const text = ascii(head, 0, head.length);
     const m = /V_[A-Z0-9/]+/.exec(text);
-    if (m) codec = Object.keys(CODECS).filter((k) => m[0].startsWith(k)).sort((a, b) => b.length - a.length)[0] || m[0];
+    if (m) {
+      codec = Object.keys(CODECS).filter((k) => m[0].startsWith(k)).sort((a, b) => b.length - a.length)[0] || m[0];
+      frameS = defaultDuration(head, m.index);
+    }
   } else if (ascii(head, 0, 4) === 'RIFF' && ascii(head, 8, 3) === 'AVI') {
     const at = ascii(head, 0, head.length).indexOf('vids');
     if (at >= 0) codec = ascii(head, at + 4, 4);
@@ -162,29 +184,56 @@ export function closeVideo(video) {
   if (url.startsWith('blob:')) URL.revokeObjectURL(url);
 }
 
+/** Seek the paused `video` to `t` s and wait until the frame there is shown. */
+function seekTo(video, t) {
+  return new Promise((resolve) => {
+    video.addEventListener('seeked', resolve, { once: true });
+    video.currentTime = t;
+  });
+}
+
 /**
  * Every frame of the opened `video` in order, as `onFrame(index, timeMs)`
- * (awaited, the video paused on the frame: draw it from `video`); `index`
- * is the frame's number from the container's frame duration (`frameS`) or,
- * when it states none, from the shortest step between frame times seen.
- * `onFrame` returning `false` stops the reading. Resolves with the number of
- * frames read.
+ * (awaited, the video paused on the frame: draw it from `video`). The
+ * video plays and pauses on each new frame (requestVideoFrameCallback); a
+ * frame the player went past meanwhile (a busy page) is fetched by seeking
+ * to its middle, so every frame is given once, in order. `index` is the
+ * frame's number from the container's frame duration (`frameS`) or, when
+ * it states none, from the step between the first two frames. `onFrame`
+ * returning `false` stops the reading. Resolves with the number of frames
+ * read.
  */
 export function eachFrame(video, frameS, onFrame) {
   if (!video.requestVideoFrameCallback) return eachFrameBySeeking(video, frameS || 1 / 30, onFrame);
   return new Promise((resolve, reject) => {
     let step = frameS;
     let firstTime = null; // the first frame waits for the step when the container gave none
+    let next = 0; // the index of the next frame to give
     let read = 0;
     let stopped = false;
     let busy = false;
+    let ending = false;
+    let pending = 0; // the requestVideoFrameCallback handle
     const finish = () => { stopped = true; video.pause(); video.onended = null; resolve(read); };
-    const give = async (t) => {
+    const give = async (index, t) => {
       read++;
-      return onFrame(step ? Math.round(t / step) : 0, t * 1000);
+      next = index + 1;
+      return (await onFrame(index, t * 1000)) !== false;
+    };
+    /** The frames from `next` to the one at `t` (those skipped fetched by seeking). */
+    const upTo = async (t) => {
+      const index = Math.round(t / step);
+      if (index < next) return true; // shown again (after a seek): given already
+      const missed = index - next;
+      for (let m = next; m < index; m++) {
+        await seekTo(video, t + (m - index + 0.5) * step);
+        if (!(await give(m, t + (m - index) * step))) return false;
+      }
+      if (missed) await seekTo(video, t + step / 2);
+      return give(index, t);
     };
     const turn = async (_now, meta) => {
-      if (stopped) return;
+      if (stopped || ending) return;
       video.pause();
       busy = true;
       try {
@@ -194,13 +243,19 @@ export function eachFrame(video, frameS, onFrame) {
           firstTime = t;
         } else {
           if (!step) step = t - firstTime > 1e-6 ? t - firstTime : null;
-          if (firstTime !== null && step) { go = (await give(firstTime)) !== false; firstTime = null; }
-          if (go) go = (await give(t)) !== false;
+          if (firstTime !== null && step) {
+            // The first frame, now that its index is known: shown again, then back here.
+            await seekTo(video, firstTime + step / 2);
+            go = await give(Math.round(firstTime / step), firstTime);
+            firstTime = null;
+            if (go) await seekTo(video, t + step / 2);
+          }
+          if (go && step) go = await upTo(t);
         }
         busy = false;
         if (!go) return finish();
         if (video.ended) return end();
-        video.requestVideoFrameCallback(turn);
+        pending = video.requestVideoFrameCallback(turn);
         await video.play();
       } catch (err) {
         stopped = true;
@@ -210,13 +265,27 @@ export function eachFrame(video, frameS, onFrame) {
     };
     const end = async () => {
       if (stopped || busy) return;
-      // A one-frame video: its frame is frame 0.
-      if (firstTime !== null) { await give(firstTime); firstTime = null; }
+      // The seeks below show frames: the callback waiting for the next one must not run.
+      ending = true;
+      video.cancelVideoFrameCallback(pending);
+      try {
+        // A one-frame video: its frame is frame 0.
+        if (firstTime !== null) { await give(0, firstTime); firstTime = null; }
+        // The last frames, when the player ran past them to the end.
+        for (let m = next; step && (m + 0.5) * step < video.duration; m++) {
+          await seekTo(video, (m + 0.5) * step);
+          if (!(await give(m, m * step))) break;
+        }
+      } catch (err) {
+        stopped = true;
+        reject(err);
+        return;
+      }
       finish();
     };
     video.onended = () => end();
     video.currentTime = 0;
-    video.requestVideoFrameCallback(turn);
+    pending = video.requestVideoFrameCallback(turn);
     video.play().catch(reject);
   });
 }
