@@ -58,8 +58,9 @@ export const tests = [
       await ready(page);
       const t0 = Date.now();
       await page.setInputFiles('#video-input', video);
-      await page.waitForFunction(() => document.getElementById('video-status').dataset.state === 'done', null, { timeout: 240000 })
+      await page.waitForFunction(() => ['done', 'refused'].includes(document.getElementById('video-status').dataset.state), null, { timeout: 240000 })
         .catch(async (e) => { throw new Error(`${await page.textContent('#video-status')} ${await page.textContent('#video-message')} (${e.message})`); });
+      assert.equal(await page.textContent('#video-message'), '');
       const summary = await page.textContent('#video-status');
       console.log(`     ${summary} (${Date.now() - t0} ms)`);
       const m = /^board\.webm: (\d+) frames read \(640 × 480, V_VP8\), board in (\d+), (\d+) kept by the capture rules( \(left out: .+\))?\.$/.exec(summary);

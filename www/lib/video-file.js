@@ -17,7 +17,8 @@ const CODECS = {
   'V_MPEG4/ISO/ASP': 'MPEG-4 Part 2', 'V_MPEG4/ISO/SP': 'MPEG-4 Part 2', 'V_THEORA': 'Theora', 'V_MJPEG': 'Motion JPEG',
 };
 
-const ascii = (bytes, at, n) => String.fromCharCode(...bytes.subarray(at, at + n));
+/** Bytes as text, one character per byte (latin1: any byte reads). */
+const ascii = (bytes, at, n) => new TextDecoder('latin1').decode(bytes.subarray(at, at + n));
 
 /** `file`'s bytes `[from, to)`. */
 async function slice(file, from, to) {
