@@ -2031,6 +2031,8 @@ export interface RobocalJson {
   pair_images: [string[], ImagePairing];
   /** `rig_frame_keys(JSON.stringify(cameras), groupBy)` (groupBy `'number'` or `'last'` (the last number in the name), `'first'`, `'order'`, a pattern with one `(\\d+)` such as `'sync(\\d+)'`, or `''`: by number unless no name has one) -> each image's frame key, as `robocal rig --group-by` groups them. */
   rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
+  /** `video_timestamps(text)` -> caliscope's `timestamps.csv` (sync_index, cam_id, frame_index, frame_time) per camera in video frame order, as `robocal rig --timestamps` reads it. */
+  video_timestamps: [never, VideoTimestamps];
   /** `read_camera_file(text)` -> the camera of any camera format robocal exports (robocal JSON camera export or calibration report, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON tuple or .dat, MATLAB script, text matrix), as `robocal rig --camera-file` reads it. */
   read_camera_file: [never, CameraFileReading];
   /** `check_camera(request)` -> the check of a saved calibration against new views: ok, drifted or broken (docs/check.md). */
@@ -2067,6 +2069,11 @@ export interface RigFrameGrouping {
   grouped_by: string;
   keys: string[][];
   frames: string[];
+}
+
+/** What `video_timestamps` returns: per cam_id (the N of `cam_N.mp4`), the sync index and capture time of each video frame (entry k is the video's frame k). */
+export interface VideoTimestamps {
+  cameras: Record<string, { sync_index: number[]; time_s: number[] }>;
 }
 
 /** One board point of `target_points`: id and position in the board frame (z = 0), metres. */

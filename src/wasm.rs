@@ -1,6 +1,6 @@
 //! The WebAssembly boundary: the only module with `#[wasm_bindgen]` (this file,
 //! and camera_file.rs, check.rs, demo.rs, laser.rs, lens_models.rs, live_capture.rs, plan.rs,
-//! rig_frames.rs, rig_handeye.rs and targets.rs beside it).
+//! rig_frames.rs, rig_handeye.rs, targets.rs and video.rs beside it).
 //!
 //! A few stateless functions: bytes or JSON in, JSON (or plain bytes) out,
 //! errors as `JsError` whose message is the library's error text. Pixels
@@ -24,6 +24,7 @@ mod plan;
 mod rig_frames;
 mod rig_handeye;
 mod targets;
+mod video;
 pub use camera_file::read_camera_file;
 pub use check::{check_camera, diff_cameras};
 pub use demo::{render_demo, DemoData};
@@ -35,6 +36,7 @@ pub use rig_frames::rig_frame_keys;
 pub use rig_handeye::calibrate_rig_handeye;
 use targets::target_from;
 pub use targets::{parse_target, read_kalibr_target, target_points, target_spec, target_svg};
+pub use video::video_timestamps;
 
 use crate::image::{decode, DecodeOptions, GrayImage};
 use serde::Serialize;

@@ -7,6 +7,7 @@ import { $, h, fill, download } from './lib/dom.js';
 import { initTarget } from './views/target.js';
 import { ImagesView } from './views/images.js';
 import { CaptureView } from './views/capture.js';
+import { VideoView } from './views/video.js';
 import { CameraView } from './views/camera.js';
 import { loadLensModels } from './views/lens.js';
 import { RobotView } from './views/robot.js';
@@ -202,6 +203,8 @@ async function startSteps(versionPromise) {
   await images.restore();
   // The live camera detects in a worker of its own: solves never hold up the preview.
   new CaptureView(store, images, engine, () => new Engine(), () => robotView);
+  // Video files: decoded by the browser, frames chosen in a worker of their own.
+  new VideoView(store, images, () => new Engine());
   await lensModels;
   const camera = new CameraView(store, engine, images);
   const robot = new RobotView(store, engine);

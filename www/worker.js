@@ -142,6 +142,12 @@ handlers.undistort = async ({ bytes, camera, maxSide, maxPixels }) => {
   return { image: robocal.undistort_preview(new Uint8Array(bytes), camera, maxSide, imageOptions(maxPixels)) };
 };
 
+/** caliscope's timestamps.csv per camera in video frame order (io::video_timestamps). */
+handlers.videoTimestamps = async ({ text }) => {
+  await ready;
+  return JSON.parse(robocal.video_timestamps(text));
+};
+
 /** Rig frames by file name: the rule of `robocal rig` (io::pairing). */
 handlers.rigFrames = async ({ cameras, groupBy }) => {
   await ready;
@@ -277,6 +283,33 @@ handlers.guide = async ({ op, index, pose, included }) => {
   if (op === 'calibrate') return JSON.parse(live.calibrate());
   if (op === 'state') return JSON.parse(live.state());
   throw new Error(`unknown guide request '${op}'`);
+};
+
+// Video files (www/views/video.js): one LiveCapture per video, its own
+// session beside the live camera's, deciding on each decoded frame by the
+// same rules (found, still, sharp, adding coverage; robocal's video input
+// in the CLI gives its frames to the same session).
+let videoSession = null;
+
+/**
+ * `reset` starts a new video; otherwise one frame (an ImageBitmap, closed
+ * here) at `time` ms of the video: the frame report of docs/live-capture.md.
+ */
+handlers.videoFrame = async ({ reset, bitmap, spec, time }) => {
+  await ready;
+  if (reset) {
+    if (videoSession) videoSession.live.free();
+    videoSession = null;
+    return null;
+  }
+  const { grey, width, height } = greyFromBitmap(bitmap);
+  const key = `${spec}|${width}x${height}`;
+  if (!videoSession || videoSession.key !== key) {
+    if (videoSession) videoSession.live.free();
+    videoSession = { key, live: new robocal.LiveCapture(spec, width, height), time: -Infinity };
+  }
+  videoSession.time = Math.max(time, videoSession.time + 1e-3);
+  return JSON.parse(videoSession.live.push_grey(grey, width, height, videoSession.time));
 };
 
 function greyFromBitmap(bitmap) {

@@ -61,7 +61,7 @@ use std::time::{Duration, Instant};
 /// `<meta http-equiv="Content-Security-Policy">` (tests/cli_serve.rs checks
 /// they agree) plus `frame-ancestors 'none'`, so no other site can frame
 /// the page.
-pub const CONTENT_SECURITY_POLICY: &str = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; style-src 'self'; img-src 'self' blob: data:; worker-src 'self'; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
+pub const CONTENT_SECURITY_POLICY: &str = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; style-src 'self'; img-src 'self' blob: data:; media-src 'self' blob:; worker-src 'self'; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
 
 /// Most headers one request may carry (431 beyond).
 pub const MAX_HEADERS: usize = 64;

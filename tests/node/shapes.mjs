@@ -319,6 +319,10 @@ assert.deepEqual(byNumber, { paired_by: 'number', pairs: [[0, 1], [1, 0]] });
 const byOrder = output('pair_images', JSON.parse(robocal.pair_images('["left.png","l.png"]', '["right.png","r.png"]')), 'pair_images order');
 assert.deepEqual(byOrder, { paired_by: 'order', pairs: [[0, 0], [1, 1]] });
 // Rig frames: the number in the names across cameras, or by order when no name has one.
+// caliscope's timestamps.csv: rows sorted by frame_index per camera are the video's frames.
+const stamps = output('video_timestamps', JSON.parse(robocal.video_timestamps('sync_index,cam_id,frame_index,frame_time\n26,1,26,123.33\n26,0,26,123.34\n27,0,27,123.5\n27,1,28,123.51\n')));
+assert.deepEqual(stamps, { cameras: { 0: { sync_index: [26, 27], time_s: [123.34, 123.5] }, 1: { sync_index: [26, 27], time_s: [123.33, 123.51] } } });
+assert.throws(() => robocal.video_timestamps('sync,cam\n1,2\n'), /sync_index,cam_id,frame_index,frame_time/);
 const rigNames = input('rig_frame_keys', [{ name: 'front', images: ['front07.png', 'front2.png'] }, { name: 'side', images: ['side/2.jpg'] }]);
 const rigFrames = output('rig_frame_keys', JSON.parse(robocal.rig_frame_keys(JSON.stringify(rigNames), '')), 'rig_frame_keys number');
 assert.deepEqual(rigFrames, { grouped_by: 'number', keys: [['7', '2'], ['2']], frames: ['2', '7'] });

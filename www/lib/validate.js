@@ -246,6 +246,7 @@ export function checkSession(raw, path = 'session') {
   s.rig = step('rig');
   check.string(s.rig.model, `${path}.rig.model`);
   s.rig.result = check.objectOrNull(s.rig.result, `${path}.rig.result`);
+  if (s.rig.videoGrouping !== undefined) check.oneOf(s.rig.videoGrouping, `${path}.rig.videoGrouping`, ['sync_index', 'frame']);
   check.list(s.rig.cameras, `${path}.rig.cameras`).forEach((cam, i) => {
     const p = `${path}.rig.cameras[${i}]`;
     check.object(cam, p);
@@ -254,6 +255,8 @@ export function checkSession(raw, path = 'session') {
       check.object(f, `${p}.files[${j}]`);
       if (!(typeof f.id === 'string' && f.id) && !Number.isFinite(f.id)) fail(`${p}.files[${j}].id`, 'a text or number', f.id);
       check.string(f.name, `${p}.files[${j}].name`);
+      // A video frame's rig frame key (rig-video.js: its sync index or frame index).
+      if (f.frameKey !== undefined) check.string(f.frameKey, `${p}.files[${j}].frameKey`);
     });
     // Held intrinsics (rig-intrinsics.js); absent in sessions saved before them.
     if (cam.intrinsics !== undefined) check.oneOf(cam.intrinsics, `${p}.intrinsics`, ['solve', 'file', 'solo']);

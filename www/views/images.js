@@ -4,6 +4,7 @@
 import { $, h, fill, trapFocus, droppedFiles } from '../lib/dom.js';
 import { targetSpec } from './target.js';
 import { MARKER_BOARDS, pointCount, otherBoard, notTheTarget, otherBoardsText, fillBoardButtons, drawOtherBoards } from './boards.js';
+import { VIDEO_EXT } from '../lib/video-file.js';
 
 const THUMB_SIDE = 320;
 const IMAGE_EXT = /\.(png|jpe?g|tiff?|bmp|pgm|ppm|pnm|gif)$/i;
@@ -128,6 +129,12 @@ export class ImagesView {
   }
 
   async addFiles(files) {
+    // Videos (dropped or chosen with images) are read by the video view (views/video.js).
+    const videos = [...files].filter((f) => VIDEO_EXT.test(f.name));
+    if (videos.length && this.videos) {
+      this.videos.add(videos);
+      files = [...files].filter((f) => !VIDEO_EXT.test(f.name));
+    }
     const added = [];
     // A file picker may list im_28 first: the session's order (which pairs
     // images with poses) is the names' natural order, shown on the cards.

@@ -21,6 +21,7 @@ import { stereoOfRig, stereoOfLegacy, stereoSection } from './rig-stereo.js';
 import { frustum, invert, rotvecDeg, boardOutline, apply, flat } from '../lib/rig3d.js';
 import { intrinsicsControl, heldCamera, driftCamera, driftHint } from './rig-intrinsics.js';
 import { RigRobot } from './rig-robot.js';
+import { RigVideos, rigGrouping } from './rig-video.js';
 
 /** Frames a rig solve needs (each camera's intrinsics need 3 views: api::camera::MIN_VIEWS). */
 const MIN_FRAMES = 3;
@@ -38,6 +39,8 @@ const groupedText = (rule) => ({
   last: 'by the last number in the file names',
   first: 'by the first number in the file names',
   order: 'by order (sorted names)',
+  sync_index: 'by the timestamps\' sync_index (video frames)',
+  'frame index': 'by frame index (video frames)',
 })[rule] || `by the pattern ${rule} in the file names`;
 const freeName = (cams) => { let k = 0; while (cams.some((c) => c.name === `cam${k}`)) k++; return `cam${k}`; };
 
@@ -48,6 +51,7 @@ export class RigView {
     this.panel = panel;
     this.grouping = { error: null, frames: [], keys: [] };
     this.robot = new RigRobot(store, engine, () => this.rigInput());
+    this.videos = new RigVideos(this);
     this.render();
   }
 
@@ -89,6 +93,7 @@ export class RigView {
       h('p', { class: 'hint' }, 'Two or more cameras that saw the target of step 1 at the same moments: a stereo pair is a rig of two. Any camera may miss the board in any frame, but every camera must share frames with the others, directly or through other cameras. Images are grouped into frames as robocal rig groups them: by the last number in their names (left01.jpg with right1.jpg, front07.png with side7.jpg), or by order (sorted names) when no name has a number. Choose another rule when the last number is not the frame\'s: the first number (sync036_cam0.jpg), order, or a pattern: plain text with one (\\d+), such as sync(\\d+) for sync036_cam0.jpg with cam1_sync36.png. The rig frame is the first camera\'s. Each camera\'s intrinsics are solved with the rig, or held: from a camera file (robocal JSON, OpenCV YAML/XML, ROS camera_info; robocal rig --camera-file NAME=FILE) or from its own calibration (its images alone), the fix when the joint fit drags a camera\'s intrinsics away from what its own images say. Once solved, the rig can be put on a robot: a robot pose file, one pose per frame, gives gripper_from_rig or base_from_rig (robocal rig --setup … --poses FILE).'),
       this.camerasOut,
       h('div', { class: 'row' }, h('button', { type: 'button', id: 'rig-add', onclick: () => this.addCamera() }, 'Add a camera')),
+      this.videos.element(),
       grouping,
       h('details', { id: 'rig-lens-details', open: st.model !== 'brown' || st.radial === '2' || st.tangential === false },
         h('summary', {}, 'Lens model and held parameters (every solved camera)'),
@@ -180,7 +185,7 @@ export class RigView {
     const named = this.namesError();
     try {
       if (named) throw new Error(named);
-      const g = await this.engine.call('rigFrames', { cameras: JSON.stringify(cams.map((c) => ({ name: c.name, images: c.files.map((f) => f.name) }))), groupBy: this.state.groupBy || '' });
+      const g = await rigGrouping(this.engine, cams, this.state.groupBy || '', this.state.videoGrouping);
       grouping = { ...g, error: null };
     } catch (err) {
       grouping = { error: err.message, frames: [], keys: [] };
