@@ -136,6 +136,7 @@ export const tests = [
         assert.match(mrcal.text, new RegExp(`'lensmodel': +'LENSMODEL_SPLINED_STEREOGRAPHIC_order=${ORDER}_Nx=${NX}_Ny=${NY}_fov_x_deg=\\d+'`));
       }
       await shot('exports');
+      console.log(`     splined ${NX}x${NY} order ${ORDER} on ${found} views: RMS ${m[1]} px; ${v[1]} of ${NX * NY} control points with data, ${v[3]} % of the image; cross-validation ${rows.map((r) => `${r[0]} ${r[1]}/${r[2]} px`).join(', ')}; mrcal: ${status.slice(0, 90)}...`);
     } finally {
       rmSync(dir, { recursive: true, force: true });
     }
