@@ -82,6 +82,11 @@ export const tests = [
       assert.equal(Number(m[2]), found);
       assert.ok(Number(m[1]) < RMS_BOUND_PX, `RMS ${m[1]} px, bound ${RMS_BOUND_PX}`);
 
+      // The correlation warnings (hundreds for a spline's control points): one folded box.
+      const boxes = await page.$$eval('#camera-results .msg-warning', (els) => els.map((e) => e.textContent));
+      const single = boxes.filter((t) => /^\S+ and \S+ are strongly correlated \(/.test(t));
+      const foldedText = await page.$eval('#camera-correlated-warnings', (e) => e.firstChild.textContent).catch(() => null);
+      const pageHeight = await page.evaluate(() => document.body.scrollHeight);
       // The valid region: supported control points of the 70 and the image share.
       const hint = await page.textContent('#camera-valid-region');
       const v = /^Splined lens: (\d+) of (\d+) control points have data; the valid region \(image cells holding points\) is (\d+) % of the image/.exec(hint);
@@ -118,6 +123,16 @@ export const tests = [
       const report = JSON.parse(await page.textContent('#export-preview'));
       assert.deepEqual(report.spline_support.knots, [NX, NY]);
       const s = report.camera.distortion;
+      const correlated = report.warnings.filter((w) => / are strongly correlated \(/.test(typeof w === 'string' ? w : w.message)).length;
+      if (correlated > 3) {
+        assert.equal(foldedText, `${correlated} pairs of parameters are strongly correlated: the views do not separate them.`);
+        assert.equal(single.length, 0, single.join(' | '));
+      } else {
+        assert.equal(foldedText, null);
+        assert.equal(single.length, correlated);
+      }
+      // 7,500 px with the 145 parameter rows; 20,500 px with a warning box per pair.
+      assert.ok(pageHeight < 10000, `the solved camera step is ${pageHeight} px tall`);
       assert.deepEqual([s.model, s.nx, s.ny, s.order], ['splined', NX, NY, ORDER]);
 
       // mrcal: its file when the knots sit on mrcal's grid, else the reason.
@@ -136,7 +151,7 @@ export const tests = [
         assert.match(mrcal.text, new RegExp(`'lensmodel': +'LENSMODEL_SPLINED_STEREOGRAPHIC_order=${ORDER}_Nx=${NX}_Ny=${NY}_fov_x_deg=\\d+'`));
       }
       await shot('exports');
-      console.log(`     splined ${NX}x${NY} order ${ORDER} on ${found} views: RMS ${m[1]} px; ${v[1]} of ${NX * NY} control points with data, ${v[3]} % of the image; cross-validation ${rows.map((r) => `${r[0]} ${r[1]}/${r[2]} px`).join(', ')}; mrcal: ${status.slice(0, 90)}...`);
+      console.log(`     splined ${NX}x${NY} order ${ORDER} on ${found} views: RMS ${m[1]} px; ${v[1]} of ${NX * NY} control points with data, ${v[3]} % of the image; ${correlated} correlated pairs folded; page ${pageHeight} px tall; cross-validation ${rows.map((r) => `${r[0]} ${r[1]}/${r[2]} px`).join(', ')}; mrcal: ${status.slice(0, 90)}...`);
     } finally {
       rmSync(dir, { recursive: true, force: true });
     }
