@@ -227,7 +227,7 @@ fn json(c: &Camera, info: &CameraExportInfo) -> Result<String> {
     {
         distortion.insert((*name).to_string(), serde_json::json!(value));
     }
-    let value = serde_json::json!({
+    let mut value = serde_json::json!({
         "schema": "robocal.camera.v1",
         "robocal_version": crate::VERSION,
         "name": info.name,
@@ -237,6 +237,17 @@ fn json(c: &Camera, info: &CameraExportInfo) -> Result<String> {
         "distortion": distortion,
         "rms_px": info.rms_px,
     });
+    // The splined model's layout: its values alone (dx0 dy0 ...) do not say
+    // where its knots sit.
+    if let Distortion::Splined(s) = &c.distortion {
+        value["spline"] = serde_json::json!({
+            "order": s.order,
+            "nx": s.nx,
+            "ny": s.ny,
+            "u_max": s.u_max,
+            "smoothness": s.smoothness,
+        });
+    }
     Ok(super::to_string_pretty(&value) + "\n")
 }
 

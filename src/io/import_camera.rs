@@ -13,7 +13,8 @@ use super::import_camera_halcon::{
 };
 use super::import_camera_matlab::{from_matlab, from_text, is_matlab, is_text_matrix};
 use super::import_camera_tools::{from_kalibr, from_mrcal, is_kalibr, is_mrcal};
-use crate::camera::{Camera, Distortion};
+use crate::camera::splined::MAX_KNOTS;
+use crate::camera::{Camera, Distortion, Spline};
 use crate::error::{Error, Result};
 
 /// The formats [`import_camera`] recognises.
@@ -109,7 +110,10 @@ fn from_json(text: &str) -> Result<Camera> {
     let model = v["model"]
         .as_str()
         .ok_or_else(|| missing("model", "the lens model's name, e.g. \"brown\""))?;
-    let template = distortion_template(model)?;
+    let mut template = distortion_template(model)?;
+    if let (Distortion::Splined(_), Some(layout)) = (&template, spline_layout(&v)) {
+        template = Distortion::Splined(layout?);
+    }
     let coeffs = template
         .coefficient_names()
         .iter()
@@ -123,7 +127,54 @@ fn from_json(text: &str) -> Result<Camera> {
         })
         .collect::<Result<Vec<f64>>>()?;
     let distortion = template.with_coefficients(&coeffs)?;
+    if let Distortion::Splined(s) = &distortion {
+        if !s.control.is_empty() {
+            s.check()?;
+        }
+    }
     camera_from_k(&k, width, height, distortion)
+}
+
+/// A splined camera's layout (degree, control points, knot field): the
+/// camera JSON's `spline` (robocal's JSON export) or a calibration report's
+/// `camera.distortion`; None when the JSON has neither (then the model
+/// reads without its control values). The values themselves are the
+/// coefficients `dx0 dy0 ...` of `distortion`.
+fn spline_layout(v: &serde_json::Value) -> Option<Result<Spline>> {
+    let layout = [&v["spline"], &v["camera"]["distortion"]]
+        .into_iter()
+        .find(|l| l.is_object())?;
+    let count = |key: &str| {
+        layout[key]
+            .as_u64()
+            .filter(|&n| n >= 1 && n <= MAX_KNOTS as u64)
+            .map(|n| n as usize)
+            .ok_or_else(|| {
+                Error::invalid(
+                    "spline",
+                    format!("the splined model's layout needs '{key}': a whole number from 1 to {MAX_KNOTS}"),
+                )
+            })
+    };
+    let field = layout["u_max"]
+        .as_array()
+        .filter(|a| a.len() == 2)
+        .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]))
+        .ok_or_else(|| {
+            Error::invalid(
+                "spline",
+                "the splined model's layout needs 'u_max': [x, y], the knot field's half extent",
+            )
+        });
+    let read = || {
+        let mut spline = Spline::new(count("order")?, count("nx")?, count("ny")?);
+        spline.u_max = field?;
+        if let Some(w) = layout["smoothness"].as_f64() {
+            spline.smoothness = w;
+        }
+        Ok(spline)
+    };
+    Some(read())
 }
 
 /// What a camera JSON's `image_size_px` must be.

@@ -43,6 +43,18 @@ fn assert_same(back: &Camera, camera: &Camera, what: &str) {
     );
     let (a, b) = (canonical(&back.distortion), canonical(&camera.distortion));
     assert_eq!(a.model_name(), b.model_name(), "{what}");
+    assert_eq!(
+        a.coefficients().len(),
+        b.coefficients().len(),
+        "{what}: coefficient count"
+    );
+    if let (Distortion::Splined(x), Distortion::Splined(y)) = (&a, &b) {
+        assert_eq!(
+            (x.order, x.nx, x.ny, x.u_max, x.smoothness),
+            (y.order, y.nx, y.ny, y.u_max, y.smoothness),
+            "{what}: spline layout"
+        );
+    }
     let numbers = |c: &Camera, d: &Distortion| {
         let mut v = vec![c.fx, c.fy, c.cx, c.cy, c.skew];
         v.extend(d.coefficients());
@@ -399,4 +411,38 @@ pub(super) fn milder_for_halcon(entry: Option<&str>, camera: &mut Camera) {
             .collect();
         camera.distortion = camera.distortion.with_coefficients(&values).unwrap();
     }
+}
+
+/// A splined calibration report (top-level `dx0 dy0 ...`, the layout only in
+/// its `camera`): the JSON export keeps the spline, and mrcal's refusal says
+/// why (the knot spacing), not that the field is unset.
+#[test]
+fn a_splined_report_exports_its_spline() {
+    let camera = Camera::example_splined();
+    let mut distortion = serde_json::Map::new();
+    for (n, v) in camera
+        .distortion
+        .coefficient_names()
+        .iter()
+        .zip(camera.distortion.coefficients())
+    {
+        distortion.insert((*n).to_string(), serde_json::json!(v));
+    }
+    let report = serde_json::json!({
+        "kind": "camera",
+        "model": "splined",
+        "image_size_px": [camera.width, camera.height],
+        "camera_matrix": [[camera.fx, camera.skew, camera.cx], [0.0, camera.fy, camera.cy], [0.0, 0.0, 1.0]],
+        "distortion": distortion,
+        "camera": serde_json::to_value(&camera).unwrap(),
+        "rms_px": 0.1,
+    })
+    .to_string();
+    let json = super::export::export(&report, "json", None).unwrap();
+    let (back, _) = import_camera(&json).unwrap();
+    assert_same(&back, &camera, "splined report as json");
+    let refused = super::export::export(&report, "mrcal", None)
+        .unwrap_err()
+        .to_string();
+    assert!(refused.contains("its knot spacing is"), "{refused}");
 }

@@ -2,7 +2,7 @@
 // `node tests/e2e/run.mjs datasets offline`); exits non-zero on any failure.
 import { run } from './harness.mjs';
 
-const all = ['foundation', 'workflows', 'flow', 'pages', 'datasets', 'offline', 'reliability', 'badinputs', 'badposes', 'guidance', 'reports', 'markers', 'boards', 'capture', 'rig', 'check', 'laser', 'video'];
+const all = ['foundation', 'workflows', 'flow', 'pages', 'datasets', 'offline', 'reliability', 'badinputs', 'badposes', 'guidance', 'reports', 'markers', 'boards', 'capture', 'rig', 'check', 'laser', 'video', 'lens'];
 const wanted = process.argv.slice(2);
 for (const w of wanted) if (!all.includes(w)) throw new Error(`unknown suite '${w}' (known: ${all.join(', ')})`);
 const suites = wanted.length ? wanted : all;

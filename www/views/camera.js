@@ -14,6 +14,15 @@ export const METHODS = [
   ['all', 'All, side by side'],
 ];
 const UNDISTORT_SIDE = 480;
+/** The core's correlation warning (calib/report.rs), and how many are shown one by one before they fold into one. */
+const CORRELATED = /^\S+ and \S+ are strongly correlated \(/;
+const FOLD_PAIRS = 3;
+
+/** One warning that says `text` and lists `items` folded (a splined lens has hundreds of correlated control points). */
+function foldedPairs(id, text, items) {
+  return h('div', { class: 'msg msg-warning', role: 'status', id }, text, ' ',
+    h('details', {}, h('summary', {}, `The ${items.length} pairs`), h('ul', {}, items.map((x) => h('li', {}, x)))));
+}
 
 function putPixels(canvas, p) {
   canvas.width = p.image.width;
@@ -114,7 +123,13 @@ export class CameraView {
     const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
     const std = r.std || {};
     const params = table(['parameter', 'value', 'std'], names.map((n) => [n, num(value[n], 6), stdText(std[n])]), { id: 'camera-params' });
-    const warnings = (r.warnings || []).map((w) => this.warning(typeof w === 'string' ? w : w.message, r.model));
+    const texts = (r.warnings || []).map((w) => (typeof w === 'string' ? w : w.message));
+    // Many "X and Y are strongly correlated" (a splined lens's neighbouring
+    // control points): one warning with the pairs folded, not a box each.
+    const pairs = texts.filter((t) => CORRELATED.test(t));
+    const folded = pairs.length > FOLD_PAIRS;
+    const warnings = [...texts.filter((t) => !folded || !CORRELATED.test(t)).map((t) => this.warning(t, r.model)),
+      folded ? foldedPairs('camera-correlated-warnings', `${pairs.length} pairs of parameters are strongly correlated: the views do not separate them.`, pairs) : null];
     const perView = (r.views || []).map((v) => ({ label: v.name, value: v.rms_px, highlight: v.rms_px > 2 * r.rms_px }));
     const residualPoints = [];
     const residualVectors = [];
@@ -296,7 +311,9 @@ export class CameraView {
   correlationNote({ names, matrix }) {
     const strong = [];
     for (let i = 0; i < matrix.length; i++) for (let j = i + 1; j < matrix.length; j++) if (Math.abs(matrix[i][j]) > 0.95) strong.push(`${names[i]}–${names[j]}: ${num(matrix[i][j], 3)}`);
-    return strong.length ? message('warning', `Strongly correlated parameters (|r| > 0.95): ${strong.join(', ')}. Add views with more tilt and coverage to separate them.`) : null;
+    const advice = 'Add views with more tilt and coverage to separate them.';
+    if (strong.length > FOLD_PAIRS) return foldedPairs('camera-correlation-note', `${strong.length} pairs of parameters are strongly correlated (|r| > 0.95). ${advice}`, strong);
+    return strong.length ? message('warning', `Strongly correlated parameters (|r| > 0.95): ${strong.join(', ')}. ${advice}`) : null;
   }
 }
 
