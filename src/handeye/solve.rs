@@ -310,7 +310,9 @@ fn apply_focal_check(
                 summary.work_point_std_mm = Some(work_point_std_mm(summary, &rotation, &q));
             }
         }
-        summary.focal_check = Some(found.check);
+        if found.check.is_some() {
+            summary.focal_check = found.check;
+        }
     }
     result.warnings.extend(found.warning);
 }

@@ -23,6 +23,20 @@
 //! length is off and what to do, when `|s - 1|` exceeds [`FOCAL_MIN`] or
 //! the shift exceeds the held std on some axis of the camera transform.
 //!
+//! Below [`FOCAL_ALERT_STD`] std the scale is not named, but a bias can
+//! still hide there: kinematic error inflates the jackknife std of `s`, and
+//! a real 1 % focal error then often lands within 3 std of 1 while its
+//! shift lies outside the held std. So whenever `|s - 1|` exceeds one std
+//! the freed solution is computed as well and the shift joins the
+//! covariance silently (no warning, no `focal_check`), scaled so that its
+//! outer product is `max(0, (s-1)^2 - std^2) / (s-1)^2` of the full one
+//! ([`real_share`]): the shift is about linear in `s - 1`, and
+//! `(s-1)^2 - std^2` is the unbiased estimate of the squared true offset
+//! (`E[(s-1)^2] = (s_true-1)^2 + std^2`), so the added covariance is the
+//! part of the shift the data say is real. At the right focal length the
+//! share is small on average (zero within one std, where two thirds of
+//! such trials lie).
+//!
 //! Why the shift, not `|s - 1|`, decides the warning: how far a focal
 //! error moves the answer grows with the working distance. On RWHE-Calib's
 //! CS_synthetic_1 (board 7-8 m away, 15 poses) fx 0.05 % short (1079.5 px
@@ -66,8 +80,10 @@ pub struct FocalScale {
 /// The finding of [`check_focal`], for the orchestrator to write.
 #[derive(Debug, Clone)]
 pub struct FocalFinding {
-    /// The report's object.
-    pub check: FocalCheck,
+    /// The report's object: none when the scale is within
+    /// [`FOCAL_ALERT_STD`] of its std from 1 (the shift then only widens
+    /// the std, scaled by [`real_share`]).
+    pub check: Option<FocalCheck>,
     /// The freed solution `(x, y)`, when its refit ran.
     pub freed: Option<(Pose, Pose)>,
     /// The shift from the reported to the freed camera and target
@@ -151,10 +167,26 @@ pub fn check_focal(
         (&result.x, &result.y),
     )?;
     let off = fit.scale - 1.0;
-    if !(off.abs() > FOCAL_ALERT_STD * fit.std) {
+    if !(off.abs() > fit.std) {
         return None;
     }
     let freed = freed_solution(result, input, views, camera, fit.scale, motion_pairs);
+    if !(off.abs() > FOCAL_ALERT_STD * fit.std) {
+        // Not named: only the part of the shift the data say is real.
+        let part = real_share(off, fit.std).sqrt();
+        let scaled = |d: [f64; 6]| d.map(|v| v * part);
+        return Some(FocalFinding {
+            check: None,
+            freed,
+            shift: freed.map(|(x, y)| {
+                (
+                    scaled(pose_shift(&result.x, &x)),
+                    scaled(pose_shift(&result.y, &y)),
+                )
+            }),
+            warning: None,
+        });
+    }
     let moves = freed.map(|(x, _)| pose_difference(&result.x, &x));
     let shift = freed.map(|(x, y)| (pose_shift(&result.x, &x), pose_shift(&result.y, &y)));
     let beyond_std = shift.as_ref().is_some_and(|(dx, _)| {
@@ -193,15 +225,24 @@ pub fn check_focal(
         )
     });
     Some(FocalFinding {
-        check: FocalCheck {
+        check: Some(FocalCheck {
             scale: fit.scale,
             scale_std: fit.std,
             freed_moves: moves.map(|(mm, deg)| [mm, deg]),
-        },
+        }),
         freed,
         shift,
         warning,
     })
+}
+
+/// The share of the squared focal offset `off^2` that is real rather than
+/// noise of its std `std`: `max(0, off^2 - std^2) / off^2` (module docs).
+pub(crate) fn real_share(off: f64, std: f64) -> f64 {
+    if !(off.abs() > 0.0) {
+        return 0.0;
+    }
+    ((off * off - std * std) / (off * off)).clamp(0.0, 1.0)
 }
 
 /// Whether a shift of the camera transform (`[rotation (rad, left frame);
@@ -253,6 +294,15 @@ fn freed_solution(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_real_share_of_the_offset_grows_from_one_std() {
+        assert_eq!(real_share(0.0, 1e-3), 0.0);
+        assert_eq!(real_share(-0.8e-3, 1e-3), 0.0);
+        assert!((real_share(2e-3, 1e-3) - 0.75).abs() < 1e-12);
+        assert!((real_share(-3e-3, 1e-3) - 8.0 / 9.0).abs() < 1e-12);
+        assert_eq!(real_share(0.01, 0.0), 1.0);
+    }
 
     #[test]
     fn a_shift_is_beyond_the_std_when_one_axis_is() {
