@@ -236,6 +236,23 @@ pub fn check_focal(
     })
 }
 
+/// Whether a named focal disagreement lies within what the camera's own
+/// calibration allows: the focal scale's std over the views and the
+/// calibrated fx's relative std (`std["fx"] / fx`, when the camera came with
+/// its standard deviations) taken together. The check alone judges the
+/// scale against its own std, as if the intrinsics were exact; on clean
+/// data both are tiny (the page's demo: fx 899.985 +- 0.055 px, the robot's
+/// motion wants 0.0028 % more: 3.1 std of the check, 0.4 of both), and such a
+/// disagreement is not worth a warning. The covariance keeps the shift.
+pub fn within_camera_std(check: &FocalCheck, fx: f64, fx_std: Option<f64>) -> bool {
+    let Some(fx_std) = fx_std.filter(|s| s.is_finite() && *s > 0.0 && fx > 0.0) else {
+        return false;
+    };
+    let off = (check.scale - 1.0).abs();
+    let both = check.scale_std.hypot(fx_std / fx);
+    off <= FOCAL_MIN && off <= FOCAL_ALERT_STD * both
+}
+
 /// The share of the squared focal offset `off^2` that is real rather than
 /// noise of its std `std`: `max(0, off^2 - std^2) / off^2` (module docs).
 pub(crate) fn real_share(off: f64, std: f64) -> f64 {
@@ -302,6 +319,28 @@ mod tests {
         assert!((real_share(2e-3, 1e-3) - 0.75).abs() < 1e-12);
         assert!((real_share(-3e-3, 1e-3) - 8.0 / 9.0).abs() < 1e-12);
         assert_eq!(real_share(0.01, 0.0), 1.0);
+    }
+
+    #[test]
+    fn the_cameras_own_fx_std_joins_the_scale_std() {
+        // The demo's figures: 3.1 std of the scale alone, 0.4 of both.
+        let check = FocalCheck {
+            scale: 1.000_027_6,
+            scale_std: 8.86e-6,
+            freed_moves: None,
+        };
+        assert!(within_camera_std(&check, 899.985, Some(0.055)));
+        // Without the camera's std the check stands.
+        assert!(!within_camera_std(&check, 899.985, None));
+        assert!(!within_camera_std(&check, 899.985, Some(0.0)));
+        // Beyond 3 std of both (3.09 here), or 0.1 % off, it stands too.
+        assert!(!within_camera_std(&check, 899.985, Some(0.001)));
+        let far = FocalCheck {
+            scale: 1.002,
+            scale_std: 1e-3,
+            freed_moves: None,
+        };
+        assert!(!within_camera_std(&far, 1000.0, Some(5.0)));
     }
 
     #[test]
