@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what the build needs when it is missing; fast no-op when present.
 #   tools/setup.sh build   the wasm32 target and wasm-bindgen-cli (exact Cargo.lock version)
-#   tools/setup.sh e2e     Debian's chromium and playwright-core (for the browser tests)
+#   tools/setup.sh e2e     Debian's chromium and ffmpeg and playwright-core (for the browser tests;
+#                          the video suite encodes its WebM and mp4v test files with ffmpeg)
 #   tools/setup.sh node    the TypeScript compiler of the node tier (tests/node, pinned)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -33,6 +34,12 @@ need_e2e() {
     local sudo=""
     [ "$(id -u)" -ne 0 ] && sudo="sudo"
     $sudo apt-get install -y chromium || { $sudo apt-get update && $sudo apt-get install -y chromium; }
+  fi
+  if [ ! -x /usr/bin/ffmpeg ]; then
+    echo "setup: installing Debian's ffmpeg (the video suite makes its test videos with it)"
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    $sudo apt-get install -y ffmpeg || { $sudo apt-get update && $sudo apt-get install -y ffmpeg; }
   fi
   if [ ! -d tests/e2e/node_modules/playwright-core ]; then
     echo "setup: installing playwright-core for the browser tests"
