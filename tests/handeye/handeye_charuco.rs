@@ -42,19 +42,19 @@ use std::path::Path;
 const SPEC: &str = "charuco:8x6:30mm:22mm:DICT_4X4_50";
 /// Inner corners of the 8x6 board.
 const CORNERS: usize = 7 * 5;
-const VIEWS: usize = 8;
+pub(super) const VIEWS: usize = 8;
 /// The view pushed towards an image edge.
 const PARTIAL: usize = 3;
-const ROBOT_ROT_DEG: f64 = 0.02;
-const ROBOT_T_MM: f64 = 0.1;
-const MAX_ROT_DEG: f64 = 0.06;
-const MAX_T_MM: f64 = 0.6;
+pub(super) const ROBOT_ROT_DEG: f64 = 0.02;
+pub(super) const ROBOT_T_MM: f64 = 0.1;
+pub(super) const MAX_ROT_DEG: f64 = 0.06;
+pub(super) const MAX_T_MM: f64 = 0.6;
 
-fn camera() -> Camera {
+pub(super) fn camera() -> Camera {
     Camera::pinhole(560.0, 560.0, 321.0, 238.5, 640, 480)
 }
 
-fn pose_line(p: &Pose) -> String {
+pub(super) fn pose_line(p: &Pose) -> String {
     let m = p.to_homogeneous();
     (0..4)
         .flat_map(|r| (0..4).map(move |c| m[(r, c)]))
@@ -75,6 +75,47 @@ fn matrix(v: &Value) -> Matrix4<f64> {
 
 fn arg(p: &Path) -> String {
     p.to_string_lossy().into_owned()
+}
+
+/// `robocal handeye` on a scene `write_scene` wrote into `dir`: setup
+/// `setup` (`eye-in-hand` or `eye-to-hand`), target `spec`, the matrix
+/// poses, no bootstrap, one thread, the report to `out`.
+pub(super) fn handeye_args(dir: &Path, setup: &str, spec: &str, out: &Path) -> Vec<String> {
+    let mut args = vec![
+        "handeye".to_string(),
+        "--setup".into(),
+        setup.into(),
+        "--poses".into(),
+        arg(&dir.join("poses.txt")),
+        "--pose-format".into(),
+        "matrix".into(),
+        "--camera".into(),
+        arg(&dir.join("camera.json")),
+        "--target".into(),
+        spec.into(),
+        "--bootstrap".into(),
+        "0".into(),
+        "--threads".into(),
+        "1".into(),
+        "-o".into(),
+        arg(out),
+    ];
+    args.extend((0..VIEWS).map(|k| arg(&dir.join(format!("view_{k}.png")))));
+    args
+}
+
+/// How far the reported X (`report[key]`) is from `truth`: rotation in
+/// degrees, translation in millimetres.
+pub(super) fn x_off(x: &Value, truth: &Pose) -> (f64, f64) {
+    let est = matrix(x);
+    let truth = truth.to_homogeneous();
+    let t_mm = (est.fixed_view::<3, 1>(0, 3) - truth.fixed_view::<3, 1>(0, 3)).norm() * 1e3;
+    let r = est.fixed_view::<3, 3>(0, 0).transpose() * truth.fixed_view::<3, 3>(0, 0);
+    let rot_deg = ((r.trace() - 1.0) / 2.0)
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees();
+    (rot_deg, t_mm)
 }
 
 /// Writes the scene's images, noisy poses and camera into `dir`; returns
@@ -138,29 +179,7 @@ fn charuco_handeye_from_images_within_the_robot_noise_in_both_setups() {
             "{name}: the partial view shows {partial_corners} of {CORNERS} corners"
         );
         let out = dir.join("handeye.json");
-        let images: Vec<String> = (0..VIEWS)
-            .map(|k| arg(&dir.join(format!("view_{k}.png"))))
-            .collect();
-        let mut args = vec![
-            "handeye".to_string(),
-            "--setup".into(),
-            name.into(),
-            "--poses".into(),
-            arg(&dir.join("poses.txt")),
-            "--pose-format".into(),
-            "matrix".into(),
-            "--camera".into(),
-            arg(&dir.join("camera.json")),
-            "--target".into(),
-            SPEC.into(),
-            "--bootstrap".into(),
-            "0".into(),
-            "--threads".into(),
-            "1".into(),
-            "-o".into(),
-            arg(&out),
-        ];
-        args.extend(images);
+        let args = handeye_args(&dir, name, SPEC, &out);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let (code, _, stderr) = robocal(&args);
         assert_eq!(code, 0, "{name}: {stderr}");
@@ -181,14 +200,7 @@ fn charuco_handeye_from_images_within_the_robot_noise_in_both_setups() {
             "{name}: no refinement over pixels by default: {}",
             report["refinement"]
         );
-        let est = matrix(&report[key]);
-        let truth = x_true.to_homogeneous();
-        let t_mm = (est.fixed_view::<3, 1>(0, 3) - truth.fixed_view::<3, 1>(0, 3)).norm() * 1e3;
-        let r = est.fixed_view::<3, 3>(0, 0).transpose() * truth.fixed_view::<3, 3>(0, 0);
-        let rot_deg = ((r.trace() - 1.0) / 2.0)
-            .clamp(-1.0, 1.0)
-            .acos()
-            .to_degrees();
+        let (rot_deg, t_mm) = x_off(&report[key], &x_true);
         println!("{name}: X off by {rot_deg:.4} deg, {t_mm:.3} mm; partial view {partial_corners} of {CORNERS} corners");
         assert!(
             rot_deg < MAX_ROT_DEG,

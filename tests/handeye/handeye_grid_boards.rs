@@ -12,47 +12,16 @@
 use crate::support;
 use support::{robocal, temp_dir};
 
-use nalgebra::Matrix4;
-use robocal::camera::Camera;
+use super::handeye_charuco::{
+    camera, handeye_args, pose_line, x_off, MAX_ROT_DEG, MAX_T_MM, ROBOT_ROT_DEG, ROBOT_T_MM, VIEWS,
+};
+
 use robocal::handeye::{Pose, Setup};
 use robocal::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
 use robocal::synth::{render, RenderOptions, Rng};
 use robocal::target::Target;
 use serde_json::Value;
 use std::path::Path;
-
-const VIEWS: usize = 8;
-const ROBOT_ROT_DEG: f64 = 0.02;
-const ROBOT_T_MM: f64 = 0.1;
-const MAX_ROT_DEG: f64 = 0.06;
-const MAX_T_MM: f64 = 0.6;
-
-fn camera() -> Camera {
-    Camera::pinhole(560.0, 560.0, 321.0, 238.5, 640, 480)
-}
-
-fn pose_line(p: &Pose) -> String {
-    let m = p.to_homogeneous();
-    (0..4)
-        .flat_map(|r| (0..4).map(move |c| m[(r, c)]))
-        .map(|v| format!("{v:.17e}"))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
-fn matrix(v: &Value) -> Matrix4<f64> {
-    let mut m = Matrix4::zeros();
-    for r in 0..4 {
-        for c in 0..4 {
-            m[(r, c)] = v["matrix_row_major"][r][c].as_f64().expect("number");
-        }
-    }
-    m
-}
-
-fn arg(p: &Path) -> String {
-    p.to_string_lossy().into_owned()
-}
 
 /// Renders the scene of `spec` (its points' grid `grid` for the poses)
 /// into `dir` with noisy robot poses and the camera; returns the truth of X.
@@ -111,26 +80,7 @@ fn aruco_grid_and_origin_dot_handeye_from_images_within_the_robot_noise() {
         let dir = temp_dir("handeye_grid_boards", name);
         let x_true = write_scene(&dir, spec, grid, setup, seed);
         let out = dir.join("handeye.json");
-        let mut args = vec![
-            "handeye".to_string(),
-            "--setup".into(),
-            name.into(),
-            "--poses".into(),
-            arg(&dir.join("poses.txt")),
-            "--pose-format".into(),
-            "matrix".into(),
-            "--camera".into(),
-            arg(&dir.join("camera.json")),
-            "--target".into(),
-            spec.into(),
-            "--bootstrap".into(),
-            "0".into(),
-            "--threads".into(),
-            "1".into(),
-            "-o".into(),
-            arg(&out),
-        ];
-        args.extend((0..VIEWS).map(|k| arg(&dir.join(format!("view_{k}.png")))));
+        let args = handeye_args(&dir, name, spec, &out);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let (code, _, stderr) = robocal(&args);
         assert_eq!(code, 0, "{spec}: {stderr}");
@@ -141,14 +91,7 @@ fn aruco_grid_and_origin_dot_handeye_from_images_within_the_robot_noise() {
             pairs.iter().all(|p| p["used"] == Value::Bool(true)),
             "{spec}: every view used: {pairs:?}"
         );
-        let est = matrix(&report[key]);
-        let truth = x_true.to_homogeneous();
-        let t_mm = (est.fixed_view::<3, 1>(0, 3) - truth.fixed_view::<3, 1>(0, 3)).norm() * 1e3;
-        let r = est.fixed_view::<3, 3>(0, 0).transpose() * truth.fixed_view::<3, 3>(0, 0);
-        let rot_deg = ((r.trace() - 1.0) / 2.0)
-            .clamp(-1.0, 1.0)
-            .acos()
-            .to_degrees();
+        let (rot_deg, t_mm) = x_off(&report[key], &x_true);
         println!("{spec} {name}: X off by {rot_deg:.4} deg, {t_mm:.3} mm");
         assert!(
             rot_deg < MAX_ROT_DEG,
