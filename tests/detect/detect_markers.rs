@@ -8,54 +8,10 @@
 
 use robocal::detect::{detect, detect_all, DetectOptions};
 use robocal::image::GrayImage;
-use robocal::synth::{board_pose, render, Pinhole, RenderOptions, Rendered, Rng};
-use robocal::target::{DetectedPoint, Detection, Target};
+use robocal::synth::{board_pose, render, RenderOptions, Rng};
+use robocal::target::Target;
 
-fn camera(w: u32, h: u32, f: f64) -> Pinhole {
-    Pinhole {
-        fx: f,
-        fy: f,
-        cx: (w as f64 - 1.0) / 2.0 + 3.3,
-        cy: (h as f64 - 1.0) / 2.0 - 2.1,
-        width: w,
-        height: h,
-    }
-}
-
-fn render_board(
-    spec: &str,
-    rpy: (f64, f64, f64),
-    at: (f64, f64, f64),
-    seed: u64,
-) -> (Target, Rendered) {
-    let target = Target::parse_spec(spec).unwrap();
-    let cam = camera(1280, 960, 1100.0);
-    let o = RenderOptions {
-        seed,
-        ..RenderOptions::default()
-    };
-    let r = render(&cam, &target, &board_pose(&target, rpy, at), &o).unwrap();
-    (target, r)
-}
-
-/// Per-point errors of the detected points against the truth (by id);
-/// every detected id must be in the truth.
-fn errors(det: &Detection, truth: &[DetectedPoint]) -> Vec<f64> {
-    det.points
-        .iter()
-        .map(|d| {
-            let t = truth
-                .iter()
-                .find(|t| t.id == d.id)
-                .unwrap_or_else(|| panic!("detected id {} is not in view", d.id));
-            ((d.x_px - t.x_px).powi(2) + (d.y_px - t.y_px).powi(2)).sqrt()
-        })
-        .collect()
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
+use crate::renders::{camera, errors, mean, render_board};
 
 const VIEWS: [(f64, f64, f64); 3] = [(0.1, -0.2, 0.05), (0.45, 0.3, -0.3), (-0.35, 0.5, 0.6)];
 

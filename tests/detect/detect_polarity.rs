@@ -14,19 +14,10 @@
 
 use robocal::detect::{detect, detect_all, DetectOptions};
 use robocal::error::Error;
-use robocal::synth::{board_pose as pose, render, Pinhole, RenderOptions};
+use robocal::synth::{board_pose as pose, render, RenderOptions};
 use robocal::target::{DetectedPoint, Detection, Polarity, Target};
 
-fn camera(w: u32, h: u32, f: f64) -> Pinhole {
-    Pinhole {
-        fx: f,
-        fy: f,
-        cx: (w as f64 - 1.0) / 2.0 + 3.3,
-        cy: (h as f64 - 1.0) / 2.0 - 2.1,
-        width: w,
-        height: h,
-    }
-}
+use crate::renders::camera;
 
 /// Mean and max distance between detection and truth, matched by id; every
 /// truth point must be detected.

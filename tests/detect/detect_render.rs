@@ -9,19 +9,10 @@
 
 use nalgebra::Point3;
 use robocal::detect::{detect, DetectOptions};
-use robocal::synth::{render, Pinhole, RenderOptions};
+use robocal::synth::{render, RenderOptions};
 use robocal::target::{Detection, Target};
 
-fn camera(w: u32, h: u32, f: f64) -> Pinhole {
-    Pinhole {
-        fx: f,
-        fy: f,
-        cx: (w as f64 - 1.0) / 2.0 + 3.3,
-        cy: (h as f64 - 1.0) / 2.0 - 2.1,
-        width: w,
-        height: h,
-    }
-}
+use crate::renders::camera;
 
 use robocal::synth::board_pose as pose;
 

@@ -17,3 +17,4 @@ mod detect_polarity;
 mod detect_polarity_datasets;
 mod detect_render;
 mod fuzz_regressions;
+mod renders;
