@@ -386,8 +386,14 @@ fn search_grid_with(
         if !(search.seed_fits)(&blobs[seed], step_a, step_b) {
             continue;
         }
-        let accept = |i: usize, _: (i32, i32), _: &lattice::Prediction| {
-            let r = blobs[i].area / blobs[seed].area;
+        // A blob's area is compared with the seed's scaled by the local
+        // lattice cell's area over the seed's: perspective shrinks a circle
+        // and its cell alike, so a grid tilted 60 degrees, whose near
+        // circles have 20 times the area of its far ones, keeps one rule.
+        let seed_cell = cell_area(step_a, step_b);
+        let accept = |i: usize, _: (i32, i32), pred: &lattice::Prediction| {
+            let expected = blobs[seed].area * cell_area(pred.step_a, pred.step_b) / seed_cell;
+            let r = blobs[i].area / expected;
             (1.0 / AREA_RATIO..=max_area_ratio).contains(&r)
         };
         let mut cells = lattice::grow(&index, seed, step_a, step_b, 2 * n + 8, &accept);
@@ -411,6 +417,11 @@ fn search_grid_with(
         }
     }
     Ok(found.pop().ok_or(best_partial))
+}
+
+/// The area of the lattice cell spanned by two steps, px^2.
+fn cell_area(a: Vector2<f64>, b: Vector2<f64>) -> f64 {
+    (a.x * b.y - a.y * b.x).abs()
 }
 
 /// The seed's two lattice steps: its nearest similar blob, and the nearest

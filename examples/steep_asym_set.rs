@@ -1,0 +1,147 @@
+//! The asymmetric circle grids of tests/detect/detect_circles_asym.rs
+//! (7x11 and 11x7 at 15 mm, either print; 56-64 degrees of tilt, 0.3 m
+//! away; the pinhole and the strongly distorted example cameras), rendered
+//! with their truth for OpenCV (benches/steep_asym_opencv.py) and detected
+//! by robocal in this process.
+//!
+//! Usage: cargo run --release --example steep_asym_set -- [OUT_DIR]
+//! (default benches/out/steep_asym). Writes OUT_DIR/NN.png and
+//! OUT_DIR/truth.json: `[{"file", "target", "camera", "tilt_deg",
+//! "opencv_pattern": [cols, rows], "light_on_dark", "points": [[x_px,
+//! y_px], ...] in id order}]` for the views with every circle whole in the
+//! image (30 of 36), and prints robocal's result per view and in total: views found,
+//! mean / max distance to the truth, px.
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use robocal::camera::Camera;
+use robocal::detect::{detect, DetectOptions};
+use robocal::synth::{render, RenderOptions};
+use robocal::target::{DetectedPoint, Target};
+use serde_json::json;
+
+/// The board's centre at `at` (metres, camera frame), tilted by `tilt`
+/// radians about an axis in its plane at `axis` radians from its x axis,
+/// turned by `yaw` in its plane (the test's poses).
+fn pose(target: &Target, tilt: f64, axis: f64, yaw: f64, at: Vector3<f64>) -> Isometry3<f64> {
+    let pts = target.object_points();
+    let mx = pts.iter().map(|p| p.1.x).fold(0.0, f64::max) / 2.0;
+    let my = pts.iter().map(|p| p.1.y).fold(0.0, f64::max) / 2.0;
+    let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
+    let in_plane = nalgebra::Unit::new_normalize(Vector3::new(axis.cos(), axis.sin(), 0.0));
+    let r = UnitQuaternion::from_axis_angle(&in_plane, tilt) * turn;
+    Isometry3::from_parts(Translation3::from(at - r * Vector3::new(mx, my, 0.0)), r)
+}
+
+/// Whether every circle lies whole in the image (the test's rule): each
+/// centre at least a quarter of its distance to the nearest other centre
+/// from the border.
+fn whole_in_image(points: &[DetectedPoint], width: u32, height: u32) -> bool {
+    points.iter().all(|p| {
+        let nearest = points
+            .iter()
+            .filter(|q| q.id != p.id)
+            .map(|q| (q.x_px - p.x_px).hypot(q.y_px - p.y_px))
+            .fold(f64::INFINITY, f64::min);
+        let border = (p.x_px + 0.5)
+            .min(width as f64 - 0.5 - p.x_px)
+            .min(p.y_px + 0.5)
+            .min(height as f64 - 0.5 - p.y_px);
+        border >= 0.25 * nearest
+    })
+}
+
+/// (tilt, axis, yaw), degrees: the test's views.
+const VIEWS: [(f64, f64, f64); 6] = [
+    (58.0, 0.0, 0.0),
+    (62.0, 90.0, 0.0),
+    (60.0, 30.0, 15.0),
+    (64.0, 0.0, 90.0),
+    (56.0, 120.0, -30.0),
+    (60.0, 45.0, 45.0),
+];
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let out = std::path::PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .unwrap_or_else(|| "benches/out/steep_asym".into()),
+    );
+    std::fs::create_dir_all(&out)?;
+    let cams = [
+        ("pinhole", Camera::example_pinhole()),
+        ("brown", Camera::example_brown()),
+    ];
+    let mut truth = Vec::new();
+    let (mut found, mut errors) = (0, Vec::new());
+    for spec in [
+        "circles:7x11:15mm:asymmetric",
+        "circles:11x7:15mm:asymmetric",
+        "circles:7x11:15mm:asymmetric:light-on-dark",
+    ] {
+        let target = Target::parse_spec(spec)?;
+        let Target::CircleGrid { cols, rows, .. } = target else {
+            return Err(format!("{spec} is not a circle grid").into());
+        };
+        for (name, cam) in &cams {
+            for (k, &(tilt, axis, yaw)) in VIEWS.iter().enumerate() {
+                let p = pose(
+                    &target,
+                    tilt.to_radians(),
+                    axis.to_radians(),
+                    yaw.to_radians(),
+                    Vector3::new(0.01, -0.01, 0.3),
+                );
+                let o = RenderOptions {
+                    seed: 700 + k as u64,
+                    ..RenderOptions::default()
+                };
+                let Ok(r) = render(cam, &target, &p, &o) else {
+                    continue;
+                };
+                if r.points.len() != target.point_count()
+                    || !whole_in_image(&r.points, r.image.width, r.image.height)
+                {
+                    continue;
+                }
+                let file = out.join(format!("{:02}.png", truth.len()));
+                std::fs::write(&file, robocal::image::encode_png(&r.image)?)?;
+                let what = format!("{spec} {name} view {k} ({tilt} deg)");
+                match detect(&r.image, &target, &DetectOptions::default()) {
+                    Ok(det) => {
+                        let d: Vec<f64> = det
+                            .points
+                            .iter()
+                            .zip(&r.points)
+                            .map(|(d, t)| (d.x_px - t.x_px).hypot(d.y_px - t.y_px))
+                            .collect();
+                        let worst = d.iter().copied().fold(0.0, f64::max);
+                        println!("{what}: found, worst {worst:.4} px");
+                        found += 1;
+                        errors.extend(d);
+                    }
+                    Err(e) => println!("{what}: {e}"),
+                }
+                truth.push(json!({
+                    "file": file.to_string_lossy(),
+                    "target": spec,
+                    "camera": name,
+                    "tilt_deg": tilt,
+                    "opencv_pattern": [cols, rows],
+                    "light_on_dark": spec.ends_with(":light-on-dark"),
+                    "points": r.points.iter().map(|p| [p.x_px, p.y_px]).collect::<Vec<_>>(),
+                }));
+            }
+        }
+    }
+    std::fs::write(
+        out.join("truth.json"),
+        serde_json::to_string_pretty(&truth)?,
+    )?;
+    let mean = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
+    let max = errors.iter().copied().fold(0.0, f64::max);
+    println!(
+        "robocal: {found} of {} views found, mean / max {mean:.4} / {max:.4} px",
+        truth.len()
+    );
+    Ok(())
+}
