@@ -31,8 +31,6 @@ use robocal::target::Target;
 /// cost is this much lower (1 %, about 0.5 % in RMS).
 const CLEARLY_LOWER: f64 = 0.01;
 
-const SPEC: &str = "charuco:4x5:54mm:40.5mm:DICT_4X4_1000";
-
 fn brown() -> Distortion {
     Distortion::Brown {
         k1: 0.0,
@@ -45,20 +43,10 @@ fn brown() -> Distortion {
 
 #[test]
 fn caliscope_fits_reach_the_best_cost_from_every_start_or_say_so() {
-    let Some(videos) = support::dataset("caliscope-4cam-charuco-video/video") else {
-        eprintln!("skipped: dataset caliscope-4cam-charuco-video not found (../shared/datasets or ROBOCAL_DATASETS)");
-        return;
-    };
     let dir = support::temp_dir("calib", "caliscope-starts");
-    let target = Target::parse_spec(SPEC).expect("spec");
+    let target = Target::parse_spec(support::CALISCOPE_TARGET).expect("spec");
     for camera in [0, 1] {
-        let video = videos.join(format!("cam_{camera}.mp4"));
-        let Some(files) = support::video_frames(&video, &dir, &format!("cam{camera}"), 21, 3, 30)
-        else {
-            eprintln!(
-                "skipped: ffmpeg could not extract frames from {}",
-                video.display()
-            );
+        let Some(files) = support::caliscope_frames(&dir, camera) else {
             return;
         };
         let views: Vec<View> = files

@@ -108,23 +108,13 @@ fn small_low_contrast_aprilgrid_tags_are_read() {
 
 #[test]
 fn caliscope_small_inverted_markers_give_the_measured_corners() {
-    let Some(videos) = support::dataset("caliscope-4cam-charuco-video/video") else {
-        eprintln!("skipped: dataset caliscope-4cam-charuco-video not found (../shared/datasets or ROBOCAL_DATASETS)");
-        return;
-    };
     let dir = support::temp_dir("recall", "caliscope");
-    let target = Target::parse_spec("charuco:4x5:54mm:40.5mm:DICT_4X4_1000").unwrap();
+    let target = Target::parse_spec(support::CALISCOPE_TARGET).unwrap();
     // (camera, OpenCV 4.14's CharucoDetector on the inverted frames
     // (BENCHMARKS.md section 3), robocal measured 2026-12-07: 93 and 139
     // before the recovery of missed markers and the joint corner seeds).
     for (camera, opencv, measured) in [(2usize, 166usize, 169usize), (3, 170, 136)] {
-        let video = videos.join(format!("cam_{camera}.mp4"));
-        let Some(files) = support::video_frames(&video, &dir, &format!("cam{camera}"), 21, 3, 30)
-        else {
-            eprintln!(
-                "skipped: ffmpeg could not extract frames from {}",
-                video.display()
-            );
+        let Some(files) = support::caliscope_frames(&dir, camera) else {
             return;
         };
         let mut corners = 0;

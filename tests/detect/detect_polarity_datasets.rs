@@ -21,31 +21,12 @@ use crate::support;
 use robocal::detect::{detect, DetectOptions};
 use robocal::error::Error;
 use robocal::target::{Polarity, Target};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-const SPEC: &str = "charuco:4x5:54mm:40.5mm:DICT_4X4_1000";
-const FRAMES_PER_CAMERA: usize = 30;
-
-/// Every third frame of `video` from frame 21 (the board comes into view
-/// near frame 63 of 111), [`FRAMES_PER_CAMERA`] of them, as PNGs in
-/// `dir`; `None` when ffmpeg cannot run.
-fn extract(video: &Path, dir: &Path, camera: usize) -> Option<Vec<PathBuf>> {
-    support::video_frames(
-        video,
-        dir,
-        &format!("cam{camera}"),
-        21,
-        3,
-        FRAMES_PER_CAMERA,
-    )
-}
+const SPEC: &str = support::CALISCOPE_TARGET;
 
 #[test]
 fn caliscope_inverted_charuco_frames_are_found_without_an_option() {
-    let Some(videos) = support::dataset("caliscope-4cam-charuco-video/video") else {
-        eprintln!("skipped: dataset caliscope-4cam-charuco-video not found (../shared/datasets or ROBOCAL_DATASETS)");
-        return;
-    };
     let dir = support::temp_dir("polarity", "caliscope");
     let target = Target::parse_spec(SPEC).unwrap();
     let forced_dark = DetectOptions {
@@ -55,17 +36,12 @@ fn caliscope_inverted_charuco_frames_are_found_without_an_option() {
     // Measured (module docs): frames with a board, corners.
     let measured = [(16, 181), (26, 130), (15, 139), (14, 93)];
     for (camera, &(frames, points)) in measured.iter().enumerate() {
-        let video = videos.join(format!("cam_{camera}.mp4"));
-        let Some(files) = extract(&video, &dir, camera) else {
-            eprintln!(
-                "skipped: ffmpeg could not extract frames from {}",
-                video.display()
-            );
+        let Some(files) = support::caliscope_frames(&dir, camera) else {
             return;
         };
         assert_eq!(
             files.len(),
-            FRAMES_PER_CAMERA,
+            support::CALISCOPE_FRAMES,
             "camera {camera}: frames extracted"
         );
         let (mut found, mut full, mut corners) = (0, 0, 0);

@@ -94,3 +94,37 @@ pub fn video_frames(
     files.sort();
     Some(files)
 }
+
+/// ChArUco board of caliscope's four-webcam session
+/// (`caliscope-4cam-charuco-video`, SOURCE.md), printed light on dark.
+pub const CALISCOPE_TARGET: &str = "charuco:4x5:54mm:40.5mm:DICT_4X4_1000";
+
+/// Frames extracted from each caliscope camera by [`caliscope_frames`].
+pub const CALISCOPE_FRAMES: usize = 30;
+
+/// Every third frame of caliscope's `cam_<camera>.mp4` from frame 21 (the
+/// board comes into view near frame 63 of 111), [`CALISCOPE_FRAMES`] of
+/// them, as PNGs `cam<camera>_NNN.png` in `dir`; `None`, with the reason
+/// printed for the caller to skip, when the dataset or ffmpeg is absent.
+pub fn caliscope_frames(dir: &Path, camera: usize) -> Option<Vec<PathBuf>> {
+    let Some(videos) = dataset("caliscope-4cam-charuco-video/video") else {
+        eprintln!("skipped: dataset caliscope-4cam-charuco-video not found (../shared/datasets or ROBOCAL_DATASETS)");
+        return None;
+    };
+    let video = videos.join(format!("cam_{camera}.mp4"));
+    let files = video_frames(
+        &video,
+        dir,
+        &format!("cam{camera}"),
+        21,
+        3,
+        CALISCOPE_FRAMES,
+    );
+    if files.is_none() {
+        eprintln!(
+            "skipped: ffmpeg could not extract frames from {}",
+            video.display()
+        );
+    }
+    files
+}
