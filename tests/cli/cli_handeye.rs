@@ -48,6 +48,58 @@ pub(crate) fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+/// RWHE-Calib CS_synthetic_1's `robocal handeye` report from its 15 images
+/// (`dir`: the dataset folder): eye-in-hand, the 9x6 chessboard of 200 mm
+/// squares, no bootstrap, `--refine refine`, and a pinhole camera without
+/// distortion (fx = fy = `f` px, `principal` = (cx, cy) px) written to
+/// `tmp` beside the report (both named after `f` and `refine`).
+pub(crate) fn rwhe_report(
+    dir: &Path,
+    tmp: &Path,
+    f: f64,
+    principal: [f64; 2],
+    refine: &str,
+) -> serde_json::Value {
+    let [cx, cy] = principal;
+    let camera = tmp.join(format!("camera-{f}-{refine}.json"));
+    std::fs::write(
+        &camera,
+        format!(
+            r#"{{"fx":{f},"fy":{f},"cx":{cx},"cy":{cy},"skew":0.0,
+                "width":1920,"height":1080,"distortion":{{"model":"none"}}}}"#
+        ),
+    )
+    .unwrap();
+    let out = tmp.join(format!("handeye-{f}-{refine}.json"));
+    let poses = dir.join("RobotPosesVec.txt");
+    let mut args: Vec<String> = [
+        "handeye",
+        "--setup",
+        "eye-in-hand",
+        "--poses",
+        poses.to_str().unwrap(),
+        "--camera",
+        camera.to_str().unwrap(),
+        "--target",
+        "chessboard:9x6:200mm",
+        "--refine",
+        refine,
+        "--bootstrap",
+        "0",
+        "-o",
+        out.to_str().unwrap(),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for k in 1..=15 {
+        args.push(dir.join(format!("im_{k:02}.png")).to_str().unwrap().into());
+    }
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&robocal(&refs));
+    read_json(&out)
+}
+
 #[test]
 fn demo_images_recover_the_truth_and_failed_images_are_dropped_with_their_pose() {
     let dir = std::env::temp_dir().join(format!("robocal-handeye-{}", std::process::id()));
@@ -181,46 +233,7 @@ fn rwhe_cs_synthetic_1_recovers_its_ground_truth_from_the_images() {
     // them jointly with the hand-eye transform.
     let tmp = std::env::temp_dir().join(format!("robocal-rwhe-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
-    let camera = tmp.join("camera.json");
-    std::fs::write(
-        &camera,
-        r#"{"fx":1078.88,"fy":1078.88,"cx":959.45,"cy":539.32,"skew":0.0,
-            "width":1920,"height":1080,"distortion":{"model":"none"}}"#,
-    )
-    .unwrap();
-    let out_path = tmp.join("handeye.json");
-    let poses = dir.join("RobotPosesVec.txt");
-    let mut args: Vec<String> = [
-        "handeye",
-        "--setup",
-        "eye-in-hand",
-        "--poses",
-        poses.to_str().unwrap(),
-        "--camera",
-        camera.to_str().unwrap(),
-        "--target",
-        "chessboard:9x6:200mm",
-        "--refine",
-        "joint_intrinsics",
-        "--bootstrap",
-        "0",
-        "-o",
-        out_path.to_str().unwrap(),
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    for k in 1..=15 {
-        args.push(
-            dir.join(format!("im_{k:02}.png"))
-                .to_str()
-                .unwrap()
-                .to_string(),
-        );
-    }
-    let arg_refs: Vec<&str> = args.iter().map(String::as_str).collect();
-    ok(&robocal(&arg_refs));
-    let report = read_json(&out_path);
+    let report = rwhe_report(&dir, &tmp, 1078.88, [959.45, 539.32], "joint_intrinsics");
     let truth = [
         [1.0, 0.0, 0.0, 0.0],
         [0.0, -1.0, 0.0, 0.0],

@@ -15,17 +15,10 @@
 //! Either set absent: skipped with a message.
 
 use crate::support;
-use support::dataset;
+use support::{dataset, temp_dir};
 
 use super::cli_handeye::{matrix, ok, read_json, robocal};
 use serde_json::Value;
-use std::path::PathBuf;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("robocal-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn warnings(report: &Value, start: &str) -> Vec<String> {
     report["warnings"]
@@ -42,43 +35,7 @@ fn warnings(report: &Value, start: &str) -> Vec<String> {
 /// over pixels: the path the focal check runs on), the camera's focal
 /// length `f` px.
 fn rwhe_report(dir: &std::path::Path, tmp: &std::path::Path, f: f64) -> Value {
-    let camera = tmp.join(format!("camera-{f}.json"));
-    std::fs::write(
-        &camera,
-        format!(
-            r#"{{"fx":{f},"fy":{f},"cx":959.5,"cy":539.5,"skew":0.0,
-                "width":1920,"height":1080,"distortion":{{"model":"none"}}}}"#
-        ),
-    )
-    .unwrap();
-    let out = tmp.join(format!("handeye-{f}.json"));
-    let poses = dir.join("RobotPosesVec.txt");
-    let mut args: Vec<String> = [
-        "handeye",
-        "--setup",
-        "eye-in-hand",
-        "--poses",
-        poses.to_str().unwrap(),
-        "--camera",
-        camera.to_str().unwrap(),
-        "--target",
-        "chessboard:9x6:200mm",
-        "--refine",
-        "none",
-        "--bootstrap",
-        "0",
-        "-o",
-        out.to_str().unwrap(),
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    for k in 1..=15 {
-        args.push(dir.join(format!("im_{k:02}.png")).to_str().unwrap().into());
-    }
-    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-    ok(&robocal(&refs));
-    read_json(&out)
+    super::cli_handeye::rwhe_report(dir, tmp, f, [959.5, 539.5], "none")
 }
 
 /// The truth within 3 reported std on every component of
@@ -121,7 +78,7 @@ fn rwhe_focal_check_is_quiet_at_the_right_focal_length_and_covers_a_wrong_one() 
         eprintln!("skipped: ../shared/datasets/rwhe-calib-cs-synthetic-1 is absent");
         return;
     };
-    let tmp = temp_dir("rwhe-focal");
+    let tmp = temp_dir("cli", "rwhe-focal");
     let right = rwhe_report(&dir, &tmp, 1080.0);
     assert!(
         warnings(&right, "focal length:").is_empty(),
@@ -174,7 +131,7 @@ fn moveit_camera_poses_raise_no_focal_or_scale_warning() {
             })
             .collect()
     };
-    let tmp = temp_dir("moveit-focal");
+    let tmp = temp_dir("cli", "moveit-focal");
     let (robot, cameras, out) = (
         tmp.join("robot.txt"),
         tmp.join("cameras.txt"),
