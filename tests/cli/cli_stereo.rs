@@ -188,12 +188,7 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
             ["brown", "radial_k1_k2_k5"].contains(&recommended),
             "{advice}"
         );
-        let formats: Vec<&str> = advice["export_formats"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|f| f.as_str().unwrap())
-            .collect();
+        let formats = export_formats(advice);
         assert!(
             formats.contains(&"opencv-yaml") && formats.contains(&"ros-yaml"),
             "{formats:?}"
@@ -209,6 +204,16 @@ fn stereo_on_rendered_pairs_recovers_right_from_left_and_exports() {
             "{advice}"
         );
     }
+}
+
+/// The model advice's `export_formats` (one camera's `model_advice`).
+fn export_formats(advice: &Value) -> Vec<&str> {
+    advice["export_formats"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect()
 }
 
 /// The stereo exports of a `robocal stereo` report: OpenCV's numbers
@@ -418,12 +423,7 @@ fn a_fisheye_pair_gets_fisheye_model_advice_with_its_export_formats() {
             advice["half_diagonal_fov_deg"].as_f64().unwrap() > 50.0,
             "{advice}"
         );
-        let formats: Vec<&str> = advice["export_formats"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|f| f.as_str().unwrap())
-            .collect();
+        let formats = export_formats(advice);
         assert!(
             formats.iter().any(|f| f.starts_with("kalibr")),
             "{formats:?}"
