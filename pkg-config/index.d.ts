@@ -2033,6 +2033,8 @@ export interface RobocalJson {
   rig_frame_keys: [RigCameraNames[], RigFrameGrouping];
   /** `video_timestamps(text)` -> caliscope's `timestamps.csv` (sync_index, cam_id, frame_index, frame_time) per camera in video frame order, as `robocal rig --timestamps` reads it. */
   video_timestamps: [never, VideoTimestamps];
+  /** `video_frame_name(video, index)` returns the name of frame `index` (0 first) of the video file `video`, not JSON: `cam_0.mp4#frame0123`, as `robocal` names the frames it takes from a video. */
+  video_frame_name: [never, never];
   /** `read_camera_file(text)` -> the camera of any camera format robocal exports (robocal JSON camera export or calibration report, OpenCV YAML/XML, ROS camera_info, Kalibr, mrcal, HALCON tuple or .dat, MATLAB script, text matrix), as `robocal rig --camera-file` reads it. */
   read_camera_file: [never, CameraFileReading];
   /** `check_camera(request)` -> the check of a saved calibration against new views: ok, drifted or broken (docs/check.md). */

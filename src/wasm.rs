@@ -36,7 +36,7 @@ pub use rig_frames::rig_frame_keys;
 pub use rig_handeye::calibrate_rig_handeye;
 use targets::target_from;
 pub use targets::{parse_target, read_kalibr_target, target_points, target_spec, target_svg};
-pub use video::video_timestamps;
+pub use video::{video_frame_name, video_timestamps};
 
 use crate::image::{decode, DecodeOptions, GrayImage};
 use serde::Serialize;

@@ -295,7 +295,10 @@ let videoSession = null;
  * `reset` starts a new video; otherwise one frame (an ImageBitmap, closed
  * here) at `time` ms of the video: the frame report of docs/live-capture.md.
  */
-handlers.videoFrame = async ({ reset, bitmap, spec, time }) => {
+// One frame of a video (www/views/video.js): the capture rules' verdict,
+// with the frame's name (`cam_0.mp4#frame0123`, the CLI's, from the core)
+// when the page gives the video's file name and the frame's index.
+handlers.videoFrame = async ({ reset, bitmap, spec, time, video, index }) => {
   await ready;
   if (reset) {
     if (videoSession) videoSession.live.free();
@@ -309,7 +312,9 @@ handlers.videoFrame = async ({ reset, bitmap, spec, time }) => {
     videoSession = { key, live: new robocal.LiveCapture(spec, width, height), time: -Infinity };
   }
   videoSession.time = Math.max(time, videoSession.time + 1e-3);
-  return JSON.parse(videoSession.live.push_grey(grey, width, height, videoSession.time));
+  const verdict = JSON.parse(videoSession.live.push_grey(grey, width, height, videoSession.time));
+  if (video !== undefined) verdict.name = robocal.video_frame_name(video, index);
+  return verdict;
 };
 
 function greyFromBitmap(bitmap) {

@@ -28,11 +28,6 @@ pub fn is_video(path: &str) -> bool {
         .is_some_and(|(_, ext)| VIDEO_EXTENSIONS.iter().any(|v| v.eq_ignore_ascii_case(ext)))
 }
 
-/// The name of frame `index` of `path` in reports: `cam_0.mp4#frame0123`.
-pub fn frame_name(path: &str, index: usize) -> String {
-    format!("{path}#frame{index:04}")
-}
-
 /// The first video stream of a file, as ffprobe describes it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VideoInfo {
@@ -290,7 +285,6 @@ mod tests {
         for p in ["cam_0.png", "mp4", "a.mp4/b.jpg", "noext", "x.mp4.png"] {
             assert!(!is_video(p), "{p}");
         }
-        assert_eq!(frame_name("v/cam_0.mp4", 123), "v/cam_0.mp4#frame0123");
     }
 
     #[test]

@@ -8,12 +8,13 @@
 //! the stream's rate. At most `--max-frames` frames are kept per video;
 //! reading stops there.
 
-use super::video::{frame_name, FrameReader, VideoInfo};
+use super::video::{FrameReader, VideoInfo};
 use super::CliError;
 use rayon::prelude::*;
 use robocal::capture::{measure, CaptureConfig, CaptureSession, Reason};
 use robocal::detect::{detect, DetectOptions};
 use robocal::image::GrayImage;
+use robocal::io::video_frames::video_frame_name;
 use robocal::target::{Detection, Target};
 use std::collections::BTreeMap;
 
@@ -101,7 +102,7 @@ pub struct Budget {
 pub struct VideoFrame {
     /// Its index in the video (0 first).
     pub index: usize,
-    /// `cam_0.mp4#frame0123`.
+    /// `cam_0.mp4#frame0123` ([`video_frame_name`]).
     pub name: String,
     /// The board found, or why not.
     pub detection: Result<Detection, (String, String)>,
@@ -258,7 +259,7 @@ pub fn scan(
             kept += usize::from(keep);
             frames.push(VideoFrame {
                 index: *index,
-                name: frame_name(path, *index),
+                name: video_frame_name(path, *index),
                 detection,
                 kept: keep,
                 reason: report,

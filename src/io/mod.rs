@@ -37,6 +37,7 @@ pub mod pose_text;
 mod pose_writer;
 mod pose_yaml;
 mod poses;
+pub mod video_frames;
 pub mod video_timestamps;
 pub mod workflow_csv;
 

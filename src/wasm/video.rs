@@ -1,9 +1,11 @@
 //! Recordings in the web app (issue 36): caliscope's `timestamps.csv`
 //! read by the core parser (`robocal::io::video_timestamps`), so the page
 //! groups several cameras' video frames into rig frames by `sync_index`
-//! as `robocal rig --timestamps` does.
+//! as `robocal rig --timestamps` does; and the name of a frame taken from
+//! a video (`robocal::io::video_frames`), the CLI's.
 
 use super::js_error;
+use crate::io::video_frames;
 use crate::io::video_timestamps::parse_video_timestamps;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -45,4 +47,12 @@ pub fn video_timestamps(text: &str) -> Result<String, JsError> {
         })
         .collect();
     serde_json::to_string(&Timestamps { cameras }).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// The name of frame `index` (0 first) of the video file `video`:
+/// `cam_0.mp4#frame0123`, as `robocal` names the frames it takes from a
+/// video (plain text, not JSON).
+#[wasm_bindgen]
+pub fn video_frame_name(video: &str, index: u32) -> String {
+    video_frames::video_frame_name(video, index as usize)
 }

@@ -323,6 +323,9 @@ assert.deepEqual(byOrder, { paired_by: 'order', pairs: [[0, 0], [1, 1]] });
 const stamps = output('video_timestamps', JSON.parse(robocal.video_timestamps('sync_index,cam_id,frame_index,frame_time\n26,1,26,123.33\n26,0,26,123.34\n27,0,27,123.5\n27,1,28,123.51\n')));
 assert.deepEqual(stamps, { cameras: { 0: { sync_index: [26, 27], time_s: [123.34, 123.5] }, 1: { sync_index: [26, 27], time_s: [123.33, 123.51] } } });
 assert.throws(() => robocal.video_timestamps('sync,cam\n1,2\n'), /sync_index,cam_id,frame_index,frame_time/);
+// A video frame's name: the CLI's (robocal::io::video_frames), four digits at least.
+assert.equal(robocal.video_frame_name('cam_0.mp4', 123), 'cam_0.mp4#frame0123');
+assert.equal(robocal.video_frame_name('a.webm', 12345), 'a.webm#frame12345');
 const rigNames = input('rig_frame_keys', [{ name: 'front', images: ['front07.png', 'front2.png'] }, { name: 'side', images: ['side/2.jpg'] }]);
 const rigFrames = output('rig_frame_keys', JSON.parse(robocal.rig_frame_keys(JSON.stringify(rigNames), '')), 'rig_frame_keys number');
 assert.deepEqual(rigFrames, { grouped_by: 'number', keys: [['7', '2'], ['2']], frames: ['2', '7'] });

@@ -10,7 +10,7 @@
 import { h } from '../lib/dom.js';
 import { Engine } from '../engine.js';
 import { VIDEO_EXT } from '../lib/video-file.js';
-import { scanVideo, scanSummary, frameName } from './video.js';
+import { scanVideo, scanSummary } from './video.js';
 import { targetSpec } from './target.js';
 
 /** The number in a file name (the last run of digits of its stem, robocal::io::pairing::number_in_name). */
@@ -103,11 +103,11 @@ export class RigVideos {
       camera.files = [];
       await scanVideo(this.engine, this.video, cam.file, spec, {
         keepAll: (i) => wanted.has(cam.key(i)),
-        onKept: async (index, bytes) => {
+        onKept: async (index, bytes, r) => {
           if (!wanted.has(cam.key(index))) return;
           const id = `rig-${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`;
           await this.rig.store.putBytes(id, bytes);
-          camera.files.push({ id, name: frameName(cam.file.name, index), frameKey: cam.key(index), detection: null, error: null, spec: null });
+          camera.files.push({ id, name: r.name, frameKey: cam.key(index), detection: null, error: null, spec: null });
         },
         progress: (counts, index) => this.show('reading', `${cam.file.name}: taking the rig frames, frame ${index}`),
       });

@@ -12,9 +12,6 @@ import { targetSpec } from './target.js';
 /** Frames kept per video at most (`robocal --max-frames`'s default, src/cli/video_frames.rs). */
 export const MAX_FRAMES = 60;
 
-/** A video frame's name: `cam_0.mp4#frame0123` (src/cli/video.rs `frame_name`). */
-export const frameName = (file, index) => `${file}#frame${String(index).padStart(4, '0')}`;
-
 export const isVideo = (file) => VIDEO_EXT.test(file.name);
 
 /** The frame shown by `video` as PNG bytes. */
@@ -30,8 +27,10 @@ export async function framePng(video) {
 
 /**
  * Read `file`'s frames through `engine`'s `videoFrame` session (the
- * capture rules) in the <video> `video`: `onKept(index, pngBytes)` for each
- * frame kept, `progress(counts)` after each frame, `stop()` true to stop.
+ * capture rules) in the <video> `video`: `onKept(index, pngBytes, verdict)`
+ * for each frame kept (`verdict.name`: the frame's name `cam_0.mp4#frame0123`,
+ * the CLI's, from the core's `video_frame_name` in the worker),
+ * `progress(counts)` after each frame, `stop()` true to stop.
  * Returns `{ read, looked, found, kept, reasons, width, height, codec }`;
  * throws the undecodable-codec message for a video the browser cannot decode.
  */
@@ -45,7 +44,7 @@ export async function scanVideo(engine, video, file, spec, { onKept, progress = 
       if (stop()) return false;
       counts.read++;
       const bitmap = await createImageBitmap(video);
-      const r = await engine.call('videoFrame', { bitmap, spec, time: timeMs }, [bitmap]);
+      const r = await engine.call('videoFrame', { bitmap, spec, time: timeMs, video: file.name, index }, [bitmap]);
       if (r.status !== 'not_found') { counts.found++; counts.foundIndices.push(index); }
       // `keepAll(index)`: a frame another camera kept (a rig), taken whenever the board is in it.
       const wanted = r.keep || (keepAll && keepAll(index) && r.status !== 'not_found');
@@ -126,7 +125,7 @@ export class VideoView {
     try {
       const counts = await scanVideo(this.engine, $('video-preview'), file, spec, {
         stop: () => this.cancelled,
-        onKept: (index, bytes) => { detections.push(this.images.addBytes([{ name: frameName(file.name, index), bytes, source: 'video' }])); },
+        onKept: (index, bytes, r) => { detections.push(this.images.addBytes([{ name: r.name, bytes, source: 'video' }])); },
         progress: (c, index) => this.status('reading', `${file.name}: frame ${index} · board in ${c.found} of ${c.read} · ${c.kept} kept`, c),
       });
       await Promise.all(detections);
