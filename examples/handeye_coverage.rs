@@ -115,8 +115,14 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
     let mut held = result.clone();
     let (noise, _) = camera_noise_from_views(&input, &views, &used_camera);
     apply_pose_refinement(&mut held, &input, noise, MotionPairs::All).ok()?;
-    apply_pose_refinement_from_views(&mut result, &input, &views, &used_camera, MotionPairs::All)
-        .ok()?;
+    apply_pose_refinement_from_views(
+        &mut result,
+        &input,
+        &views,
+        (&used_camera, None),
+        MotionPairs::All,
+    )
+    .ok()?;
     let covered = |r: &HandEyeResult, scale: f64| -> Option<bool> {
         let std = &r.pose_refinement.as_ref()?.camera_transform_std;
         let dt = (r.x.translation.vector - scene.x_true.translation.vector) * 1e3;
