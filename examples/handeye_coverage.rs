@@ -30,6 +30,7 @@ use robocal::handeye::solve::{apply_pose_refinement, apply_pose_refinement_from_
 use robocal::handeye::{
     calibrate, HandEyeInput, HandEyeOptions, HandEyeResult, MotionPairs, Pose, Setup,
 };
+use robocal::optim::wilson::wilson_interval_95;
 use robocal::synth::handeye_looking::{
     grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,
 };
@@ -115,8 +116,14 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
     let mut held = result.clone();
     let (noise, _) = camera_noise_from_views(&input, &views, &used_camera);
     apply_pose_refinement(&mut held, &input, noise, MotionPairs::All).ok()?;
-    apply_pose_refinement_from_views(&mut result, &input, &views, &used_camera, MotionPairs::All)
-        .ok()?;
+    apply_pose_refinement_from_views(
+        &mut result,
+        &input,
+        &views,
+        (&used_camera, None),
+        MotionPairs::All,
+    )
+    .ok()?;
     let covered = |r: &HandEyeResult, scale: f64| -> Option<bool> {
         let std = &r.pose_refinement.as_ref()?.camera_transform_std;
         let dt = (r.x.translation.vector - scene.x_true.translation.vector) * 1e3;
@@ -248,7 +255,7 @@ fn main() {
             }
         }
         let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
-        let (low, high) = wilson(covered, n);
+        let (low, high) = wilson_interval_95(covered, n);
         println!(
             "| {} | {n} | {:.1} % | {:.1} % | {:.1}-{:.1} % | {:.2} | {:.1} % | {:.1} % | {:.1} % \
              | {:.1} % | {:.1} %, {:.1} % | {:.1} % |",
@@ -267,15 +274,4 @@ fn main() {
             pct(silent_4)
         );
     }
-}
-
-/// The 95 % Wilson score interval of a share `k` of `n`.
-fn wilson(k: usize, n: usize) -> (f64, f64) {
-    if n == 0 {
-        return (0.0, 1.0);
-    }
-    let (n, p, z) = (n as f64, k as f64 / n as f64, 1.96f64);
-    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
-    let half = z / (1.0 + z * z / n) * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
-    (centre - half, centre + half)
 }

@@ -15,10 +15,11 @@
 //! drift or the leave-frames-out spread), the mean over trials and
 //! components of |error| / std (about 0.8 for a right std) and the worst.
 
-use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig::calibrate_rig;
 use robocal::calib::multi::stereo::calibrate_stereo;
 use robocal::calib::CalibrationOptions;
 use robocal::geometry::{rotvec_from_rotation, Pose};
+use robocal::optim::wilson::wilson_interval_95;
 use robocal::synth::rig::{rig_scene, RigScene, RigSceneConfig};
 
 fn errors(got: &Pose, truth: &Pose) -> [f64; 6] {
@@ -45,21 +46,12 @@ fn names_timing(w: &str) -> bool {
 }
 
 fn rig_trial(scene: &RigScene) -> Option<Trial> {
-    let cameras: Vec<RigCameraViews> = (0..scene.names.len())
-        .map(|k| RigCameraViews {
-            name: scene.names[k].clone(),
-            image_size_px: (scene.cameras[k].width, scene.cameras[k].height),
-            views: scene.views[k].clone(),
-            camera: None,
-        })
-        .collect();
-    let options = RigOptions {
-        calibration: CalibrationOptions::default(),
-        rig_frame: None,
-        target: "chessboard:11x8:60mm".into(),
-        grouping: "number".into(),
-    };
-    let rig = calibrate_rig(&cameras, &scene.frame_keys, &options).ok()?;
+    let rig = calibrate_rig(
+        &scene.camera_views(&[]),
+        &scene.frame_keys,
+        &RigScene::rig_options(None),
+    )
+    .ok()?;
     let mut ratios = Vec::new();
     for (k, camera) in rig.cameras.iter().enumerate().skip(1) {
         let (Some(got), Some(s)) = (
@@ -97,17 +89,6 @@ fn stereo_trial(scene: &RigScene) -> Option<Trial> {
     let ratios = e.iter().zip(&std).map(|(err, sd)| err.abs() / sd).collect();
     let warned = pair.warnings.iter().any(|w| names_timing(w));
     Some(Trial { ratios, warned })
-}
-
-/// The 95 % Wilson score interval of a share `k` of `n`.
-fn wilson(k: usize, n: usize) -> (f64, f64) {
-    if n == 0 {
-        return (0.0, 1.0);
-    }
-    let (n, p, z) = (n as f64, k as f64 / n as f64, 1.96f64);
-    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
-    let half = z / (1.0 + z * z / n) * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
-    (centre - half, centre + half)
 }
 
 #[derive(Default)]
@@ -166,7 +147,7 @@ fn main() {
             row.silent_beyond_4 += usize::from(beyond_4 && !trial.warned);
         }
         let pct = |n: usize| 100.0 * n as f64 / row.trials as f64;
-        let (low, high) = wilson(row.covered, row.trials);
+        let (low, high) = wilson_interval_95(row.covered, row.trials);
         println!(
             "| {timing_ms} ms | {} | {:.1} % | {:.1}-{:.1} % | {:.0} % | {:.0} % | {:.1} % | {:.1} % | {:.2} | {:.1} |",
             row.trials,

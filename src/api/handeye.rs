@@ -457,10 +457,12 @@ pub fn solve_handeye(
                 &mut result,
                 input,
                 points.views,
-                points.camera,
+                (
+                    points.camera,
+                    points.camera_std.and_then(|s| s.get("fx").copied()),
+                ),
                 options.motion_pairs,
             )?;
-            drop_focal_warning_within_camera_std(&mut result, points.camera, points.camera_std);
         }
     }
     if let (Some(points), Some(summary)) = (images, result.pose_refinement.as_mut()) {
@@ -489,25 +491,4 @@ pub fn board_centre(views: &[View]) -> Option<Point3<f64>> {
     }
     let sum = all.iter().fold(Vector3::zeros(), |a, p| a + p.coords);
     Some(Point3::from(sum / all.len() as f64))
-}
-
-/// The focal check's warning is dropped when the camera's own fx std
-/// explains the disagreement ([`crate::handeye::quality::focal::within_camera_std`]);
-/// the widened covariance and `pose_refinement.focal_check` stay.
-fn drop_focal_warning_within_camera_std(
-    result: &mut crate::handeye::HandEyeResult,
-    camera: &Camera,
-    camera_std: Option<&std::collections::BTreeMap<String, f64>>,
-) {
-    let Some(check) = result
-        .pose_refinement
-        .as_ref()
-        .and_then(|p| p.focal_check.as_ref())
-    else {
-        return;
-    };
-    let fx_std = camera_std.and_then(|s| s.get("fx").copied());
-    if crate::handeye::quality::focal::within_camera_std(check, camera.fx, fx_std) {
-        result.warnings.retain(|w| !w.starts_with("focal length:"));
-    }
 }

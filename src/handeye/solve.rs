@@ -270,18 +270,21 @@ pub fn apply_pose_refinement(
 /// points ([`camera_noise_from_views`]): for image input whose refinement
 /// over pixels is off (`refine` none); then the reprojection RMS of the
 /// refined transforms.
+///
+/// `camera_fx_std`: the std (px) of the camera's calibrated fx, when known;
+/// the focal check writes no warning for a disagreement within it.
 pub fn apply_pose_refinement_from_views(
     result: &mut HandEyeResult,
     input: &HandEyeInput,
     views: &[View],
-    camera: &Camera,
+    (camera, camera_fx_std): (&Camera, Option<f64>),
     motion_pairs: MotionPairs,
 ) -> Result<()> {
     let (camera_noise, warning) = camera_noise_from_views(input, views, camera);
     result.warnings.extend(warning);
     apply_pose_refinement(result, input, camera_noise, motion_pairs)?;
     add_reprojection_rms(result, input, views, camera)?;
-    apply_focal_check(result, input, views, camera, motion_pairs);
+    apply_focal_check(result, input, views, (camera, camera_fx_std), motion_pairs);
     Ok(())
 }
 
@@ -294,7 +297,7 @@ fn apply_focal_check(
     result: &mut HandEyeResult,
     input: &HandEyeInput,
     views: &[View],
-    camera: &Camera,
+    camera: (&Camera, Option<f64>),
     motion_pairs: MotionPairs,
 ) {
     use crate::handeye::quality::trust::{add_shift_to_covariance, work_point_std_mm};

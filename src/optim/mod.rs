@@ -15,6 +15,7 @@ pub mod dense;
 mod loss;
 mod normal;
 pub mod student_t;
+pub mod wilson;
 
 #[cfg(test)]
 mod tests;

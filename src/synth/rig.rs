@@ -11,7 +11,8 @@
 //! [`robot_poses`] puts the rig (or the board) on a robot for the rig hand-eye.
 
 use super::Rng;
-use crate::calib::View;
+use crate::calib::multi::rig::{RigCameraViews, RigOptions};
+use crate::calib::{CalibrationOptions, View};
 use crate::camera::Camera;
 use crate::geometry::{rotation_from_rotvec, Pose};
 use crate::handeye::Setup;
@@ -83,6 +84,38 @@ pub struct RigScene {
     pub frame_keys: Vec<String>,
     /// Per camera: its views, each with its frame index.
     pub views: Vec<Vec<(usize, View)>>,
+}
+
+/// The board of every rig scene as [`RigOptions::target`] names it: 11 x 8
+/// squares of 60 mm ([`RIG_BOARD`]'s 10 x 7 inner corners).
+pub const RIG_TARGET: &str = "chessboard:11x8:60mm";
+
+impl RigScene {
+    /// The cameras' inputs to `calibrate_rig`: every camera's views, the
+    /// cameras in `held` with their true intrinsics (held), the others
+    /// calibrated from their views.
+    pub fn camera_views(&self, held: &[usize]) -> Vec<RigCameraViews> {
+        (0..self.names.len())
+            .map(|k| RigCameraViews {
+                name: self.names[k].clone(),
+                image_size_px: (self.cameras[k].width, self.cameras[k].height),
+                views: self.views[k].clone(),
+                camera: held.contains(&k).then(|| self.cameras[k].clone()),
+            })
+            .collect()
+    }
+
+    /// The rig options for these scenes: the default calibration, frames
+    /// grouped by their number (the scene's `frame_keys`), [`RIG_TARGET`],
+    /// the rig frame `rig_frame` (none: cam0's).
+    pub fn rig_options(rig_frame: Option<&str>) -> RigOptions {
+        RigOptions {
+            calibration: CalibrationOptions::default(),
+            rig_frame: rig_frame.map(str::to_string),
+            target: RIG_TARGET.into(),
+            grouping: "number".into(),
+        }
+    }
 }
 
 /// world_from_camera of a camera on the circle at `deg`, looking at the centre.

@@ -23,28 +23,13 @@ use robocal::geometry::{rotvec_from_rotation, Pose};
 use robocal::synth::rig::{rig_scene, RigScene, RigSceneConfig};
 use serde_json::Value;
 
-fn options(rig_frame: Option<&str>) -> RigOptions {
-    RigOptions {
-        calibration: CalibrationOptions::default(),
-        rig_frame: rig_frame.map(str::to_string),
-        target: "chessboard:11x8:60mm".into(),
-        grouping: "number".into(),
-    }
-}
-
-fn inputs(scene: &RigScene, held: &[usize]) -> Vec<RigCameraViews> {
-    (0..scene.names.len())
-        .map(|k| RigCameraViews {
-            name: scene.names[k].clone(),
-            image_size_px: (scene.cameras[k].width, scene.cameras[k].height),
-            views: scene.views[k].clone(),
-            camera: held.contains(&k).then(|| scene.cameras[k].clone()),
-        })
-        .collect()
-}
-
 fn solve(scene: &RigScene, held: &[usize], rig_frame: Option<&str>) -> RigCalibration {
-    calibrate_rig(&inputs(scene, held), &scene.frame_keys, &options(rig_frame)).expect("rig")
+    calibrate_rig(
+        &scene.camera_views(held),
+        &scene.frame_keys,
+        &RigScene::rig_options(rig_frame),
+    )
+    .expect("rig")
 }
 
 /// Rotation (left perturbation, rad) and translation (m) errors of a pose.
@@ -124,7 +109,12 @@ fn cameras_without_shared_frames_name_the_groups() {
         ..RigSceneConfig::default()
     };
     let scene = rig_scene(&config, 3);
-    let err = calibrate_rig(&inputs(&scene, &[]), &scene.frame_keys, &options(None)).unwrap_err();
+    let err = calibrate_rig(
+        &scene.camera_views(&[]),
+        &scene.frame_keys,
+        &RigScene::rig_options(None),
+    )
+    .unwrap_err();
     assert_eq!(
         err.to_string(),
         "cameras are not connected by shared board views: {cam0, cam1} and {cam2, cam3}; add \
@@ -249,7 +239,7 @@ fn opencv_9x6_pair_as_a_rig_gives_the_stereo_result() {
         &keys,
         &RigOptions {
             calibration,
-            ..options(None)
+            ..RigScene::rig_options(None)
         },
     )
     .expect("rig");
@@ -304,7 +294,7 @@ fn frames_of_one_camera_shifted_are_named_before_the_joint_fit() {
         "{:?}",
         right.warnings
     );
-    let mut cameras = inputs(&scene, &[]);
+    let mut cameras = scene.camera_views(&[]);
     let n = scene.frame_keys.len();
     cameras[1].views = cameras[1]
         .views
@@ -312,7 +302,7 @@ fn frames_of_one_camera_shifted_are_named_before_the_joint_fit() {
         .filter(|(f, _)| f + 2 < n)
         .map(|(f, v)| (f + 2, v.clone()))
         .collect();
-    let err = calibrate_rig(&cameras, &scene.frame_keys, &options(None))
+    let err = calibrate_rig(&cameras, &scene.frame_keys, &RigScene::rig_options(None))
         .expect_err("shifted frames")
         .to_string();
     assert!(

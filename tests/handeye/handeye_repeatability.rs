@@ -196,8 +196,14 @@ fn misspecified(
         ..Default::default()
     };
     let mut result = calibrate(&input, &options).unwrap();
-    apply_pose_refinement_from_views(&mut result, &input, &pixels, &used, MotionPairs::All)
-        .unwrap();
+    apply_pose_refinement_from_views(
+        &mut result,
+        &input,
+        &pixels,
+        (&used, None),
+        MotionPairs::All,
+    )
+    .unwrap();
     (result, scene.x_true)
 }
 

@@ -14,7 +14,7 @@
 //! BENCHMARKS.md.
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
-use robocal::calib::multi::rig::{calibrate_rig, RigCameraViews, RigOptions};
+use robocal::calib::multi::rig::calibrate_rig;
 use robocal::calib::View;
 use robocal::calib::{calibrate, CalibrationOptions};
 use robocal::geometry::{rotvec_from_rotation, Pose};
@@ -99,21 +99,9 @@ fn trial(seed: u64, setup: Setup) -> Trial {
         ..HandEyeOptions::default()
     };
     // 1. The rig from the same pixels.
-    let inputs: Vec<RigCameraViews> = (0..scene.names.len())
-        .map(|k| RigCameraViews {
-            name: scene.names[k].clone(),
-            image_size_px: (scene.cameras[k].width, scene.cameras[k].height),
-            views: scene.views[k].clone(),
-            camera: None,
-        })
-        .collect();
-    let rig_options = RigOptions {
-        calibration: CalibrationOptions::default(),
-        rig_frame: None,
-        target: "chessboard:11x8:60mm".into(),
-        grouping: "number".into(),
-    };
-    let rig = calibrate_rig(&inputs, &scene.frame_keys, &rig_options).expect("rig");
+    let rig_options = RigScene::rig_options(None);
+    let rig =
+        calibrate_rig(&scene.camera_views(&[]), &scene.frame_keys, &rig_options).expect("rig");
     let held = held_rig(&rig).expect("held rig");
     let sigma = rig_sigma_points(&rig)
         .expect("sigma points")

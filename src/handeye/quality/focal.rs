@@ -149,11 +149,16 @@ pub fn focal_scale(
 /// Check the focal length of `camera` against the robot's motion (module
 /// docs) for an image-path result whose pose refinement ran; `None` when
 /// it agrees or cannot be checked (too few views, parallel rotation axes).
+///
+/// `fx_std` is the std of the camera's calibrated fx (px), when the camera
+/// came with its standard deviations: a disagreement within it and the
+/// scale's own std together ([`within_camera_std`]) widens the std but
+/// writes no warning.
 pub fn check_focal(
     result: &HandEyeResult,
     input: &HandEyeInput,
     views: &[View],
-    camera: &Camera,
+    (camera, fx_std): (&Camera, Option<f64>),
     motion_pairs: MotionPairs,
 ) -> Option<FocalFinding> {
     if result.pose_refinement.is_none() || !result.unobservable_translation.is_empty() {
@@ -213,7 +218,8 @@ pub fn check_focal(
             fit.scale
         ),
     };
-    let warning = (off.abs() > FOCAL_MIN || beyond_std).then(|| {
+    let explained = within_camera_std(&fit, camera.fx, fx_std);
+    let warning = ((off.abs() > FOCAL_MIN || beyond_std) && !explained).then(|| {
         format!(
             "focal length: the camera's focal length disagrees with the robot's motion by {:.2} % \
          ({:.1} std): fitted through the robot poses, the image points want fx and fy {} by \
@@ -236,20 +242,20 @@ pub fn check_focal(
     })
 }
 
-/// Whether a named focal disagreement lies within what the camera's own
+/// Whether a focal disagreement lies within what the camera's own
 /// calibration allows: the focal scale's std over the views and the
-/// calibrated fx's relative std (`std["fx"] / fx`, when the camera came with
+/// calibrated fx's relative std (`fx_std / fx`, when the camera came with
 /// its standard deviations) taken together. The check alone judges the
 /// scale against its own std, as if the intrinsics were exact; on clean
 /// data both are tiny (the page's demo: fx 899.985 +- 0.055 px, the robot's
 /// motion wants 0.0028 % more: 3.1 std of the check, 0.4 of both), and such a
 /// disagreement is not worth a warning. The covariance keeps the shift.
-pub fn within_camera_std(check: &FocalCheck, fx: f64, fx_std: Option<f64>) -> bool {
+pub(crate) fn within_camera_std(fit: &FocalScale, fx: f64, fx_std: Option<f64>) -> bool {
     let Some(fx_std) = fx_std.filter(|s| s.is_finite() && *s > 0.0 && fx > 0.0) else {
         return false;
     };
-    let off = (check.scale - 1.0).abs();
-    let both = check.scale_std.hypot(fx_std / fx);
+    let off = (fit.scale - 1.0).abs();
+    let both = fit.std.hypot(fx_std / fx);
     off <= FOCAL_MIN && off <= FOCAL_ALERT_STD * both
 }
 
@@ -324,23 +330,100 @@ mod tests {
     #[test]
     fn the_cameras_own_fx_std_joins_the_scale_std() {
         // The demo's figures: 3.1 std of the scale alone, 0.4 of both.
-        let check = FocalCheck {
+        let fit = FocalScale {
             scale: 1.000_027_6,
-            scale_std: 8.86e-6,
-            freed_moves: None,
+            std: 8.86e-6,
         };
-        assert!(within_camera_std(&check, 899.985, Some(0.055)));
+        assert!(within_camera_std(&fit, 899.985, Some(0.055)));
         // Without the camera's std the check stands.
-        assert!(!within_camera_std(&check, 899.985, None));
-        assert!(!within_camera_std(&check, 899.985, Some(0.0)));
+        assert!(!within_camera_std(&fit, 899.985, None));
+        assert!(!within_camera_std(&fit, 899.985, Some(0.0)));
         // Beyond 3 std of both (3.09 here), or 0.1 % off, it stands too.
-        assert!(!within_camera_std(&check, 899.985, Some(0.001)));
-        let far = FocalCheck {
+        assert!(!within_camera_std(&fit, 899.985, Some(0.001)));
+        let far = FocalScale {
             scale: 1.002,
-            scale_std: 1e-3,
-            freed_moves: None,
+            std: 1e-3,
         };
         assert!(!within_camera_std(&far, 1000.0, Some(5.0)));
+    }
+
+    /// A clean eye-in-hand scene (0.01 px, robot noise 1e-6) whose PnP used
+    /// fx and fy 0.05 % long: the check names the scale and, without the
+    /// camera's own fx std, warns (the shift exceeds the held std); with an
+    /// fx std of 1 px (0.09 %) the disagreement lies within the camera's
+    /// calibration and no warning is written, while the check and the
+    /// widened std stay.
+    #[test]
+    fn check_focal_writes_no_warning_within_the_cameras_fx_std() {
+        use crate::calib::pnp::camera_from_target_with_covariance;
+        use crate::handeye::solve::apply_pose_refinement;
+        use crate::handeye::{calibrate, HandEyeOptions};
+        use crate::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
+        use crate::synth::Rng;
+        let truth = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
+        let config = LookingConfig {
+            setup: Setup::EyeInHand,
+            views: 12,
+            distance_m: 0.5,
+            grid: (9, 6, 0.03),
+            max_tilt_deg: 30.0,
+            max_roll_deg: 60.0,
+        };
+        let scene = looking_scene(&config, 35);
+        let mut rng = Rng::new(35);
+        let views = grid_pixels(&scene, &truth, 0.01, &mut rng);
+        let used = Camera::pinhole(1100.55, 1100.55, 639.5, 479.5, 1280, 960);
+        let cams: Vec<Pose> = views
+            .iter()
+            .map(|v| camera_from_target_with_covariance(&used, v).unwrap().0)
+            .collect();
+        let robots: Vec<Pose> = (scene.base_from_gripper.iter())
+            .map(|p| perturbed(&mut rng, p, [1e-6; 3], [1e-6; 3]))
+            .collect();
+        let input = HandEyeInput {
+            setup: Setup::EyeInHand,
+            base_from_gripper: robots,
+            camera_from_target: cams,
+        };
+        let options = HandEyeOptions {
+            bootstrap_samples: 1,
+            refine_poses: false,
+            strict_checks: false,
+            ..Default::default()
+        };
+        let mut result = calibrate(&input, &options).unwrap();
+        let noise =
+            crate::handeye::refine::over_poses::camera_noise_from_views(&input, &views, &used).0;
+        apply_pose_refinement(&mut result, &input, noise, MotionPairs::All).unwrap();
+        let alone = check_focal(&result, &input, &views, (&used, None), MotionPairs::All).unwrap();
+        let check = alone.check.clone().unwrap();
+        let off = check.scale - 1.0;
+        assert!((off + 5e-4).abs() < 1e-4, "scale {}", check.scale);
+        assert!(off.abs() > FOCAL_ALERT_STD * check.scale_std);
+        assert!(alone
+            .warning
+            .unwrap()
+            .starts_with("focal length: the camera's focal length"));
+        let within = check_focal(
+            &result,
+            &input,
+            &views,
+            (&used, Some(1.0)),
+            MotionPairs::All,
+        );
+        let within = within.unwrap();
+        assert!(within.warning.is_none());
+        assert_eq!(within.check, alone.check);
+        assert!(within.shift.is_some());
+        // 0.1 px is 0.009 %: the 0.05 % stands out of it.
+        let tight = check_focal(
+            &result,
+            &input,
+            &views,
+            (&used, Some(0.1)),
+            MotionPairs::All,
+        );
+        assert!(tight.unwrap().warning.is_some());
     }
 
     #[test]
