@@ -13,15 +13,24 @@
 //! centres independent, the board poses exact), recomputed here from the
 //! same measurements (corners detected, PnP pose, centres on the board).
 //!
-//! `cargo run --example laser_mc [TRIALS] [POSES,...]` (default 200 and
-//! 2,4,10).
+//! With `parts` after the poses, two more rows split the error: `centres`
+//! (the plane refitted to the same centres with the board poses at the
+//! truth, against the covariance without the board poses) and `boards`
+//! (the PnP poses' share: the plane with them less the one with the truth,
+//! against the board poses' part of the covariance).
+//!
+//! `cargo run --release --example laser_mc [TRIALS] [POSES,...] [parts]`
+//! (default 200 and 2,4,10).
 
 use nalgebra::{Matrix2, Matrix3, Matrix4, Point2, Vector2, Vector3};
 use robocal::api::laser::{laser_plane, LaserPlaneSettings, LaserView};
 use robocal::calib::{pnp, View};
 use robocal::camera::Camera;
 use robocal::detect::{detect, DetectOptions};
-use robocal::laser::{extract_stripe, StripeObservation, StripeOptions};
+use robocal::laser::{
+    extract_stripe, fit_plane_with_boards, BoardPose, PlaneFitOptions, StripeObservation,
+    StripeOptions,
+};
 use robocal::synth::laser::LaserStripe;
 use robocal::synth::laser_scene::{example_plane, laser_board_poses};
 use robocal::synth::{render, RenderOptions};
@@ -91,6 +100,80 @@ fn previous_covariance(
     }
     map[(3, 2)] = 1.0;
     Ok(map * inv * map.transpose())
+}
+
+/// The error's parts on one trial: the plane fitted to the same centres
+/// with the board poses at the truth (the centres' share of the error) and
+/// its covariance, and the board poses' share of the reported covariance
+/// (with the PnP poses and their covariance less without them).
+struct Parts {
+    truth_pose_plane: (Vector3<f64>, f64),
+    measured_plane: (Vector3<f64>, f64),
+    stripe_cov: Matrix4<f64>,
+    board_cov: Matrix4<f64>,
+}
+
+fn parts(
+    camera: &Camera,
+    target: &Target,
+    views: &[LaserView],
+    truth_poses: &[robocal::geometry::Pose],
+) -> Result<Parts, robocal::Error> {
+    let (mut exact, mut measured, mut boards) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, (v, truth)) in views.iter().zip(truth_poses).enumerate() {
+        let detection = detect(&v.board, target, &DetectOptions::default())?;
+        let view = View::from_detection(v.name.clone(), &detection);
+        let (pose, rms, unit) = pnp::camera_from_target_with_covariance(camera, &view)?;
+        let n = view.image_px.len() as f64;
+        boards.push(BoardPose {
+            image: i,
+            camera_from_target: pose,
+            covariance: unit * (rms * rms * n / (2.0 * n - 6.0)),
+        });
+        let (lo, hi) = view
+            .object_m
+            .iter()
+            .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
+                (
+                    [lo[0].min(p.x), lo[1].min(p.y)],
+                    [hi[0].max(p.x), hi[1].max(p.y)],
+                )
+            });
+        let on = v.stripe.as_ref().unwrap_or(&v.board);
+        let stripe = extract_stripe(on, Some(&v.board), &StripeOptions::default())?;
+        let along_y = stripe.axis == robocal::laser::ScanAxis::Columns;
+        for p in &stripe.points {
+            let px = Point2::new(p.x_px, p.y_px);
+            let Ok(o) = StripeObservation::new(camera, &pose, &px, along_y, p.std_px, i) else {
+                continue;
+            };
+            let q = pose.inverse() * o.point_camera;
+            if q.x < lo[0] || q.x > hi[0] || q.y < lo[1] || q.y > hi[1] {
+                continue;
+            }
+            measured.push(o);
+            if let Ok(t) = StripeObservation::new(camera, truth, &px, along_y, p.std_px, i) {
+                exact.push(t);
+            }
+        }
+    }
+    let options = PlaneFitOptions::default();
+    let t = fit_plane_with_boards(&exact, &[], &options)?;
+    let s = fit_plane_with_boards(&measured, &[], &options)?;
+    let b = fit_plane_with_boards(&measured, &boards, &options)?;
+    let sc = s.estimate.normal_distance_covariance();
+    Ok(Parts {
+        truth_pose_plane: (
+            t.estimate.plane.normal.into_inner(),
+            t.estimate.plane.distance_m,
+        ),
+        measured_plane: (
+            b.estimate.plane.normal.into_inner(),
+            b.estimate.plane.distance_m,
+        ),
+        stripe_cov: sc,
+        board_cov: b.estimate.normal_distance_covariance() - sc,
+    })
 }
 
 /// Normal error (2-D, in the tangent plane of `n`) and its 2x2 covariance.
@@ -170,6 +253,7 @@ fn main() -> Result<(), robocal::Error> {
         .next()
         .map(|a| a.split(',').filter_map(|v| v.parse().ok()).collect())
         .unwrap_or_else(|| vec![2, 4, 10]);
+    let breakdown = args.next().as_deref() == Some("parts");
     let camera = Camera::pinhole(800.0, 800.0, 320.0, 240.0, 640, 480);
     let target = Target::Chessboard {
         cols: 9,
@@ -199,6 +283,7 @@ fn main() -> Result<(), robocal::Error> {
     for &n_poses in &poses {
         let board_poses = laser_board_poses(n_poses);
         let (mut reported, mut previous) = (Score::default(), Score::default());
+        let (mut centres, mut boards) = (Score::default(), Score::default());
         let (mut vf, mut failed) = (0.0, 0usize);
         for trial in 0..trials {
             let mut views = Vec::new();
@@ -237,10 +322,21 @@ fn main() -> Result<(), robocal::Error> {
             let old = previous_covariance(&camera, &target, &views, &n, p.distance_m)?;
             previous.add(&n, p.distance_m, (&truth_n, truth_d), &old);
             vf += report.variance_factor;
+            if breakdown {
+                let q = parts(&camera, &target, &views, &board_poses)?;
+                let (tn, td) = q.truth_pose_plane;
+                centres.add(&tn, td, (&truth_n, truth_d), &q.stripe_cov);
+                let (mn, md) = q.measured_plane;
+                boards.add(&mn, md, (&tn, td), &q.board_cov);
+            }
         }
         let vf = vf / reported.trials.max(1) as f64;
         println!("{}", reported.row(n_poses, "reported", vf, failed));
         println!("{}", previous.row(n_poses, "previous", vf, failed));
+        if breakdown {
+            println!("{}", centres.row(n_poses, "centres", vf, failed));
+            println!("{}", boards.row(n_poses, "boards", vf, failed));
+        }
     }
     Ok(())
 }

@@ -83,6 +83,45 @@ pub(super) struct StripeArgs {
     max_width: f64,
 }
 
+/// The arguments every multi-image laser command shares (`plane`,
+/// `sphere`): the stripe extraction, the image limits, the output and the
+/// images (one per pose, or pairs with --pairs: the laser off first).
+#[derive(clap::Args)]
+pub(super) struct ScanArgs {
+    #[command(flatten)]
+    pub(super) stripe: StripeArgs,
+    #[command(flatten)]
+    pub(super) limits: ImageLimits,
+    /// Output file (default: standard output)
+    #[arg(short, long, value_name = "FILE")]
+    pub(super) output: Option<String>,
+    /// The images, one per pose (plane: showing board and stripe; sphere:
+    /// the laser image), or pairs with --pairs: the laser off, then on
+    #[arg(value_name = "IMAGES", required = true)]
+    pub(super) images: Vec<String>,
+}
+
+impl ScanArgs {
+    /// The images read in chunks of `step` (1, or 2 with --pairs): each
+    /// chunk's last path (the view's name), its first image and its second
+    /// when there is one.
+    pub(super) fn read(
+        &self,
+        step: usize,
+    ) -> Result<Vec<(String, GrayImage, Option<GrayImage>)>, CliError> {
+        let mut out = Vec::new();
+        for chunk in self.images.chunks(step) {
+            let first = read_gray(&chunk[0], &self.limits)?;
+            let second = match chunk.get(1) {
+                Some(p) => Some(read_gray(p, &self.limits)?),
+                None => None,
+            };
+            out.push((chunk.last().cloned().unwrap_or_default(), first, second));
+        }
+        Ok(out)
+    }
+}
+
 #[derive(clap::Args)]
 struct PlaneArgs {
     /// The calibrated camera (robocal/OpenCV/ROS camera file)
@@ -99,9 +138,10 @@ struct PlaneArgs {
     /// centre's std) or point_to_plane (metres)
     #[arg(long, value_name = "NAME", default_value = "image_px")]
     residual: String,
-    /// Refine the camera (every intrinsic) jointly with the plane and the
-    /// board poses from the boards' corners and the stripe (3 or more
-    /// poses); the JSON report gains refined_camera
+    /// Refine the camera jointly with the plane and the board poses from
+    /// the boards' corners and the stripe (3 or more poses; coefficients at
+    /// 0 stay 0; a tilted camera's tilt, principal point and p1, p2 are
+    /// held, with a warning); the JSON report gains refined_camera
     #[arg(long)]
     refine_intrinsics: bool,
     /// Output: json (the report), halcon (a sheet-of-light parameter list)
@@ -109,15 +149,7 @@ struct PlaneArgs {
     #[arg(long, value_name = "FORMAT", default_value = "json")]
     format: String,
     #[command(flatten)]
-    stripe: StripeArgs,
-    #[command(flatten)]
-    limits: ImageLimits,
-    /// Output file (default: standard output)
-    #[arg(short, long, value_name = "FILE")]
-    output: Option<String>,
-    /// The images: one per pose showing board and stripe, or pairs with --pairs
-    #[arg(value_name = "IMAGES", required = true)]
-    images: Vec<String>,
+    scans: ScanArgs,
 }
 
 #[derive(clap::Args)]
@@ -210,32 +242,28 @@ fn run_plane(a: PlaneArgs) -> Result<(), CliError> {
             )
         })?),
     };
-    if a.pairs && a.images.len() % 2 != 0 {
+    if a.pairs && a.scans.images.len() % 2 != 0 {
         return Err(CliError::usage(
             "laser",
             format!(
                 "--pairs needs an even number of images (board, stripe, board, stripe, ...), got {}",
-                a.images.len()
+                a.scans.images.len()
             ),
         ));
     }
-    let mut views = Vec::new();
-    let step = if a.pairs { 2 } else { 1 };
-    for chunk in a.images.chunks(step) {
-        let board = read_gray(&chunk[0], &a.limits)?;
-        let stripe = match chunk.get(1) {
-            Some(p) => Some(read_gray(p, &a.limits)?),
-            None => None,
-        };
-        views.push(LaserView {
-            name: chunk.last().cloned().unwrap_or_default(),
+    let views: Vec<LaserView> = a
+        .scans
+        .read(if a.pairs { 2 } else { 1 })?
+        .into_iter()
+        .map(|(name, board, stripe)| LaserView {
+            name,
             board,
             stripe,
-        });
-    }
+        })
+        .collect();
     let settings = LaserPlaneSettings {
         residual,
-        stripe: stripe_options(&a.stripe)?,
+        stripe: stripe_options(&a.scans.stripe)?,
         detect: super::detect_options_of(Some(&a.target)),
     };
     let (report, refined) = if a.refine_intrinsics {
@@ -273,7 +301,7 @@ fn run_plane(a: PlaneArgs) -> Result<(), CliError> {
             }
         },
     };
-    super::write_output(a.output.as_deref(), &text)
+    super::write_output(a.scans.output.as_deref(), &text)
 }
 
 /// A pose from a JSON file: a pose object, or the value of `key` in it.

@@ -2,8 +2,8 @@
 //! flange from laser images of a sphere of known radius scanned at several
 //! robot poses (docs/laser.md).
 
-use super::laser::{read_camera, read_gray, read_pose, stripe_options, StripeArgs};
-use super::{read_text, CliError, ImageLimits};
+use super::laser::{read_camera, read_pose, stripe_options, ScanArgs};
+use super::{read_text, CliError};
 use robocal::api::laser::plane_from_json;
 use robocal::api::laser_sphere::{laser_sphere, SphereScanImage};
 
@@ -32,26 +32,19 @@ pub(super) struct SphereArgs {
     #[arg(long)]
     pairs: bool,
     #[command(flatten)]
-    stripe: StripeArgs,
-    #[command(flatten)]
-    limits: ImageLimits,
-    /// Output file (default: standard output)
-    #[arg(short, long, value_name = "FILE")]
-    output: Option<String>,
-    /// The laser images, one per robot pose (pairs with --pairs)
-    #[arg(value_name = "IMAGES", required = true)]
-    images: Vec<String>,
+    scans: ScanArgs,
 }
 
 pub(super) fn run_sphere(a: SphereArgs) -> Result<(), CliError> {
     let step = if a.pairs { 2 } else { 1 };
-    if a.images.len() % step != 0 || a.images.len() / step != a.base_from_gripper.len() {
+    let images = &a.scans.images;
+    if images.len() % step != 0 || images.len() / step != a.base_from_gripper.len() {
         return Err(CliError::usage(
             "laser",
             format!(
                 "sphere needs one --base-from-gripper per scan: {} poses for {} images{}",
                 a.base_from_gripper.len(),
-                a.images.len(),
+                images.len(),
                 if a.pairs { " (in pairs: off, on)" } else { "" }
             ),
         ));
@@ -61,16 +54,15 @@ pub(super) fn run_sphere(a: SphereArgs) -> Result<(), CliError> {
         plane_from_json(&read_text(&a.plane)?).map_err(|e| CliError::from(e).in_file(&a.plane))?;
     let mount = read_pose(&a.gripper_from_camera, "gripper_from_camera")?;
     let mut scans = Vec::new();
-    for (chunk, pose) in a.images.chunks(step).zip(&a.base_from_gripper) {
+    for ((name, first, second), pose) in a.scans.read(step)?.into_iter().zip(&a.base_from_gripper) {
         // With --pairs a chunk is (off, on), else (on): the last is the laser image.
-        let on = &chunk[chunk.len() - 1];
-        let off = match chunk.len() {
-            2 => Some(read_gray(&chunk[0], &a.limits)?),
-            _ => None,
+        let (image, off) = match second {
+            Some(on) => (on, Some(first)),
+            None => (first, None),
         };
         scans.push(SphereScanImage {
-            name: on.clone(),
-            image: read_gray(on, &a.limits)?,
+            name,
+            image,
             off,
             base_from_gripper: read_pose(pose, "base_from_gripper")?,
         });
@@ -81,12 +73,12 @@ pub(super) fn run_sphere(a: SphereArgs) -> Result<(), CliError> {
         a.radius_mm * 1e-3,
         &plane,
         &mount,
-        &stripe_options(&a.stripe)?,
+        &stripe_options(&a.scans.stripe)?,
     )?;
     for w in &report.warnings {
         eprintln!("robocal laser sphere: warning: {w}");
     }
     let text =
         serde_json::to_string_pretty(&report).map_err(|e| CliError::Io(e.to_string()))? + "\n";
-    super::write_output(a.output.as_deref(), &text)
+    super::write_output(a.scans.output.as_deref(), &text)
 }

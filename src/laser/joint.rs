@@ -7,7 +7,8 @@
 //! calibration is a little off (another focus, a knock): the boards in the
 //! laser images recalibrate it while the plane is fitted.
 //!
-//! Parameters: the camera's in the global vector, then the plane's `(a,
+//! Parameters: the camera's free ones in the global vector (all, or all
+//! but those [`refine_holding`] holds), then the plane's `(a,
 //! b, d)` about the starting plane (the normal `exp(a e1 + b e2) n0`); one
 //! block of 6 numbers (rotation vector, translation) per board pose.
 //! Jacobians by central differences (a few dozen parameters; each image's
@@ -54,10 +55,23 @@ struct Problem<'a> {
     camera: &'a Camera,
     images: &'a [JointImage],
     plane0: Plane,
+    /// Indices into [`Camera::params`] of the refined parameters (the
+    /// first `n_camera` entries of the global vector).
+    free: Vec<usize>,
     n_camera: usize,
 }
 
 impl Problem<'_> {
+    /// The camera with the free parameters from `global`, the held ones
+    /// at the start camera's.
+    fn camera_at(&self, global: &[f64]) -> Result<Camera> {
+        let mut p = self.camera.params();
+        for (k, &i) in self.free.iter().enumerate() {
+            p[i] = global[k];
+        }
+        self.camera.with_params(&p)
+    }
+
     fn plane(&self, global: &[f64]) -> Plane {
         let (e1, e2) = tangent_basis(&self.plane0.normal);
         let p = &global[self.n_camera..];
@@ -69,7 +83,7 @@ impl Problem<'_> {
 
     /// The residuals of image `i`: its corners (2 each) then its centres.
     fn image_residuals(&self, i: usize, global: &[f64], pose: &[f64]) -> Result<DVector<f64>> {
-        let camera = self.camera.with_params(&global[..self.n_camera])?;
+        let camera = self.camera_at(global)?;
         let plane = self.plane(global);
         let pose = pose_from_params(pose);
         let img = &self.images[i];
@@ -156,12 +170,39 @@ fn corner_rms(camera: &Camera, images: &[JointImage], poses: &[Pose]) -> Result<
     Ok((s / n.max(1) as f64).sqrt())
 }
 
-/// Refine `camera`, the board poses and `plane` together.
+/// Refine `camera`, the board poses and `plane` together (every camera
+/// parameter free).
 pub fn refine_with_intrinsics(
     camera: &Camera,
     images: &[JointImage],
     plane: &LaserPlane,
 ) -> Result<JointSolution> {
+    refine_holding(camera, images, plane, &[])
+}
+
+/// [`refine_with_intrinsics`] with the camera parameters named in `held`
+/// ([`Camera::param_names`]) kept at `camera`'s values; an unknown name is
+/// an error naming the model's parameters.
+pub fn refine_holding(
+    camera: &Camera,
+    images: &[JointImage],
+    plane: &LaserPlane,
+    held: &[&str],
+) -> Result<JointSolution> {
+    let names = camera.param_names();
+    if let Some(bad) = held.iter().find(|h| !names.contains(h)) {
+        return Err(Error::invalid(
+            "held",
+            format!(
+                "the {} camera has no parameter '{bad}' (it has {})",
+                camera.distortion.model_name(),
+                names.join(", ")
+            ),
+        ));
+    }
+    let free: Vec<usize> = (0..names.len())
+        .filter(|&i| !held.contains(&names[i]))
+        .collect();
     if images.len() < 3 {
         return Err(Error::too_few(
             "board poses to refine the camera with the plane",
@@ -182,14 +223,16 @@ pub fn refine_with_intrinsics(
             ),
         ));
     }
-    let n_camera = camera.params().len();
+    let n_camera = free.len();
+    let start = camera.params();
+    let mut global: Vec<f64> = free.iter().map(|&i| start[i]).collect();
     let problem = Problem {
         camera,
         images,
         plane0: *plane,
+        free,
         n_camera,
     };
-    let mut global = camera.params();
     global.extend([0.0, 0.0, 0.0]);
     let initial = BlockParams {
         global,
@@ -208,7 +251,7 @@ pub fn refine_with_intrinsics(
             ..LmOptions::default()
         },
     )?;
-    let refined = camera.with_params(&lm.params.global[..n_camera])?;
+    let refined = problem.camera_at(&lm.params.global)?;
     let poses: Vec<Pose> = lm
         .params
         .blocks

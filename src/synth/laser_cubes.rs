@@ -6,7 +6,7 @@
 //! (at the cube's edges and the bore's rim), in the world (= robot base)
 //! frame, as the paper reads them from the robot controller.
 //!
-//! Rendering: every pixel is supersampled (`SUB` x `SUB` rays); each ray
+//! Rendering ([`super::laser_raycast`]): every pixel is supersampled; each ray
 //! meets the nearest of the table (`z = table_z_m`) and the cubes (axis-
 //! aligned boxes standing on it); a ray entering a bore is lost (a deep
 //! bore returns no light). A surface point `s` metres off the laser plane
@@ -18,10 +18,10 @@
 //! beside a cube is not a control point). Then Gaussian noise, clipped to
 //! 0..255.
 
+use super::laser_raycast::{render_rays, sheet, Background};
 use crate::camera::Camera;
 use crate::geometry::Pose;
 use crate::laser::LaserPlane;
-use crate::rng::Rng;
 use nalgebra::{Point2, Point3, Vector3};
 
 /// A cube standing on the table, a bore of `bore_diameter_m` through the
@@ -99,9 +99,6 @@ impl Default for CubeRenderOptions {
     }
 }
 
-/// Rays per pixel axis.
-const SUB: usize = 3;
-
 /// What a ray meets first.
 enum Hit {
     /// A point on a face, and whether the face is a cube's side.
@@ -119,38 +116,30 @@ pub fn render_cubes(
     scene: &CubeScene,
     options: &CubeRenderOptions,
 ) -> crate::error::Result<crate::image::GrayImage> {
-    let (w, h) = (camera.width as usize, camera.height as usize);
     let camera_from_base = base_from_camera.inverse();
     let origin = Point3::from(base_from_camera.translation.vector);
-    let mut rng = Rng::new(options.seed);
-    let mut pixels = Vec::with_capacity(w * h);
-    for y in 0..h {
-        for x in 0..w {
-            let mut sum = 0.0;
-            for sy in 0..SUB {
-                for sx in 0..SUB {
-                    let px = Point2::new(
-                        x as f64 - 0.5 + (sx as f64 + 0.5) / SUB as f64,
-                        y as f64 - 0.5 + (sy as f64 + 0.5) / SUB as f64,
-                    );
-                    let Ok(ray) = camera.unproject(&px) else {
-                        continue;
-                    };
-                    let dir = base_from_camera.rotation * ray;
-                    if let Hit::Surface(p, side) = cast(scene, &origin, &dir) {
-                        let s = plane.signed_distance_m(&(camera_from_base * p).coords);
-                        let reflectance = if side { options.side_reflectance } else { 1.0 };
-                        sum += reflectance
-                            * options.peak
-                            * (-0.5 * s * s / (options.sigma_m * options.sigma_m)).exp();
-                    }
+    let background = Background {
+        ambient: options.ambient,
+        noise_sigma: options.noise_sigma,
+        seed: options.seed,
+    };
+    render_rays(
+        camera,
+        &background,
+        |_, _| true,
+        |ray| {
+            let dir = base_from_camera.rotation * ray;
+            match cast(scene, &origin, &dir) {
+                Hit::Surface(p, side) => {
+                    let s = plane.signed_distance_m(&(camera_from_base * p).coords);
+                    let reflectance = if side { options.side_reflectance } else { 1.0 };
+                    // (reflectance peak) exp(..), the product's order kept.
+                    sheet(reflectance * options.peak, options.sigma_m, s)
                 }
+                Hit::Bore | Hit::Nothing => 0.0,
             }
-            let v = options.ambient + sum / (SUB * SUB) as f64 + rng.gaussian(options.noise_sigma);
-            pixels.push(v.round().clamp(0.0, 255.0) as u8);
-        }
-    }
-    crate::image::GrayImage::new(camera.width, camera.height, pixels)
+        },
+    )
 }
 
 /// The first thing the ray `origin + t dir` (t > 0) meets.

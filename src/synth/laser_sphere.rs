@@ -6,18 +6,18 @@
 //! a filtered profiler camera sees it) with the robot's poses and the true
 //! mounting as truth, for [`crate::laser::sphere`].
 //!
-//! Rendering: each pixel near the sphere's image is supersampled (`SUB` x
-//! `SUB` rays); a ray's first hit on the sphere is lit when it faces the
+//! Rendering ([`super::laser_raycast`]): each pixel near the sphere's image
+//! is supersampled; a ray's first hit on the sphere is lit when it faces the
 //! laser's emitter (a point of the plane, camera frame) and returns `peak
 //! exp(-s^2 / (2 sigma^2))` for a point `s` metres off the plane (`sigma`
 //! the sheet's half-thickness); then the ambient grey, Gaussian noise,
 //! clipped to 0..255.
 
+use super::laser_raycast::{render_rays, sheet, Background};
 use crate::camera::Camera;
 use crate::geometry::{pose_from_params, Pose};
 use crate::laser::LaserPlane;
-use crate::rng::Rng;
-use nalgebra::{Point2, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3};
 
 /// The calibration sphere in the base frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,9 +54,6 @@ impl Default for SphereRenderOptions {
         }
     }
 }
-
-/// Rays per pixel axis.
-const SUB: usize = 3;
 
 /// A sensor mounting for the examples: 120 mm out along the flange's z,
 /// offset 30 mm and -50 mm, turned about 70 deg about the flange axis and
@@ -136,38 +133,25 @@ pub fn render_sphere(
         ..((centre_px.x + reach).max(0.0) as usize + 1).min(w);
     let y_range = (centre_px.y - reach).max(0.0) as usize
         ..((centre_px.y + reach).max(0.0) as usize + 1).min(h);
-    let mut rng = Rng::new(options.seed);
-    let mut pixels = Vec::with_capacity(w * h);
-    for y in 0..h {
-        for x in 0..w {
-            let mut sum = 0.0;
-            if x_range.contains(&x) && y_range.contains(&y) {
-                for sy in 0..SUB {
-                    for sx in 0..SUB {
-                        let px = Point2::new(
-                            x as f64 - 0.5 + (sx as f64 + 0.5) / SUB as f64,
-                            y as f64 - 0.5 + (sy as f64 + 0.5) / SUB as f64,
-                        );
-                        let Ok(ray) = camera.unproject(&px) else {
-                            continue;
-                        };
-                        let Some(p) = first_hit(&ray.normalize(), &c.coords, r) else {
-                            continue;
-                        };
-                        if (emitter.coords - p).dot(&(p - c.coords)) <= 0.0 {
-                            continue;
-                        }
-                        let s = plane.signed_distance_m(&p);
-                        sum += options.peak
-                            * (-0.5 * s * s / (options.sigma_m * options.sigma_m)).exp();
-                    }
-                }
+    let background = Background {
+        ambient: options.ambient,
+        noise_sigma: options.noise_sigma,
+        seed: options.seed,
+    };
+    render_rays(
+        camera,
+        &background,
+        |x, y| x_range.contains(&x) && y_range.contains(&y),
+        |ray| {
+            let Some(p) = first_hit(&ray.normalize(), &c.coords, r) else {
+                return 0.0;
+            };
+            if (emitter.coords - p).dot(&(p - c.coords)) <= 0.0 {
+                return 0.0;
             }
-            let v = options.ambient + sum / (SUB * SUB) as f64 + rng.gaussian(options.noise_sigma);
-            pixels.push(v.round().clamp(0.0, 255.0) as u8);
-        }
-    }
-    crate::image::GrayImage::new(camera.width, camera.height, pixels)
+            sheet(options.peak, options.sigma_m, plane.signed_distance_m(&p))
+        },
+    )
 }
 
 /// Where the ray `t dir` (unit `dir`, t > 0) first meets the sphere.

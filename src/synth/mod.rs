@@ -11,6 +11,7 @@ pub mod handeye;
 pub mod handeye_looking;
 pub mod laser;
 pub mod laser_cubes;
+pub mod laser_raycast;
 pub mod laser_scene;
 pub mod laser_sphere;
 pub mod lens;

@@ -1,0 +1,165 @@
+//! A seeded Monte Carlo of `robocal laser sphere` (src/laser/sphere.rs) on
+//! renders: the 60 mm sphere of `synth::laser_sphere` scanned at N robot
+//! poses (640x480, f 800, mild barrel; noise 2 grey, new noise seeds every
+//! trial), the stripe extracted (centre of gravity), the plane, mounting
+//! and sphere centre refined from starts 1 deg / 2 mm (plane) and 2 deg /
+//! 5 mm (mounting) off. Each estimate's error against the truth is
+//! compared with the reported covariance: RMS over the trials against the
+//! RMS of the reported std (the bound; vectors: the root of the mean
+//! trace), and the share of trials within 3 std (chi^2 of the error with
+//! the reported covariance below the 99.73 % quantile of its dof).
+//!
+//! `cargo run --release --example laser_sphere_mc [TRIALS] [SCANS]`
+//! (default 200 and 8).
+
+use nalgebra::{DMatrix, DVector, Matrix3, Point2, Point3, Vector3};
+use robocal::camera::{Camera, Distortion};
+use robocal::geometry::{pose_from_params, tangent_basis, Pose};
+use robocal::laser::sphere::{calibrate_on_sphere, SphereScan};
+use robocal::laser::{extract_stripe, LaserPlane, StripeOptions};
+use robocal::synth::laser_scene::example_plane;
+use robocal::synth::laser_sphere::{
+    example_mounting, example_sphere, render_sphere, sphere_scan_poses, SphereRenderOptions,
+};
+
+/// chi^2 quantiles at 0.9973 (3 sigma) for 1, 2 and 3 dof.
+const CHI2_3SIGMA: [f64; 3] = [9.0, 11.829, 14.156];
+
+#[derive(Default)]
+struct Score {
+    se: f64,
+    sb: f64,
+    cover: usize,
+    trials: usize,
+}
+
+impl Score {
+    /// One trial: the error (in the covariance's coordinates) and the
+    /// reported covariance.
+    fn add(&mut self, e: &DVector<f64>, c: &DMatrix<f64>) {
+        self.se += e.norm_squared();
+        self.sb += c.trace();
+        if let Some(inv) = c.clone().try_inverse() {
+            if (e.transpose() * inv * e)[0] <= CHI2_3SIGMA[e.len() - 1] {
+                self.cover += 1;
+            }
+        }
+        self.trials += 1;
+    }
+
+    fn row(&self, name: &str, unit: f64, unit_name: &str) -> String {
+        let t = self.trials.max(1) as f64;
+        let (r, b) = ((self.se / t).sqrt() * unit, (self.sb / t).sqrt() * unit);
+        format!(
+            "| {name} | {r:.4} | {b:.4} | {:.2} | {:.1} % | {unit_name} |",
+            r / b,
+            100.0 * self.cover as f64 / t
+        )
+    }
+}
+
+fn camera() -> Camera {
+    Camera {
+        distortion: Distortion::Brown {
+            k1: -0.05,
+            k2: 0.02,
+            k3: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+        },
+        ..Camera::pinhole(800.0, 800.0, 319.5, 239.5, 640, 480)
+    }
+}
+
+fn main() -> Result<(), robocal::Error> {
+    let mut args = std::env::args().skip(1);
+    let trials: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(200);
+    let n_scans: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(8);
+    let (plane, mount, scene) = (example_plane(), example_mounting(), example_sphere());
+    let cam = camera();
+    let emitter = Point3::from(plane.normal.into_inner() * plane.distance_m);
+    let poses = sphere_scan_poses(n_scans, &scene, &mount, &plane);
+    // The starts of src/laser/sphere_tests.rs.
+    let turn =
+        nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.6, 0.8, 0.0) * 1f64.to_radians());
+    let start_plane = LaserPlane {
+        normal: turn * plane.normal,
+        distance_m: plane.distance_m + 0.002,
+    };
+    let start_mount = mount * pose_from_params(&[0.02, -0.025, 0.01, 0.004, -0.003, 0.0]);
+    let mut scores: [Score; 5] = Default::default();
+    let mut failed = 0;
+    for trial in 0..trials {
+        let mut scans = Vec::new();
+        for (k, b) in poses.iter().enumerate() {
+            let options = SphereRenderOptions {
+                seed: 1_000_003 * trial as u64 + 11 + k as u64,
+                ..SphereRenderOptions::default()
+            };
+            let image = render_sphere(&cam, &(b * mount), &plane, &emitter, &scene, &options)?;
+            let stripe = extract_stripe(&image, None, &StripeOptions::default())?;
+            scans.push(SphereScan {
+                base_from_gripper: *b,
+                pixels: stripe
+                    .points
+                    .iter()
+                    .map(|p| Point2::new(p.x_px, p.y_px))
+                    .collect(),
+            });
+        }
+        let c = match calibrate_on_sphere(&cam, &scans, scene.radius_m, &start_plane, &start_mount)
+        {
+            Ok(c) => c,
+            Err(e) => {
+                eprintln!("trial {trial}: {e}");
+                failed += 1;
+                continue;
+            }
+        };
+        // The plane: (a, b) in the estimate's tangent basis, then d.
+        let p = &c.plane_camera;
+        let (e1, e2) = tangent_basis(&p.plane.normal);
+        let dn = p.plane.normal.into_inner() - plane.normal.into_inner();
+        let cov = DMatrix::from_fn(3, 3, |r, k| p.covariance[(r, k)]);
+        scores[0].add(
+            &DVector::from_vec(vec![-dn.dot(&e2), dn.dot(&e1)]),
+            &cov.view((0, 0), (2, 2)).into_owned(),
+        );
+        scores[1].add(
+            &DVector::from_vec(vec![p.plane.distance_m - plane.distance_m]),
+            &cov.view((2, 2), (1, 1)).into_owned(),
+        );
+        // The mounting's right perturbation: truth^-1 * estimate.
+        let diff: Pose = mount.inverse() * c.gripper_from_camera;
+        let m = &c.gripper_from_camera_covariance;
+        let w = diff.rotation.scaled_axis();
+        scores[2].add(
+            &DVector::from_column_slice(w.as_slice()),
+            &DMatrix::from_fn(3, 3, |r, k| m[(r, k)]),
+        );
+        let v = diff.translation.vector;
+        scores[3].add(
+            &DVector::from_column_slice(v.as_slice()),
+            &DMatrix::from_fn(3, 3, |r, k| m[(3 + r, 3 + k)]),
+        );
+        let e: Vector3<f64> = c.centre_base - scene.centre_base;
+        let cc: Matrix3<f64> = c.centre_covariance;
+        scores[4].add(
+            &DVector::from_column_slice(e.as_slice()),
+            &DMatrix::from_fn(3, 3, |r, k| cc[(r, k)]),
+        );
+    }
+    println!(
+        "laser sphere Monte Carlo: {} trials ({failed} failed), {n_scans} scans",
+        scores[0].trials
+    );
+    println!("| estimate | RMS error | RMS std (bound) | RMS / bound | within 3 std | unit |");
+    println!("|---|---|---|---|---|---|");
+    let deg = 1f64.to_degrees();
+    println!("{}", scores[0].row("plane normal", deg, "deg"));
+    println!("{}", scores[1].row("plane distance", 1e3, "mm"));
+    println!("{}", scores[2].row("mounting rotation", deg, "deg"));
+    println!("{}", scores[3].row("mounting translation", 1e3, "mm"));
+    println!("{}", scores[4].row("sphere centre", 1e3, "mm"));
+    Ok(())
+}
