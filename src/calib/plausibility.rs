@@ -12,13 +12,18 @@
 //! - radial distortion that folds inside the image: along the ray towards
 //!   an image corner the distorted radius r_d(r) stops increasing before it
 //!   reaches the corner, so points beyond the fold have two projections.
+//!   A splined lens is not radial and is only the smoothness prior's
+//!   extrapolation outside its valid region (the image cells holding
+//!   points): its check is the determinant of the spline's local Jacobian
+//!   where it maps into the valid region ([`Camera::splined_fold`]).
 //!
 //! The report's `severity` is the worst level of its warnings: `error` when
 //! the first warning is error-level (it then begins with `error: `),
 //! `warning` when there are warnings, `ok` otherwise.
 
 use super::report::CameraCalibration;
-use crate::camera::Camera;
+use super::SplineSupport;
+use crate::camera::{Camera, Distortion};
 use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 
@@ -184,17 +189,62 @@ fn peak(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, known: f64) -> f64 {
         .fold(best, f64::max)
 }
 
+/// A fold of the lens model: radial for the parametric models, local for
+/// the splined one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Fold {
+    /// [`distortion_fold`]: the fold's and the corner's radius, px.
+    Radial {
+        /// Distance of the fold from the principal point, px.
+        fold_px: f64,
+        /// Distance of the image corner beyond it, px.
+        corner_px: f64,
+    },
+    /// [`Camera::splined_fold`]: the pixel where the spline's local
+    /// Jacobian turns over most, and its determinant there.
+    Splined {
+        /// The pixel, px.
+        at_px: [f64; 2],
+        /// Determinant of d m / d u there (not positive).
+        determinant: f64,
+    },
+}
+
+/// Where `camera` folds where its projection matters: the radial check over
+/// the image for the parametric models; for a splined one its local
+/// Jacobian over `support`'s valid region (the whole image without one).
+pub fn fold(camera: &Camera, support: Option<&SplineSupport>) -> Option<Fold> {
+    let size = (camera.width, camera.height);
+    match &camera.distortion {
+        Distortion::Splined(_) => camera
+            .splined_fold(|p| support.map_or(true, |s| s.is_valid_px(p.x, p.y, size)))
+            .map(|(at, determinant)| Fold::Splined {
+                at_px: [at.x, at.y],
+                determinant,
+            }),
+        _ => {
+            distortion_fold(camera).map(|(fold_px, corner_px)| Fold::Radial { fold_px, corner_px })
+        }
+    }
+}
+
 /// Whether a camera shows a signature of a wrong minimum (principal point
 /// far off, fx / fy far from 1, distortion folding inside the image):
 /// reason enough to try the other starts.
 pub fn implausible(camera: &Camera) -> bool {
-    principal_point_off(camera).is_some() || aspect_off(camera) || distortion_fold(camera).is_some()
+    principal_point_off(camera).is_some() || aspect_off(camera) || fold(camera, None).is_some()
 }
 
 /// The warnings of the checks on `camera`; `square_fit` is the RMS (px) of
 /// a fit with square pixels when fx / fy is off ([`aspect_off`]), `rms_px`
-/// the report's.
-pub fn warnings(camera: &Camera, rms_px: f64, square_fit: Option<f64>) -> Vec<String> {
+/// the report's; `support` a splined fit's valid region (the fold check's
+/// domain, see [`fold`]).
+pub fn warnings(
+    camera: &Camera,
+    rms_px: f64,
+    square_fit: Option<f64>,
+    support: Option<&SplineSupport>,
+) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(square) = square_fit {
         if square <= SAME_FIT_RATIO * rms_px + SAME_FIT_PX {
@@ -224,14 +274,23 @@ pub fn warnings(camera: &Camera, rms_px: f64, square_fit: Option<f64>) -> Vec<St
             100.0 * dy.abs() / camera.height as f64,
         ));
     }
-    if let Some((fold, corner)) = distortion_fold(camera) {
-        out.push(format!(
+    match fold(camera, support) {
+        Some(Fold::Radial { fold_px, corner_px }) => out.push(format!(
             "the lens distortion folds inside the image: the distorted radius stops increasing \
-             {fold:.0} px from the principal point, while the image corner is {corner:.0} px \
+             {fold_px:.0} px from the principal point, while the image corner is {corner_px:.0} px \
              away, so points beyond the fold have two projections: the distortion is \
              extrapolated beyond the target's points or the fit is a wrong minimum: add views \
              with the target in the image corners, or hold coefficients (CLI: --fix k3)"
-        ));
+        )),
+        Some(Fold::Splined { at_px, determinant }) => out.push(format!(
+            "the splined lens model folds inside its valid region: at pixel ({:.0}, {:.0}) \
+             the determinant of the spline's local Jacobian is {determinant:.3} (a lens keeps \
+             it positive), so rays on both sides of the fold share pixels: the spline follows \
+             wrong detections or has more knots than the data there hold: check the \
+             detections near that pixel, or lower --spline-knots",
+            at_px[0], at_px[1]
+        )),
+        None => {}
     }
     out
 }
@@ -290,7 +349,7 @@ mod tests {
         );
         assert_eq!(distortion_fold(&webcam(-0.1)), None);
         assert_eq!(distortion_fold(&webcam(0.2)), None);
-        let w = warnings(&webcam(-0.4), 0.2, None);
+        let w = warnings(&webcam(-0.4), 0.2, None, None);
         assert_eq!(w.len(), 1);
         assert!(w[0].starts_with("the lens distortion folds inside the image: the distorted radius stops increasing 554 px"), "{}", w[0]);
     }
@@ -304,7 +363,7 @@ mod tests {
             ..webcam(0.0)
         };
         assert!(implausible(&c));
-        let w = warnings(&c, 0.319, Some(0.156));
+        let w = warnings(&c, 0.319, Some(0.156), None);
         assert_eq!(w.len(), 2, "{w:?}");
         assert!(w[0].starts_with("fx / fy is 0.758 (fx 733.0 px, fy 967.0 px), yet a fit with square pixels reaches 0.156 px against 0.319 px"), "{}", w[0]);
         assert!(w[1].starts_with("the principal point (268.0, 359.5) px is -372 px, 0 px from the image centre (639.5, 359.5) (29 % of the width, 0 % of the height"), "{}", w[1]);

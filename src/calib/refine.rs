@@ -129,9 +129,15 @@ impl CalibProblem<'_> {
     }
 
     /// The smoothness prior of a splined lens: per second difference of
-    /// neighbouring control values, `weight * f * (c0 - 2 c1 + c2)` for
-    /// the x and the y correction (pixels; f the mean focal length of the
-    /// template, a constant).
+    /// neighbouring control values' change from the template's (the
+    /// start's), `weight * f * (d0 - 2 d1 + d2)` with `d = c - c_start`,
+    /// for the x and the y correction (pixels; f the mean focal length of
+    /// the template, a constant). Measured from the start (the parametric
+    /// fit's lens) because a fisheye's own correction from the
+    /// stereographic base curves strongly towards the border: a prior on
+    /// the correction itself pulled the border cells, where a few points
+    /// hold it, towards a straight extrapolation (5.4 px off the truth
+    /// where the uncertainty map said 0.86 px, BENCHMARKS 17 L3).
     fn smoothness_blocks(
         &self,
         camera: &Camera,
@@ -147,6 +153,9 @@ impl CalibProblem<'_> {
         if !(scale > 0.0) {
             return Vec::new();
         }
+        // The prior smooths what the data add to the start's lens, not the
+        // lens itself; a start without control values is the zero lens.
+        let reference = |k: usize| start.control.get(k).copied().unwrap_or(0.0);
         s.smoothness_stencils()
             .into_iter()
             .map(|idx| {
@@ -155,7 +164,7 @@ impl CalibProblem<'_> {
                 let mut j = DMatrix::zeros(2, if jacobians { n_global } else { 0 });
                 for (k, c) in idx.iter().zip(coef) {
                     for comp in 0..2 {
-                        r[comp] += scale * c * s.control[k + comp];
+                        r[comp] += scale * c * (s.control[k + comp] - reference(k + comp));
                         if jacobians {
                             j[(comp, N_PINHOLE_PARAMS + k + comp)] = scale * c;
                         }

@@ -1,7 +1,7 @@
 //! The splined lens model and the board warp in the calibration: exact
 //! recovery on noise-free scenes, the warp's effect on the focal length.
 
-use super::{calibrate, CalibrationOptions, CameraCalibration, View};
+use super::{calibrate, CalibrationOptions, CameraCalibration, SplineSupport, View};
 use crate::camera::{Camera, Distortion, Spline};
 use crate::synth::Scene;
 use nalgebra::{DMatrix, Matrix3, Point2, Point3, Vector3};
@@ -85,10 +85,21 @@ fn a_noise_free_splined_lens_is_recovered_where_the_data_fall() {
     let report = calibrate(&scene.views, (truth.width, truth.height), &options).expect("fit");
     assert_eq!(report.model, "splined");
     assert!(report.rms_px < 0.01, "rms {}", report.rms_px);
-    let worst = worst_difference_where_data_fall(&truth, &report.camera, &scene.views);
+    // Where the data reach (the valid region): outside it the spline is the
+    // prior's continuation of the parametric start, 0.26 px off here in the
+    // corners of the points' bounding box. Tolerance 0.2 px, not exact: in
+    // the border cells that hold one or two points the prior (weight 0.001,
+    // on the change from the Kannala-Brandt start, whose polynomial cannot
+    // follow the truth's bumps) still holds the spline, 0.14 px off (the
+    // prior on the correction itself left < 0.05 px on this lens, 5 px on
+    // the fisheye of BENCHMARKS 17 L3).
+    let grid = valid_grid(&scene.views, (truth.width, truth.height));
+    let worst = aligned_errors(&truth, &report.camera, &grid)
+        .into_iter()
+        .fold(0.0, f64::max);
     assert!(
-        worst < 0.05,
-        "projection differs from the truth by {worst} px"
+        worst < 0.2,
+        "projection differs from the truth by {worst} px in the valid region"
     );
     // The same machinery as the parametric models: uncertainty and support.
     assert!(report.projection_uncertainty.max_std_px.is_finite());
@@ -97,6 +108,107 @@ fn a_noise_free_splined_lens_is_recovered_where_the_data_fall() {
     assert!(support.fraction > 0.5, "{support:?}");
     assert_eq!(report.distortion.len(), 2 * 12 * 8);
     assert!(report.start.as_deref() == Some("parametric_fit"));
+}
+
+/// A default splined fit of 40 views x 100 points at 0.1 px through a
+/// fisheye (Kannala-Brandt) lens with 2 px bumps, seed `seed`: the truth,
+/// the scene and the report.
+fn fisheye_fit(seed: u64) -> (Camera, Scene, CameraCalibration) {
+    let truth =
+        crate::synth::lens::bumpy_lens(&Camera::example_kannala_brandt(), 2.0).expect("lens");
+    let scene = Scene::calibration(seed, &truth, (10, 10), 0.03, 40, 0.1).expect("scene");
+    let report = calibrate(
+        &scene.views,
+        (truth.width, truth.height),
+        &CalibrationOptions {
+            model: Distortion::named("splined").expect("model"),
+            ..CalibrationOptions::default()
+        },
+    )
+    .expect("fit");
+    (truth, scene, report)
+}
+
+/// Issue 41's bound: everywhere the data reach (the valid region), the
+/// splined fit is within 1.5x its noise bound (3 sigma of its own predicted
+/// projection std) of the truth. Before the smoothness prior measured the
+/// change from the parametric start, the fisheye's border cells were 2.1x
+/// over it (5.4 px off where 3 sigma was 2.6 px).
+#[test]
+fn a_fisheye_splined_fit_is_within_its_noise_bound_where_the_data_reach() {
+    let (truth, scene, report) = fisheye_fit(11);
+    let grid = valid_grid(&scene.views, (truth.width, truth.height));
+    let sigma = predicted_std(&report, &grid);
+    let errors = aligned_errors(&truth, &report.camera, &grid);
+    for ((p, e), s) in grid.iter().zip(&errors).zip(&sigma) {
+        assert!(
+            *e <= 1.5 * 3.0 * s,
+            "at ({:.0}, {:.0}) px the fit is {e:.3} px off the truth, 1.5x its 3-sigma bound is {:.3} px",
+            p.x,
+            p.y,
+            4.5 * s
+        );
+    }
+}
+
+/// The fold check of a splined fit looks at its valid region only, where a
+/// lens keeps the spline's local Jacobian positive: a good fit on a render
+/// draws no fold warning (the radial check of the parametric models, along
+/// the rays to the corners the spline only extrapolates, did), a spline
+/// folded inside the valid region does, one folded outside it does not.
+#[test]
+fn a_splined_fit_is_checked_for_folds_in_its_valid_region_only() {
+    use crate::calib::plausibility::{self, Fold};
+    let (_, _, report) = fisheye_fit(5);
+    // The parametric models' radial check finds a "fold" a few px from the
+    // principal point: the spline's constant part moves the image of the
+    // axis, so the distance from (cx, cy) first falls along a corner ray.
+    assert!(plausibility::distortion_fold(&report.camera).is_some());
+    let folds: Vec<&String> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("fold"))
+        .collect();
+    assert!(folds.is_empty(), "{folds:?}");
+    let support = report.spline_support.clone().expect("support");
+    // Fold it: dx jumps by -1.0 (normalised units) across the knot field's
+    // middle columns, about three times the knot spacing (0.35 for
+    // example_splined): d m_x / d u_x turns negative around the centre.
+    let mut folded = Camera::example_splined();
+    if let Distortion::Splined(s) = &mut folded.distortion {
+        for row in 2..6 {
+            s.control[2 * (row * s.nx + 5)] += 0.5;
+            s.control[2 * (row * s.nx + 6)] -= 0.5;
+        }
+    }
+    let all = |c: char| SplineSupport {
+        image_mask: vec![c.to_string().repeat(16); 12],
+        ..support.clone()
+    };
+    let fold = plausibility::fold(&folded, Some(&all('#')));
+    let Some(Fold::Splined { at_px, determinant }) = fold else {
+        panic!("no fold found: {fold:?}");
+    };
+    assert!(determinant < 0.0, "determinant {determinant}");
+    let centre = [folded.cx, folded.cy];
+    assert!(
+        (at_px[0] - centre[0]).abs() < 0.25 * folded.width as f64
+            && (at_px[1] - centre[1]).abs() < 0.25 * folded.height as f64,
+        "fold at {at_px:?} px, the jump is near the centre {centre:?}"
+    );
+    let w = plausibility::warnings(&folded, 0.1, None, Some(&all('#')));
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("the splined lens model folds inside its valid region: at pixel ("),
+        "{}",
+        w[0]
+    );
+    // The same spline with no valid region: nothing to warn about.
+    assert!(plausibility::warnings(&folded, 0.1, None, Some(&all('.'))).is_empty());
+    assert_eq!(
+        plausibility::fold(&Camera::example_splined(), Some(&all('#'))),
+        None
+    );
 }
 
 /// `scene`'s views with the board bowed by `warp` (metres, mrcal's
@@ -332,6 +444,38 @@ fn measure_splined_against_the_parametric_models_and_the_warp() {
         println!(
             "  splined predicted std in the valid region: median {s_med:.3} px, max {s_max:.3} px"
         );
+        // Other scenes through the same lens: the splined fit alone.
+        for seed in [11, 23] {
+            let scene = Scene::calibration(seed, &truth, (10, 10), 0.03, 40, 0.1).expect("scene");
+            let grid = valid_grid(&scene.views, size);
+            let options = CalibrationOptions {
+                model: Distortion::named("splined").expect("model"),
+                ..CalibrationOptions::default()
+            };
+            let Ok(r) = calibrate(&scene.views, size, &options) else {
+                println!("  seed {seed}: splined failed");
+                continue;
+            };
+            let sigma = predicted_std(&r, &grid);
+            let errors = aligned_errors(&truth, &r.camera, &grid);
+            let ratio = errors
+                .iter()
+                .zip(&sigma)
+                .map(|(e, s)| e / (3.0 * s))
+                .fold(0.0, f64::max);
+            let over = errors
+                .iter()
+                .zip(&sigma)
+                .filter(|(e, s)| **e > 4.5 * **s)
+                .count();
+            let worst = errors.iter().copied().fold(0.0, f64::max);
+            println!(
+                "  seed {seed}: splined rms {:.3} px, worst {worst:.3} px, worst error / noise bound {ratio:.2}, \
+                 {over} of {} grid pixels beyond 1.5x the bound",
+                r.rms_px,
+                grid.len()
+            );
+        }
     }
     let flat_truth = Camera::example_brown();
     let scene = Scene::calibration(9, &flat_truth, (11, 8), 0.05, 20, 0.0).expect("scene");

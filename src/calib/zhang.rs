@@ -293,10 +293,12 @@ fn finish(
     } else {
         None
     };
+    report.spline_support = super::splined::spline_support(problem, &report.camera);
     checks.extend(plausibility::warnings(
         &report.camera,
         report.rms_px,
         square,
+        report.spline_support.as_ref(),
     ));
     report.board_warp = super::board_warp::board_warp(problem, result);
     checks.extend(
@@ -305,7 +307,6 @@ fn finish(
             .as_ref()
             .and_then(super::board_warp::warp_warning),
     );
-    report.spline_support = super::splined::spline_support(problem, &report.camera);
     if let Some(support) = &report.spline_support {
         checks.extend(super::splined::spline_warnings(support, report.rms_px));
     }

@@ -122,3 +122,50 @@ impl Spline {
             .collect()
     }
 }
+
+/// Samples per knot cell and axis when a splined camera is searched for a
+/// fold (a fold narrower than an eighth of a cell needs a control value
+/// jump no smoothness prior leaves).
+const FOLD_SAMPLES_PER_CELL: usize = 8;
+/// The fold search extends this much beyond the knot field (the bundle
+/// adjustment can move border pixels' rays slightly outside it).
+const FOLD_FIELD_MARGIN: f64 = 1.1;
+
+impl Camera {
+    /// Where a splined camera folds among the pixels `keep` accepts: the
+    /// pixel and determinant of d m / d u (negative or zero: rays on both
+    /// sides of the fold share pixels) of the sampled stereographic point
+    /// with the lowest determinant that is not positive; `None` when there
+    /// is no fold there or the camera is not splined.
+    pub fn splined_fold(&self, keep: impl Fn(&Point2<f64>) -> bool) -> Option<(Point2<f64>, f64)> {
+        let Distortion::Splined(spline) = &self.distortion else {
+            return None;
+        };
+        spline.check().ok()?;
+        let (w, h) = (self.width as f64 - 0.5, self.height as f64 - 0.5);
+        let samples = |n: usize| (n - spline.order) * FOLD_SAMPLES_PER_CELL + 1;
+        let (sx, sy) = (samples(spline.nx), samples(spline.ny));
+        let along = |i: usize, n: usize, u_max: f64| {
+            FOLD_FIELD_MARGIN * u_max * (2.0 * i as f64 / (n - 1) as f64 - 1.0)
+        };
+        let mut worst: Option<(Point2<f64>, f64)> = None;
+        for iy in 0..sy {
+            for ix in 0..sx {
+                let u = Vector2::new(
+                    along(ix, sx, spline.u_max[0]),
+                    along(iy, sy, spline.u_max[1]),
+                );
+                let (m, det) = spline.map_and_determinant(&u);
+                if !(det <= 0.0) || worst.is_some_and(|(_, d)| d <= det) {
+                    continue;
+                }
+                let px = self.pixel_from_normalized(&m);
+                let inside = px.x >= -0.5 && px.y >= -0.5 && px.x <= w && px.y <= h;
+                if inside && keep(&px) {
+                    worst = Some((px, det));
+                }
+            }
+        }
+        worst
+    }
+}

@@ -59,8 +59,9 @@ pub struct Spline {
     /// along x and y; `[0, 0]` until a calibration sets it to cover the image.
     pub u_max: [f64; 2],
     /// Weight of the smoothness prior in the calibration: each second
-    /// difference of neighbouring control values, times the focal length,
-    /// is a residual of this weight (in pixels) beside the points'.
+    /// difference of neighbouring control values' change from the
+    /// calibration's start (the parametric fit's lens), times the focal
+    /// length, is a residual of this weight (in pixels) beside the points'.
     pub smoothness: f64,
     /// Control values `[dx0, dy0, dx1, dy1, ...]`, `2 nx ny` of them.
     pub control: Vec<f64>,
@@ -193,6 +194,14 @@ impl Spline {
             d_coeffs[i + 1].y += w;
         }
         Ok((m, d_point, d_coeffs))
+    }
+
+    /// The distorted normalised point `m = u + delta(u)` of the
+    /// stereographic point `u` and the determinant of d m / d u: where it
+    /// is not positive the correction folds (two rays share a pixel).
+    pub(crate) fn map_and_determinant(&self, u: &Vector2<f64>) -> (Vector2<f64>, f64) {
+        let (delta, d_delta, _) = self.eval(u);
+        (u + delta, (Matrix2::identity() + d_delta).determinant())
     }
 
     /// [`Spline::project`]'s point alone.

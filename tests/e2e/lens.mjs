@@ -82,6 +82,21 @@ export const tests = [
       assert.equal(Number(m[2]), found);
       assert.ok(Number(m[1]) < RMS_BOUND_PX, `RMS ${m[1]} px, bound ${RMS_BOUND_PX}`);
 
+      // The parameter table: the intrinsics in view, the spline's 2 x 70
+      // control values folded under a count (the page listed all 145 rows).
+      const named = await page.$$eval('#camera-params tbody tr', (trs) => trs.map((tr) => tr.cells[0].textContent));
+      assert.deepEqual(named, ['fx', 'fy', 'cx', 'cy', 'skew']);
+      assert.equal(await page.$eval('#camera-spline-values', (d) => d.tagName === 'DETAILS' && !d.open), true, 'the control values are folded');
+      assert.equal(await page.textContent('#camera-spline-values summary'),
+        `${2 * NX * NY} spline control values (${NX}x${NY} control points, dx and dy each, order ${ORDER})`);
+      const valueRows = await page.$$eval('#camera-spline-table tbody tr', (trs) => trs.map((tr) => tr.cells[0].textContent));
+      assert.equal(valueRows.length, 2 * NX * NY);
+      assert.deepEqual(valueRows.slice(0, 3), ['dx0', 'dy0', 'dx1']);
+      assert.equal(await page.isVisible('#camera-spline-table'), false, 'folded: the values are not shown until opened');
+      await page.click('#camera-spline-values summary');
+      assert.equal(await page.isVisible('#camera-spline-table'), true, 'opened: the values show');
+      await page.click('#camera-spline-values summary');
+
       // The correlation warnings (hundreds for a spline's control points): one folded box.
       const boxes = await page.$$eval('#camera-results .msg-warning', (els) => els.map((e) => e.textContent));
       const single = boxes.filter((t) => /^\S+ and \S+ are strongly correlated \(/.test(t));

@@ -24,6 +24,19 @@ function foldedPairs(id, text, items) {
     h('details', {}, h('summary', {}, `The ${items.length} pairs`), h('ul', {}, items.map((x) => h('li', {}, x)))));
 }
 
+/** The names of a splined lens's control values (calib: dx0 dy0 dx1 ...). */
+const SPLINE_VALUE = /^d[xy]\d+$/;
+
+/** A splined lens's control values (`rows` of the parameter table) in a collapsed box that says how many and their layout. */
+function splineValues(r, rows) {
+  const s = (r.camera && r.camera.distortion) || {};
+  const knots = r.spline_support ? r.spline_support.knots : [s.nx, s.ny];
+  const layout = knots[0] && knots[1] ? ` (${knots[0]}x${knots[1]} control points, dx and dy each${s.order ? `, order ${s.order}` : ''})` : '';
+  return h('details', { id: 'camera-spline-values' },
+    h('summary', {}, `${rows.length} spline control values${layout}`),
+    table(['parameter', 'value', 'std'], rows, { id: 'camera-spline-table' }));
+}
+
 function putPixels(canvas, p) {
   canvas.width = p.image.width;
   canvas.height = p.image.height;
@@ -122,7 +135,13 @@ export class CameraView {
     const k = r.camera_matrix.flat();
     const value = { fx: k[0], skew: k[1], cx: k[2], fy: k[4], cy: k[5], ...(r.distortion || {}) };
     const std = r.std || {};
-    const params = table(['parameter', 'value', 'std'], names.map((n) => [n, num(value[n], 6), stdText(std[n])]), { id: 'camera-params' });
+    const row = (n) => [n, num(value[n], 6), stdText(std[n])];
+    // A splined lens's control values (2 per control point, 140 at 10x7):
+    // folded under a count, the intrinsics and named parameters in view.
+    const control = r.model === 'splined' ? names.filter((n) => SPLINE_VALUE.test(n)) : [];
+    const params = h('div', { class: 'camera-params-box' },
+      table(['parameter', 'value', 'std'], names.filter((n) => !control.includes(n)).map(row), { id: 'camera-params' }),
+      control.length ? splineValues(r, control.map(row)) : null);
     const texts = (r.warnings || []).map((w) => (typeof w === 'string' ? w : w.message));
     // Many "X and Y are strongly correlated" (a splined lens's neighbouring
     // control points): one warning with the pairs folded, not a box each.
