@@ -116,7 +116,8 @@ pub(crate) fn find_markers(
 ) -> Vec<Marker> {
     let max_errors = MarkerOptions::default().max_bit_errors(dictionary);
     let mut found: Vec<Marker> = Vec::new();
-    quads::find_quads(img, resolutions, |q| {
+    let cells = dictionary.marker_bits() + 2 * border;
+    quads::find_quads(img, resolutions, cells, |q| {
         let Some(m) = decode::read_marker(img, q, dictionary, border, max_errors) else {
             return false;
         };
