@@ -19,15 +19,21 @@ a print option. This script runs OpenCV on the same PNGs, told the print
 A point counts as found when it lies within 1.5 px of the truth point it
 claims (robocal: by id; OpenCV: the nearest truth point, since its marker
 corner order and numbering differ from Kalibr's); any other point is
-"wrong". Error: mean / max distance of the found points.
+"wrong". Error: mean / max distance of the found points. Times: median
+per image of robocal's one `detect` call (wall time in the example's
+process, one thread; `robocal_ms`) and of OpenCV's detector call(s) here
+(wall time, cv2.setNumThreads(1)); meaningful with the example built in
+release (`--release`, the default here).
 
-Usage (crate root): python3 benches/recall_table.py [--views N] [--skip-render] [--out DIR]
-(renders in DIR, default benches/out/recall)
+Usage (crate root): python3 benches/recall_table.py [--views N] [--skip-render] [--debug] [--out DIR]
+(renders in DIR, default benches/out/recall; --debug: the example in the
+dev profile, times not comparable)
 """
 import json
 import os
 import subprocess
 import sys
+import time
 
 from opencv_venv import ensure_venv
 
@@ -146,6 +152,13 @@ def cell(d, total, wrong):
     return f"{len(d)}/{total} ({100 * len(d) / total:.0f} %), {sum(d) / len(d):.4f} / {max(d):.3f} px{w}"
 
 
+def median(v):
+    if not v:
+        return "-"
+    v = sorted(v)
+    return f"{v[len(v) // 2]:.1f}" if len(v) % 2 else f"{0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2]):.1f}"
+
+
 def main():
     ensure_venv()
     import cv2
@@ -153,18 +166,22 @@ def main():
     views = arg("--views", 6)
     out = sys.argv[sys.argv.index("--out") + 1] if "--out" in sys.argv else OUT
     if "--skip-render" not in sys.argv:
-        subprocess.check_call(["cargo", "run", "--example", "recall_table", "--", out, "--views", str(views)],
-                              cwd=ROOT)
+        profile = [] if "--debug" in sys.argv else ["--release"]
+        subprocess.check_call(["cargo", "run", *profile, "--example", "recall_table", "--", out,
+                               "--views", str(views)], cwd=ROOT)
     sets = json.load(open(os.path.join(out, "recall.json")))
     cv2.setNumThreads(1)
     print(f"OpenCV {cv2.__version__}; found = within {FOUND_PX} px of its truth point; cells: found/in view "
-          f"(recall), mean / max px of the found points, wrong points")
-    print("| kind | print | condition | robocal | OpenCV 4.14 |")
-    print("|---|---|---|---|---|")
+          f"(recall), mean / max px of the found points, wrong points; median ms per image")
+    print("| kind | print | condition | robocal | OpenCV 4.14 | robocal / OpenCV ms |")
+    print("|---|---|---|---|---|---|")
     for s in sets:
         fn = opencv_detector(s["kind"], s["spec"])
         rd, rw, od, ow, total = [], 0, [], 0, 0
+        rms, oms = [], []
         for im in s["images"]:
+            if "robocal_ms" in im:
+                rms.append(im["robocal_ms"])
             total += len(im["truth"])
             d, w = score_by_id(im["robocal"] or [], im["truth"])
             rd += d
@@ -173,11 +190,15 @@ def main():
                 g = cv2.imread(im["file"], cv2.IMREAD_GRAYSCALE)
                 if s["print"] == "light_on_dark":
                     g = 255 - g
-                d, w = score_nearest(fn(g), im["truth"])
+                t0 = time.perf_counter()
+                found = fn(g)
+                oms.append(1e3 * (time.perf_counter() - t0))
+                d, w = score_nearest(found, im["truth"])
                 od += d
                 ow += w
         ocv = cell(od, total, ow) if fn is not None else "none (no detector)"
-        print(f"| {s['kind']} | {s['print']} | {s['condition']} | {cell(rd, total, rw)} | {ocv} |")
+        print(f"| {s['kind']} | {s['print']} | {s['condition']} | {cell(rd, total, rw)} | {ocv} | "
+              f"{median(rms)} / {median(oms)} |")
 
 
 if __name__ == "__main__":

@@ -11,7 +11,9 @@
 //! and squares 12-25 px), blur 1.4 px, print 80 / 170, noise sigma 2.
 //! Writes OUT_DIR/<kind>_<print>_<condition>/NNN.png and OUT_DIR/recall.json:
 //! `[{"set", "kind", "spec", "print", "condition", "images": [{"file",
-//! "truth": [[id, x, y]], "robocal": [[id, x, y]] | null, "error"}]}]`.
+//! "truth": [[id, x, y]], "robocal": [[id, x, y]] | null, "error",
+//! "robocal_ms"}]}]` (`robocal_ms`: the wall time of the one `detect` call,
+//! one thread; meaningful in a release build).
 
 use robocal::detect::{detect, DetectOptions};
 use robocal::synth::{board_pose, render, Pinhole, RenderOptions, Rng};
@@ -119,9 +121,14 @@ fn main() {
                         render(&cam, &target, &board_pose(&target, rpy, at), &o).expect("render");
                     let file = format!("{out}/{set}/{k:03}.png");
                     save(&r.image, &file);
-                    let result = match detect(&r.image, &det_target, &DetectOptions::default()) {
-                        Ok(d) => json!({"robocal": points(&d.points)}),
-                        Err(e) => json!({"robocal": null, "error": e.to_string()}),
+                    let start = std::time::Instant::now();
+                    let detected = detect(&r.image, &det_target, &DetectOptions::default());
+                    let ms = start.elapsed().as_secs_f64() * 1e3;
+                    let result = match detected {
+                        Ok(d) => json!({"robocal": points(&d.points), "robocal_ms": ms}),
+                        Err(e) => {
+                            json!({"robocal": null, "error": e.to_string(), "robocal_ms": ms})
+                        }
                     };
                     eprintln!(
                         "{set} {k}: {} in view, robocal {}",

@@ -94,7 +94,9 @@ pub(crate) fn search<T>(
 /// not found only after the usual print's retry. `attempt` runs one print
 /// over some resolutions and says whether it read any marker (a print that
 /// read markers at half resolution is not retried, as in one print's
-/// search). The error is the usual print's, as [`search`]'s.
+/// search, unless they were small: then its own half-resolution attempt
+/// searched the full resolution too, `markers::quads`). The error is the
+/// usual print's, as [`search`]'s.
 pub(crate) fn search_markers<T>(
     target: &Target,
     forced: Option<Polarity>,
