@@ -124,6 +124,13 @@ fn main() {
             t_mm.y,
             t_mm.z
         );
+        let r_deg = (scene.x_true.rotation.inverse() * result.x.rotation)
+            .scaled_axis()
+            .map(f64::to_degrees);
+        println!(
+            "  X off by [{:.6}, {:.6}, {:.6}] mm, rotation [{:.7}, {:.7}, {:.7}] deg",
+            t_mm.x, t_mm.y, t_mm.z, r_deg.x, r_deg.y, r_deg.z
+        );
         if let Some(s) = &result.pose_refinement {
             println!(
                 "  std: rotation {:.5?} deg, translation {:.4?} mm; widened by {:?}; work point {:.4?} mm",
