@@ -146,8 +146,8 @@ pub fn run(args: DetectArgs) -> Result<(), CliError> {
     let outcomes: Vec<Processed> = files
         .iter()
         .filter_map(|f| match inputs.frame(f) {
-            Some(d) => Some(Processed {
-                outcome: Outcome::Found(d.clone(), 0.0),
+            Some((d, seconds)) => Some(Processed {
+                outcome: Outcome::Found(d.clone(), *seconds),
                 others: Vec::new(),
                 exif_orientation: None,
             }),

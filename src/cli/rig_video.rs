@@ -25,7 +25,7 @@ pub struct RigVideos {
     /// Per video frame name: its rig frame key.
     keys: HashMap<String, String>,
     /// Per video frame name: its detection.
-    frames: HashMap<String, Detection>,
+    frames: HashMap<String, (Detection, f64)>,
 }
 
 fn usage(message: impl Into<String>) -> CliError {
@@ -128,7 +128,9 @@ pub fn expand(
         for (key, frame) in frames {
             if let (true, Ok(d)) = (wanted.contains(&key), frame.detection) {
                 videos.keys.insert(frame.name.clone(), key.to_string());
-                videos.frames.insert(frame.name.clone(), d);
+                videos
+                    .frames
+                    .insert(frame.name.clone(), (d, frame.detect_s));
                 list.push(frame.name);
             }
         }

@@ -106,6 +106,8 @@ pub struct VideoFrame {
     pub name: String,
     /// The board found, or why not.
     pub detection: Result<Detection, (String, String)>,
+    /// Seconds the detector took on this frame (its `detect_ms` in `robocal detect`).
+    pub detect_s: f64,
     /// Kept by the capture rules.
     pub kept: bool,
     /// The capture's reason (kept or the first rule it failed).
@@ -163,12 +165,12 @@ impl VideoScan {
     }
 }
 
-/// The detection and blur of one frame.
-fn look(
-    image: &GrayImage,
-    target: &Target,
-    options: &DetectOptions,
-) -> (Result<Detection, (String, String)>, Option<f64>) {
+/// The detection of one frame, the detector's seconds and the blur.
+type Looked = (Result<Detection, (String, String)>, f64, Option<f64>);
+
+/// The detection, the detector's time and the blur of one frame.
+fn look(image: &GrayImage, target: &Target, options: &DetectOptions) -> Looked {
+    let started = std::time::Instant::now();
     let found = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         detect(image, target, options)
     }))
@@ -178,12 +180,13 @@ fn look(
             "the detector crashed on this frame",
         ))
     });
+    let seconds = started.elapsed().as_secs_f64();
     match found {
         Ok(d) => {
             let blur = measure::blur_px(image, &d.points);
-            (Ok(d), blur)
+            (Ok(d), seconds, blur)
         }
-        Err(e) => (Err((e.kind().to_string(), e.to_string())), None),
+        Err(e) => (Err((e.kind().to_string(), e.to_string())), seconds, None),
     }
 }
 
@@ -239,7 +242,7 @@ pub fn scan(
                 .map(|(_, image)| look(image, target, options))
                 .collect()
         });
-        for ((index, _), (detection, blur)) in batch.iter().zip(looked) {
+        for ((index, _), (detection, detect_s, blur)) in batch.iter().zip(looked) {
             let time_ms = match times_s {
                 Some(t) => t.get(*index).map_or(f64::NAN, |s| s * 1e3),
                 None => *index as f64 * 1e3 / fps,
@@ -261,6 +264,7 @@ pub fn scan(
                 index: *index,
                 name: video_frame_name(path, *index),
                 detection,
+                detect_s,
                 kept: keep,
                 reason: report,
             });

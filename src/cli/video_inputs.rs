@@ -16,8 +16,8 @@ use std::collections::HashMap;
 pub struct Inputs {
     /// Image files and video frame names, in argument order.
     pub names: Vec<String>,
-    /// The detection of each kept video frame, by name.
-    frames: HashMap<String, Detection>,
+    /// The detection of each kept video frame and the detector's seconds, by name.
+    frames: HashMap<String, (Detection, f64)>,
 }
 
 /// A pool of `threads` workers (0 or 1: one; default: one per core).
@@ -59,7 +59,7 @@ pub fn expand(
         for frame in video.frames.into_iter().filter(|f| f.kept) {
             if let Ok(d) = frame.detection {
                 inputs.names.push(frame.name.clone());
-                inputs.frames.insert(frame.name, d);
+                inputs.frames.insert(frame.name, (d, frame.detect_s));
             }
         }
     }
@@ -68,12 +68,13 @@ pub fn expand(
 
 impl Inputs {
     /// `names`, the video frames among them detected already.
-    pub fn with_frames(names: Vec<String>, frames: HashMap<String, Detection>) -> Inputs {
+    pub fn with_frames(names: Vec<String>, frames: HashMap<String, (Detection, f64)>) -> Inputs {
         Inputs { names, frames }
     }
 
-    /// The detection of a kept video frame, `None` for an image file.
-    pub fn frame(&self, name: &str) -> Option<&Detection> {
+    /// The detection of a kept video frame and the detector's seconds on it,
+    /// `None` for an image file.
+    pub fn frame(&self, name: &str) -> Option<&(Detection, f64)> {
         self.frames.get(name)
     }
 
@@ -96,7 +97,7 @@ impl Inputs {
         let mut outcomes = Vec::with_capacity(self.names.len());
         for name in &self.names {
             let outcome = match self.frames.get(name) {
-                Some(d) => Some(Outcome::Found(d.clone(), 0.0)),
+                Some((d, seconds)) => Some(Outcome::Found(d.clone(), *seconds)),
                 None => detected.next(),
             };
             outcomes.extend(outcome);

@@ -114,6 +114,9 @@ fn a_video_is_read_through_ffmpeg_and_its_frames_chosen_by_the_capture_rules() {
         let index = frame_of(image["file"].as_str().unwrap());
         assert_eq!(index % 2, 0, "--every 2 looks at even frames only");
         assert!(image["detection"]["points"].as_array().unwrap().len() == 54);
+        // The detector's time on the frame, as for an image file (it was 0).
+        let ms = image["detect_ms"].as_f64().unwrap();
+        assert!(ms > 0.0 && ms < 60_000.0, "detect_ms {ms}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
