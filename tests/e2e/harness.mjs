@@ -1,6 +1,7 @@
 // A tiny harness for the browser tests: starts `robocal serve` on a free
 // port, launches Debian's Chromium headless, gives each test a fresh page and
-// saves a screenshot per step under tests/e2e/screenshots/.
+// saves a failing test's page (or, with E2E_SHOTS=steps, every step's) under
+// tests/e2e/screenshots/.
 import { spawn } from 'node:child_process';
 import { mkdirSync } from 'node:fs';
 import { join, dirname } from 'node:path';
@@ -35,6 +36,11 @@ export async function launch(extraArgs = []) {
   });
 }
 
+// A full-page screenshot at every step a test names (`E2E_SHOTS=steps`), to
+// look at the page as the test saw it; by default only a failing test's page
+X
+const stepShots = process.env.E2E_SHOTS === 'steps';
+
 /** Runs `tests` ([name, fn(page, ctx)]) each in a fresh browser context of a Chromium launched with `launchArgs`. */
 export async function run(suite, tests, launchArgs = []) {
   mkdirSync(shotsDir, { recursive: true });
@@ -48,7 +54,9 @@ export async function run(suite, tests, launchArgs = []) {
       const consoleErrors = [];
       page.on('pageerror', (e) => consoleErrors.push(e.message));
       let step = 0;
-      const shot = (label) => page.screenshot({ path: join(shotsDir, `${suite}-${name.replace(/\W+/g, '_')}-${++step}-${label}.png`), fullPage: true });
+      const file = (label) => join(shotsDir, `${suite}-${name.replace(/\W+/g, '_')}-${++step}-${label}.png`);
+      const failureShot = () => page.screenshot({ path: file('failure'), fullPage: true });
+      const shot = stepShots ? (label) => page.screenshot({ path: file(label), fullPage: true }) : async () => {};
       const started = Date.now();
       try {
         await fn(page, { url: server.url, shot, consoleErrors, browser });
@@ -56,7 +64,7 @@ export async function run(suite, tests, launchArgs = []) {
         console.log(`ok   ${suite}: ${name} (${Date.now() - started} ms)`);
       } catch (e) {
         failed++;
-        await shot('failure').catch(() => {});
+        await failureShot().catch(() => {});
         console.log(`FAIL ${suite}: ${name}\n     ${e.stack || e}`);
       } finally {
         await context.close();
