@@ -5,16 +5,16 @@
 // machine). Each suite has its own `robocal serve` on a free port, its own
 // Chromium and its own temporary folders, so lanes share nothing; every
 // output line names its suite. The lanes are filled longest suite first from
-// the seconds a suite took on the 2-core machine (`seconds` below; a suite
-// missing there counts as 30 s), so that they end at about the same time.
+// the seconds a suite's tests took one after another on the 2-core machine
+// (`seconds` below, from s24's make test; a suite missing there counts as 30 s), so that they end at about the same time.
 import { availableParallelism } from 'node:os';
 import { run } from './harness.mjs';
 
 const all = ['foundation', 'workflows', 'flow', 'pages', 'datasets', 'offline', 'reliability', 'badinputs', 'badposes', 'guidance', 'reports', 'markers', 'boards', 'capture', 'rig', 'check', 'laser', 'video', 'lens'];
 const seconds = {
-  foundation: 20, workflows: 15, flow: 45, pages: 40, datasets: 70, offline: 10, reliability: 40,
-  badinputs: 45, badposes: 35, guidance: 60, reports: 50, markers: 40, boards: 25, capture: 70,
-  rig: 110, check: 40, laser: 25, video: 50, lens: 10,
+  badinputs: 97, capture: 69, badposes: 66, pages: 61, rig: 59, video: 49, datasets: 39, guidance: 36,
+  flow: 29, reports: 27, reliability: 27, offline: 15, boards: 14, markers: 12, foundation: 9, lens: 8,
+  check: 5, laser: 4, workflows: 3,
 };
 const wanted = process.argv.slice(2);
 for (const w of wanted) if (!all.includes(w)) throw new Error(`unknown suite '${w}' (known: ${all.join(', ')})`);
