@@ -12,6 +12,9 @@ import { makePng } from '../support/images.mjs';
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 60000 });
 const currentStep = (page) => page.$eval('#step-list a[aria-current]', (a) => a.dataset.step);
+// The step `step` in the address and on screen: the page shows it on the
+// hashchange event, a task after the address changes.
+const shownStep = (page, step) => page.waitForFunction((s) => location.hash === `#${s}` && !document.getElementById(`step-${s}`).hidden, step);
 const visibleStep = (page) => page.$$eval('section.step', (ss) => ss.filter((s) => !s.hidden).map((s) => s.id));
 
 /** Demo loaded and detected, camera solved (optionally with the robust option), hand-eye solved. */
@@ -57,24 +60,24 @@ export const tests = [
     assert.deepEqual(await visibleStep(page), ['step-target']);
     await page.focus('#step-list a[data-step=target]');
     await page.keyboard.press('ArrowRight');
-    await page.waitForFunction(() => location.hash === '#images');
+    await shownStep(page, 'images');
     assert.deepEqual(await visibleStep(page), ['step-images']);
     assert.equal(await page.evaluate(() => document.activeElement.dataset.step), 'images');
     await page.keyboard.press('ArrowRight');
-    await page.waitForFunction(() => location.hash === '#camera');
+    await shownStep(page, 'camera');
     await page.keyboard.press('ArrowLeft');
     await page.keyboard.press('ArrowLeft');
-    await page.waitForFunction(() => location.hash === '#target');
+    await shownStep(page, 'target');
     // End: the last step, the laser-line sensor (step 11); before it the
     // field check of a saved calibration (step 10).
     await page.keyboard.press('End');
-    await page.waitForFunction(() => location.hash === '#laser');
+    await shownStep(page, 'laser');
     assert.deepEqual(await visibleStep(page), ['step-laser']);
     await page.keyboard.press('ArrowLeft');
-    await page.waitForFunction(() => location.hash === '#check');
+    await shownStep(page, 'check');
     assert.deepEqual(await visibleStep(page), ['step-check']);
     await page.keyboard.press('ArrowLeft');
-    await page.waitForFunction(() => location.hash === '#share');
+    await shownStep(page, 'share');
     assert.deepEqual(await visibleStep(page), ['step-share']);
     await shot('share-by-keys');
   }],

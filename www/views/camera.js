@@ -25,7 +25,7 @@ function foldedPairs(id, text, items) {
 }
 
 /** The names of a splined lens's control values (calib: dx0 dy0 dx1 ...). */
-const SPLINE_VALUE = /^d[xy]\d+$/;
+const SPLINE_VALUE = /^(d[xy])(\d+)$/;
 
 /** A splined lens's control values (`rows` of the parameter table) in a collapsed box that says how many and their layout. */
 function splineValues(r, rows) {
@@ -138,7 +138,11 @@ export class CameraView {
     const row = (n) => [n, num(value[n], 6), stdText(std[n])];
     // A splined lens's control values (2 per control point, 140 at 10x7):
     // folded under a count, the intrinsics and named parameters in view.
-    const control = r.model === 'splined' ? names.filter((n) => SPLINE_VALUE.test(n)) : [];
+    // The report's distortion keys come sorted as text (dx0 dx1 dx10 ...):
+    // listed in the camera's own order, control point by control point.
+    const controlOrder = (n) => { const [, axis, i] = SPLINE_VALUE.exec(n); return 2 * Number(i) + (axis === 'dy' ? 1 : 0); };
+    const control = r.model === 'splined'
+      ? names.filter((n) => SPLINE_VALUE.test(n)).sort((a, b) => controlOrder(a) - controlOrder(b)) : [];
     const params = h('div', { class: 'camera-params-box' },
       table(['parameter', 'value', 'std'], names.filter((n) => !control.includes(n)).map(row), { id: 'camera-params' }),
       control.length ? splineValues(r, control.map(row)) : null);
