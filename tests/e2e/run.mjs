@@ -44,9 +44,17 @@ async function runLane(lane) {
   return failed;
 }
 
+// An error thrown outside any test (a route or event handler of a page)
+// fails the run but lets the other lane finish.
+let stray = 0;
+process.on('unhandledRejection', (e) => {
+  stray++;
+  console.log(`FAIL an error outside any test (a page's route or event handler): ${(e && e.stack) || e}`);
+});
+
 const started = Date.now();
 if (jobs > 1) console.log(`e2e: ${suites.length} suites in ${jobs} lanes: ${lanes.map((l) => l.suites.join(' ')).join(' | ')}`);
-const failed = (await Promise.all(lanes.map(runLane))).reduce((a, b) => a + b, 0);
+const failed = (await Promise.all(lanes.map(runLane))).reduce((a, b) => a + b, 0) + stray;
 console.log(`e2e: ${suites.length} suites in ${((Date.now() - started) / 1000).toFixed(0)} s`);
 if (failed) {
   console.error(`e2e: ${failed} test(s) failed; screenshots in tests/e2e/screenshots/`);
