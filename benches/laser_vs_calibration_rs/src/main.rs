@@ -16,7 +16,7 @@
 //! distance's error (mm) against the truth.
 //!
 //! Not part of robocal's build or tests: run by hand,
-//! `cd bench/laser_vs_calibration_rs && cargo run [TRIALS]` (default 20).
+//! `cd benches/laser_vs_calibration_rs && cargo run [TRIALS]` (default 20).
 
 use nalgebra::{Point2, Vector3};
 use robocal::api::laser::{
