@@ -383,7 +383,9 @@ tests.push(
     // Two captures in flight at once (a click while the first frame is still being encoded).
     await page.evaluate(() => { const b = document.getElementById('capture-frame'); b.click(); b.click(); });
     await page.waitForFunction(() => document.querySelectorAll('.card').length === 2, null, { timeout: 30000 });
-    assert.deepEqual((await cards(page)).map((c) => c.name), ['capture_001.png', 'capture_002.png']);
+    // Each card appears when its frame is encoded, so the two may come in
+    // either order (seen with two suites at once); their names are what counts.
+    assert.deepEqual((await cards(page)).map((c) => c.name).sort(), ['capture_001.png', 'capture_002.png']);
     // The last frame removed: its number is not given again.
     await page.click('button[aria-label="remove capture_002.png"]');
     await page.waitForFunction(() => document.querySelectorAll('.card').length === 1, null, { timeout: 10000 });
