@@ -28,12 +28,21 @@ export async function startServer() {
 }
 
 /** Chromium, headless; `extraArgs` are a suite's own flags (the capture suite's fake camera). */
+// Chromium has been seen to die while starting (SIGSEGV before its first
+// page, once in about 90 launches, two lanes at once): a launch that fails is
+// tried once more, and said; a second failure is the suite's.
 export async function launch(extraArgs = []) {
-  return chromium.launch({
+  const options = {
     executablePath: '/usr/bin/chromium',
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
       '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic', ...extraArgs],
-  });
+  };
+  try {
+    return await chromium.launch(options);
+  } catch (e) {
+    console.log(`     Chromium did not start (${String(e.message).split('\n')[0]}); trying once more`);
+    return chromium.launch(options);
+  }
 }
 
 // A full-page screenshot at every step a test names (`E2E_SHOTS=steps`), to
@@ -46,7 +55,13 @@ const stepShots = process.env.E2E_SHOTS === 'steps';
 export async function run(suite, tests, launchArgs = []) {
   mkdirSync(shotsDir, { recursive: true });
   const server = await startServer();
-  const browser = await launch(launchArgs);
+  let browser;
+  try {
+    browser = await launch(launchArgs);
+  } catch (e) {
+    server.stop();
+    throw e;
+  }
   let failed = 0;
   try {
     for (const [name, fn] of tests) {
