@@ -11,7 +11,7 @@ import { mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { launch, root, shotsDir } from './harness.mjs';
+import { launch, newContext, root, shotsDir } from './harness.mjs';
 import { appendViews, boardVideo, cameraJson } from './y4m.mjs';
 
 export const launchArgs = ['--use-fake-device-for-media-stream'];
@@ -183,7 +183,7 @@ export const tests = [
       mkdirSync(join(dir, 'extra'));
       const extra = await appendViews(page, path, join(dir, 'extra'), truth, { views: EXTRA_VIEWS, hold: 5, seed: 5 });
       other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
-      const context = await other.newContext({ viewport: { width: 1280, height: 900 } });
+      const context = await newContext(other);
       const p = await context.newPage();
       const errors = [];
       p.on('pageerror', (e) => errors.push(e.message));
@@ -349,7 +349,7 @@ export const tests = [
     try {
       const { path } = await boardVideo(page, dir, { spec: 'charuco:8x6:30mm:22mm:DICT_5X5_100', camera: cameraJson(640, 480), views: 2, hold: 30, seed: 4, hideRight: 0.45 });
       other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
-      const p = await (await other.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
+      const p = await (await newContext(other)).newPage();
       await open(p, url);
       await p.click('a[data-step=target]');
       await p.selectOption('#target-kind', 'charuco');

@@ -8,7 +8,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launch, shotsDir } from './harness.mjs';
+import { launch, newContext, shotsDir } from './harness.mjs';
 import { boardVideo, cameraJson } from './y4m.mjs';
 
 export const launchArgs = ['--use-fake-device-for-media-stream'];
@@ -56,7 +56,7 @@ export const tests = [
       const camera = cameraJson(640, 480);
       const { path } = await boardVideo(page, dir, { spec: 'chessboard:9x6:30mm', camera, views: 6, hold: 10, seed: 7 });
       other = await launch([...launchArgs, `--use-file-for-fake-video-capture=${path}`]);
-      const p = await (await other.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
+      const p = await (await newContext(other)).newPage();
       const errors = [];
       p.on('pageerror', (e) => errors.push(e.message));
       await p.context().grantPermissions(['camera'], { origin: url });

@@ -12,7 +12,7 @@ import { mkdtempSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { inflateRawSync } from 'node:zlib';
-import { root } from './harness.mjs';
+import { newContext, root } from './harness.mjs';
 
 const CLI = join(root, 'target/release/robocal');
 
@@ -91,7 +91,7 @@ export const tests = [
     await page.click('#make-share');
     await page.waitForFunction(() => document.getElementById('share-link').value.includes('#share='), null, { timeout: 10000 });
     const link = await page.inputValue('#share-link');
-    const shared = await (await browser.newContext()).newPage();
+    const shared = await (await newContext(browser, { viewport: { width: 1280, height: 720 } })).newPage();
     await shared.goto(link);
     await shared.locator('#readonly-banner:not([hidden])').waitFor({ timeout: 20000 });
     await shared.locator('#camera-params').waitFor({ timeout: 20000 });
@@ -182,7 +182,7 @@ export const tests = [
     // the plan's poses add about 600, still far inside an 8 KB request line.
     assert.ok(link.length < 7000, `share link with the plan: ${link.length} characters`);
     console.log(`     share link with the plan: ${link.length} characters`);
-    const shared = await (await browser.newContext()).newPage();
+    const shared = await (await newContext(browser, { viewport: { width: 1280, height: 720 } })).newPage();
     await shared.goto(link);
     await shared.locator('#readonly-banner:not([hidden])').waitFor({ timeout: 20000 });
     await shared.click('a[data-step=handeye]');

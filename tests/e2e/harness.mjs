@@ -51,6 +51,19 @@ export async function launch(extraArgs = []) {
 // tall, encoded while the test waits.
 const stepShots = process.env.E2E_SHOTS === 'steps';
 
+// Playwright's 30 s default for an action (e.g. setInputFiles, which needs
+// the page's main thread) was exceeded twice in one run of two lanes while a
+// build shared the two cores (load 8-10); every other step of those tests
+// took seconds. A wait that fails still fails, only later.
+const actionTimeoutMs = 90000;
+
+/** A browser context as every suite uses it: the suites' viewport (unless `options` says otherwise) and the action timeout above. */
+export async function newContext(browser, options = {}) {
+  const context = await browser.newContext({ viewport: { width: 1280, height: 900 }, ...options });
+  context.setDefaultTimeout(actionTimeoutMs);
+  return context;
+}
+
 /** Runs `tests` ([name, fn(page, ctx)]) each in a fresh browser context of a Chromium launched with `launchArgs`. */
 export async function run(suite, tests, launchArgs = []) {
   mkdirSync(shotsDir, { recursive: true });
@@ -65,7 +78,7 @@ export async function run(suite, tests, launchArgs = []) {
   let failed = 0;
   try {
     for (const [name, fn] of tests) {
-      const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+      const context = await newContext(browser);
       const page = await context.newPage();
       const consoleErrors = [];
       page.on('pageerror', (e) => consoleErrors.push(e.message));

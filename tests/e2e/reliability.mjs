@@ -6,6 +6,7 @@
 import assert from 'node:assert/strict';
 import { deflateRawSync } from 'node:zlib';
 import { makePng, checker } from '../support/images.mjs';
+import { newContext } from './harness.mjs';
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 30000 });
 
@@ -188,7 +189,7 @@ export const tests = [
   }],
   ['a wasm trap: the worker is replaced, the file is named, the page detects and solves as before', async (_page, { url, shot: _shot, browser }) => {
     // No service worker: it would fetch robocal.js past the route below.
-    const context = await browser.newContext({ viewport: { width: 1280, height: 900 }, serviceWorkers: 'block' });
+    const context = await newContext(browser, { serviceWorkers: 'block' });
     const page = await context.newPage();
     const shot = (label) => page.screenshot({ path: `tests/e2e/screenshots/reliability-trap-${label}.png`, fullPage: true });
     try { await trapSession(page, url, shot); } finally { await context.close(); }

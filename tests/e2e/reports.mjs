@@ -7,7 +7,7 @@ import { mkdtempSync, readFileSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { inflateRawSync } from 'node:zlib';
 import { join } from 'node:path';
-import { shotsDir } from './harness.mjs';
+import { newContext, shotsDir } from './harness.mjs';
 import { makePng } from '../support/images.mjs';
 
 const ready = (page) => page.locator('#engine-status.ready').waitFor({ timeout: 60000 });
@@ -308,7 +308,7 @@ tests.push(
     assert.ok(kept >= 30 && kept <= 240, `${kept} residuals in the link`);
     console.log(`     residuals in the link: ${kept} of ${total}`);
     assert.equal(payload.handeye.robotPoses.length, 8);
-    const shared = await (await browser.newContext({ viewport: { width: 1280, height: 900 } })).newPage();
+    const shared = await (await newContext(browser)).newPage();
     const errors = [];
     shared.on('pageerror', (e) => errors.push(e.message));
     await shared.goto(link);
