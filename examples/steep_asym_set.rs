@@ -12,12 +12,9 @@
 //! image (30 of 36), and prints robocal's result per view and in total: views found,
 //! mean / max distance to the truth, px.
 
-use nalgebra::Vector3;
 use robocal::camera::Camera;
 use robocal::detect::{detect, DetectOptions};
-use robocal::synth::{
-    circles_whole_in_image, render, tilted_board_pose, RenderOptions, STEEP_VIEWS_DEG,
-};
+use robocal::synth::{steep_view, STEEP_VIEWS_DEG};
 use robocal::target::Target;
 use serde_json::json;
 
@@ -44,26 +41,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             return Err(format!("{spec} is not a circle grid").into());
         };
         for (name, cam) in &cams {
-            for (k, &(tilt, axis, yaw)) in STEEP_VIEWS_DEG.iter().enumerate() {
-                let p = tilted_board_pose(
-                    &target,
-                    tilt.to_radians(),
-                    axis.to_radians(),
-                    yaw.to_radians(),
-                    Vector3::new(0.01, -0.01, 0.3),
-                );
-                let o = RenderOptions {
-                    seed: 700 + k as u64,
-                    ..RenderOptions::default()
-                };
-                let Ok(r) = render(cam, &target, &p, &o) else {
+            for (k, &(tilt, _, _)) in STEEP_VIEWS_DEG.iter().enumerate() {
+                let Some(r) = steep_view(&target, cam, k) else {
                     continue;
                 };
-                if r.points.len() != target.point_count()
-                    || !circles_whole_in_image(&r.points, r.image.width, r.image.height)
-                {
-                    continue;
-                }
                 let file = out.join(format!("{:02}.png", truth.len()));
                 std::fs::write(&file, robocal::image::encode_png(&r.image)?)?;
                 let what = format!("{spec} {name} view {k} ({tilt} deg)");

@@ -61,8 +61,8 @@ pub fn tilted_board_pose(
 }
 
 /// The steep views of the asymmetric circle-grid test
-/// (tests/detect/detect_circles_asym.rs) and `examples/steep_asym_set.rs`:
-/// (tilt, axis, yaw) of [`tilted_board_pose`], degrees.
+/// (tests/detect/detect_circles_asym.rs) and `examples/steep_asym_set.rs`
+/// ([`steep_view`]): (tilt, axis, yaw) of [`tilted_board_pose`], degrees.
 pub const STEEP_VIEWS_DEG: [(f64, f64, f64); 6] = [
     (58.0, 0.0, 0.0),
     (62.0, 90.0, 0.0),
@@ -80,13 +80,37 @@ fn board_centre(target: &Target) -> Vector3<f64> {
     Vector3::new(mx, my, 0.0)
 }
 
+/// The `k`-th steep view ([`STEEP_VIEWS_DEG`]) of `target` through
+/// `camera`: the board's centre at (10, -10, 300) mm, rendered with seed
+/// `700 + k`; `None` when it does not render, or when a point falls outside
+/// the image or a circle is cut by its border (each centre must lie at least
+/// a quarter of its distance to the nearest other centre from the border).
+pub fn steep_view(target: &Target, camera: &dyn Projection, k: usize) -> Option<Rendered> {
+    let (tilt, axis, yaw) = *STEEP_VIEWS_DEG.get(k)?;
+    let pose = tilted_board_pose(
+        target,
+        tilt.to_radians(),
+        axis.to_radians(),
+        yaw.to_radians(),
+        Vector3::new(0.01, -0.01, 0.3),
+    );
+    let options = RenderOptions {
+        seed: 700 + k as u64,
+        ..RenderOptions::default()
+    };
+    let r = render(camera, target, &pose, &options).ok()?;
+    let whole = r.points.len() == target.point_count()
+        && circles_whole_in_image(&r.points, r.image.width, r.image.height);
+    whole.then_some(r)
+}
+
 /// Whether every circle of `points` (a rendering's true centres) lies
 /// whole in a `width` x `height` image: each centre at least a quarter of
 /// its distance to the nearest other centre from the border. A circle's
 /// radius is a quarter of the grid unit and its nearest neighbour about
 /// 1.4 units away, so the circles of the views kept are whole; the views
 /// left out have a circle cut by the border, which no detector can centre.
-pub fn circles_whole_in_image(points: &[DetectedPoint], width: u32, height: u32) -> bool {
+fn circles_whole_in_image(points: &[DetectedPoint], width: u32, height: u32) -> bool {
     points.iter().all(|p| {
         let nearest = points
             .iter()
