@@ -22,19 +22,12 @@
 //! share, and the mean over trials and components of |error| / reported
 //! std (about 0.8 for a right Gaussian std, lower when it is too wide).
 
-use robocal::calib::pnp::camera_from_target_with_covariance;
-use robocal::calib::View;
 use robocal::camera::Camera;
 use robocal::handeye::refine::over_poses::camera_noise_from_views;
 use robocal::handeye::solve::{apply_pose_refinement, apply_pose_refinement_from_views};
-use robocal::handeye::{
-    calibrate, HandEyeInput, HandEyeOptions, HandEyeResult, MotionPairs, Pose, Setup,
-};
+use robocal::handeye::{calibrate, HandEyeOptions, HandEyeResult, MotionPairs, Setup};
 use robocal::optim::wilson::wilson_interval_95;
-use robocal::synth::handeye_looking::{
-    grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,
-};
-use robocal::synth::Rng;
+use robocal::synth::handeye_looking::{observe_looking, LookingConfig, LookingNoise};
 
 struct Cell {
     name: &'static str,
@@ -81,29 +74,16 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
         max_tilt_deg: cell.max_tilt_deg,
         max_roll_deg: cell.max_roll_deg,
     };
-    let scene = looking_scene(&config, seed);
-    let mut rng = Rng::new(seed ^ 0xc0ffee);
-    let pixels = grid_pixels(&scene, &camera, 0.2, &mut rng);
+    let measured = LookingNoise {
+        pixel_sigma: 0.2,
+        robot_sigma: (0.02f64.to_radians(), 0.1e-3),
+        kinematic: Some(cell.kinematic),
+    };
+    let seen = observe_looking(&config, seed, &camera, &measured, seed ^ 0xc0ffee);
+    let scene = &seen.scene;
     let f = 1100.0 * (1.0 + cell.focal_error);
     let used_camera = Camera::pinhole(f, f, 639.5, 479.5, 1280, 960);
-    let mut cams = Vec::new();
-    for v in &pixels {
-        cams.push(camera_from_target_with_covariance(&used_camera, v).ok()?.0);
-    }
-    let (sr, st) = (0.02f64.to_radians(), 0.1e-3);
-    let robots: Vec<Pose> = scene
-        .base_from_gripper
-        .iter()
-        .map(|p| {
-            let k = kinematic_error(p, cell.kinematic.0, cell.kinematic.1);
-            perturbed(&mut rng, &k, [sr; 3], [st; 3])
-        })
-        .collect();
-    let input = HandEyeInput {
-        setup: Setup::EyeInHand,
-        base_from_gripper: robots,
-        camera_from_target: cams,
-    };
+    let input = seen.handeye_input(&used_camera).ok()?;
     let options = HandEyeOptions {
         bootstrap_samples: 1,
         refine_poses: false,
@@ -111,15 +91,14 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
         ..Default::default()
     };
     let mut result = calibrate(&input, &options).ok()?;
-    let views: Vec<View> = pixels;
     // The same pose refinement without the focal check (as before it).
     let mut held = result.clone();
-    let (noise, _) = camera_noise_from_views(&input, &views, &used_camera);
+    let (noise, _) = camera_noise_from_views(&input, &seen.views, &used_camera);
     apply_pose_refinement(&mut held, &input, noise, MotionPairs::All).ok()?;
     apply_pose_refinement_from_views(
         &mut result,
         &input,
-        &views,
+        &seen.views,
         (&used_camera, None),
         MotionPairs::All,
     )

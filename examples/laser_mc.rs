@@ -27,6 +27,7 @@ use robocal::api::laser::{laser_plane, LaserPlaneSettings, LaserView};
 use robocal::calib::{pnp, View};
 use robocal::camera::Camera;
 use robocal::detect::{detect, DetectOptions};
+use robocal::geometry::Pose;
 use robocal::laser::{
     extract_stripe, fit_plane_with_boards, BoardPose, PlaneFitOptions, StripeObservation,
     StripeOptions,
@@ -36,28 +37,45 @@ use robocal::synth::laser_scene::{example_plane, laser_board_poses};
 use robocal::synth::{render, RenderOptions};
 use robocal::target::Target;
 
-/// The previous covariance model at the plane `(n, d)`: `s^2 (J^T J)^-1`
-/// over `(nx, ny, nz, d)` from the image-space residuals of the same
-/// measurements (board poses from PnP, centres inside the corners' extent).
-fn previous_covariance(
+/// One trial's measurements as the pipeline makes them: per view the board
+/// detected, its pose by PnP, the stripe extracted and its centres met with
+/// the board, those inside the detected corners' extent kept.
+#[derive(Default)]
+struct Measured {
+    /// The centres kept, through the PnP poses.
+    centres: Vec<StripeObservation>,
+    /// With the truth (`parts`): the same centres through the true poses
+    /// (those that meet them).
+    at_truth: Vec<StripeObservation>,
+    /// With the truth (`parts`): the PnP poses and their covariances.
+    boards: Vec<BoardPose>,
+}
+
+/// [`Measured`] for `views`; with `truth_poses` (the `parts` breakdown)
+/// also the board poses' covariances and the centres at the true poses.
+fn measure(
     camera: &Camera,
     target: &Target,
     views: &[LaserView],
-    n: &Vector3<f64>,
-    d: f64,
-) -> Result<Matrix4<f64>, robocal::Error> {
-    let helper = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let a = n.cross(&helper).normalize();
-    let b = n.cross(&a);
-    let (mut jtj, mut chi2, mut m) = (Matrix3::zeros(), 0.0, 0usize);
+    truth_poses: Option<&[Pose]>,
+) -> Result<Measured, robocal::Error> {
+    let mut out = Measured::default();
     for (i, v) in views.iter().enumerate() {
         let detection = detect(&v.board, target, &DetectOptions::default())?;
         let view = View::from_detection(v.name.clone(), &detection);
-        let (pose, _) = pnp::camera_from_target(camera, &view)?;
+        let pose = if truth_poses.is_some() {
+            let (pose, rms, unit) = pnp::camera_from_target_with_covariance(camera, &view)?;
+            let n = view.image_px.len() as f64;
+            out.boards.push(BoardPose {
+                image: i,
+                camera_from_target: pose,
+                covariance: unit * (rms * rms * n / (2.0 * n - 6.0)),
+            });
+            pose
+        } else {
+            pnp::camera_from_target(camera, &view)?.0
+        };
+        let truth = truth_poses.and_then(|t| t.get(i));
         let (lo, hi) = view
             .object_m
             .iter()
@@ -79,19 +97,41 @@ fn previous_covariance(
             if q.x < lo[0] || q.x > hi[0] || q.y < lo[1] || q.y > hi[1] {
                 continue;
             }
-            let x = o.point_camera.coords;
-            let t = o.along_scan_m_per_px;
-            let nt = n.dot(&t);
-            let e = n.dot(&x) - d;
-            let w = 1.0 / o.std_px;
-            let dn = w * (x * nt - t * e) / (nt * nt);
-            let j = Vector3::new(dn.dot(&a), dn.dot(&b), -w / nt);
-            jtj += j * j.transpose();
-            chi2 += (w * e / nt).powi(2);
-            m += 1;
+            out.centres.push(o);
+            if let Some(truth) = truth {
+                if let Ok(t) = StripeObservation::new(camera, truth, &px, along_y, p.std_px, i) {
+                    out.at_truth.push(t);
+                }
+            }
         }
     }
-    let s2 = chi2 / (m.max(4) - 3) as f64;
+    Ok(out)
+}
+
+/// The previous covariance model at the plane `(n, d)`: `s^2 (J^T J)^-1`
+/// over `(nx, ny, nz, d)` from the image-space residuals of the measured
+/// centres (board poses from PnP, centres inside the corners' extent).
+fn previous_covariance(measured: &Measured, n: &Vector3<f64>, d: f64) -> Matrix4<f64> {
+    let helper = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let a = n.cross(&helper).normalize();
+    let b = n.cross(&a);
+    let (mut jtj, mut chi2) = (Matrix3::zeros(), 0.0);
+    for o in &measured.centres {
+        let x = o.point_camera.coords;
+        let t = o.along_scan_m_per_px;
+        let nt = n.dot(&t);
+        let e = n.dot(&x) - d;
+        let w = 1.0 / o.std_px;
+        let dn = w * (x * nt - t * e) / (nt * nt);
+        let j = Vector3::new(dn.dot(&a), dn.dot(&b), -w / nt);
+        jtj += j * j.transpose();
+        chi2 += (w * e / nt).powi(2);
+    }
+    let s2 = chi2 / (measured.centres.len().max(4) - 3) as f64;
     let inv = jtj.try_inverse().unwrap_or_else(Matrix3::zeros) * s2;
     let mut map = nalgebra::Matrix4x3::zeros();
     for r in 0..3 {
@@ -99,7 +139,7 @@ fn previous_covariance(
         map[(r, 1)] = b[r];
     }
     map[(3, 2)] = 1.0;
-    Ok(map * inv * map.transpose())
+    map * inv * map.transpose()
 }
 
 /// The error's parts on one trial: the plane fitted to the same centres
@@ -113,54 +153,12 @@ struct Parts {
     board_cov: Matrix4<f64>,
 }
 
-fn parts(
-    camera: &Camera,
-    target: &Target,
-    views: &[LaserView],
-    truth_poses: &[robocal::geometry::Pose],
-) -> Result<Parts, robocal::Error> {
-    let (mut exact, mut measured, mut boards) = (Vec::new(), Vec::new(), Vec::new());
-    for (i, (v, truth)) in views.iter().zip(truth_poses).enumerate() {
-        let detection = detect(&v.board, target, &DetectOptions::default())?;
-        let view = View::from_detection(v.name.clone(), &detection);
-        let (pose, rms, unit) = pnp::camera_from_target_with_covariance(camera, &view)?;
-        let n = view.image_px.len() as f64;
-        boards.push(BoardPose {
-            image: i,
-            camera_from_target: pose,
-            covariance: unit * (rms * rms * n / (2.0 * n - 6.0)),
-        });
-        let (lo, hi) = view
-            .object_m
-            .iter()
-            .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
-                (
-                    [lo[0].min(p.x), lo[1].min(p.y)],
-                    [hi[0].max(p.x), hi[1].max(p.y)],
-                )
-            });
-        let on = v.stripe.as_ref().unwrap_or(&v.board);
-        let stripe = extract_stripe(on, Some(&v.board), &StripeOptions::default())?;
-        let along_y = stripe.axis == robocal::laser::ScanAxis::Columns;
-        for p in &stripe.points {
-            let px = Point2::new(p.x_px, p.y_px);
-            let Ok(o) = StripeObservation::new(camera, &pose, &px, along_y, p.std_px, i) else {
-                continue;
-            };
-            let q = pose.inverse() * o.point_camera;
-            if q.x < lo[0] || q.x > hi[0] || q.y < lo[1] || q.y > hi[1] {
-                continue;
-            }
-            measured.push(o);
-            if let Ok(t) = StripeObservation::new(camera, truth, &px, along_y, p.std_px, i) {
-                exact.push(t);
-            }
-        }
-    }
+/// [`Parts`] from measurements made with the truth ([`measure`]).
+fn parts(measured: &Measured) -> Result<Parts, robocal::Error> {
     let options = PlaneFitOptions::default();
-    let t = fit_plane_with_boards(&exact, &[], &options)?;
-    let s = fit_plane_with_boards(&measured, &[], &options)?;
-    let b = fit_plane_with_boards(&measured, &boards, &options)?;
+    let t = fit_plane_with_boards(&measured.at_truth, &[], &options)?;
+    let s = fit_plane_with_boards(&measured.centres, &[], &options)?;
+    let b = fit_plane_with_boards(&measured.centres, &measured.boards, &options)?;
     let sc = s.estimate.normal_distance_covariance();
     Ok(Parts {
         truth_pose_plane: (
@@ -319,11 +317,13 @@ fn main() -> Result<(), robocal::Error> {
             let n = Vector3::from(p.normal_camera);
             let c = Matrix4::from_fn(|r, k| p.covariance[r][k]);
             reported.add(&n, p.distance_m, (&truth_n, truth_d), &c);
-            let old = previous_covariance(&camera, &target, &views, &n, p.distance_m)?;
+            let truth_poses = breakdown.then_some(board_poses.as_slice());
+            let measured = measure(&camera, &target, &views, truth_poses)?;
+            let old = previous_covariance(&measured, &n, p.distance_m);
             previous.add(&n, p.distance_m, (&truth_n, truth_d), &old);
             vf += report.variance_factor;
             if breakdown {
-                let q = parts(&camera, &target, &views, &board_poses)?;
+                let q = parts(&measured)?;
                 let (tn, td) = q.truth_pose_plane;
                 centres.add(&tn, td, (&truth_n, truth_d), &q.stripe_cov);
                 let (mn, md) = q.measured_plane;

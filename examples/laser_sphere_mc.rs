@@ -12,14 +12,13 @@
 //! `cargo run --release --example laser_sphere_mc [TRIALS] [SCANS]`
 //! (default 200 and 8).
 
-use nalgebra::{DMatrix, DVector, Matrix3, Point2, Point3, Vector3};
-use robocal::camera::{Camera, Distortion};
-use robocal::geometry::{pose_from_params, tangent_basis, Pose};
-use robocal::laser::sphere::{calibrate_on_sphere, SphereScan};
-use robocal::laser::{extract_stripe, LaserPlane, StripeOptions};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use robocal::geometry::{tangent_basis, Pose};
+use robocal::laser::sphere::calibrate_on_sphere;
 use robocal::synth::laser_scene::example_plane;
 use robocal::synth::laser_sphere::{
-    example_mounting, example_sphere, render_sphere, sphere_scan_poses, SphereRenderOptions,
+    example_mounting, example_sensor_camera, example_sphere, example_starts, rendered_scans,
+    sphere_scan_poses,
 };
 
 /// chi^2 quantiles at 0.9973 (3 sigma) for 1, 2 and 3 dof.
@@ -58,55 +57,20 @@ impl Score {
     }
 }
 
-fn camera() -> Camera {
-    Camera {
-        distortion: Distortion::Brown {
-            k1: -0.05,
-            k2: 0.02,
-            k3: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-        },
-        ..Camera::pinhole(800.0, 800.0, 319.5, 239.5, 640, 480)
-    }
-}
-
 fn main() -> Result<(), robocal::Error> {
     let mut args = std::env::args().skip(1);
     let trials: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(200);
     let n_scans: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(8);
     let (plane, mount, scene) = (example_plane(), example_mounting(), example_sphere());
-    let cam = camera();
-    let emitter = Point3::from(plane.normal.into_inner() * plane.distance_m);
+    let cam = example_sensor_camera();
     let poses = sphere_scan_poses(n_scans, &scene, &mount, &plane);
-    // The starts of src/laser/sphere_tests.rs.
-    let turn =
-        nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.6, 0.8, 0.0) * 1f64.to_radians());
-    let start_plane = LaserPlane {
-        normal: turn * plane.normal,
-        distance_m: plane.distance_m + 0.002,
-    };
-    let start_mount = mount * pose_from_params(&[0.02, -0.025, 0.01, 0.004, -0.003, 0.0]);
+    // The starts of the sphere tests (src/laser/sphere_tests.rs).
+    let (start_plane, start_mount) = example_starts(&plane, &mount);
     let mut scores: [Score; 5] = Default::default();
     let mut failed = 0;
     for trial in 0..trials {
-        let mut scans = Vec::new();
-        for (k, b) in poses.iter().enumerate() {
-            let options = SphereRenderOptions {
-                seed: 1_000_003 * trial as u64 + 11 + k as u64,
-                ..SphereRenderOptions::default()
-            };
-            let image = render_sphere(&cam, &(b * mount), &plane, &emitter, &scene, &options)?;
-            let stripe = extract_stripe(&image, None, &StripeOptions::default())?;
-            scans.push(SphereScan {
-                base_from_gripper: *b,
-                pixels: stripe
-                    .points
-                    .iter()
-                    .map(|p| Point2::new(p.x_px, p.y_px))
-                    .collect(),
-            });
-        }
+        let first_seed = 1_000_003 * trial as u64 + 11;
+        let scans = rendered_scans(&cam, &poses, &mount, &plane, &scene, first_seed)?;
         let c = match calibrate_on_sphere(&cam, &scans, scene.radius_m, &start_plane, &start_mount)
         {
             Ok(c) => c,

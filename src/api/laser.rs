@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{Pose, PoseJson};
 use crate::image::GrayImage;
 use crate::laser::fit::ImageResidual;
-use crate::laser::joint::{refine_holding, JointImage};
+use crate::laser::joint::{held_parameters, refine_holding, JointImage};
 use crate::laser::points::{profile_points, ProfilePoint};
 use crate::laser::{
     extract_stripe, fit_plane_with_boards, plane_in_camera, BoardPose, LaserPlane, PlaneFitOptions,
@@ -154,7 +154,7 @@ pub fn laser_plane_refining_camera(
             scan_along_y: m.along_y,
         })
         .collect();
-    let (held, why) = held_in_joint(camera);
+    let (held, why) = held_parameters(camera);
     let joint = refine_holding(camera, &images, &start, &held)?;
     let mut again = Vec::with_capacity(measured.len());
     for (m, pose) in measured.into_iter().zip(&joint.camera_from_target) {
@@ -167,53 +167,6 @@ pub fn laser_plane_refining_camera(
     ));
     report.warnings.extend(why);
     Ok((report, joint.camera))
-}
-
-/// The camera parameters the joint refinement holds at the given camera's,
-/// and a warning saying why when it is more than the parameters held at 0.
-///
-/// - A zero skew or distortion coefficient was held at 0 by the board
-///   calibration (OpenCV's `CALIB_FIX_*`, robocal's `--fix`): it stays so.
-/// - A tilted (Scheimpflug) sensor's tilt trades with the principal point
-///   and the decentering terms (correlation 0.999 over board poses: a
-///   near-rotation of the camera frame, which the plane's normal follows).
-///   The laser images' few boards cannot separate them: refined freely,
-///   they drifted 1.40 deg along that direction (BENCHMARKS.md section 18),
-///   so tau_x, tau_y, cx, cy, p1 and p2 are held at the board calibration's
-///   and the warning says so.
-fn held_in_joint(camera: &Camera) -> (Vec<&'static str>, Option<String>) {
-    let names = camera.param_names();
-    let params = camera.params();
-    let mut held: Vec<&'static str> = names
-        .iter()
-        .zip(&params)
-        .skip(2)
-        .filter(|(n, v)| **v == 0.0 && !matches!(**n, "cx" | "cy"))
-        .map(|(n, _)| *n)
-        .collect();
-    let tilted = matches!(camera.distortion, crate::camera::Distortion::Tilted { .. });
-    if !tilted {
-        return (held, None);
-    }
-    for name in ["cx", "cy", "p1", "p2", "tau_x", "tau_y"] {
-        if !held.contains(&name) {
-            held.push(name);
-        }
-    }
-    let free: Vec<&str> = names
-        .iter()
-        .filter(|n| !held.contains(n))
-        .copied()
-        .collect();
-    (
-        held,
-        Some(format!(
-            "tilted camera: its tilt (tau_x, tau_y), principal point and p1, p2 were held at the \
-             given camera's (the boards cannot separate them: they trade with each other as a \
-             near-rotation of the camera, which the plane's normal follows); refined: {}",
-            free.join(", ")
-        )),
-    )
 }
 
 /// One board pose as measured: the board's corners and pose, the stripe

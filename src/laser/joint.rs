@@ -15,7 +15,7 @@
 //! residuals depend on its own pose only).
 
 use super::plane::{board_plane, LaserPlane, StripeObservation};
-use crate::camera::Camera;
+use crate::camera::{Camera, Distortion};
 use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, pose_from_params, tangent_basis, Plane, Pose};
 use crate::optim::{self, BlockParams, BlockProblem, LmOptions, ResidualBlock};
@@ -274,4 +274,52 @@ pub fn refine_holding(
         camera_from_target: poses,
         plane,
     })
+}
+
+/// The camera parameters the joint refinement ([`refine_holding`]) holds at
+/// the given camera's, and a warning saying why when it is more than the
+/// parameters held at 0.
+///
+/// - A zero skew or distortion coefficient was held at 0 by the board
+///   calibration (OpenCV's `CALIB_FIX_*`, robocal's `--fix`): it stays so.
+/// - A tilted (Scheimpflug) sensor's tilt trades with the principal point
+///   and the decentering terms (correlation 0.999 over board poses: a
+///   near-rotation of the camera frame, which the plane's normal follows).
+///   The laser images' few boards cannot separate them: refined freely,
+///   they drifted 1.40 deg along that direction (BENCHMARKS.md section 18),
+///   so tau_x, tau_y, cx, cy, p1 and p2 are held at the board calibration's
+///   and the warning says so.
+pub fn held_parameters(camera: &Camera) -> (Vec<&'static str>, Option<String>) {
+    let names = camera.param_names();
+    let params = camera.params();
+    let mut held: Vec<&'static str> = names
+        .iter()
+        .zip(&params)
+        .skip(2)
+        .filter(|(n, v)| **v == 0.0 && !matches!(**n, "cx" | "cy"))
+        .map(|(n, _)| *n)
+        .collect();
+    let tilted = matches!(camera.distortion, Distortion::Tilted { .. });
+    if !tilted {
+        return (held, None);
+    }
+    for name in ["cx", "cy", "p1", "p2", "tau_x", "tau_y"] {
+        if !held.contains(&name) {
+            held.push(name);
+        }
+    }
+    let free: Vec<&str> = names
+        .iter()
+        .filter(|n| !held.contains(n))
+        .copied()
+        .collect();
+    (
+        held,
+        Some(format!(
+            "tilted camera: its tilt (tau_x, tau_y), principal point and p1, p2 were held at the \
+             given camera's (the boards cannot separate them: they trade with each other as a \
+             near-rotation of the camera, which the plane's normal follows); refined: {}",
+            free.join(", ")
+        )),
+    )
 }

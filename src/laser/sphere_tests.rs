@@ -3,47 +3,14 @@
 //! bounds and within the reported std.
 
 use super::sphere::{calibrate_on_sphere, SphereCalibration, SphereScan};
-use super::{extract_stripe, LaserPlane, StripeOptions};
-use crate::camera::{Camera, Distortion};
-use crate::geometry::{pose_from_params, Pose};
+use super::LaserPlane;
+use crate::geometry::Pose;
 use crate::synth::laser_scene::example_plane;
 use crate::synth::laser_sphere::{
-    example_mounting, example_sphere, render_sphere, sphere_scan_poses, SphereRenderOptions,
-    SphereScene,
+    example_emitter, example_mounting, example_sensor_camera, example_sphere, example_starts,
+    rendered_scans, sphere_scan_poses, SphereScene,
 };
-use nalgebra::{Point2, Point3, Vector3};
-
-fn camera() -> Camera {
-    Camera {
-        distortion: Distortion::Brown {
-            k1: -0.05,
-            k2: 0.02,
-            k3: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-        },
-        ..Camera::pinhole(800.0, 800.0, 319.5, 239.5, 640, 480)
-    }
-}
-
-/// The emitter: the plane's point nearest the camera centre (about 10 cm
-/// from it, the sensor's baseline).
-fn emitter(plane: &LaserPlane) -> Point3<f64> {
-    Point3::from(plane.normal.into_inner() * plane.distance_m)
-}
-
-/// Start values off the truth: the plane turned 1 deg and 2 mm off, the
-/// mounting turned 2 deg and 5 mm off.
-fn starts(plane: &LaserPlane, mount: &Pose) -> (LaserPlane, Pose) {
-    let turn =
-        nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.6, 0.8, 0.0) * 1f64.to_radians());
-    let start_plane = LaserPlane {
-        normal: turn * plane.normal,
-        distance_m: plane.distance_m + 0.002,
-    };
-    let start_mount = mount * pose_from_params(&[0.02, -0.025, 0.01, 0.004, -0.003, 0.0]);
-    (start_plane, start_mount)
-}
+use nalgebra::{Point3, Vector3};
 
 /// Errors against the truth: plane normal deg, plane distance mm, mounting
 /// rotation deg, mounting translation mm, centre mm.
@@ -75,9 +42,9 @@ fn exact_scans(
     plane: &LaserPlane,
     scene: &SphereScene,
 ) -> Vec<SphereScan> {
-    let cam = camera();
+    let cam = example_sensor_camera();
     let n = plane.normal.into_inner();
-    let e = emitter(plane);
+    let e = example_emitter(plane);
     poses
         .iter()
         .map(|b| {
@@ -116,9 +83,9 @@ fn exact_profiles_give_the_exact_sensor() {
         "{:?}",
         scans.iter().map(|s| s.pixels.len()).collect::<Vec<_>>()
     );
-    let (start_plane, start_mount) = starts(&plane, &mount);
+    let (start_plane, start_mount) = example_starts(&plane, &mount);
     let c = calibrate_on_sphere(
-        &camera(),
+        &example_sensor_camera(),
         &scans,
         scene.radius_m,
         &start_plane,
@@ -138,58 +105,43 @@ fn scans_without_turns_or_too_few_are_refused() {
     let (plane, mount, scene) = (example_plane(), example_mounting(), example_sphere());
     let poses = sphere_scan_poses(6, &scene, &mount, &plane);
     let scans = exact_scans(&poses[..2], &mount, &plane, &scene);
-    let err = calibrate_on_sphere(&camera(), &scans, scene.radius_m, &plane, &mount).unwrap_err();
+    let err = calibrate_on_sphere(
+        &example_sensor_camera(),
+        &scans,
+        scene.radius_m,
+        &plane,
+        &mount,
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("at least 3 are needed"), "{err}");
-    let err = calibrate_on_sphere(&camera(), &scans, -1.0, &plane, &mount).unwrap_err();
+    let err =
+        calibrate_on_sphere(&example_sensor_camera(), &scans, -1.0, &plane, &mount).unwrap_err();
     assert!(err.to_string().contains("radius"), "{err}");
 }
 
 #[test]
 fn rendered_scans_give_the_sensor_within_bounds() {
     let (plane, mount, scene) = (example_plane(), example_mounting(), example_sphere());
-    let cam = camera();
+    let cam = example_sensor_camera();
     let poses = sphere_scan_poses(8, &scene, &mount, &plane);
-    let mut scans = Vec::new();
+    let scans = rendered_scans(&cam, &poses, &mount, &plane, &scene, 11).unwrap();
+    // Each centre against the true stripe: its ray meets the true plane at
+    // a point this far from the sphere.
     let mut centre_err = (0.0, 0usize);
-    for (k, b) in poses.iter().enumerate() {
-        let options = SphereRenderOptions {
-            seed: 11 + k as u64,
-            ..SphereRenderOptions::default()
-        };
-        let image = render_sphere(
-            &cam,
-            &(b * mount),
-            &plane,
-            &emitter(&plane),
-            &scene,
-            &options,
-        )
-        .unwrap();
-        let stripe = extract_stripe(&image, None, &StripeOptions::default()).unwrap();
-        // Each centre against the true stripe: its ray meets the true plane
-        // at a point this far from the sphere.
-        let c = ((b * mount).inverse() * scene.centre_base).coords;
-        let pixels: Vec<Point2<f64>> = stripe
-            .points
-            .iter()
-            .map(|p| Point2::new(p.x_px, p.y_px))
-            .collect();
-        for px in &pixels {
+    for scan in &scans {
+        let c = ((scan.base_from_gripper * mount).inverse() * scene.centre_base).coords;
+        for px in &scan.pixels {
             let x = plane.intersect_ray(&cam.unproject(px).unwrap()).unwrap();
             centre_err.0 += ((x.coords - c).norm() - scene.radius_m).abs();
             centre_err.1 += 1;
         }
-        scans.push(SphereScan {
-            base_from_gripper: *b,
-            pixels,
-        });
     }
     assert!(
         scans.iter().all(|s| s.pixels.len() > 30),
         "{:?}",
         scans.iter().map(|s| s.pixels.len()).collect::<Vec<_>>()
     );
-    let (start_plane, start_mount) = starts(&plane, &mount);
+    let (start_plane, start_mount) = example_starts(&plane, &mount);
     let c = calibrate_on_sphere(&cam, &scans, scene.radius_m, &start_plane, &start_mount).unwrap();
     let e = errors(&c, &plane, &mount, &scene);
     let std_normal_deg = (0.5

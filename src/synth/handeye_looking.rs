@@ -4,15 +4,20 @@
 //! a given angle and rolled about its optical axis, and the robot poses
 //! follow from the chain `robot[i] * x * camera[i] = y`. Used by the pose
 //! refinement's tests and the Cramér-Rao benchmark (`examples/handeye_crb.rs`).
+//! [`observe_looking`] adds what a camera and a robot measure of such a
+//! scene (noisy grid pixels, noisy robot poses) and, through PnP with a
+//! given camera, the hand-eye input of the image path.
 //!
 //! Noise is applied the way [`crate::handeye::refine::pose_residual`] models it:
 //! decoupled left perturbations, `R <- exp(w) R`, `t <- t + v`.
 
 use super::Rng;
+use crate::calib::pnp::camera_from_target_with_covariance;
 use crate::calib::View;
 use crate::camera::Camera;
+use crate::error::Result;
 use crate::handeye::refine::pose_residual::perturb;
-use crate::handeye::{Pose, Setup};
+use crate::handeye::{HandEyeInput, Pose, Setup};
 use nalgebra::{Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 
 /// What to generate.
@@ -205,6 +210,81 @@ pub fn grid_pixels(
         .collect()
 }
 
+/// What the camera and the robot of [`observe_looking`] add to the truth.
+#[derive(Debug, Clone, Copy)]
+pub struct LookingNoise {
+    /// Pixel noise per coordinate (px).
+    pub pixel_sigma: f64,
+    /// Robot pose noise per axis ([`perturbed`]): rotation (rad),
+    /// translation (m).
+    pub robot_sigma: (f64, f64),
+    /// A robot error smooth in the pose ([`kinematic_error`]: translation
+    /// mm, rotation deg), put on the true poses before the noise; `None`:
+    /// none.
+    pub kinematic: Option<(f64, f64)>,
+}
+
+/// A looking scene as measured.
+#[derive(Debug, Clone)]
+pub struct LookingObserved {
+    /// The truth.
+    pub scene: LookingScene,
+    /// Each view's grid pixels through the true camera ([`grid_pixels`]).
+    pub views: Vec<View>,
+    /// The robot poses as the robot reports them.
+    pub base_from_gripper: Vec<Pose>,
+}
+
+/// [`looking_scene`] from `seed`, seen through `camera` and moved by a
+/// robot with `noise`: one generator seeded `noise_seed` draws the pixel
+/// noise of every view, then each robot pose's noise.
+pub fn observe_looking(
+    config: &LookingConfig,
+    seed: u64,
+    camera: &Camera,
+    noise: &LookingNoise,
+    noise_seed: u64,
+) -> LookingObserved {
+    let scene = looking_scene(config, seed);
+    let mut rng = Rng::new(noise_seed);
+    let views = grid_pixels(&scene, camera, noise.pixel_sigma, &mut rng);
+    let (sr, st) = noise.robot_sigma;
+    let base_from_gripper = scene
+        .base_from_gripper
+        .iter()
+        .map(|p| {
+            let p = match noise.kinematic {
+                Some((mm, deg)) => kinematic_error(p, mm, deg),
+                None => *p,
+            };
+            perturbed(&mut rng, &p, [sr; 3], [st; 3])
+        })
+        .collect();
+    LookingObserved {
+        scene,
+        views,
+        base_from_gripper,
+    }
+}
+
+impl LookingObserved {
+    /// The hand-eye input of the image path: each view's board pose by PnP
+    /// through `camera` (the calibration in use, which need not be the
+    /// truth) and the reported robot poses.
+    pub fn handeye_input(&self, camera: &Camera) -> Result<HandEyeInput> {
+        let camera_from_target = self
+            .views
+            .iter()
+            .map(|v| Ok(camera_from_target_with_covariance(camera, v)?.0))
+            .collect::<Result<_>>()?;
+        Ok(HandEyeInput {
+            setup: self.scene.setup,
+            base_from_gripper: self.base_from_gripper.clone(),
+            camera_from_target,
+        })
+    }
+}
+
 /// Move view `view`'s camera by `offset_m` along its own axes (orientation
 /// kept) and the robot pose with it, so that the chain still closes: a
 /// lateral offset pushes the board towards an image edge, the way a
@@ -264,6 +344,51 @@ mod tests {
                     "{setup:?} view {k}: chain off by {d} (m, unitless)"
                 );
             }
+        }
+    }
+
+    /// Without noise the observation is the truth: the robot poses to
+    /// rounding (1e-12 m and rad) and the board poses by PnP from exact
+    /// pixels to 1e-9 (m and rad).
+    #[wasm_bindgen_test(unsupported = test)]
+    fn a_noise_free_observation_gives_the_true_poses() {
+        let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
+        let config = LookingConfig {
+            setup: Setup::EyeToHand,
+            views: 5,
+            distance_m: 0.5,
+            grid: (9, 6, 0.03),
+            max_tilt_deg: 30.0,
+            max_roll_deg: 60.0,
+        };
+        let clean = LookingNoise {
+            pixel_sigma: 0.0,
+            robot_sigma: (0.0, 0.0),
+            kinematic: None,
+        };
+        let seen = observe_looking(&config, 3, &camera, &clean, 4);
+        let input = seen.handeye_input(&camera).unwrap();
+        assert_eq!(input.setup, Setup::EyeToHand);
+        let off = |a: &Pose, b: &Pose| {
+            let d = a.inverse() * b;
+            (d.rotation.angle(), d.translation.vector.norm())
+        };
+        for k in 0..5 {
+            let (r, t) = off(
+                &input.base_from_gripper[k],
+                &seen.scene.base_from_gripper[k],
+            );
+            assert!(r < 1e-12 && t < 1e-12, "robot {k}: {r} rad, {t} m");
+            let (r, t) = off(
+                &input.camera_from_target[k],
+                &seen.scene.camera_from_target[k],
+            );
+            assert!(r < 1e-9 && t < 1e-9, "board {k}: {r} rad, {t} m");
+            assert_eq!(
+                seen.views[k].image_px.len(),
+                54,
+                "view {k}: points in the image"
+            );
         }
     }
 }

@@ -12,12 +12,18 @@
 //! exp(-s^2 / (2 sigma^2))` for a point `s` metres off the plane (`sigma`
 //! the sheet's half-thickness); then the ambient grey, Gaussian noise,
 //! clipped to 0..255.
+//!
+//! The example sensor ([`example_sensor_camera`], [`example_emitter`],
+//! [`example_mounting`], [`example_starts`]) and [`rendered_scans`] (the
+//! stripes of the rendered images) serve the sphere tests and
+//! `examples/laser_sphere_mc.rs`.
 
 use super::laser_raycast::{render_rays, sheet, Background};
-use crate::camera::Camera;
+use crate::camera::{Camera, Distortion};
 use crate::geometry::{pose_from_params, Pose};
-use crate::laser::LaserPlane;
-use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3};
+use crate::laser::sphere::SphereScan;
+use crate::laser::{extract_stripe, LaserPlane, StripeOptions};
+use nalgebra::{Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// The calibration sphere in the base frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,6 +66,41 @@ impl Default for SphereRenderOptions {
 /// a little off it.
 pub fn example_mounting() -> Pose {
     pose_from_params(&[0.08, -0.12, 1.2, 0.03, -0.05, 0.12])
+}
+
+/// The example sensor's camera: 640x480, f = 800 px, a mild barrel
+/// (Brown k1 = -0.05, k2 = 0.02).
+pub fn example_sensor_camera() -> Camera {
+    Camera {
+        distortion: Distortion::Brown {
+            k1: -0.05,
+            k2: 0.02,
+            k3: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+        },
+        ..Camera::pinhole(800.0, 800.0, 319.5, 239.5, 640, 480)
+    }
+}
+
+/// The example emitter: the laser `plane`'s point nearest the camera
+/// centre (about 10 cm from it for the example plane, the sensor's
+/// baseline), camera frame.
+pub fn example_emitter(plane: &LaserPlane) -> Point3<f64> {
+    Point3::from(plane.normal.into_inner() * plane.distance_m)
+}
+
+/// Start values off the truth for the sphere calibration: the `plane`
+/// turned 1 deg and moved 2 mm, the mounting turned 2 deg and moved 5 mm.
+pub fn example_starts(plane: &LaserPlane, gripper_from_camera: &Pose) -> (LaserPlane, Pose) {
+    let turn = Rotation3::from_scaled_axis(Vector3::new(0.6, 0.8, 0.0) * 1f64.to_radians());
+    let start_plane = LaserPlane {
+        normal: turn * plane.normal,
+        distance_m: plane.distance_m + 0.002,
+    };
+    let start_mount =
+        gripper_from_camera * pose_from_params(&[0.02, -0.025, 0.01, 0.004, -0.003, 0.0]);
+    (start_plane, start_mount)
 }
 
 /// The example sphere: 60 mm across, 0.8 m in front of the robot base.
@@ -152,6 +193,40 @@ pub fn render_sphere(
             sheet(options.peak, options.sigma_m, plane.signed_distance_m(&p))
         },
     )
+}
+
+/// The scans of `scene` from the robot poses `base_from_gripper`: each
+/// pose's laser image rendered ([`render_sphere`], default options, the
+/// emitter [`example_emitter`], noise seed `first_seed + k` for pose `k`)
+/// and its stripe extracted (default [`StripeOptions`]).
+pub fn rendered_scans(
+    camera: &Camera,
+    base_from_gripper: &[Pose],
+    gripper_from_camera: &Pose,
+    plane: &LaserPlane,
+    scene: &SphereScene,
+    first_seed: u64,
+) -> crate::error::Result<Vec<SphereScan>> {
+    let emitter = example_emitter(plane);
+    let mut scans = Vec::with_capacity(base_from_gripper.len());
+    for (k, b) in base_from_gripper.iter().enumerate() {
+        let options = SphereRenderOptions {
+            seed: first_seed + k as u64,
+            ..SphereRenderOptions::default()
+        };
+        let base_from_camera = b * gripper_from_camera;
+        let image = render_sphere(camera, &base_from_camera, plane, &emitter, scene, &options)?;
+        let stripe = extract_stripe(&image, None, &StripeOptions::default())?;
+        scans.push(SphereScan {
+            base_from_gripper: *b,
+            pixels: stripe
+                .points
+                .iter()
+                .map(|p| Point2::new(p.x_px, p.y_px))
+                .collect(),
+        });
+    }
+    Ok(scans)
 }
 
 /// Where the ray `t dir` (unit `dir`, t > 0) first meets the sphere.

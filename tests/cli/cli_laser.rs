@@ -384,10 +384,11 @@ fn a_tilted_sensor_camera_calibrates_and_finds_the_plane() {
 /// mounting. The report's plane is read by `laser points` and `export`.
 #[test]
 fn sphere_scans_give_the_plane_and_the_mounting() {
-    use robocal::geometry::{pose_from_params, PoseJson};
+    use robocal::geometry::PoseJson;
     use robocal::synth::laser_scene::example_plane;
     use robocal::synth::laser_sphere::{
-        example_mounting, example_sphere, render_sphere, sphere_scan_poses, SphereRenderOptions,
+        example_emitter, example_mounting, example_sphere, example_starts, render_sphere,
+        sphere_scan_poses, SphereRenderOptions,
     };
     let dir = temp_dir("cli-laser", "sphere");
     let camera_path = camera_file(&dir);
@@ -396,7 +397,7 @@ fn sphere_scans_give_the_plane_and_the_mounting() {
             .unwrap()
             .0;
     let (plane, mount, scene) = (example_plane(), example_mounting(), example_sphere());
-    let emitter = nalgebra::Point3::from(plane.normal.into_inner() * plane.distance_m);
+    let emitter = example_emitter(&plane);
     let mut args: Vec<String> = vec![
         "laser".into(),
         "sphere".into(),
@@ -437,17 +438,14 @@ fn sphere_scans_give_the_plane_and_the_mounting() {
     args.extend(images);
     // Start values: the plane turned 1 deg and 2 mm off, the mounting 2 deg
     // and 5 mm off.
-    let turn = nalgebra::Rotation3::from_scaled_axis(
-        nalgebra::Vector3::new(0.6, 0.8, 0.0) * 1f64.to_radians(),
-    );
-    let n0 = turn * plane.normal.into_inner();
+    let (start_plane, start_mount) = example_starts(&plane, &mount);
+    let n0 = start_plane.normal;
     std::fs::write(
         dir.join("start_plane.json"),
-        json!({"normal_camera": [n0.x, n0.y, n0.z], "distance_m": plane.distance_m + 0.002})
+        json!({"normal_camera": [n0.x, n0.y, n0.z], "distance_m": start_plane.distance_m})
             .to_string(),
     )
     .unwrap();
-    let start_mount = mount * pose_from_params(&[0.02, -0.025, 0.01, 0.004, -0.003, 0.0]);
     std::fs::write(
         dir.join("start_mount.json"),
         serde_json::to_string(&PoseJson::from(&start_mount)).unwrap(),

@@ -3,9 +3,9 @@
 //! calls: the image path (views and a camera, no `refine`), whose PnP poses
 //! take the camera as given.
 //!
-//! Scene: `synth::handeye_looking`, eye-in-hand, 20 views of a 9x6 grid
-//! (30 mm) at 0.5 m +-10 %, 1280x960 at f = 1100 px, pixel noise 0.2 px,
-//! robot noise 0.1 mm / 0.02 deg per axis (the cells of
+//! Scene: `synth::handeye_looking::observe_looking`, eye-in-hand, 20 views
+//! of a 9x6 grid (30 mm) at 0.5 m +-10 %, 1280x960 at f = 1100 px, pixel
+//! noise 0.2 px, robot noise 0.1 mm / 0.02 deg per axis (the cells of
 //! examples/handeye_coverage.rs). Given a camera with fx = fy = 1111 px
 //! (1 % long), the report must name the focal length and its std must
 //! cover the truth (3 std on every component); given the right camera, no
@@ -15,8 +15,7 @@ use robocal::api::handeye::solve_handeye_json;
 use robocal::camera::Camera;
 use robocal::geometry::PoseJson;
 use robocal::handeye::{Pose, Setup};
-use robocal::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
-use robocal::synth::Rng;
+use robocal::synth::handeye_looking::{observe_looking, LookingConfig, LookingNoise};
 use serde_json::{json, Value};
 
 /// The report of one solve, the camera's focal length `f` (px).
@@ -30,17 +29,20 @@ fn solve(f: f64, seed: u64) -> (Value, Pose) {
         max_tilt_deg: 30.0,
         max_roll_deg: 60.0,
     };
-    let scene = looking_scene(&config, seed);
-    let mut rng = Rng::new(seed ^ 0xc0ffee);
-    let views = grid_pixels(&scene, &truth, 0.2, &mut rng);
-    let (sr, st) = (0.02f64.to_radians(), 0.1e-3);
-    let robots: Vec<Value> = scene
+    let noise = LookingNoise {
+        pixel_sigma: 0.2,
+        robot_sigma: (0.02f64.to_radians(), 0.1e-3),
+        kinematic: None,
+    };
+    let seen = observe_looking(&config, seed, &truth, &noise, seed ^ 0xc0ffee);
+    let robots: Vec<Value> = seen
         .base_from_gripper
         .iter()
-        .map(|p| serde_json::to_value(PoseJson::from(&perturbed(&mut rng, p, [sr; 3], [st; 3]))))
+        .map(|p| serde_json::to_value(PoseJson::from(p)))
         .collect::<Result<_, _>>()
         .unwrap();
-    let views: Vec<Value> = views
+    let views: Vec<Value> = seen
+        .views
         .iter()
         .map(|v| {
             json!({
@@ -58,7 +60,7 @@ fn solve(f: f64, seed: u64) -> (Value, Pose) {
         "strict_checks": false,
     });
     let out = solve_handeye_json(&input.to_string()).unwrap_or_else(|e| panic!("{e}"));
-    (serde_json::from_str(&out).unwrap(), scene.x_true)
+    (serde_json::from_str(&out).unwrap(), seen.scene.x_true)
 }
 
 fn focal_warnings(report: &Value) -> Vec<String> {

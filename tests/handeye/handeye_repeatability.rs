@@ -150,45 +150,28 @@ fn misspecified(
     kinematic: bool,
     focal_error: f64,
 ) -> (robocal::handeye::HandEyeResult, robocal::handeye::Pose) {
-    use robocal::calib::pnp::camera_from_target_with_covariance;
     use robocal::camera::Camera;
     use robocal::handeye::solve::apply_pose_refinement_from_views;
-    use robocal::handeye::{MotionPairs, Pose};
-    use robocal::synth::handeye_looking::{grid_pixels, kinematic_error};
+    use robocal::handeye::MotionPairs;
+    use robocal::synth::handeye_looking::{observe_looking, LookingNoise};
     let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-    let scene = looking_scene(
-        &LookingConfig {
-            setup: Setup::EyeInHand,
-            views,
-            distance_m: 0.5,
-            grid: (9, 6, 0.03),
-            max_tilt_deg,
-            max_roll_deg,
-        },
-        seed,
-    );
-    let mut rng = Rng::new(seed ^ 0xc0ffee);
-    let pixels = grid_pixels(&scene, &camera, 0.2, &mut rng);
+    let config = LookingConfig {
+        setup: Setup::EyeInHand,
+        views,
+        distance_m: 0.5,
+        grid: (9, 6, 0.03),
+        max_tilt_deg,
+        max_roll_deg,
+    };
+    let noise = LookingNoise {
+        pixel_sigma: 0.2,
+        robot_sigma: (0.02f64.to_radians(), 0.1e-3),
+        kinematic: Some(if kinematic { (0.3, 0.02) } else { (0.0, 0.0) }),
+    };
+    let seen = observe_looking(&config, seed, &camera, &noise, seed ^ 0xc0ffee);
     let f = 1100.0 * (1.0 + focal_error);
     let used = Camera::pinhole(f, f, 639.5, 479.5, 1280, 960);
-    let cams: Vec<Pose> = pixels
-        .iter()
-        .map(|v| camera_from_target_with_covariance(&used, v).unwrap().0)
-        .collect();
-    let amp = if kinematic { (0.3, 0.02) } else { (0.0, 0.0) };
-    let robots: Vec<Pose> = scene
-        .base_from_gripper
-        .iter()
-        .map(|p| {
-            let kin = kinematic_error(p, amp.0, amp.1);
-            perturbed(&mut rng, &kin, [0.02f64.to_radians(); 3], [0.1e-3; 3])
-        })
-        .collect();
-    let input = HandEyeInput {
-        setup: Setup::EyeInHand,
-        base_from_gripper: robots,
-        camera_from_target: cams,
-    };
+    let input = seen.handeye_input(&used).unwrap();
     let options = HandEyeOptions {
         bootstrap_samples: 1,
         refine_poses: false,
@@ -199,12 +182,12 @@ fn misspecified(
     apply_pose_refinement_from_views(
         &mut result,
         &input,
-        &pixels,
+        &seen.views,
         (&used, None),
         MotionPairs::All,
     )
     .unwrap();
-    (result, scene.x_true)
+    (result, seen.scene.x_true)
 }
 
 /// The truth within 3 reported std on all six components of X.

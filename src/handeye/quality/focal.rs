@@ -355,11 +355,9 @@ mod tests {
     /// widened std stay.
     #[test]
     fn check_focal_writes_no_warning_within_the_cameras_fx_std() {
-        use crate::calib::pnp::camera_from_target_with_covariance;
         use crate::handeye::solve::apply_pose_refinement;
         use crate::handeye::{calibrate, HandEyeOptions};
-        use crate::synth::handeye_looking::{grid_pixels, looking_scene, perturbed, LookingConfig};
-        use crate::synth::Rng;
+        use crate::synth::handeye_looking::{observe_looking, LookingConfig, LookingNoise};
         let truth = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
         let config = LookingConfig {
             setup: Setup::EyeInHand,
@@ -369,22 +367,15 @@ mod tests {
             max_tilt_deg: 30.0,
             max_roll_deg: 60.0,
         };
-        let scene = looking_scene(&config, 35);
-        let mut rng = Rng::new(35);
-        let views = grid_pixels(&scene, &truth, 0.01, &mut rng);
-        let used = Camera::pinhole(1100.55, 1100.55, 639.5, 479.5, 1280, 960);
-        let cams: Vec<Pose> = views
-            .iter()
-            .map(|v| camera_from_target_with_covariance(&used, v).unwrap().0)
-            .collect();
-        let robots: Vec<Pose> = (scene.base_from_gripper.iter())
-            .map(|p| perturbed(&mut rng, p, [1e-6; 3], [1e-6; 3]))
-            .collect();
-        let input = HandEyeInput {
-            setup: Setup::EyeInHand,
-            base_from_gripper: robots,
-            camera_from_target: cams,
+        let clean = LookingNoise {
+            pixel_sigma: 0.01,
+            robot_sigma: (1e-6, 1e-6),
+            kinematic: None,
         };
+        let seen = observe_looking(&config, 35, &truth, &clean, 35);
+        let used = Camera::pinhole(1100.55, 1100.55, 639.5, 479.5, 1280, 960);
+        let input = seen.handeye_input(&used).unwrap();
+        let views = seen.views;
         let options = HandEyeOptions {
             bootstrap_samples: 1,
             refine_poses: false,
