@@ -32,7 +32,7 @@ use robocal::handeye::{
 };
 use robocal::optim::wilson::wilson_interval_95;
 use robocal::synth::handeye_looking::{
-    grid_pixels, kinematic_error, looking_scene, perturbed, LookingConfig,
+    grid_pixels, kinematic_error, looking_scene, looking_scene_one_height, perturbed, LookingConfig,
 };
 use robocal::synth::Rng;
 
@@ -46,6 +46,8 @@ struct Cell {
     kinematic: (f64, f64),
     /// Relative focal-length error of the camera used for PnP.
     focal_error: f64,
+    /// Every camera at one height above the board (the flange on one plane).
+    one_height: bool,
 }
 
 /// One trial's outcome.
@@ -81,7 +83,11 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
         max_tilt_deg: cell.max_tilt_deg,
         max_roll_deg: cell.max_roll_deg,
     };
-    let scene = looking_scene(&config, seed);
+    let scene = if cell.one_height {
+        looking_scene_one_height(&config, seed)
+    } else {
+        looking_scene(&config, seed)
+    };
     let mut rng = Rng::new(seed ^ 0xc0ffee);
     let pixels = grid_pixels(&scene, &camera, 0.2, &mut rng);
     let f = 1100.0 * (1.0 + cell.focal_error);
@@ -175,6 +181,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.0, 0.0),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "20 poses, robot kinematic error 0.3 mm / 0.02 deg",
@@ -183,6 +190,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "20 poses, focal length 1 % off",
@@ -191,6 +199,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.0, 0.0),
             focal_error: 0.01,
+            one_height: false,
         },
         Cell {
             name: "4 poses, kinematic error",
@@ -199,6 +208,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "8 poses, kinematic error",
@@ -207,6 +217,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "30 poses, kinematic error + focal 1 %",
@@ -215,6 +226,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.01,
+            one_height: false,
         },
         Cell {
             name: "12 poses, tilts and rolls to 8 deg, kinematic error",
@@ -223,6 +235,25 @@ fn main() {
             max_roll_deg: 8.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
+        },
+        Cell {
+            name: "20 poses at one height, tilts to 10 deg, kinematic error",
+            views: 20,
+            max_tilt_deg: 10.0,
+            max_roll_deg: 60.0,
+            kinematic: (0.3, 0.02),
+            focal_error: 0.0,
+            one_height: true,
+        },
+        Cell {
+            name: "5 poses at one height, tilts to 10 deg, kinematic error",
+            views: 5,
+            max_tilt_deg: 10.0,
+            max_roll_deg: 60.0,
+            kinematic: (0.3, 0.02),
+            focal_error: 0.0,
+            one_height: true,
         },
     ];
     println!(
