@@ -27,7 +27,9 @@ use robocal::handeye::refine::over_poses::camera_noise_from_views;
 use robocal::handeye::solve::{apply_pose_refinement, apply_pose_refinement_from_views};
 use robocal::handeye::{calibrate, HandEyeOptions, HandEyeResult, MotionPairs, Setup};
 use robocal::optim::wilson::wilson_interval_95;
-use robocal::synth::handeye_looking::{observe_looking, LookingConfig, LookingNoise};
+use robocal::synth::handeye_looking::{
+    looking_scene, looking_scene_one_height, observe_scene, LookingConfig, LookingNoise,
+};
 
 struct Cell {
     name: &'static str,
@@ -39,6 +41,8 @@ struct Cell {
     kinematic: (f64, f64),
     /// Relative focal-length error of the camera used for PnP.
     focal_error: f64,
+    /// Every camera at one height above the board (the flange on one plane).
+    one_height: bool,
 }
 
 /// One trial's outcome.
@@ -79,7 +83,12 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
         robot_sigma: (0.02f64.to_radians(), 0.1e-3),
         kinematic: Some(cell.kinematic),
     };
-    let seen = observe_looking(&config, seed, &camera, &measured, seed ^ 0xc0ffee);
+    let scene = if cell.one_height {
+        looking_scene_one_height(&config, seed)
+    } else {
+        looking_scene(&config, seed)
+    };
+    let seen = observe_scene(scene, &camera, &measured, seed ^ 0xc0ffee);
     let scene = &seen.scene;
     let f = 1100.0 * (1.0 + cell.focal_error);
     let used_camera = Camera::pinhole(f, f, 639.5, 479.5, 1280, 960);
@@ -154,6 +163,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.0, 0.0),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "20 poses, robot kinematic error 0.3 mm / 0.02 deg",
@@ -162,6 +172,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "20 poses, focal length 1 % off",
@@ -170,6 +181,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.0, 0.0),
             focal_error: 0.01,
+            one_height: false,
         },
         Cell {
             name: "4 poses, kinematic error",
@@ -178,6 +190,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "8 poses, kinematic error",
@@ -186,6 +199,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
         },
         Cell {
             name: "30 poses, kinematic error + focal 1 %",
@@ -194,6 +208,7 @@ fn main() {
             max_roll_deg: 60.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.01,
+            one_height: false,
         },
         Cell {
             name: "12 poses, tilts and rolls to 8 deg, kinematic error",
@@ -202,6 +217,25 @@ fn main() {
             max_roll_deg: 8.0,
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
+            one_height: false,
+        },
+        Cell {
+            name: "20 poses at one height, tilts to 10 deg, kinematic error",
+            views: 20,
+            max_tilt_deg: 10.0,
+            max_roll_deg: 60.0,
+            kinematic: (0.3, 0.02),
+            focal_error: 0.0,
+            one_height: true,
+        },
+        Cell {
+            name: "5 poses at one height, tilts to 10 deg, kinematic error",
+            views: 5,
+            max_tilt_deg: 10.0,
+            max_roll_deg: 60.0,
+            kinematic: (0.3, 0.02),
+            focal_error: 0.0,
+            one_height: true,
         },
     ];
     println!(

@@ -61,6 +61,19 @@ fn random_rotation(rng: &mut Rng, max_angle: f64) -> UnitQuaternion<f64> {
 
 /// Generate a scene from a seed.
 pub fn looking_scene(config: &LookingConfig, seed: u64) -> LookingScene {
+    scene(config, seed, false)
+}
+
+/// The same scene, but every camera at one height above the board (its
+/// distance along the board normal is `distance_m` for every view, so the
+/// robot's flange stays on one horizontal plane): the weak geometry of a
+/// user who only tilts and turns the gripper at one height. The random
+/// draws are those of [`looking_scene`] with the same seed.
+pub fn looking_scene_one_height(config: &LookingConfig, seed: u64) -> LookingScene {
+    scene(config, seed, true)
+}
+
+fn scene(config: &LookingConfig, seed: u64, one_height: bool) -> LookingScene {
     let mut rng = Rng::new(seed);
     let (cols, rows, spacing) = config.grid;
     let object_points: Vec<Point3<f64>> = (0..rows)
@@ -118,7 +131,12 @@ pub fn looking_scene(config: &LookingConfig, seed: u64) -> LookingScene {
         let z_c = Rotation3::from_scaled_axis(tilt_axis * tilt) * Vector3::z();
         let aim =
             centre + Vector3::new(rng.range(-0.05, 0.05), rng.range(-0.05, 0.05), 0.0) * board;
-        let distance = config.distance_m * rng.range(0.9, 1.1);
+        let spread = rng.range(0.9, 1.1);
+        let distance = if one_height {
+            config.distance_m / z_c.z
+        } else {
+            config.distance_m * spread
+        };
         let position = aim - z_c * distance;
         let x_c0 = Vector3::y().cross(&z_c).normalize();
         let x_c = Rotation3::from_scaled_axis(z_c * roll) * x_c0;
@@ -245,7 +263,17 @@ pub fn observe_looking(
     noise: &LookingNoise,
     noise_seed: u64,
 ) -> LookingObserved {
-    let scene = looking_scene(config, seed);
+    observe_scene(looking_scene(config, seed), camera, noise, noise_seed)
+}
+
+/// `scene` (e.g. [`looking_scene_one_height`]'s) seen through `camera` and
+/// moved by a robot with `noise`, as [`observe_looking`] does.
+pub fn observe_scene(
+    scene: LookingScene,
+    camera: &Camera,
+    noise: &LookingNoise,
+    noise_seed: u64,
+) -> LookingObserved {
     let mut rng = Rng::new(noise_seed);
     let views = grid_pixels(&scene, camera, noise.pixel_sigma, &mut rng);
     let (sr, st) = noise.robot_sigma;
@@ -389,6 +417,54 @@ mod tests {
                 54,
                 "view {k}: points in the image"
             );
+        }
+    }
+
+    /// One height: every camera centre lies `distance_m` above the board
+    /// (target z = -distance), the views keep their tilts and the chain
+    /// closes; the plain scene of the same seed varies its heights.
+    #[wasm_bindgen_test(unsupported = test)]
+    fn a_one_height_scene_keeps_every_camera_at_the_distance() {
+        let config = LookingConfig {
+            setup: Setup::EyeInHand,
+            views: 12,
+            distance_m: 0.5,
+            grid: (9, 6, 0.03),
+            max_tilt_deg: 10.0,
+            max_roll_deg: 60.0,
+        };
+        let flat = looking_scene_one_height(&config, 3);
+        let plain = looking_scene(&config, 3);
+        let heights = |s: &LookingScene| -> Vec<f64> {
+            s.camera_from_target
+                .iter()
+                .map(|p| p.inverse().translation.vector.z)
+                .collect()
+        };
+        for (k, z) in heights(&flat).iter().enumerate() {
+            assert!((z + 0.5).abs() < 1e-12, "view {k}: camera at z = {z} m");
+        }
+        let spread = heights(&plain)
+            .iter()
+            .fold(0.0f64, |m, z| m.max((z + 0.5).abs()));
+        assert!(spread > 0.01, "plain scene heights within {spread} m");
+        // The same draws: the same orientations.
+        for (a, b) in flat
+            .camera_from_target
+            .iter()
+            .zip(&plain.camera_from_target)
+        {
+            assert!(a.rotation.angle_to(&b.rotation) < 1e-12);
+        }
+        for (k, (robot, camera)) in flat
+            .base_from_gripper
+            .iter()
+            .zip(&flat.camera_from_target)
+            .enumerate()
+        {
+            let y = robot * flat.x_true * camera;
+            let d = (y.to_homogeneous() - flat.y_true.to_homogeneous()).amax();
+            assert!(d < 1e-12, "view {k}: chain off by {d}");
         }
     }
 }
