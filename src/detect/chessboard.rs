@@ -225,7 +225,14 @@ fn is_x_junction(
     radius: f64,
     unit: &[(f64, f64); RING_SAMPLES],
 ) -> bool {
-    let r = radius.max(2.0);
+    // Near the image border the ring shrinks to stay inside it: clamped
+    // samples beyond the border repeat its last row or column and break
+    // the point symmetry of a corner a few pixels from the edge.
+    let inside =
+        p.x.min(p.y)
+            .min(plane.w as f64 - 1.0 - p.x)
+            .min(plane.h as f64 - 1.0 - p.y);
+    let r = radius.min(inside - 1.0).max(2.0);
     let vals: [f32; RING_SAMPLES] =
         std::array::from_fn(|k| plane.bilinear(p.x + r * unit[k].0, p.y + r * unit[k].1));
     let (lo, hi) = vals

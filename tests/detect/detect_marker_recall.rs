@@ -165,8 +165,14 @@ fn small_low_contrast_aprilgrid_tags_are_read() {
     eprintln!("small AprilGrid: {found} of {total} corners, {wrong} wrong, worst {worst:.3} px");
     assert_eq!(wrong, 0, "no wrong id, no point off");
     // Measured 2026-12-07: 84 of 2520 (36h11 tags of 18-24 px have cells
-    // of 1.8-2.4 px); a floor against regressions.
-    assert!(found >= 75, "{found} of {total}");
+    // of 1.8-2.4 px), 104 with the full-resolution search for small
+    // markers, 508 since a tag the board places is read with its own
+    // threshold and up to 6 wrong bits (`read_expected`); a floor against
+    // regressions. OpenCV 4.14's ArucoDetector (36h11, border 2, with or
+    // without refineDetectedMarkers) reads no tag of these renders, and its
+    // CharucoDetector 266 of the 972 ChArUco corners above
+    // (benches/marker_recall_opencv.py).
+    assert!(found >= 480, "{found} of {total}");
 }
 
 #[test]

@@ -8,7 +8,8 @@
 //! board corners into the image. There its sides are
 //! fitted to the image's edges ([`refine_quad`]) and its cells are read
 //! with looser contrast and border limits than a search without a place
-//! ([`read_expected`]); it is kept only when it reads as the predicted id,
+//! (and, from 6 x 6 bits on, with the expected marker's own threshold
+//! too: [`read_expected`]); it is kept only when it reads as the predicted id,
 //! in the predicted rotation, with at most [`recover_bit_errors`] wrong
 //! bits, and when its fitted corners stay within [`MAX_SHIFT_FRACTION`] of
 //! its side of the prediction. Markers recovered in one round help place
@@ -39,11 +40,16 @@ const MAX_SHIFT_FRACTION: f64 = 0.25;
 const ROUNDS: usize = 3;
 
 /// Wrong bits a recovered marker may have: an eighth of its inner bits (at
-/// least one): 2 for 4 x 4 markers, 3 for 5 x 5, 4 for 6 x 6 (the id and
-/// the rotation are known, so a random pattern passes with a chance of
-/// about 0.2 % for 4 x 4 and far less for the larger ones).
+/// least one) for markers under 6 x 6, 2 for 4 x 4 and 3 for 5 x 5; a
+/// sixth from 6 x 6 on, 6 for 6 x 6 and 8 for 7 x 7 (the id and the
+/// rotation are known, so a random pattern passes with a chance of 0.2 %
+/// for 4 x 4, 0.008 % for 5 x 5, 0.003 % for 6 x 6; an eighth, 4 wrong
+/// bits, left AprilGrid tags of 2.2 px cells unread that the board placed
+/// and that read within 6 at their place: see [`read_expected`]).
 pub(crate) fn recover_bit_errors(marker_bits: usize) -> u32 {
-    ((marker_bits * marker_bits) / 8).max(1) as u32
+    let inner = marker_bits * marker_bits;
+    let share = if marker_bits >= 6 { 6 } else { 8 };
+    (inner / share).max(1) as u32
 }
 
 /// The markers of `layout` missing from `mine` (board index, marker) that
