@@ -393,6 +393,12 @@ fn measure_splined_against_the_parametric_models_and_the_warp() {
             }
         };
         let sigma = predicted_std(&splined, &grid);
+        let folds = splined
+            .warnings
+            .iter()
+            .filter(|w| w.contains("fold"))
+            .count();
+        println!("  splined: {folds} fold warnings");
         for name in ["brown", "rational", "kannala_brandt", "eucm", "splined"] {
             let t0 = std::time::Instant::now();
             let report = match name {
@@ -443,15 +449,21 @@ fn measure_splined_against_the_parametric_models_and_the_warp() {
         println!(
             "  splined predicted std in the valid region: median {s_med:.3} px, max {s_max:.3} px"
         );
+        let fit_views = |views: &[View]| {
+            calibrate(
+                views,
+                size,
+                &CalibrationOptions {
+                    model: Distortion::named("splined").expect("model"),
+                    ..CalibrationOptions::default()
+                },
+            )
+        };
         // Other scenes through the same lens: the splined fit alone.
         for seed in [11, 23] {
             let scene = Scene::calibration(seed, &truth, (10, 10), 0.03, 40, 0.1).expect("scene");
             let grid = valid_grid(&scene.views, size);
-            let options = CalibrationOptions {
-                model: Distortion::named("splined").expect("model"),
-                ..CalibrationOptions::default()
-            };
-            let Ok(r) = calibrate(&scene.views, size, &options) else {
+            let Ok(r) = fit_views(&scene.views) else {
                 println!("  seed {seed}: splined failed");
                 continue;
             };
@@ -468,12 +480,32 @@ fn measure_splined_against_the_parametric_models_and_the_warp() {
                 .filter(|(e, s)| **e > 4.5 * **s)
                 .count();
             let worst = errors.iter().copied().fold(0.0, f64::max);
+            let folds = r.warnings.iter().filter(|w| w.contains("fold")).count();
             println!(
                 "  seed {seed}: splined rms {:.3} px, worst {worst:.3} px, worst error / noise bound {ratio:.2}, \
-                 {over} of {} grid pixels beyond 1.5x the bound",
+                 {over} of {} grid pixels beyond 1.5x the bound, {folds} fold warnings",
                 r.rms_px,
                 grid.len()
             );
+        }
+        // The same scene without noise: what remains is the fit's bias
+        // (the prior's, where the data leave control values open).
+        let scene = Scene::calibration(5, &truth, (10, 10), 0.03, 40, 0.0).expect("scene");
+        let grid = valid_grid(&scene.views, size);
+        match fit_views(&scene.views) {
+            Ok(r) => {
+                let errors = aligned_errors(&truth, &r.camera, &grid);
+                let (i, worst) =
+                    errors
+                        .iter()
+                        .enumerate()
+                        .fold((0, 0.0), |a, (i, e)| if *e > a.1 { (i, *e) } else { a });
+                println!(
+                    "  noise-free, seed 5: splined worst {worst:.3} px in the valid region at ({:.0}, {:.0})",
+                    grid[i].x, grid[i].y
+                );
+            }
+            Err(e) => println!("  noise-free: splined failed: {e}"),
         }
     }
     let flat_truth = Camera::example_brown();
