@@ -1,11 +1,11 @@
 //! Calibration with the splined lens model ([`crate::camera::splined`]):
 //! a parametric fit first (EUCM, which follows narrow and fisheye lenses
-//! alike; Kannala-Brandt when it fails), a spline fitted to reproduce it
-//! over the image, then the bundle adjustment of the spline with the base projection (fx fy cx cy)
-//! held at the parametric fit's (the spline's constant and linear terms
-//! would otherwise trade with them), its smoothness prior keeping the
-//! correction smooth where no point falls; and the report's data-support
-//! mask of the knots.
+//! alike; Kannala-Brandt when that fit fails), a spline fitted to reproduce
+//! it over the image, then the bundle adjustment of the spline with the
+//! base projection (fx fy cx cy) held at the parametric fit's (the spline's
+//! constant and linear terms would otherwise trade with them), its
+//! smoothness prior keeping the correction smooth where no point falls;
+//! and the report's data-support mask of the knots.
 
 use super::refine::{block_from_pose, CalibProblem};
 use super::zhang::{calibrate_from, calibrate_usable, CalibrationOptions};
@@ -82,7 +82,7 @@ pub(crate) fn calibrate_splined(
     // a lens's local bumps and carries that wiggle into the border cells
     // where one or two points hold the spline, and the prior kept it there
     // (noise-free bias 1.24 px vs 0.13 px, BENCHMARKS 17 L3). It is the
-    // fallback when EUCM does not converge.
+    // fallback when the EUCM fit fails.
     let prefit = |model: Distortion| {
         calibrate_usable(
             views,
