@@ -2,7 +2,7 @@
 // x 100 points in the browser under 10 s"): 40 views of a 10x10 board
 // (30 mm pitch) through a fisheye (Kannala-Brandt, fx 420 on 1280x960),
 // 0.1 px noise, every view with all 100 points in the image, solved with
-// `calibrate_camera` and the default 12x8 cubic spline (its Kannala-Brandt
+// `calibrate_camera` and the default 12x8 cubic spline (its parametric
 // pre-fit included).
 // Usage (crate root, after `make pkg`):
 //   node benches/wasm_splined.mjs [--repeat N] [--knots NXxNY] [--dump FILE] [PKG_JS]

@@ -3,7 +3,7 @@
 //!
 //! Usage: `node benches/wasm_splined.mjs --dump IN.json`, then
 //! `cargo run --release --example splined_time -- IN.json [--runs N]`.
-//! Runs `robocal::api::camera::calibrate_json` (the Kannala-Brandt pre-fit
+//! Runs `robocal::api::camera::calibrate_json` (the parametric pre-fits
 //! and the model advice included, as the page's call); prints every run's
 //! wall time, the rms and the median.
 

@@ -1,11 +1,11 @@
 //! Calibration with the splined lens model ([`crate::camera::splined`]):
-//! a parametric fit first (Kannala-Brandt, which follows narrow and fisheye
-//! lenses alike), a spline fitted to reproduce it over the image, then the
-//! bundle adjustment of the spline with the base projection (fx fy cx cy)
-//! held at the parametric fit's (the spline's constant and linear terms
-//! would otherwise trade with them), its smoothness prior keeping the
-//! correction smooth where no point falls; and the report's data-support
-//! mask of the knots.
+//! a parametric fit first (EUCM, or Kannala-Brandt where EUCM fits
+//! clearly worse: a pincushion lens), a spline fitted to reproduce
+//! it over the image, then the bundle adjustment of the spline with the
+//! base projection (fx fy cx cy) held at the parametric fit's (the spline's
+//! constant and linear terms would otherwise trade with them), its
+//! smoothness prior keeping the correction smooth where no point falls;
+//! and the report's data-support mask of the knots.
 
 use super::refine::{block_from_pose, CalibProblem};
 use super::zhang::{calibrate_from, calibrate_usable, CalibrationOptions};
@@ -67,6 +67,11 @@ pub(crate) fn coverage_cell(x: f64, y: f64, size: (u32, u32)) -> Option<(usize, 
     inside.then_some((cx as usize, cy as usize))
 }
 
+/// How much larger the EUCM pre-fit's RMS may be than Kannala-Brandt's for
+/// the splined fit to start from EUCM (on the bumpy lenses of BENCHMARKS 17
+/// L3 the two are within 1 %; on a pincushion lens EUCM's is 12x).
+const PREFIT_RMS_RATIO: f64 = 1.25;
+
 /// [`super::calibrate`] for a splined model without a given camera: the
 /// parametric fit, the spline that reproduces it, the spline's fit.
 pub(crate) fn calibrate_splined(
@@ -75,17 +80,42 @@ pub(crate) fn calibrate_splined(
     options: &CalibrationOptions,
     spline: &Spline,
 ) -> Result<CameraCalibration> {
-    let parametric = CalibrationOptions {
-        model: Distortion::KannalaBrandt {
-            k1: 0.0,
-            k2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-        },
-        fixed_coefficients: Vec::new(),
-        ..options.clone()
+    // The start, and the lens the smoothness prior measures the spline's
+    // change from: the smoother of two parametric fits when it fits about
+    // as well. EUCM's two shape parameters cannot bend between the data and
+    // the border; Kannala-Brandt's four-term polynomial also fits the
+    // radial average of a lens's local bumps and carries that wiggle into
+    // the border cells where one or two points hold the spline, and the
+    // prior kept it there (noise-free bias 1.24 px vs 0.13 px through a
+    // fisheye, BENCHMARKS 17 L3). EUCM cannot follow a pincushion lens
+    // (rms 7.8 px vs KB's 0.63 px on one): Kannala-Brandt then.
+    let prefit = |model: Distortion| {
+        calibrate_usable(
+            views,
+            image_size_px,
+            &CalibrationOptions {
+                model,
+                fixed_coefficients: Vec::new(),
+                ..options.clone()
+            },
+        )
     };
-    let first = calibrate_usable(views, image_size_px, &parametric)?;
+    let kannala_brandt = prefit(Distortion::KannalaBrandt {
+        k1: 0.0,
+        k2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+    });
+    let eucm = prefit(Distortion::Eucm {
+        alpha: 0.5,
+        beta: 1.0,
+    });
+    let first = match (eucm, kannala_brandt) {
+        (Ok(e), Ok(k)) if e.rms_px <= PREFIT_RMS_RATIO * k.rms_px => e,
+        (_, Ok(k)) => k,
+        (Ok(e), Err(_)) => e,
+        (Err(_), Err(k)) => return Err(k),
+    };
     let start = first.camera.splined_like(spline)?;
     // The parametric fit's poses: its rays through the points are the
     // spline's start's, so the bundle adjustment starts near its minimum
