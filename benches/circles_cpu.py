@@ -17,6 +17,12 @@ detection alone by default, decoding + detection with --cli.
 
 Usage (crate root, after `cargo build --release --example detect_time`):
   python3 benches/circles_cpu.py [--runs N] [--out benches/out] [--cli PATH]
+                                 [--truth FILE] [--bin PATH]
+
+--bin: another detect_time binary (e.g. one built before a change).
+--truth: another set file in render_set's truth.json format ({set: {target,
+opencv_pattern, images: [{file, points}]}}), e.g. dot plates rendered by
+`robocal render` (findCirclesGrid reads a dot plate as a symmetric grid).
 """
 import json
 import os
@@ -52,9 +58,9 @@ def main():
     runs = int(arg("--runs", "20"))
     out_dir = arg("--out", os.path.join(HERE, "out"))
     cli = arg("--cli", None)
-    binary = cli or os.path.join(ROOT, "target", "release", "examples", "detect_time")
+    binary = cli or arg("--bin", os.path.join(ROOT, "target", "release", "examples", "detect_time"))
     out_json = os.path.join(out_dir, "circles_cpu.robocal.json")
-    truth = json.load(open(os.path.join(out_dir, "truth.json")))
+    truth = json.load(open(arg("--truth", os.path.join(out_dir, "truth.json"))))
     cv2.setNumThreads(1)
     print(f"OpenCV {cv2.__version__} findCirclesGrid vs {binary}; CPU ms per call, "
           f"{runs} calls per image; load {os.getloadavg()[0]:.1f}")

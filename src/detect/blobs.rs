@@ -295,7 +295,7 @@ fn floor(v: f64) -> f64 {
     }
 }
 
-#[inline]
+#[inline(always)]
 pub(crate) fn bilinear_u8(img: &GrayImage, x: f64, y: f64) -> f64 {
     let (w, h) = (img.width as isize, img.height as isize);
     let (x0, y0) = (floor(x), floor(y));

@@ -39,18 +39,25 @@ impl Runs {
         }
     }
 
-    /// Appends one row's mask as runs.
-    fn push_row(&mut self, mask: &[bool]) {
+    /// Appends one row's mask (0: not dark, 1: dark) as runs.
+    fn push_row(&mut self, mask: &[u8]) {
         self.row_start.push(self.spans.len());
         let mut x = 0;
         let w = mask.len();
         while x < w {
-            if !mask[x] {
+            // Most of a row is not dark: eight pixels at a time.
+            if let Some(word) = mask.get(x..x + 8) {
+                if word.iter().fold(0u8, |a, &m| a | m) == 0 {
+                    x += 8;
+                    continue;
+                }
+            }
+            if mask[x] == 0 {
                 x += 1;
                 continue;
             }
             let x0 = x;
-            while x < w && mask[x] {
+            while x < w && mask[x] != 0 {
                 x += 1;
             }
             self.spans.push((x0 as u32, x as u32));
@@ -98,14 +105,12 @@ pub(crate) fn dark_runs_u8(img: &GrayImage, invert: bool) -> Runs {
     for &p in &img.pixels {
         hist[(p ^ flip) as usize] += 1;
     }
-    let p5 = percentile(&hist, w * h, 0.05) as i64;
+    let p5 = percentile(&hist, w * h, 0.05) as i32;
     let r = window_radius(w, h);
-    let cols: Vec<(usize, usize, i64)> = (0..w)
-        .map(|x| {
-            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
-            (x0, x1, (x1 - x0) as i64)
-        })
-        .collect();
+    // Each column's window [x0, x1) and its width.
+    let x0s: Vec<usize> = (0..w).map(|x| x.saturating_sub(r)).collect();
+    let x1s: Vec<usize> = (0..w).map(|x| (x + r + 1).min(w)).collect();
+    let widths: Vec<i32> = x0s.iter().zip(&x1s).map(|(a, b)| (b - a) as i32).collect();
     // Column sums over the window's rows (the window of row 0 first). Every
     // sum here is at most the image's total, below 2^32 (`fits_u8`).
     let mut col_sum = vec![0u32; w];
@@ -115,8 +120,9 @@ pub(crate) fn dark_runs_u8(img: &GrayImage, invert: bool) -> Runs {
         }
     }
     let mut prefix = vec![0u32; w + 1];
+    let mut sums = vec![0i32; w];
     let mut runs = Runs::new(w, h);
-    let mut mask = vec![false; w];
+    let mut mask = vec![0u8; w];
     for y in 0..h {
         if y > 0 {
             if y + r < h {
@@ -133,15 +139,19 @@ pub(crate) fn dark_runs_u8(img: &GrayImage, invert: bool) -> Runs {
         for x in 0..w {
             prefix[x + 1] = prefix[x] + col_sum[x];
         }
-        let rows = ((y + r + 1).min(h) - y.saturating_sub(r)) as i64;
-        for ((m, &p), &(x0, x1, width)) in mask.iter_mut().zip(row_of(y)).zip(&cols) {
-            let s = (prefix[x1] - prefix[x0]) as i64;
-            let v = (p ^ flip) as i64;
-            // v < mean - max((mean - p5) / 4, 8), times 4 and the window's
-            // area: the test of `dark_runs_plane` in integers.
+        for (s, (&x0, &x1)) in sums.iter_mut().zip(x0s.iter().zip(&x1s)) {
+            *s = (prefix[x1] - prefix[x0]) as i32;
+        }
+        let rows = ((y + r + 1).min(h) - y.saturating_sub(r)) as i32;
+        // v < mean - max((mean - p5) / 4, 8), times 4 and the window's
+        // area: the test of `dark_runs_plane` in integers. In i32: a window
+        // is at most 513x513 pixels (`fits_u8`: the short side is at most
+        // 4096, r at most 256), so 4 * 255 * area < 2^31.
+        for (((m, &p), &s), &width) in mask.iter_mut().zip(row_of(y)).zip(&sums).zip(&widths) {
             let area = rows * width;
+            let v = (p ^ flip) as i32;
             let drop4 = (s - p5 * area).max(32 * area);
-            *m = 4 * v * area < 4 * s - drop4;
+            *m = (4 * v * area < 4 * s - drop4) as u8;
         }
         runs.push_row(&mask);
     }
@@ -176,7 +186,7 @@ pub(crate) fn dark_runs_plane(plane: &Plane, invert: bool) -> Runs {
         })
         .collect();
     let mut runs = Runs::new(w, h);
-    let mut mask = vec![false; w];
+    let mut mask = vec![0u8; w];
     for y in 0..h {
         let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
         let top = &integral[y0 * (w + 1)..(y0 + 1) * (w + 1)];
@@ -189,7 +199,7 @@ pub(crate) fn dark_runs_plane(plane: &Plane, invert: bool) -> Runs {
             // (no division per pixel).
             let area = rows * width;
             let drop = (0.25 * (s - p5 * area)).max(8.0 * area);
-            *m = (val(v) as f64) * area < s - drop;
+            *m = ((val(v) as f64) * area < s - drop) as u8;
         }
         runs.push_row(&mask);
     }
@@ -374,9 +384,10 @@ mod tests {
         let mut rng = crate::rng::Rng::new(7);
         for density in [0.3, 0.5, 0.62] {
             let mask: Vec<bool> = (0..w * h).map(|_| rng.uniform() < density).collect();
+            let bytes: Vec<u8> = mask.iter().map(|&m| m as u8).collect();
             let mut runs = Runs::new(w, h);
             for y in 0..h {
-                runs.push_row(&mask[y * w..(y + 1) * w]);
+                runs.push_row(&bytes[y * w..(y + 1) * w]);
             }
             runs.finish();
             let got = components(&runs);
