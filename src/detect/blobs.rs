@@ -1,5 +1,6 @@
 //! Dark blobs: a locally adaptive threshold, connected components with
-//! moments, and sub-pixel ellipse refinement at full resolution.
+//! moments ([`super::runs`]), and sub-pixel ellipse refinement at full
+//! resolution.
 //!
 //! A pixel is "dark" when it lies below the local mean (box window of an
 //! eighth of the image) by a quarter of the local mean's distance to the
@@ -8,6 +9,7 @@
 //! step below, not from the threshold.
 
 use super::ellipse::{fit_ellipse, EllipseFit};
+use super::runs;
 use crate::image::filter::Plane;
 use crate::image::GrayImage;
 use nalgebra::{Matrix2, Point2, Vector2};
@@ -32,162 +34,54 @@ pub(crate) struct Blob {
 
 /// Dark blobs of `plane` (set `invert` for light blobs), larger first.
 pub(crate) fn find_blobs(plane: &Plane, invert: bool) -> Vec<Blob> {
-    let (w, h) = (plane.w, plane.h);
-    // Values once, inverted for light blobs.
-    let inverted: Vec<f32>;
-    let vals: &[f32] = if invert {
-        inverted = plane.data.iter().map(|v| 255.0 - v).collect();
-        &inverted
-    } else {
-        &plane.data
-    };
-    // Integral image for the local mean.
-    let mut integral = vec![0.0f64; (w + 1) * (h + 1)];
-    let mut hist = [0usize; 256];
-    for y in 0..h {
-        let mut row = 0.0;
-        let (above, here) = integral.split_at_mut((y + 1) * (w + 1));
-        let above = &above[y * (w + 1)..];
-        for (x, &v) in vals[y * w..(y + 1) * w].iter().enumerate() {
-            hist[v.clamp(0.0, 255.0) as usize] += 1;
-            row += v as f64;
-            here[x + 1] = above[x + 1] + row;
-        }
-    }
-    let p5 = percentile(&hist, w * h, 0.05);
-    let r = (w.min(h) / 16).max(8);
-    // Each column's window, once.
-    let cols: Vec<(usize, usize, f64)> = (0..w)
-        .map(|x| {
-            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
-            (x0, x1, (x1 - x0) as f64)
-        })
-        .collect();
-    let mut mask = vec![false; w * h];
-    for y in 0..h {
-        let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
-        let top = &integral[y0 * (w + 1)..(y0 + 1) * (w + 1)];
-        let bottom = &integral[y1 * (w + 1)..(y1 + 1) * (w + 1)];
-        let rows = (y1 - y0) as f64;
-        let row_vals = &vals[y * w..(y + 1) * w];
-        let row_mask = &mut mask[y * w..(y + 1) * w];
-        for ((m, &v), &(x0, x1, width)) in row_mask.iter_mut().zip(row_vals).zip(&cols) {
-            let s = bottom[x1] - top[x1] - bottom[x0] + top[x0];
-            // v < mean - max((mean - p5) / 4, 8), times the window's area
-            // (no division per pixel).
-            let area = rows * width;
-            let drop = (0.25 * (s - p5 * area)).max(8.0 * area);
-            *m = (v as f64) * area < s - drop;
-        }
-    }
-    components(&mask, w, h)
+    let runs = runs::dark_runs_plane(plane, invert);
+    blobs_of(&runs::components(&runs), plane.w, plane.h)
 }
 
-fn percentile(hist: &[usize; 256], n: usize, q: f64) -> f64 {
-    let target = (q * n as f64) as usize;
-    let mut acc = 0;
-    for (v, c) in hist.iter().enumerate() {
-        acc += c;
-        if acc > target {
-            return v as f64;
-        }
+/// [`find_blobs`] on the 8-bit image itself (the same blobs as on its
+/// float plane, without the plane), for images that fit
+/// [`runs::fits_u8`]; the float path otherwise.
+pub(crate) fn find_blobs_gray(img: &GrayImage, invert: bool) -> Vec<Blob> {
+    if !runs::fits_u8(img) {
+        return find_blobs(&Plane::from_gray(img), invert);
     }
-    255.0
+    let runs = runs::dark_runs_u8(img, invert);
+    blobs_of(
+        &runs::components(&runs),
+        img.width as usize,
+        img.height as usize,
+    )
 }
 
-#[derive(Clone, Default)]
-struct Moments {
-    n: f64,
-    sx: f64,
-    sy: f64,
-    sxx: f64,
-    sxy: f64,
-    syy: f64,
-    border: bool,
-}
-
-/// 4-connected components of `mask` (two passes with union-find).
-fn components(mask: &[bool], w: usize, h: usize) -> Vec<Blob> {
-    let mut label = vec![0u32; w * h];
-    let mut parent: Vec<u32> = vec![0];
-    fn find(parent: &mut [u32], mut a: u32) -> u32 {
-        while parent[a as usize] != a {
-            parent[a as usize] = parent[parent[a as usize] as usize];
-            a = parent[a as usize];
-        }
-        a
-    }
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            if !mask[i] {
-                continue;
-            }
-            let left = if x > 0 { label[i - 1] } else { 0 };
-            let up = if y > 0 { label[i - w] } else { 0 };
-            label[i] = match (left, up) {
-                (0, 0) => {
-                    let l = parent.len() as u32;
-                    parent.push(l);
-                    l
-                }
-                (l, 0) | (0, l) => l,
-                (a, b) => {
-                    let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-                    let (lo, hi) = (ra.min(rb), ra.max(rb));
-                    parent[hi as usize] = lo;
-                    lo
-                }
-            };
-        }
-    }
-    // Every label straight to its root: a parent is always a smaller
-    // label, so in increasing order each parent is already resolved.
-    for l in 1..parent.len() {
-        parent[l] = parent[parent[l] as usize];
-    }
-    let mut moments = vec![Moments::default(); parent.len()];
-    for y in 0..h {
-        for x in 0..w {
-            let l = label[y * w + x];
-            if l == 0 {
-                continue;
-            }
-            let root = parent[l as usize] as usize;
-            let m = &mut moments[root];
-            let (fx, fy) = (x as f64, y as f64);
-            m.n += 1.0;
-            m.sx += fx;
-            m.sy += fy;
-            m.sxx += fx * fx;
-            m.sxy += fx * fy;
-            m.syy += fy * fy;
-            m.border |= x == 0 || y == 0 || x == w - 1 || y == h - 1;
-        }
-    }
+/// The components that look like filled ellipses, larger first (equal
+/// areas in raster order of their first pixel).
+fn blobs_of(components: &[runs::Moments], w: usize, h: usize) -> Vec<Blob> {
     let max_area = (w * h) as f64 / 4.0;
-    let mut blobs: Vec<Blob> = moments
+    let mut blobs: Vec<Blob> = components
         .iter()
-        .filter(|m| m.n >= MIN_BLOB_AREA_PX && m.n <= max_area && !m.border)
         .filter_map(|m| {
-            let (cx, cy) = (m.sx / m.n, m.sy / m.n);
+            let n = m.n as f64;
+            if n < MIN_BLOB_AREA_PX || n > max_area || m.border {
+                return None;
+            }
+            let (cx, cy) = (m.sx as f64 / n, m.sy as f64 / n);
             let cov = Matrix2::new(
-                m.sxx / m.n - cx * cx + 1.0 / 12.0,
-                m.sxy / m.n - cx * cy,
-                m.sxy / m.n - cx * cy,
-                m.syy / m.n - cy * cy + 1.0 / 12.0,
+                m.sxx as f64 / n - cx * cx + 1.0 / 12.0,
+                m.sxy as f64 / n - cx * cy,
+                m.sxy as f64 / n - cx * cy,
+                m.syy as f64 / n - cy * cy + 1.0 / 12.0,
             );
             let det = cov.determinant();
             if det <= 0.0 {
                 return None;
             }
-            let fill = m.n / (4.0 * std::f64::consts::PI * det.sqrt());
+            let fill = n / (4.0 * std::f64::consts::PI * det.sqrt());
             let eig = cov.symmetric_eigenvalues();
             let elong = (eig.max() / eig.min().max(1e-9)).sqrt();
             (fill >= FILL_RANGE.0 && fill <= FILL_RANGE.1 && elong <= MAX_ELONGATION).then(|| {
                 Blob {
                     centre: Point2::new(cx, cy),
-                    area: m.n,
+                    area: n,
                     cov,
                 }
             })
@@ -227,6 +121,15 @@ pub(crate) fn refine_blob(
         }
     };
     let cov_inv = cov.try_inverse()?;
+    // Each ray's direction and its reach: the moment ellipse's boundary
+    // (Mahalanobis distance 2), the same for both passes.
+    let rays: Vec<(Vector2<f64>, f64)> = (0..RAYS)
+        .map(|k| {
+            let phi = k as f64 / RAYS as f64 * std::f64::consts::TAU;
+            let d = Vector2::new(phi.cos(), phi.sin());
+            (d, 2.0 / (d.transpose() * cov_inv * d)[(0, 0)].sqrt())
+        })
+        .collect();
     let mut c = centre;
     let mut fit = None;
     for pass in 0..2 {
@@ -234,11 +137,7 @@ pub(crate) fn refine_blob(
         // (most of the time spent here) is for the edges that are kept.
         let centroid = pass == 1;
         let mut edges = Vec::with_capacity(RAYS);
-        for k in 0..RAYS {
-            let phi = k as f64 / RAYS as f64 * std::f64::consts::TAU;
-            let d = Vector2::new(phi.cos(), phi.sin());
-            // Moment ellipse boundary: Mahalanobis distance 2.
-            let r = 2.0 / (d.transpose() * cov_inv * d)[(0, 0)].sqrt();
+        for &(d, r) in &rays {
             if let Some(e) = edge_on_ray(&plane_at, c, d, r, centroid) {
                 edges.push(e);
             }
@@ -280,7 +179,7 @@ const EDGE_CENTROID_TRAVEL_PX: f64 = 1.0;
 /// then, with `centroid`, moved to the centroid of the gradient around it
 /// ([`gradient_centroid`]).
 fn edge_on_ray(
-    sample: &dyn Fn(f64, f64) -> f64,
+    sample: &impl Fn(f64, f64) -> f64,
     c: Point2<f64>,
     d: Vector2<f64>,
     r: f64,
@@ -335,7 +234,7 @@ fn edge_on_ray(
 /// from the twelve views fell from 0.136 to 0.041 px through the strongly
 /// distorted camera, from 0.056 to 0.009 px through the 'std' one
 /// (docs/benchmark-history.md, issue 20, session 16).
-fn gradient_centroid(at: &dyn Fn(f64) -> f64, t0: f64, hw: f64) -> f64 {
+fn gradient_centroid(at: &impl Fn(f64) -> f64, t0: f64, hw: f64) -> f64 {
     let ds = EDGE_SAMPLE_PX;
     // Offsets of the gradient's sample points from t0, in grid steps: the
     // window's reach (travel + half-width) and the half pixel either side.
@@ -396,6 +295,7 @@ fn floor(v: f64) -> f64 {
     }
 }
 
+#[inline(always)]
 pub(crate) fn bilinear_u8(img: &GrayImage, x: f64, y: f64) -> f64 {
     let (w, h) = (img.width as isize, img.height as isize);
     let (x0, y0) = (floor(x), floor(y));

@@ -3,7 +3,7 @@
 //! grids with an odd number of rows are unambiguous), ellipse centres
 //! refined at full resolution.
 
-use super::blobs::{find_blobs, refine_blob, Blob};
+use super::blobs::{find_blobs, find_blobs_gray, refine_blob, Blob};
 use super::centres::circle_centres;
 use super::lattice::{self, PointIndex};
 use super::DetectOptions;
@@ -32,6 +32,11 @@ pub(crate) fn blobs_at_level(
     options: &DetectOptions,
 ) -> (u32, Vec<Blob>) {
     let max_side = options.max_working_side_px.max(BLOB_WORKING_SIDE_PX);
+    // At full resolution the 8-bit image itself is thresholded (no float
+    // copy of it).
+    if super::working_level(img, max_side) == 0 {
+        return (0, find_blobs_gray(img, invert));
+    }
     let levels = super::pyramid_levels(img, max_side);
     match levels.into_iter().next() {
         Some((level, plane)) => (level, find_blobs(&plane, invert)),

@@ -108,6 +108,7 @@ mod lattice;
 pub mod markers;
 pub mod polarity;
 mod refine;
+mod runs;
 mod saddle;
 mod squares;
 
