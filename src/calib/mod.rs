@@ -44,7 +44,6 @@ mod splined_tests;
 pub mod starts;
 mod tsai;
 pub mod usable;
-pub mod view_spread;
 mod zhang;
 
 pub use board_warp::{BoardWarp, WARP_WARNING_MM};

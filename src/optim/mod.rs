@@ -12,7 +12,6 @@
 //! [`BlockProblem::retract`].
 
 pub mod dense;
-mod leave_out;
 mod loss;
 mod normal;
 pub mod student_t;
@@ -21,7 +20,6 @@ pub mod wilson;
 #[cfg(test)]
 mod tests;
 
-pub use leave_out::{leave_block_out_covariance, MIN_BLOCKS};
 pub use loss::Loss;
 
 use crate::error::{Error, Result};
