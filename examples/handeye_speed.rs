@@ -35,17 +35,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn scene_input(poses: usize) -> (LookingScene, HandEyeInput) {
-    let scene = looking_scene(
-        &LookingConfig {
-            setup: Setup::EyeInHand,
-            views: poses,
-            distance_m: 0.5,
-            grid: (9, 6, 0.03),
-            max_tilt_deg: 30.0,
-            max_roll_deg: 60.0,
-        },
-        21,
-    );
+    let scene = looking_scene(&LookingConfig::half_metre(Setup::EyeInHand, poses), 21);
     let mut rng = Rng::new(3);
     let (r, c) = (0.02f64.to_radians(), 0.05f64.to_radians());
     let input = HandEyeInput {

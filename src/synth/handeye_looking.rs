@@ -37,6 +37,21 @@ pub struct LookingConfig {
     pub max_roll_deg: f64,
 }
 
+impl LookingConfig {
+    /// The tests' usual scene: `views` views of a 9x6 grid of 30 mm at
+    /// 0.5 m, tilted up to 30 deg and rolled up to 60 deg.
+    pub fn half_metre(setup: Setup, views: usize) -> Self {
+        LookingConfig {
+            setup,
+            views,
+            distance_m: 0.5,
+            grid: (9, 6, 0.03),
+            max_tilt_deg: 30.0,
+            max_roll_deg: 60.0,
+        }
+    }
+}
+
 /// The truth of a scene.
 #[derive(Debug, Clone)]
 pub struct LookingScene {
@@ -381,14 +396,7 @@ mod tests {
     #[wasm_bindgen_test(unsupported = test)]
     fn a_noise_free_observation_gives_the_true_poses() {
         let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-        let config = LookingConfig {
-            setup: Setup::EyeToHand,
-            views: 5,
-            distance_m: 0.5,
-            grid: (9, 6, 0.03),
-            max_tilt_deg: 30.0,
-            max_roll_deg: 60.0,
-        };
+        let config = LookingConfig::half_metre(Setup::EyeToHand, 5);
         let clean = LookingNoise {
             pixel_sigma: 0.0,
             robot_sigma: (0.0, 0.0),

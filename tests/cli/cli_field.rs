@@ -18,14 +18,7 @@ fn line(p: &robocal::handeye::Pose) -> String {
 #[test]
 fn handeye_reports_the_error_at_the_tcp_and_on_held_out_poses() {
     let scene = looking_scene(
-        &LookingConfig {
-            setup: robocal::handeye::Setup::EyeInHand,
-            views: 15,
-            distance_m: 0.5,
-            grid: (9, 6, 0.03),
-            max_tilt_deg: 30.0,
-            max_roll_deg: 60.0,
-        },
+        &LookingConfig::half_metre(robocal::handeye::Setup::EyeInHand, 15),
         21,
     );
     let dir = support::temp_dir("cli_field", "handeye");

@@ -264,14 +264,7 @@ fn camera_poses_are_refined_by_default_and_no_refine_keeps_the_closed_form() {
     use robocal::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
     use robocal::synth::Rng;
     let scene = looking_scene(
-        &LookingConfig {
-            setup: robocal::handeye::Setup::EyeInHand,
-            views: 15,
-            distance_m: 0.5,
-            grid: (9, 6, 0.03),
-            max_tilt_deg: 30.0,
-            max_roll_deg: 60.0,
-        },
+        &LookingConfig::half_metre(robocal::handeye::Setup::EyeInHand, 15),
         21,
     );
     // Robot 0.1 mm / 0.02 deg, camera 0.05 deg and 0.05 / 0.3 mm (x, y / depth).

@@ -21,14 +21,7 @@ use serde_json::{json, Value};
 /// The report of one solve, the camera's focal length `f` (px).
 fn solve(f: f64, seed: u64) -> (Value, Pose) {
     let truth = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-    let config = LookingConfig {
-        setup: Setup::EyeInHand,
-        views: 20,
-        distance_m: 0.5,
-        grid: (9, 6, 0.03),
-        max_tilt_deg: 30.0,
-        max_roll_deg: 60.0,
-    };
+    let config = LookingConfig::half_metre(Setup::EyeInHand, 20);
     let noise = LookingNoise {
         pixel_sigma: 0.2,
         robot_sigma: (0.02f64.to_radians(), 0.1e-3),

@@ -28,14 +28,7 @@ use robocal::synth::Rng;
 #[test]
 fn stochastic_image_refinement_is_at_the_bound_eye_to_hand() {
     let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-    let config = LookingConfig {
-        setup: Setup::EyeToHand,
-        views: 15,
-        distance_m: 0.5,
-        grid: (9, 6, 0.03),
-        max_tilt_deg: 30.0,
-        max_roll_deg: 60.0,
-    };
+    let config = LookingConfig::half_metre(Setup::EyeToHand, 15);
     let (pixel_sigma, sr, st) = (0.2, 0.1f64.to_radians(), 0.5e-3);
     let options = HandEyeOptions {
         bootstrap_samples: 0,

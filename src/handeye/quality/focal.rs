@@ -359,14 +359,7 @@ mod tests {
         use crate::handeye::{calibrate, HandEyeOptions};
         use crate::synth::handeye_looking::{observe_looking, LookingConfig, LookingNoise};
         let truth = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-        let config = LookingConfig {
-            setup: Setup::EyeInHand,
-            views: 12,
-            distance_m: 0.5,
-            grid: (9, 6, 0.03),
-            max_tilt_deg: 30.0,
-            max_roll_deg: 60.0,
-        };
+        let config = LookingConfig::half_metre(Setup::EyeInHand, 12);
         let clean = LookingNoise {
             pixel_sigma: 0.01,
             robot_sigma: (1e-6, 1e-6),

@@ -29,14 +29,7 @@ fn x_error2(est: &Pose, truth: &Pose) -> (f64, f64) {
 /// Eye-in-hand at 0.5 m: a 1280x960 camera, 15 views of a 9x6 board.
 fn eye_in_hand_half_metre() -> (Camera, LookingConfig) {
     let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-    let config = LookingConfig {
-        setup: Setup::EyeInHand,
-        views: 15,
-        distance_m: 0.5,
-        grid: (9, 6, 0.03),
-        max_tilt_deg: 30.0,
-        max_roll_deg: 60.0,
-    };
+    let config = LookingConfig::half_metre(Setup::EyeInHand, 15);
     (camera, config)
 }
 
