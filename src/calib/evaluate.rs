@@ -4,7 +4,7 @@
 //! Jacobian at that estimate scaled by its residual variance.
 
 use super::refine::{block_from_pose, CalibProblem};
-use super::report::build_report;
+use super::report::{build_report, SpreadCheck};
 use super::{CalibrationOptions, CameraCalibration, View};
 use crate::camera::Camera;
 use crate::error::Result;
@@ -96,6 +96,13 @@ fn refine_with(
         ..LmOptions::default()
     };
     let mut result = solve(&problem, &params, &lm)?;
+    // A covariance given from elsewhere (the filter's) is its own
+    // uncertainty: the views' spread is not checked against it.
+    let spread = if covariance.is_some() {
+        SpreadCheck::Skip
+    } else {
+        SpreadCheck::Check
+    };
     if covariance.is_some() {
         result.covariance_global = covariance;
     }
@@ -109,5 +116,6 @@ fn refine_with(
         vec![vec![]; views.len()],
         (camera.width, camera.height),
         &options,
+        spread,
     )
 }

@@ -44,6 +44,7 @@ mod splined_tests;
 pub mod starts;
 mod tsai;
 pub mod usable;
+mod view_spread;
 mod zhang;
 
 pub use board_warp::{BoardWarp, WARP_WARNING_MM};

@@ -6,8 +6,9 @@ use super::refine::{pose_from_block, CalibProblem};
 use super::rejected::{rejected_points, RejectedPoints};
 use super::residuals::{distortion_field, view_residuals, DistortionField, PixelVector};
 use super::starts::StartOutcome;
+use super::view_spread::check_view_spread;
 use super::CalibrationOptions;
-use crate::camera::Camera;
+use crate::camera::{Camera, Distortion};
 use crate::error::Result;
 use crate::geometry::{Pose, PoseJson};
 use crate::optim::{BlockProblem, LmResult, Termination};
@@ -174,12 +175,21 @@ pub struct CameraCalibration {
     pub starts: Vec<StartOutcome>,
 }
 
+/// Whether the report checks the views' agreement against the covariance
+/// ([`super::view_spread`]): not for a covariance given from elsewhere.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SpreadCheck {
+    Check,
+    Skip,
+}
+
 pub(crate) fn build_report(
     problem: &CalibProblem,
     result: &LmResult,
     outliers: Vec<Vec<Outlier>>,
     size: (u32, u32),
     options: &CalibrationOptions,
+    spread: SpreadCheck,
 ) -> Result<CameraCalibration> {
     let camera = problem.camera(&result.params.global)?;
     let names: Vec<String> = camera.param_names().iter().map(|s| s.to_string()).collect();
@@ -187,6 +197,29 @@ pub(crate) fn build_report(
     // The camera is still the least-squares solution; the uncertainty
     // outputs stay empty and a warning says why.
     let covariance = parameter_covariance(result, problem.aspect, names.len());
+    // Views that disagree beyond their residuals widen it (not for a
+    // splined lens: a view alone determines some of its control points).
+    let mut spread_warning = None;
+    let covariance = match covariance {
+        Some(c)
+            if spread == SpreadCheck::Check
+                && !matches!(camera.distortion, Distortion::Splined(_)) =>
+        {
+            let to_camera = |g: &DMatrix<f64>| camera_block(g, problem.aspect, names.len());
+            let checked = check_view_spread(
+                problem,
+                result,
+                &options.loss,
+                &c,
+                &names,
+                problem.aspect.is_some(),
+                to_camera,
+            );
+            spread_warning = checked.warning;
+            Some(checked.covariance)
+        }
+        other => other,
+    };
     let zero = DMatrix::zeros(0, 0);
     let cov = covariance.as_ref().unwrap_or(&zero);
     // Maps filled by insertion: `collect` into a BTreeMap sorts first and
@@ -249,7 +282,8 @@ pub(crate) fn build_report(
     depths.sort_by(f64::total_cmp);
     let depth = depths.get(depths.len() / 2).copied().unwrap_or(1.0);
     let k = camera.camera_matrix();
-    let warnings = warnings(problem, &poses, &correlation, covariance.is_none());
+    let mut warnings = warnings(problem, &poses, &correlation, covariance.is_none());
+    warnings.extend(spread_warning);
     Ok(CameraCalibration {
         kind: ReportKind::Camera,
         robocal_version: crate::VERSION.to_string(),
@@ -286,8 +320,17 @@ fn parameter_covariance(
     aspect: Option<f64>,
     n_camera: usize,
 ) -> Option<DMatrix<f64>> {
-    // The camera's block (a board warp's parameters follow it).
-    let full = result.covariance_global.as_ref()?;
+    Some(camera_block(
+        result.covariance_global.as_ref()?,
+        aspect,
+        n_camera,
+    ))
+}
+
+/// The camera's block of a covariance over the solver's global parameters
+/// (a board warp's parameters follow it), fy's row and column from fx's
+/// when the aspect ratio is held.
+fn camera_block(full: &DMatrix<f64>, aspect: Option<f64>, n_camera: usize) -> DMatrix<f64> {
     let n_camera = n_camera.min(full.nrows());
     let mut c = full.view((0, 0), (n_camera, n_camera)).into_owned();
     if let Some(a) = aspect {
@@ -297,7 +340,7 @@ fn parameter_covariance(
         t[(1, 1)] = 0.0;
         c = &t * c * t.transpose();
     }
-    Some(c)
+    c
 }
 
 fn correlation(names: &[String], c: &DMatrix<f64>) -> Correlation {

@@ -6,7 +6,7 @@ use super::closed_form::{intrinsics_from_homographies, pose_from_homography};
 use super::homography::homography;
 use super::plausibility::{self, aspect_off, not_converged};
 use super::refine::{block_from_pose, BoardExtent, CalibProblem};
-use super::report::{build_report, Outlier};
+use super::report::{build_report, Outlier, SpreadCheck};
 use super::starts::{best_start, converged, StartOutcome};
 use super::usable::{left_out_clause, usable_views, LeftOut};
 use super::{CameraCalibration, View};
@@ -227,6 +227,7 @@ pub(crate) fn calibrate_from(
                 vec![vec![]; views.len()],
                 image_size_px,
                 options,
+                SpreadCheck::Check,
             )?;
             return finish(
                 report,
@@ -246,7 +247,14 @@ pub(crate) fn calibrate_from(
         let (next_used, outliers) = classify(&every, &result.params, &used, k)?;
         if next_used == used || rounds >= options.max_outlier_rounds {
             // 5. The report.
-            let report = build_report(&problem, &result, outliers, image_size_px, options)?;
+            let report = build_report(
+                &problem,
+                &result,
+                outliers,
+                image_size_px,
+                options,
+                SpreadCheck::Check,
+            )?;
             return finish(
                 report,
                 &problem,

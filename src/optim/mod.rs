@@ -11,6 +11,7 @@
 //! [`LmOptions::fixed_blocks`]); manifold parameters (rotations) use
 //! [`BlockProblem::retract`].
 
+mod cluster_robust;
 pub mod dense;
 mod loss;
 mod normal;
@@ -20,6 +21,7 @@ pub mod wilson;
 #[cfg(test)]
 mod tests;
 
+pub use cluster_robust::{cluster_robust_covariance, ClusterRobust, MIN_CLUSTERS};
 pub use loss::Loss;
 
 use crate::error::{Error, Result};

@@ -241,6 +241,11 @@ impl Normal {
         Some((s, v_inv))
     }
 
+    /// `S = U - sum W_i V_i^-1 W_i^T` and the `V_i^-1`, undamped.
+    pub fn schur_undamped(&self) -> Option<(DMatrix<f64>, Vec<DMatrix<f64>>)> {
+        self.schur(|m| m.clone())
+    }
+
     /// Undamped marginal covariances (unscaled: (J^T J)^-1) of the global
     /// parameters and of each block, with zero rows and columns for held
     /// parameters. `None` when J^T J is singular (unobservable parameters).

@@ -1,6 +1,7 @@
 //! Student's t for a std estimated from the data: how much wider a
 //! 3-std interval must be when the std itself rests on few degrees of
-//! freedom.
+//! freedom; and Fisher's F ([`f_upper_quantile`]), for when two estimates
+//! of one variance disagree beyond chance.
 //!
 //! A std estimated from `nu` degrees of freedom (a delete-a-group
 //! jackknife over `G` groups has `G - 1`; a noise scale fitted to `m`
@@ -131,6 +132,41 @@ pub fn coverage_factor(nu: f64) -> f64 {
     two_sided_quantile(GAUSSIAN_TAIL_3, nu) / 3.0
 }
 
+/// `P(F > f)` for Fisher's F with `d1` and `d2` degrees of freedom (the
+/// ratio of two variances estimated from `d1` and `d2` degrees of freedom
+/// when both estimate the same variance).
+pub fn f_upper_tail(f: f64, d1: f64, d2: f64) -> f64 {
+    if !(f > 0.0) {
+        return 1.0;
+    }
+    if !f.is_finite() {
+        return 0.0;
+    }
+    incomplete_beta(d2 / (d2 + d1 * f), 0.5 * d2, 0.5 * d1)
+}
+
+/// The `f` with `P(F > f) = tail` for `d1` and `d2` degrees of freedom
+/// (bisection on the monotone tail; `tail` in (0, 1)).
+pub fn f_upper_quantile(tail: f64, d1: f64, d2: f64) -> f64 {
+    let (mut low, mut high) = (0.0, 1.0);
+    while f_upper_tail(high, d1, d2) > tail && high < 1e12 {
+        low = high;
+        high *= 2.0;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (low + high);
+        if f_upper_tail(mid, d1, d2) > tail {
+            low = mid;
+        } else {
+            high = mid;
+        }
+        if high - low <= 1e-12 * high {
+            break;
+        }
+    }
+    0.5 * (low + high)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,6 +209,25 @@ mod tests {
         }
         let t = two_sided_quantile(GAUSSIAN_TAIL_3, 7.0);
         assert!((two_sided_tail(t, 7.0) - GAUSSIAN_TAIL_3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn f_quantiles_match_tables() {
+        // Upper 5 % and 1 % points of F (any table): F(5, 10) 3.326 and
+        // 5.636, F(10, 20) 2.348 and 3.368, F(1, 12) = t(12)^2 = 4.747.
+        for (d1, d2, tail, table) in [
+            (5.0, 10.0, 0.05, 3.326),
+            (5.0, 10.0, 0.01, 5.636),
+            (10.0, 20.0, 0.05, 2.348),
+            (10.0, 20.0, 0.01, 3.368),
+            (1.0, 12.0, 0.05, 4.747),
+        ] {
+            let f = f_upper_quantile(tail, d1, d2);
+            assert!((f - table).abs() < 2e-3, "F({d1}, {d2}) {tail}: {f}");
+        }
+        // F(1, d2) is t(d2) squared.
+        let t = two_sided_quantile(0.01, 7.0);
+        assert!((f_upper_tail(t * t, 1.0, 7.0) - 0.01).abs() < 1e-12);
     }
 
     #[test]

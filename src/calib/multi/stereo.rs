@@ -12,7 +12,7 @@ use crate::calib::model_advice::{advise, ModelAdvice};
 use crate::calib::multi::same_images::{refuse_identical_views, refuse_zero_baseline};
 use crate::calib::multi::stereo_problem::StereoProblem;
 use crate::calib::refine::{block_from_pose, CalibProblem};
-use crate::calib::report::build_report;
+use crate::calib::report::{build_report, SpreadCheck};
 use crate::calib::usable::{usable_views, LeftOut};
 use crate::calib::zhang::lm_options;
 use crate::calib::{calibrate, CalibrationOptions, CameraCalibration, View};
@@ -382,5 +382,12 @@ pub(crate) fn camera_report_with(
             ..lm
         },
     )?;
-    build_report(problem, &result, outliers, size, options)
+    build_report(
+        problem,
+        &result,
+        outliers,
+        size,
+        options,
+        SpreadCheck::Check,
+    )
 }
