@@ -98,9 +98,12 @@ fn noisy_scene_is_within_bounds_from_sigma() {
             "{name}: {got} vs {want} (std {std})"
         );
     }
-    // And the standard deviations are physically sensible for 0.25 px noise.
+    // And the standard deviations are physically sensible for 0.25 px noise
+    // (here the views' check, docs/camera-uncertainty.md, widens cx's std
+    // to the views' disagreement, 1.25 px: each of fx, fy, cx, cy passes
+    // its 2-std level by chance in 2.3 % of scenes whose views agree).
     assert!(
-        report.std["fx"] < 2.0 && report.std["cx"] < 1.0,
+        report.std["fx"] < 2.0 && report.std["cx"] < 1.5,
         "{:?}",
         report.std
     );
