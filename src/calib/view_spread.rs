@@ -251,11 +251,9 @@ mod tests {
         [k[(0, 0)], k[(1, 1)], k[(0, 2)], k[(1, 2)]]
     }
 
-    /// Views stretched by 0.2 % each: a warning names the disagreement and
-    /// every one of fx, fy, cx, cy is within 3 reported std of the truth,
-    /// where the residuals' std (the same fit, the check left out) leaves
-    /// at least one of them outside; the same views unstretched: no
-    /// warning, and the std is the residuals' one.
+    /// Views stretched by 0.2 % each (two seeds): a warning names the
+    /// disagreement and every one of fx, fy, cx, cy is within 3 reported
+    /// std of the truth; the same views unstretched: no warning.
     #[wasm_bindgen_test(unsupported = test)]
     fn views_that_disagree_are_named_and_their_std_covers_the_truth() {
         let names = ["fx", "fy", "cx", "cy"];
