@@ -284,3 +284,136 @@ fn otsu(values: &[f64]) -> Option<f64> {
     }
     best
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::detect::markers::recover::recover_bit_errors;
+    use crate::rng::Rng;
+    use wasm_bindgen_test::wasm_bindgen_test;
+
+    /// Marker `id` of `dictionary` with `border` dark cells around it,
+    /// drawn axis-aligned at (8, 8) with cells of `cell` px (dark 90, light
+    /// 140: low contrast), blurred by a Gaussian of `blur` px and given
+    /// noise of std 2 grey levels; with the marker's outer corners.
+    fn drawn(
+        dictionary: Dictionary,
+        id: usize,
+        border: usize,
+        cell: f64,
+        blur: f64,
+    ) -> (GrayImage, [Point2<f64>; 4]) {
+        let bits = dictionary.marker_bits();
+        let n = bits + 2 * border;
+        let code = dictionary.code(id).unwrap();
+        let side = cell * n as f64;
+        let size = (side + 16.0).ceil() as usize;
+        let value = |x: f64, y: f64| -> f64 {
+            let (c, r) = (((x - 8.0) / cell).floor(), ((y - 8.0) / cell).floor());
+            if c < 0.0 || r < 0.0 || c >= n as f64 || r >= n as f64 {
+                return 200.0; // the white paper around the marker
+            }
+            let (r, c) = (r as usize, c as usize);
+            if r < border || c < border || r >= n - border || c >= n - border {
+                return 90.0;
+            }
+            let k = (r - border) * bits + (c - border);
+            if (code >> (bits * bits - 1 - k)) & 1 == 1 {
+                140.0
+            } else {
+                90.0
+            }
+        };
+        // 4 x 4 samples a pixel, then a separable Gaussian.
+        let mut sharp = vec![0.0; size * size];
+        for y in 0..size {
+            for x in 0..size {
+                let mut sum = 0.0;
+                for s in 0..16 {
+                    let (dx, dy) = ((s % 4) as f64 + 0.5, (s / 4) as f64 + 0.5);
+                    sum += value(x as f64 + dx / 4.0, y as f64 + dy / 4.0);
+                }
+                sharp[y * size + x] = sum / 16.0;
+            }
+        }
+        let radius = (3.0 * blur).ceil() as isize;
+        let kernel: Vec<f64> = (-radius..=radius)
+            .map(|d| (-(d * d) as f64 / (2.0 * blur * blur)).exp())
+            .collect();
+        let total: f64 = kernel.iter().sum();
+        let pass = |src: &[f64], across: bool| -> Vec<f64> {
+            let mut out = vec![0.0; size * size];
+            for y in 0..size {
+                for x in 0..size {
+                    let mut sum = 0.0;
+                    for (i, w) in kernel.iter().enumerate() {
+                        let d = i as isize - radius;
+                        let (xx, yy) = if across {
+                            ((x as isize + d).clamp(0, size as isize - 1) as usize, y)
+                        } else {
+                            (x, (y as isize + d).clamp(0, size as isize - 1) as usize)
+                        };
+                        sum += w * src[yy * size + xx];
+                    }
+                    out[y * size + x] = sum / total;
+                }
+            }
+            out
+        };
+        let blurred = pass(&pass(&sharp, true), false);
+        let mut rng = Rng::new(id as u64 + 1);
+        let pixels = blurred
+            .iter()
+            .map(|v| (v + rng.gaussian(2.0)).round().clamp(0.0, 255.0) as u8)
+            .collect();
+        // Pixel centres at integer coordinates: the cell edges sit 0.5 px
+        // before the drawn positions.
+        let (a, b) = (8.0 - 0.5, 8.0 - 0.5 + side);
+        let corners = [
+            Point2::new(a, a),
+            Point2::new(b, a),
+            Point2::new(b, b),
+            Point2::new(a, b),
+        ];
+        let image = GrayImage {
+            width: size as u32,
+            height: size as u32,
+            pixels,
+        };
+        (image, corners)
+    }
+
+    /// At a place the board predicts, the marker that is there reads as
+    /// itself, and no other marker of the dictionary reads as the predicted
+    /// id within the recovery's bit-error limit: 6x6 AprilTags (own
+    /// threshold, 6 wrong bits allowed) of 2.5 px cells under 1 px blur,
+    /// and ArUco 4x4 (Otsu only, 2 allowed); every other id of the
+    /// dictionary's first 200 tried at each place.
+    #[wasm_bindgen_test(unsupported = test)]
+    fn a_wrong_marker_at_a_predicted_place_is_not_read_as_the_predicted_one() {
+        for (dictionary, border, cell, blur) in [
+            (Dictionary::DICT_APRILTAG_36h11, 2, 2.5, 1.0),
+            (Dictionary::DICT_APRILTAG_36h11, 1, 3.0, 0.8),
+            (Dictionary::DICT_4X4_50, 1, 4.0, 1.0),
+        ] {
+            let limit = recover_bit_errors(dictionary.marker_bits());
+            let ids = dictionary.len().min(200);
+            for there in [0, 7, 23, 41] {
+                let (image, corners) = drawn(dictionary, there, border, cell, blur);
+                let own = read_expected(&image, &corners, dictionary, border, there, limit);
+                assert!(
+                    own.is_some_and(|e| e <= 1),
+                    "{dictionary:?} id {there}: read itself with {own:?} wrong bits"
+                );
+                for predicted in (0..ids).filter(|&p| p != there) {
+                    let read =
+                        read_expected(&image, &corners, dictionary, border, predicted, limit);
+                    assert!(
+                        read.is_none(),
+                        "{dictionary:?}: marker {there} read as {predicted} with {read:?} wrong bits"
+                    );
+                }
+            }
+        }
+    }
+}
