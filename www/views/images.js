@@ -138,14 +138,24 @@ export class ImagesView {
     const added = [];
     // A file picker may list im_28 first: the session's order (which pairs
     // images with poses) is the names' natural order, shown on the cards.
-    for (const file of [...files].sort((a, b) => naturalCompare(a.name, b.name))) {
+    const sorted = [...files].sort((a, b) => naturalCompare(a.name, b.name));
+    // Read at once (one after another, 20 files took 0.1 s before the first decode).
+    const read = await Promise.allSettled(sorted.map((file) => file.arrayBuffer()));
+    const list = [];
+    let unreadable = null; // a file that cannot be read: the ones before it are kept, as before
+    for (const [k, file] of sorted.entries()) {
+      if (read[k].status === 'rejected') { unreadable = read[k].reason; break; }
       const img = { id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name: file.name, size: file.size, included: true, status: 'pending', info: null, detection: null, error: null };
-      const bytes = await file.arrayBuffer();
-      await this.store.addImage(img, bytes);
+      list.push({ img, bytes: read[k].value });
+    }
+    // Stored (and listed in the saved session) before any is decoded: a reload meanwhile finds them.
+    await this.store.addImages(list);
+    for (const { img } of list) {
       this.makeCard(img);
       added.push(img);
     }
     this.refresh();
+    if (unreadable) throw unreadable;
     // One image per worker at a time: memory stays bounded.
     await eachConcurrent(added, this.lanes, async (img) => {
       await this.preview(img);
@@ -158,9 +168,12 @@ export class ImagesView {
   async addBytes(list) {
     const added = [];
     // Extra fields (a camera capture's `source`) stay on the session image.
-    for (const { name, bytes, ...extra } of list) {
-      const img = { ...extra, id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name, size: bytes.byteLength, included: true, status: 'pending', info: null, detection: null, error: null };
-      await this.store.addImage(img, bytes);
+    const stored = list.map(({ name, bytes, ...extra }) => ({
+      img: { ...extra, id: `${Date.now().toString(36)}-${Math.random().toString(36).slice(2, 8)}`, name, size: bytes.byteLength, included: true, status: 'pending', info: null, detection: null, error: null },
+      bytes,
+    }));
+    await this.store.addImages(stored);
+    for (const { img } of stored) {
       this.makeCard(img);
       added.push(img);
     }
