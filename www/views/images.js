@@ -129,6 +129,7 @@ export class ImagesView {
   }
 
   async addFiles(files) {
+    if (this.pool.warm) this.pool.warm();
     // Videos (dropped or chosen with images) are read by the video view (views/video.js).
     const videos = [...files].filter((f) => VIDEO_EXT.test(f.name));
     if (videos.length && this.videos) {
@@ -166,6 +167,7 @@ export class ImagesView {
   }
 
   async addBytes(list) {
+    if (this.pool.warm) this.pool.warm();
     const added = [];
     // Extra fields (a camera capture's `source`) stay on the session image.
     const stored = list.map(({ name, bytes, ...extra }) => ({
