@@ -36,6 +36,21 @@ export class ImagesView {
     this.wire();
     store.onChange((what) => { if (what === 'target') this.targetChanged(); });
     this.board = null; // { spec, kind, total } of the target the cards count against
+    // Detections made with a card's preview (one decode for both), by image
+    // id: { spec, boards, found } or { spec, boards, notFound }; detectAll
+    // takes them instead of asking again while the target is the same.
+    this.early = new Map();
+  }
+
+  /**
+   * What the previews of new images detect: the session's target when it
+   * is valid ({ spec, boards: a marker board's every board }), else null.
+   */
+  async detectRequest() {
+    let spec;
+    try { spec = targetSpec(this.store.session.target); } catch { return null; }
+    await this.boardInfo();
+    return { spec, boards: !!(this.board && MARKER_BOARDS.has(this.board.kind)) };
   }
 
   /**
@@ -100,6 +115,7 @@ export class ImagesView {
     $('clear-images').addEventListener('click', async () => {
       await this.store.removeImages(this.images.map((i) => i.id));
       this.previews.clear();
+      this.early.clear();
       this.cards.clear();
       fill($('cards'));
       this.refresh();
@@ -158,8 +174,9 @@ export class ImagesView {
     this.refresh();
     if (unreadable) throw unreadable;
     // One image per worker at a time: memory stays bounded.
+    const detect = await this.detectRequest();
     await eachConcurrent(added, this.lanes, async (img) => {
-      await this.preview(img);
+      await this.preview(img, detect);
       this.renderCard(img);
       this.refresh();
     });
@@ -179,15 +196,18 @@ export class ImagesView {
       this.makeCard(img);
       added.push(img);
     }
-    await eachConcurrent(added, this.lanes, async (img) => { await this.preview(img); this.renderCard(img); });
+    const detect = await this.detectRequest();
+    await eachConcurrent(added, this.lanes, async (img) => { await this.preview(img, detect); this.renderCard(img); });
     this.refresh();
     await this.detectAll(added);
   }
 
-  async preview(img) {
+  /** Decode `img` for its card; with `detect` ({ spec, boards }) its detection is made in the same decode (kept in `early`). */
+  async preview(img, detect = null) {
     try {
       const bytes = this.store.bytes.get(img.id).slice(0);
-      const p = await this.pool.call('preview', { bytes, maxSide: THUMB_SIDE, name: img.name }, [bytes]);
+      const p = await this.pool.call('preview', { bytes, maxSide: THUMB_SIDE, name: img.name, ...(detect ? { detect } : {}) }, [bytes]);
+      if (detect) this.early.set(img.id, { ...detect, found: p.found, notFound: p.notFound });
       img.info = p.info;
       if (img.status === 'pending') img.status = 'decoded';
       this.previews.set(img.id, { image: p.image, scale: p.image.width / p.info.width });
@@ -223,18 +243,29 @@ export class ImagesView {
       const card = this.cards.get(img.id);
       if (card) card.meta.textContent = 'detecting…';
       try {
-        const bytes = this.store.bytes.get(img.id).slice(0);
         img.largerGrid = null;
         img.otherBoards = null;
-        if (this.board && MARKER_BOARDS.has(this.board.kind)) {
+        const boards = !!(this.board && MARKER_BOARDS.has(this.board.kind));
+        const early = this.early.get(img.id);
+        this.early.delete(img.id);
+        // The preview's detection with this target, or a new one.
+        const ask = async (op) => {
+          if (early && early.spec === spec && early.boards === boards && (early.found !== undefined || early.notFound !== undefined)) {
+            if (early.notFound !== undefined) throw new Error(early.notFound);
+            return early.found;
+          }
+          const bytes = this.store.bytes.get(img.id).slice(0);
+          return this.pool.call(op, { bytes, spec, name: img.name }, [bytes]);
+        };
+        if (boards) {
           // Every board of the layout: the target's own and other id blocks.
-          const found = await this.pool.call('boards', { bytes, spec, name: img.name }, [bytes]);
+          const found = await ask('boards');
           img.otherBoards = found.others.map(otherBoard);
           if (!found.detection) throw new Error(notTheTarget(this.store.session.target, img.otherBoards));
           img.detection = found.detection;
         } else {
           try {
-            img.detection = await this.pool.call('detect', { bytes, spec, name: img.name }, [bytes]);
+            img.detection = await ask('detect');
           } catch (err) {
             img.detection = await this.largerGrid(img, err);
           }
@@ -329,6 +360,7 @@ export class ImagesView {
   async remove(img) {
     await this.store.removeImages([img.id]);
     this.previews.delete(img.id);
+    this.early.delete(img.id);
     this.cards.get(img.id)?.li.remove();
     this.cards.delete(img.id);
     this.refresh();
