@@ -210,6 +210,7 @@ export class ImagesView {
       if (detect) this.early.set(img.id, { ...detect, found: p.found, notFound: p.notFound });
       img.info = p.info;
       if (img.status === 'pending') img.status = 'decoded';
+      if (detect && p.found !== undefined) this.showEarly(img, detect, p.found);
       this.previews.set(img.id, { image: p.image, scale: p.image.width / p.info.width });
     } catch (err) {
       img.status = 'error';
@@ -217,6 +218,22 @@ export class ImagesView {
       img.included = false; // nothing to use (its pose keeps its place: pairing is by position)
     }
     this.store.changed('images');
+  }
+
+  /**
+   * A target found with the preview is shown at once (a failure waits for
+   * detectAll, which tries a larger grid and words the card); detectAll
+   * takes the same result again from `early`.
+   */
+  showEarly(img, { boards }, found) {
+    const detection = boards ? found.detection : found;
+    if (!detection) return;
+    img.detection = detection;
+    img.otherBoards = boards ? found.others.map(otherBoard) : null;
+    img.largerGrid = null;
+    img.status = 'detected';
+    img.error = null;
+    img.detectError = false;
   }
 
   async detectAll(subset) {
