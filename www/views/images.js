@@ -180,7 +180,8 @@ export class ImagesView {
       this.renderCard(img);
       this.refresh();
     });
-    if (added.some((i) => i.status === 'decoded')) await this.detectAll(added);
+    // Every decoded image (a target found with its preview too: detectAll takes that result).
+    if (added.some((i) => i.info)) await this.detectAll(added);
   }
 
   async addBytes(list) {
