@@ -52,7 +52,6 @@ try {
       };
     }, n);
     const page = await context.newPage();
-    page.on('console', (m) => { if (m.text().startsWith('TIMING')) console.log(n, m.text()); });
     await page.goto(server.url);
     await page.locator('#engine-status.ready').waitFor({ timeout: 60000 });
     const detect = [];
