@@ -13,7 +13,7 @@
 // Only 8-bit grey or colour PNG and JPEG without EXIF orientation are
 // compared (what a browser path could take); other files are listed as such.
 import { readFileSync } from 'node:fs';
-import { basename } from 'node:path';
+import { basename, resolve } from 'node:path';
 import { startServer, launch } from '../tests/e2e/harness.mjs';
 
 const args = process.argv.slice(2);
@@ -23,7 +23,7 @@ for (let i = 0; i < args.length; i++) {
   if (args[i] === '--reps') { reps = Number(args[++i]); continue; }
   if (args[i] === '--') continue;
   if (!groups.length || /^[a-z_]+:/.test(args[i])) groups.push({ spec: args[i], files: [] });
-  else groups[groups.length - 1].files.push(args[i]);
+  else groups[groups.length - 1].files.push(resolve(args[i])); // absolute: the page fetches it by its path
 }
 if (!groups.some((g) => g.files.length)) {
   console.log('usage: node benches/browser_decode.mjs [--reps N] SPEC FILE... [-- SPEC FILE...]');
