@@ -2092,8 +2092,9 @@ export interface ImagePairing {
 }
 
 /**
- * The optional last argument of `image_info`, `decode_image_preview`,
- * `detect_target`, `detect_boards` and `undistort_preview`, as JSON text: the largest image
+ * The optional `options_json` argument of `image_info`, `decode_image_preview`,
+ * `detect_target`, `detect_boards` and `undistort_preview` (their last but for
+ * `decode_image_preview`'s `keep_grey`), as JSON text: the largest image
  * accepted, pixels (default 64 MP in wasm). Over it the error names the
  * image size and the limit.
  */

@@ -112,11 +112,14 @@ fn image_data(rgba: &[u8], width: u32, height: u32) -> Result<ImageData, JsError
     })
 }
 
-/// A decoded image's description plus a preview for thumbnails.
+/// A decoded image's description plus a preview for thumbnails, and its
+/// grey image when [`decode_image_preview`] was asked to keep it (then the
+/// target is detected in it without decoding the file again).
 #[wasm_bindgen]
 pub struct ImagePreview {
     info_json: String,
     image: ImageData,
+    gray: Option<GrayImage>,
 }
 
 #[wasm_bindgen]
@@ -133,6 +136,34 @@ impl ImagePreview {
     #[wasm_bindgen(getter)]
     pub fn image(&self) -> ImageData {
         self.image.clone()
+    }
+    /// Whether the grey image was kept (`keep_grey`): the detections below
+    /// need it.
+    #[wasm_bindgen(getter)]
+    pub fn keeps_grey(&self) -> bool {
+        self.gray.is_some()
+    }
+    /// [`detect_target`] on the kept grey image: the same Detection JSON or
+    /// error, without a second decode.
+    pub fn detect_target(&self, target_spec_or_json: &str) -> Result<String, JsError> {
+        let request = target_request(target_spec_or_json)?;
+        detect_with(self.kept_gray()?, &request)
+    }
+    /// [`detect_boards`] on the kept grey image.
+    pub fn detect_boards(&self, target_spec_or_json: &str) -> Result<String, JsError> {
+        let request = crate::api::detect::DetectRequest::from_spec_or_json(target_spec_or_json)
+            .map_err(js_error)?;
+        boards_with(self.kept_gray()?, &request)
+    }
+}
+
+impl ImagePreview {
+    fn kept_gray(&self) -> Result<&GrayImage, JsError> {
+        self.gray.as_ref().ok_or_else(|| {
+            JsError::new(
+                "this preview kept no grey image: call decode_image_preview with keep_grey = true",
+            )
+        })
     }
 }
 
@@ -206,11 +237,16 @@ fn decode_gray(bytes: &[u8], options_json: Option<String>) -> Result<GrayImage, 
 /// Decode image bytes (PNG, JPEG, TIFF, BMP, PNM, GIF, WebP); return its
 /// description and a preview (`ImageData`) whose longer side is at most
 /// `max_side` px. `options_json`: see [`ImageOptions`] (`{"max_pixels"}`).
+/// `keep_grey`: the preview also holds the grey image (width x height
+/// bytes of wasm memory until `free()`), for its `detect_target` and
+/// `detect_boards`: the page decodes each file once for its card and its
+/// detection.
 #[wasm_bindgen]
 pub fn decode_image_preview(
     bytes: &[u8],
     max_side: u32,
     options_json: Option<String>,
+    keep_grey: Option<bool>,
 ) -> Result<ImagePreview, JsError> {
     let options = DecodeOptions {
         preview_max_side: Some(max_side),
@@ -223,7 +259,12 @@ pub fn decode_image_preview(
         .preview
         .ok_or_else(|| JsError::new("no preview was produced"))?;
     let image = image_data(&preview.pixels, preview.width, preview.height)?;
-    Ok(ImagePreview { info_json, image })
+    let gray = keep_grey.unwrap_or(false).then_some(decoded.gray);
+    Ok(ImagePreview {
+        info_json,
+        image,
+        gray,
+    })
 }
 
 /// Decode image bytes and return only the description as JSON.
@@ -274,13 +315,26 @@ pub fn detect_target(
     target_spec_or_json: &str,
     options_json: Option<String>,
 ) -> Result<String, JsError> {
-    let request = crate::api::detect::DetectRequest {
+    // The target is read first: a bad spec is reported before a bad file.
+    let request = target_request(target_spec_or_json)?;
+    let image = decode_gray(bytes, options_json)?;
+    detect_with(&image, &request)
+}
+
+fn target_request(target_spec_or_json: &str) -> Result<crate::api::detect::DetectRequest, JsError> {
+    Ok(crate::api::detect::DetectRequest {
         other_boards: false,
         ..crate::api::detect::DetectRequest::from_spec_or_json(target_spec_or_json)
             .map_err(js_error)?
-    };
-    let image = decode_gray(bytes, options_json)?;
-    let detection = crate::api::detect::detect_target(&image, &request)
+    })
+}
+
+/// [`detect_target`] after the decode.
+fn detect_with(
+    image: &GrayImage,
+    request: &crate::api::detect::DetectRequest,
+) -> Result<String, JsError> {
+    let detection = crate::api::detect::detect_target(image, request)
         .detection
         .map_err(js_error)?;
     serde_json::to_string(&detection).map_err(|e| JsError::new(&e.to_string()))
@@ -300,7 +354,15 @@ pub fn detect_boards(
     let request = crate::api::detect::DetectRequest::from_spec_or_json(target_spec_or_json)
         .map_err(js_error)?;
     let image = decode_gray(bytes, options_json)?;
-    let detections = crate::api::detect::detect_boards(&image, &request).map_err(js_error)?;
+    boards_with(&image, &request)
+}
+
+/// [`detect_boards`] after the decode.
+fn boards_with(
+    image: &GrayImage,
+    request: &crate::api::detect::DetectRequest,
+) -> Result<String, JsError> {
+    let detections = crate::api::detect::detect_boards(image, request).map_err(js_error)?;
     serde_json::to_string(&detections).map_err(|e| JsError::new(&e.to_string()))
 }
 

@@ -116,6 +116,18 @@ export class EnginePool {
     this.size = Math.max(1, size);
   }
 
+  /**
+   * Start every worker of the pool now (each loads the wasm when it starts):
+   * called when images arrive, so the workers are ready by the time the
+   * images are stored and the first decodes are sent.
+   */
+  warm() {
+    while (this.engines.length < this.size) {
+      this.engines.push(new Engine());
+      this.busy.push(0);
+    }
+  }
+
   async call(op, args = {}, transfer = []) {
     let i = this.busy.indexOf(0);
     if (i < 0 && this.engines.length < this.size) {

@@ -149,16 +149,18 @@ export class Store {
   }
 
   /**
-   * Add an image: its bytes are stored first, then the session listing it
-   * is saved at once, so a reload at any moment (e.g. during detection)
-   * finds every image added before it.
+   * Add images (`[{ img, bytes }]`): their bytes are stored first, then
+   * the session listing them is saved at once, so a reload at any moment
+   * (e.g. during detection) finds every image added before it. One storage
+   * transaction for all the bytes and one save: a transaction and a save
+   * per image made 20 images wait 0.2-0.3 s before the first was decoded.
    */
-  async addImage(img, bytes) {
-    this.bytes.set(img.id, bytes);
+  async addImages(list) {
+    for (const { img, bytes } of list) this.bytes.set(img.id, bytes);
     if (this.db && this.persistent) {
-      try { await tx(this.db, 'blobs', 'readwrite', (s) => s.put(bytes, img.id)); } catch (e) { console.warn(e); }
+      try { await tx(this.db, 'blobs', 'readwrite', (s) => { for (const { img, bytes } of list) s.put(bytes, img.id); }); } catch (e) { console.warn(e); }
     }
-    this.session.images.push(img);
+    for (const { img } of list) this.session.images.push(img);
     this.changed('images');
     await this.save();
   }

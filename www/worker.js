@@ -32,13 +32,31 @@ const handlers = {
     await ready;
     return JSON.parse(robocal.lens_models());
   },
-  async preview({ bytes, maxSide, maxPixels }) {
+  /**
+   * The file's description and a preview; with `detect` ({ spec, boards })
+   * also the target detected in the same decode (`detect` or `boards`'s
+   * reply as `found`, or its error as `notFound`): the images step decodes
+   * each file once for its card and its detection.
+   */
+  async preview({ bytes, maxSide, maxPixels, detect }) {
     await ready;
-    const p = robocal.decode_image_preview(new Uint8Array(bytes), maxSide, imageOptions(maxPixels));
-    // `image` is an ImageData (structured clone), ready for putImageData.
-    const reply = { info: JSON.parse(p.info_json), image: p.image };
-    p.free();
-    return reply;
+    const p = robocal.decode_image_preview(new Uint8Array(bytes), maxSide, imageOptions(maxPixels), !!detect);
+    try {
+      // `image` is an ImageData (structured clone), ready for putImageData.
+      const reply = { info: JSON.parse(p.info_json), image: p.image };
+      // (A host that drops the keep_grey argument gets a preview without grey: no detection here then.)
+      if (detect && p.keeps_grey) {
+        try {
+          reply.found = detect.boards ? splitBoards(JSON.parse(p.detect_boards(detect.spec)), detect.spec) : JSON.parse(p.detect_target(detect.spec));
+        } catch (err) {
+          if (err instanceof WebAssembly.RuntimeError) throw err;
+          reply.notFound = err && err.message ? err.message : String(err);
+        }
+      }
+      return reply;
+    } finally {
+      p.free();
+    }
   },
   async detect({ bytes, spec, maxPixels }) {
     await ready;
@@ -53,11 +71,7 @@ const handlers = {
    */
   async boards({ bytes, spec, maxPixels }) {
     await ready;
-    const key = (t) => robocal.target_spec(JSON.stringify(t));
-    const want = robocal.target_spec(spec);
-    const all = JSON.parse(robocal.detect_boards(new Uint8Array(bytes), spec, imageOptions(maxPixels)));
-    const own = all.find((d) => key(d.target) === want) || null;
-    return { detection: own, others: all.filter((d) => d !== own) };
+    return splitBoards(JSON.parse(robocal.detect_boards(new Uint8Array(bytes), spec, imageOptions(maxPixels))), spec);
   },
   /** Everything the target step shows, from the core: the target JSON, its CLI spec, its points and its printable sheet. */
   async target({ spec }) {
@@ -72,6 +86,14 @@ const handlers = {
     return JSON.parse(robocal.read_kalibr_target(text));
   },
 };
+
+/** `detect_boards`' detections as `{ detection, others }` (see `boards`). */
+function splitBoards(all, spec) {
+  const key = (t) => robocal.target_spec(JSON.stringify(t));
+  const want = robocal.target_spec(spec);
+  const own = all.find((d) => key(d.target) === want) || null;
+  return { detection: own, others: all.filter((d) => d !== own) };
+}
 
 /** The laser plane from board images with the stripe (laser_plane, docs/laser.md). */
 handlers.laserPlane = async ({ request, images, maxPixels }) => {

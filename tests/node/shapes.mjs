@@ -143,6 +143,18 @@ const views = meta.images.map((im, i) => ({ name: im.name, detection: detections
 input('detect_boards', meta.target);
 // A chessboard is one board: detect_boards gives detect_target's detection alone.
 assert.deepEqual(output('detect_boards', JSON.parse(robocal.detect_boards(png(meta.images[0]), JSON.stringify(meta.target)))), [detections[0]]);
+// A preview that keeps the grey image detects in it what detect_target finds in the file, without a second decode.
+{
+  const kept = robocal.decode_image_preview(png(meta.images[1]), 128, undefined, true);
+  assert.equal(kept.keeps_grey, true);
+  assert.deepEqual(JSON.parse(kept.detect_target(JSON.stringify(meta.target))), detections[1]);
+  assert.deepEqual(JSON.parse(kept.detect_boards(JSON.stringify(meta.target))), [detections[1]]);
+  kept.free();
+  const plainPreview = robocal.decode_image_preview(png(meta.images[1]), 128);
+  assert.equal(plainPreview.keeps_grey, false);
+  assert.throws(() => plainPreview.detect_target(JSON.stringify(meta.target)), { message: 'this preview kept no grey image: call decode_image_preview with keep_grey = true' });
+  plainPreview.free();
+}
 
 const all = call('calibrate_camera', { model: 'brown', method: 'all', views }, 'calibrate_camera all');
 // A flat board: the DLT is left out and the note says why.
