@@ -254,7 +254,7 @@ fn gauss_newton(
 ///
 /// The extractor's std is the image noise propagated through the centre
 /// of gravity; on rendered stripes with speckle and saturation the centres
-/// err by about 0.35 px whatever that std (0.03 px on a bright saturated
+/// err by about 0.35 px whatever that std (0.03 px on a bright
 /// stripe, 0.13 px on a dim one: BENCHMARKS.md section 18), so weights
 /// `1 / std^2` gave some centres 16 times the weight of others for no
 /// smaller error, and the plane erred several times more than unweighted.

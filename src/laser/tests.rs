@@ -88,7 +88,7 @@ fn noisy_fit_lies_within_its_covariance() {
 fn centres_whose_std_understates_their_error_get_a_floor() {
     // 0.3 px of noise on every centre, but the stds given say 0.03 px on
     // every other centre and 0.13 px on the rest (as the centre of gravity
-    // reports on a saturated and a dim stripe, BENCHMARKS.md section 18).
+    // reports on a bright and a dim stretch, BENCHMARKS.md section 18).
     let truth = example_plane();
     let poses = laser_board_poses(4);
     let mut obs =
