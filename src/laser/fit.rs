@@ -6,7 +6,10 @@
 //!   residual is the distance, along its scan direction in pixels, between
 //!   the measured centre and where the plane/board intersection line crosses
 //!   that column (row), to first order `(n . X - d) / (n . dX/dv)`, divided
-//!   by the extractor's std. The noise is in the image, so this is the
+//!   by the centre's std: `sqrt(std^2 + floor^2)`, the extractor's std
+//!   (the image noise through the estimator) and the error it does not
+//!   hold (speckle, the sub-pixel bias), estimated from the residuals
+//!   ([`centre_floor_variance`]). The noise is in the image, so this is the
 //!   maximum-likelihood fit under Gaussian centre noise: a far or grazing
 //!   board, whose points move by millimetres per pixel, weighs what its
 //!   pixels are worth.
@@ -87,11 +90,16 @@ pub struct PlaneFit {
     /// `(a, b, d)` ([`crate::geometry::plane`]'s convention); the 4x4 over
     /// `(nx, ny, nz, d)` is [`PlaneEstimate::normal_distance_covariance`].
     pub estimate: PlaneEstimate,
-    /// The residual variance `chi^2 / (m - 3)` (1 when the centres' stds
-    /// are right).
+    /// The residual variance `chi^2 / (m - 3)` with the extractor's stds
+    /// (1 when they are right).
     pub variance_factor: f64,
-    /// RMS of the minimised residuals (image: in units of the std; point:
-    /// metres).
+    /// The centres' error beyond the extractor's std, pixels along the
+    /// scan (0 for the point-to-plane model, or when the residuals are
+    /// within the stds): each centre is weighted by `1 / (std^2 +
+    /// floor^2)` ([`centre_floor_variance`]).
+    pub centre_floor_px: f64,
+    /// RMS of the minimised residuals (image: in units of the std with the
+    /// floor; point: metres).
     pub rms: f64,
     /// Per image.
     pub per_image: Vec<ImageResidual>,
@@ -159,31 +167,37 @@ pub fn fit_plane_with_boards(
             s1
         )));
     }
-    let mut n = start.normal.into_inner();
-    let mut d = start.distance_m;
     let mut warnings = geometry_warnings(obs, &images, singular);
-    for _ in 0..30 {
-        let basis = tangent_basis(&nalgebra::Unit::new_normalize(n));
-        let (a, g) = normal_equations(obs, &n, d, &basis, options.residual);
-        let Some(step) = a.cholesky().map(|ch| ch.solve(&(-g))) else {
-            return Err(Error::degenerate(
-                "the plane's normal equations are singular: the stripes do not constrain it",
-            ));
-        };
-        // n <- exp(a e1 + b e2) n = n - a e2 + b e1 to first order.
-        n = (n - basis.1 * step[0] + basis.0 * step[1]).normalize();
-        d += step[2];
-        if step.norm() < 1e-14 {
-            break;
+    let (mut n, mut d) = gauss_newton(obs, &start, options.residual)?;
+    // The centres' error beyond the extractor's std (see
+    // [`centre_floor_variance`]): estimated from the residuals and the fit
+    // repeated with it until it settles (at most three rounds).
+    let mut floor_var = 0.0;
+    let mut weighted: Vec<StripeObservation> = obs.to_vec();
+    if options.residual == PlaneResidual::ImagePx {
+        for _ in 0..3 {
+            let f = centre_floor_variance(obs, &plane_in_camera(n, d)?);
+            if (f - floor_var).abs() <= 1e-3 * f.max(1e-12) {
+                break;
+            }
+            floor_var = f;
+            for (w, o) in weighted.iter_mut().zip(obs) {
+                w.std_px = (o.std_px * o.std_px + floor_var).sqrt();
+            }
+            (n, d) = gauss_newton(&weighted, &plane_in_camera(n, d)?, options.residual)?;
         }
     }
     // The final linearisation, at the solution (the normal facing away).
     let plane = plane_in_camera(n, d)?;
-    let rows = residual_rows(obs, &plane, options.residual);
-    let chi2: f64 = rows.iter().map(|r| r.residual * r.residual).sum();
+    // The variance factor with the extractor's stds (1 when they are
+    // right); the covariance from the residuals of the weighted fit.
+    let raw = residual_rows(obs, &plane, options.residual);
+    let chi2: f64 = raw.iter().map(|r| r.residual * r.residual).sum();
     let m = obs.len();
     let variance_factor = if m > 3 { chi2 / (m - 3) as f64 } else { 1.0 };
-    let covariance = plane_covariance(obs, &rows, boards)?;
+    let rows = residual_rows(&weighted, &plane, options.residual);
+    let minimised: f64 = rows.iter().map(|r| r.residual * r.residual).sum();
+    let covariance = plane_covariance(&weighted, &rows, boards)?;
     let per_image = images
         .iter()
         .map(|&i| image_residual(obs, i, &plane))
@@ -199,11 +213,86 @@ pub fn fit_plane_with_boards(
     Ok(PlaneFit {
         estimate: PlaneEstimate { plane, covariance },
         variance_factor,
-        rms: (chi2 / m as f64).sqrt(),
+        centre_floor_px: floor_var.sqrt(),
+        rms: (minimised / m as f64).sqrt(),
         per_image,
         singular_values_m: singular,
         warnings,
     })
+}
+
+/// Gauss-Newton over the plane's `(a, b, d)` from `start`.
+fn gauss_newton(
+    obs: &[StripeObservation],
+    start: &LaserPlane,
+    model: PlaneResidual,
+) -> Result<(Vector3<f64>, f64)> {
+    let mut n = start.normal.into_inner();
+    let mut d = start.distance_m;
+    for _ in 0..30 {
+        let basis = tangent_basis(&nalgebra::Unit::new_normalize(n));
+        let (a, g) = normal_equations(obs, &n, d, &basis, model);
+        let Some(step) = a.cholesky().map(|ch| ch.solve(&(-g))) else {
+            return Err(Error::degenerate(
+                "the plane's normal equations are singular: the stripes do not constrain it",
+            ));
+        };
+        // n <- exp(a e1 + b e2) n = n - a e2 + b e1 to first order.
+        n = (n - basis.1 * step[0] + basis.0 * step[1]).normalize();
+        d += step[2];
+        if step.norm() < 1e-14 {
+            break;
+        }
+    }
+    Ok((n, d))
+}
+
+/// The variance (px^2) of the centres' error that the extractor's std
+/// does not hold, from the residuals at `plane`: the `s >= 0` with
+/// `sum r_k^2 / (std_k^2 + s) = m - 3` (`r_k` the residual along the scan,
+/// pixels), 0 when the stds already explain the residuals.
+///
+/// The extractor's std is the image noise propagated through the centre
+/// of gravity; on rendered stripes with speckle and saturation the centres
+/// err by about 0.35 px whatever that std (0.03 px on a bright
+/// stripe, 0.13 px on a dim one: BENCHMARKS.md section 18), so weights
+/// `1 / std^2` gave some centres 16 times the weight of others for no
+/// smaller error, and the plane erred several times more than unweighted.
+/// With the floor each centre's variance is `std^2 + s`.
+pub fn centre_floor_variance(obs: &[StripeObservation], plane: &LaserPlane) -> f64 {
+    let n = plane.normal.into_inner();
+    let rs: Vec<(f64, f64)> = obs
+        .iter()
+        .filter_map(|o| {
+            let nt = n.dot(&o.along_scan_m_per_px);
+            (nt.abs() > 1e-15).then(|| {
+                let r = (n.dot(&o.point_camera.coords) - plane.distance_m) / nt;
+                (r * r, o.std_px * o.std_px)
+            })
+        })
+        .collect();
+    if rs.len() <= 3 {
+        return 0.0;
+    }
+    let dof = (rs.len() - 3) as f64;
+    let chi2 = |s: f64| rs.iter().map(|(r2, v)| r2 / (v + s)).sum::<f64>();
+    if chi2(0.0) <= dof {
+        return 0.0;
+    }
+    // chi2 falls with s: bracket the root, then bisect.
+    let (mut lo, mut hi) = (0.0, rs.iter().map(|(r2, _)| *r2).sum::<f64>() / dof + 1e-12);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if chi2(mid) > dof {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= 1e-9 * hi {
+            break;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// One observation's residual, its Jacobian over the plane's `(a, b, d)`

@@ -80,6 +80,50 @@ fn noisy_fit_lies_within_its_covariance() {
     let dd = fit.estimate.plane.distance_m - truth.distance_m;
     assert!(dd.abs() < 4.0 * covariance[(3, 3)].sqrt(), "{dd}");
     assert!(angle_deg(&fit.estimate.plane, &truth) < 0.05);
+    // The stds are right: (almost) no error beyond them.
+    assert!(fit.centre_floor_px < 0.1, "{}", fit.centre_floor_px);
+}
+
+#[test]
+fn centres_whose_std_understates_their_error_get_a_floor() {
+    // 0.3 px of noise on every centre, but the stds given say 0.03 px on
+    // every other centre and 0.13 px on the rest (as the centre of gravity
+    // reports on a bright and a dim stretch, BENCHMARKS.md section 18).
+    let truth = example_plane();
+    let poses = laser_board_poses(4);
+    let mut obs =
+        stripe_observations(&camera(), &poses, &truth, EXTENT, 1, 0.3, &mut Rng::new(5)).unwrap();
+    for (k, o) in obs.iter_mut().enumerate() {
+        o.std_px = if k % 2 == 0 { 0.03 } else { 0.13 };
+    }
+    let fit = fit_plane(&obs, &PlaneFitOptions::default()).unwrap();
+    // sum 0.09 / (std^2 + s) = m over the two halves: s = 0.0811 px^2.
+    assert!(
+        (fit.centre_floor_px - 0.285).abs() < 0.03,
+        "{}",
+        fit.centre_floor_px
+    );
+    assert!(fit.variance_factor > 10.0, "{}", fit.variance_factor);
+    let e: Vector3<f64> = fit.estimate.plane.normal.into_inner() - truth.normal.into_inner();
+    let covariance = fit.estimate.normal_distance_covariance();
+    for k in 0..3 {
+        assert!(
+            e[k].abs() < 4.0 * covariance[(k, k)].sqrt(),
+            "{k}: {e:?} {fit:?}"
+        );
+    }
+    let dd = fit.estimate.plane.distance_m - truth.distance_m;
+    assert!(dd.abs() < 4.0 * covariance[(3, 3)].sqrt(), "{dd}");
+    assert!(angle_deg(&fit.estimate.plane, &truth) < 0.05);
+    // The point-to-plane model has no stds to floor.
+    let point = fit_plane(
+        &obs,
+        &PlaneFitOptions {
+            residual: PlaneResidual::PointToPlane,
+        },
+    )
+    .unwrap();
+    assert_eq!(point.centre_floor_px, 0.0);
 }
 
 #[test]
