@@ -5,7 +5,7 @@
 //! The alternative starts from the calibrated camera's intrinsics and view
 //! poses with its own starting coefficients, takes [`SCREEN_ITERATIONS`]
 //! solver iterations and the Gauss-Newton model there predicts the cost at
-//! its minimum ([`gauss_newton_floor`]). When the RMS of that prediction is
+//! its minimum ([`crate::optim::gauss_newton_floor`]). When the RMS of that prediction is
 //! more than [`SCREEN_MARGIN`] times the RMS the advice would act on, the
 //! model is left out without a refit; otherwise (and whenever the screen
 //! does not apply) the model is refitted in full, so every figure the
@@ -13,10 +13,10 @@
 
 use super::refine::{block_from_pose, CalibProblem};
 use super::report::CameraCalibration;
-use super::zhang::{lm_options, CalibrationOptions};
+use super::zhang::{held_aspect, lm_options, CalibrationOptions};
 use super::View;
 use crate::camera::{Camera, Distortion};
-use crate::optim::{gauss_newton_floor, solve, BlockParams, Loss};
+use crate::optim::{solve_with_floor, BlockParams, Loss};
 
 /// Solver iterations of the screen before its prediction.
 pub const SCREEN_ITERATIONS: usize = 3;
@@ -33,7 +33,7 @@ pub const SCREEN_MARGIN: f64 = 1.02;
 /// The RMS (px) the screen predicts for the views fitted with `options`
 /// (an alternative model), from the camera and poses of `report`. `None`
 /// when the screen does not apply (outlier rounds, a robust loss, the board
-/// warp, a held aspect ratio, a given start, a splined lens, views the
+/// warp, a given start, a splined lens, views the
 /// report does not hold one to one) or the solve fails: the full refit
 /// decides then.
 pub(crate) fn screened_rms(
@@ -44,7 +44,6 @@ pub(crate) fn screened_rms(
     let plain = options.outlier_sigma.is_none()
         && options.loss == Loss::Squared
         && !options.board_warp
-        && !options.fix_aspect_ratio
         && options.initial_camera.is_none()
         && !matches!(options.model, Distortion::Splined(_));
     let same_views = report.views.len() == views.len()
@@ -75,7 +74,10 @@ pub(crate) fn screened_rms(
         template: &template,
         views,
         used: &used,
-        aspect: None,
+        // A held aspect ratio: the chosen fit's fy / fx (the closed form's
+        // that the alternative's own fit would hold, to round-off), or the
+        // one given.
+        aspect: held_aspect(&report.camera, options),
         warp: None,
     };
     let start = BlockParams {
@@ -84,8 +86,10 @@ pub(crate) fn screened_rms(
     };
     let mut lm = lm_options(&template, options).ok()?;
     lm.max_iterations = SCREEN_ITERATIONS;
-    let result = solve(&problem, &start, &lm).ok()?;
-    let floor = gauss_newton_floor(&problem, &result.params, &lm).ok()?;
+    // The floor at the solver's last point, from the normal equations it
+    // built there (the same figure as `gauss_newton_floor` at
+    // `result.params`, without evaluating the problem again).
+    let (_, floor) = solve_with_floor(&problem, &start, &lm).ok()?;
     let n_points: usize = views.iter().map(|v| v.object_m.len()).sum();
     let rms = (2.0 * floor / n_points.max(1) as f64).sqrt();
     rms.is_finite().then_some(rms)
