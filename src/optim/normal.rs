@@ -195,6 +195,8 @@ impl Normal {
         // move a few control values each, so a view's rows are zero in most
         // of its ~200 global columns. The products over the touched ones
         // alone, added into their rows and columns, are the same sums.
+        // The block's rows untransposed, once for both products below.
+        let jb = jb_t.transpose();
         let active: Vec<usize> = (0..ng)
             .filter(|&c| jg_t.row(c).iter().any(|v| *v != 0.0))
             .collect();
@@ -209,7 +211,7 @@ impl Normal {
                 self.g_global[ai] += g[i];
             }
             if let Some(b) = block {
-                let w = &jg * jb_t.transpose();
+                let w = &jg * &jb;
                 for (i, &ai) in active.iter().enumerate() {
                     for j in 0..nb {
                         self.w[b][(ai, j)] += w[(i, j)];
@@ -220,11 +222,10 @@ impl Normal {
             self.u.gemm(1.0, jg_t, &jg_t.transpose(), 1.0);
             self.g_global.gemv(1.0, jg_t, r, 1.0);
             if let Some(b) = block {
-                self.w[b].gemm(1.0, jg_t, &jb_t.transpose(), 1.0);
+                self.w[b].gemm(1.0, jg_t, &jb, 1.0);
             }
         }
         if let Some(b) = block {
-            let jb = jb_t.transpose();
             self.v[b].gemm(1.0, jb_t, &jb, 1.0);
             self.g_blocks[b].gemv(1.0, jb_t, r, 1.0);
         }
