@@ -14,8 +14,8 @@
 //! clearly past the limit ([`FIRST_LOOK_MARGIN`]) is left out at once, at
 //! half the screen's cost ([`screened_out`]).
 
-use super::refine::{block_from_pose, CalibProblem};
 use super::model_advice::RESIDUAL_ALERT_PX;
+use super::refine::{block_from_pose, CalibProblem};
 use super::report::CameraCalibration;
 use super::zhang::{held_aspect, lm_options, CalibrationOptions};
 use super::View;
