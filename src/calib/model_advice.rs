@@ -41,7 +41,7 @@
 //! a warning names is still refitted in full.
 
 use super::compare::{calibrate_with, Method};
-use super::model_advice_screen::{screened_rms, SCREEN_MARGIN};
+use super::model_advice_screen::screened_out;
 use super::report::CameraCalibration;
 use super::zhang::CalibrationOptions;
 use super::View;
@@ -285,8 +285,7 @@ fn advise_with(
         // screen finds far worse changes nothing and is not refitted.
         if screen == Screen::Yes && !far_off {
             let limit = SAME_FIT_RATIO * report.rms_px + SAME_FIT_PX;
-            if screened_rms(views, &alternative, report).is_some_and(|r| r > SCREEN_MARGIN * limit)
-            {
+            if screened_out(views, &alternative, report, limit) {
                 continue;
             }
         }

@@ -10,7 +10,7 @@ use super::View;
 use crate::camera::{Camera, Distortion, N_PINHOLE_PARAMS};
 use crate::error::{Error, Result};
 use crate::geometry::{params_from_pose, rotation_from_rotvec, rotvec_from_rotation, Pose};
-use crate::optim::{BlockParams, BlockProblem, ResidualBlock};
+use crate::optim::{BlockParams, BlockProblem, ResidualBlock, ResidualRun};
 use nalgebra::{DMatrix, DVector, Matrix2x3, Matrix3, Point3, Vector3};
 
 /// Planar calibration as a block least-squares problem.
@@ -181,6 +181,81 @@ impl CalibProblem<'_> {
     }
 }
 
+impl CalibProblem<'_> {
+    /// One run per view with used points: see [`BlockProblem::residual_runs`].
+    fn runs(&self, params: &BlockParams) -> Result<Vec<ResidualRun>> {
+        let camera = self.camera(&params.global)?;
+        let n_global = params.global.len();
+        let n_camera = self.n_camera();
+        let warp = self.warp_of(&params.global);
+        let mut out = Vec::with_capacity(self.views.len());
+        for (b, view) in self.views.iter().enumerate() {
+            let rows = 2 * self.used[b].iter().filter(|u| **u).count();
+            if rows == 0 {
+                continue;
+            }
+            let pose = pose_from_block(&params.blocks[b]);
+            let mut residuals = DVector::zeros(rows);
+            let mut jg_t = DMatrix::zeros(n_global, rows);
+            let mut jb_t = DMatrix::zeros(6, rows);
+            let mut k = 0;
+            for (i, (object, observed)) in view.object_m.iter().zip(&view.image_px).enumerate() {
+                if !self.used[b][i] {
+                    continue;
+                }
+                let mut board = object.coords;
+                let mut d_warp = [0.0; 2];
+                if let Some(extent) = &self.warp {
+                    let (dz, d) = extent.bow(board.x, board.y, warp);
+                    board.z += dz;
+                    d_warp = d;
+                }
+                let rotated = pose.rotation * board;
+                let p = Point3::from(rotated + pose.translation.vector);
+                let (pixel, d_point) = camera.project_with_jacobian_columns(&p, |c, x, y| {
+                    if c < n_camera {
+                        jg_t[(c, k)] = x;
+                        jg_t[(c, k + 1)] = y;
+                    }
+                })?;
+                residuals[k] = pixel.x - observed.x;
+                residuals[k + 1] = pixel.y - observed.y;
+                // Left perturbation R <- exp(d) R: d(R x)/dd = -[R x]_x.
+                let d_rot = d_point * (-skew(&rotated));
+                for r in 0..2 {
+                    for c in 0..3 {
+                        jb_t[(c, k + r)] = d_rot[(r, c)];
+                        jb_t[(c + 3, k + r)] = d_point[(r, c)];
+                    }
+                }
+                if let Some(a) = self.aspect {
+                    for r in 0..2 {
+                        jg_t[(0, k + r)] += a * jg_t[(1, k + r)];
+                        jg_t[(1, k + r)] = 0.0;
+                    }
+                }
+                if self.warp.is_some() {
+                    // d p / d warp_i = R e_z d_i.
+                    let along = d_point * (pose.rotation * Vector3::z());
+                    for (i, d) in d_warp.iter().enumerate() {
+                        jg_t[(n_camera + i, k)] = along.x * d;
+                        jg_t[(n_camera + i, k + 1)] = along.y * d;
+                    }
+                }
+                k += 2;
+            }
+            out.push(ResidualRun {
+                block: Some(b),
+                group: 2,
+                residuals,
+                jac_global_t: jg_t,
+                jac_block_t: jb_t,
+            });
+        }
+        Ok(out)
+    }
+}
+
 fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
@@ -265,6 +340,17 @@ impl BlockProblem for CalibProblem<'_> {
         Ok(out)
     }
 
+    /// The residual blocks of every view but a splined lens's (whose prior
+    /// adds blocks of no view) stacked per view as they are computed: the
+    /// same values as [`Self::residuals_and_jacobian`], without its three
+    /// small matrices per point.
+    fn residual_runs(&self, params: &BlockParams) -> Option<Result<Vec<ResidualRun>>> {
+        if matches!(self.template.distortion, Distortion::Splined(_)) {
+            return None;
+        }
+        Some(self.runs(params))
+    }
+
     fn retract(&self, params: &BlockParams, step: &BlockParams) -> BlockParams {
         let global = params
             .global
@@ -291,3 +377,7 @@ impl BlockProblem for CalibProblem<'_> {
         BlockParams { global, blocks }
     }
 }
+
+#[cfg(test)]
+#[path = "refine_tests.rs"]
+mod tests;

@@ -176,25 +176,39 @@ impl Camera {
         &self,
         p_camera: &Point3<f64>,
     ) -> Result<(Point2<f64>, Matrix2x3<f64>, DMatrix<f64>)> {
+        let mut columns: Vec<(usize, f64, f64)> = Vec::with_capacity(N_PINHOLE_PARAMS + 14);
+        let (pixel, d_point) =
+            self.project_with_jacobian_columns(p_camera, |c, x, y| columns.push((c, x, y)))?;
+        let mut d_params = DMatrix::zeros(2, columns.len());
+        for (c, x, y) in columns {
+            d_params[(0, c)] = x;
+            d_params[(1, c)] = y;
+        }
+        Ok((pixel, d_point, d_params))
+    }
+
+    /// [`Camera::project_with_jacobians`] handing d pixel / d params to
+    /// `column(c, d_u, d_v)` one parameter `c` at a time (every column, in
+    /// order) instead of into a new matrix: for a solver that stacks them
+    /// itself.
+    pub(crate) fn project_with_jacobian_columns(
+        &self,
+        p_camera: &Point3<f64>,
+        mut column: impl FnMut(usize, f64, f64),
+    ) -> Result<(Point2<f64>, Matrix2x3<f64>)> {
         let ray = self.distortion.project_ray(&p_camera.coords)?;
         let k = self.linear_part();
         let (mx, my) = (ray.m.x, ray.m.y);
-        let mut d_params = DMatrix::zeros(2, N_PINHOLE_PARAMS + ray.d_coeffs.len());
-        d_params[(0, 0)] = mx;
-        d_params[(1, 1)] = my;
-        d_params[(0, 2)] = 1.0;
-        d_params[(1, 3)] = 1.0;
-        d_params[(0, 4)] = my;
+        column(0, mx, 0.0);
+        column(1, 0.0, my);
+        column(2, 1.0, 0.0);
+        column(3, 0.0, 1.0);
+        column(4, my, 0.0);
         for (i, d) in ray.d_coeffs.iter().enumerate() {
             let col = k * d;
-            d_params[(0, N_PINHOLE_PARAMS + i)] = col.x;
-            d_params[(1, N_PINHOLE_PARAMS + i)] = col.y;
+            column(N_PINHOLE_PARAMS + i, col.x, col.y);
         }
-        Ok((
-            self.pixel_from_normalized(&ray.m),
-            k * ray.d_point,
-            d_params,
-        ))
+        Ok((self.pixel_from_normalized(&ray.m), k * ray.d_point))
     }
 
     /// The unit-norm bearing (camera frame) of a pixel. Iterative for the

@@ -34,8 +34,9 @@ pub use crate::handeye::result::{HandEyeResult, MethodResult};
 pub fn calibrate(input: &HandEyeInput, options: &HandEyeOptions) -> Result<HandEyeResult> {
     // 1. Input checks and mistakes, before any solving.
     let chain = input.chain()?;
-    let mut warnings = checks::check_input(input, options)?;
-    let set = build_motions(&chain, options.motion_pairs);
+    // The checks' motions are the chain's for the requested pairs: the
+    // solve takes them rather than building them again.
+    let (mut warnings, set) = checks::check_input_keeping_motions(input, options)?;
     let motion = motion_stats(&set);
     if set.discarded > 0 {
         warnings.push(format!(

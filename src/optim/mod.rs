@@ -54,6 +54,25 @@ pub struct ResidualBlock {
     pub jac_block: DMatrix<f64>,
 }
 
+/// The residuals of one parameter block (one view's points) stacked, with
+/// transposed Jacobians: what [`BlockProblem::residual_runs`] builds
+/// directly, without a small matrix per residual group.
+#[derive(Clone, Debug)]
+pub struct ResidualRun {
+    /// The block these residuals depend on, if any.
+    pub block: Option<usize>,
+    /// Residuals per loss group (2 for a pixel): the robust loss applies
+    /// to each group's squared norm, as to a [`ResidualBlock`]'s.
+    pub group: usize,
+    /// The residuals, group after group.
+    pub residuals: DVector<f64>,
+    /// d residuals / d global parameters, transposed (n_global x rows).
+    pub jac_global_t: DMatrix<f64>,
+    /// d residuals / d block parameters, transposed (block size x rows; 0
+    /// rows without a block).
+    pub jac_block_t: DMatrix<f64>,
+}
+
 /// A least-squares problem for [`solve`].
 pub trait BlockProblem {
     /// All residual blocks at `params`; with `jacobians == false` the
@@ -64,6 +83,15 @@ pub trait BlockProblem {
         params: &BlockParams,
         jacobians: bool,
     ) -> Result<Vec<ResidualBlock>>;
+
+    /// The residuals and Jacobians of [`BlockProblem::residuals_and_jacobian`]
+    /// as runs of one block each, for a problem that can build them without
+    /// a matrix per residual group (the solver's hot path); `None` (the
+    /// default): the solver takes the residual blocks. The same values in
+    /// the same order, so the solver's arithmetic is the same either way.
+    fn residual_runs(&self, _params: &BlockParams) -> Option<Result<Vec<ResidualRun>>> {
+        None
+    }
 
     /// Apply a step; the Jacobians are with respect to this step. Additive
     /// by default; override for rotations (e.g. `R <- exp(delta) R`).
@@ -175,6 +203,52 @@ impl LmResult {
     }
 }
 
+/// The residuals and Jacobians at one point, as the problem gives them.
+enum Evaluation {
+    Blocks(Vec<ResidualBlock>),
+    Runs(Vec<ResidualRun>),
+}
+
+impl Evaluation {
+    fn at(problem: &dyn BlockProblem, params: &BlockParams) -> Result<Evaluation> {
+        match problem.residual_runs(params) {
+            Some(runs) => runs.map(Evaluation::Runs),
+            None => problem
+                .residuals_and_jacobian(params, true)
+                .map(Evaluation::Blocks),
+        }
+    }
+
+    /// `0.5 sum rho(|r_k|^2)`, group after group in order.
+    fn cost(&self, loss: &Loss) -> f64 {
+        match self {
+            Evaluation::Blocks(blocks) => blocks
+                .iter()
+                .map(|b| 0.5 * loss.evaluate(b.residuals.norm_squared()).0)
+                .sum(),
+            Evaluation::Runs(runs) => runs
+                .iter()
+                .flat_map(|run| run.residuals.as_slice().chunks(run.group.max(1)))
+                .map(|g| 0.5 * loss.evaluate(normal::squared_norm(g)).0)
+                .sum(),
+        }
+    }
+
+    fn n_residuals(&self) -> usize {
+        match self {
+            Evaluation::Blocks(blocks) => blocks.iter().map(|b| b.residuals.len()).sum(),
+            Evaluation::Runs(runs) => runs.iter().map(|r| r.residuals.len()).sum(),
+        }
+    }
+
+    fn normal(self, layout: &BlockParams, loss: &Loss, mask: &Mask) -> Normal {
+        match self {
+            Evaluation::Blocks(blocks) => Normal::build(layout, &blocks, loss, mask),
+            Evaluation::Runs(runs) => Normal::build_from_runs(layout, runs, loss, mask),
+        }
+    }
+}
+
 /// Damping beyond which the solver gives up finding a lower cost.
 const MAX_LAMBDA: f64 = 1e16;
 
@@ -184,17 +258,44 @@ pub fn solve(
     initial: &BlockParams,
     options: &LmOptions,
 ) -> Result<LmResult> {
+    solve_keeping_normal(problem, initial, options, true).map(|(result, _)| result)
+}
+
+/// [`solve`] without the covariances, and the cost the Gauss-Newton model
+/// at the solver's last point predicts at its minimum (what
+/// [`gauss_newton_floor`] gives at `result.params`, from the normal
+/// equations the solver already built there instead of a new evaluation).
+pub fn solve_with_floor(
+    problem: &dyn BlockProblem,
+    initial: &BlockParams,
+    options: &LmOptions,
+) -> Result<(LmResult, f64)> {
+    let (result, normal) = solve_keeping_normal(problem, initial, options, false)?;
+    let floor = floor_of(&normal, result.cost)?;
+    Ok((result, floor))
+}
+
+/// The Gauss-Newton floor of normal equations at a point of cost `cost`.
+fn floor_of(normal: &Normal, cost: f64) -> Result<f64> {
+    let (_, predicted) = normal.solve(0.0).ok_or_else(|| {
+        Error::degenerate("the normal equations are singular: no Gauss-Newton step")
+    })?;
+    Ok((cost - predicted).max(0.0))
+}
+
+/// The solve, with the covariances when asked, and the normal equations at
+/// the final parameters.
+fn solve_keeping_normal(
+    problem: &dyn BlockProblem,
+    initial: &BlockParams,
+    options: &LmOptions,
+    with_covariance: bool,
+) -> Result<(LmResult, Normal)> {
     let mask = make_mask(initial, options)?;
-    let cost_of = |blocks: &[ResidualBlock]| -> f64 {
-        blocks
-            .iter()
-            .map(|b| 0.5 * options.loss.evaluate(b.residuals.norm_squared()).0)
-            .sum()
-    };
     let mut params = initial.clone();
-    let mut residuals = problem.residuals_and_jacobian(&params, true)?;
-    let n_residuals: usize = residuals.iter().map(|b| b.residuals.len()).sum();
-    let initial_cost = cost_of(&residuals);
+    let evaluation = Evaluation::at(problem, &params)?;
+    let n_residuals = evaluation.n_residuals();
+    let initial_cost = evaluation.cost(&options.loss);
     if !initial_cost.is_finite() {
         return Err(Error::invalid(
             "initial",
@@ -204,7 +305,7 @@ pub fn solve(
     let mut cost = initial_cost;
     let mut lambda = options.initial_lambda;
     let mut iterations = 0;
-    let mut normal = Normal::build(&params, &residuals, &options.loss, &mask);
+    let mut normal = evaluation.normal(&params, &options.loss, &mask);
     let termination = 'outer: loop {
         if cost == 0.0 {
             break Termination::CostTolerance;
@@ -226,14 +327,14 @@ pub fn solve(
                 continue;
             };
             let candidate = problem.retract(&params, &step);
-            let new_residuals = match problem.residuals_and_jacobian(&candidate, true) {
+            let new_evaluation = match Evaluation::at(problem, &candidate) {
                 Ok(r) => r,
                 Err(_) => {
                     lambda *= 10.0;
                     continue;
                 }
             };
-            let new_cost = cost_of(&new_residuals);
+            let new_cost = new_evaluation.cost(&options.loss);
             if !(new_cost < cost) {
                 if predicted <= options.cost_tolerance * cost {
                     // The model promised only round-off: at the minimum.
@@ -259,9 +360,8 @@ pub fn solve(
             let small_step = step_norm(&step)
                 <= options.step_tolerance * (step_norm(&params) + options.step_tolerance);
             params = candidate;
-            residuals = new_residuals;
             cost = new_cost;
-            normal = Normal::build(&params, &residuals, &options.loss, &mask);
+            normal = new_evaluation.normal(&params, &options.loss, &mask);
             if decrease <= options.cost_tolerance * (cost + decrease) {
                 break 'outer Termination::CostTolerance;
             }
@@ -285,8 +385,12 @@ pub fn solve(
     } else {
         0.0
     };
-    let covariances = normal.covariances(&mask);
-    Ok(LmResult {
+    let covariances = if with_covariance {
+        normal.covariances(&mask)
+    } else {
+        None
+    };
+    let result = LmResult {
         initial_cost,
         cost,
         iterations,
@@ -298,7 +402,8 @@ pub fn solve(
         covariance_blocks: covariances
             .map(|(_, b)| b.into_iter().map(|c| c * residual_variance).collect()),
         params,
-    })
+    };
+    Ok((result, normal))
 }
 
 /// The cost the Gauss-Newton model of `problem` at `params` predicts at
@@ -317,10 +422,7 @@ pub fn gauss_newton_floor(
         .map(|b| 0.5 * options.loss.evaluate(b.residuals.norm_squared()).0)
         .sum();
     let normal = Normal::build(params, &residuals, &options.loss, &mask);
-    let (_, predicted) = normal.solve(0.0).ok_or_else(|| {
-        Error::degenerate("the normal equations are singular: no Gauss-Newton step")
-    })?;
-    Ok((cost - predicted).max(0.0))
+    floor_of(&normal, cost)
 }
 
 fn step_norm(p: &BlockParams) -> f64 {

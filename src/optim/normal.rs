@@ -10,7 +10,7 @@
 //! Each V_i is small (6 for a pose), so the cost is linear in the number
 //! of blocks.
 
-use super::{BlockParams, Loss, ResidualBlock};
+use super::{BlockParams, Loss, ResidualBlock, ResidualRun};
 use nalgebra::{DMatrix, DVector};
 
 /// Floor of the Marquardt scaling `diag(H)`, so that parameters the data
@@ -32,6 +32,13 @@ pub(crate) struct Normal {
     pub g_blocks: Vec<DVector<f64>>,
 }
 
+/// `sum v^2` of one residual group, summed as nalgebra's `norm_squared`
+/// sums a short vector (in order from 0), so either path gives the same
+/// cost bit for bit.
+pub(crate) fn squared_norm(group: &[f64]) -> f64 {
+    group.iter().fold(0.0, |acc, v| acc + v * v)
+}
+
 /// Which parameters move (true) and which are held.
 #[derive(Clone, Debug)]
 pub(crate) struct Mask {
@@ -47,8 +54,76 @@ impl Normal {
         loss: &Loss,
         mask: &Mask,
     ) -> Normal {
+        let mut n = Normal::zeros(layout);
+        // Residual blocks come in runs that share a parameter block (one
+        // view's points): stack each run's weighted rows and accumulate with
+        // a few dense products (nalgebra hands them to matrixmultiply),
+        // instead of 2-row products per point, which cost 10x more.
+        let mut start = 0;
+        while start < residuals.len() {
+            let block = residuals[start].block;
+            let end = residuals[start..]
+                .iter()
+                .position(|rb| rb.block != block)
+                .map_or(residuals.len(), |k| start + k);
+            n.add_run(&residuals[start..end], block, loss);
+            start = end;
+        }
+        n.apply_mask(mask);
+        n
+    }
+
+    /// [`Normal::build`] from runs the problem stacked itself: the same
+    /// weighting and products, so the same sums bit for bit.
+    pub fn build_from_runs(
+        layout: &BlockParams,
+        runs: Vec<ResidualRun>,
+        loss: &Loss,
+        mask: &Mask,
+    ) -> Normal {
+        let mut n = Normal::zeros(layout);
+        let ng = n.u.nrows();
+        for mut run in runs {
+            let nb = run.block.map_or(0, |b| n.v[b].nrows());
+            let global = run.jac_global_t.nrows() == ng && ng > 0;
+            let has_block = run.jac_block_t.nrows() == nb && nb > 0;
+            let rows = run.residuals.len();
+            if !global {
+                run.jac_global_t = DMatrix::zeros(ng, rows);
+            }
+            if !has_block {
+                run.jac_block_t = DMatrix::zeros(nb, rows);
+            }
+            let group = run.group.max(1);
+            for start in (0..rows).step_by(group) {
+                let end = (start + group).min(rows);
+                let (_, d_rho) = loss.evaluate(squared_norm(&run.residuals.as_slice()[start..end]));
+                let w = d_rho.max(0.0).sqrt();
+                for k in start..end {
+                    run.residuals[k] *= w;
+                    for c in 0..ng {
+                        run.jac_global_t[(c, k)] *= w;
+                    }
+                    for c in 0..nb {
+                        run.jac_block_t[(c, k)] *= w;
+                    }
+                }
+            }
+            n.add_stacked(
+                &run.jac_global_t,
+                &run.jac_block_t,
+                &run.residuals,
+                run.block,
+            );
+        }
+        n.apply_mask(mask);
+        n
+    }
+
+    /// Zero normal equations for the parameters of `layout`.
+    fn zeros(layout: &BlockParams) -> Normal {
         let ng = layout.global.len();
-        let mut n = Normal {
+        Normal {
             u: DMatrix::zeros(ng, ng),
             w: layout
                 .blocks
@@ -66,23 +141,7 @@ impl Normal {
                 .iter()
                 .map(|b| DVector::zeros(b.len()))
                 .collect(),
-        };
-        // Residual blocks come in runs that share a parameter block (one
-        // view's points): stack each run's weighted rows and accumulate with
-        // a few dense products (nalgebra hands them to matrixmultiply),
-        // instead of 2-row products per point, which cost 10x more.
-        let mut start = 0;
-        while start < residuals.len() {
-            let block = residuals[start].block;
-            let end = residuals[start..]
-                .iter()
-                .position(|rb| rb.block != block)
-                .map_or(residuals.len(), |k| start + k);
-            n.add_run(&residuals[start..end], block, loss);
-            start = end;
         }
-        n.apply_mask(mask);
-        n
     }
 
     /// Add the rows of residual blocks that all touch `block`.
@@ -117,17 +176,34 @@ impl Normal {
                 k += 1;
             }
         }
+        self.add_stacked(&jg_t, &jb_t, &r, block);
+    }
+
+    /// Add the weighted rows of one run: `jg_t` (global parameters x rows),
+    /// `jb_t` (the block's parameters x rows) and the residuals `r`.
+    fn add_stacked(
+        &mut self,
+        jg_t: &DMatrix<f64>,
+        jb_t: &DMatrix<f64>,
+        r: &DVector<f64>,
+        block: Option<usize>,
+    ) {
+        let ng = self.u.nrows();
+        let nb = jb_t.nrows();
+        let rows = r.len();
         // The global parameters this run touches: a splined lens's points
         // move a few control values each, so a view's rows are zero in most
         // of its ~200 global columns. The products over the touched ones
         // alone, added into their rows and columns, are the same sums.
+        // The block's rows untransposed, once for both products below.
+        let jb = jb_t.transpose();
         let active: Vec<usize> = (0..ng)
             .filter(|&c| jg_t.row(c).iter().any(|v| *v != 0.0))
             .collect();
         if ng > 0 && active.len() * 4 < ng * 3 {
             let jg = DMatrix::from_fn(active.len(), rows, |i, k| jg_t[(active[i], k)]);
             let u = &jg * jg.transpose();
-            let g = &jg * &r;
+            let g = &jg * r;
             for (i, &ai) in active.iter().enumerate() {
                 for (j, &aj) in active.iter().enumerate() {
                     self.u[(ai, aj)] += u[(i, j)];
@@ -135,7 +211,7 @@ impl Normal {
                 self.g_global[ai] += g[i];
             }
             if let Some(b) = block {
-                let w = &jg * jb_t.transpose();
+                let w = &jg * &jb;
                 for (i, &ai) in active.iter().enumerate() {
                     for j in 0..nb {
                         self.w[b][(ai, j)] += w[(i, j)];
@@ -143,16 +219,15 @@ impl Normal {
                 }
             }
         } else if ng > 0 {
-            self.u.gemm(1.0, &jg_t, &jg_t.transpose(), 1.0);
-            self.g_global.gemv(1.0, &jg_t, &r, 1.0);
+            self.u.gemm(1.0, jg_t, &jg_t.transpose(), 1.0);
+            self.g_global.gemv(1.0, jg_t, r, 1.0);
             if let Some(b) = block {
-                self.w[b].gemm(1.0, &jg_t, &jb_t.transpose(), 1.0);
+                self.w[b].gemm(1.0, jg_t, &jb, 1.0);
             }
         }
         if let Some(b) = block {
-            let jb = jb_t.transpose();
-            self.v[b].gemm(1.0, &jb_t, &jb, 1.0);
-            self.g_blocks[b].gemv(1.0, &jb_t, &r, 1.0);
+            self.v[b].gemm(1.0, jb_t, &jb, 1.0);
+            self.g_blocks[b].gemv(1.0, jb_t, r, 1.0);
         }
     }
 

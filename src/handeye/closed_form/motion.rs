@@ -70,18 +70,23 @@ pub fn build_motions(chain: &Chain, pairs: MotionPairs) -> MotionSet {
         }
     }
     let min = MIN_MOTION_ROTATION_DEG.to_radians();
-    let mut kept = Vec::new();
+    let mut kept = Vec::with_capacity(index_pairs.len());
     let mut discarded = 0;
     let mut largest: f64 = 0.0;
+    // Each pose's inverse once, not once per pair (half a million pairs at
+    // 1,000 poses): the same values, so the same motions.
+    let robot_inverse: Vec<Pose> = chain.robot.iter().map(|p| p.inverse()).collect();
+    let camera_inverse: Vec<Pose> = chain.camera.iter().map(|p| p.inverse()).collect();
     for (i, j) in index_pairs {
         let m = Motion {
             from: i,
             to: j,
-            robot: chain.robot[j].inverse() * chain.robot[i],
-            camera: chain.camera[j] * chain.camera[i].inverse(),
+            robot: robot_inverse[j] * chain.robot[i],
+            camera: chain.camera[j] * camera_inverse[i],
         };
-        largest = largest.max(m.robot_angle());
-        if m.robot_angle() < min || m.camera_angle() < min {
+        let robot_angle = m.robot_angle();
+        largest = largest.max(robot_angle);
+        if robot_angle < min || m.camera_angle() < min {
             discarded += 1;
         } else {
             kept.push(m);

@@ -6,7 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::handeye::closed_form::axxb;
-use crate::handeye::closed_form::motion::build_motions;
+use crate::handeye::closed_form::motion::{build_motions, MotionSet};
 use crate::handeye::quality::residuals::{motion_residuals, motion_rms};
 use crate::handeye::{
     Chain, HandEyeInput, HandEyeMethod, HandEyeOptions, MotionPairs, Pose, Setup,
@@ -240,6 +240,16 @@ pub fn recommend_candidate(scores: &[CandidateScore]) -> Option<String> {
 /// warnings; errors for what cannot be solved (and for mistakes when
 /// `options.strict_checks`).
 pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec<String>> {
+    check_input_keeping_motions(input, options).map(|(findings, _)| findings)
+}
+
+/// [`check_input`] and the motions it built (`options.motion_pairs` of the
+/// input's chain), for the solve that follows to take instead of building
+/// them again.
+pub(crate) fn check_input_keeping_motions(
+    input: &HandEyeInput,
+    options: &HandEyeOptions,
+) -> Result<(Vec<String>, MotionSet)> {
     let n = input
         .base_from_gripper
         .len()
@@ -298,14 +308,18 @@ pub fn check_input(input: &HandEyeInput, options: &HandEyeOptions) -> Result<Vec
             set.kept.len()
         )));
     }
-    crate::handeye::quality::gross::refuse_gross_pose(&chain, options.motion_pairs)?;
+    crate::handeye::quality::gross::refuse_gross_pose_with(
+        &chain,
+        options.motion_pairs,
+        Some(&set.kept),
+    )?;
     let findings = mistakes(input)?;
     if options.strict_checks {
         if let Some(first) = findings.first() {
             return Err(Error::invalid("robot poses", first.clone()));
         }
     }
-    Ok(findings)
+    Ok((findings, set))
 }
 
 /// Messages for likely input mistakes (empty when the input looks right).

@@ -4,9 +4,9 @@
 //! down-weight it and report a transform far off.
 
 use crate::error::{Error, Result};
-use crate::handeye::closed_form::solve_method;
+use crate::handeye::closed_form::{solve_method, solve_with_motions};
 use crate::handeye::quality::residuals::{lever_arm_m, view_residuals, ViewResidual};
-use crate::handeye::{Chain, HandEyeMethod, MotionPairs, Pose, MIN_POSES};
+use crate::handeye::{Chain, HandEyeMethod, Motion, MotionPairs, Pose, MIN_POSES};
 
 /// A pose pair is a gross error when, with it left out, its residual (the
 /// displacement at the target, mm) is this many times the median of the
@@ -26,6 +26,19 @@ const GROSS_CANDIDATES: usize = 3;
 /// others best), its residual is above [`GROSS_RATIO`] times the median of
 /// the others and above [`GROSS_MIN_MM`]. The error names the pair.
 pub fn refuse_gross_pose(chain: &Chain, pairs: MotionPairs) -> Result<()> {
+    refuse_gross_pose_with(chain, pairs, None)
+}
+
+/// [`refuse_gross_pose`] with the chain's motions for `pairs` already built
+/// (`kept` of [`crate::handeye::closed_form::motion::build_motions`]): with
+/// every pair, a chain with one pose left out has exactly the motions that
+/// do not touch it, in the same order, so they are filtered instead of
+/// rebuilt (half a million motions at 1,000 poses, four times).
+pub(crate) fn refuse_gross_pose_with(
+    chain: &Chain,
+    pairs: MotionPairs,
+    motions: Option<&[Motion]>,
+) -> Result<()> {
     let n = chain.len();
     if n <= MIN_POSES {
         return Ok(());
@@ -35,11 +48,25 @@ pub fn refuse_gross_pose(chain: &Chain, pairs: MotionPairs) -> Result<()> {
         let rot_mm = r.rotation_deg.to_radians() * lever * 1e3;
         r.translation_mm.hypot(rot_mm)
     };
-    let solve = |c: &Chain| -> Option<(Pose, Pose)> {
-        let (x, y, _) = solve_method(HandEyeMethod::ParkMartin, c, pairs).ok()?;
+    let motions = motions.filter(|_| pairs == MotionPairs::All);
+    // The Park-Martin solution of `c`, the chain with `left_out` removed.
+    let solve = |c: &Chain, left_out: Option<usize>| -> Option<(Pose, Pose)> {
+        let (x, y, _) = match (motions, left_out) {
+            (Some(all), None) => solve_with_motions(HandEyeMethod::ParkMartin, c, all),
+            (Some(all), Some(k)) => {
+                let rest: Vec<Motion> = all
+                    .iter()
+                    .filter(|m| m.from != k && m.to != k)
+                    .cloned()
+                    .collect();
+                solve_with_motions(HandEyeMethod::ParkMartin, c, &rest)
+            }
+            (None, _) => solve_method(HandEyeMethod::ParkMartin, c, pairs),
+        }
+        .ok()?;
         Some((x, y))
     };
-    let Some((x, y)) = solve(chain) else {
+    let Some((x, y)) = solve(chain, None) else {
         return Ok(());
     };
     let full: Vec<f64> = view_residuals(chain, &x, &y)
@@ -56,7 +83,9 @@ pub fn refuse_gross_pose(chain: &Chain, pairs: MotionPairs) -> Result<()> {
             robot: keep.iter().map(|&i| chain.robot[i]).collect(),
             camera: keep.iter().map(|&i| chain.camera[i]).collect(),
         };
-        let Some((x, y)) = solve(&rest) else { continue };
+        let Some((x, y)) = solve(&rest, Some(c)) else {
+            continue;
+        };
         let residuals = view_residuals(chain, &x, &y);
         let mut others: Vec<f64> = keep.iter().map(|&i| displacement(&residuals[i])).collect();
         others.sort_by(f64::total_cmp);

@@ -147,12 +147,17 @@ pub fn evaluate(
     x: &Pose,
     y: &Pose,
 ) -> Result<(Vec<f64>, f64)> {
+    let lins: Vec<ViewLinearisation> = views.iter().map(|m| linearise(setup, m, x, y)).collect();
+    evaluate_linearised(&lins, noise)
+}
+
+/// [`evaluate`] from the views' linearisations at `(x, y)`.
+fn evaluate_linearised(lins: &[ViewLinearisation], noise: &NoiseModel) -> Result<(Vec<f64>, f64)> {
     let loss = Loss::Huber { scale: HUBER_SCALE };
-    let mut norms = Vec::with_capacity(views.len());
+    let mut norms = Vec::with_capacity(lins.len());
     let mut cost = 0.0;
-    for (i, m) in views.iter().enumerate() {
-        let lin = linearise(setup, m, x, y);
-        let l = whitening(&noise.covariance(i, &lin))
+    for (i, lin) in lins.iter().enumerate() {
+        let l = whitening(&noise.covariance(i, lin))
             .ok_or_else(|| Error::degenerate(format!("view {i}: singular residual covariance")))?;
         let s = (l * lin.residual).norm_squared();
         norms.push(s.sqrt());
@@ -236,25 +241,21 @@ pub(crate) fn translation_basis(axis: Option<Vector3<f64>>) -> Matrix3<f64> {
     Matrix3::from_columns(&[u, v, k])
 }
 
-/// One re-estimation of the levels at `(x, y)`: when fewer than half the
-/// views are inliers under the current levels (they are far off, e.g. the
-/// defaults on a noisier robot), first one robust common scale from the
-/// median whitened norm; then the variance-component update over inliers.
-#[allow(clippy::too_many_arguments)]
+/// One re-estimation of the levels at the point where the views were
+/// linearised (`lins`): when fewer than half the views are inliers under
+/// the current levels (they are far off, e.g. the defaults on a noisier
+/// robot), first one robust common scale from the median whitened norm;
+/// then the variance-component update over inliers.
 fn noise_round(
-    setup: Setup,
-    views: &[PoseMeasurement],
     noise: &mut NoiseModel,
-    x: &Pose,
-    y: &Pose,
     lins: &[ViewLinearisation],
     basis: &Matrix3<f64>,
     held: bool,
 ) -> Result<()> {
-    let (mut norms, _) = evaluate(setup, views, noise, x, y)?;
-    if norms.iter().filter(|n| **n <= HUBER_SCALE).count() * 2 < views.len() {
+    let (mut norms, _) = evaluate_linearised(lins, noise)?;
+    if norms.iter().filter(|n| **n <= HUBER_SCALE).count() * 2 < lins.len() {
         noise.rescale_to_median(&norms.iter().map(|n| n * n).collect::<Vec<_>>());
-        norms = evaluate(setup, views, noise, x, y)?.0;
+        norms = evaluate_linearised(lins, noise)?.0;
     }
     let inlier: Vec<bool> = norms.iter().map(|n| *n <= HUBER_SCALE).collect();
     let cov = parameter_covariance(lins, noise, basis, held)
@@ -278,7 +279,7 @@ pub fn estimate_noise(
     // Twice: the first pass moves the levels from the defaults to the data,
     // the second judges inliers with those levels.
     for _ in 0..2 {
-        noise_round(setup, views, noise, x, y, &lins, &basis, axis.is_some())?;
+        noise_round(noise, &lins, &basis, axis.is_some())?;
     }
     Ok(())
 }
@@ -315,7 +316,7 @@ pub fn refine(
         // Noise levels at the current solution, then a solve with them.
         let lins = lin_all(&x, &y);
         let before = noise.variances.clone();
-        noise_round(setup, views, &mut noise, &x, &y, &lins, &basis, held)?;
+        noise_round(&mut noise, &lins, &basis, held)?;
         let whiten = lins
             .iter()
             .enumerate()
