@@ -100,7 +100,8 @@ pub(crate) fn check_view_spread(
         return unchanged;
     };
     let free: Vec<bool> = global.diagonal().iter().map(|v| *v > 0.0).collect();
-    let Ok(residuals) = problem.residuals_and_jacobian(&result.params, true) else {
+    // The views' stacked rows, as the solver takes them.
+    let Some(Ok(residuals)) = problem.residual_runs(&result.params) else {
         return unchanged;
     };
     let Some(robust) = cluster_robust_covariance(&result.params, &residuals, loss, &free) else {

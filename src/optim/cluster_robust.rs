@@ -43,8 +43,8 @@
 //! samples"); Pustejovsky and Tipton 2018 (J. Bus. Econ. Stat. 36(4)) for
 //! the degrees of freedom of a single coefficient.
 
-use super::normal::{Mask, Normal};
-use super::{BlockParams, Loss, ResidualBlock};
+use super::normal::{squared_norm, Mask, Normal};
+use super::{BlockParams, Loss, ResidualRun};
 use nalgebra::{DMatrix, DVector};
 
 /// Fewest blocks for a spread that means anything.
@@ -90,13 +90,15 @@ impl Cluster {
 }
 
 /// The CR2 covariance of the free global parameters (`free_global`) from
-/// the residual blocks with their Jacobians at the solution, clustered by
-/// their parameter block; residual blocks without one (priors) count in
-/// `Q` only. `None` with fewer than [`MIN_CLUSTERS`] clusters, a singular
-/// information matrix, or a view that alone determines a parameter.
+/// the residuals with their Jacobians at the solution, stacked one run a
+/// parameter block ([`ResidualRun`], as [`super::BlockProblem::residual_runs`]
+/// gives them) and clustered by that block; runs without one (priors)
+/// count in `Q` only. `None` with fewer than [`MIN_CLUSTERS`] clusters, a
+/// singular information matrix, or a view that alone determines a
+/// parameter.
 pub fn cluster_robust_covariance(
     layout: &BlockParams,
-    residuals: &[ResidualBlock],
+    runs: &[ResidualRun],
     loss: &Loss,
     free_global: &[bool],
 ) -> Option<ClusterRobust> {
@@ -113,13 +115,15 @@ pub fn cluster_robust_covariance(
         global: (0..ng).map(|i| free_global.get(i) == Some(&true)).collect(),
         blocks: vec![true; nb],
     };
-    let (s, _) = Normal::build(layout, residuals, loss, &mask).schur_undamped()?;
+    let (s, _) = Normal::build_from_runs(layout, runs.to_vec(), loss, &mask).schur_undamped()?;
     let s = DMatrix::from_fn(nf, nf, |i, j| s[(free[i], free[j])]);
     let q = s.cholesky()?.inverse();
     let q_half = q.clone().cholesky()?.l();
     let mut clusters = Vec::with_capacity(nb);
-    for b in 0..nb {
-        clusters.extend(cluster(b, layout, residuals, loss, &free, &q_half)?);
+    for run in runs {
+        if let Some(b) = run.block {
+            clusters.extend(cluster(run, layout.blocks[b].len(), loss, &free, &q_half)?);
+        }
     }
     if clusters.len() < MIN_CLUSTERS {
         return None;
@@ -168,40 +172,43 @@ pub fn cluster_robust_covariance(
     Some(ClusterRobust { covariance, dof })
 }
 
-/// View `b`'s cluster: `Some(None)` when it has no residuals, `None` when
-/// its pose is undetermined or its leverage reaches 1.
+/// One view's cluster from its run: `Some(None)` when it has no rows,
+/// `None` when its pose is undetermined or its leverage reaches 1.
 fn cluster(
-    b: usize,
-    layout: &BlockParams,
-    residuals: &[ResidualBlock],
+    run: &ResidualRun,
+    np: usize,
     loss: &Loss,
     free: &[usize],
     q_half: &DMatrix<f64>,
 ) -> Option<Option<Cluster>> {
-    let own: Vec<&ResidualBlock> = residuals.iter().filter(|r| r.block == Some(b)).collect();
-    let rows: usize = own.iter().map(|r| r.residuals.len()).sum();
+    let rows = run.residuals.len();
     if rows == 0 {
         return Some(None);
     }
-    let np = layout.blocks[b].len();
     let nf = free.len();
     let mut j = DMatrix::zeros(rows, nf);
     let mut p = DMatrix::zeros(rows, np);
     let mut e = DVector::zeros(rows);
-    let mut k = 0;
-    for r in own {
+    let group = run.group.max(1);
+    let has_global = run.jac_global_t.ncols() == rows;
+    let has_block = run.jac_block_t.ncols() == rows && run.jac_block_t.nrows() == np;
+    for start in (0..rows).step_by(group) {
+        let end = (start + group).min(rows);
         // The solver's IRLS weights: rows scaled by sqrt(rho').
-        let (_, d_rho) = loss.evaluate(r.residuals.norm_squared());
+        let (_, d_rho) = loss.evaluate(squared_norm(&run.residuals.as_slice()[start..end]));
         let w = d_rho.max(0.0).sqrt();
-        for i in 0..r.residuals.len() {
-            e[k] = w * r.residuals[i];
-            for (c, &f) in free.iter().enumerate() {
-                j[(k, c)] = w * r.jac_global.get((i, f)).copied().unwrap_or(0.0);
+        for k in start..end {
+            e[k] = w * run.residuals[k];
+            if has_global {
+                for (c, &f) in free.iter().enumerate() {
+                    j[(k, c)] = w * run.jac_global_t[(f, k)];
+                }
             }
-            for c in 0..np.min(r.jac_block.ncols()) {
-                p[(k, c)] = w * r.jac_block[(i, c)];
+            if has_block {
+                for c in 0..np {
+                    p[(k, c)] = w * run.jac_block_t[(c, k)];
+                }
             }
-            k += 1;
         }
     }
     // Project the pose out of the Jacobian and the residuals.
@@ -239,7 +246,7 @@ mod tests {
         seed: u64,
         sigma: f64,
         shared: f64,
-    ) -> (DVector<f64>, Vec<ResidualBlock>, BlockParams) {
+    ) -> (DVector<f64>, Vec<ResidualRun>, BlockParams) {
         let mut d = Rng::new(design);
         // Uneven leverage: cluster g's first regressor spreads by 0.3 + g / 4.
         let x: Vec<Vec<[f64; 3]>> = (0..CLUSTERS)
@@ -285,15 +292,18 @@ mod tests {
             .cholesky()
             .unwrap()
             .solve(&(a.transpose() * &rhs));
-        let residuals = (0..m)
-            .map(|row| {
-                let g = row / ROWS;
-                let jb = DMatrix::from_row_slice(1, 2, &[a[(row, 2 + 2 * g)], a[(row, 3 + 2 * g)]]);
-                ResidualBlock {
+        let residuals = (0..CLUSTERS)
+            .map(|g| {
+                let rows = g * ROWS..(g + 1) * ROWS;
+                ResidualRun {
                     block: Some(g),
-                    residuals: DVector::from_element(1, (a.row(row) * &beta)[0] - rhs[row]),
-                    jac_global: DMatrix::from_row_slice(1, 2, &[a[(row, 0)], a[(row, 1)]]),
-                    jac_block: jb,
+                    group: 1,
+                    residuals: DVector::from_iterator(
+                        ROWS,
+                        rows.clone().map(|r| (a.row(r) * &beta)[0] - rhs[r]),
+                    ),
+                    jac_global_t: DMatrix::from_fn(2, ROWS, |c, k| a[(g * ROWS + k, c)]),
+                    jac_block_t: DMatrix::from_fn(2, ROWS, |c, k| a[(g * ROWS + k, 2 + 2 * g + c)]),
                 }
             })
             .collect();
@@ -307,12 +317,12 @@ mod tests {
     }
 
     /// `Q = S^-1` of the design (the model-based covariance over sigma^2).
-    fn q_of(residuals: &[ResidualBlock], layout: &BlockParams) -> DMatrix<f64> {
+    fn q_of(residuals: &[ResidualRun], layout: &BlockParams) -> DMatrix<f64> {
         let mask = Mask {
             global: vec![true; 2],
             blocks: vec![true; CLUSTERS],
         };
-        let (s, _) = Normal::build(layout, residuals, &Loss::Squared, &mask)
+        let (s, _) = Normal::build_from_runs(layout, residuals.to_vec(), &Loss::Squared, &mask)
             .schur_undamped()
             .unwrap();
         s.cholesky().unwrap().inverse()
@@ -418,7 +428,7 @@ mod tests {
     #[wasm_bindgen_test(unsupported = test)]
     fn too_few_clusters_give_none() {
         let (_, residuals, mut layout) = fit(5, 1, 0.5, 0.0);
-        let kept: Vec<ResidualBlock> = residuals
+        let kept: Vec<ResidualRun> = residuals
             .into_iter()
             .filter(|r| r.block.unwrap() < 3)
             .collect();
