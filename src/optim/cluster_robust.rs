@@ -34,9 +34,11 @@
 //! `nu` smaller than `G - 1`). [`ClusterRobust::dof`] holds `nu` per
 //! parameter.
 //!
-//! Costs: one thin SVD of each view's `X_g Q^1/2` (rows x global
-//! parameters), no refit. `(I - H_gg)^-1/2` on the view's residual space is
-//! `I + U ((1 - s^2)^-1/2 - 1) U^T` from that SVD (`U`, `s`).
+//! Costs: one small eigenproblem per view (global parameters squared), no
+//! refit. `(I - H_gg)^-1/2` on the view's residual space is
+//! `I + U ((1 - s^2)^-1/2 - 1) U^T` with `U`, `s` the thin SVD of
+//! `X_g Q^1/2`, taken from the eigenvectors of its Gram matrix
+//! ([`Cluster::adjust`]).
 //!
 //! References: Bell and McCaffrey 2002 (Survey Methodology 28(2), "Bias
 //! reduction in standard errors for linear regression with multi-stage
@@ -68,24 +70,22 @@ pub struct ClusterRobust {
 }
 
 /// One view's rows: the global Jacobian with the pose projected out, its
-/// residuals (already orthogonal to the pose's columns at the minimum) and
-/// the thin SVD of `X_g Q^1/2`.
+/// residuals (already orthogonal to the pose's columns at the minimum),
+/// `Y = X_g Q^1/2` and the small matrix `M` of [`Cluster::adjust`].
 struct Cluster {
     x: DMatrix<f64>,
     e: DVector<f64>,
-    u: DMatrix<f64>,
-    /// `(1 - s^2)^-1/2 - 1` per singular value.
-    lift: DVector<f64>,
+    y: DMatrix<f64>,
+    m: DMatrix<f64>,
 }
 
 impl Cluster {
-    /// `A_g v = v + U diag(lift) U^T v`.
+    /// `A_g v = (I - Y Y^T)^-1/2 v`. With `Y^T Y = V S^2 V^T` (a small
+    /// eigenproblem), `Y`'s left singular vectors are `Y V S^-1`, so
+    /// `A_g v = v + Y M Y^T v` with `M = V diag(lift(s) / s^2) V^T`,
+    /// `lift(s) = (1 - s^2)^-1/2 - 1`: no SVD of the tall `Y`.
     fn adjust(&self, v: &DMatrix<f64>) -> DMatrix<f64> {
-        let mut t = self.u.transpose() * v;
-        for (i, mut row) in t.row_iter_mut().enumerate() {
-            row *= self.lift[i];
-        }
-        v + &self.u * t
+        v + &self.y * (&self.m * (self.y.transpose() * v))
     }
 }
 
@@ -215,14 +215,24 @@ fn cluster(
     let chol = (p.transpose() * &p).cholesky()?;
     let x = &j - &p * chol.solve(&(p.transpose() * &j));
     let e = &e - &p * chol.solve(&(p.transpose() * &e));
-    let svd = (&x * q_half).svd(true, false);
-    let u = svd.u?;
-    let s = svd.singular_values;
-    if s.iter().any(|v| v * v > MAX_LEVERAGE) {
+    let y = &x * q_half;
+    let eigen = (y.transpose() * &y).symmetric_eigen();
+    if eigen.eigenvalues.iter().any(|l| *l > MAX_LEVERAGE) {
         return None;
     }
-    let lift = s.map(|v| 1.0 / (1.0 - v * v).sqrt() - 1.0);
-    Some(Some(Cluster { x, e, u, lift }))
+    // lift(s) / s^2 -> 1/2 as s -> 0 (and a zero direction of Y adds
+    // nothing whatever it is).
+    let scale = eigen.eigenvalues.map(|l| {
+        let l = l.max(0.0);
+        if l > 1e-12 {
+            (1.0 / (1.0 - l).sqrt() - 1.0) / l
+        } else {
+            0.5
+        }
+    });
+    let v = &eigen.eigenvectors;
+    let m = v * DMatrix::from_diagonal(&scale) * v.transpose();
+    Some(Some(Cluster { x, e, y, m }))
 }
 
 #[cfg(test)]
