@@ -22,8 +22,8 @@ fn to_json<T: Serialize>(value: &T) -> Result<String, JsError> {
     serde_json::to_string(value).map_err(|e| JsError::new(&e.to_string()))
 }
 
-/// Grey from RGBA with `image`'s luma weights (0.2126 R + 0.7152 G +
-/// 0.0722 B), as decoded files get.
+/// Grey from RGBA with `image`'s luma conversion, as decoded files get:
+/// `(2126 R + 7152 G + 722 B) / 10000` in integers, truncated.
 fn grey_from_rgba(rgba: &[u8], width: u32, height: u32) -> Result<GrayImage, JsError> {
     let n = width as usize * height as usize;
     if rgba.len() != 4 * n {
@@ -35,7 +35,10 @@ fn grey_from_rgba(rgba: &[u8], width: u32, height: u32) -> Result<GrayImage, JsE
     }
     let grey = rgba
         .chunks_exact(4)
-        .map(|p| (0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32).round() as u8)
+        .map(|p| {
+            let sum = 2126 * u32::from(p[0]) + 7152 * u32::from(p[1]) + 722 * u32::from(p[2]);
+            (sum / 10_000) as u8
+        })
         .collect();
     GrayImage::new(width, height, grey).map_err(js_error)
 }

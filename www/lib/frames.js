@@ -7,12 +7,16 @@
 /** Rec. 709 luma weights in ten-thousandths, as the `image` crate's RGB-to-luma. */
 const LUMA = [2126, 7152, 722];
 
-/** RGBA bytes (`width`*`height`*4) to grey bytes. */
+/**
+ * RGBA bytes (`width`*`height`*4) to grey bytes: the weighted sum divided
+ * by 10000 and truncated, as `image`'s integer conversion does (a
+ * Uint8Array store truncates the quotient).
+ */
 export function greyFromRgba(rgba, width, height) {
   const n = width * height;
   const grey = new Uint8Array(n);
   for (let i = 0, j = 0; i < n; i++, j += 4) {
-    grey[i] = (LUMA[0] * rgba[j] + LUMA[1] * rgba[j + 1] + LUMA[2] * rgba[j + 2] + 5000) / 10000;
+    grey[i] = (LUMA[0] * rgba[j] + LUMA[1] * rgba[j + 1] + LUMA[2] * rgba[j + 2]) / 10000;
   }
   return grey;
 }
