@@ -102,14 +102,20 @@ pub fn two_sided_tail(t: f64, nu: f64) -> f64 {
 /// The `t > 0` with `P(|T| > t) = tail` for `nu` degrees of freedom
 /// (bisection on the monotone tail; `tail` in (0, 1)).
 pub fn two_sided_quantile(tail: f64, nu: f64) -> f64 {
+    quantile_of(|t| two_sided_tail(t, nu), tail)
+}
+
+/// The `x > 0` where a tail that falls with `x` equals `tail`: doubling
+/// from 1 to bracket it, then bisection to 1e-12 relative.
+fn quantile_of(upper_tail: impl Fn(f64) -> f64, tail: f64) -> f64 {
     let (mut low, mut high) = (0.0, 1.0);
-    while two_sided_tail(high, nu) > tail && high < 1e12 {
+    while upper_tail(high) > tail && high < 1e12 {
         low = high;
         high *= 2.0;
     }
     for _ in 0..200 {
         let mid = 0.5 * (low + high);
-        if two_sided_tail(mid, nu) > tail {
+        if upper_tail(mid) > tail {
             low = mid;
         } else {
             high = mid;
@@ -148,23 +154,7 @@ pub fn f_upper_tail(f: f64, d1: f64, d2: f64) -> f64 {
 /// The `f` with `P(F > f) = tail` for `d1` and `d2` degrees of freedom
 /// (bisection on the monotone tail; `tail` in (0, 1)).
 pub fn f_upper_quantile(tail: f64, d1: f64, d2: f64) -> f64 {
-    let (mut low, mut high) = (0.0, 1.0);
-    while f_upper_tail(high, d1, d2) > tail && high < 1e12 {
-        low = high;
-        high *= 2.0;
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (low + high);
-        if f_upper_tail(mid, d1, d2) > tail {
-            low = mid;
-        } else {
-            high = mid;
-        }
-        if high - low <= 1e-12 * high {
-            break;
-        }
-    }
-    0.5 * (low + high)
+    quantile_of(|f| f_upper_tail(f, d1, d2), tail)
 }
 
 #[cfg(test)]
