@@ -43,6 +43,9 @@ struct Cell {
     focal_error: f64,
     /// Every camera at one height above the board (the flange on one plane).
     one_height: bool,
+    /// The std of the camera's fx (px) given with it, as a camera JSON from
+    /// `robocal intrinsics` holds it; none: a camera without its std.
+    fx_std: Option<f64>,
 }
 
 /// One trial's outcome.
@@ -108,7 +111,7 @@ fn trial(cell: &Cell, seed: u64) -> Option<Outcome> {
         &mut result,
         &input,
         &seen.views,
-        (&used_camera, None),
+        (&used_camera, cell.fx_std),
         MotionPairs::All,
     )
     .ok()?;
@@ -157,6 +160,16 @@ fn main() {
     let only = std::env::args().nth(2).unwrap_or_default();
     let cells = [
         Cell {
+            name: "20 poses, model right, the camera's fx std given (0.5 px)",
+            views: 20,
+            max_tilt_deg: 30.0,
+            max_roll_deg: 60.0,
+            kinematic: (0.0, 0.0),
+            focal_error: 0.0,
+            one_height: false,
+            fx_std: Some(0.5),
+        },
+        Cell {
             name: "20 poses, tilts to 30 deg (model right)",
             views: 20,
             max_tilt_deg: 30.0,
@@ -164,6 +177,7 @@ fn main() {
             kinematic: (0.0, 0.0),
             focal_error: 0.0,
             one_height: false,
+            fx_std: None,
         },
         Cell {
             name: "20 poses, robot kinematic error 0.3 mm / 0.02 deg",
@@ -173,6 +187,7 @@ fn main() {
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
             one_height: false,
+            fx_std: None,
         },
         Cell {
             name: "20 poses, focal length 1 % off",
@@ -182,6 +197,7 @@ fn main() {
             kinematic: (0.0, 0.0),
             focal_error: 0.01,
             one_height: false,
+            fx_std: None,
         },
         Cell {
             name: "4 poses, kinematic error",
@@ -191,6 +207,7 @@ fn main() {
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
             one_height: false,
+            fx_std: None,
         },
         Cell {
             name: "8 poses, kinematic error",
@@ -200,6 +217,7 @@ fn main() {
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
             one_height: false,
+            fx_std: None,
         },
         Cell {
             name: "30 poses, kinematic error + focal 1 %",
@@ -209,6 +227,7 @@ fn main() {
             kinematic: (0.3, 0.02),
             focal_error: 0.01,
             one_height: false,
+            fx_std: None,
         },
         Cell {
             name: "12 poses, tilts and rolls to 8 deg, kinematic error",
@@ -218,6 +237,7 @@ fn main() {
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
             one_height: false,
+            fx_std: None,
         },
         Cell {
             name: "20 poses at one height, tilts to 10 deg, kinematic error",
@@ -227,6 +247,7 @@ fn main() {
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
             one_height: true,
+            fx_std: None,
         },
         Cell {
             name: "5 poses at one height, tilts to 10 deg, kinematic error",
@@ -236,6 +257,7 @@ fn main() {
             kinematic: (0.3, 0.02),
             focal_error: 0.0,
             one_height: true,
+            fx_std: None,
         },
     ];
     println!(
