@@ -135,13 +135,19 @@ export const tests = [
     const predicted = await page.textContent('#plan-predicted');
     const bound = Number(/work point: (\S+) mm \(95 %\)/.exec(predicted)[1]);
     assert.ok(bound > 0 && bound < 10, predicted);
-    // The 3-D view: the flange frames drawn (coloured pixels on the light background).
-    const drawn = await page.$eval('#plan-3d', (c) => {
+    // The 3-D view: the flange frames drawn (coloured pixels on the light
+    // background). draw3d is async (it asks the engine for the frames): wait
+    // for the drawing, which once lagged the table under load.
+    // The count when over `min`, else 0 (falsy: waitForFunction polls on).
+    const colouredOver = (min) => {
+      const c = document.getElementById('plan-3d');
       const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
       let n = 0;
       for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - d[i + 1]) > 40 || Math.abs(d[i + 1] - d[i + 2]) > 40) n++;
-      return n;
-    });
+      return n > min ? n : 0;
+    };
+    await page.waitForFunction(colouredOver, 500, { timeout: 30000 }).catch(() => {});
+    const drawn = await page.evaluate(colouredOver, -1);
     assert.ok(drawn > 500, `coloured pixels in the 3-D view: ${drawn}`);
     // The UR script: one movel per pose.
     await page.waitForFunction(() => /^ur-script: \d+ bytes/.test(document.getElementById('plan-move-status').textContent), null, { timeout: 10000 });
