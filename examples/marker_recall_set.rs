@@ -14,51 +14,19 @@
 //! set's `"markers": [[id, [[x, y] x 4]]]` (board metres, OpenCV's corner
 //! order) for OpenCV's refinement from the board.
 //!
-//! The poses and conditions must stay the test's (`VIEWS`, `CONDITIONS`
-//! there): the bench compares OpenCV with the test's floors.
+//! The scene is `robocal::synth::small_markers`, the test's own: the bench
+//! compares OpenCV with the test's floors.
 
 use robocal::detect::{detect, DetectOptions};
-use robocal::synth::{board_pose, render, Pinhole, RenderOptions};
+use robocal::synth::small_markers;
 use robocal::target::{marker_board, Target};
 use serde_json::{json, Value};
-
-/// A pose: (roll, pitch, yaw) radians, board centre (metres).
-type View = ((f64, f64, f64), (f64, f64, f64));
-
-/// tests/detect/detect_marker_recall.rs's `VIEWS`.
-const VIEWS: [View; 6] = [
-    ((0.1, -0.2, 0.05), (0.0, 0.0, 1.0)),
-    ((0.45, 0.3, -0.3), (0.12, -0.05, 1.1)),
-    ((-0.35, 0.5, 0.6), (-0.15, 0.08, 1.2)),
-    ((0.6, 0.0, 0.2), (0.05, 0.1, 0.95)),
-    ((0.0, -0.55, -0.1), (-0.1, -0.1, 1.05)),
-    ((0.3, 0.3, 1.2), (0.2, 0.05, 1.25)),
-];
-
-/// tests/detect/detect_marker_recall.rs's `CONDITIONS`: (blur sigma px,
-/// black, white, noise sigma).
-const CONDITIONS: [(f64, f64, f64, f64); 3] = [
-    (1.2, 30.0, 220.0, 2.0),
-    (1.6, 80.0, 170.0, 2.0),
-    (1.4, 100.0, 160.0, 3.0),
-];
 
 /// (kind, spec): the test's two boards.
 const BOARDS: [(&str, &str); 2] = [
     ("charuco", "charuco:10x7:30mm:22mm:DICT_4X4_50"),
     ("aprilgrid", "aprilgrid:7x5:25mm:0.3"),
 ];
-
-fn webcam() -> Pinhole {
-    Pinhole {
-        fx: 900.0,
-        fy: 900.0,
-        cx: 641.2,
-        cy: 358.7,
-        width: 1280,
-        height: 720,
-    }
-}
 
 fn save(img: &robocal::image::GrayImage, path: &str) {
     image::GrayImage::from_raw(img.width, img.height, img.pixels.clone())
@@ -92,22 +60,16 @@ fn main() {
                 ])
             })
             .collect();
-        for (c, &(blur, black, white, noise)) in CONDITIONS.iter().enumerate() {
-            let condition = format!("blur {blur}, print {black}/{white}, noise {noise}");
+        for (c, k) in small_markers::CONDITIONS.iter().enumerate() {
+            let condition = format!(
+                "blur {}, print {}/{}, noise {}",
+                k.blur, k.black, k.white, k.noise
+            );
             let set = format!("{kind}_{c}");
             std::fs::create_dir_all(format!("{out}/{set}")).expect("mkdir");
             let mut images = Vec::new();
-            for (v, &(rpy, at)) in VIEWS.iter().enumerate() {
-                let o = RenderOptions {
-                    blur_sigma_px: blur,
-                    black,
-                    white,
-                    noise_sigma: noise,
-                    seed: (10 * c + v) as u64,
-                    ..RenderOptions::default()
-                };
-                let r =
-                    render(&webcam(), &target, &board_pose(&target, rpy, at), &o).expect("render");
+            for v in 0..small_markers::VIEWS.len() {
+                let r = small_markers::render_view(&target, c, v).expect("render");
                 let file = format!("{out}/{set}/{v:03}.png");
                 save(&r.image, &file);
                 let result = match detect(&r.image, &target, &DetectOptions::default()) {

@@ -18,6 +18,7 @@ pub mod lens;
 pub mod render;
 pub mod rig;
 pub mod scene;
+pub mod small_markers;
 pub mod video;
 
 pub use scene::Scene;

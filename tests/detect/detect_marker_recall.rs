@@ -11,56 +11,17 @@
 
 use crate::support;
 use robocal::detect::{detect, DetectOptions};
-use robocal::synth::{board_pose, render, Pinhole, RenderOptions, Rng};
+use robocal::synth::{board_pose, render, small_markers, Pinhole, RenderOptions, Rng};
 use robocal::target::{Polarity, Target};
-
-/// 1280x720 webcam, f = 900 px.
-fn webcam() -> Pinhole {
-    Pinhole {
-        fx: 900.0,
-        fy: 900.0,
-        cx: 641.2,
-        cy: 358.7,
-        width: 1280,
-        height: 720,
-    }
-}
-
-/// A pose: (roll, pitch, yaw) radians, board centre (metres).
-type View = ((f64, f64, f64), (f64, f64, f64));
-
-const VIEWS: [View; 6] = [
-    ((0.1, -0.2, 0.05), (0.0, 0.0, 1.0)),
-    ((0.45, 0.3, -0.3), (0.12, -0.05, 1.1)),
-    ((-0.35, 0.5, 0.6), (-0.15, 0.08, 1.2)),
-    ((0.6, 0.0, 0.2), (0.05, 0.1, 0.95)),
-    ((0.0, -0.55, -0.1), (-0.1, -0.1, 1.05)),
-    ((0.3, 0.3, 1.2), (0.2, 0.05, 1.25)),
-];
-
-/// Photometric conditions: (blur sigma px, black, white, noise sigma).
-const CONDITIONS: [(f64, f64, f64, f64); 3] = [
-    (1.2, 30.0, 220.0, 2.0),
-    (1.6, 80.0, 170.0, 2.0),
-    (1.4, 100.0, 160.0, 3.0),
-];
 
 /// (points detected, points in view, wrong ids or points off > 0.5 px,
 /// worst error px) over every view and condition.
 fn recall(spec: &str) -> (usize, usize, usize, f64) {
     let target = Target::parse_spec(spec).unwrap();
     let (mut found, mut total, mut wrong, mut worst) = (0, 0, 0, 0.0f64);
-    for (c, &(blur, black, white, noise)) in CONDITIONS.iter().enumerate() {
-        for (v, &(rpy, at)) in VIEWS.iter().enumerate() {
-            let o = RenderOptions {
-                blur_sigma_px: blur,
-                black,
-                white,
-                noise_sigma: noise,
-                seed: (10 * c + v) as u64,
-                ..RenderOptions::default()
-            };
-            let r = render(&webcam(), &target, &board_pose(&target, rpy, at), &o).unwrap();
+    for c in 0..small_markers::CONDITIONS.len() {
+        for v in 0..small_markers::VIEWS.len() {
+            let r = small_markers::render_view(&target, c, v).unwrap();
             total += r.points.len();
             let Ok(det) = detect(&r.image, &target, &DetectOptions::default()) else {
                 continue;
