@@ -132,13 +132,15 @@ pub(crate) fn refine_blob(
         .collect();
     let mut c = centre;
     let mut fit = None;
+    let mut line = Vec::new();
     for pass in 0..2 {
         // The first pass only re-centres the rays; the gradient centroid
         // (most of the time spent here) is for the edges that are kept.
         let centroid = pass == 1;
         let mut edges = Vec::with_capacity(RAYS);
         for &(d, r) in &rays {
-            if let Some(e) = edge_on_ray(&plane_at, c, d, r, centroid) {
+            let ray = Ray { img, invert, c, d };
+            if let Some(e) = edge_on_ray(&ray, &plane_at, r, centroid, &mut line) {
                 edges.push(e);
             }
         }
@@ -174,17 +176,42 @@ const EDGE_CENTROID_PASSES: usize = 4;
 /// window reaching a neighbouring edge, not this one.
 const EDGE_CENTROID_TRAVEL_PX: f64 = 1.0;
 
+/// A ray `c + t d` through the image (its profile inverted for a light
+/// blob on a dark ground).
+struct Ray<'a> {
+    img: &'a GrayImage,
+    invert: bool,
+    c: Point2<f64>,
+    d: Vector2<f64>,
+}
+
+impl Ray<'_> {
+    /// The profile at `t0 + k step`, `k < count`, into `out`
+    /// ([`bilinear_line`]: one pass along the line).
+    fn profile(&self, t0: f64, step: f64, count: usize, out: &mut Vec<f64>) {
+        bilinear_line(self.img, self.c, self.d, (t0, step), count, out);
+        if self.invert {
+            out.iter_mut().for_each(|v| *v = 255.0 - *v);
+        }
+    }
+}
+
+/// Samples of the march in [`edge_on_ray`] taken along the line at once.
+const MARCH_CHUNK: usize = 16;
+
 /// Edge point on the ray `c + t d` where the profile rises through the
 /// mid level between the blob's inside and the background just outside,
 /// then, with `centroid`, moved to the centroid of the gradient around it
-/// ([`gradient_centroid`]).
+/// ([`gradient_centroid`]). `sample` is the point sampler of the level's
+/// six samples; the march takes the profile in chunks along the line.
 fn edge_on_ray(
+    ray: &Ray,
     sample: &impl Fn(f64, f64) -> f64,
-    c: Point2<f64>,
-    d: Vector2<f64>,
     r: f64,
     centroid: bool,
+    line: &mut Vec<f64>,
 ) -> Option<Point2<f64>> {
+    let (c, d) = (ray.c, ray.d);
     let at = |t: f64| sample(c.x + d.x * t, c.y + d.y * t);
     let inside = (at(0.35 * r) + at(0.45 * r) + at(0.55 * r)) / 3.0;
     let outside = (at(1.45 * r + 1.0) + at(1.55 * r + 1.0) + at(1.65 * r + 1.0)) / 3.0;
@@ -193,24 +220,30 @@ fn edge_on_ray(
     }
     let level = 0.5 * (inside + outside);
     let step = 0.25;
-    let mut t = 0.55 * r;
-    let mut prev = at(t);
+    let start = 0.55 * r;
     let end = 1.45 * r + 1.0;
-    while t < end {
-        let tn = t + step;
-        let v = at(tn);
-        if prev < level && v >= level {
-            let f = (level - prev) / (v - prev);
-            let te = t + f * step;
-            let te = if centroid {
-                gradient_centroid(&at, te, EDGE_HALF_WINDOW_PX.min(0.3 * r))
-            } else {
-                te
-            };
-            return Some(Point2::new(c.x + d.x * te, c.y + d.y * te));
+    // Steps k = 0, 1, ... while start + k step < end, each comparing the
+    // sample at k with the one at k + 1.
+    let steps = ((end - start) / step).ceil().max(0.0) as usize;
+    let mut prev = at(start);
+    let mut k0 = 0;
+    while k0 < steps {
+        let n = MARCH_CHUNK.min(steps - k0);
+        ray.profile(start + (k0 + 1) as f64 * step, step, n, line);
+        for (i, &v) in line.iter().enumerate() {
+            if prev < level && v >= level {
+                let f = (level - prev) / (v - prev);
+                let te = start + (k0 + i) as f64 * step + f * step;
+                let te = if centroid {
+                    gradient_centroid(ray, te, EDGE_HALF_WINDOW_PX.min(0.3 * r), line)
+                } else {
+                    te
+                };
+                return Some(Point2::new(c.x + d.x * te, c.y + d.y * te));
+            }
+            prev = v;
         }
-        prev = v;
-        t = tn;
+        k0 += n;
     }
     None
 }
@@ -234,15 +267,16 @@ fn edge_on_ray(
 /// from the twelve views fell from 0.136 to 0.041 px through the strongly
 /// distorted camera, from 0.056 to 0.009 px through the 'std' one
 /// (docs/benchmark-history.md, issue 20, session 16).
-fn gradient_centroid(at: &impl Fn(f64) -> f64, t0: f64, hw: f64) -> f64 {
+fn gradient_centroid(ray: &Ray, t0: f64, hw: f64, profile: &mut Vec<f64>) -> f64 {
     let ds = EDGE_SAMPLE_PX;
     // Offsets of the gradient's sample points from t0, in grid steps: the
     // window's reach (travel + half-width) and the half pixel either side.
     let half_pixel = (0.5 / ds).round() as i64;
     let reach = ((EDGE_CENTROID_TRAVEL_PX + hw) / ds).ceil() as i64;
-    let profile: Vec<f64> = (-reach - half_pixel..=reach + half_pixel)
-        .map(|j| at(t0 + j as f64 * ds))
-        .collect();
+    let first = -reach - half_pixel;
+    let count = (2 * (reach + half_pixel) + 1) as usize;
+    ray.profile(t0 + first as f64 * ds, ds, count, profile);
+    let profile = &*profile;
     // Gradient at grid offset j (|j| <= reach), from the profile above.
     let gradient = |j: i64| {
         let k = (j + reach + half_pixel) as usize;
