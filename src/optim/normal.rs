@@ -30,6 +30,11 @@ pub(crate) struct Normal {
     pub v: Vec<DMatrix<f64>>,
     pub g_global: DVector<f64>,
     pub g_blocks: Vec<DVector<f64>>,
+    /// The runs these sums came from, their rows already weighted by
+    /// `sqrt(rho')` (empty when built from residual blocks): kept for a
+    /// covariance that needs the rows themselves
+    /// ([`super::cluster_robust`]), so it need not evaluate them again.
+    pub weighted_runs: Vec<ResidualRun>,
 }
 
 /// `sum v^2` of one residual group, summed as nalgebra's `norm_squared`
@@ -115,6 +120,7 @@ impl Normal {
                 &run.residuals,
                 run.block,
             );
+            n.weighted_runs.push(run);
         }
         n.apply_mask(mask);
         n
@@ -141,6 +147,7 @@ impl Normal {
                 .iter()
                 .map(|b| DVector::zeros(b.len()))
                 .collect(),
+            weighted_runs: Vec::new(),
         }
     }
 
