@@ -100,10 +100,17 @@ impl Normal {
                 run.jac_block_t = DMatrix::zeros(nb, rows);
             }
             let group = run.group.max(1);
-            for start in (0..rows).step_by(group) {
+            // Squared loss: every weight is 1, nothing to scale.
+            let weighted = !matches!(loss, Loss::Squared);
+            for start in (0..rows).step_by(group).filter(|_| weighted) {
                 let end = (start + group).min(rows);
                 let (_, d_rho) = loss.evaluate(squared_norm(&run.residuals.as_slice()[start..end]));
                 let w = d_rho.max(0.0).sqrt();
+                if w == 1.0 {
+                    // Squared loss, or an inlier of a robust one: the rows
+                    // as they are (`x * 1.0 == x`, bit for bit).
+                    continue;
+                }
                 for k in start..end {
                     run.residuals[k] *= w;
                     for c in 0..ng {
