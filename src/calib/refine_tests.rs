@@ -2,7 +2,10 @@
 //! its residual blocks: the same fit, bit for bit.
 
 use super::*;
-use crate::optim::{gauss_newton_floor, solve, solve_with_floor, LmOptions, Loss};
+use crate::optim::{
+    cluster_robust_covariance, cluster_robust_from_final, gauss_newton_floor, solve,
+    solve_with_floor, LmOptions, Loss,
+};
 use crate::synth::Scene;
 
 /// The calibration problem without its runs: the solver takes the blocks.
@@ -84,11 +87,60 @@ fn the_runs_give_the_blocks_fit_bit_for_bit() {
         assert_eq!(fast.termination, blocks.termination);
         assert_eq!(fast.covariance_global, blocks.covariance_global);
         assert_eq!(fast.covariance_blocks, blocks.covariance_blocks);
+        // The views' check from the normal equations the solver kept at
+        // its last evaluation: the cluster-robust covariance and its
+        // degrees of freedom equal, bit for bit, to those from a new
+        // evaluation of the views' runs.
+        let free: Vec<bool> = (fast.covariance_global.as_ref().unwrap())
+            .diagonal()
+            .iter()
+            .map(|v| *v > 0.0)
+            .collect();
+        let runs = problem.residual_runs(&fast.params).unwrap().unwrap();
+        let evaluated = cluster_robust_covariance(&fast.params, &runs, &loss, &free).unwrap();
+        let last = fast.final_normal.as_deref().unwrap();
+        let kept = cluster_robust_from_final(last, &fast.params, &loss, &free)
+            .expect("the solver's normal equations are reusable")
+            .unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        assert_eq!(
+            bits(kept.covariance.as_slice()),
+            bits(evaluated.covariance.as_slice())
+        );
+        assert_eq!(bits(&kept.dof), bits(&evaluated.dof));
+        // Normal equations built otherwise are not taken: another loss,
+        // other parameters, other free parameters.
+        let other = if loss == Loss::Squared {
+            Loss::Huber { scale: 1.0 }
+        } else {
+            Loss::Squared
+        };
+        assert!(cluster_robust_from_final(last, &fast.params, &other, &free).is_none());
+        assert!(cluster_robust_from_final(last, &start, &loss, &free).is_none());
+        let mut fewer = free.clone();
+        fewer[0] = false;
+        assert!(cluster_robust_from_final(last, &fast.params, &loss, &fewer).is_none());
+        // From residual blocks: no rows kept, nothing reused.
+        assert!(blocks
+            .final_normal
+            .as_deref()
+            .unwrap()
+            .normal
+            .weighted_runs
+            .is_empty());
+        assert!(cluster_robust_from_final(
+            blocks.final_normal.as_deref().unwrap(),
+            &blocks.params,
+            &loss,
+            &free
+        )
+        .is_none());
         let few = LmOptions {
             max_iterations: 2,
             ..lm.clone()
         };
         let (short, floor) = solve_with_floor(&problem, &start, &few).unwrap();
+        assert!(short.final_normal.is_none());
         let again = gauss_newton_floor(&BlocksOnly(&problem), &short.params, &few).unwrap();
         assert_eq!(floor.to_bits(), again.to_bits());
         assert!(floor < short.cost, "{floor} {}", short.cost);

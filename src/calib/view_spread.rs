@@ -41,7 +41,9 @@
 
 use super::refine::CalibProblem;
 use crate::optim::student_t::{coverage_factor, f_upper_quantile};
-use crate::optim::{cluster_robust_covariance, BlockProblem, LmResult, Loss};
+use crate::optim::{
+    cluster_robust_covariance, cluster_robust_from_final, BlockProblem, LmResult, Loss, ResidualRun,
+};
 use nalgebra::DMatrix;
 
 /// The parameters whose disagreement decides (the distortion coefficients
@@ -100,14 +102,28 @@ pub(crate) fn check_view_spread(
         return unchanged;
     };
     let free: Vec<bool> = global.diagonal().iter().map(|v| *v > 0.0).collect();
-    // The views' stacked rows, as the solver takes them.
-    let Some(Ok(residuals)) = problem.residual_runs(&result.params) else {
+    // The views' stacked rows, as the solver took them at its last
+    // evaluation; evaluated again only when the solver kept none.
+    let rows = |runs: &[ResidualRun]| runs.iter().map(|r| r.residuals.len()).sum::<usize>();
+    let reused = result.final_normal.as_deref().and_then(|last| {
+        cluster_robust_from_final(last, &result.params, loss, &free)
+            .map(|robust| (robust, rows(&last.normal.weighted_runs)))
+    });
+    let (robust, n_residuals) = match reused {
+        Some(found) => found,
+        None => {
+            let Some(Ok(residuals)) = problem.residual_runs(&result.params) else {
+                return unchanged;
+            };
+            (
+                cluster_robust_covariance(&result.params, &residuals, loss, &free),
+                rows(&residuals),
+            )
+        }
+    };
+    let Some(robust) = robust else {
         return unchanged;
     };
-    let Some(robust) = cluster_robust_covariance(&result.params, &residuals, loss, &free) else {
-        return unchanged;
-    };
-    let n_residuals: usize = residuals.iter().map(|r| r.residuals.len()).sum();
     let n_free = free.iter().filter(|f| **f).count()
         + result.params.blocks.iter().map(|b| b.len()).sum::<usize>();
     let dof = n_residuals.saturating_sub(n_free) as f64;

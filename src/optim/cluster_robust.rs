@@ -103,20 +103,76 @@ pub fn cluster_robust_covariance(
     free_global: &[bool],
 ) -> Option<ClusterRobust> {
     let ng = layout.global.len();
-    let free: Vec<usize> = (0..ng)
-        .filter(|&i| free_global.get(i) == Some(&true))
-        .collect();
     let nb = layout.blocks.len();
-    let nf = free.len();
-    if nf == 0 || nb < MIN_CLUSTERS {
+    if !(0..ng).any(|i| free_global.get(i) == Some(&true)) || nb < MIN_CLUSTERS {
         return None;
     }
     let mask = Mask {
         global: (0..ng).map(|i| free_global.get(i) == Some(&true)).collect(),
         blocks: vec![true; nb],
     };
-    let (s, _) = Normal::build_from_runs(layout, runs.to_vec(), loss, &mask).schur_undamped()?;
-    let s = DMatrix::from_fn(nf, nf, |i, j| s[(free[i], free[j])]);
+    let normal = Normal::build_from_runs(layout, runs.to_vec(), loss, &mask);
+    let (s, _) = normal.schur_undamped()?;
+    sandwich(layout, runs, loss, free_global, &s)
+}
+
+/// [`cluster_robust_covariance`] from the normal equations the solver
+/// built at its final parameters ([`super::FinalNormal`]): their Schur
+/// complement and their rows, already weighted, instead of a new
+/// evaluation. `None` when they were built otherwise than the check needs
+/// (another loss, other parameters, held blocks, other free global
+/// parameters, or from residual blocks, which keep no rows): then the
+/// caller evaluates the runs. The same arithmetic on the same numbers
+/// (the weighted rows times a weight of exactly 1), so the same result bit
+/// for bit.
+pub(crate) fn cluster_robust_from_final(
+    last: &super::FinalNormal,
+    params: &BlockParams,
+    loss: &Loss,
+    free_global: &[bool],
+) -> Option<Option<ClusterRobust>> {
+    let ng = params.global.len();
+    let reusable = last.loss == *loss
+        && last.params == *params
+        && !last.normal.weighted_runs.is_empty()
+        && last.mask.blocks.iter().all(|b| *b)
+        && last.mask.global.len() == ng
+        && (0..ng).all(|i| last.mask.global[i] == (free_global.get(i) == Some(&true)));
+    if !reusable {
+        return None;
+    }
+    let nb = params.blocks.len();
+    if !(0..ng).any(|i| free_global.get(i) == Some(&true)) || nb < MIN_CLUSTERS {
+        return Some(None);
+    }
+    let Some((s, _)) = last.normal.schur_undamped() else {
+        return Some(None);
+    };
+    Some(sandwich(
+        params,
+        &last.normal.weighted_runs,
+        &Loss::Squared,
+        free_global,
+        &s,
+    ))
+}
+
+/// The CR2 sandwich from the runs and the Schur complement `s_full` of
+/// their normal equations (every global parameter's row and column).
+fn sandwich(
+    layout: &BlockParams,
+    runs: &[ResidualRun],
+    loss: &Loss,
+    free_global: &[bool],
+    s_full: &DMatrix<f64>,
+) -> Option<ClusterRobust> {
+    let ng = layout.global.len();
+    let free: Vec<usize> = (0..ng)
+        .filter(|&i| free_global.get(i) == Some(&true))
+        .collect();
+    let nb = layout.blocks.len();
+    let nf = free.len();
+    let s = DMatrix::from_fn(nf, nf, |i, j| s_full[(free[i], free[j])]);
     let q = s.cholesky()?.inverse();
     let q_half = q.clone().cholesky()?.l();
     let mut clusters = Vec::with_capacity(nb);

@@ -21,6 +21,7 @@ pub mod wilson;
 #[cfg(test)]
 mod tests;
 
+pub(crate) use cluster_robust::cluster_robust_from_final;
 pub use cluster_robust::{cluster_robust_covariance, ClusterRobust, MIN_CLUSTERS};
 pub use loss::Loss;
 
@@ -28,6 +29,7 @@ use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use normal::{Mask, Normal};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// Parameter values (or a step): the global vector and one vector per block.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -192,6 +194,20 @@ pub struct LmResult {
     pub covariance_global: Option<DMatrix<f64>>,
     /// Marginal covariance of each block, scaled likewise.
     pub covariance_blocks: Option<Vec<DMatrix<f64>>>,
+    /// The normal equations the solver built at `params` (its last
+    /// evaluation), for a check that needs them again
+    /// ([`cluster_robust_from_final`]); `None` from [`solve_with_floor`].
+    pub(crate) final_normal: Option<Arc<FinalNormal>>,
+}
+
+/// The normal equations at the solver's final parameters, with what they
+/// were built under.
+#[derive(Debug)]
+pub(crate) struct FinalNormal {
+    pub normal: Normal,
+    pub mask: Mask,
+    pub loss: Loss,
+    pub params: BlockParams,
 }
 
 impl LmResult {
@@ -258,7 +274,14 @@ pub fn solve(
     initial: &BlockParams,
     options: &LmOptions,
 ) -> Result<LmResult> {
-    solve_keeping_normal(problem, initial, options, true).map(|(result, _)| result)
+    let (mut result, normal) = solve_keeping_normal(problem, initial, options, true)?;
+    result.final_normal = Some(Arc::new(FinalNormal {
+        normal,
+        mask: make_mask(initial, options)?,
+        loss: options.loss,
+        params: result.params.clone(),
+    }));
+    Ok(result)
 }
 
 /// [`solve`] without the covariances, and the cost the Gauss-Newton model
@@ -402,6 +425,7 @@ fn solve_keeping_normal(
         covariance_blocks: covariances
             .map(|(_, b)| b.into_iter().map(|c| c * residual_variance).collect()),
         params,
+        final_normal: None,
     };
     Ok((result, normal))
 }

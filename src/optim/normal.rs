@@ -30,6 +30,11 @@ pub(crate) struct Normal {
     pub v: Vec<DMatrix<f64>>,
     pub g_global: DVector<f64>,
     pub g_blocks: Vec<DVector<f64>>,
+    /// The runs these sums came from, their rows already weighted by
+    /// `sqrt(rho')` (empty when built from residual blocks): kept for a
+    /// covariance that needs the rows themselves
+    /// ([`super::cluster_robust`]), so it need not evaluate them again.
+    pub weighted_runs: Vec<ResidualRun>,
 }
 
 /// `sum v^2` of one residual group, summed as nalgebra's `norm_squared`
@@ -95,10 +100,17 @@ impl Normal {
                 run.jac_block_t = DMatrix::zeros(nb, rows);
             }
             let group = run.group.max(1);
-            for start in (0..rows).step_by(group) {
+            // Squared loss: every weight is 1, nothing to scale.
+            let weighted = !matches!(loss, Loss::Squared);
+            for start in (0..rows).step_by(group).filter(|_| weighted) {
                 let end = (start + group).min(rows);
                 let (_, d_rho) = loss.evaluate(squared_norm(&run.residuals.as_slice()[start..end]));
                 let w = d_rho.max(0.0).sqrt();
+                if w == 1.0 {
+                    // Squared loss, or an inlier of a robust one: the rows
+                    // as they are (`x * 1.0 == x`, bit for bit).
+                    continue;
+                }
                 for k in start..end {
                     run.residuals[k] *= w;
                     for c in 0..ng {
@@ -115,6 +127,7 @@ impl Normal {
                 &run.residuals,
                 run.block,
             );
+            n.weighted_runs.push(run);
         }
         n.apply_mask(mask);
         n
@@ -141,6 +154,7 @@ impl Normal {
                 .iter()
                 .map(|b| DVector::zeros(b.len()))
                 .collect(),
+            weighted_runs: Vec::new(),
         }
     }
 

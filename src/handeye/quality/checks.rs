@@ -52,6 +52,11 @@ pub fn consistency(
 ) -> Result<Consistency> {
     let chain = Chain::new(setup, base_from_gripper, camera_from_target)?;
     let set = build_motions(&chain, MotionPairs::All);
+    consistency_of(&set)
+}
+
+/// [`consistency`] of motions already built over all pairs of the chain.
+fn consistency_of(set: &MotionSet) -> Result<Consistency> {
     let axes = crate::handeye::closed_form::motion::robot_axes(&set.kept);
     let x = if crate::handeye::closed_form::motion::axis_spread(&axes).1
         < crate::handeye::closed_form::scara::PARALLEL_AXES_DEG
@@ -313,7 +318,10 @@ pub(crate) fn check_input_keeping_motions(
         options.motion_pairs,
         Some(&set.kept),
     )?;
-    let findings = mistakes(input)?;
+    // The motions just built are those of the input's own consistency
+    // when they are every pair: not built again.
+    let all = (options.motion_pairs == MotionPairs::All).then_some(&set);
+    let findings = mistakes_with(input, all)?;
     if options.strict_checks {
         if let Some(first) = findings.first() {
             return Err(Error::invalid("robot poses", first.clone()));
@@ -324,8 +332,17 @@ pub(crate) fn check_input_keeping_motions(
 
 /// Messages for likely input mistakes (empty when the input looks right).
 pub fn mistakes(input: &HandEyeInput) -> Result<Vec<String>> {
+    mistakes_with(input, None)
+}
+
+/// [`mistakes`], with the input's motions over all pairs when the caller
+/// has them.
+fn mistakes_with(input: &HandEyeInput, all_pairs: Option<&MotionSet>) -> Result<Vec<String>> {
     let (bfg, cft) = (&input.base_from_gripper, &input.camera_from_target);
-    let given = consistency(input.setup, bfg, cft)?;
+    let given = match all_pairs {
+        Some(set) => consistency_of(set)?,
+        None => consistency(input.setup, bfg, cft)?,
+    };
     let mut found = Vec::new();
     let off = given.rotation_rms_deg;
     let better = |alt: &Consistency| {
