@@ -28,6 +28,7 @@ const SHELL = [
   'lib/validate.js',
   'lib/video-file.js',
   'lib/view3d.js',
+  'lib/wasm-features.js',
   'views/boards.js',
   'views/camera.js',
   'views/capture.js',

@@ -6,11 +6,18 @@
 // worker.
 import init, * as robocal from './pkg/robocal.js';
 import { greyFromRgba, greyFromVideoFrame, pgm } from './lib/frames.js';
+import { missingWasmFeature } from './lib/wasm-features.js';
 
-const ready = init().then(() => {
-  robocal.init();
-  return robocal.version();
-});
+// Checked before the module is fetched: a browser without WebAssembly SIMD
+// gets the reason (every request's error), not the compiler's invalid opcode.
+const missing = missingWasmFeature();
+const ready = missing
+  ? Promise.reject(new Error(missing))
+  : init().then(() => {
+    robocal.init();
+    return robocal.version();
+  });
+ready.catch(() => {}); // reported by each request that awaits it
 
 let trapped = null; // the message of the trap that broke this instance
 

@@ -22,7 +22,7 @@ use super::refine::refine_saddle;
 use super::saddle::{self, Candidate};
 use super::DetectOptions;
 use crate::error::{Error, Result};
-use crate::image::filter::{box_level, to_full, Plane};
+use crate::image::filter::{box_level, max_f32, min_f32, min_f64, to_full, Plane};
 use crate::image::GrayImage;
 use crate::target::DetectedPoint;
 use nalgebra::{Point2, Vector2};
@@ -228,16 +228,16 @@ fn is_x_junction(
     // Near the image border the ring shrinks to stay inside it: clamped
     // samples beyond the border repeat its last row or column and break
     // the point symmetry of a corner a few pixels from the edge.
-    let inside =
-        p.x.min(p.y)
-            .min(plane.w as f64 - 1.0 - p.x)
-            .min(plane.h as f64 - 1.0 - p.y);
+    let inside = min_f64(
+        min_f64(p.x, p.y),
+        min_f64(plane.w as f64 - 1.0 - p.x, plane.h as f64 - 1.0 - p.y),
+    );
     let r = radius.min(inside - 1.0).max(2.0);
     let vals: [f32; RING_SAMPLES] =
         std::array::from_fn(|k| plane.bilinear(p.x + r * unit[k].0, p.y + r * unit[k].1));
-    let (lo, hi) = vals
-        .iter()
-        .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let (lo, hi) = vals.iter().fold((f32::MAX, f32::MIN), |(l, h), &v| {
+        (min_f32(l, v), max_f32(h, v))
+    });
     let mid = 0.5 * (lo + hi);
     let band = 0.2 * (hi - lo);
     let mut classes = [false; RING_SAMPLES];

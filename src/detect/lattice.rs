@@ -47,8 +47,10 @@ impl<'a> PointIndex<'a> {
     }
 
     fn bucket(cell: f64, cols: usize, rows: usize, p: &Point2<f64>) -> (usize, usize) {
-        let bx = ((p.x / cell).max(0.0) as usize).min(cols - 1);
-        let by = ((p.y / cell).max(0.0) as usize).min(rows - 1);
+        // `as usize` saturates: negatives and NaN give 0 (an `f64::max`
+        // here was a call to `fmax` per lookup in the wasm build).
+        let bx = ((p.x / cell) as usize).min(cols - 1);
+        let by = ((p.y / cell) as usize).min(rows - 1);
         (bx, by)
     }
 

@@ -7,7 +7,7 @@
 //! relative to the strongest response become candidates. The Hessian also
 //! gives each candidate's polarity for the grid growth.
 
-use crate::image::filter::Plane;
+use crate::image::filter::{max_f32, Plane};
 use nalgebra::{Matrix2, Point2};
 
 /// Smoothing of the working pyramid level before differentiation, pixels.
@@ -65,18 +65,18 @@ pub(crate) fn candidates(level: &Plane, max_count: usize) -> Vec<Candidate> {
             let xx = r[i] - 2.0 * c[i] + l[i];
             let yy = d[i] - 2.0 * c[i] + u[i];
             let xy = 0.25 * (dr[i] - dl[i] - ur[i] + ul[i]);
-            out[i] = (xy * xy - xx * yy).max(0.0);
+            out[i] = max_f32(xy * xy - xx * yy, 0.0);
         }
         for chunk in out.chunks_exact(8) {
             for (m, &v) in lanes.iter_mut().zip(chunk) {
-                *m = m.max(v);
+                *m = max_f32(*m, v);
             }
         }
         for &v in out.chunks_exact(8).remainder() {
-            lanes[0] = lanes[0].max(v);
+            lanes[0] = max_f32(lanes[0], v);
         }
     }
-    let max_r = lanes.iter().fold(0.0f32, |m, &v| m.max(v));
+    let max_r = lanes.iter().fold(0.0f32, |m, &v| max_f32(m, v));
     let threshold = (max_r * RELATIVE_THRESHOLD).max(ABSOLUTE_THRESHOLD);
     let mut out = Vec::new();
     // Stay 3 px from the border: the fit and the 3x3 maximum need the ring.

@@ -36,10 +36,22 @@ impl Plane {
         let fx = (x - x0) as f32;
         let fy = (y - y0) as f32;
         let (xi, yi) = (x0 as isize, y0 as isize);
-        let a = self.at(xi, yi);
-        let b = self.at(xi + 1, yi);
-        let c = self.at(xi, yi + 1);
-        let d = self.at(xi + 1, yi + 1);
+        // Inside the image the four pixels are two pairs of neighbours,
+        // read without the clamps (the same values; the clamped reads were
+        // a call per pixel in the wasm build).
+        let (a, b, c, d) =
+            if xi >= 0 && yi >= 0 && xi + 1 < self.w as isize && yi + 1 < self.h as isize {
+                let i = yi as usize * self.w + xi as usize;
+                let (top, bottom) = (&self.data[i..i + 2], &self.data[i + self.w..i + self.w + 2]);
+                (top[0], top[1], bottom[0], bottom[1])
+            } else {
+                (
+                    self.at(xi, yi),
+                    self.at(xi + 1, yi),
+                    self.at(xi, yi + 1),
+                    self.at(xi + 1, yi + 1),
+                )
+            };
         (a * (1.0 - fx) + b * fx) * (1.0 - fy) + (c * (1.0 - fx) + d * fx) * fy
     }
 
@@ -152,8 +164,11 @@ pub(crate) fn box_level(img: &GrayImage, level: u32) -> Plane {
             }
             std::mem::swap(&mut a, &mut b);
         }
+        // Block sums are below 2^24 (256 x 256 x 255): `as i32` is exact,
+        // and the signed conversion is one instruction in wasm SIMD (the
+        // unsigned one is emulated).
         for (o, &v) in out.iter_mut().zip(&a[..whole]) {
-            *o = v as f32 * scale;
+            *o = v as i32 as f32 * scale;
         }
         for (x, o) in out.iter_mut().enumerate().skip(whole) {
             let mut acc = 0u32;
@@ -164,6 +179,41 @@ pub(crate) fn box_level(img: &GrayImage, level: u32) -> Plane {
         }
     }
     Plane { w, h, data }
+}
+
+/// The larger of two numbers that are never NaN (pixel values, responses,
+/// coordinates): one compare and select. `f32::max` is the same for such
+/// operands, but it must return the other operand for a NaN, which wasm's
+/// `f32.max` does not do, so in the wasm build it is a call to `fmaxf` in
+/// every iteration and the loop around it cannot vectorise (issue 38: a
+/// tenth of the wasm chessboard detection). Natively both are `maxss`.
+#[inline(always)]
+pub(crate) fn max_f32(a: f32, b: f32) -> f32 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The smaller of two numbers that are never NaN (see [`max_f32`]).
+#[inline(always)]
+pub(crate) fn min_f32(a: f32, b: f32) -> f32 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// [`min_f32`] for f64 (`f64::min` is a call to `fmin` in wasm).
+#[inline(always)]
+pub(crate) fn min_f64(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
 }
 
 /// The half-width of [`gaussian_kernel`]'s taps for `sigma`.
@@ -194,6 +244,31 @@ pub(crate) fn to_full(v: f64, level: u32) -> f64 {
 mod tests {
     use super::*;
     use wasm_bindgen_test::wasm_bindgen_test;
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn the_select_helpers_agree_with_the_library_max_and_min() {
+        let values = [
+            -3.5f32,
+            -1.0,
+            -f32::MIN_POSITIVE,
+            0.0,
+            1e-30,
+            0.25,
+            1.0,
+            255.0,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        for &a in &values {
+            for &b in &values {
+                assert_eq!(max_f32(a, b).to_bits(), a.max(b).to_bits(), "{a} {b}");
+                assert_eq!(min_f32(a, b).to_bits(), a.min(b).to_bits(), "{a} {b}");
+                let (a, b) = (a as f64, b as f64);
+                assert_eq!(min_f64(a, b).to_bits(), a.min(b).to_bits(), "{a} {b}");
+            }
+        }
+    }
 
     #[wasm_bindgen_test(unsupported = test)]
     fn smoothing_keeps_constants_and_pyramid_maps_centres() {

@@ -16,6 +16,17 @@ export const tests = [
     assert.match(await page.textContent('#engine-status'), /^Calibration engine ready \(robocal \d+\.\d+\.\d+\)\.$/);
     await shot('loaded');
   }],
+  ['a browser without WebAssembly SIMD is told which browsers the engine needs', async (page, { url }) => {
+    // The worker's feature check answers as in a browser whose WebAssembly
+    // validates no SIMD module (Chrome < 91, Firefox < 89, Safari < 16.4).
+    const source = readFileSync(join(root, 'www/lib/wasm-features.js'), 'utf8');
+    const patched = source.replace('!wasm.validate(SIMD_PROBE)', '!wasm.validate(new Uint8Array([0]))');
+    assert.notEqual(patched, source);
+    await page.route('**/lib/wasm-features.js', (route) => route.fulfill({ contentType: 'text/javascript', body: patched }));
+    await page.goto(url);
+    await page.locator('#engine-status.failed').waitFor({ timeout: 30000 });
+    assert.equal(await page.textContent('#engine-status'), "The calibration engine could not start: this browser's WebAssembly lacks the SIMD instructions the calibration engine is built with: use Chrome or Edge 91+, Firefox 89+, Safari 16.4+, or update this one");
+  }],
   ['two images decode, a corrupt file gets an error card', async (page, { url, shot }) => {
     await page.goto(url);
     await page.locator('#engine-status.ready').waitFor({ timeout: 30000 });

@@ -176,4 +176,6 @@ process.stdout.write(execFileSync('node', [join(here, 'laser.mjs'), work]).toStr
 // LiveCapture on the renderer's test video (320x240, 5 fps: a hold is 5 frames).
 execFileSync(join(root, 'target/release/robocal'), ['render', '--video', join(work, 'live.y4m'), '--size', '320x240', '--fps', '5', '--seed', '11'], { stdio: 'ignore' });
 process.stdout.write(execFileSync('node', [join(here, 'live.mjs'), work]).toString());
+// The page's WebAssembly SIMD check (www/lib/wasm-features.js).
+process.stdout.write(execFileSync('node', [join(here, 'wasm_features.mjs')]).toString());
 console.log(`node smoke test passed (${tarball})`);
