@@ -13,8 +13,9 @@
 //! distance, around the start plane), the mounting `gripper_from_camera`
 //! (a right perturbation, rotation vector then translation, around the
 //! start mounting) and the sphere's centre in the base frame. The camera's
-//! intrinsics are held (calibrate them first). The covariance is `s^2
-//! (J^T J)^-1` with `s^2` the residuals' variance (centres independent).
+//! intrinsics are held (calibrate them first). The covariance is a
+//! sandwich over the residuals with neighbouring centres' errors
+//! correlated (Newey-West, [`sandwich_covariance`]).
 //!
 //! Why the twelve numbers are determined: with the intrinsics known, the
 //! map from pixels to the plane fixes the camera's pose relative to the
@@ -29,6 +30,7 @@
 //! within a few millimetres and degrees. The centre starts where the start
 //! values put the points: a least-squares sphere of the known radius.
 
+use super::covariance::newey_west;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::{pose_from_params, tangent_basis, Plane, PlaneEstimate, Pose};
@@ -159,6 +161,39 @@ impl BlockProblem for Problem<'_> {
     }
 }
 
+/// The twelve numbers' covariance at the solution: the sandwich `A^-1 B
+/// A^-1` (`A = J^T J`) whose middle sums each centre's `J_k r_k` with its
+/// neighbours' along the scan's stripe (Newey-West, as the plane fit's
+/// [`super::covariance`]), times `m / (m - 12)`. Neighbouring centres err
+/// alike (the extractor's systematic error over a stretch of the stripe),
+/// so `s^2 (J^T J)^-1`, which takes them as independent, was 1.5 times
+/// too narrow in std over robot poses moved a little between runs
+/// (BENCHMARKS.md section 18, s27). `None` when `A` is singular.
+fn sandwich_covariance(problem: &Problem, params: &BlockParams) -> Result<Option<DMatrix<f64>>> {
+    let blocks = problem.residuals_and_jacobian(params, true)?;
+    let mut a = DMatrix::zeros(N_PARAMS, N_PARAMS);
+    let mut meat = DMatrix::zeros(N_PARAMS, N_PARAMS);
+    let mut m = 0usize;
+    for b in &blocks {
+        a += b.jac_global.transpose() * &b.jac_global;
+        let g: Vec<DVector<f64>> = (0..b.residuals.len())
+            .map(|k| b.jac_global.row(k).transpose() * b.residuals[k])
+            .collect();
+        meat += newey_west(&g, N_PARAMS);
+        m += b.residuals.len();
+    }
+    let Some(inv) = a.try_inverse() else {
+        return Ok(None);
+    };
+    let scale = if m > N_PARAMS {
+        m as f64 / (m - N_PARAMS) as f64
+    } else {
+        1.0
+    };
+    let c = &inv * meat * &inv * scale;
+    Ok(Some(0.5 * (&c + c.transpose())))
+}
+
 /// The least-squares sphere of known `radius_m` through `points`: the
 /// algebraic fit `2 p . c - k = |p|^2` for a start, then Gauss-Newton on
 /// `|p - c| - r` with the radius held.
@@ -271,12 +306,16 @@ pub fn calibrate_on_sphere(
         ..LmOptions::default()
     };
     let result = optim::solve(&problem, &initial, &options)?;
-    let covariance = result.covariance_global.clone().ok_or_else(|| {
+    let undetermined = || {
         Error::degenerate(
             "the scans do not determine the plane and the mounting: turn the robot about \
              different axes between scans and cut the sphere at different heights",
         )
-    })?;
+    };
+    if result.covariance_global.is_none() {
+        return Err(undetermined());
+    }
+    let covariance = sandwich_covariance(&problem, &result.params)?.ok_or_else(undetermined)?;
     let p = &result.params.global;
     let plane = problem.plane(p);
     let mount = problem.mount(p);
