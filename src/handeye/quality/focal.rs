@@ -379,6 +379,34 @@ mod tests {
         assert_eq!(real_share(0.01, 0.0), 1.0);
     }
 
+    /// Twelve eye-in-hand views at 0.5 m through `truth` (seed `seed`), the
+    /// PnP poses from `used`, solved and pose-refined without the focal
+    /// check: the result, its input and the views.
+    fn refined_scene(
+        truth: &Camera,
+        used: &Camera,
+        noise: &crate::synth::handeye_looking::LookingNoise,
+        seed: u64,
+    ) -> (HandEyeResult, HandEyeInput, Vec<View>) {
+        use crate::handeye::refine::over_poses::camera_noise_from_views;
+        use crate::handeye::solve::apply_pose_refinement;
+        use crate::handeye::{calibrate, HandEyeOptions};
+        use crate::synth::handeye_looking::{observe_looking, LookingConfig};
+        let config = LookingConfig::half_metre(Setup::EyeInHand, 12);
+        let seen = observe_looking(&config, seed, truth, noise, seed);
+        let input = seen.handeye_input(used).unwrap();
+        let options = HandEyeOptions {
+            bootstrap_samples: 1,
+            refine_poses: false,
+            strict_checks: false,
+            ..Default::default()
+        };
+        let mut result = calibrate(&input, &options).unwrap();
+        let levels = camera_noise_from_views(&input, &seen.views, used).0;
+        apply_pose_refinement(&mut result, &input, levels, MotionPairs::All).unwrap();
+        (result, input, seen.views)
+    }
+
     #[test]
     fn the_known_scale_std_takes_the_cameras_own_with_the_robots() {
         assert_eq!(known_scale_std(2e-3, None), 2e-3);
@@ -411,29 +439,14 @@ mod tests {
     /// shrinks to what both know together, `known / std` of it.
     #[test]
     fn a_focal_length_confirmed_only_to_its_std_widens_the_std() {
-        use crate::handeye::solve::apply_pose_refinement;
-        use crate::handeye::{calibrate, HandEyeOptions};
-        use crate::synth::handeye_looking::{observe_looking, LookingConfig, LookingNoise};
+        use crate::synth::handeye_looking::LookingNoise;
         let camera = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-        let config = LookingConfig::half_metre(Setup::EyeInHand, 12);
         let noise = LookingNoise {
             pixel_sigma: 0.2,
             robot_sigma: (0.02f64.to_radians(), 1e-4),
             kinematic: None,
         };
-        let seen = observe_looking(&config, 41, &camera, &noise, 41);
-        let input = seen.handeye_input(&camera).unwrap();
-        let views = seen.views;
-        let options = HandEyeOptions {
-            bootstrap_samples: 1,
-            refine_poses: false,
-            strict_checks: false,
-            ..Default::default()
-        };
-        let mut result = calibrate(&input, &options).unwrap();
-        let levels =
-            crate::handeye::refine::over_poses::camera_noise_from_views(&input, &views, &camera).0;
-        apply_pose_refinement(&mut result, &input, levels, MotionPairs::All).unwrap();
+        let (result, input, views) = refined_scene(&camera, &camera, &noise, 41);
         let pose = (&result.x, &result.y);
         let fit = focal_scale(input.setup, &input.base_from_gripper, &views, &camera, pose);
         let fit = fit.unwrap();
@@ -493,30 +506,15 @@ mod tests {
     /// widened std stay.
     #[test]
     fn check_focal_writes_no_warning_within_the_cameras_fx_std() {
-        use crate::handeye::solve::apply_pose_refinement;
-        use crate::handeye::{calibrate, HandEyeOptions};
-        use crate::synth::handeye_looking::{observe_looking, LookingConfig, LookingNoise};
+        use crate::synth::handeye_looking::LookingNoise;
         let truth = Camera::pinhole(1100.0, 1100.0, 639.5, 479.5, 1280, 960);
-        let config = LookingConfig::half_metre(Setup::EyeInHand, 12);
         let clean = LookingNoise {
             pixel_sigma: 0.01,
             robot_sigma: (1e-6, 1e-6),
             kinematic: None,
         };
-        let seen = observe_looking(&config, 35, &truth, &clean, 35);
         let used = Camera::pinhole(1100.55, 1100.55, 639.5, 479.5, 1280, 960);
-        let input = seen.handeye_input(&used).unwrap();
-        let views = seen.views;
-        let options = HandEyeOptions {
-            bootstrap_samples: 1,
-            refine_poses: false,
-            strict_checks: false,
-            ..Default::default()
-        };
-        let mut result = calibrate(&input, &options).unwrap();
-        let noise =
-            crate::handeye::refine::over_poses::camera_noise_from_views(&input, &views, &used).0;
-        apply_pose_refinement(&mut result, &input, noise, MotionPairs::All).unwrap();
+        let (result, input, views) = refined_scene(&truth, &used, &clean, 35);
         let alone = check_focal(&result, &input, &views, (&used, None), MotionPairs::All).unwrap();
         let check = alone.check.clone().unwrap();
         let off = check.scale - 1.0;
