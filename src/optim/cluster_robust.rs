@@ -45,6 +45,7 @@
 //! samples"); Pustejovsky and Tipton 2018 (J. Bus. Econ. Stat. 36(4)) for
 //! the degrees of freedom of a single coefficient.
 
+use super::dense::transpose_times;
 use super::normal::{squared_norm, Mask, Normal};
 use super::{BlockParams, Loss, ResidualRun};
 use nalgebra::{DMatrix, DVector};
@@ -85,7 +86,7 @@ impl Cluster {
     /// `A_g v = v + Y M Y^T v` with `M = V diag(lift(s) / s^2) V^T`,
     /// `lift(s) = (1 - s^2)^-1/2 - 1`: no SVD of the tall `Y`.
     fn adjust(&self, v: &DMatrix<f64>) -> DMatrix<f64> {
-        v + &self.y * (&self.m * (self.y.transpose() * v))
+        v + &self.y * (&self.m * transpose_times(&self.y, v))
     }
 }
 
@@ -195,7 +196,7 @@ fn sandwich(
         meat += &m * m.transpose();
         let w = c.adjust(&(&c.x * &q));
         w_norms.push(DVector::from_fn(nf, |k, _| w.column(k).norm_squared()));
-        us.push(c.x.transpose() * w);
+        us.push(transpose_times(&c.x, &w));
     }
     let v = &q * meat * &q;
     // nu per parameter: G^T G = diag(|w_g|^2) - [u_g]^T Q [u_h], and
@@ -204,7 +205,7 @@ fn sandwich(
     let dof_free: Vec<f64> = (0..nf)
         .map(|k| {
             let u = DMatrix::from_fn(nf, g, |i, c| us[c][(i, k)]);
-            let mut m = -(u.transpose() * &q * &u);
+            let mut m = -(transpose_times(&u, &q) * &u);
             for c in 0..g {
                 m[(c, c)] += w_norms[c][k];
             }
@@ -268,11 +269,11 @@ fn cluster(
         }
     }
     // Project the pose out of the Jacobian and the residuals.
-    let chol = (p.transpose() * &p).cholesky()?;
-    let x = &j - &p * chol.solve(&(p.transpose() * &j));
+    let chol = transpose_times(&p, &p).cholesky()?;
+    let x = &j - &p * chol.solve(&transpose_times(&p, &j));
     let e = &e - &p * chol.solve(&(p.transpose() * &e));
     let y = &x * q_half;
-    let eigen = (y.transpose() * &y).symmetric_eigen();
+    let eigen = transpose_times(&y, &y).symmetric_eigen();
     if eigen.eigenvalues.iter().any(|l| *l > MAX_LEVERAGE) {
         return None;
     }

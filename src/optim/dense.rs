@@ -4,7 +4,46 @@
 //! this crate's speed settings (nalgebra's generic operators are compiled in
 //! the crate that calls them).
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DMatrixView, Dyn};
+
+/// `m^T` as a view of `m`'s own storage (row and column strides swapped):
+/// no copy. Private: nalgebra 0.34's small-matrix product path (any
+/// dimension of 5 or less) walks a strided *left* operand's columns past
+/// their end, so the view is only handed out by the two products below,
+/// which keep it where that cannot happen.
+fn transposed(m: &DMatrix<f64>) -> DMatrixView<'_, f64, Dyn, Dyn> {
+    DMatrixView::from_slice_with_strides(m.as_slice(), m.ncols(), m.nrows(), m.nrows(), 1)
+}
+
+/// nalgebra's bound: a product with every dimension above it goes to
+/// matrixmultiply (which takes any strides), below it column by column.
+const SMALL_DIM: usize = 5;
+
+/// `out += alpha a b^T` without copying `b^T`. The view is the right operand,
+/// read element by element on either of nalgebra's paths, and
+/// matrixmultiply packs either layout into the same panels: the same
+/// numbers added in the same order as `out.gemm(alpha, a, &b.transpose(),
+/// 1.0)`, bit for bit.
+pub fn add_times_transpose(out: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>) {
+    out.gemm(alpha, a, &transposed(b), 1.0);
+}
+
+/// `a * b^T` without copying `b^T` (as [`add_times_transpose`]).
+pub fn times_transpose(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
+    a * transposed(b)
+}
+
+/// `a^T * b`, bit for bit `a.transpose() * b`: without the copy of `a^T`
+/// when the product goes to matrixmultiply (every dimension above
+/// [`SMALL_DIM`]), with it otherwise (the case where a strided left
+/// operand is not safe, see [`transposed`]).
+pub fn transpose_times(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
+    if a.nrows() > SMALL_DIM && a.ncols() > SMALL_DIM && b.ncols() > SMALL_DIM {
+        transposed(a) * b
+    } else {
+        a.transpose() * b
+    }
+}
 
 /// `p[:, cols] * h^T` for an `m x cols.len()` matrix `h`: the gain
 /// numerator `P H^T` when `H` is zero outside the columns `cols`.
@@ -106,5 +145,41 @@ mod tests {
         let want = (&raw + raw.transpose()) * 0.5;
         assert!((&p - &want).amax() < 1e-12);
         assert_eq!(p, p.transpose(), "exactly symmetric");
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
+    fn products_with_a_transposed_view_equal_the_copied_transpose_bit_for_bit() {
+        // Shapes on both of nalgebra's paths: every dimension above 5
+        // (matrixmultiply) and some at or below it (column by column),
+        // including a single column and an empty block.
+        let shapes = [
+            (9, 176, 6),
+            (6, 176, 6),
+            (3, 40, 2),
+            (12, 5, 9),
+            (7, 30, 1),
+            (4, 0, 3),
+        ];
+        for (m, k, n) in shapes {
+            let a = matrix(m, k, 0.37);
+            let b = matrix(n, k, 0.91);
+            let mut out = matrix(m, n, 0.13);
+            let mut reference = out.clone();
+            reference.gemm(-1.0, &a, &b.transpose(), 1.0);
+            add_times_transpose(&mut out, -1.0, &a, &b);
+            assert_eq!(out, reference, "a b^T added, {m} x {k} x {n}");
+            assert_eq!(
+                times_transpose(&a, &b),
+                &a * b.transpose(),
+                "a b^T, {m} x {k} x {n}"
+            );
+            let c = matrix(k, n, 0.53);
+            let d = matrix(k, m, 0.29);
+            assert_eq!(
+                transpose_times(&d, &c),
+                d.transpose() * &c,
+                "d^T c, {k} x {m} x {n}"
+            );
+        }
     }
 }

@@ -10,6 +10,7 @@
 //! Each V_i is small (6 for a pose), so the cost is linear in the number
 //! of blocks.
 
+use super::dense::{add_times_transpose, times_transpose};
 use super::{BlockParams, Loss, ResidualBlock, ResidualRun};
 use nalgebra::{DMatrix, DVector};
 
@@ -209,8 +210,6 @@ impl Normal {
         // move a few control values each, so a view's rows are zero in most
         // of its ~200 global columns. The products over the touched ones
         // alone, added into their rows and columns, are the same sums.
-        // The block's rows untransposed, once for both products below.
-        let jb = jb_t.transpose();
         let active: Vec<usize> = (0..ng)
             .filter(|&c| jg_t.row(c).iter().any(|v| *v != 0.0))
             .collect();
@@ -225,7 +224,7 @@ impl Normal {
                 self.g_global[ai] += g[i];
             }
             if let Some(b) = block {
-                let w = &jg * &jb;
+                let w = times_transpose(&jg, jb_t);
                 for (i, &ai) in active.iter().enumerate() {
                     for j in 0..nb {
                         self.w[b][(ai, j)] += w[(i, j)];
@@ -233,14 +232,14 @@ impl Normal {
                 }
             }
         } else if ng > 0 {
-            self.u.gemm(1.0, jg_t, &jg_t.transpose(), 1.0);
+            add_times_transpose(&mut self.u, 1.0, jg_t, jg_t);
             self.g_global.gemv(1.0, jg_t, r, 1.0);
             if let Some(b) = block {
-                self.w[b].gemm(1.0, jg_t, &jb, 1.0);
+                add_times_transpose(&mut self.w[b], 1.0, jg_t, jb_t);
             }
         }
         if let Some(b) = block {
-            self.v[b].gemm(1.0, jb_t, &jb, 1.0);
+            add_times_transpose(&mut self.v[b], 1.0, jb_t, jb_t);
             self.g_blocks[b].gemv(1.0, jb_t, r, 1.0);
         }
     }
@@ -324,7 +323,7 @@ impl Normal {
         for (b, v) in self.v.iter().enumerate() {
             let inv = damp(v).cholesky()?.inverse();
             let y = &self.w[b] * &inv;
-            s.gemm(-1.0, &y, &self.w[b].transpose(), 1.0);
+            add_times_transpose(&mut s, -1.0, &y, &self.w[b]);
             v_inv.push(inv);
         }
         Some((s, v_inv))
