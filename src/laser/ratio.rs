@@ -22,7 +22,8 @@
 //! product of the profile and the blur kernel integrated over the light
 //! side). Saturated pixels (`on` at or above `255 - 1.5 noise`) hold no
 //! profile and are left out; the others count alike (the noise is additive
-//! on the difference), Gauss-Newton from the centre of gravity. The
+//! on the difference), Levenberg-Marquardt from five starts about the
+//! centre of gravity. The
 //! centre's std is `noise sqrt((J^T J)^-1)`. When the fit fails (too few
 //! unsaturated samples, no convergence, a centre outside the window) the
 //! centre of gravity is kept with a std of at least `FALLBACK_STD_PX`, so
@@ -209,7 +210,8 @@ pub(crate) fn across_edge(
         (jtj, jtr)
     };
     // Gauss-Newton (Levenberg-Marquardt) from a start; the clipped core
-    // and the step leave more than one minimum, so three starts.
+    // and the step leave more than one minimum: five starts, the centre of
+    // gravity and 1 or 2 sigmas either side.
     let solve = |start: f64| -> (Vector4<f64>, f64) {
         let mut q = Vector4::new(0.0, p.contrast.max(1.0) / level, start, w0);
         let mut current = cost(&q);
