@@ -25,6 +25,7 @@ pub mod fit;
 pub mod joint;
 pub mod plane;
 pub mod points;
+mod ratio;
 pub mod ridge;
 pub mod skeleton;
 pub mod sphere;

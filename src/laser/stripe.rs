@@ -145,6 +145,8 @@ pub(crate) struct Scan {
     pub len: usize,
     pub data: Vec<f32>,
     pub raw: Vec<u8>,
+    /// The laser-off image in scan order, when given.
+    pub off: Option<Vec<f32>>,
 }
 
 impl Scan {
@@ -156,6 +158,7 @@ impl Scan {
         };
         let mut data = vec![0f32; w * h];
         let mut raw = vec![0u8; w * h];
+        let mut off_scan = off.map(|_| vec![0f32; w * h]);
         for y in 0..h {
             for x in 0..w {
                 let k = y * w + x;
@@ -167,6 +170,9 @@ impl Scan {
                 };
                 data[idx] = s;
                 raw[idx] = v;
+                if let (Some(o), Some(t)) = (off, off_scan.as_mut()) {
+                    t[idx] = o.pixels[k] as f32;
+                }
             }
         }
         Scan {
@@ -174,6 +180,7 @@ impl Scan {
             len,
             data,
             raw,
+            off: off_scan,
         }
     }
     pub(crate) fn line(&self, i: usize) -> &[f32] {
@@ -298,8 +305,17 @@ pub(crate) fn median(v: &mut [f64]) -> Option<f64> {
 
 fn first_pass(scan: &Scan, options: &StripeOptions, noise: f64) -> Vec<Option<Peak>> {
     let raw = |i: usize| &scan.raw[i * scan.len..(i + 1) * scan.len];
+    // The step model across albedo edges refines the centre of gravity
+    // (the ridge detector starts from the plain first pass).
+    let refit = options.method == StripeMethod::CentreOfGravity;
+    let off = |i: usize| {
+        scan.off
+            .as_ref()
+            .filter(|_| refit)
+            .map(|o| &o[i * scan.len..(i + 1) * scan.len])
+    };
     let mut peaks: Vec<Option<Peak>> = (0..scan.lines)
-        .map(|i| peak_in_line(scan.line(i), raw(i), options, noise, (0, scan.len)))
+        .map(|i| peak_in_line(scan.line(i), raw(i), off(i), options, noise, (0, scan.len)))
         .collect();
     // The stripe is continuous: a centre far from its neighbourhood's
     // median (a light square of the pattern outshining a dim stretch of
@@ -324,7 +340,7 @@ fn first_pass(scan: &Scan, options: &StripeOptions, noise: f64) -> Vec<Option<Pe
         if (p.centre - m).abs() > reach {
             let lo = (m - reach).max(0.0) as usize;
             let hi = ((m + reach) as usize + 1).min(scan.len);
-            *slot = peak_in_line(scan.line(i), raw(i), options, noise, (lo, hi))
+            *slot = peak_in_line(scan.line(i), raw(i), off(i), options, noise, (lo, hi))
                 .filter(|q| (q.centre - m).abs() <= reach);
         }
     }
@@ -343,6 +359,7 @@ const MIN_STD_PX: f64 = 0.01;
 fn peak_in_line(
     line: &[f32],
     raw: &[u8],
+    off: Option<&[f32]>,
     options: &StripeOptions,
     noise: f64,
     search: (usize, usize),
@@ -443,13 +460,17 @@ fn peak_in_line(
     } else {
         (n - 1) as f64
     };
-    Some(Peak {
+    let p = Peak {
         centre,
         std,
         width: right_edge - left_edge,
         peak,
         contrast,
         saturated: raw[a..=b].contains(&255),
+    };
+    Some(match off {
+        Some(off) => super::ratio::across_edge(line, raw, off, p, (a, b, jp), offset, noise),
+        None => p,
     })
 }
 
