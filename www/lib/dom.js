@@ -42,6 +42,14 @@ export function num(x, digits = 4) {
   return x.toFixed(digits);
 }
 
+/** Format a number with exactly `digits` decimals (never exponential: a
+ * unit vector's component near 0 reads 0.00003, not 3.0000e-5), '—' for null. */
+export function fixed(x, digits = 4) {
+  if (x === null || x === undefined || Number.isNaN(x)) return '—';
+  if (typeof x !== 'number') return String(x);
+  return x.toFixed(digits);
+}
+
 /** Offer `text` as a download named `name`. */
 export function download(name, text, type = 'text/plain') {
   const url = URL.createObjectURL(new Blob([text], { type }));

@@ -8,7 +8,7 @@
 // parameters and a URDF / ROS static TF frame (export_report, the bytes of
 // `robocal export`). Images stay in this tab; the plane report is kept in
 // the session.
-import { $, h, fill, table, num, message, download, readTextFile } from '../lib/dom.js';
+import { $, h, fill, table, num, fixed, message, download, readTextFile } from '../lib/dom.js';
 import { targetSpec } from './target.js';
 import { readCameraFile } from '../lib/reports.js';
 
@@ -155,7 +155,7 @@ export class LaserView {
     const p = report.laser_plane;
     const n = p.normal_camera;
     const plane = h('p', { id: 'laser-plane', dataset: { normal: JSON.stringify(n), distanceM: String(p.distance_m), normalStdDeg: String(p.normal_std_deg), distanceStdMm: String(p.distance_std_mm) } },
-      `Laser plane in the camera frame (n · X = d): normal (${num(n[0], 5)}, ${num(n[1], 5)}, ${num(n[2], 5)}) ± ${num(p.normal_std_deg, 4)}°, distance ${num(p.distance_m * 1e3, 3)} ± ${num(p.distance_std_mm, 3)} mm (1 std from the covariance; ${report.residual} residual, ${report.extractor} centres, variance factor ${num(report.variance_factor, 2)}).`);
+      `Laser plane in the camera frame (n · X = d): normal (${fixed(n[0], 5)}, ${fixed(n[1], 5)}, ${fixed(n[2], 5)}) ± ${num(p.normal_std_deg, 4)}°, distance ${num(p.distance_m * 1e3, 3)} ± ${num(p.distance_std_mm, 3)} mm (1 std from the covariance; ${report.residual} residual, ${report.extractor} centres, variance factor ${num(report.variance_factor, 2)}).`);
     const rows = report.images.map((i) => [i.name, num(i.board_rms_px, 3), String(i.stripe_points), String(i.n_points), num(i.rms_px, 3), num(i.rms_mm, 4), i.gaps.length ? i.gaps.map(([a, b]) => `${a}–${b}`).join(', ') : '—']);
     this.exportText = null;
     fill($('laser-result'),
