@@ -46,8 +46,9 @@
 
 use super::blobs::Outline;
 use super::ellipse::fit_ellipse;
+use super::markers::homography::dlt_normal_equations;
 use crate::target::CentreModel;
-use nalgebra::{Matrix3, Point2, SMatrix, SVector, Vector2, Vector3};
+use nalgebra::{Matrix3, Point2, Vector2, Vector3};
 
 /// Half-width of the window of grid neighbours a local map is fitted to,
 /// lattice cells, on symmetric grids and dot plates: 1, a 3x3 window of 9
@@ -348,17 +349,7 @@ impl LocalMap {
             return None;
         }
         let local = |i: usize| (cells[i] - cell, (centres[i].coords - origin) / scale);
-        let mut ata = SMatrix::<f64, 8, 8>::zeros();
-        let mut atb = SVector::<f64, 8>::zeros();
-        for &i in members {
-            let (b, u) = local(i);
-            let r1 =
-                SVector::<f64, 8>::from([b.x, b.y, 1.0, 0.0, 0.0, 0.0, -u.x * b.x, -u.x * b.y]);
-            let r2 =
-                SVector::<f64, 8>::from([0.0, 0.0, 0.0, b.x, b.y, 1.0, -u.y * b.x, -u.y * b.y]);
-            ata += r1 * r1.transpose() + r2 * r2.transpose();
-            atb += r1 * u.x + r2 * u.y;
-        }
+        let (ata, atb) = dlt_normal_equations(members.iter().map(|&i| local(i)));
         let x = ata.cholesky()?.solve(&atb);
         let h = Matrix3::new(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], 1.0);
         let h_inv = h.try_inverse()?;

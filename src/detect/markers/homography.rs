@@ -2,7 +2,7 @@
 //! `h33 = 1` (board points near the origin map to finite pixels, so `h33`
 //! is far from 0) solved by least squares over any number of points >= 4.
 
-use nalgebra::{Matrix3, Point2, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, Point2, SMatrix, SVector, Vector2, Vector3};
 
 /// A homography with its normalisations: `image = T_img^-1 H T_board board`.
 #[derive(Debug, Clone)]
@@ -21,7 +21,11 @@ impl Homography {
             normaliser(pairs.iter().map(|p| p.0)),
             normaliser(pairs.iter().map(|p| p.1)),
         );
-        let (ata, atb) = normal_equations(pairs, &tb, &ti);
+        let (ata, atb) = dlt_normal_equations(pairs.iter().map(|(b, i)| {
+            let b = tb * Vector3::new(b.x, b.y, 1.0);
+            let u = ti * Vector3::new(i.x, i.y, 1.0);
+            (b.xy(), u.xy())
+        }));
         let x = ata.cholesky()?.solve(&atb);
         let h = Matrix3::new(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], 1.0);
         let h = ti.try_inverse()? * h * tb;
@@ -36,21 +40,18 @@ impl Homography {
 }
 
 /// The normal equations of the DLT rows r1 = (b, 1, 0, 0, 0, -u.x b) and
-/// r2 = (0, 0, 0, b, 1, -u.y b) (b, u: the normalised board and image
-/// points), summed entry by entry as `ata += r1 r1^T + r2 r2^T` would sum
-/// them but without the products of the structural zeros (half the
+/// r2 = (0, 0, 0, b, 1, -u.y b) over `(b, u)` pairs (normalised board and
+/// image points; also the local homographies of `detect::centres`),
+/// summed entry by entry as `ata += r1 r1^T + r2 r2^T` would sum them but
+/// without the products of the structural zeros (half the
 /// multiplications): an entry never holds -0 (it starts at +0), so adding
 /// a zero product changes no bit.
-fn normal_equations(
-    pairs: &[(Point2<f64>, Point2<f64>)],
-    tb: &Matrix3<f64>,
-    ti: &Matrix3<f64>,
+pub(crate) fn dlt_normal_equations(
+    pairs: impl Iterator<Item = (Vector2<f64>, Vector2<f64>)>,
 ) -> (SMatrix<f64, 8, 8>, SVector<f64, 8>) {
     let mut ata = [[0.0f64; 8]; 8];
     let mut atb = [0.0f64; 8];
-    for (b, i) in pairs {
-        let b = tb * Vector3::new(b.x, b.y, 1.0);
-        let u = ti * Vector3::new(i.x, i.y, 1.0);
+    for (b, u) in pairs {
         let r1 = [b.x, b.y, 1.0, 0.0, 0.0, 0.0, -u.x * b.x, -u.x * b.y];
         let r2 = [0.0, 0.0, 0.0, b.x, b.y, 1.0, -u.y * b.x, -u.y * b.y];
         for i in 0..3 {
@@ -160,7 +161,11 @@ mod tests {
             let (ata, atb) = dense_normal_equations(&pairs);
             let tb = normaliser(pairs.iter().map(|p| p.0));
             let ti = normaliser(pairs.iter().map(|p| p.1));
-            let (sparse_ata, sparse_atb) = normal_equations(&pairs, &tb, &ti);
+            let (sparse_ata, sparse_atb) = dlt_normal_equations(pairs.iter().map(|(b, i)| {
+                let b = tb * Vector3::new(b.x, b.y, 1.0);
+                let u = ti * Vector3::new(i.x, i.y, 1.0);
+                (b.xy(), u.xy())
+            }));
             let bits = |m: &[f64]| m.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(sparse_ata.as_slice()), bits(ata.as_slice()), "n = {n}");
             assert_eq!(bits(sparse_atb.as_slice()), bits(atb.as_slice()), "n = {n}");
