@@ -17,8 +17,7 @@
 
 use robocal::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions};
 use robocal::handeye::{Pose, Setup};
-use robocal::synth::handeye_looking::{looking_scene, perturbed, LookingConfig, LookingScene};
-use robocal::synth::Rng;
+use robocal::synth::handeye_looking::{looking_scene, noisy_input, LookingConfig, LookingScene};
 use std::time::Instant;
 
 fn args_of(name: &str) -> Vec<String> {
@@ -36,21 +35,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn scene_input(poses: usize) -> (LookingScene, HandEyeInput) {
     let scene = looking_scene(&LookingConfig::half_metre(Setup::EyeInHand, poses), 21);
-    let mut rng = Rng::new(3);
-    let (r, c) = (0.02f64.to_radians(), 0.05f64.to_radians());
-    let input = HandEyeInput {
-        setup: Setup::EyeInHand,
-        base_from_gripper: scene
-            .base_from_gripper
-            .iter()
-            .map(|p| perturbed(&mut rng, p, [r; 3], [1e-4; 3]))
-            .collect(),
-        camera_from_target: scene
-            .camera_from_target
-            .iter()
-            .map(|p| perturbed(&mut rng, p, [c, c, c / 5.0], [5e-5, 5e-5, 3e-4]))
-            .collect(),
-    };
+    let input = noisy_input(&scene, 3);
     (scene, input)
 }
 

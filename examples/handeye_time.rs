@@ -11,10 +11,9 @@
 //! --camera-poses ... --bootstrap 0`). The two variants alternate, `--runs`
 //! times each; printed: every run and the medians (seconds).
 
-use robocal::handeye::solve::{calibrate, HandEyeInput, HandEyeOptions};
+use robocal::handeye::solve::{calibrate, HandEyeOptions};
 use robocal::handeye::Setup;
-use robocal::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
-use robocal::synth::Rng;
+use robocal::synth::handeye_looking::{looking_scene, noisy_input, LookingConfig};
 use std::time::Instant;
 
 fn arg(name: &str, default: usize) -> usize {
@@ -34,22 +33,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let (poses, runs) = (arg("--poses", 1000), arg("--runs", 3));
     let scene = looking_scene(&LookingConfig::half_metre(Setup::EyeInHand, poses), 21);
-    let mut rng = Rng::new(3);
-    let r = 0.02f64.to_radians();
-    let c = 0.05f64.to_radians();
-    let input = HandEyeInput {
-        setup: Setup::EyeInHand,
-        base_from_gripper: scene
-            .base_from_gripper
-            .iter()
-            .map(|p| perturbed(&mut rng, p, [r; 3], [1e-4; 3]))
-            .collect(),
-        camera_from_target: scene
-            .camera_from_target
-            .iter()
-            .map(|p| perturbed(&mut rng, p, [c, c, c / 5.0], [5e-5, 5e-5, 3e-4]))
-            .collect(),
-    };
+    let input = noisy_input(&scene, 3);
     let (mut with, mut without) = (Vec::new(), Vec::new());
     for run in 0..runs {
         for refine_poses in [true, false] {

@@ -74,10 +74,8 @@ fn centre(rng: &mut Rng, z: f64, partial: bool) -> Vector3<f64> {
 }
 
 fn save(img: &GrayImage, path: &str) {
-    image::GrayImage::from_raw(img.width, img.height, img.pixels.clone())
-        .expect("image buffer")
-        .save(path)
-        .expect("write png");
+    let png = robocal::image::encode_png(img).expect("encode png");
+    std::fs::write(path, png).expect("write png");
 }
 
 /// robocal's detection: median time of `repeat` calls and the points.

@@ -29,10 +29,8 @@ const BOARDS: [(&str, &str); 2] = [
 ];
 
 fn save(img: &robocal::image::GrayImage, path: &str) {
-    image::GrayImage::from_raw(img.width, img.height, img.pixels.clone())
-        .expect("image buffer")
-        .save(path)
-        .expect("write png");
+    let png = robocal::image::encode_png(img).expect("encode png");
+    std::fs::write(path, png).expect("write png");
 }
 
 fn points(p: &[robocal::target::DetectedPoint]) -> Vec<Value> {

@@ -261,15 +261,11 @@ fn rwhe_cs_synthetic_1_recovers_its_ground_truth_from_the_images() {
 
 #[test]
 fn camera_poses_are_refined_by_default_and_no_refine_keeps_the_closed_form() {
-    use robocal::synth::handeye_looking::{looking_scene, perturbed, LookingConfig};
-    use robocal::synth::Rng;
+    use robocal::synth::handeye_looking::{looking_scene, noisy_input, LookingConfig};
     let scene = looking_scene(
         &LookingConfig::half_metre(robocal::handeye::Setup::EyeInHand, 15),
         21,
     );
-    // Robot 0.1 mm / 0.02 deg, camera 0.05 deg and 0.05 / 0.3 mm (x, y / depth).
-    let mut rng = Rng::new(3);
-    let r = 0.02f64.to_radians();
     let line = |p: &robocal::handeye::Pose| {
         let m = p.to_homogeneous();
         (0..4)
@@ -278,19 +274,10 @@ fn camera_poses_are_refined_by_default_and_no_refine_keeps_the_closed_form() {
             .join(" ")
             + "\n"
     };
-    let robot: String = scene
-        .base_from_gripper
-        .iter()
-        .map(|p| line(&perturbed(&mut rng, p, [r; 3], [1e-4; 3])))
-        .collect();
-    let camera: String = scene
-        .camera_from_target
-        .iter()
-        .map(|p| {
-            let c = 0.05f64.to_radians();
-            line(&perturbed(&mut rng, p, [c, c, c / 5.0], [5e-5, 5e-5, 3e-4]))
-        })
-        .collect();
+    // Robot 0.1 mm / 0.02 deg, camera 0.05 deg and 0.05 / 0.3 mm (x, y / depth).
+    let input = noisy_input(&scene, 3);
+    let robot: String = input.base_from_gripper.iter().map(line).collect();
+    let camera: String = input.camera_from_target.iter().map(line).collect();
     let dir = std::env::temp_dir().join(format!("robocal-cli-pose-refine-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (robot_path, camera_path) = (dir.join("robot.txt"), dir.join("camera.txt"));
