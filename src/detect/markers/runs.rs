@@ -11,7 +11,7 @@ use crate::image::GrayImage;
 
 /// Grey levels below the local mean for a dark pixel (OpenCV's
 /// adaptiveThreshConstant is 7).
-const THRESHOLD_OFFSET: i64 = 7;
+const THRESHOLD_OFFSET: u32 = 7;
 
 /// Dark pixels `x0..x1` (end exclusive) of one row.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,59 +36,78 @@ impl Runs {
 }
 
 /// Summed-area table: `s[y * (w + 1) + x]` is the sum of the pixels above
-/// and left of (x, y).
-pub(super) fn integral_image(img: &GrayImage) -> Vec<u64> {
+/// and left of (x, y), modulo 2^32. A window's sum (four entries, wrapping
+/// arithmetic) is exact while the true sum stays under 2^32: windows of up
+/// to 16.8 million pixels ([`MAX_WINDOW`]). Half the memory of 64-bit sums,
+/// and 32-bit lanes for the vectorised threshold.
+pub(super) fn integral_image(img: &GrayImage) -> Vec<u32> {
     let (w, h) = (img.width as usize, img.height as usize);
-    let mut s = vec![0u64; (w + 1) * (h + 1)];
+    let mut s = vec![0u32; (w + 1) * (h + 1)];
     for y in 0..h {
-        let mut row = 0u64;
+        let mut row = 0u32;
         let src = &img.pixels[y * w..(y + 1) * w];
-        for (x, &v) in src.iter().enumerate() {
-            row += u64::from(v);
-            s[(y + 1) * (w + 1) + x + 1] = s[y * (w + 1) + x + 1] + row;
+        let (above, below) = s[y * (w + 1)..(y + 2) * (w + 1)].split_at_mut(w + 1);
+        for ((&v, a), b) in src.iter().zip(&above[1..]).zip(&mut below[1..]) {
+            row = row.wrapping_add(u32::from(v));
+            *b = a.wrapping_add(row);
         }
     }
     s
 }
 
+/// Largest window side [`threshold`] takes (larger ones are cut to it): its
+/// sums and `(v + 7) * area` stay under 2^32. The marker search's windows
+/// are at most 91 pixels.
+pub(super) const MAX_WINDOW: usize = 4001;
+
 /// Runs of pixels more than [`THRESHOLD_OFFSET`] below the mean of the
-/// `win` x `win` window around them (cut at the image edge).
-pub(super) fn threshold(img: &GrayImage, s: &[u64], win: usize) -> Runs {
+/// `win` x `win` window around them (cut at the image edge). Each row is
+/// first written as a byte mask (the middle, where the window is not cut
+/// at the left or right edge, in one loop without branches that compilers
+/// vectorise; its two ends pixel by pixel), then read as runs, eight bytes
+/// at a time where the mask does not change.
+pub(super) fn threshold(img: &GrayImage, s: &[u32], win: usize) -> Runs {
     let (w, h) = (img.width as usize, img.height as usize);
-    let r = win / 2;
+    let r = win.min(MAX_WINDOW) / 2;
     let mut runs = Vec::new();
     let mut row_start = Vec::with_capacity(h + 1);
+    let mut mask = vec![0u8; w];
+    // x in lo..hi: the window spans x - r ..= x + r inside the image.
+    let (lo, hi) = (r.min(w), w.saturating_sub(r).max(r.min(w)));
     for y in 0..h {
         row_start.push(runs.len());
         let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
         let top = &s[y0 * (w + 1)..(y0 + 1) * (w + 1)];
         let bottom = &s[y1 * (w + 1)..(y1 + 1) * (w + 1)];
-        let rows = (y1 - y0) as i64;
+        let rows = (y1 - y0) as u32;
         let src = &img.pixels[y * w..(y + 1) * w];
-        let mut start: Option<usize> = None;
-        for (x, &v) in src.iter().enumerate() {
+        let dark = |x: usize| {
             let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
-            let sum = (bottom[x1] + top[x0] - top[x1] - bottom[x0]) as i64;
-            let area = rows * (x1 - x0) as i64;
-            let dark = (i64::from(v) + THRESHOLD_OFFSET) * area < sum;
-            match (dark, start) {
-                (true, None) => start = Some(x),
-                (false, Some(x0)) => {
-                    runs.push(Run {
-                        x0: x0 as u32,
-                        x1: x as u32,
-                    });
-                    start = None;
-                }
-                _ => {}
+            let sum = bottom[x1]
+                .wrapping_sub(bottom[x0])
+                .wrapping_sub(top[x1])
+                .wrapping_add(top[x0]);
+            let area = rows * (x1 - x0) as u32;
+            u8::from((u32::from(src[x]) + THRESHOLD_OFFSET) * area < sum)
+        };
+        for x in (0..lo).chain(hi..w) {
+            mask[x] = dark(x);
+        }
+        if hi > lo {
+            let area = rows * (2 * r + 1) as u32;
+            let n = hi - lo;
+            let (t0, t1) = (&top[..n], &top[2 * r + 1..2 * r + 1 + n]);
+            let (b0, b1) = (&bottom[..n], &bottom[2 * r + 1..2 * r + 1 + n]);
+            let (v, m) = (&src[lo..hi], &mut mask[lo..hi]);
+            for i in 0..n {
+                let sum = b1[i]
+                    .wrapping_sub(b0[i])
+                    .wrapping_sub(t1[i])
+                    .wrapping_add(t0[i]);
+                m[i] = u8::from((u32::from(v[i]) + THRESHOLD_OFFSET) * area < sum);
             }
         }
-        if let Some(x0) = start {
-            runs.push(Run {
-                x0: x0 as u32,
-                x1: w as u32,
-            });
-        }
+        mask_runs(&mask, &mut runs);
     }
     row_start.push(runs.len());
     Runs {
@@ -96,6 +115,41 @@ pub(super) fn threshold(img: &GrayImage, s: &[u64], win: usize) -> Runs {
         height: h,
         runs,
         row_start,
+    }
+}
+
+/// The runs of ones in a 0 / 1 byte mask, appended to `out`; eight bytes
+/// at a time while they all equal the current state.
+fn mask_runs(mask: &[u8], out: &mut Vec<Run>) {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    let mut start: Option<usize> = None;
+    let mut x = 0;
+    while x < mask.len() {
+        if x + 8 <= mask.len() {
+            let word = u64::from_le_bytes(mask[x..x + 8].try_into().unwrap_or([2; 8]));
+            if word == if start.is_some() { ONES } else { 0 } {
+                x += 8;
+                continue;
+            }
+        }
+        match (mask[x] != 0, start) {
+            (true, None) => start = Some(x),
+            (false, Some(x0)) => {
+                out.push(Run {
+                    x0: x0 as u32,
+                    x1: x as u32,
+                });
+                start = None;
+            }
+            _ => {}
+        }
+        x += 1;
+    }
+    if let Some(x0) = start {
+        out.push(Run {
+            x0: x0 as u32,
+            x1: mask.len() as u32,
+        });
     }
 }
 
@@ -296,6 +350,7 @@ pub(super) fn decimate(img: &GrayImage) -> GrayImage {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use wasm_bindgen_test::wasm_bindgen_test;
 
     fn image(rows: &[&str]) -> GrayImage {
         let h = rows.len();
@@ -318,7 +373,7 @@ mod tests {
         threshold(&img, &s, 2 * img.width.max(img.height) as usize + 1)
     }
 
-    #[test]
+    #[wasm_bindgen_test(unsupported = test)]
     fn threshold_runs_are_the_dark_pixels_row_by_row() {
         let m = runs_of(&["........", ".##..##.", ".#######", "........"]);
         assert_eq!(m.row(0), &[]);
@@ -327,7 +382,68 @@ mod tests {
         assert_eq!(m.row(3), &[]);
     }
 
-    #[test]
+    #[wasm_bindgen_test(unsupported = test)]
+    fn threshold_equals_the_window_means_pixel_by_pixel() {
+        // A seeded noisy image with dark blobs: every window size the search
+        // uses (and one wider than the image) against the mean of each
+        // window summed directly, so the vectorised middle, the cut ends
+        // and the 32-bit sums give exactly the dark pixels.
+        let (w, h) = (97usize, 61usize);
+        let mut state = 12345u32;
+        let pixels: Vec<u8> = (0..w * h)
+            .map(|i| {
+                state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                let (x, y) = (i % w, i / w);
+                let blob = (x / 13 + y / 11) % 3 == 0;
+                let noise = (state >> 24) as u8 / 4;
+                if blob {
+                    40 + noise
+                } else {
+                    150 + noise
+                }
+            })
+            .collect();
+        let img = GrayImage {
+            width: w as u32,
+            height: h as u32,
+            pixels,
+        };
+        let s = integral_image(&img);
+        for win in [1, 7, 21, 31, 91, 301] {
+            let m = threshold(&img, &s, win);
+            let r = win / 2;
+            for y in 0..h {
+                let mut expected = Vec::new();
+                let mut start = None;
+                for x in 0..=w {
+                    let dark = x < w && {
+                        let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(w));
+                        let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(h));
+                        let sum: u64 = (y0..y1)
+                            .flat_map(|yy| (x0..x1).map(move |xx| (xx, yy)))
+                            .map(|(xx, yy)| u64::from(img.pixels[yy * w + xx]))
+                            .sum();
+                        let area = ((x1 - x0) * (y1 - y0)) as u64;
+                        (u64::from(img.pixels[y * w + x]) + 7) * area < sum
+                    };
+                    match (dark, start) {
+                        (true, None) => start = Some(x),
+                        (false, Some(x0)) => {
+                            expected.push(Run {
+                                x0: x0 as u32,
+                                x1: x as u32,
+                            });
+                            start = None;
+                        }
+                        _ => {}
+                    }
+                }
+                assert_eq!(m.row(y), &expected[..], "window {win}, row {y}");
+            }
+        }
+    }
+
+    #[wasm_bindgen_test(unsupported = test)]
     fn regions_are_4_connected_and_skip_the_border() {
         // Two blocks touching at a corner only, and one touching the right edge.
         let m = runs_of(&[
@@ -360,7 +476,7 @@ mod tests {
         assert_eq!(regions(&u, 3).len(), 0, "extent 3 x 2 is below 3 in y");
     }
 
-    #[test]
+    #[wasm_bindgen_test(unsupported = test)]
     fn erosion_keeps_pixels_whose_four_neighbours_are_dark() {
         let m = runs_of(&[".....", ".###.", ".####", ".###.", "....."]);
         let e = erode(&m);
@@ -370,7 +486,7 @@ mod tests {
         assert_eq!(e.row(4), &[]);
     }
 
-    #[test]
+    #[wasm_bindgen_test(unsupported = test)]
     fn decimation_averages_2x2_blocks() {
         let img = GrayImage {
             width: 5,
