@@ -237,9 +237,7 @@ impl Normal {
             }
         } else if let Some(b) = block.filter(|_| ng > GEMM_DIM && nb > GEMM_DIM && rows > GEMM_DIM)
         {
-            self.add_stacked_product(jg_t, jb_t, b);
-            self.g_global.gemv(1.0, jg_t, r, 1.0);
-            self.g_blocks[b].gemv(1.0, jb_t, r, 1.0);
+            self.add_stacked_product(jg_t, jb_t, r, b);
             return;
         } else if ng > 0 {
             add_times_transpose(&mut self.u, 1.0, jg_t, jg_t);
@@ -261,7 +259,16 @@ impl Normal {
     /// [`GEMM_DIM`], so all four go to it), and adds it to the entry the
     /// same way, so the same numbers bit for bit, with two packings (`J`, `J^T`)
     /// instead of six and 4 of its 8 x 8 kernels instead of 7 (15 parameters).
-    fn add_stacked_product(&mut self, jg_t: &DMatrix<f64>, jb_t: &DMatrix<f64>, b: usize) {
+    /// The gradients `g += J r` likewise in one pass over `J`'s columns,
+    /// each entry summed in the rows' order as nalgebra's `gemv` sums it
+    /// (`g_i + J_ik r_k`, k = 0, 1, ...): the same bits.
+    fn add_stacked_product(
+        &mut self,
+        jg_t: &DMatrix<f64>,
+        jb_t: &DMatrix<f64>,
+        r: &DVector<f64>,
+        b: usize,
+    ) {
         let (ng, nb) = (jg_t.nrows(), jb_t.nrows());
         let n = ng + nb;
         // Column-major: column k of J is column k of J_g, then of J_b.
@@ -274,6 +281,19 @@ impl Normal {
             j.extend_from_slice(g);
             j.extend_from_slice(b);
         }
+        let mut g: Vec<f64> = self
+            .g_global
+            .iter()
+            .chain(self.g_blocks[b].iter())
+            .copied()
+            .collect();
+        for (column, &rk) in j.chunks_exact(n).zip(r.iter()) {
+            for (gi, &a) in g.iter_mut().zip(column) {
+                *gi += a * rk;
+            }
+        }
+        self.g_global.copy_from_slice(&g[..ng]);
+        self.g_blocks[b].copy_from_slice(&g[ng..]);
         let j = DMatrix::from_vec(n, jg_t.ncols(), j);
         // S's columns: U's (and zeros), then W_b's and V_b's.
         let mut s = Vec::with_capacity(n * n);
@@ -476,19 +496,26 @@ mod tests {
                 u: noise(ng, ng, seed + 20),
                 w: vec![noise(ng, 6, seed + 30)],
                 v: vec![noise(6, 6, seed + 40)],
-                g_global: DVector::zeros(ng),
-                g_blocks: vec![DVector::zeros(6)],
+                g_global: DVector::from_column_slice(noise(ng, 1, seed + 60).as_slice()),
+                g_blocks: vec![DVector::from_column_slice(
+                    noise(6, 1, seed + 70).as_slice(),
+                )],
                 weighted_runs: Vec::new(),
             };
+            let r = DVector::from_column_slice(noise(rows, 1, seed + 50).as_slice());
             let mut stacked = start.clone();
-            stacked.add_stacked_product(&jg, &jb, 0);
+            stacked.add_stacked_product(&jg, &jb, &r, 0);
             let mut three = start;
             add_times_transpose(&mut three.u, 1.0, &jg, &jg);
             add_times_transpose(&mut three.w[0], 1.0, &jg, &jb);
             add_times_transpose(&mut three.v[0], 1.0, &jb, &jb);
+            three.g_global.gemv(1.0, &jg, &r, 1.0);
+            three.g_blocks[0].gemv(1.0, &jb, &r, 1.0);
             assert_eq!(stacked.u, three.u, "U, {ng} x {rows}");
             assert_eq!(stacked.w, three.w, "W, {ng} x {rows}");
             assert_eq!(stacked.v, three.v, "V, {ng} x {rows}");
+            assert_eq!(stacked.g_global, three.g_global, "g, {ng} x {rows}");
+            assert_eq!(stacked.g_blocks, three.g_blocks, "g_b, {ng} x {rows}");
         }
     }
 }
