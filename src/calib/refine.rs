@@ -188,6 +188,8 @@ impl CalibProblem<'_> {
         let n_global = params.global.len();
         let n_camera = self.n_camera();
         let warp = self.warp_of(&params.global);
+        // The polynomial lens's coefficients taken once, not per point.
+        let poly = camera.poly_parts();
         let mut out = Vec::with_capacity(self.views.len());
         for (b, view) in self.views.iter().enumerate() {
             let rows = 2 * self.used[b].iter().filter(|u| **u).count();
@@ -212,12 +214,18 @@ impl CalibProblem<'_> {
                 }
                 let rotated = pose.rotation * board;
                 let p = Point3::from(rotated + pose.translation.vector);
-                let (pixel, d_point) = camera.project_with_jacobian_columns(&p, |c, x, y| {
+                let column = |c: usize, x: f64, y: f64| {
                     if c < n_camera {
                         jg_t[(c, k)] = x;
                         jg_t[(c, k + 1)] = y;
                     }
-                })?;
+                };
+                let (pixel, d_point) = match &poly {
+                    Some((poly, cols)) => {
+                        camera.poly_jacobian_columns(poly, cols, &p.coords, column)
+                    }
+                    None => camera.project_with_jacobian_columns(&p, column),
+                }?;
                 residuals[k] = pixel.x - observed.x;
                 residuals[k + 1] = pixel.y - observed.y;
                 // Left perturbation R <- exp(d) R: d(R x)/dd = -[R x]_x.

@@ -333,7 +333,7 @@ impl Distortion {
     /// The model's math family; the polynomial models share one
     /// implementation, with their own coefficients' columns in
     /// [`Poly::distort`]'s Jacobian.
-    fn family(&self) -> Family<'_> {
+    pub(super) fn family(&self) -> Family<'_> {
         use col::*;
         match *self {
             Distortion::Splined(ref s) => Family::Splined(s),
@@ -444,7 +444,7 @@ impl Distortion {
         }
     }
 
-    fn beyond_fold(&self, n: &Vector2<f64>) -> Error {
+    pub(super) fn beyond_fold(&self, n: &Vector2<f64>) -> Error {
         Error::invalid(
             "point",
             format!(
@@ -573,7 +573,7 @@ impl Distortion {
 }
 
 /// The math behind each variant.
-enum Family<'a> {
+pub(super) enum Family<'a> {
     Pinhole,
     Poly(Poly, &'static [usize]),
     Division(f64),
@@ -584,7 +584,7 @@ enum Family<'a> {
 }
 
 /// The refusal of a point at or behind the camera (or not finite).
-fn not_in_front(p: &Vector3<f64>) -> Error {
+pub(super) fn not_in_front(p: &Vector3<f64>) -> Error {
     Error::invalid(
         "point",
         format!(

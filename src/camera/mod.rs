@@ -196,6 +196,9 @@ impl Camera {
         p_camera: &Point3<f64>,
         mut column: impl FnMut(usize, f64, f64),
     ) -> Result<(Point2<f64>, Matrix2x3<f64>)> {
+        if let Some((poly, cols)) = self.poly_parts() {
+            return self.poly_jacobian_columns(&poly, cols, &p_camera.coords, column);
+        }
         let ray = self.distortion.project_ray(&p_camera.coords)?;
         let k = self.linear_part();
         let (mx, my) = (ray.m.x, ray.m.y);
@@ -209,6 +212,50 @@ impl Camera {
             column(N_PINHOLE_PARAMS + i, col.x, col.y);
         }
         Ok((self.pixel_from_normalized(&ray.m), k * ray.d_point))
+    }
+
+    /// The polynomial family's coefficients and the model's columns of
+    /// them, for [`Camera::poly_jacobian_columns`]; `None` for other models.
+    pub(crate) fn poly_parts(&self) -> Option<(polynomial::Poly, &'static [usize])> {
+        match self.distortion.family() {
+            distortion::Family::Poly(poly, cols) => Some((poly, cols)),
+            _ => None,
+        }
+    }
+
+    /// [`Camera::project_with_jacobian_columns`] of the polynomial family
+    /// (`poly` and `cols` from [`Camera::poly_parts`], taken once for many
+    /// points): the expressions of [`Distortion::project_ray`] (so the same
+    /// bits) without its vector of columns, and only the model's own
+    /// coefficient columns computed.
+    pub(crate) fn poly_jacobian_columns(
+        &self,
+        poly: &polynomial::Poly,
+        cols: &[usize],
+        p: &Vector3<f64>,
+        mut column: impl FnMut(usize, f64, f64),
+    ) -> Result<(Point2<f64>, Matrix2x3<f64>)> {
+        if !(p.z > 0.0) || !p.iter().all(|v| v.is_finite()) {
+            return Err(distortion::not_in_front(p));
+        }
+        let n = Vector2::new(p.x / p.z, p.y / p.z);
+        let d_n_d_p = Matrix2x3::new(1.0 / p.z, 0.0, -n.x / p.z, 0.0, 1.0 / p.z, -n.y / p.z);
+        if !poly.in_domain(n.norm_squared()) {
+            return Err(self.distortion.beyond_fold(&n));
+        }
+        let (m, d_n, columns) = poly.distort_lazy(&n);
+        let d_point = d_n * d_n_d_p;
+        let k = self.linear_part();
+        column(0, m.x, 0.0);
+        column(1, 0.0, m.y);
+        column(2, 1.0, 0.0);
+        column(3, 0.0, 1.0);
+        column(4, m.y, 0.0);
+        for (i, &c) in cols.iter().enumerate() {
+            let col = k * columns.column(c);
+            column(N_PINHOLE_PARAMS + i, col.x, col.y);
+        }
+        Ok((self.pixel_from_normalized(&m), k * d_point))
     }
 
     /// The unit-norm bearing (camera frame) of a pixel. Iterative for the

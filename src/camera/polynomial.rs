@@ -59,6 +59,7 @@ impl Poly {
     /// [`DOMAIN_SAMPLES`] radii). Beyond the first fold a polynomial lens
     /// model maps far-away rays back into the image, which no real lens does.
     /// The tangential and thin-prism terms are assumed small here.
+    #[inline]
     pub fn in_domain(&self, r2: f64) -> bool {
         let [k1, k2, k3, k4, k5, k6] = self.k;
         // Fast exact path without a denominator (b = 1): the derivative
@@ -106,6 +107,22 @@ impl Poly {
     /// and the 2x12 Jacobian with respect to the coefficients (columns in
     /// the order of [`col`]).
     pub fn distort(&self, n: &Vector2<f64>) -> (Vector2<f64>, Matrix2<f64>, [Vector2<f64>; 12]) {
+        let (m, d_n, columns) = self.distort_lazy(n);
+        let mut d_c = [Vector2::zeros(); 12];
+        for (c, d) in d_c.iter_mut().enumerate() {
+            *d = columns.column(c);
+        }
+        (m, d_n, d_c)
+    }
+
+    /// [`Poly::distort`] with the coefficient columns left to compute one
+    /// at a time ([`CoefficientColumns::column`], the same expressions, so
+    /// the same bits): a model that uses 5 of the 12 columns skips the
+    /// others' divisions.
+    pub fn distort_lazy(
+        &self,
+        n: &Vector2<f64>,
+    ) -> (Vector2<f64>, Matrix2<f64>, CoefficientColumns) {
         let (x, y) = (n.x, n.y);
         let [k1, k2, k3, k4, k5, k6] = self.k;
         let [p1, p2] = self.p;
@@ -115,11 +132,17 @@ impl Poly {
         let r6 = r4 * r2;
         let a = 1.0 + k1 * r2 + k2 * r4 + k3 * r6;
         let b = 1.0 + k4 * r2 + k5 * r4 + k6 * r6;
-        let radial = a / b;
+        // Without a denominator (b is 1 exactly) a division by it or its
+        // square changes no bit, and is skipped.
+        let radial = if b == 1.0 { a } else { a / b };
         let da = k1 + 2.0 * k2 * r2 + 3.0 * k3 * r4;
         let db = k4 + 2.0 * k5 * r2 + 3.0 * k6 * r4;
         // d radial / d r2
-        let dr = (da * b - a * db) / (b * b);
+        let dr = if b == 1.0 {
+            da * b - a * db
+        } else {
+            (da * b - a * db) / (b * b)
+        };
         let xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) + s1 * r2 + s2 * r4;
         let yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y + s3 * r2 + s4 * r4;
         let d_n = Matrix2::new(
@@ -138,23 +161,16 @@ impl Poly {
                 + 2.0 * s3 * y
                 + 4.0 * s4 * r2 * y,
         );
-        let v = |a: f64, b: f64| Vector2::new(a, b);
-        let num = |rp: f64| v(x * rp / b, y * rp / b);
-        let den = |rp: f64| v(-x * a * rp / (b * b), -y * a * rp / (b * b));
-        let mut d_c = [Vector2::zeros(); 12];
-        d_c[col::K1] = num(r2);
-        d_c[col::K2] = num(r4);
-        d_c[col::K3] = num(r6);
-        d_c[col::K4] = den(r2);
-        d_c[col::K5] = den(r4);
-        d_c[col::K6] = den(r6);
-        d_c[col::P1] = v(2.0 * x * y, r2 + 2.0 * y * y);
-        d_c[col::P2] = v(r2 + 2.0 * x * x, 2.0 * x * y);
-        d_c[col::S1] = v(r2, 0.0);
-        d_c[col::S2] = v(r4, 0.0);
-        d_c[col::S3] = v(0.0, r2);
-        d_c[col::S4] = v(0.0, r4);
-        (Vector2::new(xd, yd), d_n, d_c)
+        let columns = CoefficientColumns {
+            x,
+            y,
+            r2,
+            r4,
+            r6,
+            a,
+            b,
+        };
+        (Vector2::new(xd, yd), d_n, columns)
     }
 
     /// The undistorted normalised point whose distortion is `m`, by Newton's
@@ -197,5 +213,57 @@ impl Poly {
                 m.x, m.y
             ),
         })
+    }
+}
+
+/// What the coefficient columns of [`Poly::distort`] need at one point.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CoefficientColumns {
+    x: f64,
+    y: f64,
+    r2: f64,
+    r4: f64,
+    r6: f64,
+    a: f64,
+    b: f64,
+}
+
+impl CoefficientColumns {
+    /// d distorted point / d coefficient `c` (an index of [`col`]).
+    #[inline]
+    pub fn column(&self, c: usize) -> Vector2<f64> {
+        let Self {
+            x,
+            y,
+            r2,
+            r4,
+            r6,
+            a,
+            b,
+        } = *self;
+        let v = |a: f64, b: f64| Vector2::new(a, b);
+        // Without a denominator (b is 1 exactly) as in `distort_lazy`.
+        let num = |rp: f64| {
+            if b == 1.0 {
+                v(x * rp, y * rp)
+            } else {
+                v(x * rp / b, y * rp / b)
+            }
+        };
+        let den = |rp: f64| v(-x * a * rp / (b * b), -y * a * rp / (b * b));
+        match c {
+            col::K1 => num(r2),
+            col::K2 => num(r4),
+            col::K3 => num(r6),
+            col::K4 => den(r2),
+            col::K5 => den(r4),
+            col::K6 => den(r6),
+            col::P1 => v(2.0 * x * y, r2 + 2.0 * y * y),
+            col::P2 => v(r2 + 2.0 * x * x, 2.0 * x * y),
+            col::S1 => v(r2, 0.0),
+            col::S2 => v(r4, 0.0),
+            col::S3 => v(0.0, r2),
+            _ => v(0.0, r4),
+        }
     }
 }

@@ -6,8 +6,8 @@
 
 use crate::error::Result;
 use crate::handeye::refine::pose_noise::{CameraNoise, NoiseModel, MIN_POSES_FOR_NOISE_ESTIMATE};
-use crate::handeye::refine::pose_problem::{estimate_noise, negative_log_likelihood};
-use crate::handeye::refine::pose_residual::PoseMeasurement;
+use crate::handeye::refine::pose_problem::{estimate_noise_at, negative_log_likelihood_at};
+use crate::handeye::refine::pose_residual::{linearise, PoseMeasurement, ViewLinearisation};
 use crate::handeye::refine::pose_shape::{predicted_covariances, NominalTarget};
 use crate::handeye::{Pose, Setup};
 use nalgebra::Vector3;
@@ -82,7 +82,9 @@ pub fn choose_noise_model(
         pivot: None,
         nominal: None,
     };
-    estimate_noise(setup, views, &mut chosen.noise, x, y, axis)?;
+    // Every model is fitted at (x, y): the views linearised there once.
+    let lins: Vec<ViewLinearisation> = views.iter().map(|m| linearise(setup, m, x, y)).collect();
+    estimate_noise_at(&lins, &mut chosen.noise, axis)?;
     if !diagonal {
         return Ok(chosen);
     }
@@ -91,9 +93,9 @@ pub fn choose_noise_model(
     if let Some(p) = board_pivot(views) {
         let mut pivoted = NoiseModel::new(CameraNoise::Diagonal);
         pivoted.pivot_levers = pivot_levers(views, &p);
-        let better = estimate_noise(setup, views, &mut pivoted, x, y, axis).and_then(|_| {
-            let with = negative_log_likelihood(setup, views, &pivoted, x, y)?;
-            let without = negative_log_likelihood(setup, views, &chosen.noise, x, y)?;
+        let better = estimate_noise_at(&lins, &mut pivoted, axis).and_then(|_| {
+            let with = negative_log_likelihood_at(&lins, &pivoted)?;
+            let without = negative_log_likelihood_at(&lins, &chosen.noise)?;
             Ok(with < without)
         });
         if better.unwrap_or(false) {
@@ -105,8 +107,7 @@ pub fn choose_noise_model(
     // from each pose for a nominal target, when the data make it more
     // likely than the diagonal (Akaike).
     if predict_shape && views.len() >= MIN_POSES_FOR_NOISE_ESTIMATE {
-        let shaped =
-            choose_predicted_shape(setup, views, &chosen.noise, x, y, axis, board_pivot(views));
+        let shaped = choose_predicted_shape(views, &lins, &chosen.noise, axis, board_pivot(views));
         if let Some((noise, target)) = shaped {
             chosen = ChosenNoise {
                 noise,
@@ -130,20 +131,19 @@ const SHAPE_SCALE_STARTS: [f64; 4] = [4e-8, 4e-10, 4e-12, 4e-14];
 
 /// The likeliest per-view predicted shape ([`crate::handeye::refine::pose_shape`]) over the
 /// nominal target candidates, if it is more likely than `diagonal` (whose
-/// levels were fitted at `(x, y)`); its levels fitted at `(x, y)` too.
+/// levels were fitted at `(x, y)`, where `lins` linearised the views); its
+/// levels fitted there too.
 fn choose_predicted_shape(
-    setup: Setup,
     views: &[PoseMeasurement],
+    lins: &[ViewLinearisation],
     diagonal: &NoiseModel,
-    x: &Pose,
-    y: &Pose,
     axis: Option<Vector3<f64>>,
     pivot: Option<Vector3<f64>>,
 ) -> Option<(NoiseModel, NominalTarget)> {
     // Akaike: each estimated level costs 1 in negative log-likelihood; the
     // diagonal has 8 levels, the predicted shape 3.
-    let mut best_nll = negative_log_likelihood(setup, views, diagonal, x, y).ok()?
-        + diagonal.variances.len() as f64;
+    let mut best_nll =
+        negative_log_likelihood_at(lins, diagonal).ok()? + diagonal.variances.len() as f64;
     let mut best = None;
     for target in NominalTarget::candidates(views, pivot) {
         let Some(covs) = predicted_covariances(views, &target) else {
@@ -152,10 +152,10 @@ fn choose_predicted_shape(
         for start in SHAPE_SCALE_STARTS {
             let mut model = NoiseModel::new(CameraNoise::PerView(covs.clone()));
             model.variances[2] = start;
-            if estimate_noise(setup, views, &mut model, x, y, axis).is_err() {
+            if estimate_noise_at(lins, &mut model, axis).is_err() {
                 continue;
             }
-            if let Ok(nll) = negative_log_likelihood(setup, views, &model, x, y) {
+            if let Ok(nll) = negative_log_likelihood_at(lins, &model) {
                 let nll = nll + model.variances.len() as f64;
                 if nll < best_nll {
                     best_nll = nll;

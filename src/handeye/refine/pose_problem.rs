@@ -176,11 +176,16 @@ pub fn negative_log_likelihood(
     x: &Pose,
     y: &Pose,
 ) -> Result<f64> {
+    let lins: Vec<ViewLinearisation> = views.iter().map(|m| linearise(setup, m, x, y)).collect();
+    negative_log_likelihood_at(&lins, noise)
+}
+
+/// [`negative_log_likelihood`] of views already linearised at `(x, y)`.
+pub fn negative_log_likelihood_at(lins: &[ViewLinearisation], noise: &NoiseModel) -> Result<f64> {
     let loss = Loss::Huber { scale: HUBER_SCALE };
     let mut total = 0.0;
-    for (i, m) in views.iter().enumerate() {
-        let lin = linearise(setup, m, x, y);
-        let c = noise.covariance(i, &lin);
+    for (i, lin) in lins.iter().enumerate() {
+        let c = noise.covariance(i, lin);
         let l = whitening(&c)
             .ok_or_else(|| Error::degenerate(format!("view {i}: singular residual covariance")))?;
         let det = c.determinant();
@@ -274,12 +279,22 @@ pub fn estimate_noise(
     y: &Pose,
     axis: Option<Vector3<f64>>,
 ) -> Result<()> {
-    let basis = translation_basis(axis);
     let lins: Vec<ViewLinearisation> = views.iter().map(|m| linearise(setup, m, x, y)).collect();
+    estimate_noise_at(&lins, noise, axis)
+}
+
+/// [`estimate_noise`] of views already linearised at `(x, y)` (the same
+/// numbers: several noise models fitted at one point share them).
+pub fn estimate_noise_at(
+    lins: &[ViewLinearisation],
+    noise: &mut NoiseModel,
+    axis: Option<Vector3<f64>>,
+) -> Result<()> {
+    let basis = translation_basis(axis);
     // Twice: the first pass moves the levels from the defaults to the data,
     // the second judges inliers with those levels.
     for _ in 0..2 {
-        noise_round(noise, &lins, &basis, axis.is_some())?;
+        noise_round(noise, lins, &basis, axis.is_some())?;
     }
     Ok(())
 }
