@@ -26,7 +26,8 @@
 //! is the project's solver ([`crate::optim::solve`], analytic Jacobian)
 //! from one start: the best of a grid of centres and sigmas about the
 //! centre of gravity, where the model is linear in `b` and `A`. The
-//! centre's std is `noise sqrt((J^T J)^-1)`. When the fit fails (too few
+//! centre's std is `s sqrt((J^T J)^-1)`, `s` the larger of the image
+//! noise and the fit's residual RMS. When the fit fails (too few
 //! unsaturated samples, no convergence, a centre outside the window) the
 //! centre of gravity is kept with a std of at least `FALLBACK_STD_PX`, so
 //! the plane fit weights it down.
@@ -337,7 +338,12 @@ pub(crate) fn across_edge(
     let Some(cov) = (&jt * jt.transpose()).try_inverse() else {
         return fallback;
     };
-    let std = noise * cov[(2, 2)].max(0.0).sqrt();
+    // The samples' scatter about the fit: the image noise, or more where
+    // the profile is not the model's (speckle, a misjudged step); the
+    // image noise alone made these centres' std 0.04 px where they erred
+    // 0.3 px (BENCHMARKS.md section 18, s28).
+    let scatter = noise.max(fit.residual_variance.max(0.0).sqrt());
+    let std = scatter * cov[(2, 2)].max(0.0).sqrt();
     if !std.is_finite() || std > FALLBACK_STD_PX {
         return fallback;
     }
