@@ -405,6 +405,19 @@ fn main() -> Result<(), robocal::Error> {
             }
             let truth_poses = breakdown.then_some(trial_poses.as_slice());
             let measured = measure(&camera, &target, &views, truth_poses)?;
+            if flags.iter().any(|f| f == "z") {
+                // Per image: centres kept, and those the step model could
+                // not fit (the centre of gravity kept, std 0.5 px or more).
+                let per: Vec<String> = (0..n_poses)
+                    .map(|i| {
+                        let c = measured.centres.iter().filter(|o| o.image == i);
+                        let all = c.clone().count();
+                        let wide = c.filter(|o| o.std_px >= 0.5).count();
+                        format!("{wide}/{all}")
+                    })
+                    .collect();
+                println!("fallbacks {n_poses} {trial} {}", per.join(" "));
+            }
             let old = previous_covariance(&measured, &n, p.distance_m);
             previous.add(&n, p.distance_m, (&truth_n, truth_d), &old);
             vf += report.variance_factor;

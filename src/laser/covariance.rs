@@ -14,12 +14,16 @@
 //!   in std; the sandwich also needs no assumption on the centres' stds
 //!   being right (their scale cancels). The residuals first lose, image by
 //!   image, their fit by the image's own rows of `J` (the stripe line
-//!   shifted and turned on that board alone: [`own_line`]) and the variance
-//!   is scaled by `m / (m - removed dof)`: a board pose error moves the
-//!   line in exactly that way, so without it the board poses' errors were
-//!   counted twice, once here through the residuals and once below (the
-//!   std 8 % narrower at 4 and 10 poses with it; BENCHMARKS.md section 18,
-//!   where the 10-pose std is still 1.5 times the true error).
+//!   shifted and turned on that board alone: [`own_line`]): a board pose
+//!   error moves the line in exactly that way, so without it the board
+//!   poses' errors were counted twice, once here through the residuals and
+//!   once below. After the removal an image's `J_k r_k` sum to 0, so the
+//!   windowed sum sees less than the errors' variance, the more the longer
+//!   the window is against the stripe; the middle is scaled back by the
+//!   exact expectation of that shortfall for independent errors
+//!   ([`kept_information`], [`unbiased_meat`]; until s28 a scalar `m / (m -
+//!   removed dof)`, which left the std 25-40 % narrow: BENCHMARKS.md
+//!   section 18).
 //! - **the board poses' errors** (when given): a board pose error moves all
 //!   of its image's points together; `dX = (X / e) (w . (m x (t - X)) + m .
 //!   v)` for the board plane `m . X = e` under the pose perturbation
@@ -70,7 +74,10 @@ pub(crate) fn plane_covariance(
     images.sort_unstable();
     images.dedup();
     let mut meat = Matrix3::zeros();
-    let mut removed = 0usize;
+    // What the Newey-West sum of residuals with their own lines removed
+    // expects for independent errors of unit variance (see
+    // [`kept_information`]).
+    let mut kept = Matrix3::zeros();
     for &image in &images {
         let (j, r): (Vec<Vector3<f64>>, Vec<f64>) = obs
             .iter()
@@ -78,8 +85,8 @@ pub(crate) fn plane_covariance(
             .filter(|(o, _)| o.image == image)
             .map(|(_, r)| (r.jacobian, r.residual))
             .unzip();
-        let (beta, rank) = own_line(&j, &r);
-        removed += rank;
+        let (beta, pinv) = own_line(&j, &r);
+        kept += kept_information(&j, &pinv);
         let g: Vec<DVector<f64>> = j
             .iter()
             .zip(&r)
@@ -87,13 +94,8 @@ pub(crate) fn plane_covariance(
             .collect();
         meat += newey_west(&g, 3).fixed_view::<3, 3>(0, 0);
     }
-    let m = rows.len();
-    let dof = if m > removed {
-        m as f64 / (m - removed) as f64
-    } else {
-        1.0
-    };
-    let mut covariance = inv * meat * inv * dof;
+    let meat = unbiased_meat(&a, &kept, &meat)?;
+    let mut covariance = inv * meat * inv;
     for board in boards {
         let sensitivity = inv * board_jacobian(obs, rows, board);
         covariance += sensitivity * board.covariance * sensitivity.transpose();
@@ -122,12 +124,82 @@ pub(crate) fn newey_west(g: &[DVector<f64>], p: usize) -> DMatrix<f64> {
     meat
 }
 
+/// Bartlett's weight of a pair of centres `lag` apart along the stripe.
+fn bartlett(lag: usize) -> f64 {
+    if lag > LAGS {
+        0.0
+    } else {
+        1.0 - lag as f64 / (LAGS + 1) as f64
+    }
+}
+
+/// The Newey-West middle one image's residuals give, in expectation, for
+/// independent errors of unit variance: `sum_kl w_kl J_k J_l^T (I - P)_kl`
+/// (`P_kl = J_k^T pinv J_l`, the projection [`own_line`] takes out).
+/// Without the removal it would be `sum_k J_k J_k^T`, the image's
+/// information; with it, it is less, and much less when the window
+/// ([`LAGS`]) is not small against the number of centres: the removed line
+/// is exactly what the image's `J_k r_k` sum to (they sum to 0 after it),
+/// so a window as long as the stripe would see nothing. For errors that
+/// are correlated over fewer lines than the window the shortfall is the
+/// same share of their long-run variance, to first order (the removed
+/// line varies slowly along the stripe).
+fn kept_information(j: &[Vector3<f64>], pinv: &Matrix3<f64>) -> Matrix3<f64> {
+    let mut out = Matrix3::zeros();
+    for (k, jk) in j.iter().enumerate() {
+        out += jk * jk.transpose();
+        let q = pinv * jk;
+        let lo = k.saturating_sub(LAGS);
+        let hi = (k + LAGS).min(j.len() - 1);
+        for (l, jl) in j.iter().enumerate().take(hi + 1).skip(lo) {
+            out -= jk * jl.transpose() * (bartlett(k.abs_diff(l)) * q.dot(jl));
+        }
+    }
+    out
+}
+
+/// The Newey-West middle `meat` made unbiased for independent errors:
+/// `T meat T^T` with `T kept T^T = information` (`T = I^1/2 K^-1/2`), so
+/// its expectation is the information times the errors' variance, as the
+/// sandwich needs (for one image's worth of lags, `m / (m - removed dof)`
+/// on average, which this replaces). The window's shortfall is largest
+/// along the stripe lines' turn, where the removed line weighs most: with
+/// the scalar factor the 2-pose std was 25-35 % narrow (BENCHMARKS.md
+/// section 18, s28).
+fn unbiased_meat(
+    information: &Matrix3<f64>,
+    kept: &Matrix3<f64>,
+    meat: &Matrix3<f64>,
+) -> Result<Matrix3<f64>> {
+    let root = |m: &Matrix3<f64>, power: f64| -> Option<Matrix3<f64>> {
+        let eig = nalgebra::SymmetricEigen::new(*m);
+        let top = eig.eigenvalues.max();
+        if !(top > 0.0) {
+            return None;
+        }
+        let d = eig.eigenvalues.map(|v| v.max(MIN_KEPT * top).powf(power));
+        Some(eig.eigenvectors * Matrix3::from_diagonal(&d) * eig.eigenvectors.transpose())
+    };
+    let (Some(half), Some(inverse_half)) = (root(information, 0.5), root(kept, -0.5)) else {
+        return Err(Error::degenerate(
+            "the plane's information matrix is singular: the stripes do not constrain it",
+        ));
+    };
+    let t = half * inverse_half;
+    Ok(t * meat * t.transpose())
+}
+
+/// The smallest eigenvalue of the expected middle [`kept_information`]
+/// taken, relative to its largest (a stripe of fewer centres than the
+/// window leaves almost nothing along its turn).
+const MIN_KEPT: f64 = 1e-6;
+
 /// The least-squares fit of one image's residuals `r` by its own rows of
 /// the Jacobian `j` (the plane moved for this image alone: its stripe line
-/// shifted and turned on the board, two dof) and the rank of that fit.
-/// What it takes out of the residuals is what a board pose error also
-/// does: the line's own offset and slope.
-fn own_line(j: &[Vector3<f64>], r: &[f64]) -> (Vector3<f64>, usize) {
+/// shifted and turned on the board, two dof) and the pseudo-inverse of
+/// `sum J_k J_k^T` it used. What it takes out of the residuals is what a
+/// board pose error also does: the line's own offset and slope.
+fn own_line(j: &[Vector3<f64>], r: &[f64]) -> (Vector3<f64>, Matrix3<f64>) {
     let mut a = Matrix3::zeros();
     let mut b = Vector3::zeros();
     for (j, r) in j.iter().zip(r) {
@@ -136,16 +208,14 @@ fn own_line(j: &[Vector3<f64>], r: &[f64]) -> (Vector3<f64>, usize) {
     }
     let eig = nalgebra::SymmetricEigen::new(a);
     let top = eig.eigenvalues.iter().fold(0.0f64, |m, v| m.max(*v));
-    let mut beta = Vector3::zeros();
-    let mut rank = 0;
+    let mut pinv = Matrix3::zeros();
     for (k, &l) in eig.eigenvalues.iter().enumerate() {
         if top > 0.0 && l > OWN_LINE_TOLERANCE * top {
             let v = eig.eigenvectors.column(k);
-            beta += v * (v.dot(&b) / l);
-            rank += 1;
+            pinv += v * v.transpose() / l;
         }
     }
-    (beta, rank)
+    (pinv * b, pinv)
 }
 
 /// Directions of an image's own Jacobian weaker than this (relative to its
