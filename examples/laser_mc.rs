@@ -50,9 +50,8 @@ use robocal::laser::{
     StripeOptions,
 };
 use robocal::rng::Rng;
-use robocal::synth::laser::LaserStripe;
+use robocal::synth::laser::{laser_pair, LaserStripe};
 use robocal::synth::laser_scene::{example_plane, laser_board_poses};
-use robocal::synth::{render, RenderOptions};
 use robocal::target::Target;
 
 /// One trial's measurements as the pipeline makes them: per view the board
@@ -362,21 +361,13 @@ fn main() -> Result<(), robocal::Error> {
                 .collect();
             for (i, pose) in trial_poses.iter().enumerate() {
                 let seed = 1_000_003 * n_poses as u64 + 1009 * trial as u64 + 17 * i as u64;
-                let off_options = RenderOptions {
-                    seed,
-                    ..RenderOptions::default()
-                };
                 let mut laser = LaserStripe::new(example_plane());
                 laser.seed = seed ^ 0x5EED;
-                let on_options = RenderOptions {
-                    seed: seed + 1,
-                    laser: Some(laser),
-                    ..RenderOptions::default()
-                };
+                let (board, stripe) = laser_pair(&camera, &target, pose, &laser, seed)?;
                 views.push(LaserView {
                     name: format!("pose {i}"),
-                    board: render(&camera, &target, pose, &off_options)?.image,
-                    stripe: Some(render(&camera, &target, pose, &on_options)?.image),
+                    board,
+                    stripe: Some(stripe),
                 });
             }
             let report = match laser_plane(&camera, &target, &views, &LaserPlaneSettings::default())

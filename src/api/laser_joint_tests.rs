@@ -2,9 +2,8 @@
 //! from a perturbed start camera.
 
 use super::*;
-use crate::synth::laser::LaserStripe;
+use crate::synth::laser::{laser_pair, LaserStripe};
 use crate::synth::laser_scene::{example_plane, laser_board_poses};
-use crate::synth::{render, RenderOptions};
 
 fn views(camera: &Camera, target: &Target, n: usize) -> Vec<LaserView> {
     laser_board_poses(n)
@@ -14,25 +13,12 @@ fn views(camera: &Camera, target: &Target, n: usize) -> Vec<LaserView> {
             let seed = 40 + 2 * i as u64;
             let mut laser = LaserStripe::new(example_plane());
             laser.seed = seed;
-            let off = RenderOptions {
-                seed,
-                ..RenderOptions::default()
-            };
-            let on = RenderOptions {
-                seed: seed + 1,
-                laser: Some(laser),
-                ..RenderOptions::default()
-            };
+            let (board, stripe) =
+                laser_pair(camera, target, pose, &laser, seed).unwrap_or_else(|e| panic!("{e}"));
             LaserView {
                 name: format!("pose {i}"),
-                board: render(camera, target, pose, &off)
-                    .unwrap_or_else(|e| panic!("{e}"))
-                    .image,
-                stripe: Some(
-                    render(camera, target, pose, &on)
-                        .unwrap_or_else(|e| panic!("{e}"))
-                        .image,
-                ),
+                board,
+                stripe: Some(stripe),
             }
         })
         .collect()

@@ -241,3 +241,29 @@ pub fn stripe_truth(
         .filter_map(|(i, v)| v.map(|v| (i, v)))
         .collect()
 }
+
+/// One board pose as a laser sensor films it for the plane's pairs: the
+/// board with the laser off (render seed `seed`) and with `stripe` on
+/// (seed `seed + 1`), the same scene otherwise (default render options).
+/// Returns `(board, stripe)`.
+pub fn laser_pair(
+    camera: &dyn Projection,
+    target: &crate::target::Target,
+    camera_from_target: &Isometry3<f64>,
+    stripe: &LaserStripe,
+    seed: u64,
+) -> crate::error::Result<(crate::image::GrayImage, crate::image::GrayImage)> {
+    let off = super::RenderOptions {
+        seed,
+        ..super::RenderOptions::default()
+    };
+    let on = super::RenderOptions {
+        seed: seed + 1,
+        laser: Some(stripe.clone()),
+        ..super::RenderOptions::default()
+    };
+    Ok((
+        super::render(camera, target, camera_from_target, &off)?.image,
+        super::render(camera, target, camera_from_target, &on)?.image,
+    ))
+}

@@ -46,9 +46,8 @@ use robocal::laser::joint::{refine_holding, JointImage};
 use robocal::laser::{
     extract_stripe, fit_plane, plane_in_camera, PlaneFitOptions, StripeObservation, StripeOptions,
 };
-use robocal::synth::laser::{stripe_truth, LaserStripe};
+use robocal::synth::laser::{laser_pair, stripe_truth, LaserStripe};
 use robocal::synth::laser_scene::{example_plane, laser_board_poses};
-use robocal::synth::{render, RenderOptions};
 use robocal::target::Target;
 use vision_calibration::common::config::CameraConfig;
 use vision_calibration::core::{
@@ -393,19 +392,11 @@ fn main() -> Result<(), Error> {
                 let seed = 7_000_003 * n_poses as u64 + 1009 * trial as u64 + 17 * i as u64;
                 let mut laser = LaserStripe::new(example_plane());
                 laser.seed = seed ^ 0x5EED;
-                let off = RenderOptions {
-                    seed,
-                    ..RenderOptions::default()
-                };
-                let on = RenderOptions {
-                    seed: seed + 1,
-                    laser: Some(laser),
-                    ..RenderOptions::default()
-                };
+                let (board, stripe) = laser_pair(&camera, &target, pose, &laser, seed)?;
                 views.push(LaserView {
                     name: format!("pose {i}"),
-                    board: render(&camera, &target, pose, &off)?.image,
-                    stripe: Some(render(&camera, &target, pose, &on)?.image),
+                    board,
+                    stripe: Some(stripe),
                 });
             }
             let settings = LaserPlaneSettings::default();
