@@ -197,6 +197,9 @@ impl CalibProblem<'_> {
                 continue;
             }
             let pose = pose_from_block(&params.blocks[b]);
+            // The view's rotation as a matrix once, not the quaternion turn
+            // per point (about half the flops).
+            let rotation = pose.rotation.to_rotation_matrix();
             let mut residuals = DVector::zeros(rows);
             let mut jg_t = DMatrix::zeros(n_global, rows);
             let mut jb_t = DMatrix::zeros(6, rows);
@@ -212,7 +215,7 @@ impl CalibProblem<'_> {
                     board.z += dz;
                     d_warp = d;
                 }
-                let rotated = pose.rotation * board;
+                let rotated = rotation * board;
                 let p = Point3::from(rotated + pose.translation.vector);
                 let column = |c: usize, x: f64, y: f64| {
                     if c < n_camera {
@@ -244,7 +247,7 @@ impl CalibProblem<'_> {
                 }
                 if self.warp.is_some() {
                     // d p / d warp_i = R e_z d_i.
-                    let along = d_point * (pose.rotation * Vector3::z());
+                    let along = d_point * (rotation * Vector3::z());
                     for (i, d) in d_warp.iter().enumerate() {
                         jg_t[(n_camera + i, k)] = along.x * d;
                         jg_t[(n_camera + i, k + 1)] = along.y * d;
@@ -281,6 +284,7 @@ impl BlockProblem for CalibProblem<'_> {
         let mut out = Vec::with_capacity(n_used);
         for (b, view) in self.views.iter().enumerate() {
             let pose = pose_from_block(&params.blocks[b]);
+            let rotation = pose.rotation.to_rotation_matrix();
             for (i, (object, observed)) in view.object_m.iter().zip(&view.image_px).enumerate() {
                 if !self.used[b][i] {
                     continue;
@@ -292,7 +296,7 @@ impl BlockProblem for CalibProblem<'_> {
                     board.z += dz;
                     d_warp = d;
                 }
-                let rotated = pose.rotation * board;
+                let rotated = rotation * board;
                 let p = Point3::from(rotated + pose.translation.vector);
                 let (pixel, d_point, mut d_params) = if jacobians {
                     camera.project_with_jacobians(&p)?
@@ -326,7 +330,7 @@ impl BlockProblem for CalibProblem<'_> {
                         // d p / d warp_i = R e_z d_i.
                         let n = d_params.ncols();
                         d_params = d_params.resize_horizontally(n_global, 0.0);
-                        let along = d_point * (pose.rotation * Vector3::z());
+                        let along = d_point * (rotation * Vector3::z());
                         for (i, d) in d_warp.iter().enumerate() {
                             d_params[(0, n + i)] = along.x * d;
                             d_params[(1, n + i)] = along.y * d;
