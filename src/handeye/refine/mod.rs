@@ -16,6 +16,7 @@
 //! from the best closed form.
 
 pub mod noise_choice;
+pub(crate) mod noise_em;
 pub mod over_pixels;
 pub mod over_poses;
 pub mod pixel_problem;
