@@ -92,9 +92,9 @@ pub(crate) fn refine_saddle(img: &GrayImage, start: Point2<f64>, window: f64) ->
     let origin = Vector2::new((cx - margin) as f64, (cy - margin) as f64);
     let mut c = start.coords - origin;
     let c0 = c;
-    let sigma_w2 = 2.0 * (0.5 * w) * (0.5 * w);
+    let weights = Weights::new(w, patch.sigma_s);
     for _ in 0..MAX_ITERATIONS {
-        let (h, g) = fit_quadratic(&patch, c, w, sigma_w2)?;
+        let (h, g) = fit_quadratic(&patch, c, &weights)?;
         let det = h.determinant();
         if det >= 0.0 || !det.is_finite() {
             return None;
@@ -111,7 +111,7 @@ pub(crate) fn refine_saddle(img: &GrayImage, start: Point2<f64>, window: f64) ->
         }
     }
     // Not converged to the tolerance: accept only a surface that is still a saddle.
-    let (h, _) = fit_quadratic(&patch, c, w, sigma_w2)?;
+    let (h, _) = fit_quadratic(&patch, c, &weights)?;
     (h.determinant() < 0.0).then(|| SaddleFit {
         pos: Point2::from(c + origin),
     })
@@ -132,61 +132,96 @@ struct Axis {
     kernels: [Vec<f32>; 3],
 }
 
-fn axis(c: f64, w: f64, sigma_w2: f64, sigma_s: f64, rs: usize) -> Axis {
-    let n = (WINDOW_REACH * w).floor() as isize;
+/// What [`axis`] needs that does not depend on the window centre, built
+/// once per corner: the fit weights `g(t) = exp(-t^2 / s)` at the integers
+/// `|t| <= n`, the monomials they weight and their moments, and the
+/// smoothing's constants.
+struct Weights {
+    n: isize,
+    /// `[g, g t, g t^2]` at `t = -n ..= n`.
+    phi: Vec<[f64; 3]>,
+    /// `sum g(t) t^k`, k = 0..4.
+    moments: [f64; 5],
+    /// The smoothing's reach and `2 sigma^2`.
+    rs: usize,
+    s: f64,
+    /// `exp(-2 / s)`: how the smoothing taps' ratio falls per tap.
+    fall: f64,
+}
+
+impl Weights {
+    fn new(w: f64, sigma_s: f64) -> Weights {
+        let sigma_w2 = 2.0 * (0.5 * w) * (0.5 * w);
+        let n = (WINDOW_REACH * w).floor() as isize;
+        let count = (2 * n + 1) as usize;
+        let mut moments = [0.0f64; 5];
+        let mut phi = Vec::with_capacity(count);
+        // g(t) by recurrence over the unit steps of t: the ratio
+        // g(t + 1) / g(t) = exp(-(2 t + 1) / s) itself shrinks by exp(-2 / s).
+        let t0 = -n as f64;
+        let mut g = (-t0 * t0 / sigma_w2).exp();
+        let mut ratio = (-(2.0 * t0 + 1.0) / sigma_w2).exp();
+        let shrink = (-2.0 / sigma_w2).exp();
+        for k in 0..count {
+            let t = t0 + k as f64;
+            let mut p = g;
+            for m in moments.iter_mut() {
+                *m += p;
+                p *= t;
+            }
+            phi.push([g, g * t, g * t * t]);
+            g *= ratio;
+            ratio *= shrink;
+        }
+        let rs = gaussian_radius(sigma_s);
+        let s = 2.0 * sigma_s * sigma_s;
+        Weights {
+            n,
+            phi,
+            moments,
+            rs,
+            s,
+            fall: (-2.0 / s).exp(),
+        }
+    }
+}
+
+fn axis(c: f64, weights: &Weights) -> Axis {
+    let Weights { n, rs, s, .. } = *weights;
     let base = c.floor();
     let frac = c - base;
-    let count = (2 * n + 1) as usize;
+    let count = weights.phi.len();
     // Taps G(frac - j), j = -rs ..= rs + 1, normalised to sum 1: the
     // offset d = frac - j falls by 1 from tap to tap, so G by the same
-    // recurrence as g below (three exponentials instead of one a tap: the
+    // recurrence as g (two exponentials a call instead of one a tap: the
     // wasm build's `exp` is a software one, 5 % of its chessboard
     // detection when taken per tap).
-    let s = 2.0 * sigma_s * sigma_s;
     let d0 = frac + rs as f64;
     let mut tap = (-d0 * d0 / s).exp();
     let mut step = ((2.0 * d0 - 1.0) / s).exp();
-    let fall = (-2.0 / s).exp();
     let mut taps: Vec<f64> = (0..2 * rs + 2)
         .map(|_| {
             let t = tap;
             tap *= step;
-            step *= fall;
+            step *= weights.fall;
             t
         })
         .collect();
     let sum: f64 = taps.iter().sum();
     taps.iter_mut().for_each(|v| *v /= sum);
-    let mut moments = [0.0f64; 5];
     let len = count + 2 * rs + 1;
     let mut kernels = [vec![0.0f32; len], vec![0.0f32; len], vec![0.0f32; len]];
-    // g(t) = exp(-t^2 / s) by recurrence over the unit steps of t: the
-    // ratio g(t + 1) / g(t) = exp(-(2 t + 1) / s) itself shrinks by
-    // exp(-2 / s).
-    let t0 = -n as f64;
-    let mut g = (-t0 * t0 / sigma_w2).exp();
-    let mut ratio = (-(2.0 * t0 + 1.0) / sigma_w2).exp();
-    let shrink = (-2.0 / sigma_w2).exp();
-    for k in 0..count {
-        let t = t0 + k as f64;
-        let mut p = g;
-        for m in moments.iter_mut() {
-            *m += p;
-            p *= t;
-        }
-        let phi = [g, g * t, g * t * t];
+    for (k, phi) in weights.phi.iter().enumerate() {
         // Fit point k reads raw pixels k .. k + 2 rs + 1 (kernel offsets).
-        for (kernel, &f) in kernels.iter_mut().zip(&phi) {
+        for (kernel, &f) in kernels.iter_mut().zip(phi) {
             for (dst, &tap) in kernel[k..k + 2 * rs + 2].iter_mut().zip(&taps) {
                 *dst += (f * tap) as f32;
             }
         }
-        g *= ratio;
-        ratio *= shrink;
     }
     Axis {
         first: base as isize - n,
-        moments,
+        moments: weights.moments,
         kernels,
     }
 }
@@ -229,12 +264,11 @@ const LANES: usize = 4;
 fn fit_quadratic(
     patch: &Patch,
     c: Vector2<f64>,
-    w: f64,
-    sigma_w2: f64,
+    weights: &Weights,
 ) -> Option<(Matrix2<f64>, Vector2<f64>)> {
     let rs = patch.rs as isize;
-    let ax = axis(c.x, w, sigma_w2, patch.sigma_s, patch.rs);
-    let ay = axis(c.y, w, sigma_w2, patch.sigma_s, patch.rs);
+    let ax = axis(c.x, weights);
+    let ay = axis(c.y, weights);
     let (x0, y0) = (ax.first - rs, ay.first - rs);
     let (nx, ny) = (ax.kernels[0].len(), ay.kernels[0].len());
     if x0 < 0 || y0 < 0 || x0 as usize + nx > patch.size || y0 as usize + ny > patch.size {
