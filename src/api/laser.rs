@@ -135,15 +135,16 @@ pub fn laser_plane_refining_camera(
     settings: &LaserPlaneSettings,
 ) -> Result<(LaserPlaneReport, Camera)> {
     let measured = measure(camera, target, views, settings)?;
-    let (first, centre_variance) = fit_measured(camera, measured.clone(), settings)?;
+    let (first, centre_variance, correlation) = fit_measured(camera, measured.clone(), settings)?;
     let start = plane_in_camera(
         nalgebra::Vector3::from(first.laser_plane.normal_camera),
         first.laser_plane.distance_m,
     )?;
-    // Each centre's std from the first fit's variance function: the
-    // stripe residuals then have unit variance, as the corners' have by
-    // their own scatter.
-    let stripe_std = |s: f64| centre_variance.variance(s).sqrt();
+    // Each centre's std from the first fit's variance function, widened
+    // by its correlation factor: the stripe then carries the information
+    // on the plane its correlated errors leave (the corners have unit
+    // variance by their own scatter).
+    let stripe_std = |s: f64| (centre_variance.variance(s) * correlation).sqrt();
     let images: Vec<JointImage> = measured
         .iter()
         .map(|m| JointImage {
@@ -165,7 +166,7 @@ pub fn laser_plane_refining_camera(
     for (m, pose) in measured.into_iter().zip(&joint.camera_from_target) {
         again.push(remeasure(&joint.camera, m, pose)?);
     }
-    let (mut report, _) = fit_measured(&joint.camera, again, settings)?;
+    let (mut report, ..) = fit_measured(&joint.camera, again, settings)?;
     report.warnings.push(format!(
         "the camera was refined with the plane: corner RMS {:.3} px (was {:.3} px)",
         joint.corner_rms_px.0, joint.corner_rms_px.1
@@ -273,7 +274,7 @@ fn fit_measured(
     camera: &Camera,
     measured: Vec<Measured>,
     settings: &LaserPlaneSettings,
-) -> Result<(LaserPlaneReport, crate::laser::CentreVariance)> {
+) -> Result<(LaserPlaneReport, crate::laser::CentreVariance, f64)> {
     let mut observations = Vec::new();
     let mut boards = Vec::new();
     let mut images = Vec::new();
@@ -332,7 +333,7 @@ fn fit_measured(
         singular_values_m: fit.singular_values_m,
         warnings,
     };
-    Ok((report, fit.centre_variance))
+    Ok((report, fit.centre_variance, fit.centre_correlation))
 }
 
 /// The report's plane from a fit.
