@@ -120,7 +120,7 @@ pub fn laser_plane(
     settings: &LaserPlaneSettings,
 ) -> Result<LaserPlaneReport> {
     let measured = measure(camera, target, views, settings)?;
-    fit_measured(camera, measured, settings)
+    Ok(fit_measured(camera, measured, settings)?.0)
 }
 
 /// [`laser_plane`] with the camera refined jointly with the plane
@@ -135,14 +135,16 @@ pub fn laser_plane_refining_camera(
     settings: &LaserPlaneSettings,
 ) -> Result<(LaserPlaneReport, Camera)> {
     let measured = measure(camera, target, views, settings)?;
-    let first = fit_measured(camera, measured.clone(), settings)?;
+    let (first, centre_variance, correlation) = fit_measured(camera, measured.clone(), settings)?;
     let start = plane_in_camera(
         nalgebra::Vector3::from(first.laser_plane.normal_camera),
         first.laser_plane.distance_m,
     )?;
-    // The stripe stds scaled so their residuals have unit variance, as the
-    // corners' are by their own scatter.
-    let scale = first.variance_factor.max(1e-12).sqrt();
+    // Each centre's std from the first fit's variance function, widened
+    // by its correlation factor: the stripe then carries the information
+    // on the plane its correlated errors leave (the corners have unit
+    // variance by their own scatter).
+    let stripe_std = |s: f64| (centre_variance.variance(s) * correlation).sqrt();
     let images: Vec<JointImage> = measured
         .iter()
         .map(|m| JointImage {
@@ -150,7 +152,11 @@ pub fn laser_plane_refining_camera(
             image_px: m.view.image_px.clone(),
             corner_std_px: m.corner_variance.sqrt().max(1e-3),
             camera_from_target: m.pose,
-            stripe: m.centres.iter().map(|(p, s)| (*p, s * scale)).collect(),
+            stripe: m
+                .centres
+                .iter()
+                .map(|(p, s)| (*p, stripe_std(*s)))
+                .collect(),
             scan_along_y: m.along_y,
         })
         .collect();
@@ -160,7 +166,7 @@ pub fn laser_plane_refining_camera(
     for (m, pose) in measured.into_iter().zip(&joint.camera_from_target) {
         again.push(remeasure(&joint.camera, m, pose)?);
     }
-    let mut report = fit_measured(&joint.camera, again, settings)?;
+    let (mut report, ..) = fit_measured(&joint.camera, again, settings)?;
     report.warnings.push(format!(
         "the camera was refined with the plane: corner RMS {:.3} px (was {:.3} px)",
         joint.corner_rms_px.0, joint.corner_rms_px.1
@@ -268,7 +274,7 @@ fn fit_measured(
     camera: &Camera,
     measured: Vec<Measured>,
     settings: &LaserPlaneSettings,
-) -> Result<LaserPlaneReport> {
+) -> Result<(LaserPlaneReport, crate::laser::CentreVariance, f64)> {
     let mut observations = Vec::new();
     let mut boards = Vec::new();
     let mut images = Vec::new();
@@ -316,7 +322,7 @@ fn fit_measured(
         }
     }
     warnings.extend(fit.warnings.iter().cloned());
-    Ok(LaserPlaneReport {
+    let report = LaserPlaneReport {
         kind: crate::report_kind::ReportKind::LaserPlane.name(),
         robocal_version: crate::VERSION,
         laser_plane: plane_json(&fit),
@@ -326,7 +332,8 @@ fn fit_measured(
         images,
         singular_values_m: fit.singular_values_m,
         warnings,
-    })
+    };
+    Ok((report, fit.centre_variance, fit.centre_correlation))
 }
 
 /// The report's plane from a fit.

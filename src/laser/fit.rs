@@ -6,13 +6,13 @@
 //!   residual is the distance, along its scan direction in pixels, between
 //!   the measured centre and where the plane/board intersection line crosses
 //!   that column (row), to first order `(n . X - d) / (n . dX/dv)`, divided
-//!   by the centre's std: `sqrt(std^2 + floor^2)`, the extractor's std
-//!   (the image noise through the estimator) and the error it does not
-//!   hold (speckle, the sub-pixel bias), estimated from the residuals
-//!   ([`centre_floor_variance`]). The noise is in the image, so this is the
-//!   maximum-likelihood fit under Gaussian centre noise: a far or grazing
-//!   board, whose points move by millimetres per pixel, weighs what its
-//!   pixels are worth.
+//!   by the centre's std: `sqrt(v(std))`, `v` a non-decreasing function
+//!   of the std the extractor reports whose values the residuals of a
+//!   first fit with every centre alike give ([`CentreVariance`]: the
+//!   extractor's std ranks the centres, it does not give their error's
+//!   scale). The noise is in the image, so a far or grazing board, whose
+//!   points move by millimetres per pixel, weighs what its pixels are
+//!   worth.
 //! - [`PlaneResidual::PointToPlane`]: the metric distance of each 3-D point
 //!   to the plane, unweighted: the classic total-least-squares plane, which
 //!   over-weights far and grazing boards.
@@ -25,6 +25,7 @@
 
 use super::covariance::{plane_covariance, BoardPose};
 use super::plane::{plane_in_camera, LaserPlane, StripeObservation};
+use super::weights::CentreVariance;
 use crate::error::{Error, Result};
 use crate::geometry::{tangent_basis, Plane, PlaneEstimate};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
@@ -93,13 +94,21 @@ pub struct PlaneFit {
     /// The residual variance `chi^2 / (m - 3)` with the extractor's stds
     /// (1 when they are right).
     pub variance_factor: f64,
-    /// The centres' error beyond the extractor's std, pixels along the
-    /// scan (0 for the point-to-plane model, or when the residuals are
-    /// within the stds): each centre is weighted by `1 / (std^2 +
-    /// floor^2)` ([`centre_floor_variance`]).
+    /// The error scale every centre has, pixels along the scan: the root
+    /// of the smallest variance of [`PlaneFit::centre_variance`] (0 for
+    /// the point-to-plane model).
     pub centre_floor_px: f64,
-    /// RMS of the minimised residuals (image: in units of the std with the
-    /// floor; point: metres).
+    /// Each centre's variance (px^2 along the scan) as a function of the
+    /// std the extractor reported ([`CentreVariance`]).
+    pub centre_variance: CentreVariance,
+    /// How many times the centres' correlation along the stripe widens
+    /// the plane's covariance over independent errors with the variances
+    /// of [`PlaneFit::centre_variance`]: the cube root of the ratio of the
+    /// determinants of the two (board poses left out), at least 1 (1 for
+    /// the point-to-plane model). On renders 1.1-3.1, median 1.85.
+    pub centre_correlation: f64,
+    /// RMS of the minimised residuals (image: in units of each centre's
+    /// root variance; point: metres).
     pub rms: f64,
     /// Per image.
     pub per_image: Vec<ImageResidual>,
@@ -169,23 +178,26 @@ pub fn fit_plane_with_boards(
     }
     let mut warnings = geometry_warnings(obs, &images, singular);
     let (mut n, mut d) = gauss_newton(obs, &start, options.residual)?;
-    // The centres' error beyond the extractor's std (see
-    // [`centre_floor_variance`]): estimated from the residuals and the fit
-    // repeated with it until it settles (at most three rounds).
-    let mut floor_var = 0.0;
+    // Each centre's variance from its reported std ([`CentreVariance`]):
+    // a fit with every centre alike, the variance function from its
+    // residuals (3 parameters fitted to them), the fit again with it.
     let mut weighted: Vec<StripeObservation> = obs.to_vec();
+    let mut centre_variance = CentreVariance::default();
     if options.residual == PlaneResidual::ImagePx {
-        for _ in 0..3 {
-            let f = centre_floor_variance(obs, &plane_in_camera(n, d)?);
-            if (f - floor_var).abs() <= 1e-3 * f.max(1e-12) {
-                break;
-            }
-            floor_var = f;
-            for (w, o) in weighted.iter_mut().zip(obs) {
-                w.std_px = (o.std_px * o.std_px + floor_var).sqrt();
-            }
-            (n, d) = gauss_newton(&weighted, &plane_in_camera(n, d)?, options.residual)?;
+        for w in weighted.iter_mut() {
+            w.std_px = 1.0;
         }
+        (n, d) = gauss_newton(&weighted, &plane_in_camera(n, d)?, options.residual)?;
+        let pairs: Vec<(f64, f64)> = obs
+            .iter()
+            .zip(scan_residuals(obs, &plane_in_camera(n, d)?))
+            .filter_map(|(o, r)| r.map(|r| (o.std_px, r * r)))
+            .collect();
+        centre_variance = CentreVariance::fit(&pairs, 3);
+        for (w, o) in weighted.iter_mut().zip(obs) {
+            w.std_px = centre_variance.variance(o.std_px).sqrt();
+        }
+        (n, d) = gauss_newton(&weighted, &plane_in_camera(n, d)?, options.residual)?;
     }
     // The final linearisation, at the solution (the normal facing away).
     let plane = plane_in_camera(n, d)?;
@@ -198,6 +210,14 @@ pub fn fit_plane_with_boards(
     let rows = residual_rows(&weighted, &plane, options.residual);
     let minimised: f64 = rows.iter().map(|r| r.residual * r.residual).sum();
     let covariance = plane_covariance(&weighted, &rows, boards)?;
+    // The centres' errors are correlated along the stripe: how much that
+    // widens the plane's covariance over independent errors of the same
+    // variances (the joint refinement weighs the stripe by it).
+    let centre_correlation = if options.residual == PlaneResidual::ImagePx && m > 3 {
+        correlation_factor(&weighted, &rows, minimised / (m - 3) as f64)?
+    } else {
+        1.0
+    };
     let per_image = images
         .iter()
         .map(|&i| image_residual(obs, i, &plane))
@@ -213,7 +233,9 @@ pub fn fit_plane_with_boards(
     Ok(PlaneFit {
         estimate: PlaneEstimate { plane, covariance },
         variance_factor,
-        centre_floor_px: floor_var.sqrt(),
+        centre_floor_px: centre_variance.floor().sqrt(),
+        centre_variance,
+        centre_correlation,
         rms: (minimised / m as f64).sqrt(),
         per_image,
         singular_values_m: singular,
@@ -247,52 +269,31 @@ fn gauss_newton(
     Ok((n, d))
 }
 
-/// The variance (px^2) of the centres' error that the extractor's std
-/// does not hold, from the residuals at `plane`: the `s >= 0` with
-/// `sum r_k^2 / (std_k^2 + s) = m - 3` (`r_k` the residual along the scan,
-/// pixels), 0 when the stds already explain the residuals.
-///
-/// The extractor's std is the image noise propagated through the centre
-/// of gravity; on rendered stripes with speckle and saturation the centres
-/// err by about 0.35 px whatever that std (0.03 px on a bright
-/// stripe, 0.13 px on a dim one: BENCHMARKS.md section 18), so weights
-/// `1 / std^2` gave some centres 16 times the weight of others for no
-/// smaller error, and the plane erred several times more than unweighted.
-/// With the floor each centre's variance is `std^2 + s`.
-pub fn centre_floor_variance(obs: &[StripeObservation], plane: &LaserPlane) -> f64 {
+/// [`PlaneFit::centre_correlation`] from the weighted rows and their
+/// residual variance `s2`.
+fn correlation_factor(obs: &[StripeObservation], rows: &[ResidualRow], s2: f64) -> Result<f64> {
+    let correlated = plane_covariance(obs, rows, &[])?;
+    let mut a = Matrix3::zeros();
+    for r in rows {
+        a += r.jacobian * r.jacobian.transpose();
+    }
+    let Some(inverse) = a.try_inverse() else {
+        return Ok(1.0);
+    };
+    let k = (correlated.determinant() / (inverse * s2).determinant()).cbrt();
+    Ok(if k.is_finite() { k.max(1.0) } else { 1.0 })
+}
+
+/// Each centre's residual along its scan (pixels) at `plane`, None where
+/// the plane runs along the scan direction.
+fn scan_residuals(obs: &[StripeObservation], plane: &LaserPlane) -> Vec<Option<f64>> {
     let n = plane.normal.into_inner();
-    let rs: Vec<(f64, f64)> = obs
-        .iter()
-        .filter_map(|o| {
+    obs.iter()
+        .map(|o| {
             let nt = n.dot(&o.along_scan_m_per_px);
-            (nt.abs() > 1e-15).then(|| {
-                let r = (n.dot(&o.point_camera.coords) - plane.distance_m) / nt;
-                (r * r, o.std_px * o.std_px)
-            })
+            (nt.abs() > 1e-15).then(|| (n.dot(&o.point_camera.coords) - plane.distance_m) / nt)
         })
-        .collect();
-    if rs.len() <= 3 {
-        return 0.0;
-    }
-    let dof = (rs.len() - 3) as f64;
-    let chi2 = |s: f64| rs.iter().map(|(r2, v)| r2 / (v + s)).sum::<f64>();
-    if chi2(0.0) <= dof {
-        return 0.0;
-    }
-    // chi2 falls with s: bracket the root, then bisect.
-    let (mut lo, mut hi) = (0.0, rs.iter().map(|(r2, _)| *r2).sum::<f64>() / dof + 1e-12);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if chi2(mid) > dof {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= 1e-9 * hi {
-            break;
-        }
-    }
-    0.5 * (lo + hi)
+        .collect()
 }
 
 /// One observation's residual, its Jacobian over the plane's `(a, b, d)`

@@ -10,7 +10,8 @@
 //!   fitted to (a stripe centre on a board of known pose);
 //! - [`fit`]: the least-squares plane (a [`crate::geometry::PlaneEstimate`])
 //!   with per-image residuals and the warnings when the poses do not
-//!   constrain it; [`covariance`]: its covariance from the residuals'
+//!   constrain it; [`weights`]: the centres' variances it weighs them by;
+//!   [`covariance`]: its covariance from the residuals'
 //!   correlated scatter and the board poses' uncertainty;
 //! - [`points`]: a stripe's centres to 3-D points (camera, flange or base);
 //! - [`skeleton`]: seed 003's control points: the laser image binarised,
@@ -30,11 +31,13 @@ pub mod ridge;
 pub mod skeleton;
 pub mod sphere;
 pub mod stripe;
+pub mod weights;
 
 pub use covariance::BoardPose;
 pub use fit::{fit_plane, fit_plane_with_boards, PlaneFit, PlaneFitOptions, PlaneResidual};
 pub use plane::{plane_in_camera, LaserPlane, StripeObservation};
 pub use stripe::{extract_stripe, ScanAxis, Stripe, StripeMethod, StripeOptions, StripePoint};
+pub use weights::CentreVariance;
 
 #[cfg(test)]
 mod sphere_tests;
