@@ -427,6 +427,15 @@ fn geometry_warnings(obs: &[StripeObservation], images: &[usize], sv: [f64; 3]) 
             line_direction(&pts)
         })
         .collect();
+    if directions.len() == 2 {
+        warnings.push(
+            "only 2 board poses: with two stripe lines each line is fitted by itself alone, so \
+             a bias of one line (a stripe running along the board's square edges, a board pose \
+             off) shows in no residual and the reported std can be too small; add board poses \
+             (4 or more, tilted about different axes) for a std that holds"
+                .into(),
+        );
+    }
     if directions.len() >= 2 {
         let worst = directions
             .iter()

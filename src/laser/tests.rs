@@ -244,6 +244,16 @@ fn parallel_stripes_warn_and_one_line_is_an_error() {
         "{:?}",
         fit.warnings
     );
+    // Two poses: the std may be too small, and the user is told how to fix it.
+    assert!(
+        fit.warnings.iter().any(|w| w.starts_with(
+            "only 2 board poses: with two stripe lines each line is fitted by itself alone"
+        ) && w.ends_with(
+            "add board poses (4 or more, tilted about different axes) for a std that holds"
+        )),
+        "{:?}",
+        fit.warnings
+    );
     // Two images of one line (the same pose twice): no plane.
     let same = [at(0.5), at(0.5)];
     let obs = stripe_observations(&cam, &same, &truth, EXTENT, 4, 0.0, &mut Rng::new(2)).unwrap();
