@@ -35,13 +35,17 @@ export const shownCell = (page, table, name) => page.$eval(`${table} tbody`, (tb
  * exponent form below 1e-4: the CLI's exact value must round to what is
  * shown. 1e-9 relative (and 1e-12 absolute, for components near 0) on top
  * covers wasm-vs-native libm differences in the last bits (the solver
- * converges to the same optimum).
+ * converges to the same optimum). `slack`: what a solve's own stopping
+ * precision adds where page and CLI run their own solve (the products'
+ * sums differ in their last bits natively and in wasm, so each stops at
+ * its own point within the stopping rule of a relative cost decrease of
+ * 1e-12, about 1e-4 of the parameter's std with a few thousand residuals).
  */
-export function assertShown(shown, exact, what, decimals = 6) {
+export function assertShown(shown, exact, what, decimals = 6, slack = 0) {
   assert.ok(shown !== null, `${what}: not shown`);
   const x = Number(shown);
   const rounding = /e/.test(shown) ? 0.5 * 10 ** (1 - decimals) * Math.abs(exact) : 0.5 * 10 ** -decimals;
-  const tol = rounding * 1.0001 + 1e-9 * Math.abs(exact) + 1e-12;
+  const tol = rounding * 1.0001 + 1e-9 * Math.abs(exact) + 1e-12 + slack;
   assert.ok(Math.abs(x - exact) <= tol, `${what}: page ${shown}, CLI ${exact} (tolerance ${tol.toExponential(2)})`);
 }
 
@@ -267,7 +271,7 @@ export const tests = [
     assert.match(await page.textContent('#image-summary'), /^15 files, 15 decoded, 15 with the target/);
     await solveCamera(page);
     const K = camera.camera_matrix;
-    for (const [name, value] of Object.entries({ fx: K[0][0], fy: K[1][1], cx: K[0][2], cy: K[1][2] })) assertShown(await shownCell(page, '#camera-params', name), value, name);
+    for (const [name, value] of Object.entries({ fx: K[0][0], fy: K[1][1], cx: K[0][2], cy: K[1][2] })) assertShown(await shownCell(page, '#camera-params', name), value, name, 6, 1e-4 * camera.std[name]);
     await page.click('a[data-step=robot]');
     await page.setInputFiles('#pose-input', poses);
     await page.locator('#pose-table').waitFor({ timeout: 20000 });
@@ -284,12 +288,17 @@ export const tests = [
       assert.ok(m, text.slice(0, 300));
       return m;
     };
+    // The page's hand-eye starts from its own camera solve, whose poses
+    // differ from the CLI's within that solve's stopping precision (about
+    // 1e-9 relative here): a quaternion component may move by that much
+    // (1e-9 rad is 6e-8 deg; measured 7e-11), far below what the shown
+    // 6 significant digits of a component near 0 resolve.
     const assertX = (m, X, what) => {
       X.translation_m.forEach((t, i) => assertShown(m[1 + i], t * 1000, `${what} gripper_from_camera t[${i}] (mm)`, 3));
-      X.quaternion_xyzw.forEach((q, i) => assertShown(m[4 + i], q, `${what} gripper_from_camera q[${i}]`));
+      X.quaternion_xyzw.forEach((q, i) => assertShown(m[4 + i], q, `${what} gripper_from_camera q[${i}]`, 6, 1e-9));
     };
     // Camera poses only (refine 'none': the pose refinement, the CLI's default
-    // with --camera-poses): the page equals the CLI on the same camera poses.
+    // with --camera-poses): the page equals the CLI on the camera poses.
     assertX(await solveShown('none'), cli.gripper_from_camera, 'pose refinement');
     assert.equal((/^Result \((.*)\)$/.exec(await page.textContent('#handeye-results h3')) || [])[1], cli.method);
     // Refined over the image points, robot poses exact.
