@@ -66,6 +66,9 @@ fn main() {
         .map(|v| v.parse().expect("--runs takes a whole number"))
         .unwrap_or(3);
     let write = args_of("--write").first().cloned();
+    if let Some(dir) = &write {
+        std::fs::create_dir_all(dir).expect("creating the --write folder");
+    }
     for &n in &poses {
         let (scene, input) = scene_input(n);
         if let Some(dir) = &write {
