@@ -284,14 +284,9 @@ pub(crate) fn plain_em(
     tolerance: f64,
 ) -> usize {
     for step in 1..=max_steps {
-        let before = variances.to_vec();
+        let before = logs(variances);
         em_step_packed(variances, terms, true);
-        let change = before
-            .iter()
-            .zip(variances.iter())
-            .map(|(a, b)| (a / b).ln().abs())
-            .fold(0.0, f64::max);
-        if change < tolerance {
+        if moved(&before, &logs(variances)) < tolerance {
             return step;
         }
     }
